@@ -1,0 +1,4 @@
+//! Prism: a spectral Monte Carlo path tracer for Mitsuba 3 XML scenes.
+pub mod error;
+pub mod sampling;
+pub mod scene;

@@ -1,0 +1,2 @@
+//! Scenes: the Mitsuba XML reader, mesh readers and the scene builder.
+pub mod mitsuba;
