@@ -2,3 +2,4 @@
 pub mod error;
 pub mod sampling;
 pub mod scene;
+pub mod spectrum;

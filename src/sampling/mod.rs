@@ -1,2 +1,5 @@
-//! Sampling: random numbers, warps, distributions and the per-pixel sampler.
+//! Sampling: random numbers, warps from the unit square, tabulated distributions and the
+//! per-pixel sampler.
+pub mod distribution;
 pub mod rng;
+pub mod warp;

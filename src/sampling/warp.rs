@@ -1,0 +1,206 @@
+//! Warps from the unit square to other domains. Each comes as a triple: `sample_*` maps
+//! u in [0,1)^2 to the domain, `*_pdf` is the density of the result, and `invert_*` maps a point
+//! back to the u that produces it (used by tests and, later, by stratified path guiding).
+
+use std::f32::consts::{FRAC_1_PI, FRAC_PI_2, FRAC_PI_4, PI};
+
+use glam::{Vec2, Vec3};
+
+/// Shirley–Chiu concentric map of the square onto the unit disk (Shirley & Chiu 1997, "A
+/// Low Distortion Map Between Disk and Square"); uniform density 1/π.
+pub fn sample_uniform_disk_concentric(u: Vec2) -> Vec2 {
+    let offset = 2.0 * u - Vec2::ONE;
+    if offset == Vec2::ZERO {
+        return Vec2::ZERO;
+    }
+    let (r, theta) = if offset.x.abs() > offset.y.abs() {
+        (offset.x, FRAC_PI_4 * (offset.y / offset.x))
+    } else {
+        (offset.y, FRAC_PI_2 - FRAC_PI_4 * (offset.x / offset.y))
+    };
+    r * Vec2::new(theta.cos(), theta.sin())
+}
+
+/// Density of [`sample_uniform_disk_concentric`] per unit area.
+pub fn uniform_disk_pdf(p: Vec2) -> f32 {
+    if p.length_squared() <= 1.0 {
+        FRAC_1_PI
+    } else {
+        0.0
+    }
+}
+
+/// Inverse of [`sample_uniform_disk_concentric`].
+pub fn invert_uniform_disk_concentric(p: Vec2) -> Vec2 {
+    let r = p.length();
+    if r == 0.0 {
+        return Vec2::splat(0.5);
+    }
+    let mut phi = p.y.atan2(p.x);
+    if phi < -FRAC_PI_4 {
+        phi += 2.0 * PI;
+    }
+    // The four wedges of the square, as in the forward map.
+    let (a, b) = if phi < FRAC_PI_4 {
+        (r, r * phi / FRAC_PI_4)
+    } else if phi < 3.0 * FRAC_PI_4 {
+        (-r * (phi - FRAC_PI_2) / FRAC_PI_4, r)
+    } else if phi < 5.0 * FRAC_PI_4 {
+        (-r, -r * (phi - PI) / FRAC_PI_4)
+    } else {
+        (r * (phi - 3.0 * FRAC_PI_2) / FRAC_PI_4, -r)
+    };
+    (Vec2::new(a, b) + Vec2::ONE) * 0.5
+}
+
+/// Cosine-weighted hemisphere about +z by Nusselt's analogue (Malley's method): a uniform point
+/// (x, y) on the unit disk is lifted to (x, y, sqrt(1 - x² - y²)), giving density cos θ / π.
+/// (The lecture's slide writes the lift as 1 - sqrt(x² + y²); that is a slip, see DESIGN.md §4.)
+pub fn sample_cosine_hemisphere(u: Vec2) -> Vec3 {
+    let d = sample_uniform_disk_concentric(u);
+    let z = (1.0 - d.length_squared()).max(0.0).sqrt();
+    Vec3::new(d.x, d.y, z)
+}
+
+/// Density of [`sample_cosine_hemisphere`] per unit solid angle: cos θ / π, zero below the horizon.
+pub fn cosine_hemisphere_pdf(w: Vec3) -> f32 {
+    w.z.max(0.0) * FRAC_1_PI
+}
+
+/// Inverse of [`sample_cosine_hemisphere`].
+pub fn invert_cosine_hemisphere(w: Vec3) -> Vec2 {
+    invert_uniform_disk_concentric(Vec2::new(w.x, w.y))
+}
+
+/// Uniform direction on the unit sphere (Archimedes: z uniform in [-1, 1]); density 1/(4π).
+pub fn sample_uniform_sphere(u: Vec2) -> Vec3 {
+    let z = 1.0 - 2.0 * u.x;
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    let phi = 2.0 * PI * u.y;
+    Vec3::new(r * phi.cos(), r * phi.sin(), z)
+}
+
+/// Density of [`sample_uniform_sphere`] per unit solid angle.
+pub fn uniform_sphere_pdf() -> f32 {
+    1.0 / (4.0 * PI)
+}
+
+/// Inverse of [`sample_uniform_sphere`].
+pub fn invert_uniform_sphere(w: Vec3) -> Vec2 {
+    let mut phi = w.y.atan2(w.x);
+    if phi < 0.0 {
+        phi += 2.0 * PI;
+    }
+    Vec2::new((1.0 - w.z) * 0.5, phi / (2.0 * PI))
+}
+
+/// Uniform direction in the cone of half-angle θmax about +z, given cos θmax; density
+/// 1 / (2π (1 - cos θmax)). Written with 1 - cos θ computed directly so that very small cones
+/// (distant sphere lights) keep their precision.
+pub fn sample_uniform_cone(u: Vec2, cos_theta_max: f32) -> Vec3 {
+    let one_minus_cos_max = 1.0 - cos_theta_max;
+    let one_minus_cos = u.x * one_minus_cos_max;
+    let cos_theta = 1.0 - one_minus_cos;
+    // sin² θ = (1 - cos θ)(1 + cos θ), exact for small angles.
+    let sin_theta = (one_minus_cos * (2.0 - one_minus_cos)).max(0.0).sqrt();
+    let phi = 2.0 * PI * u.y;
+    Vec3::new(sin_theta * phi.cos(), sin_theta * phi.sin(), cos_theta)
+}
+
+/// Density of [`sample_uniform_cone`] per unit solid angle (zero outside the cone).
+pub fn uniform_cone_pdf(w: Vec3, cos_theta_max: f32) -> f32 {
+    if w.z >= cos_theta_max {
+        1.0 / (2.0 * PI * (1.0 - cos_theta_max))
+    } else {
+        0.0
+    }
+}
+
+/// Inverse of [`sample_uniform_cone`].
+pub fn invert_uniform_cone(w: Vec3, cos_theta_max: f32) -> Vec2 {
+    let mut phi = w.y.atan2(w.x);
+    if phi < 0.0 {
+        phi += 2.0 * PI;
+    }
+    Vec2::new((1.0 - w.z) / (1.0 - cos_theta_max), phi / (2.0 * PI))
+}
+
+/// Uniform barycentric coordinates (b0, b1) on a triangle, b2 = 1 - b0 - b1 (the square-root
+/// parametrisation, Osada et al. 2002, "Shape Distributions", eq. 1).
+pub fn sample_uniform_triangle(u: Vec2) -> Vec2 {
+    let su = u.x.sqrt();
+    Vec2::new(1.0 - su, u.y * su)
+}
+
+/// Inverse of [`sample_uniform_triangle`].
+pub fn invert_uniform_triangle(b: Vec2) -> Vec2 {
+    let su = 1.0 - b.x;
+    Vec2::new(su * su, if su > 0.0 { b.y / su } else { 0.0 })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sampling::rng::Pcg32;
+
+    fn random_points(n: usize) -> Vec<Vec2> {
+        let mut rng = Pcg32::seeded(11);
+        (0..n)
+            .map(|_| Vec2::new(rng.next_f32(), rng.next_f32()))
+            .collect()
+    }
+
+    #[test]
+    fn disk_round_trip() {
+        for u in random_points(10_000) {
+            let p = sample_uniform_disk_concentric(u);
+            assert!(p.length() <= 1.0 + 1e-6);
+            let back = invert_uniform_disk_concentric(p);
+            assert!((back - u).abs().max_element() < 1e-4, "{u} -> {p} -> {back}");
+        }
+    }
+
+    #[test]
+    fn cosine_hemisphere_round_trip_and_unit_length() {
+        for u in random_points(10_000) {
+            let w = sample_cosine_hemisphere(u);
+            assert!((w.length() - 1.0).abs() < 1e-5);
+            assert!(w.z >= 0.0);
+            let back = invert_cosine_hemisphere(w);
+            assert!((back - u).abs().max_element() < 1e-4);
+        }
+    }
+
+    #[test]
+    fn sphere_and_cone_round_trip() {
+        for u in random_points(10_000) {
+            let w = sample_uniform_sphere(u);
+            assert!((w.length() - 1.0).abs() < 1e-5);
+            assert!((invert_uniform_sphere(w) - u).abs().max_element() < 1e-4);
+            let cos_max = 0.3;
+            let c = sample_uniform_cone(u, cos_max);
+            assert!((c.length() - 1.0).abs() < 1e-5 && c.z >= cos_max - 1e-6);
+            assert!((invert_uniform_cone(c, cos_max) - u).abs().max_element() < 1e-3);
+        }
+    }
+
+    #[test]
+    fn tiny_cone_keeps_its_directions_inside() {
+        let cos_max = 1.0 - 1e-7;
+        for u in random_points(1000) {
+            let c = sample_uniform_cone(u, cos_max);
+            assert!((c.length() - 1.0).abs() < 1e-5);
+            let sin = (c.x * c.x + c.y * c.y).sqrt();
+            assert!(sin <= (2.0 * (1.0 - cos_max)).sqrt() * 1.01);
+        }
+    }
+
+    #[test]
+    fn triangle_round_trip() {
+        for u in random_points(10_000) {
+            let b = sample_uniform_triangle(u);
+            assert!(b.x >= 0.0 && b.y >= 0.0 && b.x + b.y <= 1.0 + 1e-6);
+            assert!((invert_uniform_triangle(b) - u).abs().max_element() < 1e-3);
+        }
+    }
+}

@@ -1,0 +1,193 @@
+//! Spectral distributions given by a scene: constants, piecewise-linear tables and upsampled RGB.
+
+use super::cie::{cie_y, d65_normalized};
+use super::rgb::RgbSigmoidPolynomial;
+use super::sampled::{SampledSpectrum, SampledWavelengths};
+use super::{LAMBDA_MAX, LAMBDA_MIN};
+
+/// A spectral distribution, evaluated at the wavelengths of a path.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Spectrum {
+    /// The same value at every wavelength.
+    Constant(f32),
+    /// Linear interpolation of (λ, value) samples, zero outside their range (Mitsuba 3's
+    /// `irregular` spectrum semantics).
+    PiecewiseLinear(PiecewiseLinear),
+    /// An upsampled RGB reflectance, `scale` times a sigmoid polynomial; the scale is 1 for
+    /// colours within [0, 1] and 2·max(rgb) for brighter ones (pbrt-v4's unbounded RGB spectrum).
+    Rgb {
+        polynomial: RgbSigmoidPolynomial,
+        scale: f32,
+    },
+    /// An RGB illuminant: `scale` times a sigmoid polynomial times D65 of luminance 1 (Mitsuba 3's
+    /// `srgb_d65`: scale = 2·max(rgb), the polynomial fitted to rgb/scale), so that the emission
+    /// (1, 1, 1) is D65 white of luminance 1.
+    RgbIlluminant {
+        polynomial: RgbSigmoidPolynomial,
+        scale: f32,
+    },
+}
+
+/// Which physical quantity an RGB triple describes; it decides how the triple is upsampled.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RgbIntent {
+    /// A reflectance or transmittance, in [0, 1].
+    Albedo,
+    /// Emitted radiance or intensity: the colour of a light.
+    Illuminant,
+}
+
+impl Spectrum {
+    /// The spectrum for an RGB triple (linear sRGB, components ≥ 0).
+    pub fn from_rgb(rgb: [f32; 3], intent: RgbIntent) -> Spectrum {
+        let max = rgb[0].max(rgb[1]).max(rgb[2]);
+        match intent {
+            RgbIntent::Albedo if max <= 1.0 => {
+                if rgb[0] == rgb[1] && rgb[1] == rgb[2] {
+                    Spectrum::Constant(rgb[0])
+                } else {
+                    Spectrum::Rgb {
+                        polynomial: RgbSigmoidPolynomial::fit(rgb),
+                        scale: 1.0,
+                    }
+                }
+            }
+            RgbIntent::Albedo => {
+                let scale = 2.0 * max;
+                Spectrum::Rgb {
+                    polynomial: RgbSigmoidPolynomial::fit(rgb.map(|c| c / scale)),
+                    scale,
+                }
+            }
+            RgbIntent::Illuminant => {
+                if max <= 0.0 {
+                    return Spectrum::Constant(0.0);
+                }
+                let scale = 2.0 * max;
+                Spectrum::RgbIlluminant {
+                    polynomial: RgbSigmoidPolynomial::fit(rgb.map(|c| c / scale)),
+                    scale,
+                }
+            }
+        }
+    }
+
+    /// The value at one wavelength in nm.
+    #[inline]
+    pub fn value(&self, lambda: f32) -> f32 {
+        match self {
+            Spectrum::Constant(v) => *v,
+            Spectrum::PiecewiseLinear(table) => table.value(lambda),
+            Spectrum::Rgb { polynomial, scale } => scale * polynomial.eval(lambda),
+            Spectrum::RgbIlluminant { polynomial, scale } => {
+                scale * polynomial.eval(lambda) * d65_normalized(lambda)
+            }
+        }
+    }
+
+    /// The values at the wavelengths of a path.
+    #[inline]
+    pub fn sample(&self, wavelengths: &SampledWavelengths) -> SampledSpectrum {
+        match self {
+            Spectrum::Constant(v) => SampledSpectrum::splat(*v),
+            _ => SampledSpectrum::from_fn(|i| self.value(wavelengths.lambda(i))),
+        }
+    }
+
+    /// The largest value over 360–830 nm (sampled at 1 nm), used to bound reflectances.
+    pub fn max_value(&self) -> f32 {
+        match self {
+            Spectrum::Constant(v) => *v,
+            _ => (0..=470)
+                .map(|i| self.value(LAMBDA_MIN + i as f32))
+                .fold(0.0, f32::max),
+        }
+    }
+
+    /// Luminance Y = ∫ S ȳ dλ / ∫ ȳ dλ (1 nm trapezoid rule), the brightness of an emission
+    /// spectrum as the eye sees it; used to choose lights in proportion to their power.
+    pub fn luminance(&self) -> f32 {
+        let (mut num, mut den) = (0.0f64, 0.0f64);
+        let n = (LAMBDA_MAX - LAMBDA_MIN) as usize;
+        for i in 0..=n {
+            let lambda = LAMBDA_MIN + i as f32;
+            let w = if i == 0 || i == n { 0.5 } else { 1.0 };
+            let y = f64::from(cie_y(lambda)) * w;
+            num += f64::from(self.value(lambda)) * y;
+            den += y;
+        }
+        (num / den) as f32
+    }
+}
+
+/// Samples (λᵢ, vᵢ) with strictly increasing λ, linearly interpolated; zero outside [λ₀, λₙ].
+#[derive(Clone, Debug, PartialEq)]
+pub struct PiecewiseLinear {
+    lambdas: Vec<f32>,
+    values: Vec<f32>,
+}
+
+impl PiecewiseLinear {
+    /// A table from samples with strictly increasing wavelengths (checked by the caller); None
+    /// for an empty list.
+    pub fn new(samples: &[(f32, f32)]) -> Option<Self> {
+        if samples.is_empty() {
+            return None;
+        }
+        Some(PiecewiseLinear {
+            lambdas: samples.iter().map(|s| s.0).collect(),
+            values: samples.iter().map(|s| s.1).collect(),
+        })
+    }
+
+    #[inline]
+    pub fn value(&self, lambda: f32) -> f32 {
+        let n = self.lambdas.len();
+        if !(lambda >= self.lambdas[0] && lambda <= self.lambdas[n - 1]) {
+            return 0.0;
+        }
+        if n == 1 {
+            return self.values[0];
+        }
+        let i = self.lambdas.partition_point(|&l| l <= lambda).clamp(1, n - 1) - 1;
+        let t = (lambda - self.lambdas[i]) / (self.lambdas[i + 1] - self.lambdas[i]);
+        self.values[i] + t * (self.values[i + 1] - self.values[i])
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn piecewise_linear_interpolates_and_is_zero_outside() {
+        let s = PiecewiseLinear::new(&[(400.0, 0.0), (500.0, 8.0), (600.0, 15.6), (700.0, 18.4)])
+            .unwrap();
+        assert_eq!(s.value(399.9), 0.0);
+        assert_eq!(s.value(450.0), 4.0);
+        assert_eq!(s.value(500.0), 8.0);
+        assert!((s.value(650.0) - 17.0).abs() < 1e-5);
+        assert_eq!(s.value(700.0), 18.4);
+        assert_eq!(s.value(700.1), 0.0);
+    }
+
+    #[test]
+    fn white_illuminant_has_unit_luminance() {
+        let white = Spectrum::from_rgb([1.0, 1.0, 1.0], RgbIntent::Illuminant);
+        assert!((white.luminance() - 1.0).abs() < 1e-3, "{}", white.luminance());
+        let bright = Spectrum::from_rgb([17.0, 12.0, 4.0], RgbIntent::Illuminant);
+        // Y of linear sRGB (17, 12, 4) is 0.2127·17 + 0.7152·12 + 0.0722·4.
+        let expected = 0.212_672_9 * 17.0 + 0.715_152_2 * 12.0 + 0.072_175 * 4.0;
+        assert!((bright.luminance() / expected - 1.0).abs() < 2e-3);
+    }
+
+    #[test]
+    fn albedo_above_one_is_scaled_like_pbrt_unbounded_rgb() {
+        let s = Spectrum::from_rgb([1.5, 1.2, 0.9], RgbIntent::Albedo);
+        let Spectrum::Rgb { scale, .. } = s else {
+            panic!("expected an RGB spectrum, got {s:?}");
+        };
+        assert_eq!(scale, 3.0);
+        assert!(s.max_value() <= 3.0 && s.max_value() > 1.0);
+    }
+}
