@@ -2,4 +2,5 @@
 //! per-pixel sampler.
 pub mod distribution;
 pub mod rng;
+pub mod sampler;
 pub mod warp;

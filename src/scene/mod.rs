@@ -1,2 +1,86 @@
-//! Scenes: the Mitsuba XML reader, mesh readers and the scene builder.
+//! Scenes: the renderable [`Scene`], and the Mitsuba XML reader and plugin factory that build it.
+
 pub mod mitsuba;
+
+use glam::UVec2;
+
+use crate::bsdf::Material;
+use crate::camera::Camera;
+use crate::film::{CropWindow, Filter};
+use crate::geometry::Geometry;
+use crate::integrator::Integrator;
+use crate::light::{Light, LightSampler};
+use crate::spectrum::WavelengthSampling;
+
+/// What a shape is made of and whether it emits.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ShapeInfo {
+    /// Index into [`Scene::materials`].
+    pub material: u32,
+    /// Index into [`Scene::lights`] of the area light on this shape.
+    pub light: Option<u32>,
+}
+
+/// Film settings: size, crop window and reconstruction filter.
+#[derive(Clone, Debug)]
+pub struct FilmSettings {
+    pub size: UVec2,
+    pub crop: CropWindow,
+    pub filter: Filter,
+}
+
+/// Which per-pixel sampler to use and how many samples per pixel.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SamplerKind {
+    Independent,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SamplerSettings {
+    pub kind: SamplerKind,
+    pub samples_per_pixel: u32,
+}
+
+/// Everything needed to render an image.
+pub struct Scene {
+    pub geometry: Geometry,
+    /// One entry per shape of `geometry`.
+    pub shape_info: Vec<ShapeInfo>,
+    pub materials: Vec<Material>,
+    pub lights: Vec<Light>,
+    pub light_sampler: LightSampler,
+    pub camera: Camera,
+    pub film: FilmSettings,
+    pub sampler: SamplerSettings,
+    pub integrator: Integrator,
+    pub wavelength_sampling: WavelengthSampling,
+}
+
+impl Scene {
+    /// A scene from its parts; the light sampler is built from the lights' powers.
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(
+        geometry: Geometry,
+        shape_info: Vec<ShapeInfo>,
+        materials: Vec<Material>,
+        lights: Vec<Light>,
+        camera: Camera,
+        film: FilmSettings,
+        sampler: SamplerSettings,
+        integrator: Integrator,
+    ) -> Scene {
+        let powers: Vec<f32> = lights.iter().map(|l| l.power(&geometry.shapes)).collect();
+        Scene {
+            light_sampler: LightSampler::new(&powers),
+            geometry,
+            shape_info,
+            materials,
+            lights,
+            camera,
+            film,
+            sampler,
+            integrator,
+            wavelength_sampling: WavelengthSampling::default(),
+        }
+    }
+}

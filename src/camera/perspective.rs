@@ -1,0 +1,130 @@
+//! Mitsuba's `perspective` sensor: an ideal pinhole camera.
+//!
+//! ```xml
+//! <sensor type="perspective">
+//!     <float name="fov" value="39.3"/>          <!-- or focal_length="50mm" (the default) -->
+//!     <string name="fov_axis" value="x"/>       <!-- x, y, diagonal, smaller, larger -->
+//!     <float name="near_clip" value="0.01"/>    <!-- defaults 1e-2 and 1e4 -->
+//!     <float name="far_clip" value="10000"/>
+//!     <transform name="to_world"> <lookat origin="..." target="..." up="..."/> </transform>
+//!     <film .../> <sampler .../>
+//! </sensor>
+//! ```
+//! The camera looks along +z of its frame, with +y up and +x to the left of the image (Mitsuba's
+//! convention: `lookat` builds the frame [left, up, forward, origin]).
+
+use glam::{Vec2, Vec3};
+
+use crate::math::{Ray, Transform};
+
+#[derive(Clone, Debug)]
+pub struct PerspectiveCamera {
+    pub to_world: Transform,
+    /// Size of the full film in pixels (not the crop window).
+    pub film_size: Vec2,
+    /// tan(fov_x / 2).
+    pub tan_half_fov_x: f32,
+    pub near_clip: f32,
+    pub far_clip: f32,
+}
+
+/// Converts a field of view given along `axis` into the horizontal one, for a film of aspect
+/// `aspect` = width / height (Mitsuba 3's `parse_fov`). Angles in degrees.
+pub fn horizontal_fov(fov: f64, axis: FovAxis, aspect: f64) -> f64 {
+    let axis = match axis {
+        FovAxis::Smaller => {
+            if aspect > 1.0 { FovAxis::Y } else { FovAxis::X }
+        }
+        FovAxis::Larger => {
+            if aspect > 1.0 { FovAxis::X } else { FovAxis::Y }
+        }
+        other => other,
+    };
+    let half = (0.5 * fov).to_radians();
+    match axis {
+        FovAxis::Y => (2.0 * (half.tan() * aspect).atan()).to_degrees(),
+        FovAxis::Diagonal => {
+            let diagonal = 2.0 * half.tan();
+            let width = diagonal / (1.0 + 1.0 / (aspect * aspect)).sqrt();
+            (2.0 * (0.5 * width).atan()).to_degrees()
+        }
+        _ => fov,
+    }
+}
+
+/// The axis along which a field of view is measured.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FovAxis {
+    X,
+    Y,
+    Diagonal,
+    Smaller,
+    Larger,
+}
+
+/// The diagonal field of view of a lens of focal length `mm` on 35 mm film (36 × 24 mm), as
+/// Mitsuba computes it for `focal_length` (default "50mm").
+pub fn focal_length_to_diagonal_fov(mm: f64) -> f64 {
+    (2.0 * ((36.0f64 * 36.0 + 24.0 * 24.0).sqrt() / (2.0 * mm)).atan()).to_degrees()
+}
+
+impl PerspectiveCamera {
+    /// The ray through film position `film` (pixels, origin at the top-left of the full film).
+    /// It starts on the near plane and ends on the far plane, as in Mitsuba.
+    #[inline]
+    pub fn generate_ray(&self, film: Vec2) -> Ray {
+        let ndc = film / self.film_size;
+        let aspect = self.film_size.x / self.film_size.y;
+        let local = Vec3::new(
+            (1.0 - 2.0 * ndc.x) * self.tan_half_fov_x,
+            (1.0 - 2.0 * ndc.y) * self.tan_half_fov_x / aspect,
+            1.0,
+        )
+        .normalize();
+        let inv_z = 1.0 / local.z;
+        let near_t = self.near_clip * inv_z;
+        let far_t = self.far_clip * inv_z;
+        let d = self.to_world.vector(local).normalize();
+        let o = self.to_world.point(Vec3::ZERO) + d * near_t;
+        Ray::new(o, d, far_t - near_t)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fov_conversions_match_mitsuba() {
+        // Square film: every axis agrees.
+        for axis in [FovAxis::X, FovAxis::Y, FovAxis::Smaller, FovAxis::Larger] {
+            assert!((horizontal_fov(40.0, axis, 1.0) - 40.0).abs() < 1e-9);
+        }
+        // 2:1 film, vertical fov 30 degrees: tan(hx) = 2 tan(15 degrees).
+        let expected = (2.0 * (2.0 * 15f64.to_radians().tan()).atan()).to_degrees();
+        assert!((horizontal_fov(30.0, FovAxis::Y, 2.0) - expected).abs() < 1e-9);
+        assert!((horizontal_fov(30.0, FovAxis::Smaller, 2.0) - expected).abs() < 1e-9);
+        // The default 50 mm lens on a square film (DESIGN.md §5: 34.022 degrees).
+        let fov = horizontal_fov(focal_length_to_diagonal_fov(50.0), FovAxis::Diagonal, 1.0);
+        assert!((fov - 34.022).abs() < 1e-3, "{fov}");
+    }
+
+    #[test]
+    fn image_corners_map_to_the_left_top_of_the_camera() {
+        let camera = PerspectiveCamera {
+            to_world: Transform::IDENTITY,
+            film_size: Vec2::new(200.0, 100.0),
+            tan_half_fov_x: 1.0,
+            near_clip: 0.01,
+            far_clip: 100.0,
+        };
+        let center = camera.generate_ray(Vec2::new(100.0, 50.0));
+        assert!((center.d - Vec3::Z).length() < 1e-6);
+        let top_left = camera.generate_ray(Vec2::ZERO);
+        assert!(top_left.d.x > 0.0 && top_left.d.y > 0.0);
+        // Horizontal half-angle 45 degrees; vertical half extent 0.5.
+        let expected = Vec3::new(1.0, 0.5, 1.0).normalize();
+        assert!((top_left.d - expected).length() < 1e-6);
+        assert!((center.o - Vec3::new(0.0, 0.0, 0.01)).length() < 1e-7);
+    }
+}

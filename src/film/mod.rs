@@ -1,0 +1,8 @@
+//! The film: reconstruction filters and their samplers, per-pixel accumulation of XYZ, and
+//! image files.
+
+pub mod film;
+pub mod filter;
+
+pub use film::{CropWindow, Film, PixelSums};
+pub use filter::{Filter, FilterSampler};

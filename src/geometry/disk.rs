@@ -1,0 +1,81 @@
+//! Mitsuba's `disk` shape: the unit disk in the xy plane of its object frame, normal +z.
+
+use std::f32::consts::PI;
+
+use glam::{Vec2, Vec3};
+
+use super::interaction::SurfaceInteraction;
+use super::mesh::SurfaceSample;
+use crate::math::{Frame, Transform};
+use crate::sampling::warp::sample_uniform_disk_concentric;
+
+/// A (possibly elliptic, by a non-uniform `to_world`) disk.
+#[derive(Clone, Debug)]
+pub struct Disk {
+    pub to_world: Transform,
+    /// Unit world-space normal (after `flip_normals`).
+    pub normal: Vec3,
+    area: f32,
+}
+
+impl Disk {
+    pub fn new(to_world: Transform, flip_normals: bool) -> Disk {
+        let n = to_world.normal(Vec3::Z).normalize();
+        let area = PI * to_world.vector(Vec3::X).cross(to_world.vector(Vec3::Y)).length();
+        Disk {
+            to_world,
+            normal: if flip_normals { -n } else { n },
+            area,
+        }
+    }
+
+    pub fn area(&self) -> f32 {
+        self.area
+    }
+
+    /// Intersection in the object frame, where the disk is z = 0, x² + y² ≤ 1; t is the same
+    /// in both frames because the map is affine.
+    pub fn intersect(&self, o: Vec3, d: Vec3, t_max: f32) -> Option<f32> {
+        let o_local = self.to_world.inverse_point(o);
+        let d_local = self.to_world.inverse_vector(d);
+        if d_local.z == 0.0 {
+            return None;
+        }
+        let t = -o_local.z / d_local.z;
+        if !(t > 0.0 && t < t_max) {
+            return None;
+        }
+        let p = o_local + d_local * t;
+        (p.x * p.x + p.y * p.y <= 1.0).then_some(t)
+    }
+
+    pub fn interaction(&self, o: Vec3, d: Vec3, t: f32, shape: u32) -> SurfaceInteraction {
+        let local = self.to_world.inverse_point(o + d * t);
+        let local = Vec3::new(local.x, local.y, 0.0);
+        let r = (local.x * local.x + local.y * local.y).sqrt();
+        let mut phi = local.y.atan2(local.x);
+        if phi < 0.0 {
+            phi += 2.0 * PI;
+        }
+        SurfaceInteraction {
+            p: self.to_world.point(local),
+            t,
+            n: self.normal,
+            shading: Frame::from_normal(self.normal),
+            uv: Vec2::new(r, phi / (2.0 * PI)),
+            shape,
+            primitive: 0,
+        }
+    }
+
+    /// A uniform point (a linear map keeps the concentric map's uniformity); pdf per unit area.
+    pub fn sample_area(&self, u: Vec2) -> SurfaceSample {
+        let d = sample_uniform_disk_concentric(u);
+        SurfaceSample {
+            p: self.to_world.point(Vec3::new(d.x, d.y, 0.0)),
+            n: self.normal,
+            shading_n: self.normal,
+            pdf: 1.0 / self.area,
+        }
+    }
+}

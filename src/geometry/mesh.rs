@@ -1,0 +1,189 @@
+//! Triangle meshes: Mitsuba's `obj`, `ply`, `rectangle` and `cube` shapes.
+
+use glam::{Vec2, Vec3};
+
+use super::interaction::SurfaceInteraction;
+use super::triangle::TriangleHit;
+use crate::math::Frame;
+use crate::sampling::distribution::AliasTable;
+use crate::sampling::warp::sample_uniform_triangle;
+
+/// A triangle mesh in world space.
+#[derive(Clone, Debug)]
+pub struct TriangleMesh {
+    pub positions: Vec<Vec3>,
+    /// Per-vertex shading normals (unit length), if the mesh is smooth.
+    pub normals: Option<Vec<Vec3>>,
+    pub uvs: Option<Vec<Vec2>>,
+    pub triangles: Vec<[u32; 3]>,
+    /// Whether the geometric and shading normals are reversed (Mitsuba's `flip_normals`).
+    pub flip_normals: bool,
+    /// Triangles chosen in proportion to their area (None when the area is zero).
+    area_table: Option<AliasTable>,
+    area: f32,
+}
+
+/// A point drawn on a surface.
+#[derive(Clone, Copy, Debug)]
+pub struct SurfaceSample {
+    pub p: Vec3,
+    /// Unit geometric normal at the point.
+    pub n: Vec3,
+    /// Unit shading normal at the point (decides the side a one-sided emitter lights).
+    pub shading_n: Vec3,
+    /// Density of the point, per unit area or per unit solid angle (said by the method).
+    pub pdf: f32,
+}
+
+impl TriangleMesh {
+    /// A mesh from world-space data; every index must be in range (the mesh readers validate).
+    pub fn new(
+        positions: Vec<Vec3>,
+        normals: Option<Vec<Vec3>>,
+        uvs: Option<Vec<Vec2>>,
+        triangles: Vec<[u32; 3]>,
+        flip_normals: bool,
+    ) -> TriangleMesh {
+        let mut mesh = TriangleMesh {
+            positions,
+            normals,
+            uvs,
+            triangles,
+            flip_normals,
+            area_table: None,
+            area: 0.0,
+        };
+        let areas: Vec<f64> = (0..mesh.triangles.len())
+            .map(|i| f64::from(mesh.triangle_area(i)))
+            .collect();
+        mesh.area = areas.iter().sum::<f64>() as f32;
+        mesh.area_table = AliasTable::new(&areas);
+        mesh
+    }
+
+    #[inline]
+    pub fn vertices(&self, triangle: usize) -> [Vec3; 3] {
+        let [a, b, c] = self.triangles[triangle];
+        [
+            self.positions[a as usize],
+            self.positions[b as usize],
+            self.positions[c as usize],
+        ]
+    }
+
+    pub fn triangle_area(&self, triangle: usize) -> f32 {
+        let [p0, p1, p2] = self.vertices(triangle);
+        0.5 * (p1 - p0).cross(p2 - p0).length()
+    }
+
+    /// Total surface area.
+    pub fn area(&self) -> f32 {
+        self.area
+    }
+
+    /// The unit geometric normal of a triangle: (p1 − p0) × (p2 − p0), counter-clockwise
+    /// vertices facing the viewer (Mitsuba's convention), reversed by `flip_normals`.
+    fn face_normal(&self, triangle: usize) -> Vec3 {
+        let [p0, p1, p2] = self.vertices(triangle);
+        let n = (p1 - p0).cross(p2 - p0).normalize_or_zero();
+        if self.flip_normals { -n } else { n }
+    }
+
+    /// Shading normal at barycentric coordinates (b0, b1, b2) of a triangle.
+    fn shading_normal(&self, triangle: usize, b: [f32; 3], geometric: Vec3) -> Vec3 {
+        let Some(normals) = &self.normals else {
+            return geometric;
+        };
+        let [a, bb, c] = self.triangles[triangle];
+        let n = (normals[a as usize] * b[0] + normals[bb as usize] * b[1] + normals[c as usize] * b[2])
+            .normalize_or_zero();
+        if n == Vec3::ZERO {
+            geometric
+        } else if self.flip_normals {
+            -n
+        } else {
+            n
+        }
+    }
+
+    /// The surface interaction of a ray hit on a triangle.
+    pub fn interaction(&self, triangle: usize, hit: &TriangleHit, shape: u32) -> SurfaceInteraction {
+        let [p0, p1, p2] = self.vertices(triangle);
+        let b = [hit.b0, hit.b1, hit.b2];
+        // The barycentric combination is closer to the surface than o + t·d.
+        let p = p0 * b[0] + p1 * b[1] + p2 * b[2];
+        let n = self.face_normal(triangle);
+        let shading_n = self.shading_normal(triangle, b, n);
+        let uv = match &self.uvs {
+            Some(uvs) => {
+                let [a, bb, c] = self.triangles[triangle];
+                uvs[a as usize] * b[0] + uvs[bb as usize] * b[1] + uvs[c as usize] * b[2]
+            }
+            None => Vec2::new(b[1], b[2]),
+        };
+        SurfaceInteraction {
+            p,
+            t: hit.t,
+            n,
+            shading: Frame::from_normal(shading_n),
+            uv,
+            shape,
+            primitive: triangle as u32,
+        }
+    }
+
+    /// A point uniformly distributed over the mesh's area: a triangle chosen in proportion to its
+    /// area by `u_choice`, then a uniform point in it. The pdf is 1/area. None for a mesh of zero
+    /// area.
+    pub fn sample_area(&self, u_choice: f32, u: Vec2) -> Option<SurfaceSample> {
+        let table = self.area_table.as_ref()?;
+        let (triangle, _) = table.sample(u_choice);
+        let [p0, p1, p2] = self.vertices(triangle);
+        let b = sample_uniform_triangle(u);
+        let b = [b.x, b.y, 1.0 - b.x - b.y];
+        let p = p0 * b[0] + p1 * b[1] + p2 * b[2];
+        let n = self.face_normal(triangle);
+        Some(SurfaceSample {
+            p,
+            n,
+            shading_n: self.shading_normal(triangle, b, n),
+            pdf: 1.0 / self.area,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn unit_square() -> TriangleMesh {
+        TriangleMesh::new(
+            vec![Vec3::ZERO, Vec3::X, Vec3::new(1.0, 1.0, 0.0), Vec3::Y],
+            None,
+            None,
+            vec![[0, 1, 2], [2, 3, 0]],
+            false,
+        )
+    }
+
+    #[test]
+    fn area_and_normals() {
+        let mesh = unit_square();
+        assert!((mesh.area() - 1.0).abs() < 1e-6);
+        assert_eq!(mesh.face_normal(0), Vec3::Z);
+        let mut flipped = unit_square();
+        flipped.flip_normals = true;
+        assert_eq!(flipped.face_normal(1), -Vec3::Z);
+    }
+
+    #[test]
+    fn area_samples_lie_on_the_mesh() {
+        let mesh = unit_square();
+        for i in 0..100 {
+            let u = Vec2::new((i % 10) as f32 / 10.0 + 0.05, (i / 10) as f32 / 10.0 + 0.05);
+            let s = mesh.sample_area((i as f32 + 0.5) / 100.0, u).unwrap();
+            assert!(s.p.z == 0.0 && (0.0..=1.0).contains(&s.p.x) && (0.0..=1.0).contains(&s.p.y));
+            assert_eq!(s.pdf, 1.0);
+        }
+    }
+}

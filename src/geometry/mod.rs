@@ -1,0 +1,16 @@
+//! Geometry: shapes (triangle meshes, spheres, disks), ray intersection, the BVH, and robust
+//! ray offsets.
+
+pub mod accel;
+pub mod disk;
+pub mod interaction;
+pub mod mesh;
+pub mod offset;
+pub mod shape;
+pub mod sphere;
+pub mod triangle;
+
+pub use accel::Geometry;
+pub use interaction::SurfaceInteraction;
+pub use mesh::{SurfaceSample, TriangleMesh};
+pub use shape::Shape;

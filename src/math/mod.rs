@@ -1,0 +1,13 @@
+//! Vectors, matrices, shading frames, transforms and rays.
+//!
+//! Geometry is single precision (as in Mitsuba 3's scalar variants and pbrt-v4); transforms are
+//! composed in double precision by the scene reader and rounded once.
+
+pub mod frame;
+pub mod ray;
+pub mod transform;
+
+pub use frame::Frame;
+pub use glam::{DMat4, DVec3, Mat3, Mat4, UVec2, Vec2, Vec3, Vec4};
+pub use ray::Ray;
+pub use transform::Transform;
