@@ -1,8 +1,9 @@
 //! The film: reconstruction filters and their samplers, per-pixel accumulation of XYZ, and
-//! image files.
+//! image files (OpenEXR, PNG).
 
 pub mod film;
 pub mod filter;
+pub mod output;
 
 pub use film::{CropWindow, Film, PixelSums};
 pub use filter::{Filter, FilterSampler};
