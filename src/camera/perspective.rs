@@ -33,10 +33,18 @@ pub struct PerspectiveCamera {
 pub fn horizontal_fov(fov: f64, axis: FovAxis, aspect: f64) -> f64 {
     let axis = match axis {
         FovAxis::Smaller => {
-            if aspect > 1.0 { FovAxis::Y } else { FovAxis::X }
+            if aspect > 1.0 {
+                FovAxis::Y
+            } else {
+                FovAxis::X
+            }
         }
         FovAxis::Larger => {
-            if aspect > 1.0 { FovAxis::X } else { FovAxis::Y }
+            if aspect > 1.0 {
+                FovAxis::X
+            } else {
+                FovAxis::Y
+            }
         }
         other => other,
     };

@@ -95,7 +95,9 @@ impl FilterSampler {
         let weights: Vec<f32> = (0..cells)
             .map(|i| (cell_integral(i, &|x| filter.eval(x).abs()) / f64::from(width)) as f32)
             .collect();
-        let integral: f64 = (0..cells).map(|i| cell_integral(i, &|x| filter.eval(x))).sum();
+        let integral: f64 = (0..cells)
+            .map(|i| cell_integral(i, &|x| filter.eval(x)))
+            .sum();
         FilterSampler {
             filter,
             distribution: PiecewiseConstant1D::new(&weights, -r, r),
@@ -147,7 +149,10 @@ mod tests {
     /// The weights average to 1 (the filter is normalised) within 4 standard errors.
     #[test]
     fn filter_weights_have_unit_mean() {
-        for filter in [Filter::Tent { radius: 1.0 }, Filter::Gaussian { stddev: 0.5 }] {
+        for filter in [
+            Filter::Tent { radius: 1.0 },
+            Filter::Gaussian { stddev: 0.5 },
+        ] {
             let sampler = FilterSampler::new(filter);
             let mut rng = Pcg32::seeded(3);
             let n = 200_000;
@@ -159,7 +164,10 @@ mod tests {
             }
             let mean = sum / n as f64;
             let se = ((sum2 / n as f64 - mean * mean) / n as f64).sqrt();
-            assert!((mean - 1.0).abs() < 4.0 * se + 1e-6, "{filter:?}: {mean} ± {se}");
+            assert!(
+                (mean - 1.0).abs() < 4.0 * se + 1e-6,
+                "{filter:?}: {mean} ± {se}"
+            );
         }
     }
 }

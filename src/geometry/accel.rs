@@ -71,7 +71,10 @@ impl Geometry {
                 }
                 Shape::Sphere(sphere) => {
                     let r = Vec3::splat(sphere.radius);
-                    bounds.push(Aabb::new(to_obvhs(sphere.center - r), to_obvhs(sphere.center + r)));
+                    bounds.push(Aabb::new(
+                        to_obvhs(sphere.center - r),
+                        to_obvhs(sphere.center + r),
+                    ));
                     primitives.push(Primitive::Analytic { shape: shape_index });
                 }
                 Shape::Disk(disk) => {
@@ -92,7 +95,11 @@ impl Geometry {
                 primitives,
             };
         }
-        let bvh = build_cwbvh(&bounds, BvhBuildParams::medium_build(), &mut Duration::default());
+        let bvh = build_cwbvh(
+            &bounds,
+            BvhBuildParams::medium_build(),
+            &mut Duration::default(),
+        );
         let primitives = bvh
             .primitive_indices
             .iter()
@@ -133,12 +140,14 @@ impl Geometry {
                 Primitive::Triangle { vertices, .. } => {
                     intersect_triangle(ray.o, ray.d, t_max, vertices[0], vertices[1], vertices[2])
                 }
-                Primitive::Analytic { shape } => self.hit_analytic(*shape, ray, t_max).map(|t| TriangleHit {
-                    t,
-                    b0: 0.0,
-                    b1: 0.0,
-                    b2: 0.0,
-                }),
+                Primitive::Analytic { shape } => {
+                    self.hit_analytic(*shape, ray, t_max).map(|t| TriangleHit {
+                        t,
+                        b0: 0.0,
+                        b1: 0.0,
+                        b2: 0.0,
+                    })
+                }
             };
             match found {
                 Some(h) if h.t < t_max => {
@@ -171,7 +180,8 @@ impl Geometry {
             let t_max = bvh_ray.tmax;
             let t = match &self.primitives[id] {
                 Primitive::Triangle { vertices, .. } => {
-                    intersect_triangle(ray.o, ray.d, t_max, vertices[0], vertices[1], vertices[2]).map(|h| h.t)
+                    intersect_triangle(ray.o, ray.d, t_max, vertices[0], vertices[1], vertices[2])
+                        .map(|h| h.t)
                 }
                 Primitive::Analytic { shape } => self.hit_analytic(*shape, ray, t_max),
             };

@@ -21,7 +21,11 @@ pub struct Disk {
 impl Disk {
     pub fn new(to_world: Transform, flip_normals: bool) -> Disk {
         let n = to_world.normal(Vec3::Z).normalize();
-        let area = PI * to_world.vector(Vec3::X).cross(to_world.vector(Vec3::Y)).length();
+        let area = PI
+            * to_world
+                .vector(Vec3::X)
+                .cross(to_world.vector(Vec3::Y))
+                .length();
         Disk {
             to_world,
             normal: if flip_normals { -n } else { n },

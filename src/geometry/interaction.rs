@@ -28,7 +28,11 @@ impl SurfaceInteraction {
     /// A ray leaving the surface in direction `d`, starting just off the surface on the side
     /// `d` points to.
     pub fn spawn_ray(&self, d: Vec3) -> Ray {
-        let n = if d.dot(self.n) >= 0.0 { self.n } else { -self.n };
+        let n = if d.dot(self.n) >= 0.0 {
+            self.n
+        } else {
+            -self.n
+        };
         Ray::new(offset_ray_origin(self.p, n), d, f32::INFINITY)
     }
 
@@ -37,12 +41,20 @@ impl SurfaceInteraction {
     /// the target (t < 1 − ε) so that the target itself is never reported as an occluder.
     pub fn spawn_ray_to(&self, target: Vec3, target_n: Vec3) -> Ray {
         let d = target - self.p;
-        let n = if d.dot(self.n) >= 0.0 { self.n } else { -self.n };
+        let n = if d.dot(self.n) >= 0.0 {
+            self.n
+        } else {
+            -self.n
+        };
         let origin = offset_ray_origin(self.p, n);
         let end = if target_n == Vec3::ZERO {
             target
         } else {
-            let m = if d.dot(target_n) <= 0.0 { target_n } else { -target_n };
+            let m = if d.dot(target_n) <= 0.0 {
+                target_n
+            } else {
+                -target_n
+            };
             offset_ray_origin(target, m)
         };
         Ray::new(origin, end - origin, 1.0 - SHADOW_EPSILON)

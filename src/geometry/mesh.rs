@@ -95,8 +95,9 @@ impl TriangleMesh {
             return geometric;
         };
         let [a, bb, c] = self.triangles[triangle];
-        let n = (normals[a as usize] * b[0] + normals[bb as usize] * b[1] + normals[c as usize] * b[2])
-            .normalize_or_zero();
+        let n =
+            (normals[a as usize] * b[0] + normals[bb as usize] * b[1] + normals[c as usize] * b[2])
+                .normalize_or_zero();
         if n == Vec3::ZERO {
             geometric
         } else if self.flip_normals {
@@ -107,7 +108,12 @@ impl TriangleMesh {
     }
 
     /// The surface interaction of a ray hit on a triangle.
-    pub fn interaction(&self, triangle: usize, hit: &TriangleHit, shape: u32) -> SurfaceInteraction {
+    pub fn interaction(
+        &self,
+        triangle: usize,
+        hit: &TriangleHit,
+        shape: u32,
+    ) -> SurfaceInteraction {
         let [p0, p1, p2] = self.vertices(triangle);
         let b = [hit.b0, hit.b1, hit.b2];
         // The barycentric combination is closer to the surface than o + t·d.

@@ -27,7 +27,11 @@ pub fn offset_ray_origin(p: Vec3, n: Vec3) -> Vec3 {
         let ulps = (INT_SCALE * normal) as i32;
         let bits = coordinate.to_bits() as i32;
         // Moving away from zero adds ulps to the magnitude; towards zero removes them.
-        let moved = if coordinate < 0.0 { bits - ulps } else { bits + ulps };
+        let moved = if coordinate < 0.0 {
+            bits - ulps
+        } else {
+            bits + ulps
+        };
         f32::from_bits(moved as u32)
     };
     Vec3::new(

@@ -140,7 +140,11 @@ impl Sphere {
         let phi = 2.0 * PI * u.y;
         let frame = Frame::from_normal(-to_center / dc);
         let outward = frame
-            .to_world(Vec3::new(sin_alpha * phi.cos(), sin_alpha * phi.sin(), cos_alpha))
+            .to_world(Vec3::new(
+                sin_alpha * phi.cos(),
+                sin_alpha * phi.sin(),
+                cos_alpha,
+            ))
             .normalize();
         Some(SurfaceSample {
             pdf: 1.0 / (2.0 * PI * one_minus_cos_max),
@@ -198,7 +202,9 @@ mod tests {
         let si = s.interaction(Vec3::ZERO, Vec3::Z, t, 0);
         assert!((si.n + Vec3::Z).length() < 1e-6);
         // From inside, the far wall.
-        let t = s.intersect(Vec3::new(0.0, 0.0, 5.0), Vec3::Z, f32::INFINITY).unwrap();
+        let t = s
+            .intersect(Vec3::new(0.0, 0.0, 5.0), Vec3::Z, f32::INFINITY)
+            .unwrap();
         assert!((t - 1.0).abs() < 1e-6);
         assert!(s.intersect(Vec3::ZERO, Vec3::X, f32::INFINITY).is_none());
         // Rays leaving the surface do not hit it again.
@@ -210,14 +216,23 @@ mod tests {
     #[test]
     fn cone_samples_are_visible_points_on_the_sphere() {
         let s = unit_sphere();
-        for (i, reference) in [Vec3::ZERO, Vec3::new(0.0, 0.0, -1e4)].into_iter().enumerate() {
+        for (i, reference) in [Vec3::ZERO, Vec3::new(0.0, 0.0, -1e4)]
+            .into_iter()
+            .enumerate()
+        {
             for k in 0..1000 {
                 let u = Vec2::new((k % 37) as f32 / 37.0, (k / 37) as f32 / 27.0);
                 let sample = s.sample_from(reference, u).unwrap();
-                assert!(((sample.p - s.center).length() - 1.0).abs() < 1e-4, "case {i}");
+                assert!(
+                    ((sample.p - s.center).length() - 1.0).abs() < 1e-4,
+                    "case {i}"
+                );
                 // Visible: the normal faces the reference.
                 assert!(sample.n.dot(reference - sample.p) >= -1e-3, "case {i}");
-                assert!((s.pdf_from(reference, sample.p, sample.n) - sample.pdf).abs() <= 1e-6 * sample.pdf);
+                assert!(
+                    (s.pdf_from(reference, sample.p, sample.n) - sample.pdf).abs()
+                        <= 1e-6 * sample.pdf
+                );
             }
         }
     }

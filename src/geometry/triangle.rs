@@ -41,7 +41,14 @@ fn permute(v: Vec3, x: usize, y: usize, z: usize) -> Vec3 {
 
 /// Intersects the ray o + t·d, 0 < t < t_max, with the triangle (p0, p1, p2); both faces count.
 #[inline]
-pub fn intersect_triangle(o: Vec3, d: Vec3, t_max: f32, p0: Vec3, p1: Vec3, p2: Vec3) -> Option<TriangleHit> {
+pub fn intersect_triangle(
+    o: Vec3,
+    d: Vec3,
+    t_max: f32,
+    p0: Vec3,
+    p1: Vec3,
+    p2: Vec3,
+) -> Option<TriangleHit> {
     // Degenerate triangles have no hits.
     if (p2 - p0).cross(p1 - p0).length_squared() == 0.0 {
         return None;
@@ -79,7 +86,9 @@ pub fn intersect_triangle(o: Vec3, d: Vec3, t_max: f32, p0: Vec3, p1: Vec3, p2: 
     let mut e1 = difference_of_products(p2t.x, p0t.y, p2t.y, p0t.x);
     let mut e2 = difference_of_products(p0t.x, p1t.y, p0t.y, p1t.x);
     if e0 == 0.0 || e1 == 0.0 || e2 == 0.0 {
-        let f = |a: f32, b: f32, c: f32, d: f32| (f64::from(a) * f64::from(b) - f64::from(c) * f64::from(d)) as f32;
+        let f = |a: f32, b: f32, c: f32, d: f32| {
+            (f64::from(a) * f64::from(b) - f64::from(c) * f64::from(d)) as f32
+        };
         e0 = f(p1t.x, p2t.y, p1t.y, p2t.x);
         e1 = f(p2t.x, p0t.y, p2t.y, p0t.x);
         e2 = f(p0t.x, p1t.y, p0t.y, p1t.x);
@@ -117,7 +126,8 @@ pub fn intersect_triangle(o: Vec3, d: Vec3, t_max: f32, p0: Vec3, p1: Vec3, p2: 
     let delta_y = gamma(5) * (max_yt + max_zt);
     let delta_e = 2.0 * (gamma(2) * max_xt * max_yt + delta_y * max_xt + delta_x * max_yt);
     let max_e = Vec3::new(e0, e1, e2).abs().max_element();
-    let delta_t = 3.0 * (gamma(3) * max_e * max_zt + delta_e * max_zt + delta_z * max_e) * inv_det.abs();
+    let delta_t =
+        3.0 * (gamma(3) * max_e * max_zt + delta_e * max_zt + delta_z * max_e) * inv_det.abs();
     if t <= delta_t {
         return None;
     }
@@ -132,30 +142,75 @@ mod tests {
     #[test]
     fn hits_inside_and_misses_outside() {
         let (p0, p1, p2) = (Vec3::ZERO, Vec3::X, Vec3::Y);
-        let hit = intersect_triangle(Vec3::new(0.25, 0.25, 1.0), -Vec3::Z, f32::INFINITY, p0, p1, p2).unwrap();
+        let hit = intersect_triangle(
+            Vec3::new(0.25, 0.25, 1.0),
+            -Vec3::Z,
+            f32::INFINITY,
+            p0,
+            p1,
+            p2,
+        )
+        .unwrap();
         assert!((hit.t - 1.0).abs() < 1e-6);
         assert!((hit.b1 - 0.25).abs() < 1e-6 && (hit.b2 - 0.25).abs() < 1e-6);
-        assert!(intersect_triangle(Vec3::new(0.75, 0.75, 1.0), -Vec3::Z, f32::INFINITY, p0, p1, p2).is_none());
+        assert!(
+            intersect_triangle(
+                Vec3::new(0.75, 0.75, 1.0),
+                -Vec3::Z,
+                f32::INFINITY,
+                p0,
+                p1,
+                p2
+            )
+            .is_none()
+        );
         // Behind the origin and beyond t_max.
-        assert!(intersect_triangle(Vec3::new(0.25, 0.25, 1.0), Vec3::Z, f32::INFINITY, p0, p1, p2).is_none());
-        assert!(intersect_triangle(Vec3::new(0.25, 0.25, 1.0), -Vec3::Z, 0.5, p0, p1, p2).is_none());
+        assert!(
+            intersect_triangle(
+                Vec3::new(0.25, 0.25, 1.0),
+                Vec3::Z,
+                f32::INFINITY,
+                p0,
+                p1,
+                p2
+            )
+            .is_none()
+        );
+        assert!(
+            intersect_triangle(Vec3::new(0.25, 0.25, 1.0), -Vec3::Z, 0.5, p0, p1, p2).is_none()
+        );
     }
 
     /// Rays through the shared edge of two triangles hit exactly one or both, never neither.
     #[test]
     fn shared_edges_are_watertight() {
-        let a = [Vec3::new(-1.0, -1.0, 0.0), Vec3::new(1.0, -1.0, 0.0), Vec3::new(1.0, 1.0, 0.0)];
-        let b = [Vec3::new(1.0, 1.0, 0.0), Vec3::new(-1.0, 1.0, 0.0), Vec3::new(-1.0, -1.0, 0.0)];
+        let a = [
+            Vec3::new(-1.0, -1.0, 0.0),
+            Vec3::new(1.0, -1.0, 0.0),
+            Vec3::new(1.0, 1.0, 0.0),
+        ];
+        let b = [
+            Vec3::new(1.0, 1.0, 0.0),
+            Vec3::new(-1.0, 1.0, 0.0),
+            Vec3::new(-1.0, -1.0, 0.0),
+        ];
         let mut rng = Pcg32::seeded(4);
         for _ in 0..100_000 {
             // Points on the diagonal x = y, seen from random origins.
             let s = rng.next_f32() * 1.8 - 0.9;
             let target = Vec3::new(s, s, 0.0);
-            let o = Vec3::new(rng.next_f32() * 4.0 - 2.0, rng.next_f32() * 4.0 - 2.0, 1.0 + rng.next_f32() * 3.0);
+            let o = Vec3::new(
+                rng.next_f32() * 4.0 - 2.0,
+                rng.next_f32() * 4.0 - 2.0,
+                1.0 + rng.next_f32() * 3.0,
+            );
             let d = target - o;
             let ha = intersect_triangle(o, d, f32::INFINITY, a[0], a[1], a[2]);
             let hb = intersect_triangle(o, d, f32::INFINITY, b[0], b[1], b[2]);
-            assert!(ha.is_some() || hb.is_some(), "ray {o} -> {target} slipped through the edge");
+            assert!(
+                ha.is_some() || hb.is_some(),
+                "ray {o} -> {target} slipped through the edge"
+            );
         }
     }
 }

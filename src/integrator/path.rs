@@ -131,12 +131,17 @@ impl PathIntegrator {
             let Some((bsdf, flip)) = material.side(wo_shading.z) else {
                 break;
             };
-            let frame = if flip { si.shading.flipped() } else { si.shading };
+            let frame = if flip {
+                si.shading.flipped()
+            } else {
+                si.shading
+            };
             let wo = frame.to_local(wo_world);
 
             // Direct light sampling.
             if bsdf.flags().has_smooth_lobe() {
-                result += throughput * self.sample_direct(scene, &si, &frame, bsdf, wo, lambda, sampler, count);
+                result += throughput
+                    * self.sample_direct(scene, &si, &frame, bsdf, wo, lambda, sampler, count);
             }
 
             // BSDF sampling for the next direction.
@@ -191,7 +196,8 @@ impl PathIntegrator {
             return SampledSpectrum::ZERO;
         };
         let light = &scene.lights[light_index];
-        let Some(ls) = light.sample_incident(&scene.geometry.shapes, si.p, u_choice, u, lambda) else {
+        let Some(ls) = light.sample_incident(&scene.geometry.shapes, si.p, u_choice, u, lambda)
+        else {
             return SampledSpectrum::ZERO;
         };
         let wi = frame.to_local(ls.wi);

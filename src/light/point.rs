@@ -23,7 +23,11 @@ pub struct PointLight {
 }
 
 impl PointLight {
-    pub fn sample_incident(&self, reference: Vec3, lambda: &SampledWavelengths) -> Option<LightSample> {
+    pub fn sample_incident(
+        &self,
+        reference: Vec3,
+        lambda: &SampledWavelengths,
+    ) -> Option<LightSample> {
         let d = self.position - reference;
         let dist2 = d.length_squared();
         if !(dist2 > 0.0) {

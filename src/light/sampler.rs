@@ -16,7 +16,13 @@ impl LightSampler {
     pub fn new(powers: &[f32]) -> LightSampler {
         let weights: Vec<f64> = powers
             .iter()
-            .map(|&p| if p.is_finite() && p > 0.0 { f64::from(p) } else { 0.0 })
+            .map(|&p| {
+                if p.is_finite() && p > 0.0 {
+                    f64::from(p)
+                } else {
+                    0.0
+                }
+            })
             .collect();
         LightSampler {
             table: AliasTable::new(&weights),

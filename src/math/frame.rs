@@ -31,7 +31,11 @@ impl Frame {
             return Frame::from_normal(n);
         }
         let s = s / length;
-        Frame { s, t: n.cross(s), n }
+        Frame {
+            s,
+            t: n.cross(s),
+            n,
+        }
     }
 
     #[inline]
@@ -73,7 +77,9 @@ mod tests {
             let f = Frame::from_normal(n);
             assert!((f.s.length() - 1.0).abs() < 1e-5);
             assert!((f.t.length() - 1.0).abs() < 1e-5);
-            assert!(f.s.dot(f.t).abs() < 1e-5 && f.s.dot(n).abs() < 1e-5 && f.t.dot(n).abs() < 1e-5);
+            assert!(
+                f.s.dot(f.t).abs() < 1e-5 && f.s.dot(n).abs() < 1e-5 && f.t.dot(n).abs() < 1e-5
+            );
             assert!((f.s.cross(f.t) - n).length() < 1e-4, "right-handed");
             let v = Vec3::new(0.3, -0.2, 0.9);
             assert!((f.to_world(f.to_local(v)) - v).length() < 1e-5);

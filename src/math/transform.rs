@@ -79,8 +79,7 @@ mod tests {
 
     #[test]
     fn normals_stay_perpendicular_under_non_uniform_scale() {
-        let m = DMat4::from_scale(glam::DVec3::new(2.0, 0.5, 1.0))
-            * DMat4::from_rotation_z(0.3);
+        let m = DMat4::from_scale(glam::DVec3::new(2.0, 0.5, 1.0)) * DMat4::from_rotation_z(0.3);
         let t = Transform::new(m).unwrap();
         let tangent = Vec3::new(1.0, 1.0, 0.0);
         let normal = Vec3::new(1.0, -1.0, 0.0);

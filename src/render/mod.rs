@@ -73,7 +73,12 @@ fn make_sampler(scene: &Scene, seed: u64) -> Sampler {
 }
 
 /// Renders all samples of one tile; returns its pixels (row-major) and the rays traced.
-fn render_tile(scene: &Scene, filter: &FilterSampler, tile: Tile, options: &RenderOptions) -> (Vec<PixelSums>, u64) {
+fn render_tile(
+    scene: &Scene,
+    filter: &FilterSampler,
+    tile: Tile,
+    options: &RenderOptions,
+) -> (Vec<PixelSums>, u64) {
     let mut sampler = make_sampler(scene, options.seed);
     let mut count = RayCount::default();
     let mut pixels = vec![PixelSums::default(); (tile.size.x * tile.size.y) as usize];
@@ -84,11 +89,15 @@ fn render_tile(scene: &Scene, filter: &FilterSampler, tile: Tile, options: &Rend
             let sums = &mut pixels[(y * tile.size.x + x) as usize];
             for index in 0..options.samples_per_pixel {
                 sampler.start_pixel_sample(pixel, index);
-                let lambda = SampledWavelengths::sample(sampler.next_1d(), scene.wavelength_sampling);
+                let lambda =
+                    SampledWavelengths::sample(sampler.next_1d(), scene.wavelength_sampling);
                 let (offset, weight) = filter.sample(sampler.next_2d());
                 let film_position = pixel.as_vec2() + Vec2::splat(0.5) + offset;
                 let ray = scene.camera.generate_ray(film_position);
-                let radiance = scene.integrator.radiance(scene, ray, &lambda, &mut sampler, &mut count);
+                let radiance =
+                    scene
+                        .integrator
+                        .radiance(scene, ray, &lambda, &mut sampler, &mut count);
                 let xyz = lambda.to_xyz(&radiance).map(|v| v * weight);
                 sums.add(xyz);
             }
@@ -103,7 +112,8 @@ pub fn render(scene: &Scene, options: &RenderOptions) -> Result<RenderOutput> {
     let mut film = Film::new(scene.film.size, crop);
     let filter = FilterSampler::new(scene.film.filter);
     let tiles = tiles(crop.size);
-    let total_samples = u64::from(crop.size.x) * u64::from(crop.size.y) * u64::from(options.samples_per_pixel);
+    let total_samples =
+        u64::from(crop.size.x) * u64::from(crop.size.y) * u64::from(options.samples_per_pixel);
 
     let mut builder = rayon::ThreadPoolBuilder::new();
     if let Some(threads) = options.threads {
@@ -133,7 +143,9 @@ pub fn render(scene: &Scene, options: &RenderOptions) -> Result<RenderOutput> {
             .map(|&tile| {
                 let (pixels, tile_rays) = render_tile(scene, &filter, tile, options);
                 rays.fetch_add(tile_rays, Ordering::Relaxed);
-                progress.inc(u64::from(tile.size.x * tile.size.y) * u64::from(options.samples_per_pixel));
+                progress.inc(
+                    u64::from(tile.size.x * tile.size.y) * u64::from(options.samples_per_pixel),
+                );
                 (tile, pixels)
             })
             .collect()

@@ -156,7 +156,14 @@ mod tests {
     fn reference_sequence_of_the_pcg32_paper() {
         // pcg32-demo with seed 42, stream 54 prints these first values.
         let mut rng = Pcg32::new(42, 54);
-        let expected = [0xa15c02b7u32, 0x7b47f409, 0xba1d3330, 0x83d2f293, 0xbfa4784b, 0xcbed606e];
+        let expected = [
+            0xa15c02b7u32,
+            0x7b47f409,
+            0xba1d3330,
+            0x83d2f293,
+            0xbfa4784b,
+            0xcbed606e,
+        ];
         for e in expected {
             assert_eq!(rng.next_u32(), e);
         }

@@ -156,7 +156,10 @@ mod tests {
             let p = sample_uniform_disk_concentric(u);
             assert!(p.length() <= 1.0 + 1e-6);
             let back = invert_uniform_disk_concentric(p);
-            assert!((back - u).abs().max_element() < 1e-4, "{u} -> {p} -> {back}");
+            assert!(
+                (back - u).abs().max_element() < 1e-4,
+                "{u} -> {p} -> {back}"
+            );
         }
     }
 

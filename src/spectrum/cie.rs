@@ -1,7 +1,9 @@
 //! Evaluation of the CIE tables: colour matching functions and D65 at any wavelength, and the
 //! conversions between CIE XYZ and linear sRGB.
 
-use super::cie_tables::{CIE_X, CIE_Y, CIE_Y_INTEGRAL, CIE_Z, D65, D65_LUMINANCE, TABLE_LAMBDA_MIN};
+use super::cie_tables::{
+    CIE_X, CIE_Y, CIE_Y_INTEGRAL, CIE_Z, D65, D65_LUMINANCE, TABLE_LAMBDA_MIN,
+};
 
 /// Linear interpolation in a 1 nm table starting at 360 nm; zero outside 360..=830 nm.
 #[inline]
@@ -18,7 +20,11 @@ fn lookup(table: &[f32; 471], lambda: f32) -> f32 {
 /// The CIE 1931 2° colour matching functions (x̄, ȳ, z̄) at `lambda` nm.
 #[inline]
 pub fn cie_xyz(lambda: f32) -> [f32; 3] {
-    [lookup(&CIE_X, lambda), lookup(&CIE_Y, lambda), lookup(&CIE_Z, lambda)]
+    [
+        lookup(&CIE_X, lambda),
+        lookup(&CIE_Y, lambda),
+        lookup(&CIE_Z, lambda),
+    ]
 }
 
 /// ȳ at `lambda` nm (the luminous efficiency function).

@@ -148,7 +148,11 @@ fn lab(xyz: [f64; 3]) -> [f64; 3] {
             r / (3.0 * DELTA * DELTA) + 4.0 / 29.0
         }
     };
-    let (fx, fy, fz) = (f(xyz[0] / white[0]), f(xyz[1] / white[1]), f(xyz[2] / white[2]));
+    let (fx, fy, fz) = (
+        f(xyz[0] / white[0]),
+        f(xyz[1] / white[1]),
+        f(xyz[2] / white[2]),
+    );
     [116.0 * fy - 16.0, 500.0 * (fx - fy), 200.0 * (fy - fz)]
 }
 
@@ -158,7 +162,11 @@ fn gauss_newton(rgb: [f64; 3], mut coefficients: [f64; 3]) -> [f64; 3] {
     let target = lab(mul3(&LINEAR_SRGB_TO_XYZ, rgb32).map(f64::from));
     let residual = |c: &[f64; 3]| {
         let model = lab(xyz_of(c));
-        [target[0] - model[0], target[1] - model[1], target[2] - model[2]]
+        [
+            target[0] - model[0],
+            target[1] - model[1],
+            target[2] - model[2],
+        ]
     };
     for _ in 0..30 {
         let r = residual(&coefficients);
@@ -240,7 +248,10 @@ mod tests {
             let poly = RgbSigmoidPolynomial::fit(rgb);
             let back = srgb_of(&poly);
             for c in 0..3 {
-                assert!((back[c] - rgb[c]).abs() < 2e-3, "{rgb:?} -> {back:?} ({poly:?})");
+                assert!(
+                    (back[c] - rgb[c]).abs() < 2e-3,
+                    "{rgb:?} -> {back:?} ({poly:?})"
+                );
             }
             for l in [360.0, 450.0, 600.0, 829.0] {
                 let v = poly.eval(l);

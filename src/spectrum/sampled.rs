@@ -163,8 +163,7 @@ impl WavelengthSampling {
         let lambda = match self {
             WavelengthSampling::CieSum => Self::cie_sum_distribution().sample(u).0,
             WavelengthSampling::Visible => {
-                VISIBLE_CENTER
-                    - (0.856_910_6 - 1.827_502 * u).atanh() * (1.0 / VISIBLE_SLOPE)
+                VISIBLE_CENTER - (0.856_910_6 - 1.827_502 * u).atanh() * (1.0 / VISIBLE_SLOPE)
             }
             WavelengthSampling::Uniform => LAMBDA_MIN + u * (LAMBDA_MAX - LAMBDA_MIN),
         };
@@ -333,7 +332,10 @@ mod tests {
             }
             let mean = sum / n as f64;
             let se = ((sum2 / n as f64 - mean * mean) / n as f64).sqrt();
-            assert!((mean - 1.0).abs() < 4.0 * se + 1e-4, "{sampling:?}: {mean} ± {se}");
+            assert!(
+                (mean - 1.0).abs() < 4.0 * se + 1e-4,
+                "{sampling:?}: {mean} ± {se}"
+            );
         }
     }
 

@@ -149,7 +149,11 @@ impl PiecewiseLinear {
         if n == 1 {
             return self.values[0];
         }
-        let i = self.lambdas.partition_point(|&l| l <= lambda).clamp(1, n - 1) - 1;
+        let i = self
+            .lambdas
+            .partition_point(|&l| l <= lambda)
+            .clamp(1, n - 1)
+            - 1;
         let t = (lambda - self.lambdas[i]) / (self.lambdas[i + 1] - self.lambdas[i]);
         self.values[i] + t * (self.values[i + 1] - self.values[i])
     }
@@ -174,7 +178,11 @@ mod tests {
     #[test]
     fn white_illuminant_has_unit_luminance() {
         let white = Spectrum::from_rgb([1.0, 1.0, 1.0], RgbIntent::Illuminant);
-        assert!((white.luminance() - 1.0).abs() < 1e-3, "{}", white.luminance());
+        assert!(
+            (white.luminance() - 1.0).abs() < 1e-3,
+            "{}",
+            white.luminance()
+        );
         let bright = Spectrum::from_rgb([17.0, 12.0, 4.0], RgbIntent::Illuminant);
         // Y of linear sRGB (17, 12, 4) is 0.2127·17 + 0.7152·12 + 0.0722·4.
         let expected = 0.212_672_9 * 17.0 + 0.715_152_2 * 12.0 + 0.072_175 * 4.0;

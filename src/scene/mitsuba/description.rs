@@ -72,7 +72,9 @@ impl PluginClass {
 
     /// The class declared by an XML tag, if the tag declares a plugin.
     pub fn from_tag(tag: &str) -> Option<PluginClass> {
-        PluginClass::ALL.into_iter().find(|class| class.tag() == tag)
+        PluginClass::ALL
+            .into_iter()
+            .find(|class| class.tag() == tag)
     }
 }
 
@@ -163,7 +165,11 @@ impl PluginNode {
     /// A short description for messages: `bsdf "diffuse"` or `bsdf "diffuse" (id "white")`.
     pub fn describe(&self) -> String {
         match &self.id {
-            Some(id) => format!("{} \"{}\" (id \"{id}\")", self.class.tag(), self.plugin_type),
+            Some(id) => format!(
+                "{} \"{}\" (id \"{id}\")",
+                self.class.tag(),
+                self.plugin_type
+            ),
             None => format!("{} \"{}\"", self.class.tag(), self.plugin_type),
         }
     }
@@ -189,14 +195,15 @@ impl PluginNode {
             .iter()
             .map(|dir| format!("\"{}\"", dir.display()))
             .collect();
-        Err(Error::input(location, format!("file \"{name}\" not found"))
-            .with_help(format!(
+        Err(
+            Error::input(location, format!("file \"{name}\" not found")).with_help(format!(
                 "check the file name; relative names are looked up in {}",
                 if searched.is_empty() {
                     "the current folder".to_string()
                 } else {
                     searched.join(", ")
                 }
-            )))
+            )),
+        )
     }
 }

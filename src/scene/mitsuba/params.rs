@@ -233,7 +233,12 @@ impl<'a> Params<'a> {
         let asked = self.asked.borrow();
         for (property, used) in self.node.properties.iter().zip(&self.used_properties) {
             if !used.get() {
-                return Err(unknown_parameter(self.node, &property.name, &property.location, &asked));
+                return Err(unknown_parameter(
+                    self.node,
+                    &property.name,
+                    &property.location,
+                    &asked,
+                ));
             }
         }
         for (child, used) in self.node.children.iter().zip(&self.used_children) {
@@ -244,9 +249,8 @@ impl<'a> Params<'a> {
                     child.node.class.tag(),
                     child.node.describe()
                 );
-                return Err(Error::input(&child.location, message).with_help(
-                    "remove it, or check that it is nested in the right element",
-                ));
+                return Err(Error::input(&child.location, message)
+                    .with_help("remove it, or check that it is nested in the right element"));
             }
         }
         Ok(())
