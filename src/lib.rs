@@ -1,5 +1,6 @@
 //! Prism: a spectral Monte Carlo path tracer for Mitsuba 3 XML scenes.
 pub mod bsdf;
+pub mod cli;
 pub mod camera;
 pub mod error;
 pub mod film;

@@ -1,0 +1,3 @@
+//! The subcommands of the `prism` program, one per file.
+
+pub mod render;

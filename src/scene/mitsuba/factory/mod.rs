@@ -1,0 +1,123 @@
+//! The plugin factory: turns a parsed Mitsuba scene description into a renderable [`Scene`].
+//!
+//! Each plugin class has a builder in its own file; a builder reads its parameters through
+//! [`Params`], so that unknown or misspelled parameters are reported with their location.
+//! Objects declared once and referenced many times (a BSDF with an `id`) are built once.
+
+pub mod integrators;
+pub mod lights;
+pub mod materials;
+pub mod sensor;
+pub mod shapes;
+pub mod spectra;
+
+use std::collections::HashMap;
+use std::sync::Arc;
+
+use super::description::{PluginClass, PluginNode};
+use super::params::Params;
+use crate::bsdf::Material;
+use crate::error::{Error, Result};
+use crate::geometry::Geometry;
+use crate::integrator::{Integrator, PathIntegrator};
+use crate::scene::{Scene, ShapeInfo};
+
+/// A renderable scene and the settings its file gives for rendering it.
+pub struct LoadedScene {
+    pub scene: Scene,
+    /// The sampler's `seed` parameter.
+    pub seed: u64,
+}
+
+/// Builds the scene described by the root `<scene>` node.
+pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
+    let params = Params::new(root);
+    let mut materials: Vec<Material> = Vec::new();
+    let mut material_ids: HashMap<*const PluginNode, u32> = HashMap::new();
+    let mut shapes = Vec::new();
+    let mut shape_info = Vec::new();
+    let mut lights = Vec::new();
+
+    let integrator = match params.single_child(PluginClass::Integrator)? {
+        Some(child) => integrators::build_integrator(&child.node)?,
+        None => Integrator::Path(PathIntegrator::default()),
+    };
+    let sensors = params.children(PluginClass::Sensor);
+    let Some(sensor) = sensors.first() else {
+        return Err(Error::input(&root.location, "the scene has no <sensor>")
+            .with_help("add a <sensor type=\"perspective\"> with a film and a sampler"));
+    };
+    if let Some(second) = sensors.get(1) {
+        return Err(Error::input(&second.location, "the scene has more than one <sensor>")
+            .with_help("Prism renders one sensor per scene: remove the others"));
+    }
+    let sensor = sensor::build_sensor(&sensor.node)?;
+
+    for child in params.children(PluginClass::Shape) {
+        let shape_params = Params::new(&child.node);
+        let shape = shapes::build_shape(&shape_params)?;
+        if shape.area() == 0.0 || !shape.area().is_finite() {
+            return Err(Error::input(&child.location, format!("{} has no area", child.node.describe()))
+                .with_help("remove degenerate shapes or fix their transform"));
+        }
+        let shape_index = shapes.len() as u32;
+        let material = match shape_params.single_child(PluginClass::Bsdf)? {
+            Some(bsdf) => {
+                let key = Arc::as_ptr(&bsdf.node);
+                match material_ids.get(&key) {
+                    Some(&index) => index,
+                    None => {
+                        materials.push(materials::build_material(&bsdf.node)?);
+                        let index = (materials.len() - 1) as u32;
+                        material_ids.insert(key, index);
+                        index
+                    }
+                }
+            }
+            None => {
+                materials.push(materials::default_material());
+                (materials.len() - 1) as u32
+            }
+        };
+        let light = match shape_params.single_child(PluginClass::Emitter)? {
+            Some(emitter) => {
+                lights.push(lights::build_area_light(&emitter.node, shape_index)?);
+                Some((lights.len() - 1) as u32)
+            }
+            None => None,
+        };
+        shape_params.finish()?;
+        shapes.push(shape);
+        shape_info.push(ShapeInfo { material, light });
+    }
+
+    for child in params.children(PluginClass::Emitter) {
+        lights.push(lights::build_scene_light(&child.node)?);
+    }
+
+    // BSDFs declared at the top level (to be referenced by id) are built even when unused, so
+    // that their errors are reported as Mitsuba would.
+    for child in params.children(PluginClass::Bsdf) {
+        let key = Arc::as_ptr(&child.node);
+        if !material_ids.contains_key(&key) {
+            materials.push(materials::build_material(&child.node)?);
+            material_ids.insert(key, (materials.len() - 1) as u32);
+        }
+    }
+    params.finish()?;
+
+    let scene = Scene::new(
+        Geometry::new(shapes),
+        shape_info,
+        materials,
+        lights,
+        sensor.camera,
+        sensor.film,
+        sensor.sampler,
+        integrator,
+    );
+    Ok(LoadedScene {
+        scene,
+        seed: sensor.seed,
+    })
+}

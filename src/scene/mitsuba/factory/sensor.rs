@@ -1,0 +1,256 @@
+//! The sensor and what it carries: `perspective` camera, `hdrfilm` film with its `rfilter`, and
+//! the `independent` sampler.
+
+use glam::{UVec2, Vec2};
+
+use crate::camera::perspective::{FovAxis, focal_length_to_diagonal_fov, horizontal_fov};
+use crate::camera::{Camera, PerspectiveCamera};
+use crate::error::{Error, Result};
+use crate::film::{CropWindow, Filter};
+use crate::math::Transform;
+use crate::scene::mitsuba::description::{PluginClass, PluginNode};
+use crate::scene::mitsuba::params::Params;
+use crate::scene::{FilmSettings, SamplerKind, SamplerSettings};
+
+pub const SUPPORTED_SENSORS: &[&str] = &["perspective"];
+pub const SUPPORTED_FILMS: &[&str] = &["hdrfilm"];
+pub const SUPPORTED_FILTERS: &[&str] = &["box", "tent", "gaussian"];
+pub const SUPPORTED_SAMPLERS: &[&str] = &["independent"];
+
+/// Largest film side, and largest pixel count, accepted (each pixel keeps 64 bytes of sums).
+const MAX_FILM_SIDE: i64 = 1 << 16;
+const MAX_FILM_PIXELS: i64 = 1 << 26;
+
+/// The camera, film settings, sampler settings and sampler seed of a `<sensor>`.
+pub struct SensorSettings {
+    pub camera: Camera,
+    pub film: FilmSettings,
+    pub sampler: SamplerSettings,
+    pub seed: u64,
+}
+
+pub fn build_sensor(node: &PluginNode) -> Result<SensorSettings> {
+    let params = Params::new(node);
+    if node.plugin_type != "perspective" {
+        return Err(Error::input(&node.location, format!("unknown sensor type \"{}\"", node.plugin_type))
+            .with_help(format!("supported sensor types: {}", SUPPORTED_SENSORS.join(", "))));
+    }
+    let film = match params.single_child(PluginClass::Film)? {
+        Some(child) => build_film(&child.node)?,
+        None => default_film(),
+    };
+    let (sampler, seed) = match params.single_child(PluginClass::Sampler)? {
+        Some(child) => build_sampler(&child.node)?,
+        None => (
+            SamplerSettings {
+                kind: SamplerKind::Independent,
+                samples_per_pixel: 4,
+            },
+            0,
+        ),
+    };
+
+    let aspect = f64::from(film.size.x) / f64::from(film.size.y);
+    let fov_x = match (params.float_opt("fov")?, params.string_opt("focal_length")?) {
+        (Some(_), Some(_)) => {
+            return Err(Error::input(
+                params.location_of("focal_length"),
+                "give either \"fov\" or \"focal_length\", not both",
+            ));
+        }
+        (Some(fov), None) => {
+            let axis_name = params.string("fov_axis", "x")?;
+            let axis = match axis_name.to_ascii_lowercase().as_str() {
+                "x" => FovAxis::X,
+                "y" => FovAxis::Y,
+                "diagonal" => FovAxis::Diagonal,
+                "smaller" => FovAxis::Smaller,
+                "larger" => FovAxis::Larger,
+                _ => {
+                    return Err(Error::input(
+                        params.location_of("fov_axis"),
+                        format!("unknown fov_axis \"{axis_name}\""),
+                    )
+                    .with_help("use one of x, y, diagonal, smaller, larger"));
+                }
+            };
+            horizontal_fov(fov, axis, aspect)
+        }
+        (None, focal_length) => {
+            let text = focal_length.unwrap_or("50mm");
+            let mm: f64 = text.trim().trim_end_matches("mm").trim().parse().map_err(|_| {
+                Error::input(
+                    params.location_of("focal_length"),
+                    format!("could not read the focal length \"{text}\""),
+                )
+                .with_help("write it as a number of millimetres, e.g. \"35mm\"")
+            })?;
+            if !(mm > 0.0) {
+                return Err(Error::input(params.location_of("focal_length"), "the focal length must be positive"));
+            }
+            horizontal_fov(focal_length_to_diagonal_fov(mm), FovAxis::Diagonal, aspect)
+        }
+    };
+    if !(fov_x > 0.0 && fov_x < 180.0) {
+        return Err(Error::input(
+            params.location_of("fov"),
+            format!("the horizontal field of view is {fov_x} degrees; it must lie strictly between 0 and 180"),
+        ));
+    }
+    let near_clip = params.float("near_clip", 1e-2)?;
+    let far_clip = params.float("far_clip", 1e4)?;
+    if !(near_clip > 0.0) || !(far_clip > near_clip) || !far_clip.is_finite() {
+        return Err(Error::input(
+            params.location_of("near_clip"),
+            format!("near_clip ({near_clip}) must be positive and smaller than far_clip ({far_clip})"),
+        ));
+    }
+    let matrix = params.transform("to_world")?;
+    let to_world = Transform::new(matrix).ok_or_else(|| {
+        Error::input(params.location_of("to_world"), "the sensor's \"to_world\" transform is singular")
+    })?;
+    params.finish()?;
+
+    let camera = Camera::Perspective(PerspectiveCamera {
+        to_world,
+        film_size: Vec2::new(film.size.x as f32, film.size.y as f32),
+        tan_half_fov_x: (0.5 * fov_x).to_radians().tan() as f32,
+        near_clip: near_clip as f32,
+        far_clip: far_clip as f32,
+    });
+    Ok(SensorSettings {
+        camera,
+        film,
+        sampler,
+        seed,
+    })
+}
+
+/// Mitsuba's default film: 768 × 576 with a Gaussian filter.
+fn default_film() -> FilmSettings {
+    let size = UVec2::new(768, 576);
+    FilmSettings {
+        size,
+        crop: CropWindow {
+            offset: UVec2::ZERO,
+            size,
+        },
+        filter: Filter::Gaussian { stddev: 0.5 },
+    }
+}
+
+/// `hdrfilm`: `width` (768), `height` (576), `crop_offset_x/y`, `crop_width/height`, a nested
+/// `rfilter` (Gaussian by default). `file_format`, `pixel_format` and `component_format` are
+/// accepted for compatibility; Prism always writes 32-bit linear RGB and XYZ to EXR.
+fn build_film(node: &PluginNode) -> Result<FilmSettings> {
+    let params = Params::new(node);
+    if node.plugin_type != "hdrfilm" {
+        return Err(Error::input(&node.location, format!("unknown film type \"{}\"", node.plugin_type))
+            .with_help(format!("supported film types: {}", SUPPORTED_FILMS.join(", "))));
+    }
+    let width = params.integer("width", 768)?;
+    let height = params.integer("height", 576)?;
+    if !(1..=MAX_FILM_SIDE).contains(&width) || !(1..=MAX_FILM_SIDE).contains(&height) || width * height > MAX_FILM_PIXELS {
+        return Err(Error::input(
+            params.location_of(if (1..=MAX_FILM_SIDE).contains(&width) { "height" } else { "width" }),
+            format!("a film of {width} × {height} pixels is not possible"),
+        )
+        .with_help(format!(
+            "width and height must be between 1 and {MAX_FILM_SIDE}, with at most {MAX_FILM_PIXELS} pixels in all"
+        )));
+    }
+    let crop_x = params.integer("crop_offset_x", 0)?;
+    let crop_y = params.integer("crop_offset_y", 0)?;
+    let crop_width = params.integer("crop_width", width - crop_x)?;
+    let crop_height = params.integer("crop_height", height - crop_y)?;
+    if crop_x < 0 || crop_y < 0 || crop_width < 1 || crop_height < 1 || crop_x + crop_width > width || crop_y + crop_height > height {
+        return Err(Error::input(
+            params.location_of("crop_width"),
+            format!(
+                "the crop window at ({crop_x}, {crop_y}) of size {crop_width} × {crop_height} does not fit in the {width} × {height} film"
+            ),
+        ));
+    }
+    for (name, allowed) in [
+        ("file_format", &["openexr", "exr"][..]),
+        ("pixel_format", &["rgb", "rgba", "xyz", "xyza", "luminance", "luminance_alpha"][..]),
+        ("component_format", &["float16", "float32", "uint32"][..]),
+    ] {
+        if let Some(value) = params.string_opt(name)?
+            && !allowed.contains(&value.to_ascii_lowercase().as_str())
+        {
+            return Err(Error::input(params.location_of(name), format!("unknown {name} \"{value}\""))
+                .with_help(format!("use one of {}", allowed.join(", "))));
+        }
+    }
+    let filter = match params.single_child(PluginClass::Rfilter)? {
+        Some(child) => build_filter(&child.node)?,
+        None => Filter::Gaussian { stddev: 0.5 },
+    };
+    params.finish()?;
+    let size = UVec2::new(width as u32, height as u32);
+    Ok(FilmSettings {
+        size,
+        crop: CropWindow {
+            offset: UVec2::new(crop_x as u32, crop_y as u32),
+            size: UVec2::new(crop_width as u32, crop_height as u32),
+        },
+        filter,
+    })
+}
+
+fn build_filter(node: &PluginNode) -> Result<Filter> {
+    let params = Params::new(node);
+    let positive = |name: &'static str, default: f64| -> Result<f32> {
+        let v = params.float(name, default)?;
+        if !(v > 0.0 && v <= 64.0) {
+            return Err(Error::input(
+                params.location_of(name),
+                format!("the filter's \"{name}\" must be positive (and at most 64 pixels), not {v}"),
+            ));
+        }
+        Ok(v as f32)
+    };
+    let filter = match node.plugin_type.as_str() {
+        "box" => Filter::Box {
+            radius: positive("radius", 0.5)?,
+        },
+        "tent" => Filter::Tent {
+            radius: positive("radius", 1.0)?,
+        },
+        "gaussian" => Filter::Gaussian {
+            stddev: positive("stddev", 0.5)?,
+        },
+        other => {
+            return Err(Error::input(&node.location, format!("unknown rfilter type \"{other}\""))
+                .with_help(format!("supported rfilter types: {}", SUPPORTED_FILTERS.join(", "))));
+        }
+    };
+    params.finish()?;
+    Ok(filter)
+}
+
+/// `independent`: `sample_count` (default 4), `seed` (default 0).
+fn build_sampler(node: &PluginNode) -> Result<(SamplerSettings, u64)> {
+    let params = Params::new(node);
+    if node.plugin_type != "independent" {
+        return Err(Error::input(&node.location, format!("unknown sampler type \"{}\"", node.plugin_type))
+            .with_help(format!("supported sampler types: {}", SUPPORTED_SAMPLERS.join(", "))));
+    }
+    let spp = params.integer("sample_count", 4)?;
+    if !(1..=(1 << 24)).contains(&spp) {
+        return Err(Error::input(
+            params.location_of("sample_count"),
+            format!("sample_count must be between 1 and {}, not {spp}", 1 << 24),
+        ));
+    }
+    let seed = params.integer("seed", 0)?;
+    params.finish()?;
+    Ok((
+        SamplerSettings {
+            kind: SamplerKind::Independent,
+            samples_per_pixel: spp as u32,
+        },
+        seed as u64,
+    ))
+}

@@ -1,0 +1,257 @@
+//! Chi-square tests (DESIGN.md §6) of every sampling routine of the core: each draws 10^6
+//! samples and compares their histogram with the density the routine claims.
+
+mod common;
+
+use std::f64::consts::PI;
+
+use common::chi2::{
+    assert_passes, chi2_discrete, chi2_interval, chi2_rectangle, chi2_sphere,
+};
+use glam::{Mat3, Vec2, Vec3};
+use prism::film::{Filter, FilterSampler};
+use prism::geometry::TriangleMesh;
+use prism::geometry::sphere::Sphere;
+use prism::light::LightSampler;
+use prism::sampling::rng::Pcg32;
+use prism::sampling::warp;
+use prism::spectrum::WavelengthSampling;
+
+/// Number of chi-square tests in this file, for Šidák's correction.
+const TESTS: usize = 11;
+const SAMPLES: usize = 1_000_000;
+
+fn u2(rng: &mut Pcg32) -> Vec2 {
+    Vec2::new(rng.next_f32(), rng.next_f32())
+}
+
+#[test]
+fn cosine_hemisphere_sampling_follows_cos_theta_over_pi() {
+    let outcome = chi2_sphere(
+        SAMPLES,
+        101,
+        202,
+        1,
+        |rng| Some(warp::sample_cosine_hemisphere(u2(rng))),
+        |w| f64::from(w.z.max(0.0)) / PI,
+    )
+    .unwrap();
+    assert_passes("cosine hemisphere", &outcome, TESTS);
+}
+
+#[test]
+fn uniform_sphere_sampling_is_uniform() {
+    let outcome = chi2_sphere(
+        SAMPLES,
+        101,
+        202,
+        2,
+        |rng| Some(warp::sample_uniform_sphere(u2(rng))),
+        |_| 1.0 / (4.0 * PI),
+    )
+    .unwrap();
+    assert_passes("uniform sphere", &outcome, TESTS);
+}
+
+#[test]
+fn concentric_disk_sampling_is_uniform() {
+    let outcome = chi2_rectangle(
+        SAMPLES,
+        (-1.0, 1.0),
+        (-1.0, 1.0),
+        40,
+        40,
+        3,
+        |rng| {
+            let p = warp::sample_uniform_disk_concentric(u2(rng));
+            Some((f64::from(p.x), f64::from(p.y)))
+        },
+        |x, y| if x * x + y * y <= 1.0 { 1.0 / PI } else { 0.0 },
+    )
+    .unwrap();
+    assert_passes("concentric disk", &outcome, TESTS);
+}
+
+#[test]
+fn wavelength_sampling_follows_the_sum_of_the_colour_matching_functions() {
+    let sampling = WavelengthSampling::CieSum;
+    let outcome = chi2_interval(
+        SAMPLES,
+        360.0,
+        830.0,
+        235,
+        4,
+        |rng| Some(f64::from(sampling.sample(rng.next_f32()))),
+        |l| f64::from(sampling.pdf(l as f32)),
+    )
+    .unwrap();
+    assert_passes("wavelengths p ~ x+y+z", &outcome, TESTS);
+    // The tabulated density is x̄+ȳ+z̄ normalised: compare a few points with the CIE tables.
+    let sum = |l: f32| prism::spectrum::cie::cie_xyz(l).iter().sum::<f32>();
+    let normalisation = sampling.pdf(555.5) / (0.5 * (sum(555.0) + sum(556.0)));
+    for l in [400.5f32, 450.5, 600.5, 700.5] {
+        let expected = 0.5 * (sum(l - 0.5) + sum(l + 0.5)) * normalisation;
+        assert!((sampling.pdf(l) - expected).abs() <= 1e-5 * expected, "{l}");
+    }
+}
+
+#[test]
+fn visible_wavelength_sampling_follows_its_density() {
+    let sampling = WavelengthSampling::Visible;
+    let outcome = chi2_interval(
+        SAMPLES,
+        360.0,
+        830.0,
+        235,
+        5,
+        |rng| Some(f64::from(sampling.sample(rng.next_f32()))),
+        |l| f64::from(sampling.pdf(l as f32)),
+    )
+    .unwrap();
+    assert_passes("wavelengths cosh^-2", &outcome, TESTS);
+}
+
+#[test]
+fn light_selection_is_proportional_to_power() {
+    let powers = [1.0f32, 5.0, 0.5, 3.0, 0.0, 12.0];
+    let sampler = LightSampler::new(&powers);
+    let total: f32 = powers.iter().sum();
+    let probabilities: Vec<f64> = powers.iter().map(|&p| f64::from(p / total)).collect();
+    let outcome = chi2_discrete(SAMPLES, &probabilities, 6, |rng| {
+        let (index, pmf) = sampler.sample(rng.next_f32()).unwrap();
+        assert_eq!(pmf, sampler.pmf(index), "the pmf returned with a sample is the reported pmf");
+        index
+    })
+    .unwrap();
+    assert_passes("light selection", &outcome, TESTS);
+}
+
+/// A unit square split into four triangles of unequal area around an off-centre point.
+fn uneven_square_mesh() -> TriangleMesh {
+    let c = Vec3::new(0.2, 0.7, 0.0);
+    TriangleMesh::new(
+        vec![Vec3::ZERO, Vec3::X, Vec3::new(1.0, 1.0, 0.0), Vec3::Y, c],
+        None,
+        None,
+        vec![[0, 1, 4], [1, 2, 4], [2, 3, 4], [3, 0, 4]],
+        false,
+    )
+}
+
+#[test]
+fn triangle_mesh_area_sampling_is_uniform() {
+    let mesh = uneven_square_mesh();
+    let outcome = chi2_rectangle(
+        SAMPLES,
+        (0.0, 1.0),
+        (0.0, 1.0),
+        40,
+        40,
+        7,
+        |rng| {
+            let s = mesh.sample_area(rng.next_f32(), u2(rng))?;
+            assert!((s.pdf - 1.0).abs() < 1e-5);
+            Some((f64::from(s.p.x), f64::from(s.p.y)))
+        },
+        |_, _| 1.0,
+    )
+    .unwrap();
+    assert_passes("triangle mesh area", &outcome, TESTS);
+}
+
+fn sphere() -> Sphere {
+    Sphere {
+        center: Vec3::new(0.0, 0.0, 3.0),
+        radius: 1.0,
+        rotation: Mat3::IDENTITY,
+        flip_normals: false,
+    }
+}
+
+#[test]
+fn sphere_cone_sampling_is_uniform_over_the_visible_cone() {
+    let s = sphere();
+    let reference = Vec3::ZERO;
+    let cos_max = (1.0 - 1.0 / 9.0f64).sqrt();
+    let outcome = chi2_sphere(
+        SAMPLES,
+        101,
+        202,
+        8,
+        |rng| {
+            let sample = s.sample_from(reference, u2(rng))?;
+            let w = (sample.p - reference).normalize();
+            let claimed = s.pdf_from(reference, sample.p, sample.n);
+            assert!((claimed - sample.pdf).abs() <= 1e-4 * claimed);
+            Some(w)
+        },
+        |w| {
+            if f64::from(w.z) >= cos_max {
+                1.0 / (2.0 * PI * (1.0 - cos_max))
+            } else {
+                0.0
+            }
+        },
+    )
+    .unwrap();
+    assert_passes("sphere cone", &outcome, TESTS);
+}
+
+#[test]
+fn sphere_sampling_from_inside_converts_area_to_solid_angle() {
+    let s = sphere();
+    let reference = Vec3::new(0.3, -0.2, 3.4);
+    // From inside, every direction hits the sphere once: p_ω = d² / (|cos| A).
+    let outcome = chi2_sphere(
+        SAMPLES,
+        101,
+        202,
+        9,
+        |rng| {
+            let sample = s.sample_from(reference, u2(rng))?;
+            Some((sample.p - reference).normalize())
+        },
+        |w| {
+            let w = w.as_dvec3();
+            let o = reference.as_dvec3() - s.center.as_dvec3();
+            // Distance to the sphere along w from inside: t = -o·w + sqrt((o·w)² - |o|² + r²).
+            let b = o.dot(w);
+            let t = -b + (b * b - o.length_squared() + 1.0).sqrt();
+            let p = o + w * t;
+            let cos = p.normalize().dot(w).abs();
+            t * t / (cos * 4.0 * PI)
+        },
+    )
+    .unwrap();
+    assert_passes("sphere from inside", &outcome, TESTS);
+}
+
+fn filter_chi2(filter: Filter, seed: u64) {
+    let sampler = FilterSampler::new(filter);
+    let r = f64::from(filter.radius());
+    let outcome = chi2_rectangle(
+        SAMPLES,
+        (-r, r),
+        (-r, r),
+        32,
+        32,
+        seed,
+        |rng| {
+            let (offset, _) = sampler.sample(u2(rng));
+            Some((f64::from(offset.x), f64::from(offset.y)))
+        },
+        |x, y| f64::from(sampler.pdf(Vec2::new(x as f32, y as f32))),
+    )
+    .unwrap();
+    assert_passes(&format!("{filter:?}"), &outcome, TESTS);
+}
+
+#[test]
+fn tent_filter_sampling_follows_its_table() {
+    filter_chi2(Filter::Tent { radius: 1.0 }, 10);
+}
+
+#[test]
+fn gaussian_filter_sampling_follows_its_table() {
+    filter_chi2(Filter::Gaussian { stddev: 0.5 }, 11);
+}
