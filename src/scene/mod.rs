@@ -1,5 +1,7 @@
-//! Scenes: the renderable [`Scene`], and the Mitsuba XML reader and plugin factory that build it.
+//! Scenes: the renderable [`Scene`], the mesh readers, and the Mitsuba XML reader and plugin
+//! factory that build it.
 
+pub mod mesh;
 pub mod mitsuba;
 
 use glam::UVec2;
