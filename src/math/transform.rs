@@ -73,9 +73,38 @@ impl Transform {
     }
 }
 
+/// Mitsuba's look-at matrix: the camera (or object) at `origin` looking at `target`, with the
+/// columns [left, up, forward, origin] where forward = normalize(target − origin),
+/// left = normalize(up × forward) and up is re-orthogonalised. None when origin = target or
+/// `up` is parallel to the viewing direction.
+pub fn look_at(origin: glam::DVec3, target: glam::DVec3, up: glam::DVec3) -> Option<DMat4> {
+    let forward = (target - origin).try_normalize()?;
+    let left = up.cross(forward).try_normalize()?;
+    let new_up = forward.cross(left);
+    Some(DMat4::from_cols(
+        left.extend(0.0),
+        new_up.extend(0.0),
+        forward.extend(0.0),
+        origin.extend(1.0),
+    ))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn look_at_builds_left_up_forward_columns() {
+        use glam::DVec3;
+        let m = look_at(DVec3::new(0.0, 0.0, -5.0), DVec3::ZERO, DVec3::Y).unwrap();
+        // Looking along +z with +y up, "left" is +x (Mitsuba's camera convention).
+        assert!((m.x_axis.truncate() - DVec3::X).length() < 1e-12);
+        assert!((m.y_axis.truncate() - DVec3::Y).length() < 1e-12);
+        assert!((m.z_axis.truncate() - DVec3::Z).length() < 1e-12);
+        assert_eq!(m.w_axis.truncate(), DVec3::new(0.0, 0.0, -5.0));
+        assert!(look_at(DVec3::ZERO, DVec3::ZERO, DVec3::Y).is_none());
+        assert!(look_at(DVec3::ZERO, DVec3::Y, DVec3::Y).is_none());
+    }
 
     #[test]
     fn normals_stay_perpendicular_under_non_uniform_scale() {

@@ -5,3 +5,4 @@
 #![allow(dead_code)]
 
 pub mod chi2;
+pub mod scenes;

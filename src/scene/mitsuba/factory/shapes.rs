@@ -130,7 +130,7 @@ fn mesh_error(mut error: Error, node: &PluginNode) -> Error {
 /// Moves a mesh to world space. Normals go through the inverse transpose; for the built-in
 /// meshes (`oriented` = true) a transform that mirrors space also reverses the winding, so the
 /// geometric normal stays the transformed +z normal as for Mitsuba's analytic rectangle.
-fn transform_mesh(data: MeshData, to_world: &Transform, flip_normals: bool, oriented: bool) -> TriangleMesh {
+pub fn transform_mesh(data: MeshData, to_world: &Transform, flip_normals: bool, oriented: bool) -> TriangleMesh {
     let positions = data.positions.iter().map(|&p| to_world.point(p)).collect();
     let normals = data
         .normals
@@ -145,7 +145,7 @@ fn transform_mesh(data: MeshData, to_world: &Transform, flip_normals: bool, orie
 }
 
 /// Mitsuba's `rectangle`: [−1, 1]² in the z = 0 plane, normal +z, uv from (0, 0) to (1, 1).
-fn rectangle() -> MeshData {
+pub fn rectangle() -> MeshData {
     MeshData {
         positions: vec![
             Vec3::new(-1.0, -1.0, 0.0),
@@ -161,7 +161,7 @@ fn rectangle() -> MeshData {
 
 /// Mitsuba's `cube`: [−1, 1]³ with outward normals, four vertices per face so that faces
 /// are shaded flat.
-fn cube() -> MeshData {
+pub fn cube() -> MeshData {
     let mut data = MeshData {
         positions: Vec::new(),
         normals: Some(Vec::new()),

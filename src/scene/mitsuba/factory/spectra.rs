@@ -3,7 +3,9 @@
 //!
 //! * `<rgb>` is upsampled (Jakob & Hanika 2019); inside an emitter it is an illuminant, the
 //!   upsampled colour times D65 (Mitsuba's `srgb_d65`/`d65` with a colour).
-//! * `<spectrum value="v"/>` and `<float>` are the constant v at every wavelength.
+//! * `<spectrum value="v"/>` is the constant v at every wavelength; so is `<float>`, except in an
+//!   emitter, where Mitsuba 3 makes it D65 scaled to luminance v (checked against Mitsuba 3.9.1:
+//!   a float radiance of 1 renders as XYZ (0.950, 1.000, 1.088), a uniform spectrum as (1, 1, 1)).
 //! * `<spectrum value="λ:v, ..."/>` is piecewise linear in λ and zero outside the given range.
 
 use crate::error::{Error, Result};
@@ -53,17 +55,15 @@ pub fn spectrum_param(params: &Params, name: &'static str, default: f32, range: 
         Range::Emission => RgbIntent::Illuminant,
     };
     let spectrum = match &property.value {
-        PropertyValue::Float(v) => {
-            if !(*v >= 0.0 && v.is_finite()) {
+        PropertyValue::Float(_) | PropertyValue::Integer(_) => {
+            let v = number(&property.value);
+            if !(v >= 0.0 && v.is_finite()) {
                 return Err(negative());
             }
-            Spectrum::Constant(*v as f32)
-        }
-        PropertyValue::Integer(v) => {
-            if *v < 0 {
-                return Err(negative());
+            match range {
+                Range::Albedo => Spectrum::Constant(v as f32),
+                Range::Emission => Spectrum::from_rgb([v as f32; 3], RgbIntent::Illuminant),
             }
-            Spectrum::Constant(*v as f32)
         }
         PropertyValue::Rgb(rgb) => {
             if !rgb.iter().all(|c| *c >= 0.0 && c.is_finite()) {
@@ -102,6 +102,15 @@ pub fn spectrum_param(params: &Params, name: &'static str, default: f32, range: 
         check_reflectance(&spectrum, property)?;
     }
     Ok(spectrum)
+}
+
+/// The value of a float or integer property (NaN for other kinds).
+fn number(value: &PropertyValue) -> f64 {
+    match *value {
+        PropertyValue::Float(v) => v,
+        PropertyValue::Integer(v) => v as f64,
+        _ => f64::NAN,
+    }
 }
 
 /// Reflectances given as spectra or numbers must lie in [0, 1]: above 1 a surface would create

@@ -1,0 +1,155 @@
+//! The path tracer against closed-form answers (DESIGN.md §7): furnaces and a point light over
+//! a plane. Every tolerance comes from the standard error of the estimate being tested.
+
+mod common;
+
+use common::chi2::regularized_gamma_q;
+use common::scenes::{Object, assert_mean_luminance, build, camera, pixel_mean_and_variance, render_film};
+use glam::{DMat4, DVec3, Mat3, UVec2, Vec2, Vec3};
+use prism::geometry::Shape;
+use prism::geometry::sphere::Sphere;
+use prism::integrator::PathIntegrator;
+use prism::light::{Light, PointLight};
+use prism::math::Transform;
+use prism::scene::mitsuba::factory::shapes::{cube, rectangle, transform_mesh};
+use prism::spectrum::Spectrum;
+
+/// The inside of a unit sphere: normals point inwards, so the inner face is the front.
+fn inner_sphere() -> Shape {
+    Shape::Sphere(Sphere {
+        center: Vec3::ZERO,
+        radius: 1.0,
+        rotation: Mat3::IDENTITY,
+        flip_normals: true,
+    })
+}
+
+/// The inside of a 2 × 3 × 4 box.
+fn inner_box() -> Shape {
+    let to_world = Transform::new(DMat4::from_scale(DVec3::new(1.0, 1.5, 2.0))).unwrap();
+    Shape::Mesh(transform_mesh(cube(), &to_world, true, true))
+}
+
+/// Renders a closed room whose every surface has reflectance rho and emits le: the radiance
+/// everywhere is le / (1 − rho) (the Neumann series of the rendering equation).
+fn furnace(shape: Shape, rho: f32, le: f32, integrator: PathIntegrator, seed: u64) -> prism::film::Film {
+    let size = UVec2::new(8, 8);
+    let camera = camera(DVec3::new(0.1, 0.2, -0.3), DVec3::new(0.5, 0.3, 1.0), DVec3::Y, 70.0, size);
+    let scene = build(
+        vec![Object {
+            shape,
+            reflectance: rho,
+            emission: Some(le),
+        }],
+        vec![],
+        camera,
+        size,
+        integrator,
+    );
+    render_film(&scene, 512, seed, None)
+}
+
+#[test]
+fn closed_sphere_furnace_gives_le_over_one_minus_rho() {
+    let film = furnace(inner_sphere(), 0.5, 1.0, PathIntegrator::default(), 1);
+    assert_mean_luminance("sphere furnace, rho 0.5", &film, 2.0);
+}
+
+#[test]
+fn closed_box_furnace_gives_le_over_one_minus_rho() {
+    let film = furnace(inner_box(), 0.7, 0.6, PathIntegrator::default(), 2);
+    assert_mean_luminance("box furnace, rho 0.7", &film, 0.6 / 0.3);
+}
+
+#[test]
+fn russian_roulette_from_the_first_bounce_keeps_the_mean() {
+    let integrator = PathIntegrator {
+        rr_depth: 1,
+        ..PathIntegrator::default()
+    };
+    let film = furnace(inner_sphere(), 0.8, 1.0, integrator, 3);
+    assert_mean_luminance("sphere furnace, rho 0.8, roulette from depth 1", &film, 5.0);
+}
+
+#[test]
+fn hidden_emitters_remove_exactly_the_directly_seen_emission() {
+    let integrator = PathIntegrator {
+        hide_emitters: true,
+        ..PathIntegrator::default()
+    };
+    let film = furnace(inner_box(), 0.5, 1.0, integrator, 4);
+    assert_mean_luminance("box furnace without the directly seen emission", &film, 1.0);
+}
+
+/// With max_depth = k only paths of fewer than k bounces count: L = le (1 + rho + ... + rho^(k-1)),
+/// Mitsuba's convention (1: emitters only, 2: direct lighting).
+#[test]
+fn max_depth_truncates_the_neumann_series_as_mitsuba_counts_it() {
+    for (k, seed) in [(1, 5u64), (2, 6), (3, 7)] {
+        let integrator = PathIntegrator {
+            max_depth: k,
+            ..PathIntegrator::default()
+        };
+        let film = furnace(inner_sphere(), 0.5, 1.0, integrator, seed);
+        let expected: f64 = (0..k).map(|j| 0.5f64.powi(j)).sum();
+        assert_mean_luminance(&format!("sphere furnace, max_depth {k}"), &film, expected);
+    }
+}
+
+/// A point light of intensity I at height h over a diffuse plane of reflectance rho:
+/// L(x) = rho I cos θ / (π d²) with d the distance to the light and cos θ = h / d. Each pixel's
+/// estimate is compared with the average of L over the pixel's footprint (fine quadrature), and
+/// the pixels' standardised errors together with a chi-square test.
+#[test]
+fn point_light_over_a_diffuse_plane() {
+    let (rho, intensity, height) = (0.6f32, 10.0f32, 1.0f32);
+    let light_position = Vec3::new(0.3, -0.2, height);
+    let size = UVec2::new(16, 12);
+    let camera = camera(DVec3::new(0.0, 0.0, 3.0), DVec3::ZERO, DVec3::Y, 60.0, size);
+    let plane = Transform::new(DMat4::from_scale(DVec3::splat(50.0))).unwrap();
+    let scene = build(
+        vec![Object {
+            shape: Shape::Mesh(transform_mesh(rectangle(), &plane, false, true)),
+            reflectance: rho,
+            emission: None,
+        }],
+        vec![Light::Point(PointLight {
+            position: light_position,
+            intensity: Spectrum::Constant(intensity),
+        })],
+        camera.clone(),
+        size,
+        PathIntegrator::default(),
+    );
+    let film = render_film(&scene, 256, 8, None);
+
+    let radiance = |film_position: Vec2| -> f64 {
+        let ray = camera.generate_ray(film_position);
+        let t = -ray.o.z / ray.d.z;
+        let x = (ray.o + ray.d * t).as_dvec3();
+        let to_light = light_position.as_dvec3() - x;
+        let d = to_light.length();
+        f64::from(rho * intensity) * (f64::from(height) / d) / (std::f64::consts::PI * d * d)
+    };
+    let quadrature = 32;
+    let mut statistic = 0.0;
+    for y in 0..size.y {
+        for x in 0..size.x {
+            let mut exact = 0.0;
+            for j in 0..quadrature {
+                for i in 0..quadrature {
+                    let offset = Vec2::new((i as f32 + 0.5) / quadrature as f32, (j as f32 + 0.5) / quadrature as f32);
+                    exact += radiance(Vec2::new(x as f32, y as f32) + offset);
+                }
+            }
+            exact /= f64::from(quadrature * quadrature);
+            let (mean, variance) = pixel_mean_and_variance(&film, film.index(x, y), 1);
+            statistic += (mean - exact).powi(2) / variance;
+            // Each pixel on its own: 5 standard errors (Bonferroni over 192 pixels at 1e-4).
+            assert!((mean - exact).abs() < 5.0 * variance.sqrt(), "pixel ({x}, {y}): {mean} vs {exact}");
+        }
+    }
+    let pixels = f64::from(size.x * size.y);
+    let p_value = regularized_gamma_q(pixels / 2.0, statistic / 2.0);
+    assert!(p_value > 1e-3, "chi-square of the pixel errors {statistic} over {pixels} pixels: p = {p_value}");
+}

@@ -1,0 +1,131 @@
+//! Scenes built in code for the closed-form tests (DESIGN.md §7), and statistics of rendered
+//! films.
+
+use glam::{DVec3, UVec2, Vec2};
+use prism::bsdf::{Bsdf, Diffuse, Material};
+use prism::camera::{Camera, PerspectiveCamera};
+use prism::film::{CropWindow, Film, Filter};
+use prism::geometry::{Geometry, Shape};
+use prism::integrator::{Integrator, PathIntegrator};
+use prism::light::{AreaLight, Light};
+use prism::math::Transform;
+use prism::math::transform::look_at;
+use prism::render::{RenderOptions, render};
+use prism::scene::{FilmSettings, SamplerKind, SamplerSettings, Scene, ShapeInfo};
+use prism::spectrum::Spectrum;
+
+/// A shape with a one-sided diffuse material and, optionally, constant emitted radiance.
+pub struct Object {
+    pub shape: Shape,
+    pub reflectance: f32,
+    pub emission: Option<f32>,
+}
+
+/// A pinhole camera at `origin` looking at `target` with horizontal field of view `fov`.
+pub fn camera(origin: DVec3, target: DVec3, up: DVec3, fov_degrees: f64, size: UVec2) -> Camera {
+    Camera::Perspective(PerspectiveCamera {
+        to_world: Transform::new(look_at(origin, target, up).unwrap()).unwrap(),
+        film_size: Vec2::new(size.x as f32, size.y as f32),
+        tan_half_fov_x: (0.5 * fov_degrees).to_radians().tan() as f32,
+        near_clip: 1e-3,
+        far_clip: 1e4,
+    })
+}
+
+/// A scene from objects and extra (non-area) lights, with a box-filtered film.
+pub fn build(objects: Vec<Object>, extra_lights: Vec<Light>, camera: Camera, size: UVec2, integrator: PathIntegrator) -> Scene {
+    let mut shapes = Vec::new();
+    let mut info = Vec::new();
+    let mut materials = Vec::new();
+    let mut lights = Vec::new();
+    for (i, object) in objects.into_iter().enumerate() {
+        materials.push(Material {
+            front: Bsdf::Diffuse(Diffuse {
+                reflectance: Spectrum::Constant(object.reflectance),
+            }),
+            back: None,
+        });
+        let light = object.emission.map(|radiance| {
+            lights.push(Light::Area(AreaLight {
+                shape: i as u32,
+                radiance: Spectrum::Constant(radiance),
+            }));
+            (lights.len() - 1) as u32
+        });
+        info.push(ShapeInfo {
+            material: i as u32,
+            light,
+        });
+        shapes.push(object.shape);
+    }
+    lights.extend(extra_lights);
+    Scene::new(
+        Geometry::new(shapes),
+        info,
+        materials,
+        lights,
+        camera,
+        FilmSettings {
+            size,
+            crop: CropWindow {
+                offset: UVec2::ZERO,
+                size,
+            },
+            filter: Filter::Box { radius: 0.5 },
+        },
+        SamplerSettings {
+            kind: SamplerKind::Independent,
+            samples_per_pixel: 1,
+        },
+        Integrator::Path(integrator),
+    )
+}
+
+/// Renders with a fixed seed and no progress bar.
+pub fn render_film(scene: &Scene, spp: u32, seed: u64, threads: Option<usize>) -> Film {
+    render(
+        scene,
+        &RenderOptions {
+            samples_per_pixel: spp,
+            threads,
+            seed,
+            progress: false,
+        },
+    )
+    .unwrap()
+    .film
+}
+
+/// Mean of a pixel's estimate of channel `c` (0 = X, 1 = Y, 2 = Z) and the variance of that
+/// mean, estimated from the samples: (Σv²/N − m²)/(N − 1).
+pub fn pixel_mean_and_variance(film: &Film, index: usize, c: usize) -> (f64, f64) {
+    let p = &film.pixels[index];
+    let n = p.samples as f64;
+    let mean = p.xyz[c] / n;
+    let variance = ((p.xyz_squared[c] / n - mean * mean) / (n - 1.0)).max(0.0);
+    (mean, variance)
+}
+
+/// The image's mean of channel `c` and its standard error (pixels are independent).
+pub fn image_mean_and_standard_error(film: &Film, c: usize) -> (f64, f64) {
+    let count = film.pixels.len() as f64;
+    let (sum, variance) = (0..film.pixels.len())
+        .map(|i| pixel_mean_and_variance(film, i, c))
+        .fold((0.0, 0.0), |(s, v), (m, var)| (s + m, v + var));
+    (sum / count, variance.sqrt() / count)
+}
+
+/// Asserts that a film's mean luminance Y equals `expected` within 4 standard errors (a false
+/// alarm has probability 6·10⁻⁵), and that the error is small enough for a 1 % bias to be seen.
+pub fn assert_mean_luminance(name: &str, film: &Film, expected: f64) {
+    let (mean, se) = image_mean_and_standard_error(film, 1);
+    assert!(
+        se < 0.0025 * expected,
+        "{name}: the standard error {se} is too large to detect a 1 % bias in {expected}"
+    );
+    assert!(
+        (mean - expected).abs() < 4.0 * se,
+        "{name}: mean Y {mean} differs from the closed form {expected} by {:.2} standard errors ({se})",
+        (mean - expected).abs() / se
+    );
+}
