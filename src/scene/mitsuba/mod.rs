@@ -1,7 +1,13 @@
-//! Mitsuba 3 XML scenes: the parsed description and checked parameter access.
+//! Mitsuba 3 XML scenes: the reader that parses a file into a described tree of plugins, checked
+//! access to plugin parameters, and the factory that builds a renderable scene from the tree.
 pub mod description;
+mod element;
 pub mod factory;
 pub mod params;
+mod property_values;
+pub mod reader;
+mod substitution;
+mod transform_ops;
 
 use std::path::Path;
 
