@@ -4,7 +4,9 @@
 mod common;
 
 use common::chi2::regularized_gamma_q;
-use common::scenes::{Object, assert_mean_luminance, build, camera, pixel_mean_and_variance, render_film};
+use common::scenes::{
+    Object, assert_mean_luminance, build, camera, pixel_mean_and_variance, render_film,
+};
 use glam::{DMat4, DVec3, Mat3, UVec2, Vec2, Vec3};
 use prism::geometry::Shape;
 use prism::geometry::sphere::Sphere;
@@ -32,9 +34,22 @@ fn inner_box() -> Shape {
 
 /// Renders a closed room whose every surface has reflectance rho and emits le: the radiance
 /// everywhere is le / (1 − rho) (the Neumann series of the rendering equation).
-fn furnace(shape: Shape, rho: f32, le: f32, integrator: PathIntegrator, seed: u64) -> prism::film::Film {
+fn furnace(
+    shape: Shape,
+    rho: f32,
+    le: f32,
+    integrator: PathIntegrator,
+    spp: u32,
+    seed: u64,
+) -> prism::film::Film {
     let size = UVec2::new(8, 8);
-    let camera = camera(DVec3::new(0.1, 0.2, -0.3), DVec3::new(0.5, 0.3, 1.0), DVec3::Y, 70.0, size);
+    let camera = camera(
+        DVec3::new(0.1, 0.2, -0.3),
+        DVec3::new(0.5, 0.3, 1.0),
+        DVec3::Y,
+        70.0,
+        size,
+    );
     let scene = build(
         vec![Object {
             shape,
@@ -46,18 +61,18 @@ fn furnace(shape: Shape, rho: f32, le: f32, integrator: PathIntegrator, seed: u6
         size,
         integrator,
     );
-    render_film(&scene, 512, seed, None)
+    render_film(&scene, spp, seed, None)
 }
 
 #[test]
 fn closed_sphere_furnace_gives_le_over_one_minus_rho() {
-    let film = furnace(inner_sphere(), 0.5, 1.0, PathIntegrator::default(), 1);
+    let film = furnace(inner_sphere(), 0.5, 1.0, PathIntegrator::default(), 2048, 1);
     assert_mean_luminance("sphere furnace, rho 0.5", &film, 2.0);
 }
 
 #[test]
 fn closed_box_furnace_gives_le_over_one_minus_rho() {
-    let film = furnace(inner_box(), 0.7, 0.6, PathIntegrator::default(), 2);
+    let film = furnace(inner_box(), 0.7, 0.6, PathIntegrator::default(), 2048, 2);
     assert_mean_luminance("box furnace, rho 0.7", &film, 0.6 / 0.3);
 }
 
@@ -67,7 +82,7 @@ fn russian_roulette_from_the_first_bounce_keeps_the_mean() {
         rr_depth: 1,
         ..PathIntegrator::default()
     };
-    let film = furnace(inner_sphere(), 0.8, 1.0, integrator, 3);
+    let film = furnace(inner_sphere(), 0.8, 1.0, integrator, 4096, 3);
     assert_mean_luminance("sphere furnace, rho 0.8, roulette from depth 1", &film, 5.0);
 }
 
@@ -77,7 +92,7 @@ fn hidden_emitters_remove_exactly_the_directly_seen_emission() {
         hide_emitters: true,
         ..PathIntegrator::default()
     };
-    let film = furnace(inner_box(), 0.5, 1.0, integrator, 4);
+    let film = furnace(inner_box(), 0.5, 1.0, integrator, 2048, 4);
     assert_mean_luminance("box furnace without the directly seen emission", &film, 1.0);
 }
 
@@ -90,7 +105,7 @@ fn max_depth_truncates_the_neumann_series_as_mitsuba_counts_it() {
             max_depth: k,
             ..PathIntegrator::default()
         };
-        let film = furnace(inner_sphere(), 0.5, 1.0, integrator, seed);
+        let film = furnace(inner_sphere(), 0.5, 1.0, integrator, 1024, seed);
         let expected: f64 = (0..k).map(|j| 0.5f64.powi(j)).sum();
         assert_mean_luminance(&format!("sphere furnace, max_depth {k}"), &film, expected);
     }
@@ -138,7 +153,10 @@ fn point_light_over_a_diffuse_plane() {
             let mut exact = 0.0;
             for j in 0..quadrature {
                 for i in 0..quadrature {
-                    let offset = Vec2::new((i as f32 + 0.5) / quadrature as f32, (j as f32 + 0.5) / quadrature as f32);
+                    let offset = Vec2::new(
+                        (i as f32 + 0.5) / quadrature as f32,
+                        (j as f32 + 0.5) / quadrature as f32,
+                    );
                     exact += radiance(Vec2::new(x as f32, y as f32) + offset);
                 }
             }
@@ -146,10 +164,16 @@ fn point_light_over_a_diffuse_plane() {
             let (mean, variance) = pixel_mean_and_variance(&film, film.index(x, y), 1);
             statistic += (mean - exact).powi(2) / variance;
             // Each pixel on its own: 5 standard errors (Bonferroni over 192 pixels at 1e-4).
-            assert!((mean - exact).abs() < 5.0 * variance.sqrt(), "pixel ({x}, {y}): {mean} vs {exact}");
+            assert!(
+                (mean - exact).abs() < 5.0 * variance.sqrt(),
+                "pixel ({x}, {y}): {mean} vs {exact}"
+            );
         }
     }
     let pixels = f64::from(size.x * size.y);
     let p_value = regularized_gamma_q(pixels / 2.0, statistic / 2.0);
-    assert!(p_value > 1e-3, "chi-square of the pixel errors {statistic} over {pixels} pixels: p = {p_value}");
+    assert!(
+        p_value > 1e-3,
+        "chi-square of the pixel errors {statistic} over {pixels} pixels: p = {p_value}"
+    );
 }

@@ -33,13 +33,22 @@ fn one_and_two_threads_give_identical_films() {
             },
         ],
         vec![],
-        camera(DVec3::new(0.0, 0.0, -2.5), DVec3::new(0.0, 0.2, 0.0), DVec3::Y, 60.0, size),
+        camera(
+            DVec3::new(0.0, 0.0, -2.5),
+            DVec3::new(0.0, 0.2, 0.0),
+            DVec3::Y,
+            60.0,
+            size,
+        ),
         size,
         PathIntegrator::default(),
     );
     let one = render_film(&scene, 8, 42, Some(1));
     let two = render_film(&scene, 8, 42, Some(2));
-    assert!(one.pixels.iter().any(|p| p.xyz[1] > 0.0), "the image is black");
+    assert!(
+        one.pixels.iter().any(|p| p.xyz[1] > 0.0),
+        "the image is black"
+    );
     assert_eq!(one.pixels, two.pixels);
     let other_seed = render_film(&scene, 8, 43, Some(2));
     assert_ne!(one.pixels, other_seed.pixels);

@@ -51,7 +51,9 @@ fn parse_crop(text: &str) -> Result<[u32; 4], String> {
         .map_err(|_| format!("expected four non-negative integers x0,y0,x1,y1, got \"{text}\""))?;
     match numbers.as_slice() {
         [x0, y0, x1, y1] if x1 > x0 && y1 > y0 => Ok([*x0, *y0, *x1, *y1]),
-        [_, _, _, _] => Err(format!("the crop window \"{text}\" is empty: x1 must exceed x0 and y1 must exceed y0")),
+        [_, _, _, _] => Err(format!(
+            "the crop window \"{text}\" is empty: x1 must exceed x0 and y1 must exceed y0"
+        )),
         _ => Err(format!("expected four numbers x0,y0,x1,y1, got \"{text}\"")),
     }
 }
@@ -59,7 +61,13 @@ fn parse_crop(text: &str) -> Result<[u32; 4], String> {
 /// The EXR and PNG paths for a render.
 fn output_paths(args: &RenderArgs) -> (PathBuf, PathBuf) {
     let exr = match &args.output {
-        Some(path) if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr")) => path.clone(),
+        Some(path)
+            if path
+                .extension()
+                .is_some_and(|e| e.eq_ignore_ascii_case("exr")) =>
+        {
+            path.clone()
+        }
         Some(path) => path.with_extension("exr"),
         None => PathBuf::from(format!("{}.exr", default_name(&args.scene))),
     };
@@ -69,12 +77,16 @@ fn output_paths(args: &RenderArgs) -> (PathBuf, PathBuf) {
 
 /// The scene's file stem, or its folder's name for the common `<name>/scene.xml` layout.
 fn default_name(scene: &Path) -> String {
-    let stem = scene.file_stem().and_then(|s| s.to_str()).unwrap_or("render");
+    let stem = scene
+        .file_stem()
+        .and_then(|s| s.to_str())
+        .unwrap_or("render");
     if stem == "scene"
-        && let Some(folder) = scene
-            .canonicalize()
-            .ok()
-            .and_then(|p| p.parent().and_then(|d| d.file_name()).map(|n| n.to_string_lossy().into_owned()))
+        && let Some(folder) = scene.canonicalize().ok().and_then(|p| {
+            p.parent()
+                .and_then(|d| d.file_name())
+                .map(|n| n.to_string_lossy().into_owned())
+        })
     {
         return folder;
     }

@@ -124,9 +124,14 @@ impl FilterSampler {
         (Vec2::new(x, y), weight)
     }
 
-    /// Density of an offset (per unit area of the film).
+    /// Density of an offset (per unit area of the film): the product of the per-axis densities.
     pub fn pdf(&self, offset: Vec2) -> f32 {
         self.distribution.pdf(offset.x) * self.distribution.pdf(offset.y)
+    }
+
+    /// Density of one coordinate of an offset (both axes are sampled alike and independently).
+    pub fn pdf_1d(&self, x: f32) -> f32 {
+        self.distribution.pdf(x)
     }
 }
 

@@ -23,6 +23,11 @@ pub struct Sphere {
 /// because 1 − √(1 − sin²θ) loses all its digits in single precision (pbrt-v4 §6.2.4).
 const SMALL_CONE_SIN2: f32 = 0.000_685_23;
 
+/// Relative margin by which a reference point must lie outside the sphere for the cone to be
+/// sampled: points on the surface itself (a sphere lighting its own inside, say) are rounded to
+/// either side, and only area sampling is valid for them.
+const OUTSIDE_MARGIN: f32 = 1e-4;
+
 impl Sphere {
     pub fn area(&self) -> f32 {
         4.0 * PI * self.radius * self.radius
@@ -97,6 +102,11 @@ impl Sphere {
         }
     }
 
+    /// Whether a point at squared distance `dc2` from the centre is clearly outside the sphere.
+    fn is_outside(&self, dc2: f32) -> bool {
+        dc2 > self.radius * self.radius * (1.0 + OUTSIDE_MARGIN)
+    }
+
     /// A uniform point on the whole sphere; pdf per unit area.
     pub fn sample_area(&self, u: Vec2) -> SurfaceSample {
         SurfaceSample {
@@ -112,7 +122,7 @@ impl Sphere {
         let to_center = self.center - reference;
         let dc2 = to_center.length_squared();
         let r = self.radius;
-        if dc2 <= r * r {
+        if !self.is_outside(dc2) {
             let s = self.sample_area(u);
             let pdf = area_to_solid_angle(s.pdf, reference, s.p, s.n)?;
             return Some(SurfaceSample { pdf, ..s });
@@ -156,7 +166,7 @@ impl Sphere {
     pub fn pdf_from(&self, reference: Vec3, p: Vec3, n: Vec3) -> f32 {
         let dc2 = (self.center - reference).length_squared();
         let r = self.radius;
-        if dc2 <= r * r {
+        if !self.is_outside(dc2) {
             return area_to_solid_angle(1.0 / self.area(), reference, p, n).unwrap_or(0.0);
         }
         let sin2_max = r * r / dc2;
@@ -211,6 +221,28 @@ mod tests {
         let si = s.interaction(Vec3::ZERO, Vec3::Z, 4.0, 0);
         let ray = si.spawn_ray(-Vec3::Z);
         assert!(s.intersect(ray.o, ray.d, f32::INFINITY).is_none());
+    }
+
+    /// A point on the inside of a sphere that lights itself sees the whole sphere: for every
+    /// light sample cos θ_x cos θ_y A / d² = π exactly, so the irradiance estimate has no variance.
+    #[test]
+    fn points_on_the_inner_surface_sample_the_whole_sphere() {
+        let s = Sphere {
+            flip_normals: true,
+            ..unit_sphere()
+        };
+        for k in 0..1000 {
+            let u = Vec2::new((k % 31) as f32 / 31.0 + 0.01, (k / 31) as f32 / 33.0 + 0.01);
+            let x = s.sample_area(u);
+            let v = Vec2::new(
+                ((k * 7) % 29) as f32 / 29.0 + 0.02,
+                ((k * 3) % 37) as f32 / 37.0 + 0.03,
+            );
+            let y = s.sample_from(x.p, v).unwrap();
+            let w = (y.p - x.p).normalize();
+            let estimate = w.dot(x.n).max(0.0) / y.pdf;
+            assert!((estimate - PI).abs() < 1e-2 * PI, "sample {k}: {estimate}");
+        }
     }
 
     #[test]

@@ -100,24 +100,24 @@ impl PathIntegrator {
             let info = scene.shape_info[si.shape as usize];
 
             // Emission found by the previous BSDF sample (or by the camera ray).
-            if let Some(light_index) = info.light {
-                if !(self.hide_emitters && depth == 0) {
-                    let Light::Area(light) = &scene.lights[light_index as usize] else {
-                        unreachable!("only area lights are attached to shapes");
+            if let Some(light_index) = info.light
+                && !(self.hide_emitters && depth == 0)
+            {
+                let Light::Area(light) = &scene.lights[light_index as usize] else {
+                    unreachable!("only area lights are attached to shapes");
+                };
+                let emitted = light.emitted(si.shading.n, wo_world, lambda);
+                if !emitted.is_black() {
+                    let weight = match &previous {
+                        Some(prev) if !prev.specular => {
+                            let shape = &scene.geometry.shapes[si.shape as usize];
+                            let light_pdf = scene.light_sampler.pmf(light_index as usize)
+                                * shape.pdf_from(prev.interaction.p, si.p, si.n);
+                            power_heuristic(prev.pdf, light_pdf)
+                        }
+                        _ => 1.0,
                     };
-                    let emitted = light.emitted(si.shading.n, wo_world, lambda);
-                    if !emitted.is_black() {
-                        let weight = match &previous {
-                            Some(prev) if !prev.specular => {
-                                let shape = &scene.geometry.shapes[si.shape as usize];
-                                let light_pdf = scene.light_sampler.pmf(light_index as usize)
-                                    * shape.pdf_from(prev.interaction.p, si.p, si.n);
-                                power_heuristic(prev.pdf, light_pdf)
-                            }
-                            _ => 1.0,
-                        };
-                        result += throughput * emitted * weight;
-                    }
+                    result += throughput * emitted * weight;
                 }
             }
 
@@ -169,7 +169,7 @@ impl PathIntegrator {
                 if !(sampler.next_1d() < survival) {
                     break;
                 }
-                throughput = throughput * (1.0 / survival);
+                throughput *= 1.0 / survival;
             }
         }
         result

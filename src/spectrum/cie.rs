@@ -9,7 +9,7 @@ use super::cie_tables::{
 #[inline]
 fn lookup(table: &[f32; 471], lambda: f32) -> f32 {
     let t = lambda - TABLE_LAMBDA_MIN;
-    if !(t >= 0.0 && t <= 470.0) {
+    if !(0.0..=470.0).contains(&t) {
         return 0.0;
     }
     let i = (t as usize).min(469);
@@ -47,7 +47,7 @@ pub fn d65_normalized(lambda: f32) -> f32 {
 /// XYZ → linear sRGB (IEC 61966-2-1, D65 white), rows applied to (X, Y, Z).
 pub const XYZ_TO_LINEAR_SRGB: [[f32; 3]; 3] = [
     [3.240_454_2, -1.537_138_5, -0.498_531_4],
-    [-0.969_266_0, 1.876_010_8, 0.041_556_0],
+    [-0.969_266, 1.876_010_8, 0.041_556],
     [0.055_643_4, -0.204_025_9, 1.057_225_2],
 ];
 
@@ -55,7 +55,7 @@ pub const XYZ_TO_LINEAR_SRGB: [[f32; 3]; 3] = [
 pub const LINEAR_SRGB_TO_XYZ: [[f32; 3]; 3] = [
     [0.412_456_4, 0.357_576_1, 0.180_437_5],
     [0.212_672_9, 0.715_152_2, 0.072_175_0],
-    [0.019_333_9, 0.119_192_0, 0.950_304_1],
+    [0.019_333_9, 0.119_192, 0.950_304_1],
 ];
 
 /// Applies a 3×3 matrix to a colour.

@@ -139,7 +139,7 @@ pub enum WavelengthSampling {
 /// Constants of the visible-wavelength density (pbrt-v4 `SampleVisibleWavelengths`).
 const VISIBLE_CENTER: f32 = 538.0;
 const VISIBLE_SLOPE: f32 = 0.0072;
-const VISIBLE_NORMALIZATION: f32 = 0.003_939_804_2;
+const VISIBLE_NORMALIZATION: f32 = 0.003_939_804;
 
 impl WavelengthSampling {
     /// The table for [`WavelengthSampling::CieSum`]: 470 cells of 1 nm, each weighted by the mean

@@ -33,7 +33,13 @@ pub fn camera(origin: DVec3, target: DVec3, up: DVec3, fov_degrees: f64, size: U
 }
 
 /// A scene from objects and extra (non-area) lights, with a box-filtered film.
-pub fn build(objects: Vec<Object>, extra_lights: Vec<Light>, camera: Camera, size: UVec2, integrator: PathIntegrator) -> Scene {
+pub fn build(
+    objects: Vec<Object>,
+    extra_lights: Vec<Light>,
+    camera: Camera,
+    size: UVec2,
+    integrator: PathIntegrator,
+) -> Scene {
     let mut shapes = Vec::new();
     let mut info = Vec::new();
     let mut materials = Vec::new();

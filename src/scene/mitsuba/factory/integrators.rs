@@ -33,8 +33,14 @@ pub fn build_integrator(node: &PluginNode) -> Result<Integrator> {
             })
         }
         other => {
-            return Err(Error::input(&node.location, format!("unknown integrator type \"{other}\""))
-                .with_help(format!("supported integrator types: {}", SUPPORTED_INTEGRATORS.join(", "))));
+            return Err(Error::input(
+                &node.location,
+                format!("unknown integrator type \"{other}\""),
+            )
+            .with_help(format!(
+                "supported integrator types: {}",
+                SUPPORTED_INTEGRATORS.join(", ")
+            )));
         }
     };
     params.finish()?;

@@ -21,7 +21,10 @@ pub fn build_area_light(node: &PluginNode, shape: u32) -> Result<Light> {
         };
         return Err(Error::input(
             &node.location,
-            format!("emitter \"{}\" cannot be attached to a shape", node.plugin_type),
+            format!(
+                "emitter \"{}\" cannot be attached to a shape",
+                node.plugin_type
+            ),
         )
         .with_help(help));
     }
@@ -51,17 +54,31 @@ pub fn build_scene_light(node: &PluginNode) -> Result<Light> {
                 (None, None) => Vec3::ZERO,
             };
             if !position.is_finite() {
-                return Err(Error::input(params.location(), "the point emitter's position is not finite"));
+                return Err(Error::input(
+                    params.location(),
+                    "the point emitter's position is not finite",
+                ));
             }
-            Light::Point(PointLight { position, intensity })
+            Light::Point(PointLight {
+                position,
+                intensity,
+            })
         }
         "area" => {
-            return Err(Error::input(&node.location, "an \"area\" emitter must be nested in a shape")
-                .with_help("move it inside the <shape> that should emit light"));
+            return Err(Error::input(
+                &node.location,
+                "an \"area\" emitter must be nested in a shape",
+            )
+            .with_help("move it inside the <shape> that should emit light"));
         }
         other => {
-            return Err(Error::input(&node.location, format!("unknown emitter type \"{other}\""))
-                .with_help(format!("supported emitter types: {}", SUPPORTED_EMITTERS.join(", "))));
+            return Err(
+                Error::input(&node.location, format!("unknown emitter type \"{other}\""))
+                    .with_help(format!(
+                        "supported emitter types: {}",
+                        SUPPORTED_EMITTERS.join(", ")
+                    )),
+            );
         }
     };
     params.finish()?;

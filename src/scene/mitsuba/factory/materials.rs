@@ -33,9 +33,14 @@ pub fn build_material(node: &PluginNode) -> Result<Material> {
             _ => {
                 return Err(Error::input(
                     &node.location,
-                    format!("bsdf \"twosided\" needs one or two nested BSDFs, found {}", nested.len()),
+                    format!(
+                        "bsdf \"twosided\" needs one or two nested BSDFs, found {}",
+                        nested.len()
+                    ),
                 )
-                .with_help("nest the BSDF to use on both sides, or one for the front and one for the back"));
+                .with_help(
+                    "nest the BSDF to use on both sides, or one for the front and one for the back",
+                ));
             }
         };
         params.finish()?;
@@ -58,8 +63,11 @@ fn build_one_sided(node: &PluginNode) -> Result<Bsdf> {
             reflectance: spectrum_param(&params, "reflectance", 0.5, Range::Albedo)?,
         }),
         "twosided" => {
-            return Err(Error::input(&node.location, "a \"twosided\" BSDF cannot be nested in another \"twosided\"")
-                .with_help("remove the inner twosided wrapper"));
+            return Err(Error::input(
+                &node.location,
+                "a \"twosided\" BSDF cannot be nested in another \"twosided\"",
+            )
+            .with_help("remove the inner twosided wrapper"));
         }
         other => return Err(unknown_type(node, other)),
     };
@@ -68,6 +76,8 @@ fn build_one_sided(node: &PluginNode) -> Result<Bsdf> {
 }
 
 fn unknown_type(node: &PluginNode, name: &str) -> Error {
-    Error::input(&node.location, format!("unknown bsdf type \"{name}\""))
-        .with_help(format!("supported bsdf types: {}", SUPPORTED_BSDFS.join(", ")))
+    Error::input(&node.location, format!("unknown bsdf type \"{name}\"")).with_help(format!(
+        "supported bsdf types: {}",
+        SUPPORTED_BSDFS.join(", ")
+    ))
 }

@@ -12,6 +12,7 @@ pub mod shapes;
 pub mod spectra;
 
 use std::collections::HashMap;
+use std::collections::hash_map::Entry;
 use std::sync::Arc;
 
 use super::description::{PluginClass, PluginNode};
@@ -48,8 +49,10 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
             .with_help("add a <sensor type=\"perspective\"> with a film and a sampler"));
     };
     if let Some(second) = sensors.get(1) {
-        return Err(Error::input(&second.location, "the scene has more than one <sensor>")
-            .with_help("Prism renders one sensor per scene: remove the others"));
+        return Err(
+            Error::input(&second.location, "the scene has more than one <sensor>")
+                .with_help("Prism renders one sensor per scene: remove the others"),
+        );
     }
     let sensor = sensor::build_sensor(&sensor.node)?;
 
@@ -57,8 +60,11 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
         let shape_params = Params::new(&child.node);
         let shape = shapes::build_shape(&shape_params)?;
         if shape.area() == 0.0 || !shape.area().is_finite() {
-            return Err(Error::input(&child.location, format!("{} has no area", child.node.describe()))
-                .with_help("remove degenerate shapes or fix their transform"));
+            return Err(Error::input(
+                &child.location,
+                format!("{} has no area", child.node.describe()),
+            )
+            .with_help("remove degenerate shapes or fix their transform"));
         }
         let shape_index = shapes.len() as u32;
         let material = match shape_params.single_child(PluginClass::Bsdf)? {
@@ -98,10 +104,9 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
     // BSDFs declared at the top level (to be referenced by id) are built even when unused, so
     // that their errors are reported as Mitsuba would.
     for child in params.children(PluginClass::Bsdf) {
-        let key = Arc::as_ptr(&child.node);
-        if !material_ids.contains_key(&key) {
+        if let Entry::Vacant(entry) = material_ids.entry(Arc::as_ptr(&child.node)) {
             materials.push(materials::build_material(&child.node)?);
-            material_ids.insert(key, (materials.len() - 1) as u32);
+            entry.insert((materials.len() - 1) as u32);
         }
     }
     params.finish()?;

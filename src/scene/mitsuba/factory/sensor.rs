@@ -32,8 +32,14 @@ pub struct SensorSettings {
 pub fn build_sensor(node: &PluginNode) -> Result<SensorSettings> {
     let params = Params::new(node);
     if node.plugin_type != "perspective" {
-        return Err(Error::input(&node.location, format!("unknown sensor type \"{}\"", node.plugin_type))
-            .with_help(format!("supported sensor types: {}", SUPPORTED_SENSORS.join(", "))));
+        return Err(Error::input(
+            &node.location,
+            format!("unknown sensor type \"{}\"", node.plugin_type),
+        )
+        .with_help(format!(
+            "supported sensor types: {}",
+            SUPPORTED_SENSORS.join(", ")
+        )));
     }
     let film = match params.single_child(PluginClass::Film)? {
         Some(child) => build_film(&child.node)?,
@@ -78,15 +84,23 @@ pub fn build_sensor(node: &PluginNode) -> Result<SensorSettings> {
         }
         (None, focal_length) => {
             let text = focal_length.unwrap_or("50mm");
-            let mm: f64 = text.trim().trim_end_matches("mm").trim().parse().map_err(|_| {
-                Error::input(
-                    params.location_of("focal_length"),
-                    format!("could not read the focal length \"{text}\""),
-                )
-                .with_help("write it as a number of millimetres, e.g. \"35mm\"")
-            })?;
+            let mm: f64 = text
+                .trim()
+                .trim_end_matches("mm")
+                .trim()
+                .parse()
+                .map_err(|_| {
+                    Error::input(
+                        params.location_of("focal_length"),
+                        format!("could not read the focal length \"{text}\""),
+                    )
+                    .with_help("write it as a number of millimetres, e.g. \"35mm\"")
+                })?;
             if !(mm > 0.0) {
-                return Err(Error::input(params.location_of("focal_length"), "the focal length must be positive"));
+                return Err(Error::input(
+                    params.location_of("focal_length"),
+                    "the focal length must be positive",
+                ));
             }
             horizontal_fov(focal_length_to_diagonal_fov(mm), FovAxis::Diagonal, aspect)
         }
@@ -94,7 +108,9 @@ pub fn build_sensor(node: &PluginNode) -> Result<SensorSettings> {
     if !(fov_x > 0.0 && fov_x < 180.0) {
         return Err(Error::input(
             params.location_of("fov"),
-            format!("the horizontal field of view is {fov_x} degrees; it must lie strictly between 0 and 180"),
+            format!(
+                "the horizontal field of view is {fov_x} degrees; it must lie strictly between 0 and 180"
+            ),
         ));
     }
     let near_clip = params.float("near_clip", 1e-2)?;
@@ -102,12 +118,17 @@ pub fn build_sensor(node: &PluginNode) -> Result<SensorSettings> {
     if !(near_clip > 0.0) || !(far_clip > near_clip) || !far_clip.is_finite() {
         return Err(Error::input(
             params.location_of("near_clip"),
-            format!("near_clip ({near_clip}) must be positive and smaller than far_clip ({far_clip})"),
+            format!(
+                "near_clip ({near_clip}) must be positive and smaller than far_clip ({far_clip})"
+            ),
         ));
     }
     let matrix = params.transform("to_world")?;
     let to_world = Transform::new(matrix).ok_or_else(|| {
-        Error::input(params.location_of("to_world"), "the sensor's \"to_world\" transform is singular")
+        Error::input(
+            params.location_of("to_world"),
+            "the sensor's \"to_world\" transform is singular",
+        )
     })?;
     params.finish()?;
 
@@ -145,12 +166,21 @@ fn default_film() -> FilmSettings {
 fn build_film(node: &PluginNode) -> Result<FilmSettings> {
     let params = Params::new(node);
     if node.plugin_type != "hdrfilm" {
-        return Err(Error::input(&node.location, format!("unknown film type \"{}\"", node.plugin_type))
-            .with_help(format!("supported film types: {}", SUPPORTED_FILMS.join(", "))));
+        return Err(Error::input(
+            &node.location,
+            format!("unknown film type \"{}\"", node.plugin_type),
+        )
+        .with_help(format!(
+            "supported film types: {}",
+            SUPPORTED_FILMS.join(", ")
+        )));
     }
     let width = params.integer("width", 768)?;
     let height = params.integer("height", 576)?;
-    if !(1..=MAX_FILM_SIDE).contains(&width) || !(1..=MAX_FILM_SIDE).contains(&height) || width * height > MAX_FILM_PIXELS {
+    if !(1..=MAX_FILM_SIDE).contains(&width)
+        || !(1..=MAX_FILM_SIDE).contains(&height)
+        || width * height > MAX_FILM_PIXELS
+    {
         return Err(Error::input(
             params.location_of(if (1..=MAX_FILM_SIDE).contains(&width) { "height" } else { "width" }),
             format!("a film of {width} × {height} pixels is not possible"),
@@ -163,7 +193,13 @@ fn build_film(node: &PluginNode) -> Result<FilmSettings> {
     let crop_y = params.integer("crop_offset_y", 0)?;
     let crop_width = params.integer("crop_width", width - crop_x)?;
     let crop_height = params.integer("crop_height", height - crop_y)?;
-    if crop_x < 0 || crop_y < 0 || crop_width < 1 || crop_height < 1 || crop_x + crop_width > width || crop_y + crop_height > height {
+    if crop_x < 0
+        || crop_y < 0
+        || crop_width < 1
+        || crop_height < 1
+        || crop_x + crop_width > width
+        || crop_y + crop_height > height
+    {
         return Err(Error::input(
             params.location_of("crop_width"),
             format!(
@@ -173,14 +209,20 @@ fn build_film(node: &PluginNode) -> Result<FilmSettings> {
     }
     for (name, allowed) in [
         ("file_format", &["openexr", "exr"][..]),
-        ("pixel_format", &["rgb", "rgba", "xyz", "xyza", "luminance", "luminance_alpha"][..]),
+        (
+            "pixel_format",
+            &["rgb", "rgba", "xyz", "xyza", "luminance", "luminance_alpha"][..],
+        ),
         ("component_format", &["float16", "float32", "uint32"][..]),
     ] {
         if let Some(value) = params.string_opt(name)?
             && !allowed.contains(&value.to_ascii_lowercase().as_str())
         {
-            return Err(Error::input(params.location_of(name), format!("unknown {name} \"{value}\""))
-                .with_help(format!("use one of {}", allowed.join(", "))));
+            return Err(Error::input(
+                params.location_of(name),
+                format!("unknown {name} \"{value}\""),
+            )
+            .with_help(format!("use one of {}", allowed.join(", "))));
         }
     }
     let filter = match params.single_child(PluginClass::Rfilter)? {
@@ -206,7 +248,9 @@ fn build_filter(node: &PluginNode) -> Result<Filter> {
         if !(v > 0.0 && v <= 64.0) {
             return Err(Error::input(
                 params.location_of(name),
-                format!("the filter's \"{name}\" must be positive (and at most 64 pixels), not {v}"),
+                format!(
+                    "the filter's \"{name}\" must be positive (and at most 64 pixels), not {v}"
+                ),
             ));
         }
         Ok(v as f32)
@@ -222,8 +266,13 @@ fn build_filter(node: &PluginNode) -> Result<Filter> {
             stddev: positive("stddev", 0.5)?,
         },
         other => {
-            return Err(Error::input(&node.location, format!("unknown rfilter type \"{other}\""))
-                .with_help(format!("supported rfilter types: {}", SUPPORTED_FILTERS.join(", "))));
+            return Err(
+                Error::input(&node.location, format!("unknown rfilter type \"{other}\""))
+                    .with_help(format!(
+                        "supported rfilter types: {}",
+                        SUPPORTED_FILTERS.join(", ")
+                    )),
+            );
         }
     };
     params.finish()?;
@@ -234,8 +283,14 @@ fn build_filter(node: &PluginNode) -> Result<Filter> {
 fn build_sampler(node: &PluginNode) -> Result<(SamplerSettings, u64)> {
     let params = Params::new(node);
     if node.plugin_type != "independent" {
-        return Err(Error::input(&node.location, format!("unknown sampler type \"{}\"", node.plugin_type))
-            .with_help(format!("supported sampler types: {}", SUPPORTED_SAMPLERS.join(", "))));
+        return Err(Error::input(
+            &node.location,
+            format!("unknown sampler type \"{}\"", node.plugin_type),
+        )
+        .with_help(format!(
+            "supported sampler types: {}",
+            SUPPORTED_SAMPLERS.join(", ")
+        )));
     }
     let spp = params.integer("sample_count", 4)?;
     if !(1..=(1 << 24)).contains(&spp) {

@@ -24,7 +24,10 @@ fn transform_param(params: &Params, name: &'static str) -> Result<(DMat4, Transf
     let transform = Transform::new(matrix).ok_or_else(|| {
         Error::input(
             params.location_of(name),
-            format!("the \"{name}\" transform of {} is singular or not affine", params.node().describe()),
+            format!(
+                "the \"{name}\" transform of {} is singular or not affine",
+                params.node().describe()
+            ),
         )
         .with_help("check for a zero scale or a malformed matrix")
     })?;
@@ -38,8 +41,11 @@ pub fn build_shape(params: &Params) -> Result<Shape> {
     match node.plugin_type.as_str() {
         "obj" | "ply" => {
             let filename = params.string_opt("filename")?.ok_or_else(|| {
-                Error::input(&node.location, format!("{} needs a \"filename\"", node.describe()))
-                    .with_help("add <string name=\"filename\" value=\"mesh.obj\"/>")
+                Error::input(
+                    &node.location,
+                    format!("{} needs a \"filename\"", node.describe()),
+                )
+                .with_help("add <string name=\"filename\" value=\"mesh.obj\"/>")
             })?;
             let location = params.location_of("filename");
             let path = node.resolve_file(filename, location)?;
@@ -50,7 +56,11 @@ pub fn build_shape(params: &Params) -> Result<Shape> {
                 false
             };
             let (_, to_world) = transform_param(params, "to_world")?;
-            let loaded = if node.plugin_type == "obj" { load_obj(&path) } else { load_ply(&path) };
+            let loaded = if node.plugin_type == "obj" {
+                load_obj(&path)
+            } else {
+                load_ply(&path)
+            };
             let mut data = loaded.map_err(|e| mesh_error(e, node))?;
             data.validate(&path).map_err(|e| mesh_error(e, node))?;
             if !flip_tex_coords && let Some(uvs) = &mut data.uvs {
@@ -60,22 +70,40 @@ pub fn build_shape(params: &Params) -> Result<Shape> {
                 }
             }
             if data.triangles.is_empty() {
-                return Err(Error::input(location, format!("the mesh \"{filename}\" has no triangles")));
+                return Err(Error::input(
+                    location,
+                    format!("the mesh \"{filename}\" has no triangles"),
+                ));
             }
             if face_normals {
                 data.normals = None;
             } else if data.normals.is_none() {
                 data.compute_vertex_normals();
             }
-            Ok(Shape::Mesh(transform_mesh(data, &to_world, flip_normals, false)))
+            Ok(Shape::Mesh(transform_mesh(
+                data,
+                &to_world,
+                flip_normals,
+                false,
+            )))
         }
         "rectangle" => {
             let (_, to_world) = transform_param(params, "to_world")?;
-            Ok(Shape::Mesh(transform_mesh(rectangle(), &to_world, flip_normals, true)))
+            Ok(Shape::Mesh(transform_mesh(
+                rectangle(),
+                &to_world,
+                flip_normals,
+                true,
+            )))
         }
         "cube" => {
             let (_, to_world) = transform_param(params, "to_world")?;
-            Ok(Shape::Mesh(transform_mesh(cube(), &to_world, flip_normals, true)))
+            Ok(Shape::Mesh(transform_mesh(
+                cube(),
+                &to_world,
+                flip_normals,
+                true,
+            )))
         }
         "sphere" => {
             let center = params.point_opt("center")?.unwrap_or(DVec3::ZERO);
@@ -87,9 +115,15 @@ pub fn build_shape(params: &Params) -> Result<Shape> {
                 ));
             }
             let (matrix, _) = transform_param(params, "to_world")?;
-            let axes = [matrix.x_axis.truncate(), matrix.y_axis.truncate(), matrix.z_axis.truncate()];
+            let axes = [
+                matrix.x_axis.truncate(),
+                matrix.y_axis.truncate(),
+                matrix.z_axis.truncate(),
+            ];
             let scale = axes[0].length();
-            let uniform = axes.iter().all(|a| (a.length() - scale).abs() <= 1e-5 * scale)
+            let uniform = axes
+                .iter()
+                .all(|a| (a.length() - scale).abs() <= 1e-5 * scale)
                 && axes[0].dot(axes[1]).abs() <= 1e-5 * scale * scale
                 && axes[1].dot(axes[2]).abs() <= 1e-5 * scale * scale
                 && axes[0].dot(axes[2]).abs() <= 1e-5 * scale * scale;
@@ -116,25 +150,40 @@ pub fn build_shape(params: &Params) -> Result<Shape> {
             let (_, to_world) = transform_param(params, "to_world")?;
             Ok(Shape::Disk(Disk::new(to_world, flip_normals)))
         }
-        other => Err(Error::input(&node.location, format!("unknown shape type \"{other}\""))
-            .with_help(format!("supported shape types: {}", SUPPORTED_SHAPES.join(", ")))),
+        other => Err(
+            Error::input(&node.location, format!("unknown shape type \"{other}\"")).with_help(
+                format!("supported shape types: {}", SUPPORTED_SHAPES.join(", ")),
+            ),
+        ),
     }
 }
 
 /// Says which scene element loaded a mesh that failed.
 fn mesh_error(mut error: Error, node: &PluginNode) -> Error {
-    error.message = format!("{} (mesh of {} at {})", error.message, node.describe(), node.location);
+    error.message = format!(
+        "{} (mesh of {} at {})",
+        error.message,
+        node.describe(),
+        node.location
+    );
     error
 }
 
 /// Moves a mesh to world space. Normals go through the inverse transpose; for the built-in
 /// meshes (`oriented` = true) a transform that mirrors space also reverses the winding, so the
 /// geometric normal stays the transformed +z normal as for Mitsuba's analytic rectangle.
-pub fn transform_mesh(data: MeshData, to_world: &Transform, flip_normals: bool, oriented: bool) -> TriangleMesh {
+pub fn transform_mesh(
+    data: MeshData,
+    to_world: &Transform,
+    flip_normals: bool,
+    oriented: bool,
+) -> TriangleMesh {
     let positions = data.positions.iter().map(|&p| to_world.point(p)).collect();
-    let normals = data
-        .normals
-        .map(|ns| ns.iter().map(|&n| to_world.normal(n).normalize_or_zero()).collect());
+    let normals = data.normals.map(|ns| {
+        ns.iter()
+            .map(|&n| to_world.normal(n).normalize_or_zero())
+            .collect()
+    });
     let mut triangles = data.triangles;
     if oriented && to_world.flips_handedness() {
         for t in &mut triangles {
@@ -154,7 +203,12 @@ pub fn rectangle() -> MeshData {
             Vec3::new(-1.0, 1.0, 0.0),
         ],
         normals: Some(vec![Vec3::Z; 4]),
-        uvs: Some(vec![Vec2::new(0.0, 0.0), Vec2::new(1.0, 0.0), Vec2::new(1.0, 1.0), Vec2::new(0.0, 1.0)]),
+        uvs: Some(vec![
+            Vec2::new(0.0, 0.0),
+            Vec2::new(1.0, 0.0),
+            Vec2::new(1.0, 1.0),
+            Vec2::new(0.0, 1.0),
+        ]),
         triangles: vec![[0, 1, 2], [2, 3, 0]],
     }
 }
@@ -179,7 +233,10 @@ pub fn cube() -> MeshData {
                 (axes[(axis + 2) % 3], axes[(axis + 1) % 3])
             };
             let base = data.positions.len() as u32;
-            for (i, (sb, sc)) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)].into_iter().enumerate() {
+            for (i, (sb, sc)) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]
+                .into_iter()
+                .enumerate()
+            {
                 data.positions.push(n + b * sb + c * sc);
                 if let Some(normals) = &mut data.normals {
                     normals.push(n);

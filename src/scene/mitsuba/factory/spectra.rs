@@ -24,7 +24,12 @@ pub enum Range {
 }
 
 /// The spectrum given for parameter `name`, or `default` when absent.
-pub fn spectrum_param(params: &Params, name: &'static str, default: f32, range: Range) -> Result<Spectrum> {
+pub fn spectrum_param(
+    params: &Params,
+    name: &'static str,
+    default: f32,
+    range: Range,
+) -> Result<Spectrum> {
     if let Some(child) = params.named_child(name) {
         return Err(Error::input(
             &child.location,
@@ -78,10 +83,14 @@ pub fn spectrum_param(params: &Params, name: &'static str, default: f32, range: 
             Spectrum::Constant(*v as f32)
         }
         PropertyValue::Spectrum(SpectrumValue::Samples(samples)) => {
-            if !samples.iter().all(|(l, v)| *v >= 0.0 && v.is_finite() && l.is_finite()) {
+            if !samples
+                .iter()
+                .all(|(l, v)| *v >= 0.0 && v.is_finite() && l.is_finite())
+            {
                 return Err(negative());
             }
-            let samples: Vec<(f32, f32)> = samples.iter().map(|&(l, v)| (l as f32, v as f32)).collect();
+            let samples: Vec<(f32, f32)> =
+                samples.iter().map(|&(l, v)| (l as f32, v as f32)).collect();
             match PiecewiseLinear::new(&samples) {
                 Some(table) => Spectrum::PiecewiseLinear(table),
                 None => Spectrum::Constant(0.0),

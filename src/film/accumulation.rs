@@ -31,10 +31,10 @@ impl PixelSums {
             self.rejected += 1;
             return;
         }
-        for c in 0..3 {
-            let v = f64::from(xyz[c]);
-            self.xyz[c] += v;
-            self.xyz_squared[c] += v * v;
+        for ((sum, squares), v) in self.xyz.iter_mut().zip(&mut self.xyz_squared).zip(xyz) {
+            let v = f64::from(v);
+            *sum += v;
+            *squares += v * v;
         }
     }
 
