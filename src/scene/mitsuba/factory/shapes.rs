@@ -158,14 +158,14 @@ pub fn build_shape(params: &Params) -> Result<Shape> {
     }
 }
 
-/// Says which scene element loaded a mesh that failed.
-fn mesh_error(mut error: Error, node: &PluginNode) -> Error {
-    error.message = format!(
-        "{} (mesh of {} at {})",
-        error.message,
-        node.describe(),
-        node.location
-    );
+/// Makes a mesh reading error an input error (the scene names the file) that also says which
+/// scene element loaded the mesh; errors without a place in the mesh file get the element's.
+fn mesh_error(error: Error, node: &PluginNode) -> Error {
+    let in_mesh_file = error.location.is_some();
+    let mut error = error.at(&node.location);
+    if in_mesh_file {
+        error.message = format!("{} (mesh of {} at {})", error.message, node.describe(), node.location);
+    }
     error
 }
 
