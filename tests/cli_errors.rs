@@ -39,7 +39,10 @@ fn render(dir: &Path, extra: &[&str]) -> (i32, String) {
         .args(extra)
         .output()
         .unwrap();
-    (output.status.code().unwrap_or(-1), String::from_utf8_lossy(&output.stderr).into_owned())
+    (
+        output.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&output.stderr).into_owned(),
+    )
 }
 
 /// Asserts a failed render: status 2, one error message with `location` (a "file:line:col"
@@ -49,9 +52,15 @@ fn assert_error(dir: &Path, extra: &[&str], location: &str, says: &[&str]) {
     assert_eq!(status, 2, "exit status for:\n{stderr}");
     assert!(!stderr.contains("panicked"), "{stderr}");
     assert!(stderr.starts_with("error: "), "{stderr}");
-    assert!(stderr.contains(location), "expected location {location} in:\n{stderr}");
+    assert!(
+        stderr.contains(location),
+        "expected location {location} in:\n{stderr}"
+    );
     for phrase in says {
-        assert!(stderr.contains(phrase), "expected \"{phrase}\" in:\n{stderr}");
+        assert!(
+            stderr.contains(phrase),
+            "expected \"{phrase}\" in:\n{stderr}"
+        );
     }
 }
 
@@ -62,17 +71,28 @@ fn write(dir: &Path, name: &str, text: &str) {
 #[test]
 fn a_good_scene_renders() {
     let dir = folder("good");
-    write(&dir, "scene.xml", &scene(r#"    <shape type="sphere"/>"#, ""));
+    write(
+        &dir,
+        "scene.xml",
+        &scene(r#"    <shape type="sphere"/>"#, ""),
+    );
     let (status, stderr) = render(&dir, &[]);
     assert_eq!(status, 0, "{stderr}");
     assert!(dir.join("out.exr").exists() && dir.join("out.png").exists());
-    assert!(stderr.contains("samples/s") && stderr.contains("rays/s"), "{stderr}");
+    assert!(
+        stderr.contains("samples/s") && stderr.contains("rays/s"),
+        "{stderr}"
+    );
 }
 
 #[test]
 fn malformed_xml() {
     let dir = folder("malformed");
-    write(&dir, "scene.xml", "<scene version=\"3.0.0\">\n    <shape type=\"sphere\">\n</scene>\n");
+    write(
+        &dir,
+        "scene.xml",
+        "<scene version=\"3.0.0\">\n    <shape type=\"sphere\">\n</scene>\n",
+    );
     assert_error(&dir, &[], "scene.xml:3:", &[]);
 }
 
@@ -81,10 +101,24 @@ fn unknown_plugin_lists_the_supported_ones() {
     let dir = folder("unknown-plugin");
     let shape = "    <shape type=\"sphere\">\n        <bsdf type=\"plastik\"/>\n    </shape>";
     write(&dir, "scene.xml", &scene(shape, ""));
-    assert_error(&dir, &[], "scene.xml:9:9", &["unknown bsdf type \"plastik\"", "diffuse, twosided"]);
+    assert_error(
+        &dir,
+        &[],
+        "scene.xml:9:9",
+        &["unknown bsdf type \"plastik\"", "diffuse, twosided"],
+    );
     let dir = folder("unknown-shape");
-    write(&dir, "scene.xml", &scene("    <shape type=\"teapot\"/>", ""));
-    assert_error(&dir, &[], "scene.xml:8:5", &["unknown shape type \"teapot\"", "obj, ply, rectangle"]);
+    write(
+        &dir,
+        "scene.xml",
+        &scene("    <shape type=\"teapot\"/>", ""),
+    );
+    assert_error(
+        &dir,
+        &[],
+        "scene.xml:8:5",
+        &["unknown shape type \"teapot\"", "obj, ply, rectangle"],
+    );
 }
 
 #[test]
@@ -92,27 +126,61 @@ fn misspelled_parameter_suggests_the_right_one() {
     let dir = folder("misspelled");
     let shape = "    <shape type=\"sphere\">\n        <bsdf type=\"diffuse\">\n            <rgb name=\"reflectanse\" value=\"0.5\"/>\n        </bsdf>\n    </shape>";
     write(&dir, "scene.xml", &scene(shape, ""));
-    assert_error(&dir, &[], "scene.xml:10:13", &["unknown parameter \"reflectanse\"", "did you mean \"reflectance\""]);
+    assert_error(
+        &dir,
+        &[],
+        "scene.xml:10:13",
+        &[
+            "unknown parameter \"reflectanse\"",
+            "did you mean \"reflectance\"",
+        ],
+    );
 }
 
 #[test]
 fn value_of_the_wrong_type() {
     let dir = folder("wrong-type");
-    write(&dir, "scene.xml", &scene("    <shape type=\"sphere\"/>", "\n            <string name=\"crop_width\" value=\"two\"/>"));
-    assert_error(&dir, &[], "scene.xml:6:13", &["\"crop_width\"", "must be an integer"]);
+    write(
+        &dir,
+        "scene.xml",
+        &scene(
+            "    <shape type=\"sphere\"/>",
+            "\n            <string name=\"crop_width\" value=\"two\"/>",
+        ),
+    );
+    assert_error(
+        &dir,
+        &[],
+        "scene.xml:6:13",
+        &["\"crop_width\"", "must be an integer"],
+    );
 }
 
 #[test]
 fn unparsable_number() {
     let dir = folder("bad-number");
-    write(&dir, "scene.xml", &scene("    <shape type=\"sphere\">\n        <float name=\"radius\" value=\"1.0.0\"/>\n    </shape>", ""));
+    write(
+        &dir,
+        "scene.xml",
+        &scene(
+            "    <shape type=\"sphere\">\n        <float name=\"radius\" value=\"1.0.0\"/>\n    </shape>",
+            "",
+        ),
+    );
     assert_error(&dir, &[], "scene.xml:9:30", &["radius", "1.0.0"]);
 }
 
 #[test]
 fn parameter_without_a_default() {
     let dir = folder("no-default");
-    write(&dir, "scene.xml", &scene("    <shape type=\"sphere\">\n        <float name=\"radius\" value=\"$size\"/>\n    </shape>", ""));
+    write(
+        &dir,
+        "scene.xml",
+        &scene(
+            "    <shape type=\"sphere\">\n        <float name=\"radius\" value=\"$size\"/>\n    </shape>",
+            "",
+        ),
+    );
     assert_error(&dir, &[], "scene.xml:9:30", &["$size", "-D"]);
     // With the define it renders.
     let (status, stderr) = render(&dir, &["-D", "size=2"]);
@@ -122,7 +190,14 @@ fn parameter_without_a_default() {
 #[test]
 fn missing_mesh_file() {
     let dir = folder("missing-mesh");
-    write(&dir, "scene.xml", &scene("    <shape type=\"obj\">\n        <string name=\"filename\" value=\"nowhere.obj\"/>\n    </shape>", ""));
+    write(
+        &dir,
+        "scene.xml",
+        &scene(
+            "    <shape type=\"obj\">\n        <string name=\"filename\" value=\"nowhere.obj\"/>\n    </shape>",
+            "",
+        ),
+    );
     assert_error(&dir, &[], "scene.xml:9:9", &["nowhere.obj", "not found"]);
 }
 
@@ -131,15 +206,33 @@ fn unreadable_mesh_file() {
     let dir = folder("unreadable-mesh");
     // A folder where the mesh should be: found, but it cannot be read.
     std::fs::create_dir_all(dir.join("mesh.obj")).unwrap();
-    write(&dir, "scene.xml", &scene("    <shape type=\"obj\">\n        <string name=\"filename\" value=\"mesh.obj\"/>\n    </shape>", ""));
+    write(
+        &dir,
+        "scene.xml",
+        &scene(
+            "    <shape type=\"obj\">\n        <string name=\"filename\" value=\"mesh.obj\"/>\n    </shape>",
+            "",
+        ),
+    );
     assert_error(&dir, &[], "scene.xml:8:5", &["mesh.obj"]);
 }
 
 #[test]
 fn mesh_with_an_index_out_of_range() {
     let dir = folder("bad-index");
-    write(&dir, "mesh.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 9\n");
-    write(&dir, "scene.xml", &scene("    <shape type=\"obj\">\n        <string name=\"filename\" value=\"mesh.obj\"/>\n    </shape>", ""));
+    write(
+        &dir,
+        "mesh.obj",
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 9\n",
+    );
+    write(
+        &dir,
+        "scene.xml",
+        &scene(
+            "    <shape type=\"obj\">\n        <string name=\"filename\" value=\"mesh.obj\"/>\n    </shape>",
+            "",
+        ),
+    );
     assert_error(&dir, &[], "mesh.obj:5:", &["vertex 9", "scene.xml:8:5"]);
 }
 
@@ -147,7 +240,14 @@ fn mesh_with_an_index_out_of_range() {
 fn mesh_with_nan_coordinates() {
     let dir = folder("nan-mesh");
     write(&dir, "mesh.obj", "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n");
-    write(&dir, "scene.xml", &scene("    <shape type=\"obj\">\n        <string name=\"filename\" value=\"mesh.obj\"/>\n    </shape>", ""));
+    write(
+        &dir,
+        "scene.xml",
+        &scene(
+            "    <shape type=\"obj\">\n        <string name=\"filename\" value=\"mesh.obj\"/>\n    </shape>",
+            "",
+        ),
+    );
     assert_error(&dir, &[], "mesh.obj:2:", &["finite"]);
 }
 
@@ -156,14 +256,22 @@ fn ply_with_an_index_out_of_range() {
     let dir = folder("bad-ply");
     let ply = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n";
     write(&dir, "mesh.ply", ply);
-    write(&dir, "scene.xml", &scene("    <shape type=\"ply\">\n        <string name=\"filename\" value=\"mesh.ply\"/>\n    </shape>", ""));
+    write(
+        &dir,
+        "scene.xml",
+        &scene(
+            "    <shape type=\"ply\">\n        <string name=\"filename\" value=\"mesh.ply\"/>\n    </shape>",
+            "",
+        ),
+    );
     assert_error(&dir, &[], "mesh.ply:13:", &["7"]);
 }
 
 #[test]
 fn zero_size_film() {
     let dir = folder("zero-film");
-    let text = scene("    <shape type=\"sphere\"/>", "").replace("name=\"width\" value=\"4\"", "name=\"width\" value=\"0\"");
+    let text = scene("    <shape type=\"sphere\"/>", "")
+        .replace("name=\"width\" value=\"4\"", "name=\"width\" value=\"0\"");
     write(&dir, "scene.xml", &text);
     assert_error(&dir, &[], "scene.xml:4:13", &["0 × 4"]);
 }
@@ -171,7 +279,11 @@ fn zero_size_film() {
 #[test]
 fn unknown_define_and_bad_arguments() {
     let dir = folder("bad-args");
-    write(&dir, "scene.xml", &scene("    <shape type=\"sphere\"/>", ""));
+    write(
+        &dir,
+        "scene.xml",
+        &scene("    <shape type=\"sphere\"/>", ""),
+    );
     let (status, stderr) = render(&dir, &["-D", "nothing=1"]);
     assert_eq!(status, 2, "{stderr}");
     assert!(stderr.contains("nothing"), "{stderr}");

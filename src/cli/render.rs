@@ -28,7 +28,7 @@ pub struct RenderArgs {
     /// Seed of the random numbers [default: the sampler's seed, else 0]
     #[arg(long, value_name = "S")]
     pub seed: Option<u64>,
-    /// Set a scene parameter declared with <default name=... value=...> (repeatable)
+    /// Set a scene parameter declared with `<default name=... value=...>` (repeatable)
     #[arg(short = 'D', value_name = "NAME=VALUE", value_parser = parse_define)]
     pub defines: Vec<(String, String)>,
     /// Render only the pixels x0 <= x < x1, y0 <= y < y1 of the film

@@ -1,6 +1,6 @@
 //! Image files: 32-bit float OpenEXR for linear data and 8-bit sRGB PNG for viewing.
 //!
-//! Both writers go through [`write_atomically`]: the file is written to `<path>.tmp` and renamed
+//! Both writers go through `write_atomically`: the file is written to `<path>.tmp` and renamed
 //! over `<path>` only once complete, so an error (a full disk, say) or a reader looking at a
 //! checkpoint never sees a truncated image under the final name.
 
@@ -47,7 +47,7 @@ impl ChannelImage {
 const EXR_COMPRESSION: Compression = Compression::ZIP16;
 
 /// Writes 32-bit float channels to an OpenEXR file: one layer, scanlines in increasing y, ZIP
-/// compression (see [`EXR_COMPRESSION`]). Channel names are stored as given; the file lists them
+/// compression (see `EXR_COMPRESSION`). Channel names are stored as given; the file lists them
 /// alphabetically, as the format requires.
 pub fn write_exr(path: &Path, image: &ChannelImage) -> Result<()> {
     let invalid = |message: String| Error::io(path, &io::Error::other(message), "write");

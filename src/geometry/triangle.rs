@@ -3,8 +3,9 @@
 //!
 //! The triangle is translated to the ray origin, the axes permuted so the ray's dominant axis is
 //! z, and sheared so the ray points along +z; the 2-D edge functions of the projected vertices
-//! then decide the hit with no gaps or double hits along shared edges. Edge functions that round
-//! to exactly zero are recomputed in double precision.
+//! then decide the hit with no gaps or double hits along shared edges. The edge functions are
+//! evaluated in double precision and rounded once, so their signs are exact whenever they are not
+//! tiny (Woop et al. fall back to double precision only for exact zeros).
 
 use glam::Vec3;
 
@@ -25,13 +26,10 @@ fn gamma(n: i32) -> f32 {
     (n as f32 * e) / (1.0 - n as f32 * e)
 }
 
-/// a·b − c·d with one rounding (Kahan's algorithm with an FMA).
+/// a·b − c·d with a single rounding: the products of two f32 are exact in f64.
 #[inline]
 fn difference_of_products(a: f32, b: f32, c: f32, d: f32) -> f32 {
-    let cd = c * d;
-    let dop = a.mul_add(b, -cd);
-    let err = (-c).mul_add(d, cd);
-    dop + err
+    (f64::from(a) * f64::from(b) - f64::from(c) * f64::from(d)) as f32
 }
 
 #[inline]
@@ -40,6 +38,7 @@ fn permute(v: Vec3, x: usize, y: usize, z: usize) -> Vec3 {
 }
 
 /// Intersects the ray o + t·d, 0 < t < t_max, with the triangle (p0, p1, p2); both faces count.
+/// A degenerate triangle (zero area) may or may not report hits: callers leave them out.
 #[inline]
 pub fn intersect_triangle(
     o: Vec3,
@@ -49,10 +48,6 @@ pub fn intersect_triangle(
     p1: Vec3,
     p2: Vec3,
 ) -> Option<TriangleHit> {
-    // Degenerate triangles have no hits.
-    if (p2 - p0).cross(p1 - p0).length_squared() == 0.0 {
-        return None;
-    }
     let mut p0t = p0 - o;
     let mut p1t = p1 - o;
     let mut p2t = p2 - o;
@@ -82,17 +77,9 @@ pub fn intersect_triangle(
     p2t.x += sx * p2t.z;
     p2t.y += sy * p2t.z;
     // Edge functions.
-    let mut e0 = difference_of_products(p1t.x, p2t.y, p1t.y, p2t.x);
-    let mut e1 = difference_of_products(p2t.x, p0t.y, p2t.y, p0t.x);
-    let mut e2 = difference_of_products(p0t.x, p1t.y, p0t.y, p1t.x);
-    if e0 == 0.0 || e1 == 0.0 || e2 == 0.0 {
-        let f = |a: f32, b: f32, c: f32, d: f32| {
-            (f64::from(a) * f64::from(b) - f64::from(c) * f64::from(d)) as f32
-        };
-        e0 = f(p1t.x, p2t.y, p1t.y, p2t.x);
-        e1 = f(p2t.x, p0t.y, p2t.y, p0t.x);
-        e2 = f(p0t.x, p1t.y, p0t.y, p1t.x);
-    }
+    let e0 = difference_of_products(p1t.x, p2t.y, p1t.y, p2t.x);
+    let e1 = difference_of_products(p2t.x, p0t.y, p2t.y, p0t.x);
+    let e2 = difference_of_products(p0t.x, p1t.y, p0t.y, p1t.x);
     if (e0 < 0.0 || e1 < 0.0 || e2 < 0.0) && (e0 > 0.0 || e1 > 0.0 || e2 > 0.0) {
         return None;
     }

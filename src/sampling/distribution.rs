@@ -3,11 +3,16 @@
 
 /// A piecewise-constant density on `[min, max)` with `n` equal cells, proportional to given
 /// non-negative weights; sampled by inverting its CDF (pbrt-v4, §A.4.1 "Piecewise-Constant 1D").
+/// The cell holding u is found through a guide table (Chen & Asau 1974, "On Generating Random
+/// Variates from an Empirical Distribution"): guide[j] is the cell where u = j/G falls, so the
+/// search starts next to the answer and usually takes one or two steps.
 #[derive(Clone, Debug)]
 pub struct PiecewiseConstant1D {
     weights: Vec<f32>,
     /// cdf[i] = integral of the normalised density over the first i cells; cdf[n] = 1.
     cdf: Vec<f64>,
+    /// guide[j] = the cell containing u = j / guide.len().
+    guide: Vec<u32>,
     /// Integral of the (unnormalised) weights over the domain.
     integral: f64,
     min: f32,
@@ -39,9 +44,20 @@ impl PiecewiseConstant1D {
                 *c = i as f64 / n as f64;
             }
         }
+        let guide_len = n.next_power_of_two().max(16);
+        let mut guide = Vec::with_capacity(guide_len);
+        let mut cell = 0usize;
+        for j in 0..guide_len {
+            let u = j as f64 / guide_len as f64;
+            while cell + 1 < n && cdf[cell + 1] <= u {
+                cell += 1;
+            }
+            guide.push(cell as u32);
+        }
         PiecewiseConstant1D {
             weights,
             cdf,
+            guide,
             integral,
             min,
             max,
@@ -68,10 +84,14 @@ impl PiecewiseConstant1D {
     /// Maps `u` in [0, 1) to a point of the domain with density [`Self::pdf`]. Returns the point
     /// and the index of its cell.
     pub fn sample(&self, u: f32) -> (f32, usize) {
-        let u = f64::from(u);
-        // Largest i with cdf[i] <= u, among the cells 0..n.
         let n = self.weights.len();
-        let index = self.cdf[1..n].partition_point(|&c| c <= u);
+        // The last cell whose start cdf[i] is at most u, searched from the guide's cell on.
+        let slot = ((u * self.guide.len() as f32) as usize).min(self.guide.len() - 1);
+        let u = f64::from(u);
+        let mut index = self.guide[slot] as usize;
+        while index + 1 < n && self.cdf[index + 1] <= u {
+            index += 1;
+        }
         let lo = self.cdf[index];
         let width = self.cdf[index + 1] - lo;
         let offset = if width > 0.0 { (u - lo) / width } else { 0.0 };

@@ -121,10 +121,15 @@ impl Spectrum {
 }
 
 /// Samples (λᵢ, vᵢ) with strictly increasing λ, linearly interpolated; zero outside [λ₀, λₙ].
+/// Regularly spaced samples (the common case: measured data every 1, 4, 5 or 10 nm) are looked
+/// up in constant time, others by binary search.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PiecewiseLinear {
     lambdas: Vec<f32>,
     values: Vec<f32>,
+    /// 1 / spacing when the wavelengths are equally spaced (to within 10⁻³ of the spacing, the
+    /// tolerance of Mitsuba's `regular` spectrum detection).
+    inverse_spacing: Option<f32>,
 }
 
 impl PiecewiseLinear {
@@ -134,9 +139,17 @@ impl PiecewiseLinear {
         if samples.is_empty() {
             return None;
         }
+        let lambdas: Vec<f32> = samples.iter().map(|s| s.0).collect();
+        let steps = lambdas.windows(2).map(|w| w[1] - w[0]);
+        let (min, max) = steps.fold((f32::INFINITY, 0.0f32), |(lo, hi), d| {
+            (lo.min(d), hi.max(d))
+        });
+        let inverse_spacing = (lambdas.len() > 1 && max - min <= 1e-3 * min)
+            .then(|| (lambdas.len() - 1) as f32 / (lambdas[lambdas.len() - 1] - lambdas[0]));
         Some(PiecewiseLinear {
-            lambdas: samples.iter().map(|s| s.0).collect(),
+            lambdas,
             values: samples.iter().map(|s| s.1).collect(),
+            inverse_spacing,
         })
     }
 
@@ -149,12 +162,24 @@ impl PiecewiseLinear {
         if n == 1 {
             return self.values[0];
         }
-        let i = self
-            .lambdas
-            .partition_point(|&l| l <= lambda)
-            .clamp(1, n - 1)
-            - 1;
-        let t = (lambda - self.lambdas[i]) / (self.lambdas[i + 1] - self.lambdas[i]);
+        let (i, t) = match self.inverse_spacing {
+            Some(inverse) => {
+                let x = (lambda - self.lambdas[0]) * inverse;
+                let i = (x as usize).min(n - 2);
+                (i, x - i as f32)
+            }
+            None => {
+                let i = self
+                    .lambdas
+                    .partition_point(|&l| l <= lambda)
+                    .clamp(1, n - 1)
+                    - 1;
+                (
+                    i,
+                    (lambda - self.lambdas[i]) / (self.lambdas[i + 1] - self.lambdas[i]),
+                )
+            }
+        };
         self.values[i] + t * (self.values[i + 1] - self.values[i])
     }
 }
@@ -173,6 +198,32 @@ mod tests {
         assert!((s.value(650.0) - 17.0).abs() < 1e-5);
         assert_eq!(s.value(700.0), 18.4);
         assert_eq!(s.value(700.1), 0.0);
+    }
+
+    #[test]
+    fn regular_and_irregular_tables_interpolate_alike() {
+        let regular: Vec<(f32, f32)> = (0..20)
+            .map(|i| (400.0 + 4.0 * i as f32, (i * i % 7) as f32))
+            .collect();
+        let mut irregular = regular.clone();
+        irregular[5].0 += 0.5;
+        let a = PiecewiseLinear::new(&regular).unwrap();
+        let b = PiecewiseLinear::new(&irregular).unwrap();
+        assert!(a.inverse_spacing.is_some() && b.inverse_spacing.is_none());
+        for k in 0..=400 {
+            let l = 398.0 + 0.2 * k as f32;
+            let expected = if !(400.0..=476.0).contains(&l) {
+                0.0
+            } else {
+                let i = (((l - 400.0) / 4.0) as usize).min(18);
+                let t = (l - regular[i].0) / 4.0;
+                regular[i].1 + t * (regular[i + 1].1 - regular[i].1)
+            };
+            assert!((a.value(l) - expected).abs() < 1e-5, "{l}");
+            if !(416.0..=424.0).contains(&l) {
+                assert!((b.value(l) - expected).abs() < 1e-5, "{l}");
+            }
+        }
     }
 
     #[test]

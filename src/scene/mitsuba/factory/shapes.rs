@@ -164,7 +164,12 @@ fn mesh_error(error: Error, node: &PluginNode) -> Error {
     let in_mesh_file = error.location.is_some();
     let mut error = error.at(&node.location);
     if in_mesh_file {
-        error.message = format!("{} (mesh of {} at {})", error.message, node.describe(), node.location);
+        error.message = format!(
+            "{} (mesh of {} at {})",
+            error.message,
+            node.describe(),
+            node.location
+        );
     }
     error
 }
