@@ -1,6 +1,7 @@
 //! Scenes: the renderable [`Scene`], the mesh readers, and the Mitsuba XML reader and plugin
 //! factory that build it.
 
+pub mod image_file;
 pub mod mesh;
 pub mod mitsuba;
 
