@@ -6,6 +6,8 @@
 
 pub mod cie;
 pub mod cie_tables;
+pub mod conductors;
+pub mod ior;
 pub mod rgb;
 pub mod sampled;
 pub mod spectra;
