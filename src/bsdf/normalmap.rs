@@ -1,31 +1,32 @@
 //! Mitsuba's `normalmap` adapter: the nested BSDF seen in a shading frame whose normal is read
-//! from an RGB texture, n = normalize(2 rgb − 1) in the local shading frame (so (0.5, 0.5, 1)
-//! changes nothing).
+//! from an RGB texture, n = 2 rgb − 1 in the local shading frame (so (0.5, 0.5, 1) changes
+//! nothing).
 //!
 //! ```xml
 //! <bsdf type="normalmap">
 //!     <texture type="bitmap" name="normalmap">
 //!         <boolean name="raw" value="true"/> <string name="filename" value="normals.png"/>
 //!     </texture>
+//!     <boolean name="flip_invalid_normals" value="true"/>
+//!     <boolean name="use_shadowing_function" value="true"/>
 //!     <bsdf type="roughplastic"/>
 //! </bsdf>
 //! ```
-//! The texture must be read raw (no sRGB decoding), as in Mitsuba 3. The new frame's first
-//! tangent is the shading frame's (the direction of ∂p/∂u) made orthogonal to the new normal;
-//! Mitsuba 3.9 mixes a world-space ∂p/∂u into its local frame here, which only matters for
-//! anisotropic BSDFs.
+//! The texture must be read raw (no sRGB decoding), as in Mitsuba 3. The tilted frame is built
+//! as for `bumpmap` ([`super::bumpmap::Perturbation`]), as Mitsuba 3.9's `perturbed_bsdf.h`.
 
 use glam::{Vec2, Vec3};
 
-use super::bumpmap::{perturbed_eval, perturbed_pdf, perturbed_sample};
+use super::bumpmap::Perturbation;
 use super::{Bsdf, BsdfFlags, BsdfSample, ShadingPoint, Texture};
-use crate::math::Frame;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 
 #[derive(Clone, Debug)]
 pub struct NormalMap {
     pub normals: Texture,
     pub nested: Box<Bsdf>,
+    pub flip_invalid_normals: bool,
+    pub use_shadowing_function: bool,
 }
 
 impl NormalMap {
@@ -34,15 +35,14 @@ impl NormalMap {
     }
 
     #[inline]
-    fn perturbed(&self, sp: &ShadingPoint) -> ShadingPoint {
-        let local = (self.normals.eval_3(sp.uv) * 2.0 - Vec3::ONE).normalize_or_zero();
-        if local == Vec3::ZERO {
-            return *sp;
-        }
-        ShadingPoint {
-            frame: Frame::from_normal_and_tangent(sp.frame.to_world(local), sp.frame.s),
-            ..*sp
-        }
+    fn perturbation(&self, sp: &ShadingPoint, wo: Vec3) -> Perturbation {
+        Perturbation::new(
+            sp,
+            self.normals.eval_3(sp.uv) * 2.0 - Vec3::ONE,
+            wo,
+            self.flip_invalid_normals,
+            self.use_shadowing_function,
+        )
     }
 
     pub fn eval(
@@ -52,11 +52,11 @@ impl NormalMap {
         wi: Vec3,
         lambda: &SampledWavelengths,
     ) -> SampledSpectrum {
-        perturbed_eval(&self.nested, sp, &self.perturbed(sp), wo, wi, lambda)
+        self.perturbation(sp, wo).eval(&self.nested, wo, wi, lambda)
     }
 
     pub fn pdf(&self, sp: &ShadingPoint, wo: Vec3, wi: Vec3, lambda: &SampledWavelengths) -> f32 {
-        perturbed_pdf(&self.nested, sp, &self.perturbed(sp), wo, wi, lambda)
+        self.perturbation(sp, wo).pdf(&self.nested, wo, wi, lambda)
     }
 
     pub fn sample(
@@ -67,6 +67,7 @@ impl NormalMap {
         u: Vec2,
         lambda: &SampledWavelengths,
     ) -> Option<BsdfSample> {
-        perturbed_sample(&self.nested, sp, &self.perturbed(sp), wo, u_lobe, u, lambda)
+        self.perturbation(sp, wo)
+            .sample(&self.nested, wo, u_lobe, u, lambda)
     }
 }

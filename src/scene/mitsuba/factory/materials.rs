@@ -340,6 +340,8 @@ pub fn build_bsdf(node: &PluginNode, textures: &mut TextureCache) -> Result<Bsdf
                 height: build_texture(&height.node, TextureUse::Scalar, t)?,
                 scale,
                 nested: Box::new(single_nested_bsdf(&params, t)?),
+                flip_invalid_normals: params.boolean("flip_invalid_normals", true)?,
+                use_shadowing_function: params.boolean("use_shadowing_function", true)?,
             })
         }
         "normalmap" => {
@@ -359,6 +361,8 @@ pub fn build_bsdf(node: &PluginNode, textures: &mut TextureCache) -> Result<Bsdf
             Bsdf::NormalMap(NormalMap {
                 normals: build_texture(&normals.node, TextureUse::Rgb, t)?,
                 nested: Box::new(single_nested_bsdf(&params, t)?),
+                flip_invalid_normals: params.boolean("flip_invalid_normals", true)?,
+                use_shadowing_function: params.boolean("use_shadowing_function", true)?,
             })
         }
         other => return Err(unknown_type(node, other)),
