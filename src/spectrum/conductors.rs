@@ -9,6 +9,9 @@
 //! (LLNL)" (Mitsuba 3 documentation, `conductor`). Written by `tools/gen_conductor_ior.py`;
 //! do not edit.
 
+// Measured values that happen to be close to π or 2π are data, not approximations of them.
+#![allow(clippy::approx_constant)]
+
 /// A preset: its name and samples (λ in nm, η, k).
 pub struct ConductorData {
     pub name: &'static str,

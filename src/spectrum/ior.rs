@@ -58,7 +58,8 @@ pub fn named_ior(name: &str) -> Option<f32> {
 /// Sellmeier coefficients of glasses, n²(λ) = 1 + Σᵢ Bᵢ λ² / (λ² − Cᵢ) with λ in µm.
 /// Sources: SCHOTT optical glass data sheets (N-BK7, N-SF11, N-F2); Malitson 1965, "Interspecimen
 /// Comparison of the Refractive Index of Fused Silica", JOSA 55 (fused silica); Peter 1923 as
-/// tabulated by refractiveindex.info (diamond).
+/// tabulated by refractiveindex.info (diamond). The coefficients are written as published.
+#[allow(clippy::excessive_precision)]
 pub const SELLMEIER_GLASSES: &[(&str, [f32; 3], [f32; 3])] = &[
     (
         "N-BK7",
