@@ -16,7 +16,7 @@ use common::chi2::assert_passes;
 use glam::Vec3;
 
 /// Chi-square tests in this file (for Šidák's correction): one per (BSDF, direction).
-const TESTS: usize = 41;
+const TESTS: usize = 43;
 
 /// Incident directions above the surface: normal, moderate, oblique and grazing.
 fn upper_directions() -> [Vec3; 4] {
@@ -178,4 +178,31 @@ fn adapters() {
         &[direction(35.0, 20.0), direction(60.0, 45.0)],
         17,
     );
+}
+
+/// A bump map needs a height texture with a gradient: a small EXR of sinusoidal heights.
+#[test]
+fn bumpmap() {
+    let (w, h) = (16, 16);
+    let heights: Vec<f32> = (0..w * h)
+        .map(|i| 0.5 + 0.5 * ((i % w) as f32 * 0.7).sin() * ((i / w) as f32 * 0.4).cos())
+        .collect();
+    let path = std::env::temp_dir().join(format!("prism-bump-{}.exr", std::process::id()));
+    let image = prism::film::output::ChannelImage {
+        width: w,
+        height: h,
+        channels: ["R", "G", "B"]
+            .iter()
+            .map(|c| (c.to_string(), heights.clone()))
+            .collect(),
+    };
+    prism::film::output::write_exr(&path, &image).unwrap();
+    let xml = format!(
+        r#"<bsdf type="bumpmap"><texture type="bitmap"><string name="filename" value="{}"/>
+            <boolean name="raw" value="true"/></texture><float name="scale" value="0.05"/>
+            <bsdf type="roughplastic"><float name="alpha" value="0.3"/></bsdf></bsdf>"#,
+        path.display()
+    );
+    check("bumpmap", &xml, &upper_directions()[1..3], 18);
+    std::fs::remove_file(&path).ok();
 }
