@@ -333,6 +333,14 @@ fn textures_vary_with_uv() {
     let lambda = wavelengths();
     assert_eq!(d.reflectance.eval(Vec2::new(0.1, 0.1), &lambda)[0], 0.8);
     assert_eq!(d.reflectance.eval(Vec2::new(0.3, 0.1), &lambda)[0], 0.1);
+    // A texture declared at the top level and referenced by id, here as a roughness.
+    let referenced = bsdf_from_xml(
+        r#"<texture type="checkerboard" id="checks"><float name="color0" value="0.3"/></texture>
+           <bsdf type="roughconductor"><ref name="alpha" id="checks"/></bsdf>"#,
+    );
+    let Bsdf::RoughConductor(rc) = &referenced else { panic!() };
+    assert_eq!(rc.alpha_u.eval_1(Vec2::new(0.1, 0.1)), 0.3);
+    assert_eq!(rc.alpha_v.eval_1(Vec2::new(0.7, 0.1)), 0.2);
 
     // A 2 × 1 PNG, left texel grey, right texel red: decoded to linear and upsampled.
     let dir = temp_dir("bitmap");
