@@ -338,7 +338,9 @@ fn textures_vary_with_uv() {
         r#"<texture type="checkerboard" id="checks"><float name="color0" value="0.3"/></texture>
            <bsdf type="roughconductor"><ref name="alpha" id="checks"/></bsdf>"#,
     );
-    let Bsdf::RoughConductor(rc) = &referenced else { panic!() };
+    let Bsdf::RoughConductor(rc) = &referenced else {
+        panic!()
+    };
     assert_eq!(rc.alpha_u.eval_1(Vec2::new(0.1, 0.1)), 0.3);
     assert_eq!(rc.alpha_v.eval_1(Vec2::new(0.7, 0.1)), 0.2);
 
