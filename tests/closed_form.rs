@@ -139,7 +139,7 @@ fn point_light_over_a_diffuse_plane() {
     let film = render_film(&scene, 256, 8, None);
 
     let radiance = |film_position: Vec2| -> f64 {
-        let ray = camera.generate_ray(film_position);
+        let ray = camera.generate_ray(film_position, Vec2::splat(0.5), 0.0);
         let t = -ray.o.z / ray.d.z;
         let x = (ray.o + ray.d * t).as_dvec3();
         let to_light = light_position.as_dvec3() - x;
@@ -225,7 +225,7 @@ fn disk_light_over_a_diffuse_plane() {
     );
     let film = render_film(&scene, 1024, 9, None);
     let exitant = |film_position: Vec2| -> f64 {
-        let ray = camera.generate_ray(film_position);
+        let ray = camera.generate_ray(film_position, Vec2::splat(0.5), 0.0);
         let t = -ray.o.z / ray.d.z;
         let x = (ray.o + ray.d * t).as_dvec3();
         let r2 = x.x * x.x + x.y * x.y;

@@ -132,7 +132,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         args.scene.display(),
         scene.film.crop.size.x,
         scene.film.crop.size.y,
-        options.samples_per_pixel,
+        output.samples_per_pixel,
         seconds,
         output.samples as f64 / seconds / 1e6,
         output.rays as f64 / seconds / 1e6,

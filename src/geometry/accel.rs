@@ -158,7 +158,7 @@ impl Geometry {
             }
         });
         let (id, h) = closest?;
-        Some(match self.primitives[id] {
+        let mut si = match self.primitives[id] {
             Primitive::Triangle { shape, index, .. } => match &self.shapes[shape as usize] {
                 Shape::Mesh(mesh) => mesh.interaction(index as usize, &h, shape),
                 _ => unreachable!("triangle primitives belong to meshes"),
@@ -168,7 +168,9 @@ impl Geometry {
                 Shape::Disk(disk) => disk.interaction(ray.o, ray.d, h.t, shape),
                 Shape::Mesh(_) => unreachable!("meshes are made of triangle primitives"),
             },
-        })
+        };
+        si.time = ray.time;
+        Some(si)
     }
 
     /// Whether anything blocks the ray in (0, t_max).

@@ -69,6 +69,7 @@ impl Disk {
             uv: Vec2::new(r, phi / (2.0 * PI)),
             shape,
             primitive: 0,
+            time: 0.0,
         }
     }
 

@@ -135,6 +135,7 @@ impl TriangleMesh {
             uv,
             shape,
             primitive: triangle as u32,
+            time: 0.0,
         }
     }
 

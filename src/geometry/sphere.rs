@@ -79,6 +79,7 @@ impl Sphere {
             uv: self.uv(outward),
             shape,
             primitive: 0,
+            time: 0.0,
         }
     }
 

@@ -15,8 +15,8 @@ use rayon::prelude::*;
 use crate::error::{Error, Result};
 use crate::film::{Film, FilterSampler, PixelSums};
 use crate::integrator::RayCount;
-use crate::sampling::sampler::{IndependentSampler, Sampler};
-use crate::scene::{SamplerKind, Scene};
+use crate::sampling::sampler::Sampler;
+use crate::scene::Scene;
 use crate::spectrum::SampledWavelengths;
 
 /// Edge length of the square tiles the image is divided into.
@@ -25,7 +25,8 @@ const TILE_SIZE: u32 = 16;
 /// How to render.
 #[derive(Clone, Debug)]
 pub struct RenderOptions {
-    /// Samples per pixel (the scene's sampler gives the default).
+    /// Samples per pixel requested (the scene's sampler gives the default); stratified samplers
+    /// may round it up (see [`crate::sampling::sampler::SamplerKind::sample_count`]).
     pub samples_per_pixel: u32,
     /// Worker threads; None for one per core.
     pub threads: Option<usize>,
@@ -38,6 +39,8 @@ pub struct RenderOptions {
 /// What a render produced.
 pub struct RenderOutput {
     pub film: Film,
+    /// Samples per pixel taken.
+    pub samples_per_pixel: u32,
     pub elapsed: Duration,
     /// Camera samples taken.
     pub samples: u64,
@@ -66,12 +69,6 @@ fn tiles(size: UVec2) -> Vec<Tile> {
     tiles
 }
 
-fn make_sampler(scene: &Scene, seed: u64) -> Sampler {
-    match scene.sampler.kind {
-        SamplerKind::Independent => Sampler::Independent(IndependentSampler::new(seed)),
-    }
-}
-
 /// Renders all samples of one tile; returns its pixels (row-major) and the rays traced.
 fn render_tile(
     scene: &Scene,
@@ -79,7 +76,8 @@ fn render_tile(
     tile: Tile,
     options: &RenderOptions,
 ) -> (Vec<PixelSums>, u64) {
-    let mut sampler = make_sampler(scene, options.seed);
+    let mut sampler = Sampler::new(scene.sampler.kind, options.samples_per_pixel, options.seed);
+    let samples_per_pixel = sampler.sample_count();
     let mut count = RayCount::default();
     let mut pixels = vec![PixelSums::default(); (tile.size.x * tile.size.y) as usize];
     let crop_offset = scene.film.crop.offset;
@@ -87,17 +85,20 @@ fn render_tile(
         for x in 0..tile.size.x {
             let pixel = crop_offset + tile.origin + UVec2::new(x, y);
             let sums = &mut pixels[(y * tile.size.x + x) as usize];
-            for index in 0..options.samples_per_pixel {
+            for index in 0..samples_per_pixel {
                 sampler.start_pixel_sample(pixel, index);
+                let primary = sampler.camera_sample();
                 let lambda =
-                    SampledWavelengths::sample(sampler.next_1d(), scene.wavelength_sampling);
-                let (offset, weight) = filter.sample(sampler.next_2d());
+                    SampledWavelengths::sample(primary.wavelength, scene.wavelength_sampling);
+                let (offset, filter_weight) = filter.sample(primary.film);
+                let (time, time_weight) = scene.shutter.sample(primary.time);
                 let film_position = pixel.as_vec2() + Vec2::splat(0.5) + offset;
-                let ray = scene.camera.generate_ray(film_position);
+                let ray = scene.camera.generate_ray(film_position, primary.lens, time);
                 let radiance =
                     scene
                         .integrator
                         .radiance(scene, ray, &lambda, &mut sampler, &mut count);
+                let weight = filter_weight * time_weight;
                 let xyz = lambda.to_xyz(&radiance).map(|v| v * weight);
                 sums.add(xyz);
             }
@@ -112,8 +113,9 @@ pub fn render(scene: &Scene, options: &RenderOptions) -> Result<RenderOutput> {
     let mut film = Film::new(scene.film.size, crop);
     let filter = FilterSampler::new(scene.film.filter);
     let tiles = tiles(crop.size);
+    let samples_per_pixel = scene.sampler.kind.sample_count(options.samples_per_pixel);
     let total_samples =
-        u64::from(crop.size.x) * u64::from(crop.size.y) * u64::from(options.samples_per_pixel);
+        u64::from(crop.size.x) * u64::from(crop.size.y) * u64::from(samples_per_pixel);
 
     let mut builder = rayon::ThreadPoolBuilder::new();
     if let Some(threads) = options.threads {
@@ -143,9 +145,7 @@ pub fn render(scene: &Scene, options: &RenderOptions) -> Result<RenderOutput> {
             .map(|&tile| {
                 let (pixels, tile_rays) = render_tile(scene, &filter, tile, options);
                 rays.fetch_add(tile_rays, Ordering::Relaxed);
-                progress.inc(
-                    u64::from(tile.size.x * tile.size.y) * u64::from(options.samples_per_pixel),
-                );
+                progress.inc(u64::from(tile.size.x * tile.size.y) * u64::from(samples_per_pixel));
                 (tile, pixels)
             })
             .collect()
@@ -163,6 +163,7 @@ pub fn render(scene: &Scene, options: &RenderOptions) -> Result<RenderOutput> {
     }
     Ok(RenderOutput {
         film,
+        samples_per_pixel,
         elapsed,
         samples: total_samples,
         rays: rays.into_inner(),

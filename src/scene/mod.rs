@@ -8,11 +8,12 @@ pub mod mitsuba;
 use glam::UVec2;
 
 use crate::bsdf::Material;
-use crate::camera::Camera;
+use crate::camera::{Camera, Shutter};
 use crate::film::{CropWindow, Filter};
 use crate::geometry::Geometry;
 use crate::integrator::Integrator;
 use crate::light::{Light, LightSampler};
+pub use crate::sampling::sampler::SamplerKind;
 use crate::spectrum::WavelengthSampling;
 
 /// What a shape is made of and whether it emits.
@@ -34,11 +35,6 @@ pub struct FilmSettings {
 
 /// Which per-pixel sampler to use and how many samples per pixel.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum SamplerKind {
-    Independent,
-}
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct SamplerSettings {
     pub kind: SamplerKind,
     pub samples_per_pixel: u32,
@@ -57,6 +53,8 @@ pub struct Scene {
     pub sampler: SamplerSettings,
     pub integrator: Integrator,
     pub wavelength_sampling: WavelengthSampling,
+    /// When camera rays are taken (the sensor's shutter interval and temporal filter).
+    pub shutter: Shutter,
 }
 
 impl Scene {
@@ -84,6 +82,7 @@ impl Scene {
             sampler,
             integrator,
             wavelength_sampling: WavelengthSampling::default(),
+            shutter: Shutter::instant(),
         }
     }
 }

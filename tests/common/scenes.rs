@@ -8,8 +8,8 @@ use prism::film::{CropWindow, Film, Filter};
 use prism::geometry::{Geometry, Shape};
 use prism::integrator::{Integrator, PathIntegrator};
 use prism::light::{AreaLight, Light};
-use prism::math::Transform;
 use prism::math::transform::look_at;
+use prism::math::{AnimatedTransform, Transform};
 use prism::render::{RenderOptions, render};
 use prism::scene::{FilmSettings, SamplerKind, SamplerSettings, Scene, ShapeInfo};
 use prism::spectrum::Spectrum;
@@ -24,11 +24,15 @@ pub struct Object {
 /// A pinhole camera at `origin` looking at `target` with horizontal field of view `fov`.
 pub fn camera(origin: DVec3, target: DVec3, up: DVec3, fov_degrees: f64, size: UVec2) -> Camera {
     Camera::Perspective(PerspectiveCamera {
-        to_world: Transform::new(look_at(origin, target, up).unwrap()).unwrap(),
+        to_world: AnimatedTransform::fixed(
+            Transform::new(look_at(origin, target, up).unwrap()).unwrap(),
+        ),
         film_size: Vec2::new(size.x as f32, size.y as f32),
         tan_half_fov_x: (0.5 * fov_degrees).to_radians().tan() as f32,
         near_clip: 1e-3,
         far_clip: 1e4,
+        lens_radius: 0.0,
+        focus_distance: 1.0,
     })
 }
 

@@ -111,7 +111,7 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
     }
     params.finish()?;
 
-    let scene = Scene::new(
+    let mut scene = Scene::new(
         Geometry::new(shapes),
         shape_info,
         materials,
@@ -121,6 +121,7 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
         sensor.sampler,
         integrator,
     );
+    scene.shutter = sensor.shutter;
     Ok(LoadedScene {
         scene,
         seed: sensor.seed,
