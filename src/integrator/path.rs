@@ -112,7 +112,7 @@ impl PathIntegrator {
                         Some(prev) if !prev.specular => {
                             let shape = &scene.geometry.shapes[si.shape as usize];
                             let light_pdf = scene.light_sampler.pmf(light_index as usize)
-                                * shape.pdf_from(prev.interaction.p, si.p, si.n);
+                                * shape.pdf_from(prev.interaction.p, si.time, si.p, si.n);
                             power_heuristic(prev.pdf, light_pdf)
                         }
                         _ => 1.0,
@@ -196,7 +196,8 @@ impl PathIntegrator {
             return SampledSpectrum::ZERO;
         };
         let light = &scene.lights[light_index];
-        let Some(ls) = light.sample_incident(&scene.geometry.shapes, si.p, u_choice, u, lambda)
+        let Some(ls) =
+            light.sample_incident(&scene.geometry.shapes, si.p, si.time, u_choice, u, lambda)
         else {
             return SampledSpectrum::ZERO;
         };

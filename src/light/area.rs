@@ -38,12 +38,13 @@ impl AreaLight {
         &self,
         shapes: &[Shape],
         reference: Vec3,
+        time: f32,
         u_choice: f32,
         u: Vec2,
         lambda: &SampledWavelengths,
     ) -> Option<LightSample> {
         let shape = &shapes[self.shape as usize];
-        let s = shape.sample_from(reference, u_choice, u)?;
+        let s = shape.sample_from(reference, time, u_choice, u)?;
         let d = s.p - reference;
         let dist = d.length();
         if !(dist > 0.0) || !(s.pdf > 0.0) || !s.pdf.is_finite() {

@@ -41,17 +41,22 @@ pub struct LightSample {
 }
 
 impl Light {
-    /// Samples light arriving at `reference`. `u_choice` and `u` are the random numbers.
+    /// Samples light arriving at `reference` at `time`. `u_choice` and `u` are the random
+    /// numbers.
+    #[allow(clippy::too_many_arguments)]
     pub fn sample_incident(
         &self,
         shapes: &[Shape],
         reference: Vec3,
+        time: f32,
         u_choice: f32,
         u: Vec2,
         lambda: &SampledWavelengths,
     ) -> Option<LightSample> {
         match self {
-            Light::Area(light) => light.sample_incident(shapes, reference, u_choice, u, lambda),
+            Light::Area(light) => {
+                light.sample_incident(shapes, reference, time, u_choice, u, lambda)
+            }
             Light::Point(light) => light.sample_incident(reference, lambda),
         }
     }

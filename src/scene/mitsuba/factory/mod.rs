@@ -19,7 +19,7 @@ use super::description::{PluginClass, PluginNode};
 use super::params::Params;
 use crate::bsdf::Material;
 use crate::error::{Error, Result};
-use crate::geometry::Geometry;
+use crate::geometry::{Geometry, Shape};
 use crate::integrator::{Integrator, PathIntegrator};
 use crate::scene::{Scene, ShapeInfo};
 
@@ -87,6 +87,17 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
         };
         let light = match shape_params.single_child(PluginClass::Emitter)? {
             Some(emitter) => {
+                if let Shape::Instance(instance) = &shape
+                    && !instance.to_world.is_similarity()
+                {
+                    return Err(Error::input(
+                        &emitter.location,
+                        "an emitting shape may move, turn and scale uniformly, but not stretch",
+                    )
+                    .with_help(
+                        "animate the emitter with rotations, translations and uniform scales only",
+                    ));
+                }
                 lights.push(lights::build_area_light(&emitter.node, shape_index)?);
                 Some((lights.len() - 1) as u32)
             }
