@@ -78,7 +78,7 @@ fn build_static_shape(params: &Params, to_world: &Transform) -> Result<Shape> {
             }
             Ok(Shape::Mesh(transform_mesh(
                 data,
-                &to_world,
+                to_world,
                 flip_normals,
                 false,
             )))
