@@ -5,7 +5,8 @@ mod common;
 
 use common::chi2::regularized_gamma_q;
 use common::scenes::{
-    Object, assert_mean_luminance, build, camera, pixel_mean_and_variance, render_film,
+    Object, assert_mean_luminance, build, camera, disk_light_over_plane, pixel_mean_and_variance,
+    render_film,
 };
 use glam::{DMat4, DVec3, Mat3, UVec2, Vec2, Vec3};
 use prism::geometry::Shape;
@@ -178,86 +179,22 @@ fn point_light_over_a_diffuse_plane() {
     );
 }
 
-/// A disk light of radius R and radiance L facing down from height h over a diffuse plane: the
-/// irradiance at horizontal distance r from the axis is (π L / 2)(1 − (h² + r² − R²) /
-/// √((h² + r² + R²)² − 4 r² R²)) (the parallel coaxial disk form factor), and L_o = ρ E / π.
-/// Both light sampling and BSDF sampling find the disk, so this checks their MIS combination.
+/// A disk light over a diffuse plane (see [`common::scenes::disk_light_over_plane`]): both light
+/// sampling and BSDF sampling find the disk, so this checks their MIS combination.
 #[test]
 fn disk_light_over_a_diffuse_plane() {
-    use prism::geometry::disk::Disk;
-    let (rho, radiance, radius, height) = (0.5f64, 4.0f64, 0.5f64, 1.0f64);
-    let size = UVec2::new(12, 12);
-    // Below the disk, looking down: the camera sees the lit plane and never the disk.
-    let camera = camera(
-        DVec3::new(0.0, -1.2, 0.8),
-        DVec3::ZERO,
-        DVec3::Z,
-        50.0,
-        size,
-    );
-    let plane = Transform::new(DMat4::from_scale(DVec3::splat(50.0))).unwrap();
-    let disk = Transform::new(
-        DMat4::from_translation(DVec3::new(0.0, 0.0, height))
-            * DMat4::from_rotation_x(std::f64::consts::PI)
-            * DMat4::from_scale(DVec3::splat(radius)),
-    )
-    .unwrap();
-    let scene = build(
-        vec![
-            Object {
-                shape: Shape::Mesh(transform_mesh(rectangle(), &plane, false, true)),
-                reflectance: rho as f32,
-                emission: None,
-            },
-            Object {
-                shape: Shape::Disk(Disk::new(disk, false)),
-                reflectance: 0.0,
-                emission: Some(radiance as f32),
-            },
-        ],
-        vec![],
-        camera.clone(),
-        size,
-        PathIntegrator {
-            max_depth: 2,
-            ..PathIntegrator::default()
-        },
-    );
-    let film = render_film(&scene, 1024, 9, None);
-    let exitant = |film_position: Vec2| -> f64 {
-        let ray = camera.generate_ray(film_position, Vec2::splat(0.5), 0.0);
-        let t = -ray.o.z / ray.d.z;
-        let x = (ray.o + ray.d * t).as_dvec3();
-        let r2 = x.x * x.x + x.y * x.y;
-        let (h2, big_r2) = (height * height, radius * radius);
-        let e = std::f64::consts::PI * radiance / 2.0
-            * (1.0 - (h2 + r2 - big_r2) / ((h2 + r2 + big_r2).powi(2) - 4.0 * r2 * big_r2).sqrt());
-        rho * e / std::f64::consts::PI
-    };
-    let quadrature = 32;
+    let setup = disk_light_over_plane(UVec2::new(12, 12));
+    let film = render_film(&setup.scene, 1024, 9, None);
     let mut statistic = 0.0;
-    for y in 0..size.y {
-        for x in 0..size.x {
-            let mut exact = 0.0;
-            for j in 0..quadrature {
-                for i in 0..quadrature {
-                    let offset = Vec2::new(
-                        (i as f32 + 0.5) / quadrature as f32,
-                        (j as f32 + 0.5) / quadrature as f32,
-                    );
-                    exact += exitant(Vec2::new(x as f32, y as f32) + offset);
-                }
-            }
-            exact /= f64::from(quadrature * quadrature);
-            let (mean, variance) = pixel_mean_and_variance(&film, film.index(x, y), 1);
-            statistic += (mean - exact).powi(2) / variance;
-            assert!(
-                (mean - exact).abs() < 5.0 * variance.sqrt(),
-                "pixel ({x}, {y}): {mean} vs {exact}"
-            );
-        }
+    for (i, exact) in setup.exact.iter().enumerate() {
+        let (mean, variance) = pixel_mean_and_variance(&film, i, 1);
+        statistic += (mean - exact).powi(2) / variance;
+        assert!(
+            (mean - exact).abs() < 5.0 * variance.sqrt(),
+            "pixel {i}: {mean} vs {exact}"
+        );
     }
-    let pixels = f64::from(size.x * size.y);
+    let pixels = setup.exact.len() as f64;
     let p_value = regularized_gamma_q(pixels / 2.0, statistic / 2.0);
     assert!(
         p_value > 1e-3,

@@ -1,7 +1,7 @@
 //! Scenes built in code for the closed-form tests (DESIGN.md §7), and statistics of rendered
 //! films.
 
-use glam::{DVec3, UVec2, Vec2};
+use glam::{DMat4, DVec3, UVec2, Vec2};
 use prism::bsdf::{Bsdf, Diffuse, Material};
 use prism::camera::{Camera, PerspectiveCamera};
 use prism::film::{CropWindow, Film, Filter};
@@ -138,4 +138,84 @@ pub fn assert_mean_luminance(name: &str, film: &Film, expected: f64) {
         "{name}: mean Y {mean} differs from the closed form {expected} by {:.2} standard errors ({se})",
         (mean - expected).abs() / se
     );
+}
+
+/// A disk light of radius R = 0.5 and radiance L = 4 facing down from height h = 1 over a diffuse
+/// plane of reflectance ρ = 0.5, seen from below the disk (which the camera never sees), with
+/// direct lighting only. The irradiance at horizontal distance r from the axis is
+/// (π L / 2)(1 − (h² + r² − R²) / √((h² + r² + R²)² − 4 r² R²)) (the parallel coaxial disk form
+/// factor), and L_o = ρ E / π; `exact` holds each pixel's average of it over the pixel (32 × 32
+/// midpoint quadrature through the camera).
+pub struct DiskOverPlane {
+    pub scene: Scene,
+    pub exact: Vec<f64>,
+}
+
+pub fn disk_light_over_plane(size: UVec2) -> DiskOverPlane {
+    use prism::geometry::disk::Disk;
+    use prism::scene::mitsuba::factory::shapes::{rectangle, transform_mesh};
+    let (rho, radiance, radius, height) = (0.5f64, 4.0f64, 0.5f64, 1.0f64);
+    let camera = camera(
+        DVec3::new(0.0, -1.2, 0.8),
+        DVec3::ZERO,
+        DVec3::Z,
+        50.0,
+        size,
+    );
+    let plane = Transform::new(DMat4::from_scale(DVec3::splat(50.0))).unwrap();
+    let disk = Transform::new(
+        DMat4::from_translation(DVec3::new(0.0, 0.0, height))
+            * DMat4::from_rotation_x(std::f64::consts::PI)
+            * DMat4::from_scale(DVec3::splat(radius)),
+    )
+    .unwrap();
+    let scene = build(
+        vec![
+            Object {
+                shape: Shape::Mesh(transform_mesh(rectangle(), &plane, false, true)),
+                reflectance: rho as f32,
+                emission: None,
+            },
+            Object {
+                shape: Shape::Disk(Disk::new(disk, false)),
+                reflectance: 0.0,
+                emission: Some(radiance as f32),
+            },
+        ],
+        vec![],
+        camera.clone(),
+        size,
+        PathIntegrator {
+            max_depth: 2,
+            ..PathIntegrator::default()
+        },
+    );
+    let exitant = |film_position: Vec2| -> f64 {
+        let ray = camera.generate_ray(film_position, Vec2::splat(0.5), 0.0);
+        let t = -ray.o.z / ray.d.z;
+        let x = (ray.o + ray.d * t).as_dvec3();
+        let r2 = x.x * x.x + x.y * x.y;
+        let (h2, big_r2) = (height * height, radius * radius);
+        let e = std::f64::consts::PI * radiance / 2.0
+            * (1.0 - (h2 + r2 - big_r2) / ((h2 + r2 + big_r2).powi(2) - 4.0 * r2 * big_r2).sqrt());
+        rho * e / std::f64::consts::PI
+    };
+    let quadrature = 32;
+    let mut exact = Vec::new();
+    for y in 0..size.y {
+        for x in 0..size.x {
+            let mut sum = 0.0;
+            for j in 0..quadrature {
+                for i in 0..quadrature {
+                    let offset = Vec2::new(
+                        (i as f32 + 0.5) / quadrature as f32,
+                        (j as f32 + 0.5) / quadrature as f32,
+                    );
+                    sum += exitant(Vec2::new(x as f32, y as f32) + offset);
+                }
+            }
+            exact.push(sum / f64::from(quadrature * quadrature));
+        }
+    }
+    DiskOverPlane { scene, exact }
 }
