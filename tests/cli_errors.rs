@@ -301,3 +301,59 @@ fn missing_scene_file() {
     assert_eq!(status, 2, "{stderr}");
     assert!(stderr.contains("not found"), "{stderr}");
 }
+
+/// A scene whose sensor is `sensor` (XML of the whole element) and which has one sphere.
+fn scene_with_sensor(sensor: &str) -> String {
+    format!("<scene version=\"3.0.0\">\n{sensor}\n    <shape type=\"sphere\"/>\n</scene>\n")
+}
+
+#[test]
+fn bad_lens_shutter_and_filter_parameters() {
+    let cases: [(&str, &str, &str); 8] = [
+        (
+            "<sensor type=\"thinlens\">\n  <float name=\"aperture_radius\" value=\"0\"/>\n</sensor>",
+            "scene.xml:3:3",
+            "aperture must be positive",
+        ),
+        (
+            "<sensor type=\"thinlens\">\n  <float name=\"aperture_area\" value=\"-1\"/>\n</sensor>",
+            "scene.xml:3:3",
+            "aperture must be positive",
+        ),
+        (
+            "<sensor type=\"thinlens\">\n  <float name=\"aperture_radius\" value=\"0.1\"/>\n  <float name=\"focal_distance\" value=\"0\"/>\n</sensor>",
+            "scene.xml:4:3",
+            "focus distance must be positive",
+        ),
+        (
+            "<sensor type=\"perspective\">\n  <float name=\"shutter_open\" value=\"1\"/>\n  <float name=\"shutter_close\" value=\"0.5\"/>\n</sensor>",
+            "scene.xml:4:3",
+            "before it opens",
+        ),
+        (
+            "<sensor type=\"perspective\">\n  <film type=\"hdrfilm\">\n    <rfilter type=\"tent\"><float name=\"radius\" value=\"0\"/></rfilter>\n  </film>\n</sensor>",
+            "scene.xml:4:26",
+            "must be positive",
+        ),
+        (
+            "<sensor type=\"perspective\">\n  <film type=\"hdrfilm\">\n    <rfilter type=\"mitchell\"><float name=\"B\" value=\"3\"/></rfilter>\n  </film>\n</sensor>",
+            "scene.xml:4:30",
+            "outside the valid range",
+        ),
+        (
+            "<sensor type=\"perspective\">\n  <animation name=\"to_world\">\n    <transform time=\"1\"/>\n    <transform time=\"0\"/>\n  </animation>\n</sensor>",
+            "scene.xml:5:5",
+            "comes after",
+        ),
+        (
+            "<sensor type=\"perspective\">\n  <animation name=\"toWorld\">\n    <transform time=\"0\"/>\n    <transform time=\"1\"><scale value=\"0\"/></transform>\n  </animation>\n</sensor>",
+            "scene.xml:5:5",
+            "singular",
+        ),
+    ];
+    for (i, (sensor, location, says)) in cases.iter().enumerate() {
+        let dir = folder(&format!("sensor-{i}"));
+        write(&dir, "scene.xml", &scene_with_sensor(sensor));
+        assert_error(&dir, &[], location, &[says]);
+    }
+}

@@ -329,3 +329,48 @@ fn nrooks_sampling_has_less_error_than_independent_sampling() {
         "MSE at 16 spp: independent {independent} ± {se_i}, nrooks {nrooks} ± {se_n}"
     );
 }
+
+/// A camera moving sideways past a still emitter smears it exactly as the emitter moving the
+/// other way past a still camera: same x-variance of the image (see the previous test).
+#[test]
+fn a_moving_camera_smears_a_still_emitter() {
+    let size = UVec2::new(48, 16);
+    let fov = 20.0;
+    let (depth, radius, travel) = (4.0f64, 0.02f64, 0.6f64);
+    let scale = pixels_per_tan(size.x, fov);
+    let key = |x: f64| {
+        prism::math::transform::look_at(DVec3::new(x, 0.0, 0.0), DVec3::new(x, 0.0, 1.0), DVec3::Y)
+            .unwrap()
+    };
+    let Camera::Perspective(still) = camera(DVec3::ZERO, DVec3::Z, DVec3::Y, fov, size);
+    let moving = Camera::Perspective(PerspectiveCamera {
+        to_world: AnimatedTransform::new(&[(0.0, key(-travel / 2.0)), (1.0, key(travel / 2.0))])
+            .unwrap(),
+        ..still
+    });
+    let mut scene = build(
+        vec![Object {
+            shape: facing_disk(radius, depth),
+            reflectance: 0.0,
+            emission: Some(1.0),
+        }],
+        vec![],
+        moving,
+        size,
+        PathIntegrator {
+            max_depth: 1,
+            ..PathIntegrator::default()
+        },
+    );
+    scene.shutter = Shutter::new(0.0, 1.0, None);
+    scene.sampler.kind = SamplerKind::NRooks;
+    let film = render_film(&scene, 1024, 4, None);
+    let length = travel / depth * scale;
+    let image = radius / depth * scale;
+    let expected = image * image / 4.0 + length * length / 12.0 - 1.0 / 12.0;
+    let (variance, se, _) = second_moment(&film, Vec2::new(24.0, 8.0), Some(0));
+    assert!(
+        (variance - expected).abs() < 4.0 * se + 0.01 * expected,
+        "x-variance {variance} ± {se} px², a box of {length} px predicts {expected}"
+    );
+}
