@@ -2,13 +2,15 @@
 
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
+use std::time::Duration;
 
 use clap::Args;
 
 use crate::error::{Error, Result};
 use crate::film::output::{ChannelImage, write_exr, write_png_srgb};
 use crate::film::{CropWindow, Film};
-use crate::render::{RenderOptions, render};
+use crate::render::stats::{pixel_relative_error, variance_of_mean};
+use crate::render::{RenderOptions, StopReason, StopRule, render};
 use crate::scene::mitsuba::load_scene;
 
 #[derive(Args, Debug)]
@@ -34,6 +36,14 @@ pub struct RenderArgs {
     /// Render only the pixels x0 <= x < x1, y0 <= y < y1 of the film
     #[arg(long, value_name = "X0,Y0,X1,Y1", value_parser = parse_crop)]
     pub crop: Option<[u32; 4]>,
+    /// Stop after this many seconds (the pass running then is dropped); without --spp the
+    /// number of samples is open-ended
+    #[arg(long, value_name = "SECONDS")]
+    pub time_limit: Option<f64>,
+    /// Render in passes until the image's mean relative standard error is at most E; without
+    /// --spp the number of samples is open-ended
+    #[arg(long, value_name = "E")]
+    pub target_error: Option<f64>,
 }
 
 fn parse_define(text: &str) -> Result<(String, String), String> {
@@ -93,6 +103,36 @@ fn default_name(scene: &Path) -> String {
     stem.to_string()
 }
 
+/// The stopping rule the arguments ask for. Without --time-limit or --target-error the render
+/// takes exactly the requested samples; with either, --spp (if given) only caps the samples.
+fn stop_rule(args: &RenderArgs, scene_spp: u32) -> Result<StopRule> {
+    let time_limit = match args.time_limit {
+        Some(t) if !(t > 0.0 && t.is_finite()) => {
+            return Err(Error::usage(format!(
+                "--time-limit must be a positive number of seconds, not {t}"
+            )));
+        }
+        t => t.map(Duration::from_secs_f64),
+    };
+    if let Some(e) = args.target_error
+        && !(e > 0.0 && e.is_finite())
+    {
+        return Err(Error::usage(format!(
+            "--target-error must be positive, not {e}"
+        )));
+    }
+    let open_ended = time_limit.is_some() || args.target_error.is_some();
+    Ok(StopRule {
+        samples_per_pixel: if open_ended {
+            args.spp
+        } else {
+            Some(args.spp.unwrap_or(scene_spp))
+        },
+        time_limit,
+        target_error: args.target_error,
+    })
+}
+
 pub fn run(args: &RenderArgs) -> Result<()> {
     if args.spp == Some(0) {
         return Err(Error::usage("--spp must be at least 1"));
@@ -115,8 +155,10 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             size: glam::UVec2::new(x1 - x0, y1 - y0),
         };
     }
+    let stop = stop_rule(args, scene.sampler.samples_per_pixel)?;
     let options = RenderOptions {
         samples_per_pixel: args.spp.unwrap_or(scene.sampler.samples_per_pixel),
+        stop,
         threads: args.threads,
         seed: args.seed.unwrap_or(loaded.seed),
         progress: std::io::stderr().is_terminal(),
@@ -127,8 +169,13 @@ pub fn run(args: &RenderArgs) -> Result<()> {
 
     let seconds = output.elapsed.as_secs_f64().max(1e-9);
     let (_, rejected) = output.film.sample_counts();
+    let stopped = match output.stop {
+        StopReason::Completed => "",
+        StopReason::TimeLimit => ", stopped by the time limit",
+        StopReason::TargetError => ", target error reached",
+    };
     eprintln!(
-        "prism: rendered {} ({}×{}, {} spp) in {:.2} s: {:.3} M samples/s, {:.2} M rays/s{} -> {}, {}",
+        "prism: rendered {} ({}×{}, {} spp{stopped}) in {:.2} s: {:.3} M samples/s, {:.2} M rays/s, mean relative error {:.4}{} -> {}, {}",
         args.scene.display(),
         scene.film.crop.size.x,
         scene.film.crop.size.y,
@@ -136,6 +183,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         seconds,
         output.samples as f64 / seconds / 1e6,
         output.rays as f64 / seconds / 1e6,
+        output.relative_error,
         if rejected > 0 {
             format!(", {rejected} non-finite samples dropped")
         } else {
@@ -147,11 +195,20 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     Ok(())
 }
 
-/// Writes the film as an EXR with channels R, G, B (linear sRGB) and X, Y, Z, and as an sRGB PNG.
+/// Writes the film as an EXR and as an sRGB PNG. The EXR's channels are `R`, `G`, `B` (linear
+/// sRGB), `X`, `Y`, `Z` (CIE 1931), `variance.X`, `variance.Y`, `variance.Z` (the estimated
+/// variance of each pixel's mean, see [`crate::render::stats`]) and `relative_error.Y` (the
+/// pixel's relative standard error of luminance).
 pub fn write_images(film: &Film, exr_path: &Path, png_path: &Path) -> Result<()> {
     let xyz = film.xyz();
     let rgb = film.linear_srgb();
     let channel = |values: &[[f32; 3]], c: usize| values.iter().map(|v| v[c]).collect::<Vec<f32>>();
+    let variance = |c: usize| {
+        film.pixels
+            .iter()
+            .map(|p| variance_of_mean(p, c) as f32)
+            .collect::<Vec<f32>>()
+    };
     let image = ChannelImage {
         width: film.crop.size.x as usize,
         height: film.crop.size.y as usize,
@@ -162,6 +219,16 @@ pub fn write_images(film: &Film, exr_path: &Path, png_path: &Path) -> Result<()>
             ("X".to_string(), channel(&xyz, 0)),
             ("Y".to_string(), channel(&xyz, 1)),
             ("Z".to_string(), channel(&xyz, 2)),
+            ("variance.X".to_string(), variance(0)),
+            ("variance.Y".to_string(), variance(1)),
+            ("variance.Z".to_string(), variance(2)),
+            (
+                "relative_error.Y".to_string(),
+                film.pixels
+                    .iter()
+                    .map(|p| pixel_relative_error(p) as f32)
+                    .collect(),
+            ),
         ],
     };
     write_exr(exr_path, &image)?;

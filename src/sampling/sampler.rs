@@ -124,12 +124,21 @@ impl Sampler {
         self.sample_count
     }
 
-    /// Prepares sample `index` (0 ≤ index < sample count) of `pixel` (full-film coordinates).
+    /// Prepares sample `index` of `pixel` (full-film coordinates). Indices beyond the sample
+    /// count start new, independently shuffled blocks of N stratified samples, so a render that
+    /// goes on past N samples (to reach an error target, say) stays stratified block by block.
     pub fn start_pixel_sample(&mut self, pixel: UVec2, index: u32) {
-        self.pixel_seed = hash_u64s(&[u64::from(pixel.x), u64::from(pixel.y), self.seed]);
-        self.index = index;
+        let block = index / self.sample_count;
+        self.pixel_seed = hash_u64s(&[
+            u64::from(pixel.x),
+            u64::from(pixel.y),
+            self.seed,
+            u64::from(block),
+        ]);
+        self.index = index % self.sample_count;
         self.dimension = 0;
-        self.rng = Pcg32::new(hash_u64s(&[self.seed]), self.pixel_seed);
+        let stream = hash_u64s(&[u64::from(pixel.x), u64::from(pixel.y), self.seed]);
+        self.rng = Pcg32::new(hash_u64s(&[self.seed]), stream);
         self.rng.advance(i64::from(index) * NUMBERS_PER_SAMPLE);
     }
 
@@ -410,6 +419,27 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// Sample indices past N form further blocks, each one sample per stratum again.
+    #[test]
+    fn later_blocks_are_stratified_too() {
+        let mut sampler = Sampler::new(SamplerKind::NRooks, 16, 3);
+        let block = |sampler: &mut Sampler, b: u32| -> Vec<f32> {
+            (0..16)
+                .map(|i| {
+                    sampler.start_pixel_sample(UVec2::new(2, 2), b * 16 + i);
+                    sampler.camera_sample().wavelength
+                })
+                .collect()
+        };
+        let (first, second) = (block(&mut sampler, 0), block(&mut sampler, 1));
+        for values in [&first, &second] {
+            let mut strata: Vec<u32> = values.iter().map(|v| (v * 16.0) as u32).collect();
+            strata.sort_unstable();
+            assert_eq!(strata, (0..16).collect::<Vec<u32>>());
+        }
+        assert_ne!(first, second, "the second block is shuffled anew");
     }
 
     /// Different dimensions are shuffled independently: the strata of wavelength and time are not

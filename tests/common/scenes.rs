@@ -42,7 +42,7 @@ pub fn build(
     extra_lights: Vec<Light>,
     camera: Camera,
     size: UVec2,
-    integrator: PathIntegrator,
+    integrator: impl Into<Integrator>,
 ) -> Scene {
     let mut shapes = Vec::new();
     let mut info = Vec::new();
@@ -87,23 +87,15 @@ pub fn build(
             kind: SamplerKind::Independent,
             samples_per_pixel: 1,
         },
-        Integrator::Path(integrator),
+        integrator.into(),
     )
 }
 
 /// Renders with a fixed seed and no progress bar.
 pub fn render_film(scene: &Scene, spp: u32, seed: u64, threads: Option<usize>) -> Film {
-    render(
-        scene,
-        &RenderOptions {
-            samples_per_pixel: spp,
-            threads,
-            seed,
-            progress: false,
-        },
-    )
-    .unwrap()
-    .film
+    render(scene, &RenderOptions::fixed(spp, seed, threads))
+        .unwrap()
+        .film
 }
 
 /// Mean of a pixel's estimate of channel `c` (0 = X, 1 = Y, 2 = Z) and the variance of that
