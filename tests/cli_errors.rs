@@ -357,3 +357,108 @@ fn bad_lens_shutter_and_filter_parameters() {
         assert_error(&dir, &[], location, &[says]);
     }
 }
+
+/// Runs `prism` with `args`; returns (status, stdout + stderr).
+fn prism(args: &[&str]) -> (i32, String) {
+    let output = Command::new(env!("CARGO_BIN_EXE_prism"))
+        .args(args)
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&output.stdout).into_owned()
+        + &String::from_utf8_lossy(&output.stderr);
+    (output.status.code().unwrap_or(-1), text)
+}
+
+#[test]
+fn bad_stopping_rules_and_estimator_parameters() {
+    let dir = folder("stopping");
+    write(
+        &dir,
+        "scene.xml",
+        &scene("    <shape type=\"sphere\"/>", ""),
+    );
+    let scene_path = dir.join("scene.xml");
+    let scene_path = scene_path.to_str().unwrap();
+    for (flag, value) in [
+        ("--target-error", "0"),
+        ("--target-error", "-1"),
+        ("--time-limit", "0"),
+        ("--time-limit", "nan"),
+    ] {
+        let argument = format!("{flag}={value}");
+        let (status, text) = prism(&[
+            "render",
+            scene_path,
+            "-o",
+            dir.join("o.exr").to_str().unwrap(),
+            &argument,
+        ]);
+        assert_eq!(status, 2, "{flag} {value}: {text}");
+        assert!(text.contains(flag) && !text.contains("panicked"), "{text}");
+    }
+    for (name, value, says) in [
+        ("bounce_samples", "0", "between 1 and 1024"),
+        ("shadow_rays", "-2", "between 1 and 1024"),
+        ("rr_threshold", "0", "must be positive"),
+    ] {
+        let dir = folder(&format!("distrib-{name}"));
+        let kind = if name == "rr_threshold" {
+            "float"
+        } else {
+            "integer"
+        };
+        let text = scene("    <shape type=\"sphere\"/>", "").replace(
+            "<scene version=\"3.0.0\">",
+            &format!("<scene version=\"3.0.0\">\n    <integrator type=\"distrib\"><{kind} name=\"{name}\" value=\"{value}\"/></integrator>"),
+        );
+        write(&dir, "scene.xml", &text);
+        assert_error(&dir, &[], "scene.xml:2:", &[says]);
+    }
+}
+
+#[test]
+fn compare_refuses_other_sizes_and_corrupt_files() {
+    let dir = folder("compare");
+    write(
+        &dir,
+        "scene.xml",
+        &scene("    <shape type=\"sphere\"/>", ""),
+    );
+    let (status, text) = render(&dir, &[]);
+    assert_eq!(status, 0, "{text}");
+    let image = dir.join("out.exr");
+    let image = image.to_str().unwrap();
+    let (status, text) = prism(&["compare", image, image]);
+    assert_eq!(status, 0, "{text}");
+    assert!(text.contains("relMSE"), "{text}");
+    let other = dir.join("other.exr");
+    let scene_path = dir.join("scene.xml");
+    let (status, text) = prism(&[
+        "render",
+        scene_path.to_str().unwrap(),
+        "--crop",
+        "0,0,2,2",
+        "-o",
+        other.to_str().unwrap(),
+    ]);
+    assert_eq!(status, 0, "{text}");
+    let (status, text) = prism(&["compare", image, other.to_str().unwrap()]);
+    assert_eq!(status, 2, "{text}");
+    assert!(text.contains("4×4") && text.contains("2×2"), "{text}");
+    let corrupt = dir.join("corrupt.exr");
+    std::fs::write(&corrupt, b"v/1\x01not an exr at all").unwrap();
+    let (status, text) = prism(&["compare", image, corrupt.to_str().unwrap()]);
+    assert_eq!(status, 2, "{text}");
+    assert!(
+        text.contains("corrupt.exr") && !text.contains("panicked"),
+        "{text}"
+    );
+    let (status, text) = prism(&[
+        "converge",
+        dir.join("scene.xml").to_str().unwrap(),
+        "--reference",
+        other.to_str().unwrap(),
+    ]);
+    assert_eq!(status, 2, "{text}");
+    assert!(text.contains("reference"), "{text}");
+}

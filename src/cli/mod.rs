@@ -1,3 +1,5 @@
 //! The subcommands of the `prism` program, one per file.
 
+pub mod compare;
+pub mod converge;
 pub mod render;

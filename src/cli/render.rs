@@ -46,7 +46,7 @@ pub struct RenderArgs {
     pub target_error: Option<f64>,
 }
 
-fn parse_define(text: &str) -> Result<(String, String), String> {
+pub(crate) fn parse_define(text: &str) -> Result<(String, String), String> {
     match text.split_once('=') {
         Some((name, value)) if !name.is_empty() => Ok((name.to_string(), value.to_string())),
         _ => Err(format!("expected NAME=VALUE, got \"{text}\"")),

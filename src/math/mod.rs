@@ -6,6 +6,7 @@
 pub mod animated;
 pub mod frame;
 pub mod ray;
+pub mod special;
 pub mod transform;
 
 pub use animated::AnimatedTransform;
