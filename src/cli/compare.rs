@@ -330,7 +330,7 @@ mod tests {
         let variance = vec![1.0f32; n];
         let z = z_test(&noise, &reference, &variance, None);
         assert!(z.p_value > 0.01 && z.max_z_p_value > 0.01, "{z:?}");
-        let shifted: Vec<f32> = noise.iter().map(|v| v + 0.2).collect();
+        let shifted: Vec<f32> = noise.iter().map(|v| v + 0.5).collect();
         let z = z_test(&shifted, &reference, &variance, None);
         assert!(z.p_value < 1e-6, "{z:?}");
     }

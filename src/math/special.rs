@@ -96,7 +96,7 @@ mod tests {
     #[test]
     fn q_of_one_is_the_exponential() {
         for x in [0.0, 0.5, 1.0, 3.0, 20.0] {
-            assert!((regularized_gamma_q(1.0, x) - (-x as f64).exp()).abs() < 1e-12);
+            assert!((regularized_gamma_q(1.0, x) - (-x).exp()).abs() < 1e-12);
         }
         assert!(regularized_gamma_q(0.1, 1.0).is_nan());
     }
