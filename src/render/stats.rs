@@ -22,8 +22,8 @@ pub fn variance_of_mean(pixel: &PixelSums, c: usize) -> f64 {
     if pixel.samples < 2 {
         return f64::INFINITY;
     }
-    let mean = pixel.xyz[c] / n;
-    ((pixel.xyz_squared[c] / n - mean * mean) / (n - 1.0)).max(0.0)
+    let mean = pixel.sum(c) / n;
+    ((pixel.sum_of_squares(c) / n - mean * mean) / (n - 1.0)).max(0.0)
 }
 
 /// The relative standard error of a pixel's luminance: √(var / (Y² + 0.01)).

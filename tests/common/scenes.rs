@@ -103,8 +103,8 @@ pub fn render_film(scene: &Scene, spp: u32, seed: u64, threads: Option<usize>) -
 pub fn pixel_mean_and_variance(film: &Film, index: usize, c: usize) -> (f64, f64) {
     let p = &film.pixels[index];
     let n = p.samples as f64;
-    let mean = p.xyz[c] / n;
-    let variance = ((p.xyz_squared[c] / n - mean * mean) / (n - 1.0)).max(0.0);
+    let mean = p.sum(c) / n;
+    let variance = ((p.sum_of_squares(c) / n - mean * mean) / (n - 1.0)).max(0.0);
     (mean, variance)
 }
 

@@ -23,9 +23,10 @@ pub const SUPPORTED_FILTERS: &[&str] = &[
 ];
 pub const SUPPORTED_SAMPLERS: &[&str] = &["independent", "stratified", "multijitter", "nrooks"];
 
-/// Largest film side, and largest pixel count, accepted (each pixel keeps 64 bytes of sums).
+/// Largest film side, and largest pixel count, accepted (each pixel keeps 112 bytes of sums,
+/// twice while a pass is rendered).
 const MAX_FILM_SIDE: i64 = 1 << 16;
-const MAX_FILM_PIXELS: i64 = 1 << 26;
+const MAX_FILM_PIXELS: i64 = 1 << 25;
 
 /// The camera, shutter, film settings, sampler settings and sampler seed of a `<sensor>`.
 pub struct SensorSettings {
