@@ -18,6 +18,8 @@ enum Command {
     Compare(prism::cli::compare::CompareArgs),
     /// Render at 1, 2, 4, ... samples per pixel and plot the relative MSE against a reference.
     Converge(prism::cli::converge::ConvergeArgs),
+    /// Combine render states of disjoint sample ranges into one image.
+    Merge(prism::cli::merge::MergeArgs),
 }
 
 fn main() {
@@ -26,6 +28,7 @@ fn main() {
         Command::Render(args) => prism::cli::render::run(&args),
         Command::Compare(args) => prism::cli::compare::run(&args),
         Command::Converge(args) => prism::cli::converge::run(&args),
+        Command::Merge(args) => prism::cli::merge::run(&args),
     };
     if let Err(error) = result {
         eprintln!("error: {error}");

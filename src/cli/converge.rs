@@ -188,7 +188,7 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
                 );
                 series
                     .points
-                    .push((output.samples_per_pixel, seconds, error));
+                    .push((output.samples.end - output.samples.start, seconds, error));
                 seed += 1;
                 spp *= 2;
             }

@@ -62,7 +62,10 @@ impl PixelSums {
     #[inline]
     pub fn add(&mut self, xyz: [f32; 3]) {
         self.samples += 1;
-        if !xyz.iter().all(|v| v.is_finite() && f64::from(v.abs()) < LARGEST_SAMPLE) {
+        if !xyz
+            .iter()
+            .all(|v| v.is_finite() && f64::from(v.abs()) < LARGEST_SAMPLE)
+        {
             self.rejected += 1;
             return;
         }
@@ -159,7 +162,11 @@ mod tests {
     fn sums_are_order_independent() {
         let mut rng = Pcg32::seeded(8);
         let samples: Vec<[f32; 3]> = (0..1000)
-            .map(|_| [0, 1, 2].map(|_| (rng.next_f32() - 0.3) * 10f32.powi((rng.next_f32() * 12.0) as i32 - 6)))
+            .map(|_| {
+                [0, 1, 2].map(|_| {
+                    (rng.next_f32() - 0.3) * 10f32.powi((rng.next_f32() * 12.0) as i32 - 6)
+                })
+            })
             .collect();
         let mut forward = PixelSums::default();
         samples.iter().for_each(|s| forward.add(*s));

@@ -2,20 +2,24 @@
 //! within a pass the tiles of the crop window are rendered in parallel on a rayon pool.
 //!
 //! Every pixel sample draws its random numbers from the sampler's stream for (seed, pixel,
-//! sample index), every sample lands in its own pixel, and each pixel adds its samples to its
-//! sums in index order, pass after pass. The image is therefore bit-identical whatever the
-//! number of threads, the order in which tiles finish, and the way the samples are split into
-//! passes.
+//! sample index), every sample lands in its own pixel, and pixel sums are exact (order-free) — so
+//! the image is bit-identical whatever the number of threads, the order in which tiles finish,
+//! the way the samples are split into passes, and whether the render was interrupted, resumed
+//! or assembled from several renders of disjoint sample ranges.
 //!
 //! A pass is committed only when all its tiles are done: a pass cut short (by the time limit or
 //! an interruption) is dropped whole, so every pixel always has the same number of samples and
 //! the image stays an unbiased, correctly normalised estimate whenever the render stops.
 //!
-//! Stopping rules: a fixed number of samples per pixel, a time limit, and a target for the mean
-//! relative standard error of the image ([`relative_error`]), whichever comes first.
+//! Stopping rules: the end of the requested sample range, a time limit, and a target for the
+//! image's mean relative standard error ([`relative_error`]), whichever comes first; and an
+//! interruption from outside (a signal).
 
+pub mod state;
 pub mod stats;
 
+use std::ops::Range;
+use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::time::{Duration, Instant};
 
@@ -34,15 +38,15 @@ pub use stats::relative_error;
 /// Edge length of the square tiles the image is divided into.
 const TILE_SIZE: u32 = 16;
 
-/// Largest pass, in samples per pixel, of a render with a stopping rule (so that the rule is
-/// checked often enough).
-const MAX_PASS: u32 = 64;
+/// A render made of several passes aims at passes of about this length, so that stopping rules,
+/// checkpoints and interruptions are acted on promptly and little work is dropped.
+const TARGET_PASS_TIME: Duration = Duration::from_secs(2);
 
-/// When a render stops.
+/// When a render stops (besides an interruption).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct StopRule {
-    /// Stop after this many samples per pixel (None: no limit).
-    pub samples_per_pixel: Option<u32>,
+    /// Stop before this sample index (None: no limit).
+    pub sample_end: Option<u32>,
     /// Stop when this much time has passed; the pass running then is dropped.
     pub time_limit: Option<Duration>,
     /// Stop once the image's mean relative standard error is at most this.
@@ -50,10 +54,10 @@ pub struct StopRule {
 }
 
 impl StopRule {
-    /// Render exactly `n` samples per pixel.
+    /// Render the samples 0..n.
     pub fn samples(n: u32) -> StopRule {
         StopRule {
-            samples_per_pixel: Some(n),
+            sample_end: Some(n),
             ..StopRule::default()
         }
     }
@@ -70,7 +74,14 @@ pub struct RenderOptions {
     /// stratified blocks. Stratified samplers may round it up
     /// (see [`crate::sampling::sampler::SamplerKind::sample_count`]).
     pub samples_per_pixel: u32,
+    /// Index of the first sample to take in every pixel (past a checkpoint, or the start of a
+    /// range given to this render).
+    pub first_sample: u32,
+    /// Sums the render starts from (a resumed render's), row-major over the crop window.
+    pub initial: Option<Vec<PixelSums>>,
     pub stop: StopRule,
+    /// Raised from outside (by a signal handler) to stop the render after dropping its pass.
+    pub interrupt: Option<Arc<AtomicBool>>,
     /// Worker threads; None for one per core.
     pub threads: Option<usize>,
     /// Seed of every random stream.
@@ -80,15 +91,23 @@ pub struct RenderOptions {
 }
 
 impl RenderOptions {
-    /// Options for rendering exactly `spp` samples per pixel.
+    /// Options for rendering the samples 0..spp in one go.
     pub fn fixed(spp: u32, seed: u64, threads: Option<usize>) -> RenderOptions {
         RenderOptions {
             samples_per_pixel: spp,
+            first_sample: 0,
+            initial: None,
             stop: StopRule::samples(spp),
+            interrupt: None,
             threads,
             seed,
             progress: false,
         }
+    }
+
+    /// Whether the render goes in several passes: when it can be stopped early or checkpointed.
+    fn in_passes(&self, checkpoints: bool) -> bool {
+        checkpoints || self.interrupt.is_some() || self.stop.is_open_ended()
     }
 }
 
@@ -99,16 +118,32 @@ pub enum StopReason {
     Completed,
     TimeLimit,
     TargetError,
+    Interrupted,
+}
+
+/// The state of a render between two passes, handed to the checkpoint writer.
+pub struct Snapshot<'a> {
+    /// The sample indices every pixel has had in this render (after its initial state).
+    pub samples: Range<u32>,
+    /// Pixel sums, row-major over the crop window (including the initial state).
+    pub pixels: &'a [PixelSums],
+}
+
+/// Something that saves the render's state every so often.
+pub struct Checkpoints<'a> {
+    pub every: Duration,
+    pub write: &'a mut dyn FnMut(&Snapshot) -> Result<()>,
 }
 
 /// What a render produced.
 pub struct RenderOutput {
+    /// Pixel sums, including the initial state.
     pub film: Film,
-    /// Samples per pixel taken (the same in every pixel).
-    pub samples_per_pixel: u32,
+    /// The sample indices taken in this render.
+    pub samples: Range<u32>,
     pub elapsed: Duration,
-    /// Camera samples taken.
-    pub samples: u64,
+    /// Camera samples taken in this render.
+    pub sample_count: u64,
     /// Rays traced (camera, bounce and shadow rays).
     pub rays: u64,
     pub stop: StopReason,
@@ -137,19 +172,45 @@ fn tiles(size: UVec2) -> Vec<Tile> {
     tiles
 }
 
-/// Tells a pass to stop: raised by whoever notices the deadline first (or from outside).
+/// Tells a pass to stop: raised by whoever notices the deadline first, or from outside.
 struct Cancel<'a> {
     flag: &'a AtomicBool,
+    external: Option<&'a AtomicBool>,
     deadline: Option<Instant>,
 }
 
 impl Cancel<'_> {
     fn raised(&self) -> bool {
-        if self.deadline.is_some_and(|d| Instant::now() >= d) {
+        if self.deadline.is_some_and(|d| Instant::now() >= d)
+            || self.external.is_some_and(|e| e.load(Ordering::Relaxed))
+        {
             self.flag.store(true, Ordering::Relaxed);
         }
         self.flag.load(Ordering::Relaxed)
     }
+}
+
+/// The filter-weighted CIE XYZ of sample `index` of `pixel` (full-film coordinates).
+pub fn estimate_sample(
+    scene: &Scene,
+    filter: &FilterSampler,
+    sampler: &mut Sampler,
+    pixel: UVec2,
+    index: u32,
+    count: &mut RayCount,
+) -> [f32; 3] {
+    sampler.start_pixel_sample(pixel, index);
+    let primary = sampler.camera_sample();
+    let lambda = SampledWavelengths::sample(primary.wavelength, scene.wavelength_sampling);
+    let (offset, filter_weight) = filter.sample(primary.film);
+    let (time, time_weight) = scene.shutter.sample(primary.time);
+    let film_position = pixel.as_vec2() + Vec2::splat(0.5) + offset;
+    let ray = scene.camera.generate_ray(film_position, primary.lens, time);
+    let radiance = scene
+        .integrator
+        .radiance(scene, ray, &lambda, sampler, count);
+    let weight = filter_weight * time_weight;
+    lambda.to_xyz(&radiance).map(|v| v * weight)
 }
 
 /// Adds the samples `range` of every pixel of a tile to a copy of its sums; None when the pass
@@ -159,7 +220,7 @@ fn render_tile(
     filter: &FilterSampler,
     tile: Tile,
     sums: &[PixelSums],
-    range: std::ops::Range<u32>,
+    range: Range<u32>,
     options: &RenderOptions,
     cancel: &Cancel,
 ) -> Option<(Vec<PixelSums>, u64)> {
@@ -175,20 +236,14 @@ fn render_tile(
             let pixel = crop_offset + tile.origin + UVec2::new(x, y);
             let pixel_sums = &mut pixels[(y * tile.size.x + x) as usize];
             for index in range.clone() {
-                sampler.start_pixel_sample(pixel, index);
-                let primary = sampler.camera_sample();
-                let lambda =
-                    SampledWavelengths::sample(primary.wavelength, scene.wavelength_sampling);
-                let (offset, filter_weight) = filter.sample(primary.film);
-                let (time, time_weight) = scene.shutter.sample(primary.time);
-                let film_position = pixel.as_vec2() + Vec2::splat(0.5) + offset;
-                let ray = scene.camera.generate_ray(film_position, primary.lens, time);
-                let radiance =
-                    scene
-                        .integrator
-                        .radiance(scene, ray, &lambda, &mut sampler, &mut count);
-                let weight = filter_weight * time_weight;
-                pixel_sums.add(lambda.to_xyz(&radiance).map(|v| v * weight));
+                pixel_sums.add(estimate_sample(
+                    scene,
+                    filter,
+                    &mut sampler,
+                    pixel,
+                    index,
+                    &mut count,
+                ));
             }
         }
     }
@@ -196,15 +251,23 @@ fn render_tile(
 }
 
 /// The number of samples per pixel of the next pass.
-fn next_pass(done: u32, stop: &StopRule, elapsed: Duration, error: f64) -> u32 {
-    let left = stop
-        .samples_per_pixel
-        .map_or(u32::MAX, |limit| limit.saturating_sub(done));
-    if !stop.is_open_ended() {
+fn next_pass(
+    in_passes: bool,
+    done: u32,
+    left: u32,
+    stop: &StopRule,
+    elapsed: Duration,
+    error: f64,
+) -> u32 {
+    if !in_passes {
         return left;
     }
-    // Passes grow geometrically from one sample, so the rules are checked early and often.
-    let mut pass = done.clamp(1, MAX_PASS);
+    // Passes grow geometrically from one sample, then keep to about TARGET_PASS_TIME.
+    let mut pass = done.max(1);
+    if done > 0 {
+        let per_sample = elapsed.as_secs_f64() / f64::from(done);
+        pass = pass.min((TARGET_PASS_TIME.as_secs_f64() / per_sample.max(1e-9)).ceil() as u32);
+    }
     if let Some(target) = stop.target_error
         && done > 0
         && error.is_finite()
@@ -220,24 +283,30 @@ fn next_pass(done: u32, stop: &StopRule, elapsed: Duration, error: f64) -> u32 {
         let remaining = limit.saturating_sub(elapsed).as_secs_f64();
         pass = pass.min(((remaining / per_sample) as u32).max(1));
     }
-    pass.min(left)
+    pass.clamp(1, left.max(1))
 }
 
 /// Renders the scene.
 pub fn render(scene: &Scene, options: &RenderOptions) -> Result<RenderOutput> {
+    render_with_checkpoints(scene, options, None)
+}
+
+/// Renders the scene, handing its state to `checkpoints` between passes every so often.
+pub fn render_with_checkpoints(
+    scene: &Scene,
+    options: &RenderOptions,
+    mut checkpoints: Option<Checkpoints>,
+) -> Result<RenderOutput> {
     let crop = scene.film.crop;
     let filter = FilterSampler::new(scene.film.filter);
     let tiles = tiles(crop.size);
     let pixel_count = u64::from(crop.size.x) * u64::from(crop.size.y);
-    let mut stop = options.stop;
-    if let Some(limit) = &mut stop.samples_per_pixel {
-        *limit = scene.sampler.kind.sample_count(*limit);
-    }
     let options = RenderOptions {
         samples_per_pixel: scene.sampler.kind.sample_count(options.samples_per_pixel),
-        stop,
         ..options.clone()
     };
+    let stop = options.stop;
+    let in_passes = options.in_passes(checkpoints.is_some());
 
     let mut builder = rayon::ThreadPoolBuilder::new();
     if let Some(threads) = options.threads {
@@ -247,18 +316,21 @@ pub fn render(scene: &Scene, options: &RenderOptions) -> Result<RenderOutput> {
         .build()
         .map_err(|e| Error::usage(format!("could not start the worker threads: {e}")))?;
 
+    let mut sums = tile_major(&tiles, crop.size, options.initial.as_deref())?;
     let progress = progress_bar(&options, pixel_count);
-    let mut sums: Vec<Vec<PixelSums>> = tiles
-        .iter()
-        .map(|t| vec![PixelSums::default(); (t.size.x * t.size.y) as usize])
-        .collect();
     let rays = AtomicU64::new(0);
     let abort = AtomicBool::new(false);
     let start = Instant::now();
-    let mut done = 0u32;
-    let mut error = f64::INFINITY;
+    let mut last_checkpoint = start;
+    let first = options.first_sample;
+    let mut next = first;
+    let mut error = if options.initial.is_some() {
+        relative_error(sums.iter().flatten())
+    } else {
+        f64::INFINITY
+    };
     let reason = loop {
-        if stop.samples_per_pixel.is_some_and(|limit| done >= limit) {
+        if stop.sample_end.is_some_and(|end| next >= end) {
             break StopReason::Completed;
         }
         if stop.target_error.is_some_and(|target| error <= target) {
@@ -270,10 +342,19 @@ pub fn render(scene: &Scene, options: &RenderOptions) -> Result<RenderOutput> {
         {
             break StopReason::TimeLimit;
         }
-        let pass = next_pass(done, &stop, start.elapsed(), error);
-        let range = done..done + pass;
+        if options
+            .interrupt
+            .as_ref()
+            .is_some_and(|i| i.load(Ordering::Relaxed))
+        {
+            break StopReason::Interrupted;
+        }
+        let left = stop.sample_end.map_or(u32::MAX - next, |end| end - next);
+        let pass = next_pass(in_passes, next - first, left, &stop, start.elapsed(), error);
+        let range = next..next + pass;
         let cancel = Cancel {
             flag: &abort,
+            external: options.interrupt.as_deref(),
             deadline: stop.time_limit.map(|limit| start + limit),
         };
         let results: Vec<Option<(Vec<PixelSums>, u64)>> = pool.install(|| {
@@ -298,56 +379,113 @@ pub fn render(scene: &Scene, options: &RenderOptions) -> Result<RenderOutput> {
                 .collect()
         });
         if abort.load(Ordering::Relaxed) || results.iter().any(Option::is_none) {
-            break StopReason::TimeLimit;
+            let interrupted = options
+                .interrupt
+                .as_ref()
+                .is_some_and(|i| i.load(Ordering::Relaxed));
+            break if interrupted {
+                StopReason::Interrupted
+            } else {
+                StopReason::TimeLimit
+            };
         }
         for (tile_sums, (new_sums, tile_rays)) in sums.iter_mut().zip(results.into_iter().flatten())
         {
             *tile_sums = new_sums;
             rays.fetch_add(tile_rays, Ordering::Relaxed);
         }
-        done += pass;
+        next += pass;
         error = relative_error(sums.iter().flatten());
-        if stop.is_open_ended() {
-            progress.set_message(format!("{done} spp, error {error:.4}"));
+        progress.set_message(format!("{} spp, error {error:.4}", next - first));
+        if let Some(checkpoint) = &mut checkpoints
+            && last_checkpoint.elapsed() >= checkpoint.every
+        {
+            let pixels = row_major(&tiles, crop.size, &sums);
+            (checkpoint.write)(&Snapshot {
+                samples: first..next,
+                pixels: &pixels,
+            })?;
+            last_checkpoint = Instant::now();
         }
     };
     let elapsed = start.elapsed();
     progress.finish_and_clear();
 
     let mut film = Film::new(scene.film.size, crop);
-    for (tile, tile_sums) in tiles.iter().zip(&sums) {
-        for y in 0..tile.size.y {
-            for x in 0..tile.size.x {
-                let index = film.index(tile.origin.x + x, tile.origin.y + y);
-                film.pixels[index] = tile_sums[(y * tile.size.x + x) as usize];
-            }
-        }
+    film.pixels = row_major(&tiles, crop.size, &sums);
+    if let Some(checkpoint) = &mut checkpoints {
+        (checkpoint.write)(&Snapshot {
+            samples: first..next,
+            pixels: &film.pixels,
+        })?;
     }
     Ok(RenderOutput {
         film,
-        samples_per_pixel: done,
+        samples: first..next,
         elapsed,
-        samples: pixel_count * u64::from(done),
+        sample_count: pixel_count * u64::from(next - first),
         rays: rays.into_inner(),
         stop: reason,
         relative_error: error,
     })
 }
 
+/// Pixel sums regrouped by tile (each tile's pixels row-major), from row-major sums or empty.
+fn tile_major(
+    tiles: &[Tile],
+    size: UVec2,
+    initial: Option<&[PixelSums]>,
+) -> Result<Vec<Vec<PixelSums>>> {
+    if let Some(pixels) = initial
+        && pixels.len() != (size.x * size.y) as usize
+    {
+        return Err(Error::usage(
+            "the initial state does not match the crop window",
+        ));
+    }
+    Ok(tiles
+        .iter()
+        .map(|t| {
+            let mut sums = Vec::with_capacity((t.size.x * t.size.y) as usize);
+            for y in 0..t.size.y {
+                for x in 0..t.size.x {
+                    let index = ((t.origin.y + y) * size.x + t.origin.x + x) as usize;
+                    sums.push(initial.map_or(PixelSums::default(), |p| p[index]));
+                }
+            }
+            sums
+        })
+        .collect())
+}
+
+/// Row-major pixel sums from tile-major ones.
+fn row_major(tiles: &[Tile], size: UVec2, sums: &[Vec<PixelSums>]) -> Vec<PixelSums> {
+    let mut pixels = vec![PixelSums::default(); (size.x * size.y) as usize];
+    for (tile, tile_sums) in tiles.iter().zip(sums) {
+        for y in 0..tile.size.y {
+            for x in 0..tile.size.x {
+                let index = ((tile.origin.y + y) * size.x + tile.origin.x + x) as usize;
+                pixels[index] = tile_sums[(y * tile.size.x + x) as usize];
+            }
+        }
+    }
+    pixels
+}
+
 fn progress_bar(options: &RenderOptions, pixel_count: u64) -> ProgressBar {
     if !options.progress {
         return ProgressBar::hidden();
     }
-    let template = if options.stop.is_open_ended() {
-        "{spinner} {elapsed_precise} {human_pos} samples, {per_sec} — {msg}"
-    } else {
-        "{bar:40.cyan/blue} {percent:>3}% {human_pos}/{human_len} samples, {per_sec}, ETA {eta}"
-    };
     let total = options
         .stop
-        .samples_per_pixel
+        .sample_end
         .filter(|_| !options.stop.is_open_ended())
-        .map(|n| pixel_count * u64::from(n));
+        .map(|end| pixel_count * u64::from(end.saturating_sub(options.first_sample)));
+    let template = if total.is_some() {
+        "{bar:40.cyan/blue} {percent:>3}% {human_pos}/{human_len} samples, {per_sec}, ETA {eta} — {msg}"
+    } else {
+        "{spinner} {elapsed_precise} {human_pos} samples, {per_sec} — {msg}"
+    };
     let bar = ProgressBar::with_draw_target(total, ProgressDrawTarget::stderr());
     bar.set_style(
         ProgressStyle::with_template(template).unwrap_or_else(|_| ProgressStyle::default_bar()),

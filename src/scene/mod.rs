@@ -1,6 +1,7 @@
 //! Scenes: the renderable [`Scene`], the mesh readers, and the Mitsuba XML reader and plugin
 //! factory that build it.
 
+pub mod fingerprint;
 pub mod image_file;
 pub mod mesh;
 pub mod mitsuba;
@@ -55,6 +56,9 @@ pub struct Scene {
     pub wavelength_sampling: WavelengthSampling,
     /// When camera rays are taken (the sensor's shutter interval and temporal filter).
     pub shutter: Shutter,
+    /// Hash of the scene's description and files (see [`fingerprint`]); 0 for scenes built in
+    /// code.
+    pub fingerprint: u64,
 }
 
 impl Scene {
@@ -83,6 +87,7 @@ impl Scene {
             integrator,
             wavelength_sampling: WavelengthSampling::default(),
             shutter: Shutter::instant(),
+            fingerprint: 0,
         }
     }
 }

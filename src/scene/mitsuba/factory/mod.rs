@@ -133,6 +133,7 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
         integrator,
     );
     scene.shutter = sensor.shutter;
+    scene.fingerprint = crate::scene::fingerprint::scene_fingerprint(root);
     Ok(LoadedScene {
         scene,
         seed: sensor.seed,
