@@ -90,7 +90,7 @@ fn reference(dir: &Path, spp: u32) -> PathBuf {
     path
 }
 
-fn wait(mut child: Child) -> (i32, String) {
+fn wait(child: Child) -> (i32, String) {
     let output = child.wait_with_output().unwrap();
     (
         output.status.code().unwrap_or(-1),
