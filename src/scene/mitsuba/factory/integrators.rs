@@ -1,7 +1,8 @@
-//! Integrator plugins: `path`.
+//! Integrator plugins: `path` (with Prism's `emitter_sampling`, see [`crate::light::sampler`]).
 
 use crate::error::{Error, Result};
 use crate::integrator::{Integrator, PathIntegrator};
+use crate::light::LightSelection;
 use crate::scene::mitsuba::description::PluginNode;
 use crate::scene::mitsuba::params::Params;
 
@@ -26,10 +27,24 @@ pub fn build_integrator(node: &PluginNode) -> Result<Integrator> {
                 ));
             }
             let hide_emitters = params.boolean("hide_emitters", false)?;
+            let light_selection = match params.string("emitter_sampling", "power")? {
+                "power" => LightSelection::Power,
+                "uniform" => LightSelection::Uniform,
+                other => {
+                    return Err(Error::input(
+                        params.location_of("emitter_sampling"),
+                        format!("unknown emitter_sampling \"{other}\""),
+                    )
+                    .with_help(
+                        "use \"power\" (lights chosen in proportion to their power) or \"uniform\"",
+                    ));
+                }
+            };
             Integrator::Path(PathIntegrator {
                 max_depth: max_depth as i32,
                 rr_depth: rr_depth as i32,
                 hide_emitters,
+                light_selection,
             })
         }
         other => {

@@ -97,9 +97,15 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
         shape_info.push(ShapeInfo { material, light });
     }
 
+    let mut scene_lights = Vec::new();
     for child in params.children(PluginClass::Emitter) {
-        lights.push(lights::build_scene_light(&child.node)?);
+        scene_lights.push((
+            lights::build_scene_light(&child.node)?,
+            child.location.clone(),
+        ));
     }
+    lights::check_single_environment(&scene_lights)?;
+    lights.extend(scene_lights.into_iter().map(|(light, _)| light));
 
     // BSDFs declared at the top level (to be referenced by id) are built even when unused, so
     // that their errors are reported as Mitsuba would.
