@@ -7,6 +7,7 @@
 use glam::{DMat4, DVec3, Vec3};
 
 use super::spectra::{Range, spectrum_param};
+use crate::bsdf::{Bsdf, Diffuse, Material};
 use crate::error::{Error, Result, SourceLocation};
 use crate::light::{
     AreaLight, ConstantLight, DirectionalLight, EnvironmentMap, Light, PointLight, SpotLight,
@@ -43,6 +44,17 @@ pub fn build_area_light(node: &PluginNode, shape: u32) -> Result<Light> {
     let radiance = emission_param(&params, "radiance")?;
     params.finish()?;
     Ok(Light::Area(AreaLight { shape, radiance }))
+}
+
+/// The material of an emitting shape that names no BSDF: Mitsuba 3 gives such shapes a black
+/// diffuse BSDF (not the usual 50 % grey), so an area light does not reflect other lights.
+pub fn default_emitter_material() -> Material {
+    Material {
+        front: Bsdf::Diffuse(Diffuse {
+            reflectance: Spectrum::Constant(0.0),
+        }),
+        back: None,
+    }
 }
 
 /// Builds an emitter declared at the top level of the scene.

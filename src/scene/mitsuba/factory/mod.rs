@@ -67,6 +67,7 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
             .with_help("remove degenerate shapes or fix their transform"));
         }
         let shape_index = shapes.len() as u32;
+        let emitter = shape_params.single_child(PluginClass::Emitter)?;
         let material = match shape_params.single_child(PluginClass::Bsdf)? {
             Some(bsdf) => {
                 let key = Arc::as_ptr(&bsdf.node);
@@ -80,12 +81,16 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
                     }
                 }
             }
+            None if emitter.is_some() => {
+                materials.push(lights::default_emitter_material());
+                (materials.len() - 1) as u32
+            }
             None => {
                 materials.push(materials::default_material());
                 (materials.len() - 1) as u32
             }
         };
-        let light = match shape_params.single_child(PluginClass::Emitter)? {
+        let light = match emitter {
             Some(emitter) => {
                 lights.push(lights::build_area_light(&emitter.node, shape_index)?);
                 Some((lights.len() - 1) as u32)
