@@ -68,6 +68,12 @@ pub struct EnvironmentMap {
     pub scene: BoundingSphere,
 }
 
+/// `x` wrapped into [0, 1) (x − ⌊x⌋ alone rounds tiny negative x up to 1).
+fn wrap(x: f32) -> f32 {
+    let w = x - x.floor();
+    if w < 1.0 { w } else { 0.0 }
+}
+
 /// Luminance of a linear sRGB colour (the Y row of the sRGB-to-XYZ matrix).
 fn luminance(rgb: [f32; 3]) -> f32 {
     let y = LINEAR_SRGB_TO_XYZ[1];
@@ -141,20 +147,20 @@ impl EnvironmentMap {
         }
     }
 
-    /// Image coordinates of a unit direction in the map's frame.
+    /// Image coordinates of a unit direction in the map's frame; θ = atan2(sin θ, cos θ) rather
+    /// than acos(cos θ), which loses the angle near the poles, and v stays below 1 so that a
+    /// direction at the pole still falls in the last row of sampling cells.
     fn direction_to_uv(d: Vec3) -> Vec2 {
         let u = d.x.atan2(-d.z) / (2.0 * PI);
-        Vec2::new(u - u.floor(), d.y.clamp(-1.0, 1.0).acos() / PI)
+        let theta = (d.x * d.x + d.z * d.z).sqrt().atan2(d.y);
+        Vec2::new(wrap(u), (theta / PI).min(1.0f32.next_down()))
     }
 
-    /// The direction (map frame) of image coordinates, and sin θ.
-    fn uv_to_direction(uv: Vec2) -> (Vec3, f32) {
+    /// The direction (map frame) of image coordinates.
+    fn uv_to_direction(uv: Vec2) -> Vec3 {
         let (sin_theta, cos_theta) = (PI * uv.y).sin_cos();
         let (sin_phi, cos_phi) = (2.0 * PI * uv.x).sin_cos();
-        (
-            Vec3::new(sin_phi * sin_theta, cos_theta, -cos_phi * sin_theta),
-            sin_theta,
-        )
+        Vec3::new(sin_phi * sin_theta, cos_theta, -cos_phi * sin_theta)
     }
 
     /// Half a pixel in u: the offset between the sampling grid's s and the image's u.
@@ -166,9 +172,7 @@ impl EnvironmentMap {
     /// surrounding pixel nodes, of the sigmoid values and of the scales separately (Mitsuba's
     /// `eval_spectrum`), times the map's scale and D65.
     fn lookup(&self, uv: Vec2, lambda: &SampledWavelengths) -> SampledSpectrum {
-        let mut x = uv.x - self.half_texel();
-        x -= x.floor();
-        let x = x * self.width as f32;
+        let x = wrap(uv.x - self.half_texel()) * self.width as f32;
         let y = uv.y.clamp(0.0, 1.0) * (self.height - 1) as f32;
         let (ix, iy) = (
             (x as usize).min(self.width - 1),
@@ -210,8 +214,7 @@ impl EnvironmentMap {
             return 0.0;
         }
         let uv = Self::direction_to_uv(local);
-        let mut s = uv.x - self.half_texel();
-        s -= s.floor();
+        let s = wrap(uv.x - self.half_texel());
         self.distribution.pdf(Vec2::new(s, uv.y)) / (2.0 * PI * PI * sin_theta)
     }
 
@@ -222,20 +225,21 @@ impl EnvironmentMap {
         lambda: &SampledWavelengths,
     ) -> Option<LightSample> {
         let p = self.distribution.sample(u);
-        let pdf_uv = self.distribution.pdf(p);
-        let mut uv = Vec2::new(p.x + self.half_texel(), p.y);
-        uv.x -= uv.x.floor();
-        let (local, sin_theta) = Self::uv_to_direction(uv);
-        if !(pdf_uv > 0.0 && sin_theta > 0.0) {
+        let uv = Vec2::new(wrap(p.x + self.half_texel()), p.y);
+        let local = Self::uv_to_direction(uv);
+        let wi = self.to_world.vector(local).normalize();
+        // The density of the direction as rounded, exactly what MIS evaluates for it when BSDF
+        // sampling finds it (near the poles sin θ of uv and of wi differ in their last digits).
+        let pdf = self.pdf(wi);
+        if !(pdf > 0.0 && pdf.is_finite()) {
             return None;
         }
-        let wi = self.to_world.vector(local).normalize();
         Some(LightSample {
             p: self.scene.point_beyond(reference, wi),
             n: Vec3::ZERO,
             wi,
             radiance: self.lookup(uv, lambda),
-            pdf: pdf_uv / (2.0 * PI * PI * sin_theta),
+            pdf,
             is_delta: false,
         })
     }
@@ -278,12 +282,12 @@ mod tests {
             (Vec2::new(0.3, 0.0), Vec3::Y),
         ];
         for (uv, d) in cases {
-            let (back, _) = EnvironmentMap::uv_to_direction(uv);
+            let back = EnvironmentMap::uv_to_direction(uv);
             assert!((back - d).length() < 1e-6, "{uv} -> {back}, not {d}");
         }
         for k in 0..100 {
             let uv = Vec2::new((k % 10) as f32 / 10.0 + 0.03, (k / 10) as f32 / 10.0 + 0.04);
-            let (d, _) = EnvironmentMap::uv_to_direction(uv);
+            let d = EnvironmentMap::uv_to_direction(uv);
             let back = EnvironmentMap::direction_to_uv(d);
             assert!((back - uv).length() < 1e-5, "{uv} -> {d} -> {back}");
         }
