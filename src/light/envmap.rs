@@ -25,8 +25,8 @@
 //!
 //! # Sampling
 //! Directions are drawn from a piecewise-constant density on the image's cells (the squares
-//! between four pixel nodes), each cell weighted by the mean luminance of its corners times the
-//! mean of sin θ over its rows: p(u, v) ∝ L sin θ, the density the lecture's importance
+//! between four pixel nodes), each cell weighted by the integral over it of the interpolated
+//! luminance times sin θ: p(u, v) ∝ L sin θ cell by cell, the density the lecture's importance
 //! sampling asks for, since dω = 2π² sin θ du dv. The density per solid angle is
 //! p(u, v) / (2π² sin θ). Rays that leave the scene see the map and are weighted by multiple
 //! importance sampling against these samples.
@@ -74,6 +74,20 @@ fn wrap(x: f32) -> f32 {
     if w < 1.0 { w } else { 0.0 }
 }
 
+/// For the row of cells between θ₀ = π j/rows and θ₁ = π (j + 1)/rows, with t = (θ − θ₀)/Δθ:
+/// (∫₀¹ (1 − t) sin θ dt, ∫₀¹ t sin θ dt), the weights of the row's upper and lower pixel
+/// nodes in the cell mean of (linearly interpolated luminance) · sin θ. With
+/// I₀ = ∫₀¹ sin θ dt = (cos θ₀ − cos θ₁)/Δθ and, by parts,
+/// I₁ = ∫₀¹ t sin θ dt = (sin θ₁ − sin θ₀)/Δθ² − cos θ₁/Δθ, they are (I₀ − I₁, I₁); in double
+/// precision, as I₁ cancels for fine maps.
+fn sin_theta_moments(j: usize, rows: usize) -> (f64, f64) {
+    let delta = std::f64::consts::PI / rows as f64;
+    let (theta0, theta1) = (delta * j as f64, delta * (j + 1) as f64);
+    let i0 = (theta0.cos() - theta1.cos()) / delta;
+    let i1 = (theta1.sin() - theta0.sin()) / (delta * delta) - theta1.cos() / delta;
+    (i0 - i1, i1)
+}
+
 /// Luminance of a linear sRGB colour (the Y row of the sRGB-to-XYZ matrix).
 fn luminance(rgb: [f32; 3]) -> f32 {
     let y = LINEAR_SRGB_TO_XYZ[1];
@@ -117,23 +131,19 @@ impl EnvironmentMap {
             .collect();
 
         let rows = height - 1;
+        let lum: Vec<f64> = rgb
+            .iter()
+            .map(|&c| f64::from(luminance(c).max(0.0)))
+            .collect();
         let mut weights = Vec::with_capacity(width * rows);
         for j in 0..rows {
-            let (theta0, theta1) = (
-                PI * j as f32 / rows as f32,
-                PI * (j + 1) as f32 / rows as f32,
-            );
-            let mean_sin = (theta0.cos() - theta1.cos()) / (theta1 - theta0);
+            let (upper, lower) = sin_theta_moments(j, rows);
             for i in 0..width {
                 let i1 = (i + 1) % width;
-                let corners = [
-                    rgb[j * width + i],
-                    rgb[j * width + i1],
-                    rgb[(j + 1) * width + i],
-                    rgb[(j + 1) * width + i1],
-                ];
-                let mean: f32 = corners.iter().map(|&c| luminance(c)).sum::<f32>() / 4.0;
-                weights.push(mean.max(0.0) * mean_sin);
+                // Averaged over s, the bilinear luminance is linear in v between the rows' means.
+                let top = 0.5 * (lum[j * width + i] + lum[j * width + i1]);
+                let bottom = 0.5 * (lum[(j + 1) * width + i] + lum[(j + 1) * width + i1]);
+                weights.push((top * upper + bottom * lower) as f32);
             }
         }
         EnvironmentMap {
@@ -244,9 +254,9 @@ impl EnvironmentMap {
         })
     }
 
-    /// Φ = π R² ∫ Y(L) dω, with ∫ Y(L) dω = 2π² ∫∫ Y sin θ du dv estimated from the sampling
-    /// weights (cell means of luminance and sin θ): the flux entering the scene's bounding
-    /// sphere, as for [`super::ConstantLight`]; exact for a uniform map.
+    /// Φ = π R² ∫ Y(L) dω, with ∫ Y(L) dω = 2π² ∫∫ Y sin θ du dv the integral of the sampling
+    /// weights: the flux entering the scene's bounding sphere, as for [`super::ConstantLight`];
+    /// exact for grey maps, and for colours up to the luminance of interpolated spectra.
     pub fn power(&self) -> f32 {
         let integral = 2.0 * PI * PI * self.distribution.integral() as f32 * self.scale;
         PI * self.scene.radius * self.scene.radius * integral
