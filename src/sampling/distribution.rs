@@ -7,7 +7,7 @@ use glam::Vec2;
 /// A piecewise-constant density on `[min, max)` with `n` equal cells, proportional to given
 /// non-negative weights; sampled by inverting its CDF (pbrt-v4, §A.4.1 "Piecewise-Constant 1D").
 /// The cell holding u is found through a guide table (Chen & Asau 1974, "On Generating Random
-/// Variates from an Empirical Distribution"): guide[j] is the cell where u = j/G falls, so the
+/// Variates from an Empirical Distribution"): `guide[j]` is the cell where u = j/G falls, so the
 /// search starts next to the answer and usually takes one or two steps.
 #[derive(Clone, Debug)]
 pub struct PiecewiseConstant1D {
