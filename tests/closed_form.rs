@@ -110,10 +110,10 @@ fn distribution_ray_tracer_in_a_bright_sphere_furnace() {
 /// roulette starting at once: the same answer.
 #[test]
 fn distribution_estimator_variants_keep_the_furnace_answer() {
-    use prism::integrator::distribution::LightSelection;
+    use prism::integrator::distribution::DirectLights;
     let variants = [
         DistributionIntegrator {
-            lights: LightSelection::All,
+            lights: DirectLights::All,
             bounce_samples: 8,
             shadow_rays: 8,
             ..DistributionIntegrator::default()

@@ -107,6 +107,12 @@ impl Geometry {
         self.primitives.len()
     }
 
+    /// The axis-aligned box (min, max) around all shapes; None for an empty scene.
+    pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
+        let aabb = self.bvh.as_ref()?.total_aabb;
+        Some((Vec3::from(aabb.min), Vec3::from(aabb.max)))
+    }
+
     fn bvh_ray(ray: &Ray) -> obvhs::ray::Ray {
         obvhs::ray::Ray::new(to_obvhs(ray.o), to_obvhs(ray.d), 0.0, ray.t_max)
     }

@@ -30,7 +30,7 @@
 //!     <integer name="max_depth" value="-1"/>          <!-- as for path -->
 //!     <integer name="bounce_samples" value="4"/>      <!-- N at potential 1 -->
 //!     <integer name="shadow_rays" value="4"/>         <!-- N_l at potential 1 -->
-//!     <string name="lights" value="power"/>           <!-- "power": one light chosen ∝ power; "all" -->
+//!     <string name="lights" value="power"/>           <!-- one light chosen ∝ "power" or "uniform"ly; or "all" -->
 //!     <float name="rr_threshold" value="0.1"/>        <!-- potential below which roulette starts -->
 //!     <boolean name="hide_emitters" value="false"/>
 //! </integrator>
@@ -41,17 +41,18 @@ use glam::Vec3;
 use crate::bsdf::{Bsdf, BsdfFlags};
 use crate::geometry::SurfaceInteraction;
 use crate::integrator::RayCount;
-use crate::light::{Light, LightSample};
+use crate::light::{Light, LightSample, LightSelection};
 use crate::math::{Frame, Ray};
 use crate::sampling::sampler::Sampler;
 use crate::scene::Scene;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 
-/// How shadow rays are spread over the lights.
+/// Which lights a vertex sends shadow rays to.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum LightSelection {
-    /// One light per shading point, chosen with probability ∝ power (estimate divided by it).
-    Power,
+pub enum DirectLights {
+    /// One light per shading point, drawn by the scene's light sampler (∝ power, or uniformly)
+    /// and the estimate divided by its probability.
+    One(LightSelection),
     /// Every light, each with its own shadow rays (the slides' loop over the lights).
     All,
 }
@@ -61,7 +62,7 @@ pub struct DistributionIntegrator {
     pub max_depth: i32,
     pub bounce_samples: u32,
     pub shadow_rays: u32,
-    pub lights: LightSelection,
+    pub lights: DirectLights,
     pub rr_threshold: f32,
     pub hide_emitters: bool,
 }
@@ -72,7 +73,7 @@ impl Default for DistributionIntegrator {
             max_depth: -1,
             bounce_samples: 4,
             shadow_rays: 4,
-            lights: LightSelection::Power,
+            lights: DirectLights::One(LightSelection::Power),
             rr_threshold: 0.1,
             hide_emitters: false,
         }
@@ -143,7 +144,14 @@ impl DistributionIntegrator {
     ) -> SampledSpectrum {
         count.rays += 1;
         let Some(si) = scene.geometry.intersect(&ray) else {
-            return SampledSpectrum::ZERO;
+            // Leaving the scene: the environment is a light like any other, counted here only
+            // where no shadow ray could have found it (camera rays, specular bounces).
+            return match scene.environment {
+                Some(env) if with_emission => {
+                    scene.lights[env as usize].environment_radiance(ray.d.normalize(), lambda)
+                }
+                _ => SampledSpectrum::ZERO,
+            };
         };
         let wo_world = -ray.d.normalize();
         let info = scene.shape_info[si.shape as usize];
@@ -224,7 +232,8 @@ impl DistributionIntegrator {
         result * (1.0 / survival)
     }
 
-    /// Direct light by shadow rays: N_l per light, over every light or one chosen ∝ power.
+    /// Direct light by shadow rays: N_l per light, over every light or one drawn by the scene's
+    /// light sampler.
     #[allow(clippy::too_many_arguments)]
     fn direct(
         &self,
@@ -259,14 +268,14 @@ impl DistributionIntegrator {
             sum * (1.0 / rays as f32)
         };
         match self.lights {
-            LightSelection::All => {
+            DirectLights::All => {
                 let mut total = SampledSpectrum::ZERO;
                 for light in &scene.lights {
                     total += estimate_light(light, sampler, count);
                 }
                 total
             }
-            LightSelection::Power => {
+            DirectLights::One(_) => {
                 let Some((index, pmf)) = scene.light_sampler.sample(sampler.next_1d()) else {
                     return SampledSpectrum::ZERO;
                 };

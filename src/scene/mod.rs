@@ -13,7 +13,8 @@ use crate::camera::{Camera, Shutter};
 use crate::film::{CropWindow, Filter};
 use crate::geometry::Geometry;
 use crate::integrator::Integrator;
-use crate::light::{Light, LightSampler};
+use crate::integrator::distribution::DirectLights;
+use crate::light::{BoundingSphere, Light, LightSampler, LightSelection};
 pub use crate::sampling::sampler::SamplerKind;
 use crate::spectrum::WavelengthSampling;
 
@@ -49,6 +50,9 @@ pub struct Scene {
     pub materials: Vec<Material>,
     pub lights: Vec<Light>,
     pub light_sampler: LightSampler,
+    /// Index into `lights` of the environment (`constant` or `envmap`), which rays that leave
+    /// the scene see; a scene has at most one.
+    pub environment: Option<u32>,
     pub camera: Camera,
     pub film: FilmSettings,
     pub sampler: SamplerSettings,
@@ -62,21 +66,38 @@ pub struct Scene {
 }
 
 impl Scene {
-    /// A scene from its parts; the light sampler is built from the lights' powers.
+    /// A scene from its parts. Lights at infinity learn the scene's bounding sphere; the light
+    /// sampler is built from the lights' powers as the integrator's light selection asks; the
+    /// first environment light (the factory allows only one) is the one escaped rays see.
     #[allow(clippy::too_many_arguments)]
     pub fn new(
         geometry: Geometry,
         shape_info: Vec<ShapeInfo>,
         materials: Vec<Material>,
-        lights: Vec<Light>,
+        mut lights: Vec<Light>,
         camera: Camera,
         film: FilmSettings,
         sampler: SamplerSettings,
         integrator: Integrator,
     ) -> Scene {
+        let bounds = BoundingSphere::around_box(geometry.bounds());
+        for light in &mut lights {
+            light.set_scene_bounds(bounds);
+        }
         let powers: Vec<f32> = lights.iter().map(|l| l.power(&geometry.shapes)).collect();
+        let selection = match &integrator {
+            Integrator::Path(path) => path.light_selection,
+            Integrator::Distribution(distrib) => match distrib.lights {
+                DirectLights::One(selection) => selection,
+                DirectLights::All => LightSelection::Power,
+            },
+        };
         Scene {
-            light_sampler: LightSampler::new(&powers),
+            light_sampler: LightSampler::with_selection(&powers, selection),
+            environment: lights
+                .iter()
+                .position(Light::is_environment)
+                .map(|i| i as u32),
             geometry,
             shape_info,
             materials,

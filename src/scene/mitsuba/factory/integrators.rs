@@ -1,8 +1,10 @@
-//! Integrator plugins: `path` and the lecture's `distrib`.
+//! Integrator plugins: `path` (with Prism's `emitter_sampling`, see [`crate::light::sampler`])
+//! and the lecture's `distrib`.
 
 use crate::error::{Error, Result};
-use crate::integrator::distribution::LightSelection;
+use crate::integrator::distribution::DirectLights;
 use crate::integrator::{DistributionIntegrator, Integrator, PathIntegrator};
+use crate::light::LightSelection;
 use crate::scene::mitsuba::description::PluginNode;
 use crate::scene::mitsuba::params::Params;
 
@@ -45,24 +47,39 @@ pub fn build_integrator(node: &PluginNode) -> Result<Integrator> {
                 ));
             }
             let hide_emitters = params.boolean("hide_emitters", false)?;
+            let light_selection = match params.string("emitter_sampling", "power")? {
+                "power" => LightSelection::Power,
+                "uniform" => LightSelection::Uniform,
+                other => {
+                    return Err(Error::input(
+                        params.location_of("emitter_sampling"),
+                        format!("unknown emitter_sampling \"{other}\""),
+                    )
+                    .with_help(
+                        "use \"power\" (lights chosen in proportion to their power) or \"uniform\"",
+                    ));
+                }
+            };
             Integrator::Path(PathIntegrator {
                 max_depth,
                 rr_depth: rr_depth as i32,
                 hide_emitters,
+                light_selection,
             })
         }
         "distrib" => {
             let defaults = DistributionIntegrator::default();
             let lights = match params.string("lights", "power")? {
-                "power" => LightSelection::Power,
-                "all" => LightSelection::All,
+                "power" => DirectLights::One(LightSelection::Power),
+                "uniform" => DirectLights::One(LightSelection::Uniform),
+                "all" => DirectLights::All,
                 other => {
                     return Err(Error::input(
                         params.location_of("lights"),
                         format!("unknown light selection \"{other}\""),
                     )
                     .with_help(
-                        "use \"power\" (one light chosen in proportion to its power) or \"all\"",
+                        "use \"power\" (one light chosen in proportion to its power), \"uniform\" or \"all\"",
                     ));
                 }
             };

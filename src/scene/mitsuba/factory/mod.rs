@@ -67,6 +67,7 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
             .with_help("remove degenerate shapes or fix their transform"));
         }
         let shape_index = shapes.len() as u32;
+        let emitter = shape_params.single_child(PluginClass::Emitter)?;
         let material = match shape_params.single_child(PluginClass::Bsdf)? {
             Some(bsdf) => {
                 let key = Arc::as_ptr(&bsdf.node);
@@ -80,12 +81,16 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
                     }
                 }
             }
+            None if emitter.is_some() => {
+                materials.push(lights::default_emitter_material());
+                (materials.len() - 1) as u32
+            }
             None => {
                 materials.push(materials::default_material());
                 (materials.len() - 1) as u32
             }
         };
-        let light = match shape_params.single_child(PluginClass::Emitter)? {
+        let light = match emitter {
             Some(emitter) => {
                 if let Shape::Instance(instance) = &shape
                     && !instance.to_world.is_similarity()
@@ -108,9 +113,15 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
         shape_info.push(ShapeInfo { material, light });
     }
 
+    let mut scene_lights = Vec::new();
     for child in params.children(PluginClass::Emitter) {
-        lights.push(lights::build_scene_light(&child.node)?);
+        scene_lights.push((
+            lights::build_scene_light(&child.node)?,
+            child.location.clone(),
+        ));
     }
+    lights::check_single_environment(&scene_lights)?;
+    lights.extend(scene_lights.into_iter().map(|(light, _)| light));
 
     // BSDFs declared at the top level (to be referenced by id) are built even when unused, so
     // that their errors are reported as Mitsuba would.
