@@ -73,6 +73,22 @@ fn with_mesh(
     }
 }
 
+/// A scene lit by an environment map read from `image`, a malformed image file: the error names
+/// the `filename` property and says the image could not be read.
+fn with_image(name: &'static str, image: (&'static str, &'static str)) -> Case {
+    let xml = scene!(
+        "    <emitter type=\"envmap\"><string name=\"filename\" value=\"IMAGE\"/></emitter>"
+    )
+    .replace("IMAGE", image.0);
+    Case {
+        name,
+        files: Box::leak(Box::new([("scene.xml", &*xml.leak()), image])),
+        arguments: RENDER,
+        location: "scene.xml:3:28",
+        says: "could not read the image",
+    }
+}
+
 fn cases() -> Vec<Case> {
     let mut cases = vec![
         // XML syntax.
@@ -414,6 +430,21 @@ fn cases() -> Vec<Case> {
             "mesh.ply:3:1",
             "too short",
         ),
+        // Images.
+        with_image("EXR of garbage", ("sky.exr", "v/1\u{1} and no header")),
+        with_image(
+            "PNG cut after its signature",
+            ("sky.png", "\u{89}PNG\r\n\u{1a}\n"),
+        ),
+        with_image("JPEG that is text", ("sky.jpg", "this is not a JPEG")),
+        with_image(
+            "HDR without pixels",
+            (
+                "sky.hdr",
+                "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 3 +X 6\n",
+            ),
+        ),
+        with_image("image of unknown format", ("sky.tga", "TRUEVISION")),
         // Render states.
         Case {
             name: "state of garbage",
