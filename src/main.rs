@@ -14,12 +14,21 @@ struct Cli {
 enum Command {
     /// Render a scene to an OpenEXR image (linear) and a PNG (sRGB) beside it.
     Render(prism::cli::render::RenderArgs),
+    /// Compare two EXR images: means, MSE, relative MSE, a z-test, a difference image.
+    Compare(prism::cli::compare::CompareArgs),
+    /// Render at 1, 2, 4, ... samples per pixel and plot the relative MSE against a reference.
+    Converge(prism::cli::converge::ConvergeArgs),
+    /// Combine render states of disjoint sample ranges into one image.
+    Merge(prism::cli::merge::MergeArgs),
 }
 
 fn main() {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Render(args) => prism::cli::render::run(&args),
+        Command::Compare(args) => prism::cli::compare::run(&args),
+        Command::Converge(args) => prism::cli::converge::run(&args),
+        Command::Merge(args) => prism::cli::merge::run(&args),
     };
     if let Err(error) = result {
         eprintln!("error: {error}");

@@ -5,11 +5,8 @@ mod common;
 
 use std::f64::consts::PI;
 
-use common::chi2::{
-    assert_passes, chi2_discrete, chi2_from_counts, chi2_interval, chi2_rectangle, chi2_sphere,
-};
+use common::chi2::{assert_passes, chi2_discrete, chi2_interval, chi2_rectangle, chi2_sphere};
 use glam::{Mat3, Vec2, Vec3};
-use prism::film::{Filter, FilterSampler};
 use prism::geometry::TriangleMesh;
 use prism::geometry::sphere::Sphere;
 use prism::light::LightSampler;
@@ -18,7 +15,7 @@ use prism::sampling::warp;
 use prism::spectrum::WavelengthSampling;
 
 /// Number of chi-square tests in this file, for Šidák's correction.
-const TESTS: usize = 11;
+const TESTS: usize = 9;
 const SAMPLES: usize = 1_000_000;
 
 fn u2(rng: &mut Pcg32) -> Vec2 {
@@ -234,48 +231,4 @@ fn sphere_sampling_from_inside_converts_area_to_solid_angle() {
     )
     .unwrap();
     assert_passes("sphere from inside", &outcome, TESTS);
-}
-
-/// The filter sampler's offsets against its claimed density p(x)p(y). The density is piecewise
-/// constant on a fine table, so each cell's probability is integrated by the midpoint rule on a
-/// grid of 1/1024 pixel, finer than the table and never sampling its cell boundaries.
-fn filter_chi2(filter: Filter, seed: u64) {
-    let sampler = FilterSampler::new(filter);
-    let r = f64::from(filter.radius());
-    let bins = 32;
-    let width = 2.0 * r / bins as f64;
-    let steps = (width * 1024.0).round() as usize;
-    let marginal: Vec<f64> = (0..bins)
-        .map(|b| {
-            (0..steps)
-                .map(|i| {
-                    let x = -r + b as f64 * width + (i as f64 + 0.5) / 1024.0;
-                    f64::from(sampler.pdf_1d(x as f32)) / 1024.0
-                })
-                .sum()
-        })
-        .collect();
-    let mut observed = vec![0.0; bins * bins];
-    let mut rng = Pcg32::seeded(seed);
-    let locate = |v: f32| (((f64::from(v) + r) / width) as usize).min(bins - 1);
-    for _ in 0..SAMPLES {
-        let (offset, _) = sampler.sample(u2(&mut rng));
-        assert!(offset.x.abs() <= filter.radius() && offset.y.abs() <= filter.radius());
-        observed[locate(offset.y) * bins + locate(offset.x)] += 1.0;
-    }
-    let expected: Vec<f64> = (0..bins * bins)
-        .map(|cell| marginal[cell / bins] * marginal[cell % bins] * SAMPLES as f64)
-        .collect();
-    let outcome = chi2_from_counts(&observed, &expected).unwrap();
-    assert_passes(&format!("{filter:?}"), &outcome, TESTS);
-}
-
-#[test]
-fn tent_filter_sampling_follows_its_table() {
-    filter_chi2(Filter::Tent { radius: 1.0 }, 10);
-}
-
-#[test]
-fn gaussian_filter_sampling_follows_its_table() {
-    filter_chi2(Filter::Gaussian { stddev: 0.5 }, 11);
 }

@@ -301,3 +301,164 @@ fn missing_scene_file() {
     assert_eq!(status, 2, "{stderr}");
     assert!(stderr.contains("not found"), "{stderr}");
 }
+
+/// A scene whose sensor is `sensor` (XML of the whole element) and which has one sphere.
+fn scene_with_sensor(sensor: &str) -> String {
+    format!("<scene version=\"3.0.0\">\n{sensor}\n    <shape type=\"sphere\"/>\n</scene>\n")
+}
+
+#[test]
+fn bad_lens_shutter_and_filter_parameters() {
+    let cases: [(&str, &str, &str); 8] = [
+        (
+            "<sensor type=\"thinlens\">\n  <float name=\"aperture_radius\" value=\"0\"/>\n</sensor>",
+            "scene.xml:3:3",
+            "aperture must be positive",
+        ),
+        (
+            "<sensor type=\"thinlens\">\n  <float name=\"aperture_area\" value=\"-1\"/>\n</sensor>",
+            "scene.xml:3:3",
+            "aperture must be positive",
+        ),
+        (
+            "<sensor type=\"thinlens\">\n  <float name=\"aperture_radius\" value=\"0.1\"/>\n  <float name=\"focal_distance\" value=\"0\"/>\n</sensor>",
+            "scene.xml:4:3",
+            "focus distance must be positive",
+        ),
+        (
+            "<sensor type=\"perspective\">\n  <float name=\"shutter_open\" value=\"1\"/>\n  <float name=\"shutter_close\" value=\"0.5\"/>\n</sensor>",
+            "scene.xml:4:3",
+            "before it opens",
+        ),
+        (
+            "<sensor type=\"perspective\">\n  <film type=\"hdrfilm\">\n    <rfilter type=\"tent\"><float name=\"radius\" value=\"0\"/></rfilter>\n  </film>\n</sensor>",
+            "scene.xml:4:26",
+            "must be positive",
+        ),
+        (
+            "<sensor type=\"perspective\">\n  <film type=\"hdrfilm\">\n    <rfilter type=\"mitchell\"><float name=\"B\" value=\"3\"/></rfilter>\n  </film>\n</sensor>",
+            "scene.xml:4:30",
+            "outside the valid range",
+        ),
+        (
+            "<sensor type=\"perspective\">\n  <animation name=\"to_world\">\n    <transform time=\"1\"/>\n    <transform time=\"0\"/>\n  </animation>\n</sensor>",
+            "scene.xml:5:5",
+            "comes after",
+        ),
+        (
+            "<sensor type=\"perspective\">\n  <animation name=\"toWorld\">\n    <transform time=\"0\"/>\n    <transform time=\"1\"><scale value=\"0\"/></transform>\n  </animation>\n</sensor>",
+            "scene.xml:5:5",
+            "singular",
+        ),
+    ];
+    for (i, (sensor, location, says)) in cases.iter().enumerate() {
+        let dir = folder(&format!("sensor-{i}"));
+        write(&dir, "scene.xml", &scene_with_sensor(sensor));
+        assert_error(&dir, &[], location, &[says]);
+    }
+}
+
+/// Runs `prism` with `args`; returns (status, stdout + stderr).
+fn prism(args: &[&str]) -> (i32, String) {
+    let output = Command::new(env!("CARGO_BIN_EXE_prism"))
+        .args(args)
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&output.stdout).into_owned()
+        + &String::from_utf8_lossy(&output.stderr);
+    (output.status.code().unwrap_or(-1), text)
+}
+
+#[test]
+fn bad_stopping_rules_and_estimator_parameters() {
+    let dir = folder("stopping");
+    write(
+        &dir,
+        "scene.xml",
+        &scene("    <shape type=\"sphere\"/>", ""),
+    );
+    let scene_path = dir.join("scene.xml");
+    let scene_path = scene_path.to_str().unwrap();
+    for (flag, value) in [
+        ("--target-error", "0"),
+        ("--target-error", "-1"),
+        ("--time-limit", "0"),
+        ("--time-limit", "nan"),
+    ] {
+        let argument = format!("{flag}={value}");
+        let (status, text) = prism(&[
+            "render",
+            scene_path,
+            "-o",
+            dir.join("o.exr").to_str().unwrap(),
+            &argument,
+        ]);
+        assert_eq!(status, 2, "{flag} {value}: {text}");
+        assert!(text.contains(flag) && !text.contains("panicked"), "{text}");
+    }
+    for (name, value, says) in [
+        ("bounce_samples", "0", "between 1 and 1024"),
+        ("shadow_rays", "-2", "between 1 and 1024"),
+        ("rr_threshold", "0", "must be positive"),
+    ] {
+        let dir = folder(&format!("distrib-{name}"));
+        let kind = if name == "rr_threshold" {
+            "float"
+        } else {
+            "integer"
+        };
+        let text = scene("    <shape type=\"sphere\"/>", "").replace(
+            "<scene version=\"3.0.0\">",
+            &format!("<scene version=\"3.0.0\">\n    <integrator type=\"distrib\"><{kind} name=\"{name}\" value=\"{value}\"/></integrator>"),
+        );
+        write(&dir, "scene.xml", &text);
+        assert_error(&dir, &[], "scene.xml:2:", &[says]);
+    }
+}
+
+#[test]
+fn compare_refuses_other_sizes_and_corrupt_files() {
+    let dir = folder("compare");
+    write(
+        &dir,
+        "scene.xml",
+        &scene("    <shape type=\"sphere\"/>", ""),
+    );
+    let (status, text) = render(&dir, &[]);
+    assert_eq!(status, 0, "{text}");
+    let image = dir.join("out.exr");
+    let image = image.to_str().unwrap();
+    let (status, text) = prism(&["compare", image, image]);
+    assert_eq!(status, 0, "{text}");
+    assert!(text.contains("relMSE"), "{text}");
+    let other = dir.join("other.exr");
+    let scene_path = dir.join("scene.xml");
+    let (status, text) = prism(&[
+        "render",
+        scene_path.to_str().unwrap(),
+        "--crop",
+        "0,0,2,2",
+        "-o",
+        other.to_str().unwrap(),
+    ]);
+    assert_eq!(status, 0, "{text}");
+    let (status, text) = prism(&["compare", image, other.to_str().unwrap()]);
+    assert_eq!(status, 2, "{text}");
+    assert!(text.contains("4×4") && text.contains("2×2"), "{text}");
+    let corrupt = dir.join("corrupt.exr");
+    std::fs::write(&corrupt, b"v/1\x01not an exr at all").unwrap();
+    let (status, text) = prism(&["compare", image, corrupt.to_str().unwrap()]);
+    assert_eq!(status, 2, "{text}");
+    assert!(
+        text.contains("corrupt.exr") && !text.contains("panicked"),
+        "{text}"
+    );
+    let (status, text) = prism(&[
+        "converge",
+        dir.join("scene.xml").to_str().unwrap(),
+        "--reference",
+        other.to_str().unwrap(),
+    ]);
+    assert_eq!(status, 2, "{text}");
+    assert!(text.contains("reference"), "{text}");
+}

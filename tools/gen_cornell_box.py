@@ -122,6 +122,7 @@ xml = f"""<?xml version="1.0" encoding="utf-8"?>
     <default name="resx" value="256"/>
     <default name="resy" value="256"/>
     <default name="max_depth" value="-1"/>
+    <default name="sampler" value="independent"/>
 
     <integrator type="path">
         <integer name="max_depth" value="$max_depth"/>
@@ -134,7 +135,7 @@ xml = f"""<?xml version="1.0" encoding="utf-8"?>
         <transform name="to_world">
             <lookat origin="278, 273, -800" target="278, 273, -799" up="0, 1, 0"/>
         </transform>
-        <sampler type="independent">
+        <sampler type="$sampler">
             <integer name="sample_count" value="$spp"/>
         </sampler>
         <film type="hdrfilm">

@@ -1,8 +1,10 @@
-//! Cameras: turning a point on the film into a ray.
+//! Cameras: turning a point on the film (and on the lens, at a time) into a ray.
 
 pub mod perspective;
+pub mod shutter;
 
 pub use perspective::PerspectiveCamera;
+pub use shutter::Shutter;
 
 use glam::Vec2;
 
@@ -15,11 +17,12 @@ pub enum Camera {
 }
 
 impl Camera {
-    /// The ray through the film position `film` (in pixels of the full film, origin top-left).
+    /// The ray through the film position `film` (in pixels of the full film, origin top-left),
+    /// the lens position `lens` ∈ [0, 1)², at time `time`.
     #[inline]
-    pub fn generate_ray(&self, film: Vec2) -> Ray {
+    pub fn generate_ray(&self, film: Vec2, lens: Vec2, time: f32) -> Ray {
         match self {
-            Camera::Perspective(camera) => camera.generate_ray(film),
+            Camera::Perspective(camera) => camera.generate_ray(film, lens, time),
         }
     }
 }

@@ -1,4 +1,5 @@
-//! Mitsuba's `perspective` sensor: an ideal pinhole camera.
+//! Mitsuba's `perspective` sensor, an ideal pinhole camera, and its `thinlens` sensor, which adds
+//! a circular aperture for depth of field.
 //!
 //! ```xml
 //! <sensor type="perspective">
@@ -12,20 +13,41 @@
 //! ```
 //! The camera looks along +z of its frame, with +y up and +x to the left of the image (Mitsuba's
 //! convention: `lookat` builds the frame [left, up, forward, origin]).
+//!
+//! Thin lens (the lecture's "Thin Lens" and "Depth of Field"): every point of the plane in focus
+//! at distance g (`focus_distance`, or our `focal_distance`) is imaged sharply; a ray through a
+//! film position leaves from a uniformly sampled point of the aperture disk (concentric map) and
+//! passes through the point of the focal plane the pinhole ray would reach. The aperture is
+//! `aperture_radius`, or, in the lecture's parametrisation, the aperture *area* a
+//! (`aperture_area`), so the radius is √(a/π) (DESIGN.md §4).
+//!
+//! ```xml
+//! <sensor type="thinlens">
+//!     <float name="aperture_radius" value="0.05"/>   <!-- or aperture_area -->
+//!     <float name="focus_distance" value="4"/>       <!-- or focal_distance; default far_clip -->
+//!     <float name="fov" value="40"/>
+//! </sensor>
+//! ```
 
 use glam::{Vec2, Vec3};
 
-use crate::math::{Ray, Transform};
+use crate::math::{AnimatedTransform, Ray};
+use crate::sampling::warp::sample_uniform_disk_concentric;
 
 #[derive(Clone, Debug)]
 pub struct PerspectiveCamera {
-    pub to_world: Transform,
+    /// Camera to world, possibly moving over the shutter interval.
+    pub to_world: AnimatedTransform,
     /// Size of the full film in pixels (not the crop window).
     pub film_size: Vec2,
     /// tan(fov_x / 2).
     pub tan_half_fov_x: f32,
     pub near_clip: f32,
     pub far_clip: f32,
+    /// Radius of the aperture; 0 for a pinhole.
+    pub lens_radius: f32,
+    /// Distance along the view axis of the plane in focus (irrelevant for a pinhole).
+    pub focus_distance: f32,
 }
 
 /// Converts a field of view given along `axis` into the horizontal one, for a film of aspect
@@ -77,30 +99,41 @@ pub fn focal_length_to_diagonal_fov(mm: f64) -> f64 {
 }
 
 impl PerspectiveCamera {
-    /// The ray through film position `film` (pixels, origin at the top-left of the full film).
-    /// It starts on the near plane and ends on the far plane, as in Mitsuba.
+    /// The ray through film position `film` (pixels, origin at the top-left of the full film),
+    /// through lens position `lens` ∈ [0, 1)² (unused by a pinhole) at time `time`. It starts on
+    /// the near plane and ends on the far plane, as in Mitsuba.
     #[inline]
-    pub fn generate_ray(&self, film: Vec2) -> Ray {
+    pub fn generate_ray(&self, film: Vec2, lens: Vec2, time: f32) -> Ray {
         let ndc = film / self.film_size;
         let aspect = self.film_size.x / self.film_size.y;
-        let local = Vec3::new(
+        // The pinhole direction, with z = 1.
+        let pinhole = Vec3::new(
             (1.0 - 2.0 * ndc.x) * self.tan_half_fov_x,
             (1.0 - 2.0 * ndc.y) * self.tan_half_fov_x / aspect,
             1.0,
-        )
-        .normalize();
+        );
+        let (origin, local) = if self.lens_radius > 0.0 {
+            let on_lens = sample_uniform_disk_concentric(lens) * self.lens_radius;
+            let aperture = Vec3::new(on_lens.x, on_lens.y, 0.0);
+            let in_focus = pinhole * self.focus_distance;
+            (aperture, (in_focus - aperture).normalize())
+        } else {
+            (Vec3::ZERO, pinhole.normalize())
+        };
         let inv_z = 1.0 / local.z;
         let near_t = self.near_clip * inv_z;
         let far_t = self.far_clip * inv_z;
-        let d = self.to_world.vector(local).normalize();
-        let o = self.to_world.point(Vec3::ZERO) + d * near_t;
-        Ray::new(o, d, far_t - near_t)
+        let to_world = self.to_world.at(time);
+        let d = to_world.vector(local).normalize();
+        let o = to_world.point(origin) + d * near_t;
+        Ray::new(o, d, far_t - near_t, time)
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::math::Transform;
 
     #[test]
     fn fov_conversions_match_mitsuba() {
@@ -120,19 +153,47 @@ mod tests {
     #[test]
     fn image_corners_map_to_the_left_top_of_the_camera() {
         let camera = PerspectiveCamera {
-            to_world: Transform::IDENTITY,
+            to_world: AnimatedTransform::fixed(Transform::IDENTITY),
             film_size: Vec2::new(200.0, 100.0),
             tan_half_fov_x: 1.0,
             near_clip: 0.01,
             far_clip: 100.0,
+            lens_radius: 0.0,
+            focus_distance: 1.0,
         };
-        let center = camera.generate_ray(Vec2::new(100.0, 50.0));
+        let lens = Vec2::splat(0.5);
+        let center = camera.generate_ray(Vec2::new(100.0, 50.0), lens, 0.0);
         assert!((center.d - Vec3::Z).length() < 1e-6);
-        let top_left = camera.generate_ray(Vec2::ZERO);
+        let top_left = camera.generate_ray(Vec2::ZERO, lens, 0.0);
         assert!(top_left.d.x > 0.0 && top_left.d.y > 0.0);
         // Horizontal half-angle 45 degrees; vertical half extent 0.5.
         let expected = Vec3::new(1.0, 0.5, 1.0).normalize();
         assert!((top_left.d - expected).length() < 1e-6);
         assert!((center.o - Vec3::new(0.0, 0.0, 0.01)).length() < 1e-7);
+    }
+
+    /// Rays of one film position through different lens points meet on the focal plane.
+    #[test]
+    fn thin_lens_rays_converge_on_the_focal_plane() {
+        let camera = PerspectiveCamera {
+            to_world: AnimatedTransform::fixed(Transform::IDENTITY),
+            film_size: Vec2::new(100.0, 100.0),
+            tan_half_fov_x: 0.5,
+            near_clip: 0.01,
+            far_clip: 100.0,
+            lens_radius: 0.2,
+            focus_distance: 5.0,
+        };
+        let film = Vec2::new(30.0, 70.0);
+        let points: Vec<Vec3> = [(0.1, 0.2), (0.9, 0.5), (0.5, 0.95)]
+            .into_iter()
+            .map(|(u, v)| {
+                let ray = camera.generate_ray(film, Vec2::new(u, v), 0.0);
+                ray.at((5.0 - ray.o.z) / ray.d.z)
+            })
+            .collect();
+        for p in &points[1..] {
+            assert!((*p - points[0]).length() < 1e-4, "{p} vs {}", points[0]);
+        }
     }
 }

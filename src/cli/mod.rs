@@ -1,3 +1,6 @@
 //! The subcommands of the `prism` program, one per file.
 
+pub mod compare;
+pub mod converge;
+pub mod merge;
 pub mod render;

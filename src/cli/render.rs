@@ -1,14 +1,34 @@
 //! `prism render`: load a scene, render it, write EXR and PNG, print a summary line.
+//!
+//! Long renders are safe to interrupt: on SIGINT or SIGTERM the pass in flight is dropped, the
+//! image and a render state are written, and the program exits with 130 or 143, saying how to
+//! resume; a second signal exits at once (state files are only ever replaced atomically, so
+//! nothing is corrupted). `--checkpoint` writes the state every `--checkpoint-every` seconds,
+//! `--resume` continues from a state, and `--sample-range` renders part of the samples for
+//! `prism merge` (see docs/render-farm.md).
 
 use std::io::IsTerminal;
+use std::ops::Range;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, AtomicI32, Ordering};
+use std::time::Duration;
 
 use clap::Args;
+use glam::UVec2;
 
 use crate::error::{Error, Result};
 use crate::film::output::{ChannelImage, write_exr, write_png_srgb};
-use crate::film::{CropWindow, Film};
-use crate::render::{RenderOptions, render};
+use crate::film::{CropWindow, Film, FilterSampler, PixelSums};
+use crate::integrator::RayCount;
+use crate::render::state::{RenderIdentity, RenderState};
+use crate::render::stats::{pixel_relative_error, variance_of_mean};
+use crate::render::{
+    Checkpoints, RenderOptions, Snapshot, StopReason, StopRule, estimate_sample,
+    render_with_checkpoints,
+};
+use crate::sampling::sampler::{Sampler, SamplerKind};
+use crate::scene::Scene;
 use crate::scene::mitsuba::load_scene;
 
 #[derive(Args, Debug)]
@@ -34,28 +54,80 @@ pub struct RenderArgs {
     /// Render only the pixels x0 <= x < x1, y0 <= y < y1 of the film
     #[arg(long, value_name = "X0,Y0,X1,Y1", value_parser = parse_crop)]
     pub crop: Option<[u32; 4]>,
+    /// Stop after this many seconds (the pass running then is dropped); without --spp the
+    /// number of samples is open-ended
+    #[arg(long, value_name = "SECONDS")]
+    pub time_limit: Option<f64>,
+    /// Render in passes until the image's mean relative standard error is at most E; without
+    /// --spp the number of samples is open-ended
+    #[arg(long, value_name = "E")]
+    pub target_error: Option<f64>,
+    /// Save the render state here every --checkpoint-every seconds and at the end
+    #[arg(long, value_name = "PATH")]
+    pub checkpoint: Option<PathBuf>,
+    /// Seconds between checkpoints
+    #[arg(long, value_name = "SECONDS", default_value_t = 60.0)]
+    pub checkpoint_every: f64,
+    /// Continue the render saved in this state (to the requested samples per pixel)
+    #[arg(long, value_name = "PATH")]
+    pub resume: Option<PathBuf>,
+    /// Render only the sample indices START..END of every pixel, for `prism merge`
+    #[arg(long, value_name = "START..END", value_parser = parse_range)]
+    pub sample_range: Option<Range<u32>>,
+    /// Render only pixel x,y and print every sample's value (to find the source of NaNs)
+    #[arg(long, value_name = "X,Y", value_parser = parse_pixel)]
+    pub pixel: Option<[u32; 2]>,
 }
 
-fn parse_define(text: &str) -> Result<(String, String), String> {
+pub(crate) fn parse_define(text: &str) -> Result<(String, String), String> {
     match text.split_once('=') {
         Some((name, value)) if !name.is_empty() => Ok((name.to_string(), value.to_string())),
         _ => Err(format!("expected NAME=VALUE, got \"{text}\"")),
     }
 }
 
-fn parse_crop(text: &str) -> Result<[u32; 4], String> {
+fn parse_numbers(
+    text: &str,
+    separator: &str,
+    count: usize,
+    what: &str,
+) -> Result<Vec<u32>, String> {
     let numbers: Vec<u32> = text
-        .split(',')
+        .split(separator)
         .map(|s| s.trim().parse::<u32>())
         .collect::<Result<_, _>>()
-        .map_err(|_| format!("expected four non-negative integers x0,y0,x1,y1, got \"{text}\""))?;
-    match numbers.as_slice() {
-        [x0, y0, x1, y1] if x1 > x0 && y1 > y0 => Ok([*x0, *y0, *x1, *y1]),
-        [_, _, _, _] => Err(format!(
-            "the crop window \"{text}\" is empty: x1 must exceed x0 and y1 must exceed y0"
-        )),
-        _ => Err(format!("expected four numbers x0,y0,x1,y1, got \"{text}\"")),
+        .map_err(|_| format!("expected {what}, got \"{text}\""))?;
+    if numbers.len() != count {
+        return Err(format!("expected {what}, got \"{text}\""));
     }
+    Ok(numbers)
+}
+
+fn parse_crop(text: &str) -> Result<[u32; 4], String> {
+    let n = parse_numbers(text, ",", 4, "four non-negative integers x0,y0,x1,y1")?;
+    if n[2] > n[0] && n[3] > n[1] {
+        Ok([n[0], n[1], n[2], n[3]])
+    } else {
+        Err(format!(
+            "the crop window \"{text}\" is empty: x1 must exceed x0 and y1 must exceed y0"
+        ))
+    }
+}
+
+fn parse_range(text: &str) -> Result<Range<u32>, String> {
+    let n = parse_numbers(text, "..", 2, "a range START..END of sample indices")?;
+    if n[1] > n[0] {
+        Ok(n[0]..n[1])
+    } else {
+        Err(format!(
+            "the sample range \"{text}\" is empty: END must exceed START"
+        ))
+    }
+}
+
+fn parse_pixel(text: &str) -> Result<[u32; 2], String> {
+    let n = parse_numbers(text, ",", 2, "a pixel x,y")?;
+    Ok([n[0], n[1]])
 }
 
 /// The EXR and PNG paths for a render.
@@ -93,6 +165,69 @@ fn default_name(scene: &Path) -> String {
     stem.to_string()
 }
 
+/// The stopping rule the arguments ask for, for samples from `first` on. Without --time-limit
+/// or --target-error the render takes exactly the requested samples; with either, --spp (if
+/// given) only caps them.
+fn stop_rule(args: &RenderArgs, scene_spp: u32) -> Result<StopRule> {
+    let time_limit = match args.time_limit {
+        Some(t) if !(t > 0.0 && t.is_finite()) => {
+            return Err(Error::usage(format!(
+                "--time-limit must be a positive number of seconds, not {t}"
+            )));
+        }
+        t => t.map(Duration::from_secs_f64),
+    };
+    if let Some(e) = args.target_error
+        && !(e > 0.0 && e.is_finite())
+    {
+        return Err(Error::usage(format!(
+            "--target-error must be positive, not {e}"
+        )));
+    }
+    let open_ended = time_limit.is_some() || args.target_error.is_some();
+    let sample_end = match &args.sample_range {
+        Some(range) => Some(range.end),
+        None if open_ended => args.spp,
+        None => Some(args.spp.unwrap_or(scene_spp)),
+    };
+    Ok(StopRule {
+        sample_end,
+        time_limit,
+        target_error: args.target_error,
+    })
+}
+
+/// The sampler's name in render states and messages.
+fn sampler_name(kind: SamplerKind) -> &'static str {
+    match kind {
+        SamplerKind::Independent => "independent",
+        SamplerKind::Stratified { .. } => "stratified",
+        SamplerKind::MultiJitter { .. } => "multijitter",
+        SamplerKind::NRooks => "nrooks",
+    }
+}
+
+/// Signals that stop a render: the first raises `interrupt` (and records its number), a second
+/// exits at once with the conventional status.
+fn install_signal_handlers(interrupt: Arc<AtomicBool>, signal: Arc<AtomicI32>) -> Result<()> {
+    use signal_hook::consts::{SIGINT, SIGTERM};
+    let mut signals = signal_hook::iterator::Signals::new([SIGINT, SIGTERM])
+        .map_err(|e| Error::usage(format!("could not install the signal handlers: {e}")))?;
+    std::thread::spawn(move || {
+        for received in signals.forever() {
+            if interrupt.swap(true, Ordering::SeqCst) {
+                eprintln!("\nprism: second interruption, exiting at once");
+                std::process::exit(128 + received);
+            }
+            signal.store(received, Ordering::SeqCst);
+            eprintln!(
+                "\nprism: interrupted; finishing the pass in flight (interrupt again to exit at once)"
+            );
+        }
+    });
+    Ok(())
+}
+
 pub fn run(args: &RenderArgs) -> Result<()> {
     if args.spp == Some(0) {
         return Err(Error::usage("--spp must be at least 1"));
@@ -100,58 +235,300 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     if args.threads == Some(0) {
         return Err(Error::usage("--threads must be at least 1"));
     }
+    if !(args.checkpoint_every > 0.0 && args.checkpoint_every.is_finite()) {
+        return Err(Error::usage(
+            "--checkpoint-every must be a positive number of seconds",
+        ));
+    }
     let loaded = load_scene(&args.scene, &args.defines)?;
     let mut scene = loaded.scene;
-    if let Some([x0, y0, x1, y1]) = args.crop {
+    let crop = match (args.crop, args.pixel) {
+        (Some(_), Some(_)) => return Err(Error::usage("give either --crop or --pixel, not both")),
+        (Some([x0, y0, x1, y1]), None) => Some([x0, y0, x1, y1]),
+        (None, Some([x, y])) => Some([x, y, x + 1, y + 1]),
+        (None, None) => None,
+    };
+    if let Some([x0, y0, x1, y1]) = crop {
         let size = scene.film.size;
         if x1 > size.x || y1 > size.y {
             return Err(Error::usage(format!(
-                "--crop {x0},{y0},{x1},{y1} reaches outside the {}×{} film",
+                "pixels {x0},{y0} to {x1},{y1} reach outside the {}×{} film",
                 size.x, size.y
             )));
         }
         scene.film.crop = CropWindow {
-            offset: glam::UVec2::new(x0, y0),
-            size: glam::UVec2::new(x1 - x0, y1 - y0),
+            offset: UVec2::new(x0, y0),
+            size: UVec2::new(x1 - x0, y1 - y0),
         };
     }
+    let seed = args.seed.unwrap_or(loaded.seed);
+    let strata = scene
+        .sampler
+        .kind
+        .sample_count(args.spp.unwrap_or(scene.sampler.samples_per_pixel));
+    if let Some([x, y]) = args.pixel {
+        return trace_pixel(&scene, UVec2::new(x, y), strata, seed, args);
+    }
+    let identity = RenderIdentity {
+        scene: scene.fingerprint,
+        seed,
+        sampler: sampler_name(scene.sampler.kind).to_string(),
+        samples_per_pixel: strata,
+        film_size: scene.film.size,
+        crop: scene.film.crop,
+    };
+
+    // Where the samples start: the range asked for, or past a resumed state's samples.
+    let mut first_sample = args.sample_range.as_ref().map_or(0, |r| r.start);
+    let mut initial = None;
+    let mut previous_ranges: Vec<Range<u32>> = Vec::new();
+    if let Some(path) = &args.resume {
+        let state = RenderState::read(path)?;
+        if let Some(reason) = identity.mismatch(&state.identity) {
+            return Err(Error::usage(format!("cannot resume from \"{}\": {reason}", path.display()))
+                .with_help("resume with the same scene, -D values, --spp, --seed and --crop as the interrupted render"));
+        }
+        let [range] = state.ranges.as_slice() else {
+            return Err(Error::usage(format!(
+                "\"{}\" holds several sample ranges (a merge); it cannot be resumed",
+                path.display()
+            )));
+        };
+        if range.start != first_sample {
+            return Err(Error::usage(format!(
+                "\"{}\" holds samples {}..{}, which do not start where this render's range starts ({first_sample})",
+                path.display(),
+                range.start,
+                range.end
+            )));
+        }
+        first_sample = range.end;
+        previous_ranges.push(range.clone());
+        initial = Some(state.pixels);
+    }
+    let stop = stop_rule(args, strata)?;
+    if let Some(end) = stop.sample_end
+        && first_sample >= end
+    {
+        return Err(Error::usage(format!(
+            "nothing to render: the samples before {end} are done already"
+        ))
+        .with_help("ask for more with --spp"));
+    }
+
+    let interrupt = Arc::new(AtomicBool::new(false));
+    let signal = Arc::new(AtomicI32::new(0));
+    install_signal_handlers(interrupt.clone(), signal.clone())?;
     let options = RenderOptions {
-        samples_per_pixel: args.spp.unwrap_or(scene.sampler.samples_per_pixel),
+        samples_per_pixel: strata,
+        first_sample,
+        initial,
+        stop,
+        interrupt: Some(interrupt),
         threads: args.threads,
-        seed: args.seed.unwrap_or(loaded.seed),
+        seed,
         progress: std::io::stderr().is_terminal(),
     };
-    let output = render(&scene, &options)?;
     let (exr_path, png_path) = output_paths(args);
+    let state_path = args
+        .checkpoint
+        .clone()
+        .or_else(|| args.resume.clone())
+        .unwrap_or_else(|| exr_path.with_extension("state"));
+    let state_of = |snapshot: &Snapshot| {
+        let mut ranges = previous_ranges.clone();
+        if !snapshot.samples.is_empty() {
+            match ranges.last_mut() {
+                Some(last) if last.end == snapshot.samples.start => last.end = snapshot.samples.end,
+                _ => ranges.push(snapshot.samples.clone()),
+            }
+        }
+        RenderState {
+            identity: identity.clone(),
+            ranges,
+            pixels: snapshot.pixels.to_vec(),
+        }
+    };
+    let mut write_checkpoint = |snapshot: &Snapshot| -> Result<()> {
+        let state = state_of(snapshot);
+        if state.ranges.is_empty() {
+            return Ok(());
+        }
+        state.write(&state_path)
+    };
+    let checkpoints =
+        args.checkpoint.is_some() || args.resume.is_some() || args.sample_range.is_some();
+    let output = render_with_checkpoints(
+        &scene,
+        &options,
+        checkpoints.then(|| Checkpoints {
+            every: Duration::from_secs_f64(args.checkpoint_every),
+            write: &mut write_checkpoint,
+        }),
+    )?;
     write_images(&output.film, &exr_path, &png_path)?;
+    if output.stop == StopReason::Interrupted && !checkpoints {
+        // An interrupted render always leaves a state to resume from.
+        state_of(&Snapshot {
+            samples: output.samples.clone(),
+            pixels: &output.film.pixels,
+        })
+        .write(&state_path)?;
+    }
+    report(args, &scene, &output, &exr_path, &png_path);
+    if output.stop == StopReason::Interrupted {
+        let received = signal.load(Ordering::SeqCst);
+        eprintln!(
+            "prism: interrupted after {} spp; the image so far is in {}. Resume with:\n  prism render {} --resume {}{}",
+            output.film.pixels.first().map_or(0, |p| p.samples),
+            exr_path.display(),
+            args.scene.display(),
+            state_path.display(),
+            resume_arguments(args)
+        );
+        std::process::exit(128 + if received == 0 { 2 } else { received });
+    }
+    Ok(())
+}
 
+/// The arguments a resumed render must repeat.
+fn resume_arguments(args: &RenderArgs) -> String {
+    let mut text = String::new();
+    for (name, value) in &args.defines {
+        text += &format!(" -D {name}={value}");
+    }
+    if let Some(spp) = args.spp {
+        text += &format!(" --spp {spp}");
+    }
+    if let Some(seed) = args.seed {
+        text += &format!(" --seed {seed}");
+    }
+    if let Some([a, b, c, d]) = args.crop {
+        text += &format!(" --crop {a},{b},{c},{d}");
+    }
+    if let Some(range) = &args.sample_range {
+        text += &format!(" --sample-range {}..{}", range.start, range.end);
+    }
+    if let Some(output) = &args.output {
+        text += &format!(" -o {}", output.display());
+    }
+    text
+}
+
+/// The summary line, and the pixels where samples were dropped as non-finite.
+fn report(
+    args: &RenderArgs,
+    scene: &Scene,
+    output: &crate::render::RenderOutput,
+    exr: &Path,
+    png: &Path,
+) {
     let seconds = output.elapsed.as_secs_f64().max(1e-9);
-    let (_, rejected) = output.film.sample_counts();
+    let stopped = match output.stop {
+        StopReason::Completed => "",
+        StopReason::TimeLimit => ", stopped by the time limit",
+        StopReason::TargetError => ", target error reached",
+        StopReason::Interrupted => ", interrupted",
+    };
     eprintln!(
-        "prism: rendered {} ({}×{}, {} spp) in {:.2} s: {:.3} M samples/s, {:.2} M rays/s{} -> {}, {}",
+        "prism: rendered {} ({}×{}, {} spp{stopped}) in {:.2} s: {:.3} M samples/s, {:.2} M rays/s, mean relative error {:.4} -> {}, {}",
         args.scene.display(),
         scene.film.crop.size.x,
         scene.film.crop.size.y,
-        options.samples_per_pixel,
+        output.film.pixels.first().map_or(0, |p| p.samples),
         seconds,
-        output.samples as f64 / seconds / 1e6,
+        output.sample_count as f64 / seconds / 1e6,
         output.rays as f64 / seconds / 1e6,
-        if rejected > 0 {
-            format!(", {rejected} non-finite samples dropped")
-        } else {
-            String::new()
-        },
-        exr_path.display(),
-        png_path.display(),
+        output.relative_error,
+        exr.display(),
+        png.display(),
+    );
+    if let Some(line) = rejected_report(&output.film) {
+        eprintln!("{line}");
+    }
+}
+
+/// Says how many samples were dropped as non-finite and in which pixels most of them were.
+pub fn rejected_report(film: &Film) -> Option<String> {
+    let total: u64 = film.pixels.iter().map(|p| p.rejected).sum();
+    if total == 0 {
+        return None;
+    }
+    let width = film.crop.size.x;
+    let mut worst: Vec<(u64, u32, u32)> = film
+        .pixels
+        .iter()
+        .enumerate()
+        .filter(|(_, p)| p.rejected > 0)
+        .map(|(i, p)| {
+            let (x, y) = (i as u32 % width, i as u32 / width);
+            (p.rejected, film.crop.offset.x + x, film.crop.offset.y + y)
+        })
+        .collect();
+    worst.sort_by(|a, b| b.0.cmp(&a.0).then(a.1.cmp(&b.1)).then(a.2.cmp(&b.2)));
+    let listed: Vec<String> = worst
+        .iter()
+        .take(5)
+        .map(|(n, x, y)| format!("({x}, {y}) ×{n}"))
+        .collect();
+    Some(format!(
+        "prism: {total} samples were NaN or infinite and were dropped; worst pixels: {}; inspect one with --pixel x,y",
+        listed.join(", ")
+    ))
+}
+
+/// `--pixel x,y`: renders one pixel and prints every sample, marking the non-finite ones.
+fn trace_pixel(
+    scene: &Scene,
+    pixel: UVec2,
+    strata: u32,
+    seed: u64,
+    args: &RenderArgs,
+) -> Result<()> {
+    let filter = FilterSampler::new(scene.film.filter);
+    let mut sampler = Sampler::new(scene.sampler.kind, strata, seed);
+    let mut count = RayCount::default();
+    let range = args.sample_range.clone().unwrap_or(0..strata);
+    let mut sums = PixelSums::default();
+    println!(
+        "pixel ({}, {}), samples {}..{}, seed {seed}:",
+        pixel.x, pixel.y, range.start, range.end
+    );
+    println!("{:>8} {:>14} {:>14} {:>14}", "sample", "X", "Y", "Z");
+    for index in range {
+        let xyz = estimate_sample(scene, &filter, &mut sampler, pixel, index, &mut count);
+        let bad = !xyz.iter().all(|v| v.is_finite());
+        println!(
+            "{index:>8} {:>14.6e} {:>14.6e} {:>14.6e}{}",
+            xyz[0],
+            xyz[1],
+            xyz[2],
+            if bad { "   <- not finite" } else { "" }
+        );
+        sums.add(xyz);
+    }
+    let mean = sums.mean();
+    println!(
+        "mean XYZ {:.6e} {:.6e} {:.6e}; {} of {} samples not finite",
+        mean[0], mean[1], mean[2], sums.rejected, sums.samples
     );
     Ok(())
 }
 
-/// Writes the film as an EXR with channels R, G, B (linear sRGB) and X, Y, Z, and as an sRGB PNG.
+/// Writes the film as an EXR and as an sRGB PNG. The EXR's channels are `R`, `G`, `B` (linear
+/// sRGB), `X`, `Y`, `Z` (CIE 1931), `variance.X`, `variance.Y`, `variance.Z` (the estimated
+/// variance of each pixel's mean, see [`crate::render::stats`]) and `relative_error.Y` (the
+/// pixel's relative standard error of luminance).
 pub fn write_images(film: &Film, exr_path: &Path, png_path: &Path) -> Result<()> {
     let xyz = film.xyz();
     let rgb = film.linear_srgb();
     let channel = |values: &[[f32; 3]], c: usize| values.iter().map(|v| v[c]).collect::<Vec<f32>>();
+    let variance = |c: usize| {
+        film.pixels
+            .iter()
+            .map(|p| variance_of_mean(p, c) as f32)
+            .collect::<Vec<f32>>()
+    };
     let image = ChannelImage {
         width: film.crop.size.x as usize,
         height: film.crop.size.y as usize,
@@ -162,6 +539,16 @@ pub fn write_images(film: &Film, exr_path: &Path, png_path: &Path) -> Result<()>
             ("X".to_string(), channel(&xyz, 0)),
             ("Y".to_string(), channel(&xyz, 1)),
             ("Z".to_string(), channel(&xyz, 2)),
+            ("variance.X".to_string(), variance(0)),
+            ("variance.Y".to_string(), variance(1)),
+            ("variance.Z".to_string(), variance(2)),
+            (
+                "relative_error.Y".to_string(),
+                film.pixels
+                    .iter()
+                    .map(|p| pixel_relative_error(p) as f32)
+                    .collect(),
+            ),
         ],
     };
     write_exr(exr_path, &image)?;

@@ -8,10 +8,17 @@
 //! two agree. Each sample lands in its own pixel only, so pixels are independent and the image
 //! does not depend on the order in which samples are taken.
 //!
+//! Filters with negative lobes (Mitchell–Netravali, Catmull–Rom, Lanczos) keep them: a sample
+//! drawn where k(x)k(y) < 0 gets a negative weight instead of being clipped, so the estimate
+//! remains the filtered image itself (and a constant image stays constant).
+//!
 //! ```xml
 //! <rfilter type="box"/>                                 <!-- radius 0.5 -->
 //! <rfilter type="tent"/>                                <!-- radius 1 -->
 //! <rfilter type="gaussian"><float name="stddev" value="0.5"/></rfilter>   <!-- radius 4σ -->
+//! <rfilter type="mitchell"><float name="B" value="0.3333"/><float name="C" value="0.3333"/></rfilter>
+//! <rfilter type="catmullrom"/>                          <!-- Mitchell with B = 0, C = 1/2 -->
+//! <rfilter type="lanczos"><integer name="lobes" value="3"/></rfilter>
 //! ```
 
 use glam::Vec2;
@@ -27,6 +34,11 @@ pub enum Filter {
     Tent { radius: f32 },
     /// Mitsuba 3's truncated Gaussian: k = max(0, exp(−x²/2σ²) − exp(−r²/2σ²)), r = 4σ.
     Gaussian { stddev: f32 },
+    /// The cubic of Mitchell & Netravali 1988, "Reconstruction Filters in Computer Graphics",
+    /// eq. 8, on [−2, 2]; Catmull–Rom is B = 0, C = 1/2.
+    Mitchell { b: f32, c: f32 },
+    /// Lanczos' windowed sinc, sinc(x) sinc(x/a) on [−a, a] with a = `lobes`.
+    Lanczos { lobes: u32 },
 }
 
 impl Filter {
@@ -34,6 +46,8 @@ impl Filter {
         match *self {
             Filter::Box { radius } | Filter::Tent { radius } => radius,
             Filter::Gaussian { stddev } => 4.0 * stddev,
+            Filter::Mitchell { .. } => 2.0,
+            Filter::Lanczos { lobes } => lobes as f32,
         }
     }
 
@@ -49,6 +63,29 @@ impl Filter {
             Filter::Gaussian { stddev } => {
                 let alpha = -1.0 / (2.0 * stddev * stddev);
                 ((alpha * x * x).exp() - (alpha * r * r).exp()).max(0.0)
+            }
+            Filter::Mitchell { b, c } => {
+                let x = x.abs();
+                let (x2, x3) = (x * x, x * x * x);
+                let polynomial = if x < 1.0 {
+                    (12.0 - 9.0 * b - 6.0 * c) * x3
+                        + (-18.0 + 12.0 * b + 6.0 * c) * x2
+                        + (6.0 - 2.0 * b)
+                } else {
+                    (-b - 6.0 * c) * x3
+                        + (6.0 * b + 30.0 * c) * x2
+                        + (-12.0 * b - 48.0 * c) * x
+                        + (8.0 * b + 24.0 * c)
+                };
+                polynomial / 6.0
+            }
+            Filter::Lanczos { .. } => {
+                let x = x.abs();
+                if x < 1e-6 {
+                    return 1.0;
+                }
+                let (px, pxa) = (std::f32::consts::PI * x, std::f32::consts::PI * x / r);
+                (px.sin() * pxa.sin()) / (px * pxa)
             }
         }
     }
@@ -109,19 +146,26 @@ impl FilterSampler {
         self.filter
     }
 
-    /// An offset from the pixel centre and its weight k(x)k(y) / (p(x)p(y)(∫k)²).
+    /// One coordinate of an offset, with density ∝ |k|, and its weight k(x) / (p(x) ∫k).
     #[inline]
-    pub fn sample(&self, u: Vec2) -> (Vec2, f32) {
-        let (x, _) = self.distribution.sample(u.x);
-        let (y, _) = self.distribution.sample(u.y);
-        let k = self.filter.eval(x) * self.filter.eval(y);
-        let p = self.distribution.pdf(x) * self.distribution.pdf(y);
+    pub fn sample_1d(&self, u: f32) -> (f32, f32) {
+        let (x, _) = self.distribution.sample(u);
+        let p = self.distribution.pdf(x);
         let weight = if p > 0.0 {
-            k / (p * self.integral * self.integral)
+            self.filter.eval(x) / (p * self.integral)
         } else {
             0.0
         };
-        (Vec2::new(x, y), weight)
+        (x, weight)
+    }
+
+    /// An offset from the pixel centre and its weight k(x)k(y) / (p(x)p(y)(∫k)²): the two axes
+    /// are sampled independently (the filter is a tensor product).
+    #[inline]
+    pub fn sample(&self, u: Vec2) -> (Vec2, f32) {
+        let (x, wx) = self.sample_1d(u.x);
+        let (y, wy) = self.sample_1d(u.y);
+        (Vec2::new(x, y), wx * wy)
     }
 
     /// Density of an offset (per unit area of the film): the product of the per-axis densities.
@@ -151,12 +195,39 @@ mod tests {
         }
     }
 
+    /// Mitchell–Netravali's cubic is C¹ at |x| = 1 and vanishes at 2 (for any B, C), and the
+    /// integer translates of the kernel sum to 1 (Mitchell & Netravali 1988, §4).
+    #[test]
+    fn mitchell_kernel_is_smooth_and_a_partition_of_unity() {
+        for (b, c) in [(1.0 / 3.0, 1.0 / 3.0), (0.0, 0.5), (1.0, 0.0)] {
+            let k = Filter::Mitchell { b, c };
+            assert!((k.eval(1.0 - 1e-4) - k.eval(1.0 + 1e-4)).abs() < 1e-3);
+            assert!(k.eval(1.999).abs() < 1e-4);
+            for x in [0.0f32, 0.1, 0.37, 0.5, 0.9] {
+                let sum: f32 = (-2..=2).map(|i| k.eval(x + i as f32)).sum();
+                assert!((sum - 1.0).abs() < 1e-5, "B {b} C {c} x {x}: {sum}");
+            }
+        }
+        assert!(
+            Filter::Mitchell { b: 0.0, c: 0.5 }.eval(1.5) < 0.0,
+            "Catmull-Rom has negative lobes"
+        );
+        assert_eq!(Filter::Lanczos { lobes: 3 }.eval(0.0), 1.0);
+        assert!(Filter::Lanczos { lobes: 3 }.eval(1.0).abs() < 1e-6);
+    }
+
     /// The weights average to 1 (the filter is normalised) within 4 standard errors.
     #[test]
     fn filter_weights_have_unit_mean() {
         for filter in [
             Filter::Tent { radius: 1.0 },
             Filter::Gaussian { stddev: 0.5 },
+            Filter::Mitchell {
+                b: 1.0 / 3.0,
+                c: 1.0 / 3.0,
+            },
+            Filter::Mitchell { b: 0.0, c: 0.5 },
+            Filter::Lanczos { lobes: 3 },
         ] {
             let sampler = FilterSampler::new(filter);
             let mut rng = Pcg32::seeded(3);

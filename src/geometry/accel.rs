@@ -4,7 +4,8 @@
 //! by parallel reinsertion under the SAH cost (Meister & Bittner 2017), then collapsed into the
 //! compressed wide BVH of Ylitie et al. 2017 with 8 children per node, traversed four children at
 //! a time with SIMD. Triangles are stored with their vertices in leaf order for locality;
-//! analytic shapes (spheres, disks) are single primitives.
+//! analytic shapes (spheres, disks) and moving shapes (with their own hierarchy, see
+//! [`super::instance`]) are single primitives.
 
 use std::time::Duration;
 
@@ -33,6 +34,7 @@ enum Primitive {
 }
 
 /// The scene's shapes and the hierarchy over them.
+#[derive(Clone, Debug)]
 pub struct Geometry {
     pub shapes: Vec<Shape>,
     bvh: Option<CwBvh>,
@@ -69,21 +71,9 @@ impl Geometry {
                         });
                     }
                 }
-                Shape::Sphere(sphere) => {
-                    let r = Vec3::splat(sphere.radius);
-                    bounds.push(Aabb::new(
-                        to_obvhs(sphere.center - r),
-                        to_obvhs(sphere.center + r),
-                    ));
-                    primitives.push(Primitive::Analytic { shape: shape_index });
-                }
-                Shape::Disk(disk) => {
-                    let mut aabb = Aabb::INVALID;
-                    for corner in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
-                        let p = disk.to_world.point(Vec3::new(corner.0, corner.1, 0.0));
-                        aabb.extend(to_obvhs(p));
-                    }
-                    bounds.push(aabb);
+                Shape::Sphere(_) | Shape::Disk(_) | Shape::Instance(_) => {
+                    let (lo, hi) = shape.object_bounds();
+                    bounds.push(Aabb::new(to_obvhs(lo), to_obvhs(hi)));
                     primitives.push(Primitive::Analytic { shape: shape_index });
                 }
             }
@@ -117,6 +107,12 @@ impl Geometry {
         self.primitives.len()
     }
 
+    /// The axis-aligned box (min, max) around all shapes; None for an empty scene.
+    pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
+        let aabb = self.bvh.as_ref()?.total_aabb;
+        Some((Vec3::from(aabb.min), Vec3::from(aabb.max)))
+    }
+
     fn bvh_ray(ray: &Ray) -> obvhs::ray::Ray {
         obvhs::ray::Ray::new(to_obvhs(ray.o), to_obvhs(ray.d), 0.0, ray.t_max)
     }
@@ -125,6 +121,7 @@ impl Geometry {
         match &self.shapes[shape as usize] {
             Shape::Sphere(sphere) => sphere.intersect(ray.o, ray.d, t_max),
             Shape::Disk(disk) => disk.intersect(ray.o, ray.d, t_max),
+            Shape::Instance(instance) => instance.intersect(ray, t_max),
             Shape::Mesh(_) => None,
         }
     }
@@ -158,7 +155,7 @@ impl Geometry {
             }
         });
         let (id, h) = closest?;
-        Some(match self.primitives[id] {
+        let mut si = match self.primitives[id] {
             Primitive::Triangle { shape, index, .. } => match &self.shapes[shape as usize] {
                 Shape::Mesh(mesh) => mesh.interaction(index as usize, &h, shape),
                 _ => unreachable!("triangle primitives belong to meshes"),
@@ -166,9 +163,13 @@ impl Geometry {
             Primitive::Analytic { shape } => match &self.shapes[shape as usize] {
                 Shape::Sphere(sphere) => sphere.interaction(ray.o, ray.d, h.t, shape),
                 Shape::Disk(disk) => disk.interaction(ray.o, ray.d, h.t, shape),
+                // The same query again, now keeping the object's interaction.
+                Shape::Instance(instance) => instance.interaction(ray, ray.t_max, shape)?,
                 Shape::Mesh(_) => unreachable!("meshes are made of triangle primitives"),
             },
-        })
+        };
+        si.time = ray.time;
+        Some(si)
     }
 
     /// Whether anything blocks the ray in (0, t_max).

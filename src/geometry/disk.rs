@@ -77,6 +77,7 @@ impl Disk {
             dp_dv,
             shape,
             primitive: 0,
+            time: 0.0,
         }
     }
 

@@ -26,6 +26,8 @@ pub struct SurfaceInteraction {
     pub shape: u32,
     /// Index of the primitive within the shape (triangle index; 0 for analytic shapes).
     pub primitive: u32,
+    /// The time of the ray that found the point; rays leaving it keep it.
+    pub time: f32,
 }
 
 impl SurfaceInteraction {
@@ -37,7 +39,7 @@ impl SurfaceInteraction {
         } else {
             -self.n
         };
-        Ray::new(offset_ray_origin(self.p, n), d, f32::INFINITY)
+        Ray::new(offset_ray_origin(self.p, n), d, f32::INFINITY, self.time)
     }
 
     /// A shadow ray from this surface to the point `target` on another surface with geometric
@@ -61,7 +63,7 @@ impl SurfaceInteraction {
             };
             offset_ray_origin(target, m)
         };
-        Ray::new(origin, end - origin, 1.0 - SHADOW_EPSILON)
+        Ray::new(origin, end - origin, 1.0 - SHADOW_EPSILON, self.time)
     }
 }
 

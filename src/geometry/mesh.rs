@@ -150,6 +150,7 @@ impl TriangleMesh {
             dp_dv,
             shape,
             primitive: triangle as u32,
+            time: 0.0,
         }
     }
 

@@ -3,6 +3,7 @@
 
 pub mod accel;
 pub mod disk;
+pub mod instance;
 pub mod interaction;
 pub mod mesh;
 pub mod offset;

@@ -19,10 +19,6 @@ pub struct Sphere {
     pub flip_normals: bool,
 }
 
-/// Below this sin²θmax (θmax ≈ 1.5°) the cone's 1 − cos θ is computed from its Taylor series,
-/// because 1 − √(1 − sin²θ) loses all its digits in single precision (pbrt-v4 §6.2.4).
-const SMALL_CONE_SIN2: f32 = 0.000_685_23;
-
 /// Relative margin by which a reference point must lie outside the sphere for the cone to be
 /// sampled: points on the surface itself (a sphere lighting its own inside, say) are rounded to
 /// either side, and only area sampling is valid for them.
@@ -82,6 +78,7 @@ impl Sphere {
             dp_dv,
             shape,
             primitive: 0,
+            time: 0.0,
         }
     }
 
@@ -148,20 +145,13 @@ impl Sphere {
         }
         let dc = dc2.sqrt();
         let sin2_max = r * r / dc2;
-        let cos_max = (1.0 - sin2_max).max(0.0).sqrt();
-        let one_minus_cos_max = if sin2_max < SMALL_CONE_SIN2 {
-            sin2_max / 2.0
-        } else {
-            1.0 - cos_max
-        };
-        // θ within the cone, uniform in solid angle.
-        let (sin2_theta, cos_theta) = if sin2_max < SMALL_CONE_SIN2 {
-            let s2 = sin2_max * u.x;
-            (s2, (1.0 - s2).sqrt())
-        } else {
-            let c = (cos_max - 1.0) * u.x + 1.0;
-            (1.0 - c * c, c)
-        };
+        let one_minus_cos_max = one_minus_cos(sin2_max);
+        // θ within the cone, uniform in solid angle: 1 − cos θ uniform on [0, 1 − cos θmax].
+        // Carrying 1 − cos θ (not cos θ) keeps sin²θ = (1 − cos θ)(1 + cos θ) exact for the
+        // tiny cones of small or distant spheres, where cos θ rounds to 1.
+        let one_minus_cos_theta = one_minus_cos_max * u.x;
+        let cos_theta = 1.0 - one_minus_cos_theta;
+        let sin2_theta = one_minus_cos_theta * (2.0 - one_minus_cos_theta);
         // α: angle at the centre between the axis back to the reference and the surface point.
         let cos_alpha = sin2_theta / sin2_max.sqrt()
             + cos_theta * (1.0 - sin2_theta / sin2_max).max(0.0).sqrt();
@@ -188,14 +178,15 @@ impl Sphere {
         if !self.is_outside(dc2) {
             return area_to_solid_angle(1.0 / self.area(), reference, p, n).unwrap_or(0.0);
         }
-        let sin2_max = r * r / dc2;
-        let one_minus_cos_max = if sin2_max < SMALL_CONE_SIN2 {
-            sin2_max / 2.0
-        } else {
-            1.0 - (1.0 - sin2_max).max(0.0).sqrt()
-        };
-        1.0 / (2.0 * PI * one_minus_cos_max)
+        1.0 / (2.0 * PI * one_minus_cos(r * r / dc2))
     }
+}
+
+/// 1 − cos θ from sin²θ (θ ≤ π/2), as sin²θ / (1 + cos θ): unlike 1 − √(1 − sin²θ), which
+/// loses all its digits in single precision below θ ≈ 1.5° (pbrt-v4 §6.2.4 switches to a
+/// Taylor series there), this is accurate to a few ulps at every angle.
+fn one_minus_cos(sin2: f32) -> f32 {
+    sin2 / (1.0 + (1.0 - sin2).max(0.0).sqrt())
 }
 
 /// Converts a density per unit area at `p` (normal `n`) into one per unit solid angle seen from

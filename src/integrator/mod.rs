@@ -1,7 +1,10 @@
-//! Integrators: estimators of the radiance arriving along a camera ray.
+//! Integrators: estimators of the radiance arriving along a camera ray: the path tracer and the
+//! lecture's distribution ray tracer with splitting.
 
+pub mod distribution;
 pub mod path;
 
+pub use distribution::DistributionIntegrator;
 pub use path::PathIntegrator;
 
 use crate::math::Ray;
@@ -13,6 +16,19 @@ use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 #[derive(Clone, Debug)]
 pub enum Integrator {
     Path(PathIntegrator),
+    Distribution(DistributionIntegrator),
+}
+
+impl From<PathIntegrator> for Integrator {
+    fn from(integrator: PathIntegrator) -> Integrator {
+        Integrator::Path(integrator)
+    }
+}
+
+impl From<DistributionIntegrator> for Integrator {
+    fn from(integrator: DistributionIntegrator) -> Integrator {
+        Integrator::Distribution(integrator)
+    }
 }
 
 /// Rays traced while estimating one sample, for the statistics line.
@@ -34,6 +50,9 @@ impl Integrator {
     ) -> SampledSpectrum {
         match self {
             Integrator::Path(integrator) => integrator.radiance(scene, ray, lambda, sampler, count),
+            Integrator::Distribution(integrator) => {
+                integrator.radiance(scene, ray, lambda, sampler, count)
+            }
         }
     }
 }

@@ -7,14 +7,16 @@
 //!     <integer name="max_depth" value="-1"/>     <!-- -1: unbounded; 1: emitters only; 2: direct -->
 //!     <integer name="rr_depth" value="5"/>       <!-- depth at which Russian roulette starts -->
 //!     <boolean name="hide_emitters" value="false"/>
+//!     <string name="emitter_sampling" value="power"/>   <!-- or "uniform" (Prism only) -->
 //! </integrator>
 //! ```
 //!
-//! * Light sampling picks one light with probability ∝ its power and divides by that
-//!   probability (DESIGN.md §4). Light samples and BSDF samples that hit an emitter are combined
-//!   by multiple importance sampling with the power heuristic (Veach 1997, §9.2), so no light is
-//!   counted twice; delta lights are reached only by light sampling and BSDF-specular
-//!   directions only by BSDF sampling.
+//! * Light sampling picks one light with probability ∝ its power (or uniformly, see
+//!   [`crate::light::sampler`]) and divides by that probability (DESIGN.md §4). Light samples
+//!   and BSDF samples that hit an emitter or leave the scene towards the environment are
+//!   combined by multiple importance sampling with the power heuristic (Veach 1997, §9.2), so
+//!   no light is counted twice; delta lights (point, spot, directional) are reached only by
+//!   light sampling and BSDF-specular directions only by BSDF sampling.
 //! * Russian roulette (the lecture's "Termination of Recursion"): from depth `rr_depth` on, the
 //!   path continues with probability s = min(max_λ throughput · η², 0.95), the path's potential
 //!   (η² undoes the radiance scaling of refractions, so that light inside glass is not killed
@@ -29,7 +31,7 @@
 use crate::bsdf::{Bsdf, ShadingPoint};
 use crate::geometry::SurfaceInteraction;
 use crate::integrator::RayCount;
-use crate::light::Light;
+use crate::light::{Light, LightSelection};
 use crate::math::Ray;
 use crate::sampling::sampler::Sampler;
 use crate::scene::Scene;
@@ -43,6 +45,8 @@ pub struct PathIntegrator {
     pub rr_depth: i32,
     /// Whether emitters seen directly by the camera are left black.
     pub hide_emitters: bool,
+    /// How one light is chosen for each light sample.
+    pub light_selection: LightSelection,
 }
 
 impl Default for PathIntegrator {
@@ -51,6 +55,7 @@ impl Default for PathIntegrator {
             max_depth: -1,
             rr_depth: 5,
             hide_emitters: false,
+            light_selection: LightSelection::Power,
         }
     }
 }
@@ -104,6 +109,13 @@ impl PathIntegrator {
         loop {
             count.rays += 1;
             let Some(si) = scene.geometry.intersect(&ray) else {
+                // The ray leaves the scene: the environment's emission, weighted like an area
+                // light's against the light sample that could have found it.
+                if let Some(env) = scene.environment
+                    && !(self.hide_emitters && depth == 0)
+                {
+                    result += throughput * self.environment(scene, env, &ray, &previous, &lambda);
+                }
                 break;
             };
             let wo_world = -ray.d.normalize();
@@ -122,7 +134,7 @@ impl PathIntegrator {
                         Some(prev) if !prev.specular => {
                             let shape = &scene.geometry.shapes[si.shape as usize];
                             let light_pdf = scene.light_sampler.pmf(light_index as usize)
-                                * shape.pdf_from(prev.interaction.p, si.p, si.n);
+                                * shape.pdf_from(prev.interaction.p, si.time, si.p, si.n);
                             power_heuristic(prev.pdf, light_pdf)
                         }
                         _ => 1.0,
@@ -208,6 +220,28 @@ impl PathIntegrator {
         result
     }
 
+    /// The MIS-weighted radiance of environment light `env` along the escaped `ray`.
+    fn environment(
+        &self,
+        scene: &Scene,
+        env: u32,
+        ray: &Ray,
+        previous: &Option<PreviousBounce>,
+        lambda: &SampledWavelengths,
+    ) -> SampledSpectrum {
+        let light = &scene.lights[env as usize];
+        let d = ray.d.normalize();
+        let emitted = light.environment_radiance(d, lambda);
+        let weight = match previous {
+            Some(prev) if !prev.specular && !emitted.is_black() => {
+                let light_pdf = scene.light_sampler.pmf(env as usize) * light.environment_pdf(d);
+                power_heuristic(prev.pdf, light_pdf)
+            }
+            _ => 1.0,
+        };
+        emitted * weight
+    }
+
     /// One light sample at `si`: a light chosen ∝ power, a point on it, the shadow ray, and the
     /// MIS-weighted contribution f·L·w / (p_light · p_choice).
     #[allow(clippy::too_many_arguments)]
@@ -229,7 +263,8 @@ impl PathIntegrator {
             return SampledSpectrum::ZERO;
         };
         let light = &scene.lights[light_index];
-        let Some(ls) = light.sample_incident(&scene.geometry.shapes, si.p, u_choice, u, lambda)
+        let Some(ls) =
+            light.sample_incident(&scene.geometry.shapes, si.p, si.time, u_choice, u, lambda)
         else {
             return SampledSpectrum::ZERO;
         };

@@ -3,10 +3,15 @@
 //! ```xml
 //! <shape type="rectangle">
 //!     <emitter type="area">
-//!         <rgb name="radiance" value="17, 12, 4"/>
+//!         <rgb name="radiance" value="17, 12, 4"/>   <!-- default: D65 of luminance 1 -->
 //!     </emitter>
 //! </shape>
 //! ```
+//! Light samples come from the shape ([`crate::geometry::Shape::sample_from`]): spheres by the
+//! cone of directions they subtend (uniform in solid angle, so no sample is wasted on the far
+//! side; the lecture's "Direct Light Sampling"), other shapes uniformly by area, triangle meshes
+//! choosing a triangle by area through an alias table. As in Mitsuba, an emitting shape that
+//! names no BSDF gets a black one.
 
 use std::f32::consts::PI;
 
@@ -38,12 +43,13 @@ impl AreaLight {
         &self,
         shapes: &[Shape],
         reference: Vec3,
+        time: f32,
         u_choice: f32,
         u: Vec2,
         lambda: &SampledWavelengths,
     ) -> Option<LightSample> {
         let shape = &shapes[self.shape as usize];
-        let s = shape.sample_from(reference, u_choice, u)?;
+        let s = shape.sample_from(reference, time, u_choice, u)?;
         let d = s.p - reference;
         let dist = d.length();
         if !(dist > 0.0) || !(s.pdf > 0.0) || !s.pdf.is_finite() {

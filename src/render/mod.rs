@@ -1,11 +1,26 @@
-//! The render driver: tiles of the crop window rendered in parallel on a rayon pool, each pixel
-//! sample estimated by the scene's integrator and accumulated in the film.
+//! The render driver: the image is rendered in passes, each adding samples to every pixel;
+//! within a pass the tiles of the crop window are rendered in parallel on a rayon pool.
 //!
 //! Every pixel sample draws its random numbers from the sampler's stream for (seed, pixel,
-//! sample index), and every sample lands in its own pixel, so the image is bit-identical
-//! whatever the number of threads and the order in which tiles finish.
+//! sample index), every sample lands in its own pixel, and pixel sums are exact (order-free) — so
+//! the image is bit-identical whatever the number of threads, the order in which tiles finish,
+//! the way the samples are split into passes, and whether the render was interrupted, resumed
+//! or assembled from several renders of disjoint sample ranges.
+//!
+//! A pass is committed only when all its tiles are done: a pass cut short (by the time limit or
+//! an interruption) is dropped whole, so every pixel always has the same number of samples and
+//! the image stays an unbiased, correctly normalised estimate whenever the render stops.
+//!
+//! Stopping rules: the end of the requested sample range, a time limit, and a target for the
+//! image's mean relative standard error ([`relative_error`]), whichever comes first; and an
+//! interruption from outside (a signal).
 
-use std::sync::atomic::{AtomicU64, Ordering};
+pub mod state;
+pub mod stats;
+
+use std::ops::Range;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::time::{Duration, Instant};
 
 use glam::{UVec2, Vec2};
@@ -15,18 +30,58 @@ use rayon::prelude::*;
 use crate::error::{Error, Result};
 use crate::film::{Film, FilterSampler, PixelSums};
 use crate::integrator::RayCount;
-use crate::sampling::sampler::{IndependentSampler, Sampler};
-use crate::scene::{SamplerKind, Scene};
+use crate::sampling::sampler::Sampler;
+use crate::scene::Scene;
 use crate::spectrum::SampledWavelengths;
+pub use stats::relative_error;
 
 /// Edge length of the square tiles the image is divided into.
 const TILE_SIZE: u32 = 16;
 
+/// A render made of several passes aims at passes of about this length, so that stopping rules,
+/// checkpoints and interruptions are acted on promptly and little work is dropped.
+const TARGET_PASS_TIME: Duration = Duration::from_secs(2);
+
+/// When a render stops (besides an interruption).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct StopRule {
+    /// Stop before this sample index (None: no limit).
+    pub sample_end: Option<u32>,
+    /// Stop when this much time has passed; the pass running then is dropped.
+    pub time_limit: Option<Duration>,
+    /// Stop once the image's mean relative standard error is at most this.
+    pub target_error: Option<f64>,
+}
+
+impl StopRule {
+    /// Render the samples 0..n.
+    pub fn samples(n: u32) -> StopRule {
+        StopRule {
+            sample_end: Some(n),
+            ..StopRule::default()
+        }
+    }
+
+    fn is_open_ended(&self) -> bool {
+        self.time_limit.is_some() || self.target_error.is_some()
+    }
+}
+
 /// How to render.
 #[derive(Clone, Debug)]
 pub struct RenderOptions {
-    /// Samples per pixel (the scene's sampler gives the default).
+    /// Samples per pixel over which the sampler stratifies (N); samples beyond N start new
+    /// stratified blocks. Stratified samplers may round it up
+    /// (see [`crate::sampling::sampler::SamplerKind::sample_count`]).
     pub samples_per_pixel: u32,
+    /// Index of the first sample to take in every pixel (past a checkpoint, or the start of a
+    /// range given to this render).
+    pub first_sample: u32,
+    /// Sums the render starts from (a resumed render's), row-major over the crop window.
+    pub initial: Option<Vec<PixelSums>>,
+    pub stop: StopRule,
+    /// Raised from outside (by a signal handler) to stop the render after dropping its pass.
+    pub interrupt: Option<Arc<AtomicBool>>,
     /// Worker threads; None for one per core.
     pub threads: Option<usize>,
     /// Seed of every random stream.
@@ -35,14 +90,65 @@ pub struct RenderOptions {
     pub progress: bool,
 }
 
+impl RenderOptions {
+    /// Options for rendering the samples 0..spp in one go.
+    pub fn fixed(spp: u32, seed: u64, threads: Option<usize>) -> RenderOptions {
+        RenderOptions {
+            samples_per_pixel: spp,
+            first_sample: 0,
+            initial: None,
+            stop: StopRule::samples(spp),
+            interrupt: None,
+            threads,
+            seed,
+            progress: false,
+        }
+    }
+
+    /// Whether the render goes in several passes: when it can be stopped early or checkpointed.
+    fn in_passes(&self, checkpoints: bool) -> bool {
+        checkpoints || self.interrupt.is_some() || self.stop.is_open_ended()
+    }
+}
+
+/// Why a render stopped.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum StopReason {
+    /// All requested samples were taken.
+    Completed,
+    TimeLimit,
+    TargetError,
+    Interrupted,
+}
+
+/// The state of a render between two passes, handed to the checkpoint writer.
+pub struct Snapshot<'a> {
+    /// The sample indices every pixel has had in this render (after its initial state).
+    pub samples: Range<u32>,
+    /// Pixel sums, row-major over the crop window (including the initial state).
+    pub pixels: &'a [PixelSums],
+}
+
+/// Something that saves the render's state every so often.
+pub struct Checkpoints<'a> {
+    pub every: Duration,
+    pub write: &'a mut dyn FnMut(&Snapshot) -> Result<()>,
+}
+
 /// What a render produced.
 pub struct RenderOutput {
+    /// Pixel sums, including the initial state.
     pub film: Film,
+    /// The sample indices taken in this render.
+    pub samples: Range<u32>,
     pub elapsed: Duration,
-    /// Camera samples taken.
-    pub samples: u64,
+    /// Camera samples taken in this render.
+    pub sample_count: u64,
     /// Rays traced (camera, bounce and shadow rays).
     pub rays: u64,
+    pub stop: StopReason,
+    /// The mean relative standard error of the image at the end.
+    pub relative_error: f64,
 }
 
 /// A rectangle of pixels, in crop-window coordinates.
@@ -66,54 +172,141 @@ fn tiles(size: UVec2) -> Vec<Tile> {
     tiles
 }
 
-fn make_sampler(scene: &Scene, seed: u64) -> Sampler {
-    match scene.sampler.kind {
-        SamplerKind::Independent => Sampler::Independent(IndependentSampler::new(seed)),
+/// Tells a pass to stop: raised by whoever notices the deadline first, or from outside.
+struct Cancel<'a> {
+    flag: &'a AtomicBool,
+    external: Option<&'a AtomicBool>,
+    deadline: Option<Instant>,
+}
+
+impl Cancel<'_> {
+    fn raised(&self) -> bool {
+        if self.deadline.is_some_and(|d| Instant::now() >= d)
+            || self.external.is_some_and(|e| e.load(Ordering::Relaxed))
+        {
+            self.flag.store(true, Ordering::Relaxed);
+        }
+        self.flag.load(Ordering::Relaxed)
     }
 }
 
-/// Renders all samples of one tile; returns its pixels (row-major) and the rays traced.
+/// The filter-weighted CIE XYZ of sample `index` of `pixel` (full-film coordinates).
+pub fn estimate_sample(
+    scene: &Scene,
+    filter: &FilterSampler,
+    sampler: &mut Sampler,
+    pixel: UVec2,
+    index: u32,
+    count: &mut RayCount,
+) -> [f32; 3] {
+    sampler.start_pixel_sample(pixel, index);
+    let primary = sampler.camera_sample();
+    let lambda = SampledWavelengths::sample(primary.wavelength, scene.wavelength_sampling);
+    let (offset, filter_weight) = filter.sample(primary.film);
+    let (time, time_weight) = scene.shutter.sample(primary.time);
+    let film_position = pixel.as_vec2() + Vec2::splat(0.5) + offset;
+    let ray = scene.camera.generate_ray(film_position, primary.lens, time);
+    let radiance = scene
+        .integrator
+        .radiance(scene, ray, &lambda, sampler, count);
+    let weight = filter_weight * time_weight;
+    lambda.to_xyz(&radiance).map(|v| v * weight)
+}
+
+/// Adds the samples `range` of every pixel of a tile to a copy of its sums; None when the pass
+/// was cancelled before the tile was done.
 fn render_tile(
     scene: &Scene,
     filter: &FilterSampler,
     tile: Tile,
+    sums: &[PixelSums],
+    range: Range<u32>,
     options: &RenderOptions,
-) -> (Vec<PixelSums>, u64) {
-    let mut sampler = make_sampler(scene, options.seed);
+    cancel: &Cancel,
+) -> Option<(Vec<PixelSums>, u64)> {
+    let mut sampler = Sampler::new(scene.sampler.kind, options.samples_per_pixel, options.seed);
     let mut count = RayCount::default();
-    let mut pixels = vec![PixelSums::default(); (tile.size.x * tile.size.y) as usize];
+    let mut pixels = sums.to_vec();
     let crop_offset = scene.film.crop.offset;
     for y in 0..tile.size.y {
+        if cancel.raised() {
+            return None;
+        }
         for x in 0..tile.size.x {
             let pixel = crop_offset + tile.origin + UVec2::new(x, y);
-            let sums = &mut pixels[(y * tile.size.x + x) as usize];
-            for index in 0..options.samples_per_pixel {
-                sampler.start_pixel_sample(pixel, index);
-                let lambda =
-                    SampledWavelengths::sample(sampler.next_1d(), scene.wavelength_sampling);
-                let (offset, weight) = filter.sample(sampler.next_2d());
-                let film_position = pixel.as_vec2() + Vec2::splat(0.5) + offset;
-                let ray = scene.camera.generate_ray(film_position);
-                let radiance =
-                    scene
-                        .integrator
-                        .radiance(scene, ray, &lambda, &mut sampler, &mut count);
-                let xyz = lambda.to_xyz(&radiance).map(|v| v * weight);
-                sums.add(xyz);
+            let pixel_sums = &mut pixels[(y * tile.size.x + x) as usize];
+            for index in range.clone() {
+                pixel_sums.add(estimate_sample(
+                    scene,
+                    filter,
+                    &mut sampler,
+                    pixel,
+                    index,
+                    &mut count,
+                ));
             }
         }
     }
-    (pixels, count.rays)
+    Some((pixels, count.rays))
+}
+
+/// The number of samples per pixel of the next pass.
+fn next_pass(
+    in_passes: bool,
+    done: u32,
+    left: u32,
+    stop: &StopRule,
+    elapsed: Duration,
+    error: f64,
+) -> u32 {
+    if !in_passes {
+        return left;
+    }
+    // Passes grow geometrically from one sample, then keep to about TARGET_PASS_TIME.
+    let mut pass = done.max(1);
+    if done > 0 {
+        let per_sample = elapsed.as_secs_f64() / f64::from(done);
+        pass = pass.min((TARGET_PASS_TIME.as_secs_f64() / per_sample.max(1e-9)).ceil() as u32);
+    }
+    if let Some(target) = stop.target_error
+        && done > 0
+        && error.is_finite()
+    {
+        // The error falls as 1/√n: n·(error/target)² samples reach the target.
+        let needed = (f64::from(done) * (error / target).powi(2)).ceil() as u32;
+        pass = pass.min(needed.saturating_sub(done).max(1));
+    }
+    if let Some(limit) = stop.time_limit
+        && done > 0
+    {
+        let per_sample = elapsed.as_secs_f64() / f64::from(done);
+        let remaining = limit.saturating_sub(elapsed).as_secs_f64();
+        pass = pass.min(((remaining / per_sample) as u32).max(1));
+    }
+    pass.clamp(1, left.max(1))
 }
 
 /// Renders the scene.
 pub fn render(scene: &Scene, options: &RenderOptions) -> Result<RenderOutput> {
+    render_with_checkpoints(scene, options, None)
+}
+
+/// Renders the scene, handing its state to `checkpoints` between passes every so often.
+pub fn render_with_checkpoints(
+    scene: &Scene,
+    options: &RenderOptions,
+    mut checkpoints: Option<Checkpoints>,
+) -> Result<RenderOutput> {
     let crop = scene.film.crop;
-    let mut film = Film::new(scene.film.size, crop);
     let filter = FilterSampler::new(scene.film.filter);
     let tiles = tiles(crop.size);
-    let total_samples =
-        u64::from(crop.size.x) * u64::from(crop.size.y) * u64::from(options.samples_per_pixel);
+    let pixel_count = u64::from(crop.size.x) * u64::from(crop.size.y);
+    let options = RenderOptions {
+        samples_per_pixel: scene.sampler.kind.sample_count(options.samples_per_pixel),
+        ..options.clone()
+    };
+    let stop = options.stop;
+    let in_passes = options.in_passes(checkpoints.is_some());
 
     let mut builder = rayon::ThreadPoolBuilder::new();
     if let Some(threads) = options.threads {
@@ -123,48 +316,179 @@ pub fn render(scene: &Scene, options: &RenderOptions) -> Result<RenderOutput> {
         .build()
         .map_err(|e| Error::usage(format!("could not start the worker threads: {e}")))?;
 
-    let progress = if options.progress {
-        let bar = ProgressBar::with_draw_target(Some(total_samples), ProgressDrawTarget::stderr());
-        bar.set_style(
-            ProgressStyle::with_template(
-                "{bar:40.cyan/blue} {percent:>3}% {human_pos}/{human_len} samples, {per_sec}, ETA {eta}",
-            )
-            .unwrap_or_else(|_| ProgressStyle::default_bar()),
-        );
-        bar
-    } else {
-        ProgressBar::hidden()
-    };
+    let mut sums = tile_major(&tiles, crop.size, options.initial.as_deref())?;
+    let progress = progress_bar(&options, pixel_count);
     let rays = AtomicU64::new(0);
+    let abort = AtomicBool::new(false);
     let start = Instant::now();
-    let rendered: Vec<(Tile, Vec<PixelSums>)> = pool.install(|| {
-        tiles
-            .par_iter()
-            .map(|&tile| {
-                let (pixels, tile_rays) = render_tile(scene, &filter, tile, options);
-                rays.fetch_add(tile_rays, Ordering::Relaxed);
-                progress.inc(
-                    u64::from(tile.size.x * tile.size.y) * u64::from(options.samples_per_pixel),
-                );
-                (tile, pixels)
-            })
-            .collect()
-    });
+    let mut last_checkpoint = start;
+    let first = options.first_sample;
+    let mut next = first;
+    let mut error = if options.initial.is_some() {
+        relative_error(sums.iter().flatten())
+    } else {
+        f64::INFINITY
+    };
+    let reason = loop {
+        if stop.sample_end.is_some_and(|end| next >= end) {
+            break StopReason::Completed;
+        }
+        if stop.target_error.is_some_and(|target| error <= target) {
+            break StopReason::TargetError;
+        }
+        if stop
+            .time_limit
+            .is_some_and(|limit| start.elapsed() >= limit)
+        {
+            break StopReason::TimeLimit;
+        }
+        if options
+            .interrupt
+            .as_ref()
+            .is_some_and(|i| i.load(Ordering::Relaxed))
+        {
+            break StopReason::Interrupted;
+        }
+        let left = stop.sample_end.map_or(u32::MAX - next, |end| end - next);
+        let pass = next_pass(in_passes, next - first, left, &stop, start.elapsed(), error);
+        let range = next..next + pass;
+        let cancel = Cancel {
+            flag: &abort,
+            external: options.interrupt.as_deref(),
+            deadline: stop.time_limit.map(|limit| start + limit),
+        };
+        let results: Vec<Option<(Vec<PixelSums>, u64)>> = pool.install(|| {
+            tiles
+                .par_iter()
+                .zip(&sums)
+                .map(|(&tile, tile_sums)| {
+                    let result = render_tile(
+                        scene,
+                        &filter,
+                        tile,
+                        tile_sums,
+                        range.clone(),
+                        &options,
+                        &cancel,
+                    );
+                    if result.is_some() {
+                        progress.inc(u64::from(tile.size.x * tile.size.y) * u64::from(pass));
+                    }
+                    result
+                })
+                .collect()
+        });
+        if abort.load(Ordering::Relaxed) || results.iter().any(Option::is_none) {
+            let interrupted = options
+                .interrupt
+                .as_ref()
+                .is_some_and(|i| i.load(Ordering::Relaxed));
+            break if interrupted {
+                StopReason::Interrupted
+            } else {
+                StopReason::TimeLimit
+            };
+        }
+        for (tile_sums, (new_sums, tile_rays)) in sums.iter_mut().zip(results.into_iter().flatten())
+        {
+            *tile_sums = new_sums;
+            rays.fetch_add(tile_rays, Ordering::Relaxed);
+        }
+        next += pass;
+        error = relative_error(sums.iter().flatten());
+        progress.set_message(format!("{} spp, error {error:.4}", next - first));
+        if let Some(checkpoint) = &mut checkpoints
+            && last_checkpoint.elapsed() >= checkpoint.every
+        {
+            let pixels = row_major(&tiles, crop.size, &sums);
+            (checkpoint.write)(&Snapshot {
+                samples: first..next,
+                pixels: &pixels,
+            })?;
+            last_checkpoint = Instant::now();
+        }
+    };
     let elapsed = start.elapsed();
     progress.finish_and_clear();
 
-    for (tile, pixels) in rendered {
-        for y in 0..tile.size.y {
-            for x in 0..tile.size.x {
-                let index = film.index(tile.origin.x + x, tile.origin.y + y);
-                film.pixels[index] = pixels[(y * tile.size.x + x) as usize];
-            }
-        }
+    let mut film = Film::new(scene.film.size, crop);
+    film.pixels = row_major(&tiles, crop.size, &sums);
+    if let Some(checkpoint) = &mut checkpoints {
+        (checkpoint.write)(&Snapshot {
+            samples: first..next,
+            pixels: &film.pixels,
+        })?;
     }
     Ok(RenderOutput {
         film,
+        samples: first..next,
         elapsed,
-        samples: total_samples,
+        sample_count: pixel_count * u64::from(next - first),
         rays: rays.into_inner(),
+        stop: reason,
+        relative_error: error,
     })
+}
+
+/// Pixel sums regrouped by tile (each tile's pixels row-major), from row-major sums or empty.
+fn tile_major(
+    tiles: &[Tile],
+    size: UVec2,
+    initial: Option<&[PixelSums]>,
+) -> Result<Vec<Vec<PixelSums>>> {
+    if let Some(pixels) = initial
+        && pixels.len() != (size.x * size.y) as usize
+    {
+        return Err(Error::usage(
+            "the initial state does not match the crop window",
+        ));
+    }
+    Ok(tiles
+        .iter()
+        .map(|t| {
+            let mut sums = Vec::with_capacity((t.size.x * t.size.y) as usize);
+            for y in 0..t.size.y {
+                for x in 0..t.size.x {
+                    let index = ((t.origin.y + y) * size.x + t.origin.x + x) as usize;
+                    sums.push(initial.map_or(PixelSums::default(), |p| p[index]));
+                }
+            }
+            sums
+        })
+        .collect())
+}
+
+/// Row-major pixel sums from tile-major ones.
+fn row_major(tiles: &[Tile], size: UVec2, sums: &[Vec<PixelSums>]) -> Vec<PixelSums> {
+    let mut pixels = vec![PixelSums::default(); (size.x * size.y) as usize];
+    for (tile, tile_sums) in tiles.iter().zip(sums) {
+        for y in 0..tile.size.y {
+            for x in 0..tile.size.x {
+                let index = ((tile.origin.y + y) * size.x + tile.origin.x + x) as usize;
+                pixels[index] = tile_sums[(y * tile.size.x + x) as usize];
+            }
+        }
+    }
+    pixels
+}
+
+fn progress_bar(options: &RenderOptions, pixel_count: u64) -> ProgressBar {
+    if !options.progress {
+        return ProgressBar::hidden();
+    }
+    let total = options
+        .stop
+        .sample_end
+        .filter(|_| !options.stop.is_open_ended())
+        .map(|end| pixel_count * u64::from(end.saturating_sub(options.first_sample)));
+    let template = if total.is_some() {
+        "{bar:40.cyan/blue} {percent:>3}% {human_pos}/{human_len} samples, {per_sec}, ETA {eta} — {msg}"
+    } else {
+        "{spinner} {elapsed_precise} {human_pos} samples, {per_sec} — {msg}"
+    };
+    let bar = ProgressBar::with_draw_target(total, ProgressDrawTarget::stderr());
+    bar.set_style(
+        ProgressStyle::with_template(template).unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    bar
 }

@@ -1,10 +1,13 @@
 //! Tabulated distributions: a piecewise-constant density on an interval (sampled by its inverse
-//! CDF) and the alias table for discrete choices in constant time.
+//! CDF), its extension to the unit square, and the alias table for discrete choices in constant
+//! time.
+
+use glam::Vec2;
 
 /// A piecewise-constant density on `[min, max)` with `n` equal cells, proportional to given
 /// non-negative weights; sampled by inverting its CDF (pbrt-v4, §A.4.1 "Piecewise-Constant 1D").
 /// The cell holding u is found through a guide table (Chen & Asau 1974, "On Generating Random
-/// Variates from an Empirical Distribution"): guide[j] is the cell where u = j/G falls, so the
+/// Variates from an Empirical Distribution"): `guide[j]` is the cell where u = j/G falls, so the
 /// search starts next to the answer and usually takes one or two steps.
 #[derive(Clone, Debug)]
 pub struct PiecewiseConstant1D {
@@ -132,6 +135,66 @@ impl PiecewiseConstant1D {
     }
 }
 
+/// A piecewise-constant density on the unit square [0, 1)² with `nx` × `ny` equal cells,
+/// proportional to given non-negative weights (row-major, row 0 at y = 0). Sampled as a
+/// marginal density over rows followed by the conditional density within the chosen row
+/// (pbrt-v4, §A.5.2 "Piecewise-Constant 2D"), each by its inverse CDF, so the map from the
+/// unit square is continuous within rows and invertible.
+#[derive(Clone, Debug)]
+pub struct PiecewiseConstant2D {
+    /// One conditional density over x per row.
+    rows: Vec<PiecewiseConstant1D>,
+    /// The density over y of the rows' integrals.
+    marginal: PiecewiseConstant1D,
+}
+
+impl PiecewiseConstant2D {
+    /// A density proportional to `weights` (`nx` × `ny`, row-major; absolute values are taken);
+    /// uniform if all are zero. Panics if the table is empty or of the wrong length
+    /// (programming errors).
+    pub fn new(weights: &[f32], nx: usize, ny: usize) -> Self {
+        assert!(nx > 0 && ny > 0 && weights.len() == nx * ny);
+        let rows: Vec<PiecewiseConstant1D> = weights
+            .chunks_exact(nx)
+            .map(|row| PiecewiseConstant1D::new(row, 0.0, 1.0))
+            .collect();
+        let row_integrals: Vec<f32> = rows.iter().map(|r| r.integral() as f32).collect();
+        PiecewiseConstant2D {
+            marginal: PiecewiseConstant1D::new(&row_integrals, 0.0, 1.0),
+            rows,
+        }
+    }
+
+    /// Integral of |weights| over the unit square (before normalisation).
+    pub fn integral(&self) -> f64 {
+        self.marginal.integral()
+    }
+
+    /// Maps `u` in [0, 1)² to a point of the unit square with density [`Self::pdf`].
+    pub fn sample(&self, u: Vec2) -> Vec2 {
+        let (y, row) = self.marginal.sample(u.y);
+        let (x, _) = self.rows[row].sample(u.x);
+        Vec2::new(x, y)
+    }
+
+    /// Density of [`Self::sample`] at `p` (zero outside the unit square).
+    pub fn pdf(&self, p: Vec2) -> f32 {
+        if !(p.y >= 0.0 && p.y < 1.0) {
+            return 0.0;
+        }
+        let row = ((p.y * self.rows.len() as f32) as usize).min(self.rows.len() - 1);
+        self.marginal.cell_pdf(row) * self.rows[row].pdf(p.x)
+    }
+
+    /// The `u` that [`Self::sample`] maps to `p`.
+    pub fn invert(&self, p: Vec2) -> Option<Vec2> {
+        let uy = self.marginal.invert(p.y)?;
+        let row = ((p.y * self.rows.len() as f32) as usize).min(self.rows.len() - 1);
+        let ux = self.rows[row].invert(p.x)?;
+        Some(Vec2::new(ux, uy))
+    }
+}
+
 /// Walker's alias method (Vose 1991, "A Linear Algorithm for Generating Random Numbers with a
 /// Given Distribution"): picks index i with probability w_i / sum(w) from one uniform number in
 /// constant time.
@@ -246,6 +309,28 @@ mod tests {
         let d = PiecewiseConstant1D::new(&[0.0, 0.0], 0.0, 2.0);
         assert_eq!(d.pdf(0.3), 0.5);
         assert!((d.sample(0.75).0 - 1.5).abs() < 1e-6);
+    }
+
+    #[test]
+    fn piecewise_constant_2d_density_sample_and_invert_agree() {
+        // 3 × 2 cells; the middle cell of the first row is empty.
+        let d = PiecewiseConstant2D::new(&[1.0, 0.0, 2.0, 3.0, 1.0, 5.0], 3, 2);
+        assert!((d.integral() - 2.0).abs() < 1e-9);
+        assert!((d.pdf(Vec2::new(0.9, 0.8)) - 2.5).abs() < 1e-5);
+        assert_eq!(d.pdf(Vec2::new(0.5, 0.2)), 0.0);
+        assert_eq!(d.pdf(Vec2::new(0.5, 1.0)), 0.0);
+        for i in 0..40 {
+            for j in 0..40 {
+                let u = Vec2::new((i as f32 + 0.5) / 40.0, (j as f32 + 0.5) / 40.0);
+                let p = d.sample(u);
+                assert!(d.pdf(p) > 0.0, "{u} -> {p} in an empty cell");
+                let back = d.invert(p).unwrap();
+                assert!(
+                    (back - u).abs().max_element() < 1e-4,
+                    "{u} -> {p} -> {back}"
+                );
+            }
+        }
     }
 
     #[test]

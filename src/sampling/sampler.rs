@@ -1,75 +1,298 @@
 //! The per-pixel sampler: the random numbers of one pixel sample, dimension by dimension
-//! (DESIGN.md §3.5). The numbers depend only on (seed, pixel, sample index, dimension), so an
+//! (DESIGN.md §3.5).
+//!
+//! A pixel sample first takes its *primary* dimensions, the parameters of the camera ray that
+//! the lecture samples independently ("Distribution Raytracing", "Reference Implementation:
+//! primary rays"): wavelength, time, film position (2-D) and lens position (2-D). The numbers for
+//! the path's bounces come after. Which dimensions are stratified depends on the sampler:
+//!
+//! | sampler | primary dimensions | later dimensions |
+//! | --- | --- | --- |
+//! | `independent` | uniform | uniform |
+//! | `stratified` (Mitsuba) | 1-D: N strata, 2-D: √N × √N jittered grid | the same |
+//! | `multijitter` (Mitsuba) | 1-D: N strata, 2-D: correlated multi-jittered | the same |
+//! | `nrooks` (ours) | every one of the 6 coordinates in N strata (Latin hypercube) | uniform |
+//!
+//! In every stratified sampler the strata of each dimension are assigned to the N samples of a
+//! pixel by an independent pseudo-random permutation (the lecture's `*_stratified_and_shuffle`),
+//! computed on the fly by Kensler's hash-based permutation, so no table is stored and any sample
+//! index can be drawn alone. Within its stratum a sample is jittered uniformly (or centred, when
+//! `jitter` is false). Everything depends only on (seed, pixel, sample index, dimension): the
 //! image is the same whatever the thread count or the order of tiles.
+//!
+//! ```xml
+//! <sampler type="nrooks">             <!-- or independent, stratified, multijitter -->
+//!     <integer name="sample_count" value="64"/>
+//!     <integer name="seed" value="0"/>
+//!     <boolean name="jitter" value="true"/>   <!-- stratified and multijitter -->
+//! </sampler>
+//! ```
 
 use glam::{UVec2, Vec2};
 
 use super::rng::{Pcg32, hash_u64s};
 
-/// Mitsuba's `independent` sampler: every dimension is an independent uniform number.
-///
-/// ```xml
-/// <sampler type="independent">
-///     <integer name="sample_count" value="64"/>
-/// </sampler>
-/// ```
-/// Each pixel has its own PCG32 stream (selected by a hash of seed and pixel); sample i starts
-/// 2¹⁶ numbers into it, so samples never share numbers (as pbrt-v4's `IndependentSampler`).
+/// The kinds of per-pixel sampler.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SamplerKind {
+    Independent,
+    Stratified { jitter: bool },
+    MultiJitter { jitter: bool },
+    NRooks,
+}
+
+impl SamplerKind {
+    /// The sample count the sampler really takes for a requested one: `stratified` rounds up to
+    /// a square (its 2-D grids are √N × √N) and `multijitter` to a product m·n with m ≥ n close to
+    /// √N, as Mitsuba does; the others take any count.
+    pub fn sample_count(self, requested: u32) -> u32 {
+        let (columns, rows) = self.grid(requested);
+        columns * rows
+    }
+
+    /// Columns and rows of the 2-D strata for `requested` samples (N × 1 when not gridded).
+    fn grid(self, requested: u32) -> (u32, u32) {
+        let requested = requested.max(1);
+        match self {
+            SamplerKind::Stratified { .. } => {
+                let side = (f64::from(requested).sqrt().ceil() as u32).max(1);
+                (side, side)
+            }
+            SamplerKind::MultiJitter { .. } => {
+                let rows = (f64::from(requested).sqrt() as u32).max(1);
+                (requested.div_ceil(rows), rows)
+            }
+            SamplerKind::Independent | SamplerKind::NRooks => (requested, 1),
+        }
+    }
+}
+
+/// The primary dimensions of a camera ray, each in [0, 1).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CameraSample {
+    pub wavelength: f32,
+    pub time: f32,
+    /// Position within the reconstruction filter's support.
+    pub film: Vec2,
+    /// Position on the lens.
+    pub lens: Vec2,
+}
+
+/// The random numbers of the pixel samples of a render.
 #[derive(Clone, Debug)]
-pub struct IndependentSampler {
+pub struct Sampler {
+    kind: SamplerKind,
+    sample_count: u32,
+    columns: u32,
+    rows: u32,
+    jitter: bool,
     seed: u64,
+    /// Hash of (seed, pixel): selects the pixel's permutations and random stream.
+    pixel_seed: u64,
+    index: u32,
+    dimension: u32,
     rng: Pcg32,
 }
 
-/// Numbers reserved per pixel sample in a pixel's stream.
-const DIMENSIONS_PER_SAMPLE: i64 = 1 << 16;
+/// Numbers reserved per pixel sample in the pixel's random stream.
+const NUMBERS_PER_SAMPLE: i64 = 1 << 16;
 
-impl IndependentSampler {
-    pub fn new(seed: u64) -> Self {
-        IndependentSampler {
+impl Sampler {
+    /// A sampler of `kind` for `requested` samples per pixel (see [`SamplerKind::sample_count`]).
+    pub fn new(kind: SamplerKind, requested: u32, seed: u64) -> Sampler {
+        let (columns, rows) = kind.grid(requested);
+        let jitter = match kind {
+            SamplerKind::Stratified { jitter } | SamplerKind::MultiJitter { jitter } => jitter,
+            _ => true,
+        };
+        Sampler {
+            kind,
+            sample_count: columns * rows,
+            columns,
+            rows,
+            jitter,
             seed,
+            pixel_seed: 0,
+            index: 0,
+            dimension: 0,
             rng: Pcg32::default(),
         }
     }
 
+    /// Samples per pixel.
+    pub fn sample_count(&self) -> u32 {
+        self.sample_count
+    }
+
+    /// Prepares sample `index` of `pixel` (full-film coordinates). Indices beyond the sample
+    /// count start new, independently shuffled blocks of N stratified samples, so a render that
+    /// goes on past N samples (to reach an error target, say) stays stratified block by block.
     pub fn start_pixel_sample(&mut self, pixel: UVec2, index: u32) {
+        let block = index / self.sample_count;
+        self.pixel_seed = hash_u64s(&[
+            u64::from(pixel.x),
+            u64::from(pixel.y),
+            self.seed,
+            u64::from(block),
+        ]);
+        self.index = index % self.sample_count;
+        self.dimension = 0;
         let stream = hash_u64s(&[u64::from(pixel.x), u64::from(pixel.y), self.seed]);
         self.rng = Pcg32::new(hash_u64s(&[self.seed]), stream);
-        self.rng.advance(i64::from(index) * DIMENSIONS_PER_SAMPLE);
+        self.rng.advance(i64::from(index) * NUMBERS_PER_SAMPLE);
     }
 
-    #[inline]
-    pub fn next_1d(&mut self) -> f32 {
-        self.rng.next_f32()
-    }
-}
-
-/// The sampler of a render.
-#[derive(Clone, Debug)]
-pub enum Sampler {
-    Independent(IndependentSampler),
-}
-
-impl Sampler {
-    /// Prepares the numbers of sample `index` of `pixel` (full-film pixel coordinates).
-    pub fn start_pixel_sample(&mut self, pixel: UVec2, index: u32) {
-        match self {
-            Sampler::Independent(s) => s.start_pixel_sample(pixel, index),
+    /// The primary dimensions of the current sample; call once, first, per pixel sample.
+    pub fn camera_sample(&mut self) -> CameraSample {
+        match self.kind {
+            SamplerKind::NRooks => {
+                let [wavelength, time, fx, fy, lu, lv] =
+                    std::array::from_fn(|d| self.latin_hypercube(d as u32));
+                self.dimension = 6;
+                CameraSample {
+                    wavelength,
+                    time,
+                    film: Vec2::new(fx, fy),
+                    lens: Vec2::new(lu, lv),
+                }
+            }
+            _ => CameraSample {
+                wavelength: self.next_1d(),
+                time: self.next_1d(),
+                film: self.next_2d(),
+                lens: self.next_2d(),
+            },
         }
     }
 
+    /// The next number of the path.
     #[inline]
     pub fn next_1d(&mut self) -> f32 {
-        match self {
-            Sampler::Independent(s) => s.next_1d(),
+        match self.kind {
+            SamplerKind::Independent | SamplerKind::NRooks => self.rng.next_f32(),
+            SamplerKind::Stratified { .. } | SamplerKind::MultiJitter { .. } => {
+                let dimension = self.next_dimension();
+                let stratum = permute(
+                    self.index,
+                    self.sample_count,
+                    self.permutation_seed(dimension, 0),
+                );
+                (stratum as f32 + self.jitter_value()) / self.sample_count as f32
+            }
         }
     }
 
+    /// The next pair of numbers of the path.
     #[inline]
     pub fn next_2d(&mut self) -> Vec2 {
-        let x = self.next_1d();
-        let y = self.next_1d();
-        Vec2::new(x, y)
+        match self.kind {
+            SamplerKind::Independent | SamplerKind::NRooks => {
+                let x = self.rng.next_f32();
+                let y = self.rng.next_f32();
+                Vec2::new(x, y)
+            }
+            SamplerKind::Stratified { .. } => {
+                let dimension = self.next_dimension();
+                let cell = permute(
+                    self.index,
+                    self.sample_count,
+                    self.permutation_seed(dimension, 0),
+                );
+                let (jx, jy) = (self.jitter_value(), self.jitter_value());
+                Vec2::new(
+                    ((cell % self.columns) as f32 + jx) / self.columns as f32,
+                    ((cell / self.columns) as f32 + jy) / self.rows as f32,
+                )
+            }
+            SamplerKind::MultiJitter { .. } => {
+                let dimension = self.next_dimension();
+                self.correlated_multi_jittered(dimension)
+            }
+        }
+    }
+
+    fn next_dimension(&mut self) -> u32 {
+        let d = self.dimension;
+        self.dimension += 1;
+        d
+    }
+
+    fn jitter_value(&mut self) -> f32 {
+        if self.jitter {
+            self.rng.next_f32().min(1.0f32.next_down())
+        } else {
+            0.5
+        }
+    }
+
+    /// The seed of the permutation of `dimension` (and of a sub-permutation `part`).
+    fn permutation_seed(&self, dimension: u32, part: u32) -> u32 {
+        hash_u64s(&[self.pixel_seed, u64::from(dimension), u64::from(part)]) as u32
+    }
+
+    /// Coordinate `dimension` of the current sample in a Latin hypercube over the pixel's N
+    /// samples: stratum π_d(i) of N, jittered.
+    fn latin_hypercube(&mut self, dimension: u32) -> f32 {
+        let stratum = permute(
+            self.index,
+            self.sample_count,
+            self.permutation_seed(dimension, 0),
+        );
+        (stratum as f32 + self.jitter_value()) / self.sample_count as f32
+    }
+
+    /// Kensler 2013, "Correlated Multi-Jittered Sampling" (Pixar Technical Memo 13-01), §5: the
+    /// canonical arrangement that is stratified on the m × n grid and on both axes into N strata,
+    /// with the columns' and rows' shuffles correlated; the sample index itself is permuted first.
+    fn correlated_multi_jittered(&mut self, dimension: u32) -> Vec2 {
+        let (m, n) = (self.columns, self.rows);
+        let s = permute(
+            self.index,
+            self.sample_count,
+            self.permutation_seed(dimension, 0),
+        );
+        let (x, y) = (s % m, s / m);
+        let sx = permute(x, m, self.permutation_seed(dimension, 1));
+        let sy = permute(y, n, self.permutation_seed(dimension, 2));
+        let (jx, jy) = (self.jitter_value(), self.jitter_value());
+        Vec2::new(
+            (x as f32 + (sy as f32 + jx) / n as f32) / m as f32,
+            (y as f32 + (sx as f32 + jy) / m as f32) / n as f32,
+        )
+    }
+}
+
+/// A pseudo-random permutation of [0, length), evaluated at `index` (Kensler 2013, §3): a
+/// reversible hash of the index on the smallest power-of-two domain containing `length`, repeated
+/// ("cycle walking") until the result falls below `length`.
+pub fn permute(mut index: u32, length: u32, seed: u32) -> u32 {
+    debug_assert!(index < length);
+    if length <= 1 {
+        return 0;
+    }
+    let mask = u32::MAX >> (length - 1).leading_zeros();
+    loop {
+        index ^= seed;
+        index = index.wrapping_mul(0xe170_893d);
+        index ^= seed >> 16;
+        index ^= (index & mask) >> 4;
+        index ^= seed >> 8;
+        index = index.wrapping_mul(0x0929_eb3f);
+        index ^= seed >> 23;
+        index ^= (index & mask) >> 1;
+        index = index.wrapping_mul(1 | (seed >> 27));
+        index = index.wrapping_mul(0x6935_fa69);
+        index ^= (index & mask) >> 11;
+        index = index.wrapping_mul(0x74dc_b303);
+        index ^= (index & mask) >> 2;
+        index = index.wrapping_mul(0x9e50_1cc3);
+        index ^= (index & mask) >> 2;
+        index = index.wrapping_mul(0xc860_a3df);
+        index &= mask;
+        index ^= index >> 5;
+        if index < length {
+            return (index + seed) % length;
+        }
     }
 }
 
@@ -78,9 +301,23 @@ mod tests {
     use super::*;
 
     #[test]
+    fn permutations_are_bijections() {
+        for length in [1u32, 2, 3, 7, 16, 100, 257, 1000] {
+            for seed in [0u32, 1, 0xdead_beef, 12345] {
+                let mut seen = vec![false; length as usize];
+                for i in 0..length {
+                    let p = permute(i, length, seed);
+                    assert!(!seen[p as usize], "length {length} seed {seed}: {p} twice");
+                    seen[p as usize] = true;
+                }
+            }
+        }
+    }
+
+    #[test]
     fn samples_are_reproducible_and_distinct() {
-        let mut a = Sampler::Independent(IndependentSampler::new(1));
-        let mut b = Sampler::Independent(IndependentSampler::new(1));
+        let mut a = Sampler::new(SamplerKind::Independent, 16, 1);
+        let mut b = Sampler::new(SamplerKind::Independent, 16, 1);
         a.start_pixel_sample(UVec2::new(3, 4), 7);
         let first: Vec<f32> = (0..5).map(|_| a.next_1d()).collect();
         // Interleaving other pixels does not change a pixel's numbers.
@@ -91,8 +328,132 @@ mod tests {
         assert_eq!(first, again);
         b.start_pixel_sample(UVec2::new(3, 4), 8);
         assert_ne!(first[0], b.next_1d());
-        let mut c = Sampler::Independent(IndependentSampler::new(2));
+        let mut c = Sampler::new(SamplerKind::Independent, 16, 2);
         c.start_pixel_sample(UVec2::new(3, 4), 7);
         assert_ne!(first[0], c.next_1d());
+    }
+
+    #[test]
+    fn sample_counts_are_rounded_as_mitsuba_does() {
+        assert_eq!(
+            SamplerKind::Stratified { jitter: true }.sample_count(10),
+            16
+        );
+        assert_eq!(
+            SamplerKind::Stratified { jitter: true }.sample_count(64),
+            64
+        );
+        assert_eq!(
+            SamplerKind::MultiJitter { jitter: true }.sample_count(10),
+            12
+        );
+        assert_eq!(
+            SamplerKind::MultiJitter { jitter: true }.sample_count(64),
+            64
+        );
+        assert_eq!(SamplerKind::NRooks.sample_count(10), 10);
+        assert_eq!(SamplerKind::Independent.sample_count(1), 1);
+    }
+
+    fn camera_samples(kind: SamplerKind, n: u32, pixel: UVec2) -> Vec<[f32; 6]> {
+        let mut sampler = Sampler::new(kind, n, 9);
+        (0..sampler.sample_count())
+            .map(|i| {
+                sampler.start_pixel_sample(pixel, i);
+                let c = sampler.camera_sample();
+                [c.wavelength, c.time, c.film.x, c.film.y, c.lens.x, c.lens.y]
+            })
+            .collect()
+    }
+
+    /// In each of the six primary dimensions, the N samples of a pixel occupy the N strata
+    /// [k/N, (k+1)/N) exactly once each (nrooks and multijitter; the stratified sampler's 2-D
+    /// grids are stratified in 2-D only, so only its 1-D dimensions are checked here).
+    #[test]
+    fn every_primary_dimension_has_one_sample_per_stratum() {
+        for (kind, dimensions) in [
+            (SamplerKind::NRooks, 6),
+            (SamplerKind::MultiJitter { jitter: true }, 6),
+            (SamplerKind::MultiJitter { jitter: false }, 6),
+            (SamplerKind::Stratified { jitter: true }, 2),
+        ] {
+            for n in [1u32, 4, 16, 64, 100] {
+                for pixel in [UVec2::new(0, 0), UVec2::new(17, 3)] {
+                    let samples = camera_samples(kind, n, pixel);
+                    let count = samples.len();
+                    for d in 0..dimensions {
+                        let mut strata = vec![0; count];
+                        for s in &samples {
+                            assert!((0.0..1.0).contains(&s[d]));
+                            strata[(s[d] * count as f32) as usize] += 1;
+                        }
+                        assert!(
+                            strata.iter().all(|&c| c == 1),
+                            "{kind:?} n {n} dimension {d}: {strata:?}"
+                        );
+                    }
+                }
+            }
+        }
+    }
+
+    /// The 2-D dimensions of the stratified and multi-jittered samplers put one sample in each cell
+    /// of their grid.
+    #[test]
+    fn two_dimensional_grids_have_one_sample_per_cell() {
+        for kind in [
+            SamplerKind::Stratified { jitter: true },
+            SamplerKind::MultiJitter { jitter: true },
+        ] {
+            for n in [4u32, 12, 64] {
+                let (columns, rows) = kind.grid(n);
+                let samples = camera_samples(kind, n, UVec2::new(5, 6));
+                for (dx, dy) in [(2, 3), (4, 5)] {
+                    let mut cells = vec![0; (columns * rows) as usize];
+                    for s in &samples {
+                        let cx = (s[dx] * columns as f32) as u32;
+                        let cy = (s[dy] * rows as f32) as u32;
+                        cells[(cy * columns + cx) as usize] += 1;
+                    }
+                    assert!(cells.iter().all(|&c| c == 1), "{kind:?} n {n}: {cells:?}");
+                }
+            }
+        }
+    }
+
+    /// Sample indices past N form further blocks, each one sample per stratum again.
+    #[test]
+    fn later_blocks_are_stratified_too() {
+        let mut sampler = Sampler::new(SamplerKind::NRooks, 16, 3);
+        let block = |sampler: &mut Sampler, b: u32| -> Vec<f32> {
+            (0..16)
+                .map(|i| {
+                    sampler.start_pixel_sample(UVec2::new(2, 2), b * 16 + i);
+                    sampler.camera_sample().wavelength
+                })
+                .collect()
+        };
+        let (first, second) = (block(&mut sampler, 0), block(&mut sampler, 1));
+        for values in [&first, &second] {
+            let mut strata: Vec<u32> = values.iter().map(|v| (v * 16.0) as u32).collect();
+            strata.sort_unstable();
+            assert_eq!(strata, (0..16).collect::<Vec<u32>>());
+        }
+        assert_ne!(first, second, "the second block is shuffled anew");
+    }
+
+    /// Different dimensions are shuffled independently: the strata of wavelength and time are not
+    /// the same permutation.
+    #[test]
+    fn dimensions_are_shuffled_independently() {
+        let samples = camera_samples(SamplerKind::NRooks, 64, UVec2::new(1, 1));
+        let same = samples
+            .iter()
+            .filter(|s| (s[0] * 64.0) as u32 == (s[1] * 64.0) as u32)
+            .count();
+        assert!(
+            same < 8,
+            "{same} samples share their wavelength and time strata"
+        );
     }
 }

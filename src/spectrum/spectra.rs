@@ -1,5 +1,6 @@
 //! Spectral distributions given by a scene: constants, piecewise-linear tables and upsampled RGB.
 
+use super::blackbody::Blackbody;
 use super::cie::{cie_y, d65_normalized};
 use super::rgb::RgbSigmoidPolynomial;
 use super::sampled::{SampledSpectrum, SampledWavelengths};
@@ -26,6 +27,8 @@ pub enum Spectrum {
         polynomial: RgbSigmoidPolynomial,
         scale: f32,
     },
+    /// Planck's law at a temperature, in W m⁻² sr⁻¹ nm⁻¹ (Mitsuba's `blackbody`).
+    Blackbody(Blackbody),
 }
 
 /// Which physical quantity an RGB triple describes; it decides how the triple is upsampled.
@@ -96,6 +99,7 @@ impl Spectrum {
             Spectrum::RgbIlluminant { polynomial, scale } => {
                 scale * polynomial.eval(lambda) * d65_normalized(lambda)
             }
+            Spectrum::Blackbody(blackbody) => blackbody.value(lambda),
         }
     }
 

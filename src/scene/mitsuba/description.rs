@@ -131,6 +131,8 @@ pub enum PropertyValue {
     /// A `<transform>` with its operations composed in document order (each new operation is
     /// applied after the previous ones, i.e. left-multiplied).
     Transform(DMat4),
+    /// An `<animation>`: (time, transform) keys in strictly increasing time, each invertible.
+    Animation(Vec<(f64, DMat4)>),
 }
 
 impl PropertyValue {
@@ -146,6 +148,7 @@ impl PropertyValue {
             PropertyValue::Point(_) => "point",
             PropertyValue::Vector(_) => "vector",
             PropertyValue::Transform(_) => "transform",
+            PropertyValue::Animation(_) => "animation",
         }
     }
 }

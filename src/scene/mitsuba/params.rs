@@ -10,6 +10,7 @@ use glam::{DMat4, DVec3};
 
 use super::description::{NestedPlugin, PluginClass, PluginNode, Property, PropertyValue};
 use crate::error::{Error, Result, SourceLocation};
+use crate::math::{AnimatedTransform, Transform};
 
 /// Reads the properties of one plugin node and remembers which were read.
 pub struct Params<'a> {
@@ -147,6 +148,33 @@ impl<'a> Params<'a> {
     /// A transform, or the identity when absent.
     pub fn transform(&self, name: &'static str) -> Result<DMat4> {
         Ok(self.transform_opt(name)?.unwrap_or(DMat4::IDENTITY))
+    }
+
+    /// A transform that may be animated (`<transform>` or `<animation>`); the identity when
+    /// absent. A singular transform is an error at its location.
+    pub fn animated_transform(&self, name: &'static str) -> Result<AnimatedTransform> {
+        let singular = |p: &Property| {
+            Error::input(
+                &p.location,
+                format!(
+                    "the \"{name}\" transform of {} is singular or not affine",
+                    self.node.describe()
+                ),
+            )
+            .with_help("check for a zero scale or a malformed matrix")
+        };
+        match self.property(name) {
+            None => Ok(AnimatedTransform::fixed(Transform::IDENTITY)),
+            Some(p) => match &p.value {
+                PropertyValue::Transform(m) => Transform::new(*m)
+                    .map(AnimatedTransform::fixed)
+                    .ok_or_else(|| singular(p)),
+                PropertyValue::Animation(keys) => {
+                    AnimatedTransform::new(keys).map_err(|_| singular(p))
+                }
+                _ => Err(self.wrong_type(p, "a transform")),
+            },
+        }
     }
 
     /// A point, if present.

@@ -478,6 +478,7 @@ impl Reader {
         match tag {
             "float" | "integer" | "boolean" | "string" | "rgb" | "spectrum" | "point"
             | "vector" | "transform" => self.read_property(source, node, element, parent),
+            "animation" => self.read_animation(source, node, element, parent),
             "ref" => {
                 expect_no_content(source, node, element)?;
                 self.read_ref(element, parent)
@@ -737,6 +738,76 @@ impl Reader {
         Ok(matrix)
     }
 
+    /// `<animation name="to_world">` with `<transform time="t">` keys (Mitsuba 0.6's syntax for
+    /// moving shapes and cameras); `toWorld` is accepted as a name in files of any version. Keys
+    /// must be in strictly increasing time and invertible.
+    fn read_animation(
+        &mut self,
+        source: &Source,
+        node: Node,
+        element: &Element,
+        parent: usize,
+    ) -> Result<()> {
+        element.check_attributes(&["name"])?;
+        let name = element.require("name")?;
+        let property_name = if name.value == "toWorld" {
+            "to_world".to_string()
+        } else {
+            name.value.clone()
+        };
+        let mut keys: Vec<(f64, DMat4)> = Vec::new();
+        for child in node.children() {
+            match child.node_type() {
+                NodeType::Element => {
+                    let key = self.element(source, child, None)?;
+                    if key.tag != "transform" {
+                        return Err(Error::input(
+                            &key.location,
+                            format!("<{}> cannot appear in an <animation>", quote(&key.tag)),
+                        )
+                        .with_help("an animation holds <transform time=\"...\"> keys"));
+                    }
+                    key.check_attributes(&["time"])?;
+                    let time = key.number(key.require("time")?)?;
+                    if let Some(&(previous, _)) = keys.last()
+                        && !(time > previous)
+                    {
+                        return Err(Error::input(
+                            &key.location,
+                            format!("animation key at time {time} comes after the key at time {previous}"),
+                        )
+                        .with_help("list the keys of an animation in increasing time"));
+                    }
+                    let matrix = self.read_transform(source, child, &key)?;
+                    let det = matrix.determinant();
+                    if !(det.abs() > 1e-30) || !det.is_finite() {
+                        return Err(Error::input(
+                            &key.location,
+                            format!("the animation key at time {time} is a singular transform"),
+                        )
+                        .with_help("check for a zero scale"));
+                    }
+                    keys.push((time, matrix));
+                }
+                NodeType::Text => check_text(source, child, node)?,
+                _ => {}
+            }
+        }
+        if keys.is_empty() {
+            return Err(
+                Error::input(&element.location, "an <animation> needs at least one key")
+                    .with_help("add <transform time=\"0\"> ... </transform> keys"),
+            );
+        }
+        self.register_name(parent, &property_name, &name.location)?;
+        self.drafts[parent].properties.push(Property {
+            name: property_name,
+            value: PropertyValue::Animation(keys),
+            location: element.location.clone(),
+        });
+        Ok(())
+    }
+
     /// `<ref id="..." name="..."/>`: resolved after the whole scene is read.
     fn read_ref(&mut self, element: &Element, parent: usize) -> Result<()> {
         element.check_attributes(&["id", "name"])?;
@@ -940,8 +1011,9 @@ fn expect_no_content(source: &Source, node: Node, element: &Element) -> Result<(
 }
 
 /// Every tag a scene may contain, for messages.
-const KNOWN_TAGS: [&str; 31] = [
+const KNOWN_TAGS: [&str; 32] = [
     "alias",
+    "animation",
     "boolean",
     "bsdf",
     "default",

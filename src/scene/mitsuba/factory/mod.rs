@@ -20,7 +20,7 @@ use super::description::{PluginClass, PluginNode};
 use super::params::Params;
 use crate::bsdf::Material;
 use crate::error::{Error, Result};
-use crate::geometry::Geometry;
+use crate::geometry::{Geometry, Shape};
 use crate::integrator::{Integrator, PathIntegrator};
 use crate::scene::{Scene, ShapeInfo};
 
@@ -69,6 +69,7 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
             .with_help("remove degenerate shapes or fix their transform"));
         }
         let shape_index = shapes.len() as u32;
+        let emitter = shape_params.single_child(PluginClass::Emitter)?;
         let material = match shape_params.single_child(PluginClass::Bsdf)? {
             Some(bsdf) => {
                 let key = Arc::as_ptr(&bsdf.node);
@@ -82,13 +83,28 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
                     }
                 }
             }
+            None if emitter.is_some() => {
+                materials.push(lights::default_emitter_material());
+                (materials.len() - 1) as u32
+            }
             None => {
                 materials.push(materials::default_material());
                 (materials.len() - 1) as u32
             }
         };
-        let light = match shape_params.single_child(PluginClass::Emitter)? {
+        let light = match emitter {
             Some(emitter) => {
+                if let Shape::Instance(instance) = &shape
+                    && !instance.to_world.is_similarity()
+                {
+                    return Err(Error::input(
+                        &emitter.location,
+                        "an emitting shape may move, turn and scale uniformly, but not stretch",
+                    )
+                    .with_help(
+                        "animate the emitter with rotations, translations and uniform scales only",
+                    ));
+                }
                 lights.push(lights::build_area_light(&emitter.node, shape_index)?);
                 Some((lights.len() - 1) as u32)
             }
@@ -99,9 +115,15 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
         shape_info.push(ShapeInfo { material, light });
     }
 
+    let mut scene_lights = Vec::new();
     for child in params.children(PluginClass::Emitter) {
-        lights.push(lights::build_scene_light(&child.node)?);
+        scene_lights.push((
+            lights::build_scene_light(&child.node)?,
+            child.location.clone(),
+        ));
     }
+    lights::check_single_environment(&scene_lights)?;
+    lights.extend(scene_lights.into_iter().map(|(light, _)| light));
 
     // BSDFs declared at the top level (to be referenced by id) are built even when unused, so
     // that their errors are reported as Mitsuba would.
@@ -124,7 +146,7 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
     }
     params.finish()?;
 
-    let scene = Scene::new(
+    let mut scene = Scene::new(
         Geometry::new(shapes),
         shape_info,
         materials,
@@ -134,6 +156,8 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
         sensor.sampler,
         integrator,
     );
+    scene.shutter = sensor.shutter;
+    scene.fingerprint = crate::scene::fingerprint::scene_fingerprint(root);
     Ok(LoadedScene {
         scene,
         seed: sensor.seed,

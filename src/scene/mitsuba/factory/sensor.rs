@@ -1,29 +1,37 @@
-//! The sensor and what it carries: `perspective` camera, `hdrfilm` film with its `rfilter`, and
-//! the `independent` sampler.
+//! The sensor and what it carries: the `perspective` and `thinlens` cameras with their shutter,
+//! the `hdrfilm` film with its `rfilter`, and the sampler.
 
 use glam::{UVec2, Vec2};
 
 use crate::camera::perspective::{FovAxis, focal_length_to_diagonal_fov, horizontal_fov};
-use crate::camera::{Camera, PerspectiveCamera};
+use crate::camera::{Camera, PerspectiveCamera, Shutter};
 use crate::error::{Error, Result};
 use crate::film::{CropWindow, Filter};
-use crate::math::Transform;
 use crate::scene::mitsuba::description::{PluginClass, PluginNode};
 use crate::scene::mitsuba::params::Params;
 use crate::scene::{FilmSettings, SamplerKind, SamplerSettings};
 
-pub const SUPPORTED_SENSORS: &[&str] = &["perspective"];
+pub const SUPPORTED_SENSORS: &[&str] = &["perspective", "thinlens"];
 pub const SUPPORTED_FILMS: &[&str] = &["hdrfilm"];
-pub const SUPPORTED_FILTERS: &[&str] = &["box", "tent", "gaussian"];
-pub const SUPPORTED_SAMPLERS: &[&str] = &["independent"];
+pub const SUPPORTED_FILTERS: &[&str] = &[
+    "box",
+    "tent",
+    "gaussian",
+    "mitchell",
+    "catmullrom",
+    "lanczos",
+];
+pub const SUPPORTED_SAMPLERS: &[&str] = &["independent", "stratified", "multijitter", "nrooks"];
 
-/// Largest film side, and largest pixel count, accepted (each pixel keeps 64 bytes of sums).
+/// Largest film side, and largest pixel count, accepted (each pixel keeps 112 bytes of sums,
+/// twice while a pass is rendered).
 const MAX_FILM_SIDE: i64 = 1 << 16;
-const MAX_FILM_PIXELS: i64 = 1 << 26;
+const MAX_FILM_PIXELS: i64 = 1 << 25;
 
-/// The camera, film settings, sampler settings and sampler seed of a `<sensor>`.
+/// The camera, shutter, film settings, sampler settings and sampler seed of a `<sensor>`.
 pub struct SensorSettings {
     pub camera: Camera,
+    pub shutter: Shutter,
     pub film: FilmSettings,
     pub sampler: SamplerSettings,
     pub seed: u64,
@@ -31,7 +39,7 @@ pub struct SensorSettings {
 
 pub fn build_sensor(node: &PluginNode) -> Result<SensorSettings> {
     let params = Params::new(node);
-    if node.plugin_type != "perspective" {
+    if node.plugin_type != "perspective" && node.plugin_type != "thinlens" {
         return Err(Error::input(
             &node.location,
             format!("unknown sensor type \"{}\"", node.plugin_type),
@@ -123,13 +131,20 @@ pub fn build_sensor(node: &PluginNode) -> Result<SensorSettings> {
             ),
         ));
     }
-    let matrix = params.transform("to_world")?;
-    let to_world = Transform::new(matrix).ok_or_else(|| {
-        Error::input(
+    let to_world = params.animated_transform("to_world")?;
+    let (lens_radius, focus_distance) = if node.plugin_type == "thinlens" {
+        lens(&params, far_clip)?
+    } else {
+        (0.0, far_clip)
+    };
+    if lens_radius > 0.0 && !to_world.is_similarity() || to_world.uniform_scale(0.0) > 1.0 + 1e-4 {
+        return Err(Error::input(
             params.location_of("to_world"),
-            "the sensor's \"to_world\" transform is singular",
+            "the camera's \"to_world\" transform scales; a thin lens camera must not be scaled",
         )
-    })?;
+        .with_help("use only rotations and translations (lookat) for cameras"));
+    }
+    let shutter = shutter(&params)?;
     params.finish()?;
 
     let camera = Camera::Perspective(PerspectiveCamera {
@@ -138,13 +153,94 @@ pub fn build_sensor(node: &PluginNode) -> Result<SensorSettings> {
         tan_half_fov_x: (0.5 * fov_x).to_radians().tan() as f32,
         near_clip: near_clip as f32,
         far_clip: far_clip as f32,
+        lens_radius: lens_radius as f32,
+        focus_distance: focus_distance as f32,
     });
     Ok(SensorSettings {
         camera,
+        shutter,
         film,
         sampler,
         seed,
     })
+}
+
+/// The thin lens: `aperture_radius` (Mitsuba) or the lecture's aperture area `aperture_area`
+/// (radius √(a/π)), and `focus_distance` (Mitsuba) or the lecture's `focal_distance`
+/// (default: the far clipping distance, as Mitsuba).
+fn lens(params: &Params, far_clip: f64) -> Result<(f64, f64)> {
+    let radius = match (
+        params.float_opt("aperture_radius")?,
+        params.float_opt("aperture_area")?,
+    ) {
+        (Some(_), Some(_)) => {
+            return Err(Error::input(
+                params.location_of("aperture_area"),
+                "give either \"aperture_radius\" or \"aperture_area\", not both",
+            ));
+        }
+        (Some(radius), None) => (radius, "aperture_radius"),
+        (None, Some(area)) => ((area / std::f64::consts::PI).sqrt(), "aperture_area"),
+        (None, None) => {
+            return Err(Error::input(
+                params.location(),
+                "a thinlens sensor needs an \"aperture_radius\" (or the lecture's \"aperture_area\")",
+            )
+            .with_help("add <float name=\"aperture_radius\" value=\"0.1\"/>"));
+        }
+    };
+    if !(radius.0 > 0.0 && radius.0.is_finite()) {
+        return Err(Error::input(
+            params.location_of(radius.1),
+            format!("the aperture must be positive, not {}", radius.0),
+        ));
+    }
+    let focus = match (
+        params.float_opt("focus_distance")?,
+        params.float_opt("focal_distance")?,
+    ) {
+        (Some(_), Some(_)) => {
+            return Err(Error::input(
+                params.location_of("focal_distance"),
+                "give either \"focus_distance\" or \"focal_distance\", not both",
+            ));
+        }
+        (Some(g), None) => (g, "focus_distance"),
+        (None, Some(g)) => (g, "focal_distance"),
+        (None, None) => (far_clip, "focus_distance"),
+    };
+    if !(focus.0 > 0.0 && focus.0.is_finite()) {
+        return Err(Error::input(
+            params.location_of(focus.1),
+            format!("the focus distance must be positive, not {}", focus.0),
+        ));
+    }
+    Ok((radius.0, focus.0))
+}
+
+/// `shutter_open`, `shutter_close` (default 0 and 0) and an optional nested temporal filter
+/// `<rfilter name="shutter_filter">`.
+fn shutter(params: &Params) -> Result<Shutter> {
+    let open = params.float("shutter_open", 0.0)?;
+    let close = params.float("shutter_close", open)?;
+    if !open.is_finite() || !close.is_finite() || close < open {
+        return Err(Error::input(
+            params.location_of("shutter_close"),
+            format!("the shutter closes at {close}, before it opens at {open}"),
+        )
+        .with_help("shutter_close must be at least shutter_open"));
+    }
+    let filter = match params.named_child("shutter_filter") {
+        Some(child) if child.node.class == PluginClass::Rfilter => Some(build_filter(&child.node)?),
+        Some(child) => {
+            return Err(Error::input(
+                &child.location,
+                "\"shutter_filter\" must be an <rfilter>",
+            ));
+        }
+        None => None,
+    };
+    Ok(Shutter::new(open as f32, close as f32, filter))
 }
 
 /// Mitsuba's default film: 768 × 576 with a Gaussian filter.
@@ -265,6 +361,23 @@ fn build_filter(node: &PluginNode) -> Result<Filter> {
         "gaussian" => Filter::Gaussian {
             stddev: positive("stddev", 0.5)?,
         },
+        "mitchell" => Filter::Mitchell {
+            b: params.float_in("B", 1.0 / 3.0, 0.0, 1.0)? as f32,
+            c: params.float_in("C", 1.0 / 3.0, 0.0, 1.0)? as f32,
+        },
+        "catmullrom" => Filter::Mitchell { b: 0.0, c: 0.5 },
+        "lanczos" => {
+            let lobes = params.integer("lobes", 3)?;
+            if !(1..=32).contains(&lobes) {
+                return Err(Error::input(
+                    params.location_of("lobes"),
+                    format!("lanczos needs between 1 and 32 lobes, not {lobes}"),
+                ));
+            }
+            Filter::Lanczos {
+                lobes: lobes as u32,
+            }
+        }
         other => {
             return Err(
                 Error::input(&node.location, format!("unknown rfilter type \"{other}\""))
@@ -279,19 +392,30 @@ fn build_filter(node: &PluginNode) -> Result<Filter> {
     Ok(filter)
 }
 
-/// `independent`: `sample_count` (default 4), `seed` (default 0).
+/// The sampler: `independent`, `stratified`, `multijitter` (each with `jitter`, default true) or
+/// our `nrooks`; `sample_count` (default 4) and `seed` (default 0). See [`crate::sampling::sampler`]
+/// for which dimensions each stratifies.
 fn build_sampler(node: &PluginNode) -> Result<(SamplerSettings, u64)> {
     let params = Params::new(node);
-    if node.plugin_type != "independent" {
-        return Err(Error::input(
-            &node.location,
-            format!("unknown sampler type \"{}\"", node.plugin_type),
-        )
-        .with_help(format!(
-            "supported sampler types: {}",
-            SUPPORTED_SAMPLERS.join(", ")
-        )));
-    }
+    let kind = match node.plugin_type.as_str() {
+        "independent" => SamplerKind::Independent,
+        "stratified" => SamplerKind::Stratified {
+            jitter: params.boolean("jitter", true)?,
+        },
+        "multijitter" => SamplerKind::MultiJitter {
+            jitter: params.boolean("jitter", true)?,
+        },
+        "nrooks" => SamplerKind::NRooks,
+        other => {
+            return Err(
+                Error::input(&node.location, format!("unknown sampler type \"{other}\""))
+                    .with_help(format!(
+                        "supported sampler types: {}",
+                        SUPPORTED_SAMPLERS.join(", ")
+                    )),
+            );
+        }
+    };
     let spp = params.integer("sample_count", 4)?;
     if !(1..=(1 << 24)).contains(&spp) {
         return Err(Error::input(
@@ -303,7 +427,7 @@ fn build_sampler(node: &PluginNode) -> Result<(SamplerSettings, u64)> {
     params.finish()?;
     Ok((
         SamplerSettings {
-            kind: SamplerKind::Independent,
+            kind,
             samples_per_pixel: spp as u32,
         },
         seed as u64,

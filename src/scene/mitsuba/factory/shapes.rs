@@ -4,10 +4,11 @@
 //! `filename`, `face_normals` (bool: ignore vertex normals and shade flat) and, for OBJ,
 //! `flip_tex_coords` (bool, default true: the OBJ loader's v → 1 − v, as Mitsuba).
 
-use glam::{DMat4, DVec3, Mat3, Vec2, Vec3};
+use glam::{DVec3, Mat3, Vec2, Vec3};
 
 use crate::error::{Error, Result};
 use crate::geometry::disk::Disk;
+use crate::geometry::instance::Instance;
 use crate::geometry::sphere::Sphere;
 use crate::geometry::{Shape, TriangleMesh};
 use crate::math::Transform;
@@ -18,24 +19,20 @@ use crate::scene::mitsuba::params::Params;
 /// The shape types this factory knows.
 pub const SUPPORTED_SHAPES: &[&str] = &["obj", "ply", "rectangle", "cube", "sphere", "disk"];
 
-/// A transform parameter that must be invertible.
-fn transform_param(params: &Params, name: &'static str) -> Result<(DMat4, Transform)> {
-    let matrix = params.transform(name)?;
-    let transform = Transform::new(matrix).ok_or_else(|| {
-        Error::input(
-            params.location_of(name),
-            format!(
-                "the \"{name}\" transform of {} is singular or not affine",
-                params.node().describe()
-            ),
-        )
-        .with_help("check for a zero scale or a malformed matrix")
-    })?;
-    Ok((matrix, transform))
+/// Builds a shape (its BSDF and emitter are the caller's business: it marks them used). A shape
+/// whose `to_world` is an `<animation>` is built in object space and placed by an [`Instance`];
+/// a fixed `to_world` is applied to the shape once.
+pub fn build_shape(params: &Params) -> Result<Shape> {
+    let to_world = params.animated_transform("to_world")?;
+    if to_world.is_animated() {
+        let shape = build_static_shape(params, &Transform::IDENTITY)?;
+        return Ok(Shape::Instance(Instance::new(shape, to_world)));
+    }
+    build_static_shape(params, to_world.first())
 }
 
-/// Builds a shape (its BSDF and emitter are the caller's business: it marks them used).
-pub fn build_shape(params: &Params) -> Result<Shape> {
+/// Builds a shape placed by the fixed transform `to_world`.
+fn build_static_shape(params: &Params, to_world: &Transform) -> Result<Shape> {
     let node = params.node();
     let flip_normals = params.boolean("flip_normals", false)?;
     match node.plugin_type.as_str() {
@@ -55,7 +52,6 @@ pub fn build_shape(params: &Params) -> Result<Shape> {
             } else {
                 false
             };
-            let (_, to_world) = transform_param(params, "to_world")?;
             let loaded = if node.plugin_type == "obj" {
                 load_obj(&path)
             } else {
@@ -82,29 +78,23 @@ pub fn build_shape(params: &Params) -> Result<Shape> {
             }
             Ok(Shape::Mesh(transform_mesh(
                 data,
-                &to_world,
+                to_world,
                 flip_normals,
                 false,
             )))
         }
-        "rectangle" => {
-            let (_, to_world) = transform_param(params, "to_world")?;
-            Ok(Shape::Mesh(transform_mesh(
-                rectangle(),
-                &to_world,
-                flip_normals,
-                true,
-            )))
-        }
-        "cube" => {
-            let (_, to_world) = transform_param(params, "to_world")?;
-            Ok(Shape::Mesh(transform_mesh(
-                cube(),
-                &to_world,
-                flip_normals,
-                true,
-            )))
-        }
+        "rectangle" => Ok(Shape::Mesh(transform_mesh(
+            rectangle(),
+            to_world,
+            flip_normals,
+            true,
+        ))),
+        "cube" => Ok(Shape::Mesh(transform_mesh(
+            cube(),
+            to_world,
+            flip_normals,
+            true,
+        ))),
         "sphere" => {
             let center = params.point_opt("center")?.unwrap_or(DVec3::ZERO);
             let radius = params.float("radius", 1.0)?;
@@ -114,7 +104,7 @@ pub fn build_shape(params: &Params) -> Result<Shape> {
                     format!("the sphere's radius must be positive, not {radius}"),
                 ));
             }
-            let (matrix, _) = transform_param(params, "to_world")?;
+            let matrix = to_world.matrix.as_dmat4();
             let axes = [
                 matrix.x_axis.truncate(),
                 matrix.y_axis.truncate(),
@@ -146,10 +136,7 @@ pub fn build_shape(params: &Params) -> Result<Shape> {
                 flip_normals,
             }))
         }
-        "disk" => {
-            let (_, to_world) = transform_param(params, "to_world")?;
-            Ok(Shape::Disk(Disk::new(to_world, flip_normals)))
-        }
+        "disk" => Ok(Shape::Disk(Disk::new(*to_world, flip_normals))),
         other => Err(
             Error::input(&node.location, format!("unknown shape type \"{other}\"")).with_help(
                 format!("supported shape types: {}", SUPPORTED_SHAPES.join(", ")),
@@ -260,6 +247,7 @@ pub fn cube() -> MeshData {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use glam::DMat4;
 
     #[test]
     fn cube_faces_point_outwards() {

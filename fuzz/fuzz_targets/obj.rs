@@ -1,0 +1,10 @@
+//! Any bytes given as a Wavefront OBJ file give a mesh or an error; never a panic.
+#![no_main]
+
+use std::path::Path;
+
+use libfuzzer_sys::fuzz_target;
+
+fuzz_target!(|data: &[u8]| {
+    let _ = prism::scene::mesh::obj::parse_obj(data, Path::new("fuzz.obj"));
+});

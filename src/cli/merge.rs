@@ -1,0 +1,74 @@
+//! `prism merge`: combines render states of disjoint sample ranges (from `--sample-range` renders
+//! on several machines) into the image one render of all their samples gives — bit for bit,
+//! since pixel sums are exact.
+
+use std::path::PathBuf;
+
+use clap::Args;
+
+use super::render::{rejected_report, write_images};
+use crate::error::{Error, Result};
+use crate::film::Film;
+use crate::render::state::RenderState;
+
+#[derive(Args, Debug)]
+pub struct MergeArgs {
+    /// Render states written by `prism render --sample-range ... --checkpoint ...`
+    #[arg(required = true, value_name = "STATE")]
+    pub states: Vec<PathBuf>,
+    /// The merged image (EXR; the PNG goes beside it)
+    #[arg(short, long, value_name = "OUT.exr")]
+    pub output: PathBuf,
+    /// Also write the merged render state here
+    #[arg(long, value_name = "PATH")]
+    pub state: Option<PathBuf>,
+}
+
+pub fn run(args: &MergeArgs) -> Result<()> {
+    let states = args
+        .states
+        .iter()
+        .map(|p| RenderState::read(p))
+        .collect::<Result<Vec<_>>>()?;
+    let paths: Vec<&std::path::Path> = args.states.iter().map(PathBuf::as_path).collect();
+    let merged = RenderState::merge(&states, &paths)?;
+    let identity = &merged.identity;
+    let mut film = Film::new(identity.film_size, identity.crop);
+    if film.pixels.len() != merged.pixels.len() {
+        return Err(Error::usage(
+            "the merged state does not match its crop window",
+        ));
+    }
+    film.pixels = merged.pixels.clone();
+    let exr = if args
+        .output
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("exr"))
+    {
+        args.output.clone()
+    } else {
+        args.output.with_extension("exr")
+    };
+    let png = exr.with_extension("png");
+    write_images(&film, &exr, &png)?;
+    if let Some(path) = &args.state {
+        merged.write(path)?;
+    }
+    let ranges: Vec<String> = merged
+        .ranges
+        .iter()
+        .map(|r| format!("{}..{}", r.start, r.end))
+        .collect();
+    eprintln!(
+        "prism: merged {} states (samples {}, {} spp) -> {}, {}",
+        states.len(),
+        ranges.join(", "),
+        merged.sample_count(),
+        exr.display(),
+        png.display()
+    );
+    if let Some(line) = rejected_report(&film) {
+        eprintln!("{line}");
+    }
+    Ok(())
+}

@@ -1,0 +1,133 @@
+//! Moving shapes: a shape in its object space, placed in the world by an animated transform.
+//!
+//! Rays are brought into object space at their time, intersected with the object's own BVH and
+//! the hit is carried back to the world; the scene's BVH holds the object as a single primitive
+//! bounded by its sweep over the animation. Shapes whose transform does not change are baked
+//! into world space instead, so static geometry pays nothing for motion blur.
+
+use glam::{Vec2, Vec3};
+
+use super::accel::Geometry;
+use super::interaction::SurfaceInteraction;
+use super::mesh::SurfaceSample;
+use super::shape::Shape;
+use crate::math::{AnimatedTransform, Frame, Ray};
+
+/// A shape moving along an animated transform.
+#[derive(Clone, Debug)]
+pub struct Instance {
+    /// The shape in object space, alone in its own hierarchy.
+    pub object: Box<Geometry>,
+    pub to_world: AnimatedTransform,
+    /// World-space bounds of the object over the whole animation.
+    pub swept_bounds: (Vec3, Vec3),
+}
+
+impl Instance {
+    pub fn new(shape: Shape, to_world: AnimatedTransform) -> Instance {
+        let (lo, hi) = shape.object_bounds();
+        let times: Vec<f32> = to_world.key_times().collect();
+        let (t0, t1) = (times[0], times[times.len() - 1]);
+        let swept_bounds = to_world.swept_bounds(lo, hi, t0, t1);
+        Instance {
+            object: Box::new(Geometry::new(vec![shape])),
+            to_world,
+            swept_bounds,
+        }
+    }
+
+    /// The object's shape.
+    pub fn shape(&self) -> &Shape {
+        &self.object.shapes[0]
+    }
+
+    fn local_ray(&self, ray: &Ray) -> Ray {
+        let transform = self.to_world.at(ray.time);
+        Ray::new(
+            transform.inverse_point(ray.o),
+            transform.inverse_vector(ray.d),
+            ray.t_max,
+            ray.time,
+        )
+    }
+
+    /// Distance to the nearest hit in (0, t_max); t is the same in both spaces (affine map).
+    pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<f32> {
+        let local = Ray {
+            t_max,
+            ..self.local_ray(ray)
+        };
+        self.object.intersect(&local).map(|si| si.t)
+    }
+
+    pub fn occluded(&self, ray: &Ray) -> bool {
+        self.object.occluded(&self.local_ray(ray))
+    }
+
+    /// The world-space interaction of the nearest hit, recorded as shape `shape`.
+    pub fn interaction(&self, ray: &Ray, t_max: f32, shape: u32) -> Option<SurfaceInteraction> {
+        let local = Ray {
+            t_max,
+            ..self.local_ray(ray)
+        };
+        let si = self.object.intersect(&local)?;
+        let transform = self.to_world.at(ray.time);
+        let shading_n = transform.normal(si.shading.n).normalize();
+        Some(SurfaceInteraction {
+            p: transform.point(si.p),
+            n: transform.normal(si.n).normalize(),
+            shading: Frame::from_normal(shading_n),
+            shape,
+            ..si
+        })
+    }
+
+    /// A point of the surface at `time` seen from `reference`, density per unit solid angle. The
+    /// density is the object-space one, which is correct for similarities (solid angles do not
+    /// change under rotation, translation and uniform scale); the factory only lets such
+    /// transforms carry emitters.
+    pub fn sample_from(
+        &self,
+        reference: Vec3,
+        time: f32,
+        u_choice: f32,
+        u: Vec2,
+    ) -> Option<SurfaceSample> {
+        let transform = self.to_world.at(time);
+        let s = self
+            .shape()
+            .sample_from(transform.inverse_point(reference), time, u_choice, u)?;
+        Some(SurfaceSample {
+            p: transform.point(s.p),
+            n: transform.normal(s.n).normalize(),
+            shading_n: transform.normal(s.shading_n).normalize(),
+            pdf: s.pdf,
+        })
+    }
+
+    /// Density of [`Self::sample_from`] for the world point `p` with normal `n`.
+    pub fn pdf_from(&self, reference: Vec3, time: f32, p: Vec3, n: Vec3) -> f32 {
+        let transform = self.to_world.at(time);
+        // n = normalize(M⁻ᵀ n_object), so n_object ∝ Mᵀ n.
+        let local_n = Vec3::new(
+            transform.matrix.x_axis.truncate().dot(n),
+            transform.matrix.y_axis.truncate().dot(n),
+            transform.matrix.z_axis.truncate().dot(n),
+        )
+        .normalize_or(n);
+        self.shape().pdf_from(
+            transform.inverse_point(reference),
+            time,
+            transform.inverse_point(p),
+            local_n,
+        )
+    }
+
+    /// Surface area at the first key (constant for similarities without scale animation).
+    pub fn area(&self) -> f32 {
+        let scale = self
+            .to_world
+            .uniform_scale(self.to_world.key_times().next().unwrap_or(0.0));
+        self.shape().area() * scale * scale
+    }
+}

@@ -1,0 +1,61 @@
+//! Mitsuba's `directional` emitter: a distant source that delivers irradiance E from one
+//! direction (the sun, say).
+//!
+//! ```xml
+//! <emitter type="directional">
+//!     <vector name="direction" x="0" y="-1" z="0"/>   <!-- where the light travels; or to_world -->
+//!     <rgb name="irradiance" value="5"/>              <!-- on a surface facing it; default 1 -->
+//! </emitter>
+//! ```
+//! Without `direction`, the light travels along the +z axis of `to_world` (default: world +z).
+//! A diffuse surface tilted by θ from the light reflects L = ρ E cos θ / π (DESIGN.md §7).
+
+use std::f32::consts::PI;
+
+use glam::Vec3;
+
+use super::{BoundingSphere, LightSample};
+use crate::spectrum::{SampledWavelengths, Spectrum};
+
+#[derive(Clone, Debug)]
+pub struct DirectionalLight {
+    /// Unit direction in which the light travels.
+    pub direction: Vec3,
+    pub irradiance: Spectrum,
+    /// The scene's bounding sphere (set when the scene is assembled).
+    pub scene: BoundingSphere,
+}
+
+impl DirectionalLight {
+    pub fn new(direction: Vec3, irradiance: Spectrum) -> DirectionalLight {
+        DirectionalLight {
+            direction,
+            irradiance,
+            scene: BoundingSphere::default(),
+        }
+    }
+
+    /// The light arrives from −direction at every point; the shadow ray runs to a point beyond
+    /// the scene. As a delta in direction, the "radiance" is the irradiance and the pdf 1.
+    pub fn sample_incident(
+        &self,
+        reference: Vec3,
+        lambda: &SampledWavelengths,
+    ) -> Option<LightSample> {
+        let wi = -self.direction;
+        Some(LightSample {
+            p: self.scene.point_beyond(reference, wi),
+            n: Vec3::ZERO,
+            wi,
+            radiance: self.irradiance.sample(lambda),
+            pdf: 1.0,
+            is_delta: true,
+        })
+    }
+
+    /// Φ = π R² E: the flux through the disk the scene's bounding sphere presents to the light
+    /// (pbrt-v4's `DistantLight::Phi`).
+    pub fn power(&self) -> f32 {
+        PI * self.scene.radius * self.scene.radius * self.irradiance.luminance()
+    }
+}

@@ -1,0 +1,452 @@
+//! The render state file: everything needed to continue a render or to merge several, written
+//! atomically and checked on reading.
+//!
+//! Layout (little endian): the magic `PRISMRS\0`, a format version (u32), the identity of the
+//! render (scene fingerprint, seed, sampler, samples per pixel of the stratification, film size
+//! and crop window), the sample index ranges the pixels hold, the pixel count and the pixels'
+//! exact sums (112 bytes each), and a CRC-32 of all of it. A state is written to a temporary file,
+//! flushed to disk and renamed over the old one, so a crash while writing leaves the previous
+//! state intact.
+
+use std::io::Write;
+use std::ops::Range;
+use std::path::Path;
+
+use glam::UVec2;
+
+use crate::error::{Error, ErrorKind, Result};
+use crate::film::CropWindow;
+use crate::film::accumulation::{ExactSum, PixelSums};
+
+const MAGIC: &[u8; 8] = b"PRISMRS\0";
+const VERSION: u32 = 1;
+/// Bytes per pixel: six 128-bit sums and two 64-bit counts.
+const PIXEL_BYTES: usize = 6 * 16 + 2 * 8;
+/// At most this many separate sample ranges (a merge of many farm tasks).
+const MAX_RANGES: usize = 1 << 16;
+
+/// What a render state belongs to: two states can be continued or merged only if they agree.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct RenderIdentity {
+    /// Hash of the scene's description and of the files it loads.
+    pub scene: u64,
+    pub seed: u64,
+    /// The sampler type (`independent`, `nrooks`, ...).
+    pub sampler: String,
+    /// Samples per pixel of the sampler's stratification.
+    pub samples_per_pixel: u32,
+    pub film_size: UVec2,
+    pub crop: CropWindow,
+}
+
+impl RenderIdentity {
+    /// Why `other` is not the same render, in words; None when it is.
+    pub fn mismatch(&self, other: &RenderIdentity) -> Option<String> {
+        if self.scene != other.scene {
+            return Some(
+                "it comes from a different scene (or the scene or a file it loads has changed)"
+                    .into(),
+            );
+        }
+        if self.seed != other.seed {
+            return Some(format!(
+                "it was rendered with seed {}, not {}",
+                other.seed, self.seed
+            ));
+        }
+        if self.sampler != other.sampler || self.samples_per_pixel != other.samples_per_pixel {
+            return Some(format!(
+                "it was rendered with the {} sampler at {} spp, not the {} sampler at {} spp",
+                other.sampler, other.samples_per_pixel, self.sampler, self.samples_per_pixel
+            ));
+        }
+        if self.film_size != other.film_size || self.crop != other.crop {
+            return Some(format!(
+                "it holds a {}×{} crop of a {}×{} film, not a {}×{} crop of a {}×{} film",
+                other.crop.size.x,
+                other.crop.size.y,
+                other.film_size.x,
+                other.film_size.y,
+                self.crop.size.x,
+                self.crop.size.y,
+                self.film_size.x,
+                self.film_size.y
+            ));
+        }
+        None
+    }
+}
+
+/// The accumulated sums of a render and what they belong to.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct RenderState {
+    pub identity: RenderIdentity,
+    /// Sample index ranges every pixel holds: sorted, disjoint, non-empty.
+    pub ranges: Vec<Range<u32>>,
+    /// Pixel sums, row-major over the crop window.
+    pub pixels: Vec<PixelSums>,
+}
+
+fn corrupt(path: &Path, what: impl std::fmt::Display) -> Error {
+    Error {
+        kind: ErrorKind::Input,
+        location: None,
+        message: format!("\"{}\" is not a valid render state: {what}", path.display()),
+        help: Some("use a state written by prism render --checkpoint, or render again".into()),
+    }
+}
+
+/// Reads little-endian values from a byte slice, failing cleanly at its end.
+struct Reader<'a> {
+    bytes: &'a [u8],
+    position: usize,
+}
+
+impl Reader<'_> {
+    fn take(&mut self, n: usize) -> Option<&[u8]> {
+        let end = self.position.checked_add(n)?;
+        let slice = self.bytes.get(self.position..end)?;
+        self.position = end;
+        Some(slice)
+    }
+
+    fn u32(&mut self) -> Option<u32> {
+        self.take(4)
+            .map(|b| u32::from_le_bytes(b.try_into().unwrap_or_default()))
+    }
+
+    fn u64(&mut self) -> Option<u64> {
+        self.take(8)
+            .map(|b| u64::from_le_bytes(b.try_into().unwrap_or_default()))
+    }
+
+    fn i128(&mut self) -> Option<i128> {
+        self.take(16)
+            .map(|b| i128::from_le_bytes(b.try_into().unwrap_or_default()))
+    }
+
+    fn left(&self) -> usize {
+        self.bytes.len() - self.position
+    }
+}
+
+impl RenderState {
+    /// Samples per pixel the state holds.
+    pub fn sample_count(&self) -> u32 {
+        self.ranges.iter().map(|r| r.end - r.start).sum()
+    }
+
+    fn encode(&self) -> Vec<u8> {
+        let id = &self.identity;
+        let mut out = Vec::with_capacity(128 + self.pixels.len() * PIXEL_BYTES);
+        out.extend_from_slice(MAGIC);
+        out.extend_from_slice(&VERSION.to_le_bytes());
+        out.extend_from_slice(&id.scene.to_le_bytes());
+        out.extend_from_slice(&id.seed.to_le_bytes());
+        out.extend_from_slice(&(id.sampler.len() as u32).to_le_bytes());
+        out.extend_from_slice(id.sampler.as_bytes());
+        out.extend_from_slice(&id.samples_per_pixel.to_le_bytes());
+        for v in [
+            id.film_size.x,
+            id.film_size.y,
+            id.crop.offset.x,
+            id.crop.offset.y,
+            id.crop.size.x,
+            id.crop.size.y,
+        ] {
+            out.extend_from_slice(&v.to_le_bytes());
+        }
+        out.extend_from_slice(&(self.ranges.len() as u32).to_le_bytes());
+        for r in &self.ranges {
+            out.extend_from_slice(&r.start.to_le_bytes());
+            out.extend_from_slice(&r.end.to_le_bytes());
+        }
+        out.extend_from_slice(&(self.pixels.len() as u64).to_le_bytes());
+        for p in &self.pixels {
+            for s in &p.xyz {
+                out.extend_from_slice(&s.0.to_le_bytes());
+            }
+            for s in &p.xyz_squared {
+                out.extend_from_slice(&s.0.to_le_bytes());
+            }
+            out.extend_from_slice(&p.samples.to_le_bytes());
+            out.extend_from_slice(&p.rejected.to_le_bytes());
+        }
+        let checksum = crc32fast::hash(&out);
+        out.extend_from_slice(&checksum.to_le_bytes());
+        out
+    }
+
+    /// Parses a state; every inconsistency is an error naming `path` (for messages).
+    pub fn decode(bytes: &[u8], path: &Path) -> Result<RenderState> {
+        if bytes.len() < MAGIC.len() + 8 || &bytes[..MAGIC.len()] != MAGIC {
+            return Err(corrupt(
+                path,
+                "it does not start with a Prism render state header",
+            ));
+        }
+        let (body, stored) = bytes.split_at(bytes.len() - 4);
+        let stored = u32::from_le_bytes(stored.try_into().unwrap_or_default());
+        if crc32fast::hash(body) != stored {
+            return Err(corrupt(
+                path,
+                "its checksum does not match (the file is damaged or truncated)",
+            ));
+        }
+        let mut r = Reader {
+            bytes: body,
+            position: MAGIC.len(),
+        };
+        let truncated = || corrupt(path, "it ends too early");
+        let version = r.u32().ok_or_else(truncated)?;
+        if version != VERSION {
+            return Err(corrupt(
+                path,
+                format!("it has format version {version}; this Prism reads version {VERSION}"),
+            ));
+        }
+        let scene = r.u64().ok_or_else(truncated)?;
+        let seed = r.u64().ok_or_else(truncated)?;
+        let name_length = r.u32().ok_or_else(truncated)? as usize;
+        if name_length > 64 {
+            return Err(corrupt(path, "its sampler name is too long"));
+        }
+        let sampler = std::str::from_utf8(r.take(name_length).ok_or_else(truncated)?)
+            .map_err(|_| corrupt(path, "its sampler name is not text"))?
+            .to_string();
+        let samples_per_pixel = r.u32().ok_or_else(truncated)?;
+        let mut v = [0u32; 6];
+        for value in &mut v {
+            *value = r.u32().ok_or_else(truncated)?;
+        }
+        let identity = RenderIdentity {
+            scene,
+            seed,
+            sampler,
+            samples_per_pixel,
+            film_size: UVec2::new(v[0], v[1]),
+            crop: CropWindow {
+                offset: UVec2::new(v[2], v[3]),
+                size: UVec2::new(v[4], v[5]),
+            },
+        };
+        let range_count = r.u32().ok_or_else(truncated)? as usize;
+        if range_count == 0 || range_count > MAX_RANGES || range_count * 8 > r.left() {
+            return Err(corrupt(
+                path,
+                format!("it declares {range_count} sample ranges"),
+            ));
+        }
+        let mut ranges = Vec::with_capacity(range_count);
+        for _ in 0..range_count {
+            let (start, end) = (
+                r.u32().ok_or_else(truncated)?,
+                r.u32().ok_or_else(truncated)?,
+            );
+            if start >= end
+                || ranges
+                    .last()
+                    .is_some_and(|last: &Range<u32>| last.end > start)
+            {
+                return Err(corrupt(
+                    path,
+                    "its sample ranges are empty, unsorted or overlapping",
+                ));
+            }
+            ranges.push(start..end);
+        }
+        let pixel_count = r.u64().ok_or_else(truncated)?;
+        let expected = u64::from(identity.crop.size.x) * u64::from(identity.crop.size.y);
+        if pixel_count != expected
+            || pixel_count.checked_mul(PIXEL_BYTES as u64) != Some(r.left() as u64)
+        {
+            return Err(corrupt(
+                path,
+                format!(
+                    "it declares {pixel_count} pixels for a {}×{} crop in {} bytes",
+                    identity.crop.size.x,
+                    identity.crop.size.y,
+                    r.left()
+                ),
+            ));
+        }
+        let mut pixels = Vec::with_capacity(pixel_count as usize);
+        for _ in 0..pixel_count {
+            let mut p = PixelSums::default();
+            for s in &mut p.xyz {
+                *s = ExactSum(r.i128().ok_or_else(truncated)?);
+            }
+            for s in &mut p.xyz_squared {
+                *s = ExactSum(r.i128().ok_or_else(truncated)?);
+            }
+            p.samples = r.u64().ok_or_else(truncated)?;
+            p.rejected = r.u64().ok_or_else(truncated)?;
+            pixels.push(p);
+        }
+        Ok(RenderState {
+            identity,
+            ranges,
+            pixels,
+        })
+    }
+
+    /// Writes the state atomically: to `path.tmp`, flushed to disk, then renamed over `path`.
+    pub fn write(&self, path: &Path) -> Result<()> {
+        let mut temporary = path.as_os_str().to_owned();
+        temporary.push(".tmp");
+        let temporary = std::path::PathBuf::from(temporary);
+        let write = || -> std::io::Result<()> {
+            let mut file = std::fs::File::create(&temporary)?;
+            file.write_all(&self.encode())?;
+            file.sync_all()?;
+            std::fs::rename(&temporary, path)?;
+            if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
+                // Make the rename itself durable.
+                std::fs::File::open(parent)?.sync_all()?;
+            }
+            Ok(())
+        };
+        write().map_err(|e| {
+            let _ = std::fs::remove_file(&temporary);
+            Error::io(path, &e, "write the render state")
+        })
+    }
+
+    /// Reads and checks a state file.
+    pub fn read(path: &Path) -> Result<RenderState> {
+        let bytes = std::fs::read(path).map_err(|e| {
+            let mut error = Error::io(path, &e, "read the render state");
+            if e.kind() == std::io::ErrorKind::NotFound {
+                error.kind = ErrorKind::Input;
+            }
+            error
+        })?;
+        RenderState::decode(&bytes, path)
+    }
+
+    /// The union of states of the same render over disjoint sample ranges: exactly the sums of
+    /// one render of all their samples.
+    pub fn merge(states: &[RenderState], paths: &[&Path]) -> Result<RenderState> {
+        let Some(first) = states.first() else {
+            return Err(Error::usage("nothing to merge"));
+        };
+        let mut ranges: Vec<(Range<u32>, usize)> = Vec::new();
+        for (i, state) in states.iter().enumerate() {
+            if let Some(reason) = first.identity.mismatch(&state.identity) {
+                return Err(Error::usage(format!(
+                    "\"{}\" cannot be merged with \"{}\": {reason}",
+                    paths[i].display(),
+                    paths[0].display()
+                )));
+            }
+            ranges.extend(state.ranges.iter().map(|r| (r.clone(), i)));
+        }
+        ranges.sort_by_key(|(r, _)| r.start);
+        for w in ranges.windows(2) {
+            if w[0].0.end > w[1].0.start {
+                return Err(Error::usage(format!(
+                    "\"{}\" (samples {}..{}) and \"{}\" (samples {}..{}) overlap",
+                    paths[w[0].1].display(),
+                    w[0].0.start,
+                    w[0].0.end,
+                    paths[w[1].1].display(),
+                    w[1].0.start,
+                    w[1].0.end
+                ))
+                .with_help("merge renders of disjoint --sample-range values"));
+            }
+        }
+        let mut pixels = first.pixels.clone();
+        for state in &states[1..] {
+            for (p, q) in pixels.iter_mut().zip(&state.pixels) {
+                p.merge(q);
+            }
+        }
+        // Adjacent ranges become one.
+        let mut merged: Vec<Range<u32>> = Vec::new();
+        for (r, _) in ranges {
+            match merged.last_mut() {
+                Some(last) if last.end == r.start => last.end = r.end,
+                _ => merged.push(r),
+            }
+        }
+        Ok(RenderState {
+            identity: first.identity.clone(),
+            ranges: merged,
+            pixels,
+        })
+    }
+}
+
+#[cfg(test)]
+// Lists of sample ranges that happen to hold one range.
+#[allow(clippy::single_range_in_vec_init)]
+mod tests {
+    use super::*;
+
+    fn state(ranges: Vec<Range<u32>>) -> RenderState {
+        let crop = CropWindow {
+            offset: UVec2::new(1, 2),
+            size: UVec2::new(3, 2),
+        };
+        let mut pixels = vec![PixelSums::default(); 6];
+        for (i, p) in pixels.iter_mut().enumerate() {
+            p.add([i as f32, 0.5, -1.0]);
+        }
+        RenderState {
+            identity: RenderIdentity {
+                scene: 42,
+                seed: 7,
+                sampler: "nrooks".into(),
+                samples_per_pixel: 64,
+                film_size: UVec2::new(8, 8),
+                crop,
+            },
+            ranges,
+            pixels,
+        }
+    }
+
+    #[test]
+    fn round_trip() {
+        let s = state(vec![0..4, 8..12]);
+        let path = Path::new("x.state");
+        assert_eq!(RenderState::decode(&s.encode(), path).unwrap(), s);
+    }
+
+    /// Every truncation and every flipped byte is detected; nothing panics.
+    #[test]
+    fn damage_is_detected() {
+        let bytes = state(vec![0..4]).encode();
+        let path = Path::new("x.state");
+        for n in 0..bytes.len() {
+            assert!(
+                RenderState::decode(&bytes[..n], path).is_err(),
+                "truncated to {n}"
+            );
+        }
+        for i in 0..bytes.len() {
+            let mut damaged = bytes.clone();
+            damaged[i] ^= 0x10;
+            assert!(
+                RenderState::decode(&damaged, path).is_err(),
+                "byte {i} flipped"
+            );
+        }
+    }
+
+    #[test]
+    fn merge_checks_identity_and_overlap() {
+        let (a, b) = (state(vec![0..4]), state(vec![4..8]));
+        let paths = [Path::new("a"), Path::new("b")];
+        let merged = RenderState::merge(&[a.clone(), b.clone()], &paths).unwrap();
+        assert_eq!(merged.ranges, vec![0..8]);
+        assert_eq!(merged.pixels[1].samples, 2);
+        let overlapping = state(vec![2..6]);
+        assert!(RenderState::merge(&[a.clone(), overlapping], &paths).is_err());
+        let mut other_seed = b.clone();
+        other_seed.identity.seed = 8;
+        let error = RenderState::merge(&[a, other_seed], &paths).unwrap_err();
+        assert!(error.message.contains("seed"), "{error}");
+    }
+}

@@ -1,0 +1,63 @@
+//! The error of a rendered image, estimated from its own samples (the lecture's "Monte Carlo
+//! estimation with honest error": the standard deviation of the estimate is σ/√N).
+//!
+//! For a pixel with n samples vᵢ (filter-weighted luminance Y) the estimate is the mean m and the
+//! variance of that mean is estimated by s²/n with s² = (Σvᵢ² − n m²)/(n − 1), unbiased for
+//! independent samples. With a stratified sampler the samples of a pixel are negatively
+//! correlated and s²/n overestimates the true variance: the error is then conservative.
+//!
+//! The pixel's relative standard error is √(s²/n / (m² + 0.01)): the same regularised
+//! denominator as the relative MSE of `prism compare` (and of Mitsuba's and pbrt's tools), so that
+//! black pixels do not dominate. The image's error is the mean over pixels.
+
+use crate::film::PixelSums;
+
+/// Added to the squared mean in relative errors (as in relMSE = (a − b)² / (b² + 0.01)).
+pub const RELATIVE_EPSILON: f64 = 0.01;
+
+/// Variance of the pixel mean of channel `c` (0 = X, 1 = Y, 2 = Z); infinite with fewer than two
+/// samples.
+pub fn variance_of_mean(pixel: &PixelSums, c: usize) -> f64 {
+    let n = pixel.samples as f64;
+    if pixel.samples < 2 {
+        return f64::INFINITY;
+    }
+    let mean = pixel.sum(c) / n;
+    ((pixel.sum_of_squares(c) / n - mean * mean) / (n - 1.0)).max(0.0)
+}
+
+/// The relative standard error of a pixel's luminance: √(var / (Y² + 0.01)).
+pub fn pixel_relative_error(pixel: &PixelSums) -> f64 {
+    let y = pixel.mean()[1];
+    (variance_of_mean(pixel, 1) / (y * y + RELATIVE_EPSILON)).sqrt()
+}
+
+/// The mean relative standard error over pixels (infinite while some pixel has < 2 samples).
+pub fn relative_error<'a>(pixels: impl Iterator<Item = &'a PixelSums>) -> f64 {
+    let (sum, count) = pixels.fold((0.0, 0usize), |(s, n), p| {
+        (s + pixel_relative_error(p), n + 1)
+    });
+    if count == 0 { 0.0 } else { sum / count as f64 }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn variance_of_the_mean_of_known_samples() {
+        let mut pixel = PixelSums::default();
+        for v in [1.0f32, 2.0, 3.0, 4.0] {
+            pixel.add([0.0, v, 0.0]);
+        }
+        // Sample variance of 1..4 is 5/3; of the mean, 5/12.
+        assert!((variance_of_mean(&pixel, 1) - 5.0 / 12.0).abs() < 1e-12);
+        assert!(
+            (pixel_relative_error(&pixel) - (5.0f64 / 12.0 / (2.5 * 2.5 + 0.01)).sqrt()).abs()
+                < 1e-12
+        );
+        let mut single = PixelSums::default();
+        single.add([0.0, 1.0, 0.0]);
+        assert!(variance_of_mean(&single, 1).is_infinite());
+    }
+}

@@ -1,0 +1,369 @@
+//! Chi-square tests (DESIGN.md §6) of the lights' sampling routines: sphere lights by visible
+//! cone in its small-angle and near regimes, triangle-mesh lights by area as seen from a point,
+//! environment maps by luminance · sin θ, and the choice of a light by power or uniformly. Each
+//! test works in coordinates where the density is continuous within every cell.
+
+mod common;
+
+use std::f64::consts::PI;
+
+use common::chi2::{assert_passes, chi2_discrete, chi2_from_counts, chi2_rectangle};
+use common::scenes::{Object, build, camera};
+use glam::{DMat4, DVec3, Mat3, UVec2, Vec2, Vec3};
+use prism::geometry::Shape;
+use prism::geometry::sphere::Sphere;
+use prism::integrator::PathIntegrator;
+use prism::light::{
+    AreaLight, ConstantLight, DirectionalLight, EnvironmentMap, Light, LightSelection, PointLight,
+    SpotLight,
+};
+use prism::math::{Frame, Transform};
+use prism::sampling::rng::Pcg32;
+use prism::scene::image_file::{Bitmap, Encoding};
+use prism::scene::mitsuba::factory::shapes::{rectangle, transform_mesh};
+use prism::spectrum::{SampledWavelengths, Spectrum};
+
+/// Number of chi-square tests in this file, for Šidák's correction.
+const TESTS: usize = 6;
+const SAMPLES: usize = 1_000_000;
+
+fn u2(rng: &mut Pcg32) -> Vec2 {
+    Vec2::new(rng.next_f32(), rng.next_f32())
+}
+
+/// Cone sampling of a sphere of radius 1 whose centre is `distance` from the reference, along
+/// +z. Tested in (t, φ) with t = (1 − cos θ)/(1 − cos θmax), uniform on [0, 1) × [0, 2π) for
+/// directions uniform in the cone; 1 − cos θ is computed as |w − axis|²/2 in double precision,
+/// so even a cone of a few milliradians is resolved. The claimed pdf must also equal
+/// 1/(2π(1 − cos θmax)) to 10⁻⁴, which the coordinates' normalisation cannot see.
+fn cone_chi2(distance: f32, seed: u64, name: &str) {
+    let s = Sphere {
+        center: Vec3::new(0.0, 0.0, distance),
+        radius: 1.0,
+        rotation: Mat3::IDENTITY,
+        flip_normals: false,
+    };
+    let sin2_max = 1.0 / f64::from(distance).powi(2);
+    let one_minus_cos_max = sin2_max / (1.0 + (1.0 - sin2_max).sqrt());
+    let expected_pdf = 1.0 / (2.0 * PI * one_minus_cos_max);
+    let outcome = chi2_rectangle(
+        SAMPLES,
+        (0.0, 1.0),
+        (0.0, 2.0 * PI),
+        30,
+        60,
+        seed,
+        |rng| {
+            let sample = s.sample_from(Vec3::ZERO, u2(rng))?;
+            assert!(
+                (f64::from(sample.pdf) / expected_pdf - 1.0).abs() < 1e-4,
+                "{name}: pdf {} instead of {expected_pdf}",
+                sample.pdf
+            );
+            let claimed = s.pdf_from(Vec3::ZERO, sample.p, sample.n);
+            assert_eq!(
+                claimed, sample.pdf,
+                "{name}: pdf_from disagrees with the sample"
+            );
+            let w = sample.p.as_dvec3().normalize();
+            let t = 0.5 * (w - DVec3::Z).length_squared() / one_minus_cos_max;
+            let phi = w.y.atan2(w.x).rem_euclid(2.0 * PI);
+            Some((t.min(1.0 - 1e-12), phi))
+        },
+        |_, _| 1.0 / (2.0 * PI),
+    )
+    .unwrap();
+    assert_passes(name, &outcome, TESTS);
+}
+
+/// θmax ≈ 0.57°: sin²θmax = 10⁻⁴, where 1 − √(1 − sin²θmax) in single precision keeps only a
+/// few digits (the small-angle regime).
+#[test]
+fn sphere_cone_sampling_in_the_small_angle_regime() {
+    cone_chi2(100.0, 21, "sphere cone, small angle");
+}
+
+/// θmax ≈ 72°: the reference nearly touches the sphere, the cone is almost a hemisphere.
+#[test]
+fn sphere_cone_sampling_close_to_the_sphere() {
+    cone_chi2(1.05, 22, "sphere cone, close");
+}
+
+/// A rectangle light of 2 × 1.2 seen obliquely from a point: the area light's solid-angle
+/// samples, mapped back to the rectangle's (x, y), must be uniform, and the claimed solid-angle
+/// pdf times cos/d² must be 1/area at every point (the density the chi-square integrates).
+#[test]
+fn mesh_light_sampling_is_uniform_in_area() {
+    let to_world = Transform::new(
+        DMat4::from_translation(DVec3::new(0.3, 0.2, 2.0))
+            * DMat4::from_scale(DVec3::new(1.0, 0.6, 1.0)),
+    )
+    .unwrap();
+    let shapes = vec![Shape::Mesh(transform_mesh(
+        rectangle(),
+        &to_world,
+        true,
+        true,
+    ))];
+    let light = Light::Area(AreaLight {
+        shape: 0,
+        radiance: Spectrum::Constant(1.0),
+    });
+    let reference = Vec3::new(-0.7, 0.4, 0.5);
+    let lambda = SampledWavelengths::single(550.0);
+    let outcome = chi2_rectangle(
+        SAMPLES,
+        (-0.7, 1.3),
+        (-0.4, 0.8),
+        40,
+        24,
+        23,
+        |rng| {
+            let ls =
+                light.sample_incident(&shapes, reference, 0.0, rng.next_f32(), u2(rng), &lambda)?;
+            let d = ls.p - reference;
+            let cos = d.normalize().dot(Vec3::Z).abs();
+            let area_pdf = f64::from(ls.pdf * cos / d.length_squared());
+            assert!((area_pdf * 2.4 - 1.0).abs() < 1e-3, "area pdf {area_pdf}");
+            Some((f64::from(ls.p.x), f64::from(ls.p.y)))
+        },
+        |_, _| 1.0 / 2.4,
+    )
+    .unwrap();
+    assert_passes("mesh light by area", &outcome, TESTS);
+}
+
+/// A linear greyscale bitmap from a function of the pixel.
+fn grey_bitmap(width: usize, height: usize, f: impl Fn(usize, usize) -> f32) -> Bitmap {
+    let data = (0..height)
+        .flat_map(|y| (0..width).map(move |x| (x, y)))
+        .flat_map(|(x, y)| [f(x, y); 3])
+        .collect();
+    Bitmap {
+        width,
+        height,
+        channels: 3,
+        data,
+        encoding: Encoding::Linear,
+    }
+}
+
+/// Environment map sampling against its claimed density. The sampler draws a cell of the
+/// (s, v) grid (s = u − ½/W, v = θ/π) ∝ luminance · sin θ, then a uniform point in it, so its
+/// density in (s, v) is constant per cell; the claimed solid-angle pdf times the Jacobian
+/// 2π² sin θ must be that density. Bins split every cell 3 × 3 and are integrated by the
+/// midpoint rule on 4 × 4 interior points, never on a cell's edge. The map is rotated, has
+/// empty and bright cells, and its poles differ from its equator.
+#[test]
+fn environment_map_sampling_follows_luminance_times_sin_theta() {
+    let (width, height) = (12usize, 7usize);
+    let bitmap = grey_bitmap(width, height, |x, y| {
+        if (x, y) == (7, 2) {
+            40.0
+        } else if x == 3 {
+            0.0
+        } else {
+            0.2 + 0.1 * ((x * 7 + y * 3) % 5) as f32
+        }
+    });
+    let rotation = DMat4::from_rotation_y(0.7) * DMat4::from_rotation_x(-0.4);
+    let light = Light::Envmap(EnvironmentMap::new(
+        bitmap,
+        2.0,
+        Transform::new(rotation).unwrap(),
+    ));
+    let to_local = rotation.inverse();
+    let lambda = SampledWavelengths::single(550.0);
+    let half_texel = 0.5 / width as f64;
+    let (split, nodes) = (3usize, 4usize);
+    let (nx, ny) = (width * split, (height - 1) * split);
+    let (dx, dy) = (1.0 / nx as f64, 1.0 / ny as f64);
+    // The claimed density in (s, v).
+    let density = |s: f64, v: f64| {
+        let (theta, phi) = (PI * v, 2.0 * PI * (s + half_texel));
+        let local = DVec3::new(
+            phi.sin() * theta.sin(),
+            theta.cos(),
+            -phi.cos() * theta.sin(),
+        );
+        let world = rotation.transform_vector3(local).as_vec3();
+        f64::from(light.environment_pdf(world)) * 2.0 * PI * PI * theta.sin()
+    };
+    let mut expected = vec![0.0; nx * ny];
+    for (cell, e) in expected.iter_mut().enumerate() {
+        let (x0, y0) = ((cell % nx) as f64 * dx, (cell / nx) as f64 * dy);
+        let mut sum = 0.0;
+        for j in 0..nodes {
+            for i in 0..nodes {
+                let s = x0 + (i as f64 + 0.5) / nodes as f64 * dx;
+                let v = y0 + (j as f64 + 0.5) / nodes as f64 * dy;
+                sum += density(s, v);
+            }
+        }
+        *e = sum / (nodes * nodes) as f64 * dx * dy * SAMPLES as f64;
+    }
+    let total: f64 = expected.iter().sum::<f64>() / SAMPLES as f64;
+    assert!(
+        (total - 1.0).abs() < 1e-3,
+        "the claimed density integrates to {total}"
+    );
+
+    let mut observed = vec![0.0; nx * ny];
+    let mut rng = Pcg32::seeded(24);
+    for _ in 0..SAMPLES {
+        let ls = light
+            .sample_incident(&[], Vec3::ZERO, 0.0, 0.5, u2(&mut rng), &lambda)
+            .expect("an environment sample failed");
+        assert!(
+            (ls.pdf / light.environment_pdf(ls.wi) - 1.0).abs() < 1e-3,
+            "the sample's pdf {} differs from the light's pdf {} ({:?})",
+            ls.pdf,
+            light.environment_pdf(ls.wi),
+            ls.wi
+        );
+        let local = to_local.transform_vector3(ls.wi.as_dvec3()).normalize();
+        let u = local.x.atan2(-local.z) / (2.0 * PI);
+        let s = (u - half_texel).rem_euclid(1.0);
+        let v = local.y.clamp(-1.0, 1.0).acos() / PI;
+        let bin = ((v / dy) as usize).min(ny - 1) * nx + ((s / dx) as usize).min(nx - 1);
+        observed[bin] += 1.0;
+    }
+    let outcome = chi2_from_counts(&observed, &expected).unwrap();
+    assert_passes("environment map", &outcome, TESTS);
+}
+
+/// A scene with one light of every kind; returns it and the lights' closed-form powers.
+fn every_kind_of_light(selection: LightSelection) -> (prism::scene::Scene, Vec<f64>) {
+    let size = UVec2::new(4, 4);
+    let camera = camera(DVec3::new(0.0, 0.0, 5.0), DVec3::ZERO, DVec3::Y, 40.0, size);
+    // A floor of 4 × 4 and a sphere light of radius 0.5 with radiance 3 above it.
+    let floor = Transform::new(DMat4::from_scale(DVec3::new(2.0, 2.0, 1.0))).unwrap();
+    let objects = vec![
+        Object {
+            shape: Shape::Mesh(transform_mesh(rectangle(), &floor, false, true)),
+            reflectance: 0.5,
+            emission: Some(0.25),
+        },
+        Object {
+            shape: Shape::Sphere(Sphere {
+                center: Vec3::new(0.0, 0.0, 1.0),
+                radius: 0.5,
+                rotation: Mat3::IDENTITY,
+                flip_normals: false,
+            }),
+            reflectance: 0.0,
+            emission: Some(3.0),
+        },
+    ];
+    let (cutoff, beam) = (30f64.to_radians(), 10f64.to_radians());
+    let lights = vec![
+        Light::Point(PointLight {
+            position: Vec3::new(0.0, 1.0, 1.0),
+            intensity: Spectrum::Constant(2.0),
+        }),
+        Light::Spot(SpotLight::new(
+            Transform::IDENTITY,
+            Spectrum::Constant(5.0),
+            cutoff as f32,
+            beam as f32,
+        )),
+        Light::Directional(DirectionalLight::new(-Vec3::Z, Spectrum::Constant(0.1))),
+        Light::Constant(ConstantLight::new(Spectrum::Constant(0.02))),
+    ];
+    let scene = build(
+        objects,
+        lights,
+        camera,
+        size,
+        PathIntegrator {
+            light_selection: selection,
+            ..PathIntegrator::default()
+        },
+    );
+    // The bounding box is [−2, 2]² × [0, 1.5]: radius √(4 + 4 + 0.75²) (+ 10⁻⁴ relative).
+    let r2 = (8.0 + 0.75f64 * 0.75) * (1.0f64 + 1e-4).powi(2);
+    let powers = vec![
+        PI * 16.0 * 0.25,
+        PI * 4.0 * PI * 0.25 * 3.0,
+        4.0 * PI * 2.0,
+        2.0 * PI * 5.0 * (1.0 - (cutoff.sin() - beam.sin()) / (cutoff - beam)),
+        PI * r2 * 0.1,
+        4.0 * PI * PI * r2 * 0.02,
+    ];
+    (scene, powers)
+}
+
+fn selection_chi2(selection: LightSelection, seed: u64) {
+    let (scene, powers) = every_kind_of_light(selection);
+    let total: f64 = powers.iter().sum();
+    let probabilities: Vec<f64> = match selection {
+        LightSelection::Power => powers.iter().map(|p| p / total).collect(),
+        LightSelection::Uniform => vec![1.0 / powers.len() as f64; powers.len()],
+    };
+    for (i, p) in probabilities.iter().enumerate() {
+        let reported = f64::from(scene.light_sampler.pmf(i));
+        assert!(
+            (reported / p - 1.0).abs() < 1e-4,
+            "{selection:?}: light {i} has pmf {reported}, not {p}"
+        );
+    }
+    let outcome = chi2_discrete(SAMPLES, &probabilities, seed, |rng| {
+        let (index, pmf) = scene.light_sampler.sample(rng.next_f32()).unwrap();
+        assert_eq!(
+            pmf,
+            scene.light_sampler.pmf(index),
+            "the pmf returned with a sample is the reported pmf"
+        );
+        index
+    })
+    .unwrap();
+    assert_passes(&format!("light selection {selection:?}"), &outcome, TESTS);
+}
+
+/// Lights of every kind in one scene are chosen in proportion to their closed-form powers:
+/// area πAL, sphere area π·4πR²·L, point 4πI, spot 2πI(1 − (sin c − sin β)/(c − β)),
+/// directional πR²E and constant environment 4π²R²L with R the scene's bounding radius.
+#[test]
+fn light_selection_by_power_uses_each_lights_power() {
+    selection_chi2(LightSelection::Power, 25);
+}
+
+#[test]
+fn uniform_light_selection_picks_every_light_alike() {
+    selection_chi2(LightSelection::Uniform, 26);
+}
+
+/// The spot light's direction: `to_world` turns its +z axis; only directions within the
+/// cutoff receive light, with the falloff's profile.
+#[test]
+fn spot_light_points_along_its_transformed_axis() {
+    let to_world = Transform::new(DMat4::from_rotation_x(std::f64::consts::FRAC_PI_2)).unwrap();
+    let spot = SpotLight::new(
+        to_world,
+        Spectrum::Constant(1.0),
+        20f32.to_radians(),
+        10f32.to_radians(),
+    );
+    let lambda = SampledWavelengths::single(550.0);
+    // +z rotated by 90° about x is −y: a point 1 below the light is on the axis.
+    let below = spot
+        .sample_incident(Vec3::new(0.0, -1.0, 0.0), &lambda)
+        .unwrap();
+    assert_eq!(below.radiance[0], 1.0);
+    // 15° off the axis: halfway down the ramp.
+    let off = Frame::from_normal(-Vec3::Y).to_world(Vec3::new(
+        15f32.to_radians().sin(),
+        0.0,
+        15f32.to_radians().cos(),
+    ));
+    let half = spot.sample_incident(off * 2.0, &lambda).unwrap();
+    assert!(
+        (half.radiance[0] * 4.0 - 0.5).abs() < 1e-4,
+        "{}",
+        half.radiance[0]
+    );
+    assert!(
+        spot.sample_incident(Vec3::new(0.0, 1.0, 0.0), &lambda)
+            .is_none()
+    );
+}

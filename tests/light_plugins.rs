@@ -1,0 +1,178 @@
+//! The emitter plugins as the scene reader builds them from Mitsuba XML: Mitsuba's defaults
+//! (D65 emission of luminance 1, the spot's beam at ¾ of its cutoff, black BSDFs on emitting
+//! shapes), the placement parameters, black bodies, environment maps and `emitter_sampling`.
+
+use std::f32::consts::PI;
+use std::path::Path;
+
+use glam::{Vec2, Vec3};
+use prism::bsdf::Bsdf;
+use prism::light::{Light, LightSampler};
+use prism::scene::Scene;
+use prism::scene::mitsuba::factory::build_scene;
+use prism::scene::mitsuba::reader::read_scene_str;
+use prism::spectrum::SampledWavelengths;
+use prism::spectrum::cie::d65_normalized;
+
+/// Builds a scene from XML placed after a minimal sensor, in `folder` (for files it names).
+fn load(folder: &Path, body: &str) -> Scene {
+    let text = format!(
+        r#"<scene version="3.0.0">
+    <sensor type="perspective"><film type="hdrfilm"><integer name="width" value="4"/><integer name="height" value="4"/></film></sensor>
+    {body}
+</scene>"#
+    );
+    let root = read_scene_str(&text, &folder.join("scene.xml"), &[]).unwrap();
+    build_scene(&root).unwrap().scene
+}
+
+/// The radiance (or intensity, irradiance) a light delivers at `lambda` along a sample from
+/// `reference`, undoing the distance falloff of point and spot lights.
+fn emission_at(scene: &Scene, light: usize, reference: Vec3, lambda: f32) -> f32 {
+    let ls = scene.lights[light]
+        .sample_incident(
+            &scene.geometry.shapes,
+            reference,
+            0.0,
+            0.5,
+            Vec2::splat(0.5),
+            &SampledWavelengths::single(lambda),
+        )
+        .unwrap();
+    match scene.lights[light] {
+        Light::Point(_) | Light::Spot(_) => ls.radiance[0] * (ls.p - reference).length_squared(),
+        _ => ls.radiance[0],
+    }
+}
+
+#[test]
+fn default_emission_is_d65_of_luminance_one() {
+    let scene = load(
+        Path::new("."),
+        r#"<shape type="sphere"><point name="center" x="0" y="0" z="5"/><emitter type="area"/></shape>
+    <emitter type="point"/>
+    <emitter type="spot"/>
+    <emitter type="directional"/>
+    <emitter type="constant"/>"#,
+    );
+    assert_eq!(scene.lights.len(), 5);
+    for lambda in [400.0, 550.0, 700.0] {
+        let d65 = d65_normalized(lambda);
+        for (light, reference) in [
+            (0, Vec3::ZERO),
+            (1, Vec3::new(0.0, 0.0, -2.0)),
+            (2, Vec3::new(0.0, 0.0, 3.0)),
+            (3, Vec3::ZERO),
+            (4, Vec3::ZERO),
+        ] {
+            let value = emission_at(&scene, light, reference, lambda);
+            assert!(
+                (value / d65 - 1.0).abs() < 1e-3,
+                "light {light} at {lambda} nm: {value}, D65 is {d65}"
+            );
+        }
+    }
+}
+
+/// Mitsuba gives a shape with an area emitter and no BSDF a black diffuse BSDF, other shapes
+/// a 50 % grey one.
+#[test]
+fn emitting_shapes_without_a_bsdf_are_black() {
+    let scene = load(
+        Path::new("."),
+        r#"<shape type="sphere"><emitter type="area"/></shape>
+    <shape type="sphere"><point name="center" x="3" y="0" z="0"/></shape>"#,
+    );
+    let reflectance = |shape: usize| {
+        let material = &scene.materials[scene.shape_info[shape].material as usize];
+        #[allow(unreachable_patterns)] // other BSDFs come with the materials issue
+        match &material.front {
+            Bsdf::Diffuse(diffuse) => diffuse.reflectance.eval_1(glam::Vec2::ZERO),
+            other => panic!("shape {shape} has {other:?}"),
+        }
+    };
+    assert_eq!(reflectance(0), 0.0);
+    assert_eq!(reflectance(1), 0.5);
+}
+
+/// The spot's defaults are a 20° cutoff and a beam of ¾ of it; its power is
+/// 2πI(1 − (sin c − sin β)/(c − β)) with I of luminance 1.
+#[test]
+fn spot_defaults_follow_mitsuba() {
+    let scene = load(Path::new("."), r#"<emitter type="spot"/>"#);
+    let (c, b) = (20f32.to_radians(), 15f32.to_radians());
+    let expected = 2.0 * PI * (1.0 - (c.sin() - b.sin()) / (c - b));
+    let power = scene.lights[0].power(&scene.geometry.shapes);
+    assert!(
+        (power / expected - 1.0).abs() < 1e-3,
+        "{power} vs {expected}"
+    );
+}
+
+/// `direction` is where the light travels; without it, `to_world` turns +z.
+#[test]
+fn directional_light_placement() {
+    let scene = load(
+        Path::new("."),
+        r#"<emitter type="directional"><vector name="direction" x="0" y="-2" z="0"/></emitter>
+    <emitter type="directional"><transform name="to_world"><rotate x="1" angle="90"/></transform></emitter>"#,
+    );
+    let wi = |light: usize| {
+        scene.lights[light]
+            .sample_incident(
+                &[],
+                Vec3::ZERO,
+                0.0,
+                0.5,
+                Vec2::splat(0.5),
+                &SampledWavelengths::single(550.0),
+            )
+            .unwrap()
+            .wi
+    };
+    assert!((wi(0) - Vec3::Y).length() < 1e-6, "{}", wi(0));
+    // Rotating +z by 90° about x gives −y: the light arrives from +y.
+    assert!((wi(1) - Vec3::Y).length() < 1e-6, "{}", wi(1));
+}
+
+#[test]
+fn blackbody_radiance_and_uniform_emitter_sampling() {
+    let scene = load(
+        Path::new("."),
+        r#"<integrator type="path"><string name="emitter_sampling" value="uniform"/></integrator>
+    <emitter type="constant"><spectrum type="blackbody" name="radiance"><float name="temperature" value="3000"/></spectrum></emitter>
+    <emitter type="point"><rgb name="intensity" value="100"/></emitter>"#,
+    );
+    let value = emission_at(&scene, 0, Vec3::ZERO, 555.0);
+    assert!((value / 399.639 - 1.0).abs() < 1e-4, "{value}");
+    assert!(matches!(
+        scene.light_sampler,
+        LightSampler::Uniform { count: 2 }
+    ));
+    assert_eq!(scene.light_sampler.pmf(1), 0.5);
+    assert_eq!(scene.environment, Some(0));
+}
+
+/// A PNG environment map is decoded from sRGB, and scaled.
+#[test]
+fn environment_map_from_a_png() {
+    let folder = std::env::temp_dir().join(format!("prism-light-plugins-{}", std::process::id()));
+    std::fs::create_dir_all(&folder).unwrap();
+    // The linear value whose sRGB code is exactly 128, so that the 8-bit file is exact.
+    let linear = prism::scene::image_file::srgb_decode(128.0 / 255.0);
+    prism::film::output::write_png_srgb(&folder.join("sky.png"), 4, 3, &[linear; 36]).unwrap();
+    let scene = load(
+        &folder,
+        r#"<emitter type="envmap"><string name="filename" value="sky.png"/><float name="scale" value="2"/></emitter>"#,
+    );
+    let value = scene.lights[0].environment_radiance(
+        Vec3::new(0.3, 0.5, -0.8).normalize(),
+        &SampledWavelengths::single(600.0),
+    )[0];
+    let expected = 2.0 * linear * d65_normalized(600.0);
+    assert!(
+        (value / expected - 1.0).abs() < 1e-3,
+        "{value} vs {expected}"
+    );
+    std::fs::remove_dir_all(&folder).ok();
+}
