@@ -105,7 +105,7 @@ fn unknown_plugin_lists_the_supported_ones() {
         &dir,
         &[],
         "scene.xml:9:9",
-        &["unknown bsdf type \"plastik\"", "diffuse, twosided"],
+        &["unknown bsdf type \"plastik\"", "diffuse, mask", "twosided"],
     );
     let dir = folder("unknown-shape");
     write(

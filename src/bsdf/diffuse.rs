@@ -2,35 +2,46 @@
 //!
 //! ```xml
 //! <bsdf type="diffuse">
-//!     <rgb name="reflectance" value="0.2, 0.25, 0.7"/>   <!-- default 0.5 -->
+//!     <rgb name="reflectance" value="0.2, 0.25, 0.7"/>   <!-- or a texture; default 0.5 -->
 //! </bsdf>
 //! ```
-//! Sampled by Nusselt's analogue (cosine-weighted hemisphere), so the sample weight is ρ.
+//! Sampled by Nusselt's analogue (cosine-weighted hemisphere, the lecture's "Importance Sampling
+//! of the Reflection Integral"), so the sample weight is ρ. One-sided: black from behind.
 
 use std::f32::consts::FRAC_1_PI;
 
 use glam::{Vec2, Vec3};
 
-use super::{BsdfFlags, BsdfSample};
+use super::{BsdfFlags, BsdfSample, ShadingPoint, Texture};
 use crate::sampling::warp::{cosine_hemisphere_pdf, sample_cosine_hemisphere};
-use crate::spectrum::{SampledSpectrum, SampledWavelengths, Spectrum};
+use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 
 #[derive(Clone, Debug)]
 pub struct Diffuse {
-    pub reflectance: Spectrum,
+    pub reflectance: Texture,
 }
 
 impl Diffuse {
-    #[inline]
-    pub fn eval(&self, wo: Vec3, wi: Vec3, lambda: &SampledWavelengths) -> SampledSpectrum {
-        if wo.z <= 0.0 || wi.z <= 0.0 {
-            return SampledSpectrum::ZERO;
-        }
-        self.reflectance.sample(lambda) * (FRAC_1_PI * wi.z)
+    pub fn flags(&self) -> BsdfFlags {
+        BsdfFlags::DIFFUSE.union(BsdfFlags::REFLECTION)
     }
 
     #[inline]
-    pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+    pub fn eval(
+        &self,
+        sp: &ShadingPoint,
+        wo: Vec3,
+        wi: Vec3,
+        lambda: &SampledWavelengths,
+    ) -> SampledSpectrum {
+        if wo.z <= 0.0 || wi.z <= 0.0 {
+            return SampledSpectrum::ZERO;
+        }
+        self.reflectance.eval(sp.uv, lambda) * (FRAC_1_PI * wi.z)
+    }
+
+    #[inline]
+    pub fn pdf(&self, _sp: &ShadingPoint, wo: Vec3, wi: Vec3, _lambda: &SampledWavelengths) -> f32 {
         if wo.z <= 0.0 || wi.z <= 0.0 {
             return 0.0;
         }
@@ -40,6 +51,7 @@ impl Diffuse {
     #[inline]
     pub fn sample(
         &self,
+        sp: &ShadingPoint,
         wo: Vec3,
         _u_lobe: f32,
         u: Vec2,
@@ -53,11 +65,11 @@ impl Diffuse {
         if !(pdf > 0.0) {
             return None;
         }
-        Some(BsdfSample {
+        Some(BsdfSample::new(
             wi,
-            weight: self.reflectance.sample(lambda),
+            self.reflectance.eval(sp.uv, lambda),
             pdf,
-            flags: BsdfFlags::DIFFUSE.union(BsdfFlags::REFLECTION),
-        })
+            self.flags(),
+        ))
     }
 }

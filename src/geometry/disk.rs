@@ -61,12 +61,20 @@ impl Disk {
         if phi < 0.0 {
             phi += 2.0 * PI;
         }
+        // (u, v) = (r, φ/2π): ∂p/∂u = (cos φ, sin φ, 0), ∂p/∂v = 2π r (−sin φ, cos φ, 0).
+        let (sin_phi, cos_phi) = phi.sin_cos();
+        let dp_du = self.to_world.vector(Vec3::new(cos_phi, sin_phi, 0.0));
+        let dp_dv = self
+            .to_world
+            .vector(Vec3::new(-sin_phi, cos_phi, 0.0) * (2.0 * PI * r));
         SurfaceInteraction {
             p: self.to_world.point(local),
             t,
             n: self.normal,
-            shading: Frame::from_normal(self.normal),
+            shading: Frame::from_normal_and_tangent(self.normal, dp_du),
             uv: Vec2::new(r, phi / (2.0 * PI)),
+            dp_du,
+            dp_dv,
             shape,
             primitive: 0,
             time: 0.0,

@@ -18,6 +18,10 @@ pub struct SurfaceInteraction {
     pub shading: Frame,
     /// Surface parametrisation.
     pub uv: Vec2,
+    /// ∂p/∂u and ∂p/∂v (not normalised): the tangents of the parametrisation, which orient
+    /// anisotropic BSDFs and bump maps. The shading frame's first axis follows ∂p/∂u.
+    pub dp_du: Vec3,
+    pub dp_dv: Vec3,
     /// Index of the shape in the scene.
     pub shape: u32,
     /// Index of the primitive within the shape (triangle index; 0 for analytic shapes).

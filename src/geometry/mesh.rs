@@ -120,10 +120,23 @@ impl TriangleMesh {
         let p = p0 * b[0] + p1 * b[1] + p2 * b[2];
         let n = self.face_normal(triangle);
         let shading_n = self.shading_normal(triangle, b, n);
+        // Without texture coordinates, (u, v) are the barycentrics of p1 and p2 (as Mitsuba), so
+        // ∂p/∂u and ∂p/∂v are the edges from p0.
+        let (mut dp_du, mut dp_dv) = (p1 - p0, p2 - p0);
         let uv = match &self.uvs {
             Some(uvs) => {
                 let [a, bb, c] = self.triangles[triangle];
-                uvs[a as usize] * b[0] + uvs[bb as usize] * b[1] + uvs[c as usize] * b[2]
+                let [uv0, uv1, uv2] = [uvs[a as usize], uvs[bb as usize], uvs[c as usize]];
+                // Solve [dp1 dp2] = [∂p/∂u ∂p/∂v] [duv1 duv2] (pbrt-v4 §6.5.3).
+                let (duv1, duv2) = (uv1 - uv0, uv2 - uv0);
+                let det = duv1.x * duv2.y - duv1.y * duv2.x;
+                if det.abs() > 1e-12 {
+                    let inv = 1.0 / det;
+                    let (dp1, dp2) = (dp_du, dp_dv);
+                    dp_du = (dp1 * duv2.y - dp2 * duv1.y) * inv;
+                    dp_dv = (dp2 * duv1.x - dp1 * duv2.x) * inv;
+                }
+                uv0 * b[0] + uv1 * b[1] + uv2 * b[2]
             }
             None => Vec2::new(b[1], b[2]),
         };
@@ -131,8 +144,10 @@ impl TriangleMesh {
             p,
             t: hit.t,
             n,
-            shading: Frame::from_normal(shading_n),
+            shading: Frame::from_normal_and_tangent(shading_n, dp_du),
             uv,
+            dp_du,
+            dp_dv,
             shape,
             primitive: triangle as u32,
             time: 0.0,

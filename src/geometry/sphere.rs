@@ -67,16 +67,35 @@ impl Sphere {
         let p = (c + outward * f64::from(self.radius)).as_vec3();
         let outward = outward.as_vec3();
         let n = if self.flip_normals { -outward } else { outward };
+        let (dp_du, dp_dv) = self.tangents(outward);
         SurfaceInteraction {
             p,
             t,
             n,
-            shading: Frame::from_normal(n),
+            shading: Frame::from_normal_and_tangent(n, dp_du),
             uv: self.uv(outward),
+            dp_du,
+            dp_dv,
             shape,
             primitive: 0,
             time: 0.0,
         }
+    }
+
+    /// ∂p/∂u and ∂p/∂v of the (φ/2π, θ/π) parametrisation: 2π r (−y, x, 0) and
+    /// π r (z cos φ, z sin φ, −sin θ) in the object frame.
+    fn tangents(&self, outward: Vec3) -> (Vec3, Vec3) {
+        let local = self.rotation.transpose() * outward;
+        let sin_theta = (local.x * local.x + local.y * local.y).sqrt();
+        let (cos_phi, sin_phi) = if sin_theta > 0.0 {
+            (local.x / sin_theta, local.y / sin_theta)
+        } else {
+            (1.0, 0.0)
+        };
+        let r = self.radius;
+        let dp_du = Vec3::new(-local.y, local.x, 0.0) * (2.0 * PI * r);
+        let dp_dv = Vec3::new(local.z * cos_phi, local.z * sin_phi, -sin_theta) * (PI * r);
+        (self.rotation * dp_du, self.rotation * dp_dv)
     }
 
     /// Mitsuba's parametrisation: (φ/2π, θ/π) in the object frame.

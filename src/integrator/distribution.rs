@@ -38,11 +38,11 @@
 
 use glam::Vec3;
 
-use crate::bsdf::{Bsdf, BsdfFlags};
+use crate::bsdf::{Bsdf, ShadingPoint};
 use crate::geometry::SurfaceInteraction;
 use crate::integrator::RayCount;
 use crate::light::{Light, LightSample, LightSelection};
-use crate::math::{Frame, Ray};
+use crate::math::Ray;
 use crate::sampling::sampler::Sampler;
 use crate::scene::Scene;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
@@ -188,21 +188,24 @@ impl DistributionIntegrator {
             return SampledSpectrum::ZERO;
         }
         let material = &scene.materials[scene.shape_info[si.shape as usize].material as usize];
-        let Some((bsdf, flip)) = material.side(si.shading.to_local(wo_world).z) else {
-            return SampledSpectrum::ZERO;
-        };
+        let (bsdf, flip) = material.side(si.shading.to_local(wo_world).z);
         let frame = if flip {
             si.shading.flipped()
         } else {
             si.shading
         };
+        let sp = ShadingPoint {
+            uv: si.uv,
+            frame,
+            ng: if si.n.dot(frame.n) < 0.0 { -si.n } else { si.n },
+            dp_du: si.dp_du,
+            dp_dv: si.dp_dv,
+        };
         let wo = frame.to_local(wo_world);
 
         let mut result = SampledSpectrum::ZERO;
         if bsdf.flags().has_smooth_lobe() {
-            result += self.direct(
-                scene, si, &frame, bsdf, wo, potential, lambda, sampler, count,
-            );
+            result += self.direct(scene, si, &sp, bsdf, wo, potential, lambda, sampler, count);
         }
 
         let n = self.choose_n(potential);
@@ -210,10 +213,10 @@ impl DistributionIntegrator {
         for _ in 0..n {
             let u_lobe = sampler.next_1d();
             let u = sampler.next_2d();
-            let Some(bs) = bsdf.sample(wo, u_lobe, u, lambda) else {
+            let Some(bs) = bsdf.sample(&sp, wo, u_lobe, u, lambda) else {
                 continue;
             };
-            let specular = bs.flags.contains(BsdfFlags::SPECULAR);
+            let specular = bs.flags.is_delta();
             let next_potential = potential * bs.weight.max_value() / (n as f32 * survival);
             let ray = si.spawn_ray(frame.to_world(bs.wi));
             let arriving = self.incoming(
@@ -239,7 +242,7 @@ impl DistributionIntegrator {
         &self,
         scene: &Scene,
         si: &SurfaceInteraction,
-        frame: &Frame,
+        sp: &ShadingPoint,
         bsdf: &Bsdf,
         wo: Vec3,
         potential: f32,
@@ -263,7 +266,7 @@ impl DistributionIntegrator {
                 ) else {
                     continue;
                 };
-                sum += self.shadow_ray(scene, si, frame, bsdf, wo, &ls, lambda, count);
+                sum += self.shadow_ray(scene, si, sp, bsdf, wo, &ls, lambda, count);
             }
             sum * (1.0 / rays as f32)
         };
@@ -290,15 +293,15 @@ impl DistributionIntegrator {
         &self,
         scene: &Scene,
         si: &SurfaceInteraction,
-        frame: &Frame,
+        sp: &ShadingPoint,
         bsdf: &Bsdf,
         wo: Vec3,
         ls: &LightSample,
         lambda: &SampledWavelengths,
         count: &mut RayCount,
     ) -> SampledSpectrum {
-        let wi = frame.to_local(ls.wi);
-        let f = bsdf.eval(wo, wi, lambda);
+        let wi = sp.frame.to_local(ls.wi);
+        let f = bsdf.eval(sp, wo, wi, lambda);
         if f.is_black() {
             return SampledSpectrum::ZERO;
         }

@@ -18,19 +18,24 @@
 //!   no light is counted twice; delta lights (point, spot, directional) are reached only by
 //!   light sampling and BSDF-specular directions only by BSDF sampling.
 //! * Russian roulette (the lecture's "Termination of Recursion"): from depth `rr_depth` on, the
-//!   path continues with probability s = min(max_λ throughput, 0.95), the path's potential, and
-//!   its throughput is divided by s, which keeps the estimator unbiased. `max_depth` is the
-//!   user's explicit truncation, -1 (the default) for none.
+//!   path continues with probability s = min(max_λ throughput · η², 0.95), the path's potential
+//!   (η² undoes the radiance scaling of refractions, so that light inside glass is not killed
+//!   for being compressed, as in Mitsuba 3), and its throughput is divided by s, which keeps the
+//!   estimator unbiased. `max_depth` is the user's explicit truncation, -1 (the default) for none.
+//! * Delta lobes (mirrors, clear glass, the null pass of `mask`) are found by BSDF sampling
+//!   only: no light sampling towards them and no MIS for the emitters they lead to.
+//! * Dispersion: where a BSDF refracts each wavelength its own way, the path keeps only its hero
+//!   wavelength from there on (`SampledWavelengths::terminate_secondary`).
 //! * Depth follows Mitsuba: the camera ray's hit is depth 0; a path of depth d has d bounces.
 
-use crate::bsdf::Bsdf;
+use crate::bsdf::{Bsdf, ShadingPoint};
 use crate::geometry::SurfaceInteraction;
 use crate::integrator::RayCount;
 use crate::light::{Light, LightSelection};
 use crate::math::Ray;
 use crate::sampling::sampler::Sampler;
 use crate::scene::Scene;
-use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+use crate::spectrum::{N_SPECTRUM_SAMPLES, SampledSpectrum, SampledWavelengths};
 
 #[derive(Clone, Debug)]
 pub struct PathIntegrator {
@@ -72,7 +77,7 @@ struct PreviousBounce {
     interaction: SurfaceInteraction,
     /// Solid-angle density of the BSDF sample.
     pdf: f32,
-    /// Whether it came from a specular lobe (then emitters it finds are not light-sampled).
+    /// Whether it came from a delta lobe (then emitters it finds are not light-sampled).
     specular: bool,
 }
 
@@ -85,12 +90,17 @@ impl PathIntegrator {
         &self,
         scene: &Scene,
         mut ray: Ray,
-        lambda: &SampledWavelengths,
+        wavelengths: &SampledWavelengths,
         sampler: &mut Sampler,
         count: &mut RayCount,
     ) -> SampledSpectrum {
+        // The path's own copy: a dispersive interface may drop the companion wavelengths.
+        let mut lambda = *wavelengths;
+        let lambda_was_whole = !wavelengths.secondary_terminated();
         let mut result = SampledSpectrum::ZERO;
         let mut throughput = SampledSpectrum::ONE;
+        // Product of the relative indices of refraction crossed (Mitsuba's η).
+        let mut eta_scale = 1.0f32;
         let mut previous: Option<PreviousBounce> = None;
         let mut depth = 0i32;
         if self.max_depth == 0 {
@@ -104,7 +114,7 @@ impl PathIntegrator {
                 if let Some(env) = scene.environment
                     && !(self.hide_emitters && depth == 0)
                 {
-                    result += throughput * self.environment(scene, env, &ray, &previous, lambda);
+                    result += throughput * self.environment(scene, env, &ray, &previous, &lambda);
                 }
                 break;
             };
@@ -118,7 +128,7 @@ impl PathIntegrator {
                 let Light::Area(light) = &scene.lights[light_index as usize] else {
                     unreachable!("only area lights are attached to shapes");
                 };
-                let emitted = light.emitted(si.shading.n, wo_world, lambda);
+                let emitted = light.emitted(si.shading.n, wo_world, &lambda);
                 if !emitted.is_black() {
                     let weight = match &previous {
                         Some(prev) if !prev.specular => {
@@ -140,29 +150,44 @@ impl PathIntegrator {
             // The BSDF of the side the path arrives on, in its local frame.
             let material = &scene.materials[info.material as usize];
             let wo_shading = si.shading.to_local(wo_world);
-            let Some((bsdf, flip)) = material.side(wo_shading.z) else {
-                break;
-            };
+            let (bsdf, flip) = material.side(wo_shading.z);
             let frame = if flip {
                 si.shading.flipped()
             } else {
                 si.shading
             };
+            let sp = ShadingPoint {
+                uv: si.uv,
+                frame,
+                ng: if si.n.dot(frame.n) < 0.0 { -si.n } else { si.n },
+                dp_du: si.dp_du,
+                dp_dv: si.dp_dv,
+            };
             let wo = frame.to_local(wo_world);
+            let smooth = bsdf.flags().has_smooth_lobe();
+            // A dispersive BSDF that can be evaluated uses the hero wavelength's index for all
+            // its lobes (roughdielectric), so only the hero may see it.
+            if smooth && bsdf.is_dispersive() {
+                lambda.terminate_secondary();
+            }
 
             // Direct light sampling.
-            if bsdf.flags().has_smooth_lobe() {
+            if smooth {
                 result += throughput
-                    * self.sample_direct(scene, &si, &frame, bsdf, wo, lambda, sampler, count);
+                    * self.sample_direct(scene, &si, &sp, bsdf, wo, &lambda, sampler, count);
             }
 
             // BSDF sampling for the next direction.
             let u_lobe = sampler.next_1d();
             let u = sampler.next_2d();
-            let Some(bs) = bsdf.sample(wo, u_lobe, u, lambda) else {
+            let Some(bs) = bsdf.sample(&sp, wo, u_lobe, u, &lambda) else {
                 break;
             };
+            if bs.terminates_secondary {
+                lambda.terminate_secondary();
+            }
             throughput *= bs.weight;
+            eta_scale *= bs.eta;
             if throughput.is_black() {
                 break;
             }
@@ -171,18 +196,26 @@ impl PathIntegrator {
             previous = Some(PreviousBounce {
                 interaction: si,
                 pdf: bs.pdf,
-                specular: bs.flags.contains(crate::bsdf::BsdfFlags::SPECULAR),
+                specular: bs.flags.is_delta(),
             });
             depth += 1;
 
             // Russian roulette on the path's potential.
             if depth >= self.rr_depth {
-                let survival = throughput.max_value().min(0.95);
+                let survival = (throughput.max_value() * eta_scale * eta_scale).min(0.95);
                 if !(sampler.next_1d() < survival) {
                     break;
                 }
                 throughput *= 1.0 / survival;
             }
+        }
+        if lambda_was_whole && lambda.secondary_terminated() {
+            // The hero carries the whole estimate, with a quarter of its density
+            // (`terminate_secondary`); expressed for the caller's wavelengths, whose `to_xyz`
+            // divides by the full density, that is N times its radiance.
+            let mut hero_only = SampledSpectrum::ZERO;
+            hero_only[0] = result[0] * N_SPECTRUM_SAMPLES as f32;
+            return hero_only;
         }
         result
     }
@@ -216,7 +249,7 @@ impl PathIntegrator {
         &self,
         scene: &Scene,
         si: &SurfaceInteraction,
-        frame: &crate::math::Frame,
+        sp: &ShadingPoint,
         bsdf: &Bsdf,
         wo: glam::Vec3,
         lambda: &SampledWavelengths,
@@ -235,8 +268,8 @@ impl PathIntegrator {
         else {
             return SampledSpectrum::ZERO;
         };
-        let wi = frame.to_local(ls.wi);
-        let f = bsdf.eval(wo, wi, lambda);
+        let wi = sp.frame.to_local(ls.wi);
+        let f = bsdf.eval(sp, wo, wi, lambda);
         if f.is_black() {
             return SampledSpectrum::ZERO;
         }
@@ -248,7 +281,7 @@ impl PathIntegrator {
         let weight = if ls.is_delta {
             1.0
         } else {
-            power_heuristic(light_pdf, bsdf.pdf(wo, wi))
+            power_heuristic(light_pdf, bsdf.pdf(sp, wo, wi, lambda))
         };
         f * ls.radiance * (weight / light_pdf)
     }

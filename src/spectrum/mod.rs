@@ -8,6 +8,8 @@
 pub mod blackbody;
 pub mod cie;
 pub mod cie_tables;
+pub mod conductors;
+pub mod ior;
 pub mod rgb;
 pub mod rgb_table;
 pub mod sampled;

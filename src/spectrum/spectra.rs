@@ -38,6 +38,10 @@ pub enum RgbIntent {
     Albedo,
     /// Emitted radiance or intensity: the colour of a light.
     Illuminant,
+    /// A quantity without bounds, such as an index of refraction: always upsampled as
+    /// 2·max(rgb) times the spectrum of rgb / (2·max(rgb)) (pbrt-v4's `RGBUnboundedSpectrum`),
+    /// so that the fitted colour is never saturated.
+    Unbounded,
 }
 
 impl Spectrum {
@@ -56,6 +60,16 @@ impl Spectrum {
                 }
             }
             RgbIntent::Albedo => {
+                let scale = 2.0 * max;
+                Spectrum::Rgb {
+                    polynomial: RgbSigmoidPolynomial::fit(rgb.map(|c| c / scale)),
+                    scale,
+                }
+            }
+            RgbIntent::Unbounded => {
+                if rgb[0] == rgb[1] && rgb[1] == rgb[2] {
+                    return Spectrum::Constant(rgb[0]);
+                }
                 let scale = 2.0 * max;
                 Spectrum::Rgb {
                     polynomial: RgbSigmoidPolynomial::fit(rgb.map(|c| c / scale)),
@@ -108,6 +122,29 @@ impl Spectrum {
         }
     }
 
+    /// The smallest value over 360–830 nm (sampled at 1 nm).
+    pub fn min_value(&self) -> f32 {
+        match self {
+            Spectrum::Constant(v) => *v,
+            _ => (0..=470)
+                .map(|i| self.value(LAMBDA_MIN + i as f32))
+                .fold(f32::INFINITY, f32::min),
+        }
+    }
+
+    /// The mean value over 360–830 nm (sampled at 1 nm).
+    pub fn mean(&self) -> f32 {
+        match self {
+            Spectrum::Constant(v) => *v,
+            _ => {
+                let sum: f64 = (0..=470)
+                    .map(|i| f64::from(self.value(LAMBDA_MIN + i as f32)))
+                    .sum();
+                (sum / 471.0) as f32
+            }
+        }
+    }
+
     /// Luminance Y = ∫ S ȳ dλ / ∫ ȳ dλ (1 nm trapezoid rule), the brightness of an emission
     /// spectrum as the eye sees it; used to choose lights in proportion to their power.
     pub fn luminance(&self) -> f32 {
@@ -155,6 +192,11 @@ impl PiecewiseLinear {
             values: samples.iter().map(|s| s.1).collect(),
             inverse_spacing,
         })
+    }
+
+    /// The first and last wavelength of the table.
+    pub fn range(&self) -> (f32, f32) {
+        (self.lambdas[0], self.lambdas[self.lambdas.len() - 1])
     }
 
     #[inline]

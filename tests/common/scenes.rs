@@ -51,7 +51,7 @@ pub fn build(
     for (i, object) in objects.into_iter().enumerate() {
         materials.push(Material {
             front: Bsdf::Diffuse(Diffuse {
-                reflectance: Spectrum::Constant(object.reflectance),
+                reflectance: prism::bsdf::Texture::constant(object.reflectance),
             }),
             back: None,
         });

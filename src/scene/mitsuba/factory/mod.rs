@@ -10,6 +10,7 @@ pub mod materials;
 pub mod sensor;
 pub mod shapes;
 pub mod spectra;
+pub mod textures;
 
 use std::collections::HashMap;
 use std::collections::hash_map::Entry;
@@ -38,6 +39,7 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
     let mut shapes = Vec::new();
     let mut shape_info = Vec::new();
     let mut lights = Vec::new();
+    let mut textures = textures::TextureCache::default();
 
     let integrator = match params.single_child(PluginClass::Integrator)? {
         Some(child) => integrators::build_integrator(&child.node)?,
@@ -74,7 +76,7 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
                 match material_ids.get(&key) {
                     Some(&index) => index,
                     None => {
-                        materials.push(materials::build_material(&bsdf.node)?);
+                        materials.push(materials::build_material(&bsdf.node, &mut textures)?);
                         let index = (materials.len() - 1) as u32;
                         material_ids.insert(key, index);
                         index
@@ -127,8 +129,19 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
     // that their errors are reported as Mitsuba would.
     for child in params.children(PluginClass::Bsdf) {
         if let Entry::Vacant(entry) = material_ids.entry(Arc::as_ptr(&child.node)) {
-            materials.push(materials::build_material(&child.node)?);
+            materials.push(materials::build_material(&child.node, &mut textures)?);
             entry.insert((materials.len() - 1) as u32);
+        }
+    }
+    // Textures declared at the top level (referenced by id from BSDFs) are read even when no
+    // BSDF uses them, so that a missing or corrupt image is reported.
+    for child in params.children(PluginClass::Texture) {
+        if !textures.contains(&child.node) {
+            textures::build_texture(
+                &child.node,
+                crate::bsdf::texture::TextureUse::Scalar,
+                &mut textures,
+            )?;
         }
     }
     params.finish()?;

@@ -21,6 +21,9 @@ pub enum Range {
     Albedo,
     /// Emitted radiance or intensity: non-negative.
     Emission,
+    /// Any non-negative value, such as the real and imaginary parts of an index of refraction;
+    /// `<rgb>` is upsampled without bounds ([`RgbIntent::Unbounded`]).
+    Unbounded,
 }
 
 /// The spectrum given for parameter `name`, or `default` when absent.
@@ -58,6 +61,7 @@ pub fn spectrum_param(
     let intent = match range {
         Range::Albedo => RgbIntent::Albedo,
         Range::Emission => RgbIntent::Illuminant,
+        Range::Unbounded => RgbIntent::Unbounded,
     };
     let spectrum = match &property.value {
         PropertyValue::Float(_) | PropertyValue::Integer(_) => {
@@ -66,7 +70,7 @@ pub fn spectrum_param(
                 return Err(negative());
             }
             match range {
-                Range::Albedo => Spectrum::Constant(v as f32),
+                Range::Albedo | Range::Unbounded => Spectrum::Constant(v as f32),
                 Range::Emission => Spectrum::from_rgb([v as f32; 3], RgbIntent::Illuminant),
             }
         }

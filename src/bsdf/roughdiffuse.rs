@@ -1,0 +1,122 @@
+//! Mitsuba 0.6's `roughdiffuse` BSDF: Oren & Nayar 1994, "Generalization of Lambert's
+//! Reflectance Model", with its interreflection term (or, with `use_fast_approx`, the
+//! qualitative model of the paper's eq. 30). Mitsuba 3 has no such plugin; scenes written for
+//! Mitsuba 0.6 use it.
+//!
+//! ```xml
+//! <bsdf type="roughdiffuse">
+//!     <rgb name="reflectance" value="0.5"/>         <!-- or a texture; default 0.5 -->
+//!     <float name="alpha" value="0.2"/>             <!-- or a texture; default 0.2 -->
+//!     <boolean name="use_fast_approx" value="false"/>
+//! </bsdf>
+//! ```
+//! α is a Beckmann-style RMS slope; as in Mitsuba the Oren–Nayar slope deviation is σ = α/√2.
+//! α = 0 is Lambert's law. Sampled like `diffuse` (cosine-weighted); labelled a diffuse lobe
+//! (Mitsuba 0.6 calls it glossy, which only matters to its own integrators). One-sided.
+
+use std::f32::consts::{FRAC_1_PI, FRAC_1_SQRT_2};
+
+use glam::{Vec2, Vec3};
+
+use super::{BsdfFlags, BsdfSample, ShadingPoint, Texture, mixture_sample};
+use crate::sampling::warp::{cosine_hemisphere_pdf, sample_cosine_hemisphere};
+use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+
+#[derive(Clone, Debug)]
+pub struct RoughDiffuse {
+    pub reflectance: Texture,
+    pub alpha: Texture,
+    pub use_fast_approx: bool,
+}
+
+impl RoughDiffuse {
+    pub fn flags(&self) -> BsdfFlags {
+        BsdfFlags::DIFFUSE.union(BsdfFlags::REFLECTION)
+    }
+
+    pub fn eval(
+        &self,
+        sp: &ShadingPoint,
+        wo: Vec3,
+        wi: Vec3,
+        lambda: &SampledWavelengths,
+    ) -> SampledSpectrum {
+        if wo.z <= 0.0 || wi.z <= 0.0 {
+            return SampledSpectrum::ZERO;
+        }
+        let sigma = self.alpha.eval_1(sp.uv) * FRAC_1_SQRT_2;
+        let sigma2 = sigma * sigma;
+        let rho = self.reflectance.eval(sp.uv, lambda);
+        let sin_o = (1.0 - wo.z * wo.z).max(0.0).sqrt();
+        let sin_i = (1.0 - wi.z * wi.z).max(0.0).sqrt();
+        // cos(φo − φi).
+        let cos_phi_diff = if sin_o > 1e-4 && sin_i > 1e-4 {
+            (wo.x * wi.x + wo.y * wi.y) / (sin_o * sin_i)
+        } else {
+            0.0
+        };
+        // α = max(θo, θi), β = min(θo, θi).
+        let (sin_alpha, sin_beta, tan_beta) = if wo.z > wi.z {
+            (sin_i, sin_o, sin_o / wo.z)
+        } else {
+            (sin_o, sin_i, sin_i / wi.z)
+        };
+        let value = if self.use_fast_approx {
+            let a = 1.0 - 0.5 * sigma2 / (sigma2 + 0.33);
+            let b = 0.45 * sigma2 / (sigma2 + 0.09);
+            rho * (a + b * cos_phi_diff.max(0.0) * sin_alpha * tan_beta)
+        } else {
+            // Oren & Nayar 1994, eqs. 27–29 (with C₃'s (4αβ/π²)² and the interreflection term
+            // 0.17 ρ² σ²/(σ² + 0.13) (1 − cos(φo − φi)(2β/π)²)).
+            let (theta_o, theta_i) = (wo.z.clamp(-1.0, 1.0).acos(), wi.z.clamp(-1.0, 1.0).acos());
+            let (alpha, beta) = (theta_o.max(theta_i), theta_o.min(theta_i));
+            let t = sigma2 / (sigma2 + 0.09);
+            let t2 = 4.0 * FRAC_1_PI * FRAC_1_PI * alpha * beta;
+            let t3 = 2.0 * beta * FRAC_1_PI;
+            let c1 = 1.0 - 0.5 * sigma2 / (sigma2 + 0.33);
+            let mut c2 = 0.45 * t;
+            let c3 = 0.125 * t * t2 * t2;
+            let c4 = 0.17 * sigma2 / (sigma2 + 0.13);
+            if cos_phi_diff > 0.0 {
+                c2 *= sin_alpha;
+            } else {
+                c2 *= sin_alpha - t3 * t3 * t3;
+            }
+            let tan_half = (sin_alpha + sin_beta)
+                / ((1.0 - sin_alpha * sin_alpha).max(0.0).sqrt()
+                    + (1.0 - sin_beta * sin_beta).max(0.0).sqrt());
+            let single = rho
+                * (c1 + cos_phi_diff * c2 * tan_beta + (1.0 - cos_phi_diff.abs()) * c3 * tan_half);
+            let double = rho * rho * (c4 * (1.0 - cos_phi_diff * t3 * t3));
+            single + double
+        };
+        value * (FRAC_1_PI * wi.z)
+    }
+
+    pub fn pdf(&self, _sp: &ShadingPoint, wo: Vec3, wi: Vec3, _lambda: &SampledWavelengths) -> f32 {
+        if wo.z <= 0.0 || wi.z <= 0.0 {
+            return 0.0;
+        }
+        cosine_hemisphere_pdf(wi)
+    }
+
+    pub fn sample(
+        &self,
+        sp: &ShadingPoint,
+        wo: Vec3,
+        _u_lobe: f32,
+        u: Vec2,
+        lambda: &SampledWavelengths,
+    ) -> Option<BsdfSample> {
+        if wo.z <= 0.0 {
+            return None;
+        }
+        let wi = sample_cosine_hemisphere(u);
+        mixture_sample(
+            wi,
+            self.eval(sp, wo, wi, lambda),
+            cosine_hemisphere_pdf(wi),
+            self.flags(),
+        )
+    }
+}

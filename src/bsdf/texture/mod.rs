@@ -1,0 +1,159 @@
+//! Textures: values that vary over a surface with its (u, v) coordinates. Any BSDF parameter
+//! that Mitsuba lets vary (reflectances, roughness, opacity, blend weights, η and k, bump heights,
+//! normal maps) is a [`Texture`]; a constant is the common case.
+//!
+//! A texture is read in one of three ways, fixed when the scene is built:
+//! * as a spectrum ([`Texture::eval`]): colours, upsampled from RGB by Jakob & Hanika's model;
+//! * as a number ([`Texture::eval_1`]): roughness, opacity, weights, heights;
+//! * as a raw RGB triple ([`Texture::eval_3`]): normal maps.
+
+pub mod bitmap;
+pub mod checkerboard;
+
+use std::sync::Arc;
+
+use glam::{DMat4, Vec2, Vec3};
+
+pub use bitmap::{BitmapTexture, FilterType, TextureUse, WrapMode};
+pub use checkerboard::Checkerboard;
+
+use crate::spectrum::{SampledSpectrum, SampledWavelengths, Spectrum};
+
+/// A texture, dispatched by `match`.
+#[derive(Clone, Debug)]
+pub enum Texture {
+    /// The same value everywhere.
+    Constant(Spectrum),
+    /// An image (shared between the materials that reference it).
+    Bitmap(Arc<BitmapTexture>),
+    /// Two textures in a checkerboard pattern.
+    Checkerboard(Box<Checkerboard>),
+}
+
+impl Texture {
+    /// The constant `v` everywhere.
+    pub fn constant(v: f32) -> Texture {
+        Texture::Constant(Spectrum::Constant(v))
+    }
+
+    /// The spectral value at `uv` and the wavelengths `lambda`.
+    #[inline]
+    pub fn eval(&self, uv: Vec2, lambda: &SampledWavelengths) -> SampledSpectrum {
+        match self {
+            Texture::Constant(spectrum) => spectrum.sample(lambda),
+            Texture::Bitmap(bitmap) => bitmap.eval(uv, lambda),
+            Texture::Checkerboard(checkerboard) => checkerboard.eval(uv, lambda),
+        }
+    }
+
+    /// The scalar value at `uv` (a constant spectrum's value; a non-constant one's mean over
+    /// 360–830 nm).
+    #[inline]
+    pub fn eval_1(&self, uv: Vec2) -> f32 {
+        match self {
+            Texture::Constant(Spectrum::Constant(v)) => *v,
+            Texture::Constant(spectrum) => spectrum.mean(),
+            Texture::Bitmap(bitmap) => bitmap.eval_1(uv),
+            Texture::Checkerboard(checkerboard) => checkerboard.eval_1(uv),
+        }
+    }
+
+    /// The gradient (∂/∂u, ∂/∂v) of [`Self::eval_1`] (for bump mapping); zero where the texture
+    /// is piecewise constant.
+    #[inline]
+    pub fn eval_1_grad(&self, uv: Vec2) -> Vec2 {
+        match self {
+            Texture::Bitmap(bitmap) => bitmap.eval_1_grad(uv),
+            Texture::Constant(_) | Texture::Checkerboard(_) => Vec2::ZERO,
+        }
+    }
+
+    /// The raw RGB value at `uv` (normal maps); a constant or checkerboard gives its scalar value
+    /// in all three components.
+    #[inline]
+    pub fn eval_3(&self, uv: Vec2) -> Vec3 {
+        match self {
+            Texture::Bitmap(bitmap) => bitmap.eval_3(uv),
+            _ => Vec3::splat(self.eval_1(uv)),
+        }
+    }
+
+    /// An upper bound of the values (spectral or scalar) the texture takes.
+    pub fn max_value(&self) -> f32 {
+        match self {
+            Texture::Constant(spectrum) => spectrum.max_value(),
+            Texture::Bitmap(bitmap) => bitmap.max_value(),
+            Texture::Checkerboard(checkerboard) => checkerboard.max_value(),
+        }
+    }
+
+    /// The smallest value the texture takes (for validating scalar parameters).
+    pub fn min_value(&self) -> f32 {
+        match self {
+            Texture::Constant(Spectrum::Constant(v)) => *v,
+            Texture::Constant(spectrum) => spectrum.min_value(),
+            Texture::Bitmap(bitmap) => bitmap.min_value(),
+            Texture::Checkerboard(checkerboard) => checkerboard.min_value(),
+        }
+    }
+}
+
+/// Mitsuba's `to_uv`: an affine map of texture coordinates, (u, v) ↦ A (u, v) + b. A 4 × 4
+/// `<transform>` is read as Mitsuba 3 does: rows and columns 0, 1 and 3 (x, y, translation).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct UvTransform {
+    /// Rows (a₀₀, a₀₁, b₀) and (a₁₀, a₁₁, b₁).
+    pub rows: [[f32; 3]; 2],
+}
+
+impl UvTransform {
+    pub const IDENTITY: UvTransform = UvTransform {
+        rows: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+    };
+
+    pub fn from_matrix(m: &DMat4) -> UvTransform {
+        // glam matrices are column-major: m.col(j)[i] is row i, column j.
+        let entry = |i: usize, j: usize| m.col(j)[i] as f32;
+        UvTransform {
+            rows: [
+                [entry(0, 0), entry(0, 1), entry(0, 3)],
+                [entry(1, 0), entry(1, 1), entry(1, 3)],
+            ],
+        }
+    }
+
+    #[inline]
+    pub fn apply(&self, uv: Vec2) -> Vec2 {
+        let [r0, r1] = self.rows;
+        Vec2::new(
+            r0[0] * uv.x + r0[1] * uv.y + r0[2],
+            r1[0] * uv.x + r1[1] * uv.y + r1[2],
+        )
+    }
+
+    /// The gradient of f(A uv + b) with respect to uv, given the gradient `g` of f: Aᵀ g.
+    #[inline]
+    pub fn pull_back_gradient(&self, g: Vec2) -> Vec2 {
+        let [r0, r1] = self.rows;
+        Vec2::new(r0[0] * g.x + r1[0] * g.y, r0[1] * g.x + r1[1] * g.y)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn uv_transform_keeps_the_translation_of_a_4x4_matrix() {
+        // scale (2, 3) then translate (0.25, 0.5): u' = 2u + 0.25, v' = 3v + 0.5 (as Mitsuba 3.9
+        // reads `<scale x="2" y="3"/><translate x="0.25" y="0.5"/>`).
+        let m = DMat4::from_translation(glam::DVec3::new(0.25, 0.5, 0.0))
+            * DMat4::from_scale(glam::DVec3::new(2.0, 3.0, 1.0));
+        let t = UvTransform::from_matrix(&m);
+        assert_eq!(t.apply(Vec2::new(1.0, 1.0)), Vec2::new(2.25, 3.5));
+        assert_eq!(
+            t.pull_back_gradient(Vec2::new(1.0, 1.0)),
+            Vec2::new(2.0, 3.0)
+        );
+    }
+}

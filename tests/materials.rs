@@ -1,0 +1,467 @@
+//! Materials against what a chi-square test cannot see: identities of the models (Lambert
+//! integrates to ρ, microfacet distributions are normalised and pass the weak white furnace,
+//! Fresnel at normal incidence), the delta lobes of mirrors and glass, furnaces (a glass sphere
+//! and a mirror sphere in a uniform environment render the environment's radiance), textures,
+//! and the errors bad input gets. Tolerances come from quadrature error or standard errors.
+
+#[path = "common/bsdfs.rs"]
+mod bsdfs;
+mod common;
+
+use std::f64::consts::PI;
+use std::path::{Path, PathBuf};
+
+use bsdfs::{bsdf_from_xml, direction, integrate_eval, point, try_bsdf_from_xml, wavelengths};
+use common::chi2::{assert_passes, chi2_discrete};
+use common::scenes::{image_mean_and_standard_error, render_film};
+use glam::{Vec2, Vec3};
+use prism::bsdf::fresnel::fresnel_conductor;
+use prism::bsdf::microfacet::{Microfacet, MicrofacetKind};
+use prism::bsdf::{Bsdf, BsdfFlags};
+use prism::sampling::rng::Pcg32;
+use prism::spectrum::SampledWavelengths;
+use prism::spectrum::conductors::CONDUCTORS;
+
+fn temp_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("prism-materials-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+#[test]
+fn lambert_integrates_to_rho() {
+    let bsdf = bsdf_from_xml(
+        r#"<bsdf type="diffuse"><rgb name="reflectance" value="0.8, 0.4, 0.1"/></bsdf>"#,
+    );
+    let Bsdf::Diffuse(diffuse) = &bsdf else {
+        panic!("expected diffuse")
+    };
+    let rho = diffuse.reflectance.eval(point().uv, &wavelengths());
+    for wo in [direction(0.0, 0.0), direction(70.0, 30.0)] {
+        let integral = integrate_eval(&bsdf, wo, 800, 64);
+        for c in 0..4 {
+            assert!(
+                (integral[c] - f64::from(rho[c])).abs() < 1e-4,
+                "∫f cos = {} but ρ = {}",
+                integral[c],
+                rho[c]
+            );
+        }
+    }
+}
+
+/// ∫ g(m) dm over the upper hemisphere by the midpoint rule in (θ, φ), fine enough for
+/// α ≥ 0.1 (hundreds of nodes across the narrowest peak): errors below 3·10⁻⁶ here, so the
+/// tolerance 2·10⁻⁵ catches a 1 % error in Λ (and Mitsuba's 0.35 % rational fit of Beckmann's).
+fn integrate_hemisphere(g: impl Fn(Vec3) -> f64) -> f64 {
+    let (n_theta, n_phi) = (3000, 192);
+    let (dt, dp) = (0.5 * PI / n_theta as f64, 2.0 * PI / n_phi as f64);
+    let mut sum = 0.0;
+    for i in 0..n_theta {
+        let theta = (i as f64 + 0.5) * dt;
+        let (s, c) = theta.sin_cos();
+        for j in 0..n_phi {
+            let phi = (j as f64 + 0.5) * dp;
+            let m = Vec3::new((s * phi.cos()) as f32, (s * phi.sin()) as f32, c as f32);
+            sum += g(m) * s;
+        }
+    }
+    sum * dt * dp
+}
+
+/// Heitz 2014, §3: ∫ D(m) cos θm dm = 1 (the microsurface projects onto unit area), and the weak
+/// white furnace ∫ G₁(wo, m) max(0, wo·m) D(m) dm = cos θo (the visible projected area is the
+/// macrosurface's), which holds only with the masking function that belongs to D.
+#[test]
+fn microfacet_distributions_are_normalised_and_pass_the_weak_white_furnace() {
+    for kind in [MicrofacetKind::Ggx, MicrofacetKind::Beckmann] {
+        for (au, av) in [(0.1, 0.1), (0.5, 0.5), (0.15, 0.6)] {
+            let d = Microfacet::new(kind, au, av);
+            let projected = integrate_hemisphere(|m| f64::from(d.d(m) * m.z));
+            assert!(
+                (projected - 1.0).abs() < 2e-5,
+                "{kind:?} α = ({au}, {av}): ∫D cos = {projected}"
+            );
+            for wo in [
+                direction(0.0, 0.0),
+                direction(40.0, 30.0),
+                direction(75.0, 100.0),
+            ] {
+                let visible =
+                    integrate_hemisphere(|m| f64::from(d.g1(wo, m) * wo.dot(m).max(0.0) * d.d(m)))
+                        / f64::from(wo.z);
+                assert!(
+                    (visible - 1.0).abs() < 2e-5,
+                    "{kind:?} α = ({au}, {av}), wo = {wo}: weak white furnace gives {visible}"
+                );
+            }
+        }
+    }
+}
+
+/// The probability with which a delta-only BSDF reflects at wo (from its samples' pdfs).
+fn reflection_probability(bsdf: &Bsdf, wo: Vec3) -> f32 {
+    let s = bsdf
+        .sample(&point(), wo, 0.0, Vec2::splat(0.5), &wavelengths())
+        .unwrap();
+    assert!(s.flags.contains(BsdfFlags::REFLECTION));
+    s.pdf
+}
+
+#[test]
+fn fresnel_at_normal_incidence() {
+    for (tag, ior, eta) in [
+        ("float", "1.5", 1.5f32),
+        ("string", "water", 1.333),
+        ("string", "diamond", 2.419),
+    ] {
+        let xml = format!(
+            r#"<bsdf type="dielectric"><{tag} name="int_ior" value="{ior}"/><float name="ext_ior" value="1"/></bsdf>"#
+        );
+        let r = reflection_probability(&bsdf_from_xml(&xml), Vec3::Z);
+        let expected = ((eta - 1.0) / (eta + 1.0)).powi(2);
+        assert!((r - expected).abs() < 1e-6, "η = {eta}: {r} vs {expected}");
+    }
+    // Gold at normal incidence: ((n − 1)² + k²) / ((n + 1)² + k²) with the tabulated n, k.
+    let gold =
+        bsdf_from_xml(r#"<bsdf type="conductor"><string name="material" value="Au"/></bsdf>"#);
+    let table = CONDUCTORS.iter().find(|c| c.name == "Au").unwrap().samples;
+    for lambda in [420.0f32, 550.0, 680.0] {
+        let w = SampledWavelengths::single(lambda);
+        let s = gold
+            .sample(&point(), Vec3::Z, 0.5, Vec2::splat(0.5), &w)
+            .unwrap();
+        let i = table.partition_point(|s| s.0 <= lambda) - 1;
+        let t = (lambda - table[i].0) / (table[i + 1].0 - table[i].0);
+        let n = table[i].1 + t * (table[i + 1].1 - table[i].1);
+        let k = table[i].2 + t * (table[i + 1].2 - table[i].2);
+        let expected = ((n - 1.0).powi(2) + k * k) / ((n + 1.0).powi(2) + k * k);
+        assert!(
+            (s.weight[0] - expected).abs() < 1e-5,
+            "gold at {lambda} nm: {} vs {expected}",
+            s.weight[0]
+        );
+        assert_eq!(fresnel_conductor(1.0, n, k), s.weight[0]);
+    }
+}
+
+/// The smooth dielectric chooses reflection with probability F (a chi-square test of the
+/// choice), reflects to the mirror direction, refracts by Snell's law, and conserves energy.
+#[test]
+fn smooth_dielectric_lobes() {
+    let bsdf = bsdf_from_xml(
+        r#"<bsdf type="dielectric"><float name="int_ior" value="1.5"/><float name="ext_ior" value="1"/></bsdf>"#,
+    );
+    let lambda = wavelengths();
+    for (k, wo) in [
+        direction(60.0, 30.0),
+        -direction(30.0, 200.0),
+        -direction(50.0, 10.0),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let f = prism::bsdf::fresnel::fresnel_dielectric(wo.z, 1.5).reflectance;
+        let outcome = chi2_discrete(
+            100_000,
+            &[f64::from(f), f64::from(1.0 - f)],
+            k as u64,
+            |rng| {
+                let s = bsdf
+                    .sample(&point(), wo, rng.next_f32(), Vec2::ZERO, &lambda)
+                    .unwrap();
+                usize::from(s.flags.contains(BsdfFlags::TRANSMISSION))
+            },
+        );
+        // Beyond the critical angle from inside everything reflects: no test of a choice.
+        if f < 1.0 {
+            assert_passes("dielectric lobe choice", &outcome.unwrap(), 2);
+        }
+        let mut rng = Pcg32::seeded(10 + k as u64);
+        for _ in 0..1000 {
+            let s = bsdf
+                .sample(&point(), wo, rng.next_f32(), Vec2::ZERO, &lambda)
+                .unwrap();
+            // Energy: weight · η² (the radiance compression undone) is 1 for either lobe.
+            assert!((s.weight[0] * s.eta * s.eta - 1.0).abs() < 1e-5, "{s:?}");
+            if s.flags.contains(BsdfFlags::REFLECTION) {
+                assert!((s.wi - Vec3::new(-wo.x, -wo.y, wo.z)).length() < 1e-6);
+            } else {
+                let (eta_i, eta_t) = if wo.z > 0.0 { (1.0, 1.5) } else { (1.5, 1.0) };
+                let sin_o = (1.0 - wo.z * wo.z).sqrt();
+                let sin_i = (1.0 - s.wi.z * s.wi.z).sqrt();
+                assert!((eta_i * sin_o - eta_t * sin_i).abs() < 1e-5, "Snell");
+                assert!(s.wi.z * wo.z < 0.0 && (s.wi.x * wo.x) <= 0.0);
+            }
+        }
+    }
+}
+
+#[test]
+fn thin_dielectric_and_conductor_lobes() {
+    let thin = bsdf_from_xml(
+        r#"<bsdf type="thindielectric"><float name="int_ior" value="1.5"/><float name="ext_ior" value="1"/></bsdf>"#,
+    );
+    let wo = direction(45.0, 60.0);
+    let r = prism::bsdf::fresnel::fresnel_dielectric(wo.z, 1.5).reflectance;
+    let r2 = 2.0 * r / (1.0 + r);
+    let reflected = thin
+        .sample(&point(), wo, 0.0, Vec2::ZERO, &wavelengths())
+        .unwrap();
+    assert!((reflected.pdf - r2).abs() < 1e-6);
+    let passed = thin
+        .sample(&point(), -wo, 0.999, Vec2::ZERO, &wavelengths())
+        .unwrap();
+    assert!(passed.flags.contains(BsdfFlags::NULL) && passed.wi == wo);
+    assert!((passed.weight[0] * passed.pdf - (1.0 - r2)).abs() < 1e-6);
+    let mirror = bsdf_from_xml(r#"<bsdf type="conductor"/>"#);
+    let s = mirror
+        .sample(&point(), wo, 0.3, Vec2::ZERO, &wavelengths())
+        .unwrap();
+    assert_eq!(s.weight, prism::spectrum::SampledSpectrum::ONE);
+    assert!((s.wi - Vec3::new(-wo.x, -wo.y, wo.z)).length() < 1e-6);
+    assert!(
+        mirror
+            .sample(&point(), -wo, 0.3, Vec2::ZERO, &wavelengths())
+            .is_none()
+    );
+}
+
+/// A scene inside a sphere of inward normals, reflectance 0 and radiance 1 (a uniform
+/// environment of radiance 1 for everything inside), with a unit sphere of the given BSDF in
+/// front of the camera.
+fn furnace_scene(bsdf: &str) -> String {
+    format!(
+        r#"<scene version="3.0.0">
+    <integrator type="path"/>
+    <sensor type="perspective">
+        <float name="fov" value="35"/>
+        <transform name="to_world"><lookat origin="0.3, 0.2, -4" target="0, 0, 0" up="0, 1, 0"/></transform>
+        <film type="hdrfilm"><integer name="width" value="12"/><integer name="height" value="12"/><rfilter type="box"/></film>
+    </sensor>
+    <shape type="sphere">
+        <float name="radius" value="20"/>
+        <boolean name="flip_normals" value="true"/>
+        <bsdf type="diffuse"><rgb name="reflectance" value="0"/></bsdf>
+        <emitter type="area"><spectrum name="radiance" value="1"/></emitter>
+    </shape>
+    <shape type="sphere">
+        <float name="radius" value="1"/>
+        {bsdf}
+    </shape>
+</scene>"#
+    )
+}
+
+/// Renders `xml` and returns the image's mean luminance and its standard error.
+fn render_mean(xml: &str, spp: u32, seed: u64) -> (f64, f64) {
+    let root =
+        prism::scene::mitsuba::reader::read_scene_str(xml, Path::new("furnace.xml"), &[]).unwrap();
+    let loaded = prism::scene::mitsuba::factory::build_scene(&root).unwrap();
+    let film = render_film(&loaded.scene, spp, seed, None);
+    image_mean_and_standard_error(&film, 1)
+}
+
+/// A lossless sphere in a uniform environment of radiance L looks like the environment: every
+/// path ends in the environment with throughput 1 (for glass, the radiance scaling by 1/η²
+/// entering and η² leaving cancels), so the image is L everywhere, at unbounded depth.
+#[test]
+fn glass_and_mirror_spheres_vanish_in_a_furnace() {
+    for (name, bsdf, spp) in [
+        ("mirror", r#"<bsdf type="conductor"/>"#, 64),
+        ("glass", r#"<bsdf type="dielectric"/>"#, 64),
+        (
+            "diamond",
+            r#"<bsdf type="dielectric"><string name="int_ior" value="diamond"/></bsdf>"#,
+            64,
+        ),
+        // Refraction keeps only the hero wavelength, whose estimate of Y varies with it.
+        (
+            "dispersive flint glass",
+            r#"<bsdf type="dielectric"><spectrum type="sellmeier" name="int_ior"><string name="glass" value="N-SF11"/></spectrum></bsdf>"#,
+            1024,
+        ),
+        ("thin glass", r#"<bsdf type="thindielectric"/>"#, 64),
+    ] {
+        let (mean, se) = render_mean(&furnace_scene(bsdf), spp, 3);
+        assert!(
+            (mean - 1.0).abs() < 4.0 * se + 2e-4,
+            "{name} sphere in a furnace: mean Y {mean} ± {se}, expected 1"
+        );
+        assert!(
+            se < 2.5e-3,
+            "{name}: standard error {se} too large to see a 1 % bias"
+        );
+    }
+}
+
+/// A light seen through a fully transparent mask keeps its radiance: the null pass is a delta
+/// lobe, so the emitter it leads to is not weighted against light sampling (which cannot reach
+/// it: shadow rays stop at masks).
+#[test]
+fn lights_seen_through_a_transparent_mask_keep_their_radiance() {
+    let xml = r#"<scene version="3.0.0">
+    <sensor type="perspective">
+        <float name="fov" value="10"/>
+        <transform name="to_world"><lookat origin="0, 0, 0" target="0, 0, 1" up="0, 1, 0"/></transform>
+        <film type="hdrfilm"><integer name="width" value="8"/><integer name="height" value="8"/><rfilter type="box"/></film>
+    </sensor>
+    <shape type="rectangle">
+        <transform name="to_world"><translate z="2"/></transform>
+        <bsdf type="mask"><float name="opacity" value="0"/><bsdf type="diffuse"/></bsdf>
+    </shape>
+    <shape type="rectangle">
+        <transform name="to_world"><scale value="0.5"/><rotate y="1" angle="180"/><translate z="5"/></transform>
+        <emitter type="area"><spectrum name="radiance" value="1"/></emitter>
+    </shape>
+</scene>"#;
+    let (mean, se) = render_mean(xml, 64, 5);
+    assert!(
+        (mean - 1.0).abs() < 4.0 * se + 1e-4,
+        "light through a transparent mask: mean Y {mean} ± {se}, expected 1"
+    );
+}
+
+#[test]
+fn textures_vary_with_uv() {
+    let bsdf = bsdf_from_xml(
+        r#"<bsdf type="diffuse"><texture type="checkerboard" name="reflectance">
+            <rgb name="color0" value="0.8"/><rgb name="color1" value="0.1"/>
+            <transform name="to_uv"><scale x="2" y="2"/></transform></texture></bsdf>"#,
+    );
+    let Bsdf::Diffuse(d) = &bsdf else { panic!() };
+    let lambda = wavelengths();
+    assert_eq!(d.reflectance.eval(Vec2::new(0.1, 0.1), &lambda)[0], 0.8);
+    assert_eq!(d.reflectance.eval(Vec2::new(0.3, 0.1), &lambda)[0], 0.1);
+    // A texture declared at the top level and referenced by id, here as a roughness.
+    let referenced = bsdf_from_xml(
+        r#"<texture type="checkerboard" id="checks"><float name="color0" value="0.3"/></texture>
+           <bsdf type="roughconductor"><ref name="alpha" id="checks"/></bsdf>"#,
+    );
+    let Bsdf::RoughConductor(rc) = &referenced else {
+        panic!()
+    };
+    assert_eq!(rc.alpha_u.eval_1(Vec2::new(0.1, 0.1)), 0.3);
+    assert_eq!(rc.alpha_v.eval_1(Vec2::new(0.7, 0.1)), 0.2);
+
+    // A 2 × 1 PNG, left texel grey, right texel red: decoded to linear and upsampled.
+    let dir = temp_dir("bitmap");
+    let png = dir.join("t.png");
+    prism::film::output::write_png_srgb(&png, 2, 1, &[0.5, 0.5, 0.5, 1.0, 0.0, 0.0]).unwrap();
+    let xml = |raw: bool, filter: &str| {
+        format!(
+            r#"<bsdf type="diffuse"><texture type="bitmap" name="reflectance">
+                <string name="filename" value="{}"/><boolean name="raw" value="{raw}"/>
+                <string name="filter_type" value="{filter}"/><string name="wrap_mode" value="clamp"/>
+            </texture></bsdf>"#,
+            png.display()
+        )
+    };
+    let texture = |raw, filter| match bsdf_from_xml(&xml(raw, filter)) {
+        Bsdf::Diffuse(d) => d.reflectance,
+        _ => panic!(),
+    };
+    // The PNG stores linear 0.5 as the sRGB code 188: decoded, 0.5 again (to 8-bit precision);
+    // raw, 188/255.
+    let decoded = texture(false, "nearest");
+    let grey = decoded.eval(Vec2::new(0.25, 0.5), &lambda)[0];
+    assert!((grey - 0.5).abs() < 4e-3, "{grey} vs 0.5");
+    let raw = texture(true, "nearest").eval(Vec2::new(0.25, 0.5), &lambda)[0];
+    assert!((raw - 188.0 / 255.0).abs() < 1e-6, "raw {raw}");
+    let red = decoded.eval(Vec2::new(0.75, 0.5), &SampledWavelengths::single(650.0))[0];
+    let blue = decoded.eval(Vec2::new(0.75, 0.5), &SampledWavelengths::single(450.0))[0];
+    assert!(
+        red > 0.8 && blue < 0.1,
+        "red texel: {red} at 650 nm, {blue} at 450 nm"
+    );
+    // Bilinear filtering halfway between the texel centres averages their spectra.
+    let mid =
+        texture(false, "bilinear").eval(Vec2::new(0.5, 0.5), &SampledWavelengths::single(650.0))[0];
+    let left = decoded.eval(Vec2::new(0.25, 0.5), &SampledWavelengths::single(650.0))[0];
+    assert!((mid - 0.5 * (left + red)).abs() < 1e-5);
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// Errors for bad input: a message with the location of the offending element and a hint.
+fn assert_bsdf_error(xml: &str, says: &[&str]) {
+    let error = match try_bsdf_from_xml(xml) {
+        Ok(bsdf) => panic!("expected an error for {xml}, got {bsdf:?}"),
+        Err(e) => e,
+    };
+    let text = format!("{error}");
+    assert!(text.contains("test.xml:1:"), "no location in: {text}");
+    for phrase in says {
+        assert!(text.contains(phrase), "expected \"{phrase}\" in: {text}");
+    }
+}
+
+#[test]
+fn bad_input_gets_clear_errors() {
+    assert_bsdf_error(
+        r#"<bsdf type="conductor"><string name="material" value="Unobtainium"/></bsdf>"#,
+        &[
+            "unknown conductor material \"Unobtainium\"",
+            "Au",
+            "Cu",
+            "none",
+        ],
+    );
+    assert_bsdf_error(
+        r#"<bsdf type="dielectric"><string name="int_ior" value="glass"/></bsdf>"#,
+        &[
+            "unknown index of refraction \"glass\"",
+            "bk7",
+            "water",
+            "diamond",
+        ],
+    );
+    for alpha in ["0", "-0.1"] {
+        assert_bsdf_error(
+            &format!(r#"<bsdf type="roughconductor"><float name="alpha" value="{alpha}"/></bsdf>"#),
+            &["alpha", "greater than 0"],
+        );
+    }
+    assert_bsdf_error(
+        r#"<bsdf type="roughdielectric"><float name="alpha_u" value="0.1"/></bsdf>"#,
+        &["alpha_v"],
+    );
+    assert_bsdf_error(
+        r#"<bsdf type="dielectric"><float name="int_ior" value="-1.5"/></bsdf>"#,
+        &["positive"],
+    );
+    assert_bsdf_error(
+        r#"<bsdf type="dielectric"><spectrum type="sellmeier" name="int_ior"><float name="b1" value="1"/><float name="c1" value="0.25"/></spectrum></bsdf>"#,
+        &["positive and finite", "pole"],
+    );
+    assert_bsdf_error(
+        r#"<bsdf type="mask"><float name="opacity" value="1.5"/><bsdf type="diffuse"/></bsdf>"#,
+        &["opacity", "[0, 1]"],
+    );
+    assert_bsdf_error(
+        r#"<bsdf type="diffuse"><texture type="bitmap" name="reflectance"><string name="filename" value="/nonexistent/wood.png"/></texture></bsdf>"#,
+        &["not found", "wood.png"],
+    );
+    let dir = temp_dir("corrupt");
+    let corrupt = dir.join("corrupt.png");
+    std::fs::write(&corrupt, b"\x89PNG\r\n\x1a\nnot an image").unwrap();
+    assert_bsdf_error(
+        &format!(
+            r#"<bsdf type="diffuse"><texture type="bitmap" name="reflectance"><string name="filename" value="{}"/></texture></bsdf>"#,
+            corrupt.display()
+        ),
+        &["could not read the image", "corrupt.png"],
+    );
+    std::fs::remove_dir_all(&dir).ok();
+    assert_bsdf_error(
+        r#"<bsdf type="twosided"><bsdf type="dielectric"/></bsdf>"#,
+        &["cannot be nested in \"twosided\""],
+    );
+    assert_bsdf_error(
+        r#"<bsdf type="roughconductor"><string name="distribution" value="phong"/></bsdf>"#,
+        &["unknown microfacet distribution", "ggx"],
+    );
+    assert_bsdf_error(
+        r#"<bsdf type="blendbsdf"><bsdf type="diffuse"/><bsdf type="conductor"/></bsdf>"#,
+        &["needs a \"weight\""],
+    );
+}

@@ -1,0 +1,80 @@
+#!/usr/bin/env python3
+"""Writes src/spectrum/conductors.rs: the complex indices of refraction (eta, k) of Mitsuba's
+named conductor presets, from the .spd files Mitsuba 3 ships in resources/data/ior (the
+mitsuba-data repository; the Python wheel installs them under mitsuba/data/ior).
+
+usage: tools/gen_conductor_ior.py [DIR_WITH_SPD_FILES]
+
+Default directory: the Mitsuba 3 installed by ../shared/tools/mitsuba-ref."""
+import glob
+import os
+import struct
+import sys
+
+default = os.path.expanduser(
+    "~/.cache/prism-peers/venv/lib/python3.11/site-packages/mitsuba/data/ior")
+src = sys.argv[1] if len(sys.argv) > 1 else default
+out = os.path.join(os.path.dirname(__file__), "..", "src", "spectrum", "conductors.rs")
+
+
+def f32(x):
+    """The shortest decimal that rounds to the same single-precision number."""
+    target = struct.unpack("f", struct.pack("f", x))[0]
+    for digits in range(1, 10):
+        text = f"{target:.{digits}g}"
+        if struct.unpack("f", struct.pack("f", float(text)))[0] == target:
+            break
+    if "e" not in text and "." not in text:
+        text += ".0"
+    return text
+
+
+def read(path):
+    rows = []
+    for line in open(path):
+        line = line.strip()
+        if not line or line.startswith("#"):
+            continue
+        lam, value = line.split()[:2]
+        rows.append((float(lam), float(value)))
+    return rows
+
+
+names = sorted(os.path.basename(p)[: -len(".eta.spd")] for p in glob.glob(os.path.join(src, "*.eta.spd")))
+lines = [
+    "//! Complex indices of refraction η + ik of Mitsuba's named conductor presets",
+    "//! (`<string name=\"material\" value=\"Au\"/>`), tabulated over wavelength in nm.",
+    "//!",
+    "//! Source: the `.eta.spd`/`.k.spd` files of Mitsuba 3 (`resources/data/ior`, from the",
+    "//! mitsuba-data repository), \"identical to the data distributed with PBRT. They are originally",
+    "//! from the Luxpop database (www.luxpop.com) and are based on data by Palik et al. [Handbook of",
+    "//! Optical Constants of Solids, 1998] and measurements of atomic scattering factors made by the",
+    "//! Center For X-Ray Optics (CXRO) at Berkeley and the Lawrence Livermore National Laboratory",
+    "//! (LLNL)\" (Mitsuba 3 documentation, `conductor`). Written by `tools/gen_conductor_ior.py`;",
+    "//! do not edit.",
+    "",
+    "// Measured values that happen to be close to π or 2π are data, not approximations of them.",
+    "#![allow(clippy::approx_constant)]",
+    "",
+    "/// A preset: its name and samples (λ in nm, η, k).",
+    "pub struct ConductorData {",
+    "    pub name: &'static str,",
+    "    pub samples: &'static [(f32, f32, f32)],",
+    "}",
+    "",
+    "pub const CONDUCTORS: &[ConductorData] = &[",
+]
+for name in names:
+    eta = read(os.path.join(src, name + ".eta.spd"))
+    k = read(os.path.join(src, name + ".k.spd"))
+    assert [a for a, _ in eta] == [a for a, _ in k], name
+    lines.append("    ConductorData {")
+    lines.append(f"        name: \"{name}\",")
+    lines.append("        samples: &[")
+    for (lam, e), (_, kk) in zip(eta, k):
+        lines.append(f"            ({f32(lam)}, {f32(e)}, {f32(kk)}),")
+    lines.append("        ],")
+    lines.append("    },")
+lines.append("];")
+open(out, "w").write("\n".join(lines) + "\n")
+print(f"wrote {len(names)} presets to {out}")
