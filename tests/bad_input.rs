@@ -445,6 +445,21 @@ fn cases() -> Vec<Case> {
             ),
         ),
         with_image("image of unknown format", ("sky.tga", "TRUEVISION")),
+        Case {
+            name: "bitmap texture that is not a PNG",
+            files: &[
+                (
+                    "scene.xml",
+                    scene!(
+                        "    <shape type=\"sphere\"><bsdf type=\"diffuse\"><texture type=\"bitmap\" name=\"reflectance\"><string name=\"filename\" value=\"wood.png\"/></texture></bsdf></shape>"
+                    ),
+                ),
+                ("wood.png", "\u{89}PNG\r\n\u{1a}\n and then nothing"),
+            ],
+            arguments: RENDER,
+            location: "scene.xml:3:",
+            says: "could not read the image",
+        },
         // Render states.
         Case {
             name: "state of garbage",
