@@ -32,6 +32,7 @@
 // reject NaN, which is what a renderer's guards are for.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+pub mod bench;
 pub mod bsdf;
 pub mod camera;
 pub mod cli;
