@@ -20,6 +20,8 @@ enum Command {
     Converge(prism::cli::converge::ConvergeArgs),
     /// Combine render states of disjoint sample ranges into one image.
     Merge(prism::cli::merge::MergeArgs),
+    /// Run the benchmark suite: BVH build, memory, rays/s, samples/s and efficiency per scene.
+    Bench(prism::cli::bench::BenchArgs),
 }
 
 fn main() {
@@ -29,6 +31,7 @@ fn main() {
         Command::Compare(args) => prism::cli::compare::run(&args),
         Command::Converge(args) => prism::cli::converge::run(&args),
         Command::Merge(args) => prism::cli::merge::run(&args),
+        Command::Bench(args) => prism::cli::bench::run(&args),
     };
     if let Err(error) = result {
         eprintln!("error: {error}");

@@ -1,4 +1,218 @@
 //! The benchmark suite behind `prism bench`: fixed scenes, and for each the BVH build time, its
 //! memory, incoherent rays/s, samples/s and the relative MSE reached in a fixed time.
+//!
+//! Efficiency is 1 / (relMSE × seconds) (Veach's thesis §2.3 calls the inverse the cost of an
+//! estimator): relMSE falls as 1/N, so the product is independent of how long one renders and
+//! compares renderers (or integrators) that trade speed for noise. relMSE is measured against a
+//! high-sample reference rendered by Prism itself with another seed, so it is the estimator's
+//! variance (plus the reference's own, which its sample count makes small); a bias between two
+//! renderers is the business of parity tests, not of this benchmark.
 
 pub mod generated;
+pub mod rays;
+
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+use crate::cli::compare::rel_mse_rgb;
+use crate::cli::render::write_images;
+use crate::error::{Error, Result};
+use crate::film::output::read_exr;
+use crate::geometry::Geometry;
+use crate::math::Ray;
+use crate::render::{RenderOptions, render};
+use crate::scene::Scene;
+use crate::scene::mitsuba::load_scene;
+
+/// One scene of the suite: a file and the `-D` values that set its resolution.
+#[derive(Clone, Debug)]
+pub struct BenchScene {
+    pub name: &'static str,
+    pub path: PathBuf,
+    pub defines: Vec<(String, String)>,
+}
+
+/// The fixed suite: the bundled Cornell box (256 × 256), Veach's MIS and bidirectional scenes
+/// from `shared` (at 320 × 180 and 256 × 256, a twentieth and a sixteenth of their pixels, so
+/// that references take minutes), and the generated million-triangle scene (256 × 256), written
+/// into `cache` on first use. Scenes missing from `shared` are left out with a warning.
+pub fn suite(repository: &Path, shared: &Path, cache: &Path) -> Result<Vec<BenchScene>> {
+    let resolution = |x: u32, y: u32| {
+        vec![
+            ("resx".to_string(), x.to_string()),
+            ("resy".to_string(), y.to_string()),
+        ]
+    };
+    let mut scenes = vec![BenchScene {
+        name: "cornell-box",
+        path: repository.join("scenes/cornell-box/scene.xml"),
+        defines: resolution(256, 256),
+    }];
+    for (name, x, y) in [("veach-mis", 320, 180), ("veach-bidir", 256, 256)] {
+        let path = shared.join("scenes").join(name).join("scene.xml");
+        if path.exists() {
+            scenes.push(BenchScene {
+                name,
+                path,
+                defines: resolution(x, y),
+            });
+        } else {
+            eprintln!(
+                "prism bench: {} not found; {name} left out (see --shared)",
+                path.display()
+            );
+        }
+    }
+    scenes.push(BenchScene {
+        name: "million-triangles",
+        path: generated::write_million_triangle_scene(cache)?,
+        defines: resolution(256, 256),
+    });
+    Ok(scenes)
+}
+
+/// How to measure.
+#[derive(Clone, Debug)]
+pub struct BenchOptions {
+    pub threads: usize,
+    /// Render time of the relMSE measurement.
+    pub budget: Duration,
+    /// Samples per pixel of the references.
+    pub reference_spp: u32,
+    /// Incoherent rays traced for the rays/s figure (each timed pass traces them all).
+    pub ray_count: usize,
+    /// Where references are kept between runs.
+    pub cache: PathBuf,
+}
+
+/// What was measured on one scene.
+#[derive(Clone, Debug)]
+pub struct Measurement {
+    pub scene: String,
+    /// Triangles in the BVH (after dropping degenerate ones) plus analytic shapes.
+    pub primitives: usize,
+    /// Building the BVH over all shapes (scene loading excluded).
+    pub bvh_build_seconds: f64,
+    /// Shapes plus BVH, from [`Geometry::memory_bytes`].
+    pub geometry_bytes: usize,
+    /// Closest-hit queries per second on incoherent rays ([`rays::incoherent_rays`]).
+    pub rays_per_second: f64,
+    pub samples_per_second: f64,
+    /// Samples per pixel rendered in the budget.
+    pub spp: u32,
+    pub render_seconds: f64,
+    /// Relative MSE of that render against the reference (mean over R, G, B).
+    pub rel_mse: f64,
+    /// 1 / (relMSE × seconds).
+    pub efficiency: f64,
+}
+
+impl Measurement {
+    /// Memory per BVH primitive.
+    pub fn bytes_per_primitive(&self) -> f64 {
+        self.geometry_bytes as f64 / self.primitives.max(1) as f64
+    }
+}
+
+/// A rayon pool of `threads` workers, for the parts that are not renders.
+fn pool(threads: usize) -> Result<rayon::ThreadPool> {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| Error::usage(format!("could not start the worker threads: {e}")))
+}
+
+/// Closest-hit queries per second over `rays`, traced in parallel, repeated for at least a
+/// second; returns (rays/s, number of hits).
+pub fn trace_rate(
+    threads: usize,
+    rays: &[Ray],
+    closest_hit: impl Fn(&Ray) -> bool + Sync,
+) -> Result<(f64, usize)> {
+    use rayon::prelude::*;
+    let pool = pool(threads)?;
+    let start = Instant::now();
+    let (mut traced, mut hits) = (0usize, 0usize);
+    while traced == 0 || start.elapsed() < Duration::from_secs(1) {
+        hits = pool.install(|| {
+            rays.par_chunks(1024)
+                .map(|chunk| chunk.iter().filter(|ray| closest_hit(ray)).count())
+                .sum()
+        });
+        traced += rays.len();
+    }
+    Ok((traced as f64 / start.elapsed().as_secs_f64(), hits))
+}
+
+/// The reference image of `scene` at `spp`, read from the cache or rendered (once) into it.
+fn reference(
+    scene: &Scene,
+    bench: &BenchScene,
+    options: &BenchOptions,
+) -> Result<crate::film::output::ChannelImage> {
+    // The scene's fingerprint covers its files and -D values: an edited scene gets a new one.
+    let path = options.cache.join(format!(
+        "{}-{:016x}-{}spp.exr",
+        bench.name, scene.fingerprint, options.reference_spp
+    ));
+    if !path.exists() {
+        eprintln!(
+            "prism bench: rendering the reference of {} at {} spp (once; kept in {})",
+            bench.name,
+            options.reference_spp,
+            path.display()
+        );
+        // Another seed than the measured renders', so the two are independent.
+        let seed = 0x5eed_0f4e;
+        let threads = std::thread::available_parallelism().map_or(options.threads, |n| n.get());
+        let output = render(
+            scene,
+            &RenderOptions::fixed(options.reference_spp, seed, Some(threads)),
+        )?;
+        let partial = path.with_extension("partial.exr");
+        write_images(&output.film, &partial, &path.with_extension("png"))?;
+        std::fs::rename(&partial, &path).map_err(|e| Error::io(&path, &e, "write"))?;
+    }
+    read_exr(&path)
+}
+
+/// Measures one scene.
+pub fn measure(bench: &BenchScene, options: &BenchOptions) -> Result<Measurement> {
+    let scene = load_scene(&bench.path, &bench.defines)?.scene;
+
+    // The BVH again, timed alone (the scene's own was built while loading).
+    let shapes = scene.geometry.shapes.clone();
+    let start = Instant::now();
+    let rebuilt = pool(options.threads)?.install(|| Geometry::new(shapes));
+    let bvh_build_seconds = start.elapsed().as_secs_f64();
+    let primitives = rebuilt.primitive_count();
+    let geometry_bytes = rebuilt.memory_bytes();
+    drop(rebuilt);
+
+    let rays = rays::incoherent_rays(&scene, options.ray_count, 1);
+    let (rays_per_second, _) = trace_rate(options.threads, &rays, |ray| {
+        scene.geometry.intersect(ray).is_some()
+    })?;
+
+    let reference = reference(&scene, bench, options)?;
+    // One sample per pixel says how long a sample takes; the measured render then fills the
+    // budget with a fixed sample count (so that no pass is cut short).
+    let probe = render(&scene, &RenderOptions::fixed(1, 1, Some(options.threads)))?;
+    let spp = ((options.budget.as_secs_f64() / probe.elapsed.as_secs_f64().max(1e-6)) as u32)
+        .clamp(1, 1 << 16);
+    let output = render(&scene, &RenderOptions::fixed(spp, 2, Some(options.threads)))?;
+    let render_seconds = output.elapsed.as_secs_f64();
+    let rel_mse = rel_mse_rgb(&output.film.linear_srgb(), &reference)?;
+    Ok(Measurement {
+        scene: bench.name.to_string(),
+        primitives,
+        bvh_build_seconds,
+        geometry_bytes,
+        rays_per_second,
+        samples_per_second: output.sample_count as f64 / render_seconds,
+        spp,
+        render_seconds,
+        rel_mse,
+        efficiency: 1.0 / (rel_mse * render_seconds),
+    })
+}

@@ -1,5 +1,6 @@
 //! The subcommands of the `prism` program, one per file.
 
+pub mod bench;
 pub mod compare;
 pub mod converge;
 pub mod merge;

@@ -17,7 +17,7 @@ use obvhs::cwbvh::builder::build_cwbvh;
 
 use super::interaction::SurfaceInteraction;
 use super::shape::Shape;
-use super::triangle::{TriangleHit, intersect_triangle};
+use super::triangle::{TriangleHit, WatertightRay};
 use crate::math::Ray;
 
 /// A BVH primitive: one triangle, or a whole analytic shape.
@@ -90,11 +90,16 @@ impl Geometry {
             BvhBuildParams::medium_build(),
             &mut Duration::default(),
         );
+        let mut bvh = bvh;
         let primitives = bvh
             .primitive_indices
             .iter()
             .map(|&i| primitives[i as usize])
             .collect();
+        // Leaves now address `primitives` directly: the index map is not needed any more, and
+        // the builder's spare capacity is given back.
+        bvh.primitive_indices = Vec::new();
+        bvh.nodes.shrink_to_fit();
         Geometry {
             shapes,
             bvh: Some(bvh),
@@ -105,6 +110,30 @@ impl Geometry {
     /// The number of BVH primitives (triangles plus analytic shapes).
     pub fn primitive_count(&self) -> usize {
         self.primitives.len()
+    }
+
+    /// Bytes of memory held by the shapes and the hierarchy: meshes' vertex attributes and
+    /// indices, the BVH nodes, and the primitives in leaf order. Counted from the data
+    /// structures' capacities, so it does not depend on the allocator.
+    pub fn memory_bytes(&self) -> usize {
+        use std::mem::size_of;
+        let shapes: usize = self
+            .shapes
+            .iter()
+            .map(|shape| {
+                size_of::<Shape>()
+                    + match shape {
+                        Shape::Mesh(mesh) => mesh.heap_bytes(),
+                        Shape::Instance(instance) => instance.object.memory_bytes(),
+                        Shape::Sphere(_) | Shape::Disk(_) => 0,
+                    }
+            })
+            .sum();
+        let bvh = self.bvh.as_ref().map_or(0, |bvh| {
+            bvh.nodes.capacity() * size_of::<obvhs::cwbvh::node::CwBvhNode>()
+                + bvh.primitive_indices.capacity() * size_of::<u32>()
+        });
+        size_of::<Geometry>() + shapes + bvh + self.primitives.capacity() * size_of::<Primitive>()
     }
 
     /// The axis-aligned box (min, max) around all shapes; None for an empty scene.
@@ -131,11 +160,12 @@ impl Geometry {
         let bvh = self.bvh.as_ref()?;
         let mut closest: Option<(usize, TriangleHit)> = None;
         let mut hit = obvhs::ray::RayHit::none();
+        let watertight = WatertightRay::new(ray.o, ray.d);
         bvh.ray_traverse(Self::bvh_ray(ray), &mut hit, |bvh_ray, id| {
             let t_max = bvh_ray.tmax;
             let found = match &self.primitives[id] {
                 Primitive::Triangle { vertices, .. } => {
-                    intersect_triangle(ray.o, ray.d, t_max, vertices[0], vertices[1], vertices[2])
+                    watertight.intersect(t_max, vertices[0], vertices[1], vertices[2])
                 }
                 Primitive::Analytic { shape } => {
                     self.hit_analytic(*shape, ray, t_max).map(|t| TriangleHit {
@@ -177,13 +207,13 @@ impl Geometry {
         let Some(bvh) = self.bvh.as_ref() else {
             return false;
         };
+        let watertight = WatertightRay::new(ray.o, ray.d);
         !bvh.ray_traverse_miss(Self::bvh_ray(ray), |bvh_ray, id| {
             let t_max = bvh_ray.tmax;
             let t = match &self.primitives[id] {
-                Primitive::Triangle { vertices, .. } => {
-                    intersect_triangle(ray.o, ray.d, t_max, vertices[0], vertices[1], vertices[2])
-                        .map(|h| h.t)
-                }
+                Primitive::Triangle { vertices, .. } => watertight
+                    .intersect(t_max, vertices[0], vertices[1], vertices[2])
+                    .map(|h| h.t),
                 Primitive::Analytic { shape } => self.hit_analytic(*shape, ray, t_max),
             };
             t.unwrap_or(f32::INFINITY)

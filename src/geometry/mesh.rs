@@ -1,5 +1,7 @@
 //! Triangle meshes: Mitsuba's `obj`, `ply`, `rectangle` and `cube` shapes.
 
+use std::sync::OnceLock;
+
 use glam::{Vec2, Vec3};
 
 use super::interaction::SurfaceInteraction;
@@ -18,8 +20,9 @@ pub struct TriangleMesh {
     pub triangles: Vec<[u32; 3]>,
     /// Whether the geometric and shading normals are reversed (Mitsuba's `flip_normals`).
     pub flip_normals: bool,
-    /// Triangles chosen in proportion to their area (None when the area is zero).
-    area_table: Option<AliasTable>,
+    /// Triangles chosen in proportion to their area (None when the area is zero). Built on the
+    /// first area sample, so that only meshes that are lights pay its 12 bytes per triangle.
+    area_table: OnceLock<Option<AliasTable>>,
     area: f32,
 }
 
@@ -50,15 +53,19 @@ impl TriangleMesh {
             uvs,
             triangles,
             flip_normals,
-            area_table: None,
+            area_table: OnceLock::new(),
             area: 0.0,
         };
-        let areas: Vec<f64> = (0..mesh.triangles.len())
-            .map(|i| f64::from(mesh.triangle_area(i)))
-            .collect();
-        mesh.area = areas.iter().sum::<f64>() as f32;
-        mesh.area_table = AliasTable::new(&areas);
+        mesh.area = mesh.triangle_areas().iter().sum::<f64>() as f32;
+        mesh.positions.shrink_to_fit();
+        mesh.triangles.shrink_to_fit();
         mesh
+    }
+
+    fn triangle_areas(&self) -> Vec<f64> {
+        (0..self.triangles.len())
+            .map(|i| f64::from(self.triangle_area(i)))
+            .collect()
     }
 
     #[inline]
@@ -79,6 +86,26 @@ impl TriangleMesh {
     /// Total surface area.
     pub fn area(&self) -> f32 {
         self.area
+    }
+
+    /// Bytes of heap memory the mesh holds: vertex attributes, indices and the area table.
+    pub fn heap_bytes(&self) -> usize {
+        use std::mem::size_of;
+        self.positions.capacity() * size_of::<Vec3>()
+            + self
+                .normals
+                .as_ref()
+                .map_or(0, |n| n.capacity() * size_of::<Vec3>())
+            + self
+                .uvs
+                .as_ref()
+                .map_or(0, |uv| uv.capacity() * size_of::<Vec2>())
+            + self.triangles.capacity() * size_of::<[u32; 3]>()
+            + self
+                .area_table
+                .get()
+                .and_then(Option::as_ref)
+                .map_or(0, AliasTable::heap_bytes)
     }
 
     /// The unit geometric normal of a triangle: (p1 − p0) × (p2 − p0), counter-clockwise
@@ -158,7 +185,10 @@ impl TriangleMesh {
     /// area by `u_choice`, then a uniform point in it. The pdf is 1/area. None for a mesh of zero
     /// area.
     pub fn sample_area(&self, u_choice: f32, u: Vec2) -> Option<SurfaceSample> {
-        let table = self.area_table.as_ref()?;
+        let table = self
+            .area_table
+            .get_or_init(|| AliasTable::new(&self.triangle_areas()))
+            .as_ref()?;
         let (triangle, _) = table.sample(u_choice);
         let [p0, p1, p2] = self.vertices(triangle);
         let b = sample_uniform_triangle(u);

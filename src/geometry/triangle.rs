@@ -37,88 +37,98 @@ fn permute(v: Vec3, x: usize, y: usize, z: usize) -> Vec3 {
     Vec3::new(v[x], v[y], v[z])
 }
 
-/// Intersects the ray o + t·d, 0 < t < t_max, with the triangle (p0, p1, p2); both faces count.
-/// A degenerate triangle (zero area) may or may not report hits: callers leave them out.
-#[inline]
-pub fn intersect_triangle(
-    o: Vec3,
-    d: Vec3,
-    t_max: f32,
-    p0: Vec3,
-    p1: Vec3,
-    p2: Vec3,
-) -> Option<TriangleHit> {
-    let mut p0t = p0 - o;
-    let mut p1t = p1 - o;
-    let mut p2t = p2 - o;
-    // Permute so that z is the ray direction's largest component.
-    let abs_d = d.abs();
-    let kz = if abs_d.x > abs_d.y {
-        if abs_d.x > abs_d.z { 0 } else { 2 }
-    } else if abs_d.y > abs_d.z {
-        1
-    } else {
-        2
-    };
-    let kx = if kz == 2 { 0 } else { kz + 1 };
-    let ky = if kx == 2 { 0 } else { kx + 1 };
-    let d = permute(d, kx, ky, kz);
-    p0t = permute(p0t, kx, ky, kz);
-    p1t = permute(p1t, kx, ky, kz);
-    p2t = permute(p2t, kx, ky, kz);
-    // Shear x and y so the ray runs along +z; z is scaled later, only if there is a hit.
-    let sx = -d.x / d.z;
-    let sy = -d.y / d.z;
-    let sz = 1.0 / d.z;
-    p0t.x += sx * p0t.z;
-    p0t.y += sy * p0t.z;
-    p1t.x += sx * p1t.z;
-    p1t.y += sy * p1t.z;
-    p2t.x += sx * p2t.z;
-    p2t.y += sy * p2t.z;
-    // Edge functions.
-    let e0 = difference_of_products(p1t.x, p2t.y, p1t.y, p2t.x);
-    let e1 = difference_of_products(p2t.x, p0t.y, p2t.y, p0t.x);
-    let e2 = difference_of_products(p0t.x, p1t.y, p0t.y, p1t.x);
-    if (e0 < 0.0 || e1 < 0.0 || e2 < 0.0) && (e0 > 0.0 || e1 > 0.0 || e2 > 0.0) {
-        return None;
+/// A ray prepared for watertight triangle tests: the permutation that makes the direction's
+/// largest component z, and the shear that turns the direction into +z. Computed once per ray
+/// and shared by every triangle the traversal visits.
+#[derive(Clone, Copy, Debug)]
+pub struct WatertightRay {
+    origin: Vec3,
+    /// The axes that become x, y and z.
+    permutation: [usize; 3],
+    /// (−d_x/d_z, −d_y/d_z, 1/d_z) in permuted coordinates.
+    shear: Vec3,
+}
+
+impl WatertightRay {
+    /// Prepares the ray o + t·d.
+    #[inline]
+    pub fn new(o: Vec3, d: Vec3) -> WatertightRay {
+        let abs_d = d.abs();
+        let kz = if abs_d.x > abs_d.y {
+            if abs_d.x > abs_d.z { 0 } else { 2 }
+        } else if abs_d.y > abs_d.z {
+            1
+        } else {
+            2
+        };
+        let kx = if kz == 2 { 0 } else { kz + 1 };
+        let ky = if kx == 2 { 0 } else { kx + 1 };
+        let d = permute(d, kx, ky, kz);
+        WatertightRay {
+            origin: o,
+            permutation: [kx, ky, kz],
+            shear: Vec3::new(-d.x / d.z, -d.y / d.z, 1.0 / d.z),
+        }
     }
-    let det = e0 + e1 + e2;
-    if det == 0.0 {
-        return None;
+
+    /// Intersects the ray, 0 < t < t_max, with the triangle (p0, p1, p2); both faces count.
+    /// A degenerate triangle (zero area) may or may not report hits: callers leave them out.
+    #[inline]
+    pub fn intersect(&self, t_max: f32, p0: Vec3, p1: Vec3, p2: Vec3) -> Option<TriangleHit> {
+        let [kx, ky, kz] = self.permutation;
+        let mut p0t = permute(p0 - self.origin, kx, ky, kz);
+        let mut p1t = permute(p1 - self.origin, kx, ky, kz);
+        let mut p2t = permute(p2 - self.origin, kx, ky, kz);
+        let (sx, sy, sz) = (self.shear.x, self.shear.y, self.shear.z);
+        p0t.x += sx * p0t.z;
+        p0t.y += sy * p0t.z;
+        p1t.x += sx * p1t.z;
+        p1t.y += sy * p1t.z;
+        p2t.x += sx * p2t.z;
+        p2t.y += sy * p2t.z;
+        let e0 = difference_of_products(p1t.x, p2t.y, p1t.y, p2t.x);
+        let e1 = difference_of_products(p2t.x, p0t.y, p2t.y, p0t.x);
+        let e2 = difference_of_products(p0t.x, p1t.y, p0t.y, p1t.x);
+        if (e0 < 0.0 || e1 < 0.0 || e2 < 0.0) && (e0 > 0.0 || e1 > 0.0 || e2 > 0.0) {
+            return None;
+        }
+        let det = e0 + e1 + e2;
+        if det == 0.0 {
+            return None;
+        }
+        // Scaled hit distance, compared with t_max before dividing.
+        p0t.z *= sz;
+        p1t.z *= sz;
+        p2t.z *= sz;
+        let t_scaled = e0 * p0t.z + e1 * p1t.z + e2 * p2t.z;
+        if det < 0.0 && (t_scaled >= 0.0 || t_scaled < t_max * det) {
+            return None;
+        }
+        if det > 0.0 && (t_scaled <= 0.0 || t_scaled > t_max * det) {
+            return None;
+        }
+        let inv_det = 1.0 / det;
+        let (b0, b1, b2) = (e0 * inv_det, e1 * inv_det, e2 * inv_det);
+        let t = t_scaled * inv_det;
+        if !t.is_finite() {
+            return None;
+        }
+        // Make sure t is certainly positive given the rounding errors above (pbrt-v4 §6.8.7).
+        let max_zt = Vec3::new(p0t.z, p1t.z, p2t.z).abs().max_element();
+        let delta_z = gamma(3) * max_zt;
+        let max_xt = Vec3::new(p0t.x, p1t.x, p2t.x).abs().max_element();
+        let max_yt = Vec3::new(p0t.y, p1t.y, p2t.y).abs().max_element();
+        let delta_x = gamma(5) * (max_xt + max_zt);
+        let delta_y = gamma(5) * (max_yt + max_zt);
+        let delta_e = 2.0 * (gamma(2) * max_xt * max_yt + delta_y * max_xt + delta_x * max_yt);
+        let max_e = Vec3::new(e0, e1, e2).abs().max_element();
+        let delta_t =
+            3.0 * (gamma(3) * max_e * max_zt + delta_e * max_zt + delta_z * max_e) * inv_det.abs();
+        if t <= delta_t {
+            return None;
+        }
+        Some(TriangleHit { t, b0, b1, b2 })
     }
-    // Scaled hit distance, compared with t_max before dividing.
-    p0t.z *= sz;
-    p1t.z *= sz;
-    p2t.z *= sz;
-    let t_scaled = e0 * p0t.z + e1 * p1t.z + e2 * p2t.z;
-    if det < 0.0 && (t_scaled >= 0.0 || t_scaled < t_max * det) {
-        return None;
-    }
-    if det > 0.0 && (t_scaled <= 0.0 || t_scaled > t_max * det) {
-        return None;
-    }
-    let inv_det = 1.0 / det;
-    let (b0, b1, b2) = (e0 * inv_det, e1 * inv_det, e2 * inv_det);
-    let t = t_scaled * inv_det;
-    if !t.is_finite() {
-        return None;
-    }
-    // Make sure t is certainly positive given the rounding errors above (pbrt-v4 §6.8.7).
-    let max_zt = Vec3::new(p0t.z, p1t.z, p2t.z).abs().max_element();
-    let delta_z = gamma(3) * max_zt;
-    let max_xt = Vec3::new(p0t.x, p1t.x, p2t.x).abs().max_element();
-    let max_yt = Vec3::new(p0t.y, p1t.y, p2t.y).abs().max_element();
-    let delta_x = gamma(5) * (max_xt + max_zt);
-    let delta_y = gamma(5) * (max_yt + max_zt);
-    let delta_e = 2.0 * (gamma(2) * max_xt * max_yt + delta_y * max_xt + delta_x * max_yt);
-    let max_e = Vec3::new(e0, e1, e2).abs().max_element();
-    let delta_t =
-        3.0 * (gamma(3) * max_e * max_zt + delta_e * max_zt + delta_z * max_e) * inv_det.abs();
-    if t <= delta_t {
-        return None;
-    }
-    Some(TriangleHit { t, b0, b1, b2 })
 }
 
 #[cfg(test)]
@@ -129,43 +139,16 @@ mod tests {
     #[test]
     fn hits_inside_and_misses_outside() {
         let (p0, p1, p2) = (Vec3::ZERO, Vec3::X, Vec3::Y);
-        let hit = intersect_triangle(
-            Vec3::new(0.25, 0.25, 1.0),
-            -Vec3::Z,
-            f32::INFINITY,
-            p0,
-            p1,
-            p2,
-        )
-        .unwrap();
+        let down = WatertightRay::new(Vec3::new(0.25, 0.25, 1.0), -Vec3::Z);
+        let hit = down.intersect(f32::INFINITY, p0, p1, p2).unwrap();
         assert!((hit.t - 1.0).abs() < 1e-6);
         assert!((hit.b1 - 0.25).abs() < 1e-6 && (hit.b2 - 0.25).abs() < 1e-6);
-        assert!(
-            intersect_triangle(
-                Vec3::new(0.75, 0.75, 1.0),
-                -Vec3::Z,
-                f32::INFINITY,
-                p0,
-                p1,
-                p2
-            )
-            .is_none()
-        );
+        let outside = WatertightRay::new(Vec3::new(0.75, 0.75, 1.0), -Vec3::Z);
+        assert!(outside.intersect(f32::INFINITY, p0, p1, p2).is_none());
         // Behind the origin and beyond t_max.
-        assert!(
-            intersect_triangle(
-                Vec3::new(0.25, 0.25, 1.0),
-                Vec3::Z,
-                f32::INFINITY,
-                p0,
-                p1,
-                p2
-            )
-            .is_none()
-        );
-        assert!(
-            intersect_triangle(Vec3::new(0.25, 0.25, 1.0), -Vec3::Z, 0.5, p0, p1, p2).is_none()
-        );
+        let up = WatertightRay::new(Vec3::new(0.25, 0.25, 1.0), Vec3::Z);
+        assert!(up.intersect(f32::INFINITY, p0, p1, p2).is_none());
+        assert!(down.intersect(0.5, p0, p1, p2).is_none());
     }
 
     /// Rays through the shared edge of two triangles hit exactly one or both, never neither.
@@ -192,8 +175,9 @@ mod tests {
                 1.0 + rng.next_f32() * 3.0,
             );
             let d = target - o;
-            let ha = intersect_triangle(o, d, f32::INFINITY, a[0], a[1], a[2]);
-            let hb = intersect_triangle(o, d, f32::INFINITY, b[0], b[1], b[2]);
+            let ray = WatertightRay::new(o, d);
+            let ha = ray.intersect(f32::INFINITY, a[0], a[1], a[2]);
+            let hb = ray.intersect(f32::INFINITY, b[0], b[1], b[2]);
             assert!(
                 ha.is_some() || hb.is_some(),
                 "ray {o} -> {target} slipped through the edge"

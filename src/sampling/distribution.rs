@@ -213,6 +213,11 @@ struct AliasBin {
 }
 
 impl AliasTable {
+    /// Bytes of heap memory the table holds.
+    pub fn heap_bytes(&self) -> usize {
+        self.bins.capacity() * std::mem::size_of::<AliasBin>()
+    }
+
     /// A table for non-negative, finite weights that are not all zero; `None` otherwise.
     pub fn new(weights: &[f64]) -> Option<Self> {
         let total: f64 = weights.iter().sum();

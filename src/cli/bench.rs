@@ -1,0 +1,158 @@
+//! `prism bench`: the fixed benchmark suite (see [`crate::bench`]), printed as a table or as
+//! JSON lines.
+
+use std::path::PathBuf;
+use std::time::Duration;
+
+use clap::Args;
+
+use crate::bench::{BenchOptions, Measurement, measure, suite};
+use crate::error::{Error, Result};
+
+#[derive(Args, Debug)]
+pub struct BenchArgs {
+    /// Worker threads
+    #[arg(long, value_name = "T", default_value_t = 2)]
+    pub threads: usize,
+    /// Seconds of rendering per scene for the relMSE and efficiency figures
+    #[arg(long, value_name = "SECONDS", default_value_t = 10.0)]
+    pub seconds: f64,
+    /// Samples per pixel of the references (rendered once, on all cores, and cached)
+    #[arg(long, value_name = "N", default_value_t = 1024)]
+    pub reference_spp: u32,
+    /// Incoherent rays per pass of the traversal measurement
+    #[arg(long, value_name = "N", default_value_t = 1 << 20)]
+    pub rays: usize,
+    /// Only the scenes whose names contain this (repeatable)
+    #[arg(long, value_name = "NAME")]
+    pub only: Vec<String>,
+    /// The shared folder holding scenes/veach-mis and scenes/veach-bidir
+    #[arg(long, value_name = "DIR", default_value = "../shared")]
+    pub shared: PathBuf,
+    /// Where the generated scene and the references are kept
+    #[arg(long, value_name = "DIR", default_value = "target/prism-bench")]
+    pub cache: PathBuf,
+    /// Print one JSON object per scene instead of a table
+    #[arg(long)]
+    pub json: bool,
+    /// Only list the scenes: name, file and -D values, tab-separated (writes the generated
+    /// scene; tools/bench-vs-mitsuba reads this)
+    #[arg(long)]
+    pub list: bool,
+}
+
+pub fn run(args: &BenchArgs) -> Result<()> {
+    if args.threads == 0 {
+        return Err(Error::usage("--threads must be at least 1"));
+    }
+    if !(args.seconds > 0.0 && args.seconds <= 86_400.0) {
+        return Err(Error::usage(
+            "--seconds must be more than 0 and at most a day",
+        ));
+    }
+    if !(1..=1 << 20).contains(&args.reference_spp) || args.rays == 0 {
+        return Err(Error::usage(
+            "--reference-spp must be between 1 and 2^20, and --rays at least 1",
+        ));
+    }
+    let options = BenchOptions {
+        threads: args.threads,
+        budget: Duration::from_secs_f64(args.seconds),
+        reference_spp: args.reference_spp,
+        ray_count: args.rays,
+        cache: args.cache.clone(),
+    };
+    // The bundled scene, from the repository we are run in, else the one we were built from.
+    let repository = if std::path::Path::new("scenes/cornell-box/scene.xml").exists() {
+        PathBuf::from(".")
+    } else {
+        PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+    };
+    let scenes = suite(&repository, &args.shared, &args.cache)?;
+    let scenes: Vec<_> = scenes
+        .into_iter()
+        .filter(|s| args.only.is_empty() || args.only.iter().any(|o| s.name.contains(o)))
+        .collect();
+    if scenes.is_empty() {
+        return Err(Error::usage("--only matches none of the suite's scenes")
+            .with_help("the scenes are cornell-box, veach-mis, veach-bidir, million-triangles"));
+    }
+    if args.list {
+        for scene in &scenes {
+            let defines: Vec<String> = scene
+                .defines
+                .iter()
+                .map(|(name, value)| format!("{name}={value}"))
+                .collect();
+            println!(
+                "{}\t{}\t{}",
+                scene.name,
+                scene.path.display(),
+                defines.join(" ")
+            );
+        }
+        return Ok(());
+    }
+    if !args.json {
+        println!(
+            "{} threads, {} s per scene, references at {} spp",
+            args.threads, args.seconds, args.reference_spp
+        );
+        println!(
+            "{:<18} {:>10} {:>9} {:>8} {:>9} {:>10} {:>6} {:>10} {:>10}",
+            "scene",
+            "primitives",
+            "build s",
+            "B/prim",
+            "Mrays/s",
+            "Msamples/s",
+            "spp",
+            "relMSE",
+            "efficiency"
+        );
+    }
+    for scene in &scenes {
+        let m = measure(scene, &options)?;
+        if args.json {
+            println!("{}", json(&m, args.threads));
+        } else {
+            println!(
+                "{:<18} {:>10} {:>9.3} {:>8.1} {:>9.3} {:>10.3} {:>6} {:>10.3e} {:>10.1}",
+                m.scene,
+                m.primitives,
+                m.bvh_build_seconds,
+                m.bytes_per_primitive(),
+                m.rays_per_second / 1e6,
+                m.samples_per_second / 1e6,
+                m.spp,
+                m.rel_mse,
+                m.efficiency
+            );
+        }
+    }
+    Ok(())
+}
+
+/// One scene's measurement as a JSON object (on one line).
+fn json(m: &Measurement, threads: usize) -> String {
+    format!(
+        concat!(
+            "{{\"scene\":\"{}\",\"threads\":{},\"primitives\":{},\"bvh_build_seconds\":{:.6},",
+            "\"geometry_bytes\":{},\"bytes_per_primitive\":{:.2},\"rays_per_second\":{:.1},",
+            "\"samples_per_second\":{:.1},\"spp\":{},\"render_seconds\":{:.4},",
+            "\"rel_mse\":{:.6e},\"efficiency\":{:.4}}}"
+        ),
+        m.scene,
+        threads,
+        m.primitives,
+        m.bvh_build_seconds,
+        m.geometry_bytes,
+        m.bytes_per_primitive(),
+        m.rays_per_second,
+        m.samples_per_second,
+        m.spp,
+        m.render_seconds,
+        m.rel_mse,
+        m.efficiency
+    )
+}
