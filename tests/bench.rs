@@ -1,0 +1,130 @@
+//! `prism bench` and the measurements behind it: the JSON it prints is complete and
+//! self-consistent, geometry memory stays within the budget of 100 bytes per triangle
+//! (BVH included), and the traversal benchmark's rays are incoherent.
+
+use std::process::Command;
+
+use glam::Vec3;
+use prism::bench::rays::incoherent_rays;
+use prism::geometry::{Geometry, Shape, TriangleMesh};
+use prism::scene::mitsuba::load_scene;
+
+/// The number after `"key":` in a one-line JSON object.
+fn field(json: &str, key: &str) -> f64 {
+    let start = json
+        .find(&format!("\"{key}\":"))
+        .unwrap_or_else(|| panic!("no {key} in {json}"))
+        + key.len()
+        + 3;
+    let end = json[start..]
+        .find([',', '}'])
+        .map_or(json.len(), |e| start + e);
+    json[start..end].parse().unwrap()
+}
+
+#[test]
+fn bench_prints_one_consistent_json_object_per_scene() {
+    let cache = std::env::temp_dir().join(format!("prism-bench-test-{}", std::process::id()));
+    let output = Command::new(env!("CARGO_BIN_EXE_prism"))
+        .args(["bench", "--only", "cornell", "--seconds", "0.3"])
+        .args(["--reference-spp", "16", "--rays", "4096", "--json"])
+        .arg("--cache")
+        .arg(&cache)
+        .args(["--shared", "/nonexistent"])
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .unwrap();
+    let _ = std::fs::remove_dir_all(&cache);
+    assert!(output.status.success(), "{output:?}");
+    let stdout = String::from_utf8(output.stdout).unwrap();
+    let lines: Vec<&str> = stdout.lines().collect();
+    assert_eq!(lines.len(), 1, "{stdout}");
+    let json = lines[0];
+    assert!(json.contains("\"scene\":\"cornell-box\""), "{json}");
+    // The bundled box: eight meshes of 36 non-degenerate triangles in all.
+    assert_eq!(field(json, "primitives"), 36.0);
+    for key in [
+        "bvh_build_seconds",
+        "geometry_bytes",
+        "rays_per_second",
+        "samples_per_second",
+        "spp",
+        "render_seconds",
+    ] {
+        assert!(field(json, key) > 0.0, "{key} in {json}");
+    }
+    // A 256 x 256 render of a few samples per pixel against a 16-spp reference: the relative
+    // MSE is that of a noisy image, well inside (0, 1).
+    let rel_mse = field(json, "rel_mse");
+    assert!(rel_mse > 1e-4 && rel_mse < 1.0, "{json}");
+    let efficiency = 1.0 / (rel_mse * field(json, "render_seconds"));
+    assert!(
+        (field(json, "efficiency") / efficiency - 1.0).abs() < 1e-3,
+        "{json}"
+    );
+    let samples = 256.0 * 256.0 * field(json, "spp");
+    let rate = samples / field(json, "render_seconds");
+    assert!(
+        (field(json, "samples_per_second") / rate - 1.0).abs() < 1e-3,
+        "{json}"
+    );
+}
+
+#[test]
+fn geometry_memory_is_at_most_100_bytes_per_triangle() {
+    // A 250 x 200 grid of quads, 100,000 triangles, with shading normals and uvs.
+    let (nx, ny) = (250u32, 200u32);
+    let mut positions = Vec::new();
+    for j in 0..=ny {
+        for i in 0..=nx {
+            let (x, y) = (i as f32 / nx as f32, j as f32 / ny as f32);
+            positions.push(Vec3::new(x, y, 0.1 * (7.0 * x).sin() * (5.0 * y).cos()));
+        }
+    }
+    let normals = vec![Vec3::Z; positions.len()];
+    let uvs = positions.iter().map(|p| p.truncate()).collect();
+    let at = |i: u32, j: u32| j * (nx + 1) + i;
+    let mut triangles = Vec::new();
+    for j in 0..ny {
+        for i in 0..nx {
+            triangles.push([at(i, j), at(i + 1, j), at(i + 1, j + 1)]);
+            triangles.push([at(i, j), at(i + 1, j + 1), at(i, j + 1)]);
+        }
+    }
+    let count = triangles.len();
+    let mesh = TriangleMesh::new(positions, Some(normals), Some(uvs), triangles, false);
+    let geometry = Geometry::new(vec![Shape::Mesh(mesh)]);
+    assert_eq!(geometry.primitive_count(), count);
+    let per_triangle = geometry.memory_bytes() as f64 / count as f64;
+    // At least the triangles' own data (three 12-byte vertices in the leaves, indices) ...
+    assert!(per_triangle > 48.0, "{per_triangle} bytes per triangle");
+    // ... and at most the budget of the performance issue.
+    assert!(per_triangle <= 100.0, "{per_triangle} bytes per triangle");
+}
+
+#[test]
+fn benchmark_rays_leave_surfaces_in_all_directions() {
+    let scene_path = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/cornell-box/scene.xml");
+    let defines = [
+        ("resx".to_string(), "64".to_string()),
+        ("resy".to_string(), "64".to_string()),
+    ];
+    let scene = load_scene(std::path::Path::new(scene_path), &defines)
+        .unwrap()
+        .scene;
+    let n = 20_000;
+    let rays = incoherent_rays(&scene, n, 3);
+    assert_eq!(rays.len(), n);
+    assert_eq!(rays, incoherent_rays(&scene, n, 3), "seeded");
+    let (lo, hi) = scene.geometry.bounds().unwrap();
+    let slack = 1e-3 * (hi - lo).length();
+    let mut mean = Vec3::ZERO;
+    for ray in &rays {
+        assert!(ray.o.cmpge(lo - slack).all() && ray.o.cmple(hi + slack).all());
+        mean += ray.d.normalize() / n as f32;
+    }
+    // Uniform on the sphere: each component of the mean direction is 0 with a standard error
+    // of 1/sqrt(3n).
+    let standard_error = 1.0 / (3.0 * n as f32).sqrt();
+    assert!(mean.abs().max_element() < 4.0 * standard_error, "{mean}");
+}
