@@ -26,6 +26,7 @@
 //! | [`integrator`] | the path tracer |
 //! | [`render`] | tiles, threads, progress |
 //! | [`scene`] | the scene, mesh readers, the Mitsuba XML reader and plugin factory |
+//! | [`bench`] | the benchmark suite of `prism bench`: its scenes, rays and measurements |
 //! | [`error`] | errors with source locations |
 
 // Comparisons are written `!(x > 0.0)` on purpose throughout: unlike `x <= 0.0` they also
