@@ -294,6 +294,32 @@ fn unknown_define_and_bad_arguments() {
     assert_eq!(status, 2);
 }
 
+/// `--accel embree` renders in a build with the feature `embree` and otherwise says how to get
+/// one; an unknown name is refused.
+#[test]
+fn accel_embree_needs_the_feature() {
+    let dir = folder("accel");
+    write(
+        &dir,
+        "scene.xml",
+        &scene("    <shape type=\"sphere\"/>", ""),
+    );
+    let (status, stderr) = render(&dir, &["--accel", "embree"]);
+    if cfg!(feature = "embree") {
+        assert_eq!(status, 0, "{stderr}");
+        assert!(stderr.contains("traced by Embree"), "{stderr}");
+    } else {
+        assert_eq!(status, 2, "{stderr}");
+        assert!(
+            stderr.contains("--features embree") && stderr.contains("tools/install-embree"),
+            "{stderr}"
+        );
+    }
+    let (status, stderr) = render(&dir, &["--accel", "kd-tree"]);
+    assert_eq!(status, 2, "{stderr}");
+    assert!(stderr.contains("bvh or embree"), "{stderr}");
+}
+
 #[test]
 fn missing_scene_file() {
     let dir = folder("missing-scene");

@@ -95,8 +95,11 @@ pub struct Measurement {
     pub bvh_build_seconds: f64,
     /// Shapes plus BVH, from [`Geometry::memory_bytes`].
     pub geometry_bytes: usize,
-    /// Closest-hit queries per second on incoherent rays ([`rays::incoherent_rays`]).
+    /// Closest-hit queries per second on incoherent rays ([`rays::incoherent_rays`]), without
+    /// building surface interactions.
     pub rays_per_second: f64,
+    /// The same with Embree on the same rays (builds with the cargo feature `embree` only).
+    pub embree_rays_per_second: Option<f64>,
     pub samples_per_second: f64,
     /// Samples per pixel rendered in the budget.
     pub spp: u32,
@@ -190,9 +193,27 @@ pub fn measure(bench: &BenchScene, options: &BenchOptions) -> Result<Measurement
     drop(rebuilt);
 
     let rays = rays::incoherent_rays(&scene, options.ray_count, 1);
-    let (rays_per_second, _) = trace_rate(options.threads, &rays, |ray| {
-        scene.geometry.intersect(ray).is_some()
+    let (rays_per_second, hits) = trace_rate(options.threads, &rays, |ray| {
+        scene.geometry.closest_hit(ray).is_some()
     })?;
+    let embree_rays_per_second = if cfg!(feature = "embree") {
+        let mut embree = scene.geometry.clone();
+        embree.set_accel(crate::geometry::accel::Accel::Embree)?;
+        let (rate, embree_hits) = trace_rate(options.threads, &rays, |ray| {
+            embree.closest_hit(ray).is_some()
+        })?;
+        // The two structures must agree, or the comparison means nothing (a ray grazing an
+        // edge may rarely go either way).
+        if embree_hits.abs_diff(hits) > rays.len() / 10_000 {
+            return Err(Error::usage(format!(
+                "Embree hit {embree_hits} of the {} rays and our BVH {hits}",
+                rays.len()
+            )));
+        }
+        Some(rate)
+    } else {
+        None
+    };
 
     let reference = reference(&scene, bench, options)?;
     // One sample per pixel says how long a sample takes; the measured render then fills the
@@ -209,6 +230,7 @@ pub fn measure(bench: &BenchScene, options: &BenchOptions) -> Result<Measurement
         bvh_build_seconds,
         geometry_bytes,
         rays_per_second,
+        embree_rays_per_second,
         samples_per_second: output.sample_count as f64 / render_seconds,
         spp,
         render_seconds,

@@ -128,6 +128,14 @@ pub fn run(args: &BenchArgs) -> Result<()> {
                 m.rel_mse,
                 m.efficiency
             );
+            if let Some(rate) = m.embree_rays_per_second {
+                println!(
+                    "{:<18} Embree {:.3} Mrays/s on the same rays: ours are {:.2}x",
+                    "",
+                    rate / 1e6,
+                    m.rays_per_second / rate
+                );
+            }
         }
     }
     Ok(())
@@ -140,7 +148,7 @@ fn json(m: &Measurement, threads: usize) -> String {
             "{{\"scene\":\"{}\",\"threads\":{},\"primitives\":{},\"bvh_build_seconds\":{:.6},",
             "\"geometry_bytes\":{},\"bytes_per_primitive\":{:.2},\"rays_per_second\":{:.1},",
             "\"samples_per_second\":{:.1},\"spp\":{},\"render_seconds\":{:.4},",
-            "\"rel_mse\":{:.6e},\"efficiency\":{:.4}}}"
+            "\"rel_mse\":{:.6e},\"efficiency\":{:.4},\"embree_rays_per_second\":{}}}"
         ),
         m.scene,
         threads,
@@ -153,6 +161,8 @@ fn json(m: &Measurement, threads: usize) -> String {
         m.spp,
         m.render_seconds,
         m.rel_mse,
-        m.efficiency
+        m.efficiency,
+        m.embree_rays_per_second
+            .map_or("null".to_string(), |r| format!("{r:.1}"))
     )
 }

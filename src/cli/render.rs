@@ -20,6 +20,7 @@ use glam::UVec2;
 use crate::error::{Error, Result};
 use crate::film::output::{ChannelImage, write_exr, write_png_srgb};
 use crate::film::{CropWindow, Film, FilterSampler, PixelSums};
+use crate::geometry::Accel;
 use crate::integrator::RayCount;
 use crate::render::state::{RenderIdentity, RenderState};
 use crate::render::stats::{pixel_relative_error, variance_of_mean};
@@ -77,6 +78,10 @@ pub struct RenderArgs {
     /// Render only pixel x,y and print every sample's value (to find the source of NaNs)
     #[arg(long, value_name = "X,Y", value_parser = parse_pixel)]
     pub pixel: Option<[u32; 2]>,
+    /// Trace rays with our BVH (bvh) or, for comparison, with Embree (embree; needs a build
+    /// with `--features embree`)
+    #[arg(long, value_name = "ACCEL", default_value = "bvh")]
+    pub accel: Accel,
 }
 
 pub(crate) fn parse_define(text: &str) -> Result<(String, String), String> {
@@ -240,8 +245,10 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             "--checkpoint-every must be a positive number of seconds",
         ));
     }
+    args.accel.check_available()?;
     let loaded = load_scene(&args.scene, &args.defines)?;
     let mut scene = loaded.scene;
+    scene.geometry.set_accel(args.accel)?;
     let crop = match (args.crop, args.pixel) {
         (Some(_), Some(_)) => return Err(Error::usage("give either --crop or --pixel, not both")),
         (Some([x0, y0, x1, y1]), None) => Some([x0, y0, x1, y1]),
@@ -431,11 +438,15 @@ fn report(
         StopReason::Interrupted => ", interrupted",
     };
     eprintln!(
-        "prism: rendered {} ({}×{}, {} spp{stopped}) in {:.2} s: {:.3} M samples/s, {:.2} M rays/s, mean relative error {:.4} -> {}, {}",
+        "prism: rendered {} ({}×{}, {} spp{stopped}{}) in {:.2} s: {:.3} M samples/s, {:.2} M rays/s, mean relative error {:.4} -> {}, {}",
         args.scene.display(),
         scene.film.crop.size.x,
         scene.film.crop.size.y,
         output.film.pixels.first().map_or(0, |p| p.samples),
+        match scene.geometry.accel() {
+            Accel::Bvh => "",
+            Accel::Embree => ", traced by Embree",
+        },
         seconds,
         output.sample_count as f64 / seconds / 1e6,
         output.rays as f64 / seconds / 1e6,

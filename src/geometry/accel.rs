@@ -1,4 +1,5 @@
-//! Ray queries against all shapes of a scene through a compressed 8-wide BVH.
+//! Ray queries against all shapes of a scene through a compressed 8-wide BVH, or through Embree
+//! for comparison (cargo feature `embree`, see [`super::embree`]).
 //!
 //! The hierarchy is built by the `obvhs` crate: PLOC clustering (Meister & Bittner 2018) refined
 //! by parallel reinsertion under the SAH cost (Meister & Bittner 2017), then collapsed into the
@@ -7,7 +8,8 @@
 //! analytic shapes (spheres, disks) and moving shapes (with their own hierarchy, see
 //! [`super::instance`]) are single primitives.
 
-use std::time::Duration;
+use std::str::FromStr;
+use std::time::{Duration, Instant};
 
 use glam::Vec3;
 use obvhs::BvhBuildParams;
@@ -18,7 +20,74 @@ use obvhs::cwbvh::builder::build_cwbvh;
 use super::interaction::SurfaceInteraction;
 use super::shape::Shape;
 use super::triangle::{TriangleHit, WatertightRay};
+use crate::error::Result;
 use crate::math::Ray;
+
+/// Which structure answers the ray queries.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Accel {
+    /// Our compressed wide BVH.
+    #[default]
+    Bvh,
+    /// Embree 3's BVH (only in builds with the cargo feature `embree`).
+    Embree,
+}
+
+impl Accel {
+    /// Whether this build can use the structure: Embree needs the cargo feature `embree`.
+    pub fn check_available(self) -> Result<()> {
+        if self == Accel::Embree && !cfg!(feature = "embree") {
+            return Err(crate::error::Error::usage(
+                "this prism was built without Embree, so --accel embree is not available",
+            )
+            .with_help(
+                "run tools/install-embree, then rebuild with `cargo build --release --features embree`",
+            ));
+        }
+        Ok(())
+    }
+}
+
+impl FromStr for Accel {
+    type Err = String;
+
+    fn from_str(text: &str) -> std::result::Result<Accel, String> {
+        match text {
+            "bvh" => Ok(Accel::Bvh),
+            "embree" => Ok(Accel::Embree),
+            _ => Err(format!(
+                "unknown acceleration structure \"{text}\": expected bvh or embree"
+            )),
+        }
+    }
+}
+
+/// The closest hit along a ray, before its surface interaction is built.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Hit {
+    /// Index into [`Geometry::shapes`].
+    pub shape: u32,
+    /// Index of the triangle in its mesh; 0 for analytic shapes.
+    pub primitive: u32,
+    /// The ray parameter, and for triangles the barycentric coordinates of the point (zero for
+    /// analytic shapes).
+    pub triangle: TriangleHit,
+}
+
+/// How many of a batch of rays hit something, and how long tracing them took.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TraceReport {
+    pub rays: usize,
+    pub hits: usize,
+    pub elapsed: Duration,
+}
+
+impl TraceReport {
+    /// Rays traced per second.
+    pub fn rays_per_second(&self) -> f64 {
+        self.rays as f64 / self.elapsed.as_secs_f64().max(1e-9)
+    }
+}
 
 /// A BVH primitive: one triangle, or a whole analytic shape.
 #[derive(Clone, Copy, Debug)]
@@ -40,6 +109,9 @@ pub struct Geometry {
     bvh: Option<CwBvh>,
     /// Primitives in BVH leaf order (`bvh.primitive_indices` applied).
     primitives: Vec<Primitive>,
+    /// The same shapes in Embree, which then answers the queries instead of `bvh`.
+    #[cfg(feature = "embree")]
+    embree: Option<super::embree::EmbreeScene>,
 }
 
 fn to_obvhs(v: Vec3) -> glam::Vec3A {
@@ -83,6 +155,8 @@ impl Geometry {
                 shapes,
                 bvh: None,
                 primitives,
+                #[cfg(feature = "embree")]
+                embree: None,
             };
         }
         let bvh = build_cwbvh(
@@ -104,7 +178,34 @@ impl Geometry {
             shapes,
             bvh: Some(bvh),
             primitives,
+            #[cfg(feature = "embree")]
+            embree: None,
         }
+    }
+
+    /// Chooses the structure that answers the queries; Embree's is built here (the BVH is kept,
+    /// so that both can be compared on the same geometry). Moving shapes keep their own BVH
+    /// either way. Without the cargo feature `embree`, asking for Embree is an error.
+    pub fn set_accel(&mut self, accel: Accel) -> Result<()> {
+        accel.check_available()?;
+        #[cfg(feature = "embree")]
+        match accel {
+            Accel::Bvh => self.embree = None,
+            Accel::Embree if self.embree.is_none() => {
+                self.embree = Some(super::embree::EmbreeScene::new(&self.shapes)?);
+            }
+            Accel::Embree => {}
+        }
+        Ok(())
+    }
+
+    /// The structure that answers the queries.
+    pub fn accel(&self) -> Accel {
+        #[cfg(feature = "embree")]
+        if self.embree.is_some() {
+            return Accel::Embree;
+        }
+        Accel::Bvh
     }
 
     /// The number of BVH primitives (triangles plus analytic shapes).
@@ -146,17 +247,16 @@ impl Geometry {
         obvhs::ray::Ray::new(to_obvhs(ray.o), to_obvhs(ray.d), 0.0, ray.t_max)
     }
 
-    fn hit_analytic(&self, shape: u32, ray: &Ray, t_max: f32) -> Option<f32> {
-        match &self.shapes[shape as usize] {
-            Shape::Sphere(sphere) => sphere.intersect(ray.o, ray.d, t_max),
-            Shape::Disk(disk) => disk.intersect(ray.o, ray.d, t_max),
-            Shape::Instance(instance) => instance.intersect(ray, t_max),
-            Shape::Mesh(_) => None,
+    /// The closest hit in (0, t_max), found by the chosen structure.
+    pub fn closest_hit(&self, ray: &Ray) -> Option<Hit> {
+        #[cfg(feature = "embree")]
+        if let Some(embree) = &self.embree {
+            return embree.closest_hit(&self.shapes, ray);
         }
+        self.bvh_closest_hit(ray)
     }
 
-    /// The closest surface the ray meets in (0, t_max).
-    pub fn intersect(&self, ray: &Ray) -> Option<SurfaceInteraction> {
+    fn bvh_closest_hit(&self, ray: &Ray) -> Option<Hit> {
         let bvh = self.bvh.as_ref()?;
         let mut closest: Option<(usize, TriangleHit)> = None;
         let mut hit = obvhs::ray::RayHit::none();
@@ -167,14 +267,14 @@ impl Geometry {
                 Primitive::Triangle { vertices, .. } => {
                     watertight.intersect(t_max, vertices[0], vertices[1], vertices[2])
                 }
-                Primitive::Analytic { shape } => {
-                    self.hit_analytic(*shape, ray, t_max).map(|t| TriangleHit {
+                Primitive::Analytic { shape } => self.shapes[*shape as usize]
+                    .intersect_analytic(ray, t_max)
+                    .map(|t| TriangleHit {
                         t,
                         b0: 0.0,
                         b1: 0.0,
                         b2: 0.0,
-                    })
-                }
+                    }),
             };
             match found {
                 Some(h) if h.t < t_max => {
@@ -184,19 +284,28 @@ impl Geometry {
                 _ => f32::INFINITY,
             }
         });
-        let (id, h) = closest?;
-        let mut si = match self.primitives[id] {
-            Primitive::Triangle { shape, index, .. } => match &self.shapes[shape as usize] {
-                Shape::Mesh(mesh) => mesh.interaction(index as usize, &h, shape),
-                _ => unreachable!("triangle primitives belong to meshes"),
-            },
-            Primitive::Analytic { shape } => match &self.shapes[shape as usize] {
-                Shape::Sphere(sphere) => sphere.interaction(ray.o, ray.d, h.t, shape),
-                Shape::Disk(disk) => disk.interaction(ray.o, ray.d, h.t, shape),
-                // The same query again, now keeping the object's interaction.
-                Shape::Instance(instance) => instance.interaction(ray, ray.t_max, shape)?,
-                Shape::Mesh(_) => unreachable!("meshes are made of triangle primitives"),
-            },
+        let (id, triangle) = closest?;
+        let (shape, primitive) = match self.primitives[id] {
+            Primitive::Triangle { shape, index, .. } => (shape, index),
+            Primitive::Analytic { shape } => (shape, 0),
+        };
+        Some(Hit {
+            shape,
+            primitive,
+            triangle,
+        })
+    }
+
+    /// The closest surface the ray meets in (0, t_max).
+    pub fn intersect(&self, ray: &Ray) -> Option<SurfaceInteraction> {
+        let hit = self.closest_hit(ray)?;
+        let shape = hit.shape;
+        let mut si = match &self.shapes[shape as usize] {
+            Shape::Mesh(mesh) => mesh.interaction(hit.primitive as usize, &hit.triangle, shape),
+            Shape::Sphere(sphere) => sphere.interaction(ray.o, ray.d, hit.triangle.t, shape),
+            Shape::Disk(disk) => disk.interaction(ray.o, ray.d, hit.triangle.t, shape),
+            // The same query again, now keeping the object's interaction.
+            Shape::Instance(instance) => instance.interaction(ray, ray.t_max, shape)?,
         };
         si.time = ray.time;
         Some(si)
@@ -204,6 +313,10 @@ impl Geometry {
 
     /// Whether anything blocks the ray in (0, t_max).
     pub fn occluded(&self, ray: &Ray) -> bool {
+        #[cfg(feature = "embree")]
+        if let Some(embree) = &self.embree {
+            return embree.occluded(&self.shapes, ray);
+        }
         let Some(bvh) = self.bvh.as_ref() else {
             return false;
         };
@@ -214,9 +327,27 @@ impl Geometry {
                 Primitive::Triangle { vertices, .. } => watertight
                     .intersect(t_max, vertices[0], vertices[1], vertices[2])
                     .map(|h| h.t),
-                Primitive::Analytic { shape } => self.hit_analytic(*shape, ray, t_max),
+                Primitive::Analytic { shape } => {
+                    self.shapes[*shape as usize].intersect_analytic(ray, t_max)
+                }
             };
             t.unwrap_or(f32::INFINITY)
         })
+    }
+
+    /// Finds the closest hit of every ray, one after the other on the calling thread, with the
+    /// chosen structure: the measure of ray throughput for comparing our BVH with Embree on
+    /// the same rays (surface interactions are not built, as Embree does not build them).
+    pub fn trace(&self, rays: &[Ray]) -> TraceReport {
+        let start = Instant::now();
+        let hits = rays
+            .iter()
+            .filter(|ray| self.closest_hit(ray).is_some())
+            .count();
+        TraceReport {
+            rays: rays.len(),
+            hits,
+            elapsed: start.elapsed(),
+        }
     }
 }

@@ -57,7 +57,7 @@ impl Instance {
             t_max,
             ..self.local_ray(ray)
         };
-        self.object.intersect(&local).map(|si| si.t)
+        self.object.closest_hit(&local).map(|hit| hit.triangle.t)
     }
 
     pub fn occluded(&self, ray: &Ray) -> bool {

@@ -3,6 +3,8 @@
 
 pub mod accel;
 pub mod disk;
+#[cfg(feature = "embree")]
+pub mod embree;
 pub mod instance;
 pub mod interaction;
 pub mod mesh;
@@ -11,7 +13,7 @@ pub mod shape;
 pub mod sphere;
 pub mod triangle;
 
-pub use accel::Geometry;
+pub use accel::{Accel, Geometry, Hit, TraceReport};
 pub use interaction::SurfaceInteraction;
 pub use mesh::{SurfaceSample, TriangleMesh};
 pub use shape::Shape;

@@ -6,6 +6,7 @@ use super::disk::Disk;
 use super::instance::Instance;
 use super::mesh::{SurfaceSample, TriangleMesh};
 use super::sphere::{Sphere, area_to_solid_angle};
+use crate::math::Ray;
 
 /// A shape of the scene.
 #[derive(Clone, Debug)]
@@ -43,6 +44,17 @@ impl Shape {
                     |(lo, hi), p| (lo.min(p), hi.max(p)),
                 ),
             Shape::Instance(instance) => instance.swept_bounds,
+        }
+    }
+
+    /// Distance to the nearest hit in (0, t_max) of an analytic shape (sphere, disk, moving
+    /// shape); None for meshes, whose triangles are intersected one by one by the hierarchy.
+    pub fn intersect_analytic(&self, ray: &Ray, t_max: f32) -> Option<f32> {
+        match self {
+            Shape::Sphere(sphere) => sphere.intersect(ray.o, ray.d, t_max),
+            Shape::Disk(disk) => disk.intersect(ray.o, ray.d, t_max),
+            Shape::Instance(instance) => instance.intersect(ray, t_max),
+            Shape::Mesh(_) => None,
         }
     }
 
