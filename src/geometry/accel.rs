@@ -9,7 +9,7 @@
 //! [`super::instance`]) are single primitives.
 
 use std::str::FromStr;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use glam::Vec3;
 use obvhs::BvhBuildParams;
@@ -72,21 +72,6 @@ pub struct Hit {
     /// The ray parameter, and for triangles the barycentric coordinates of the point (zero for
     /// analytic shapes).
     pub triangle: TriangleHit,
-}
-
-/// How many of a batch of rays hit something, and how long tracing them took.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct TraceReport {
-    pub rays: usize,
-    pub hits: usize,
-    pub elapsed: Duration,
-}
-
-impl TraceReport {
-    /// Rays traced per second.
-    pub fn rays_per_second(&self) -> f64 {
-        self.rays as f64 / self.elapsed.as_secs_f64().max(1e-9)
-    }
 }
 
 /// A BVH primitive: one triangle, or a whole analytic shape.
@@ -333,21 +318,5 @@ impl Geometry {
             };
             t.unwrap_or(f32::INFINITY)
         })
-    }
-
-    /// Finds the closest hit of every ray, one after the other on the calling thread, with the
-    /// chosen structure: the measure of ray throughput for comparing our BVH with Embree on
-    /// the same rays (surface interactions are not built, as Embree does not build them).
-    pub fn trace(&self, rays: &[Ray]) -> TraceReport {
-        let start = Instant::now();
-        let hits = rays
-            .iter()
-            .filter(|ray| self.closest_hit(ray).is_some())
-            .count();
-        TraceReport {
-            rays: rays.len(),
-            hits,
-            elapsed: start.elapsed(),
-        }
     }
 }

@@ -13,7 +13,7 @@ pub mod shape;
 pub mod sphere;
 pub mod triangle;
 
-pub use accel::{Accel, Geometry, Hit, TraceReport};
+pub use accel::{Accel, Geometry, Hit};
 pub use interaction::SurfaceInteraction;
 pub use mesh::{SurfaceSample, TriangleMesh};
 pub use shape::Shape;

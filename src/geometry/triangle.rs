@@ -3,9 +3,11 @@
 //!
 //! The triangle is translated to the ray origin, the axes permuted so the ray's dominant axis is
 //! z, and sheared so the ray points along +z; the 2-D edge functions of the projected vertices
-//! then decide the hit with no gaps or double hits along shared edges. The edge functions are
-//! evaluated in double precision and rounded once, so their signs are exact whenever they are not
-//! tiny (Woop et al. fall back to double precision only for exact zeros).
+//! then decide the hit with no gaps or double hits along shared edges: two triangles sharing an
+//! edge compute its edge function from the same rounded products with opposite signs, so a ray
+//! is never outside both. Only where an edge function is exactly zero (the ray passes through
+//! the edge or a vertex at float precision) are the three evaluated again in double precision,
+//! as Woop et al. (§3.4) and pbrt-v4 do, so that the tie is broken the same way by both sides.
 
 use glam::Vec3;
 
@@ -28,7 +30,7 @@ fn gamma(n: i32) -> f32 {
 
 /// a·b − c·d with a single rounding: the products of two f32 are exact in f64.
 #[inline]
-fn difference_of_products(a: f32, b: f32, c: f32, d: f32) -> f32 {
+fn difference_of_products_f64(a: f32, b: f32, c: f32, d: f32) -> f32 {
     (f64::from(a) * f64::from(b) - f64::from(c) * f64::from(d)) as f32
 }
 
@@ -86,9 +88,14 @@ impl WatertightRay {
         p1t.y += sy * p1t.z;
         p2t.x += sx * p2t.z;
         p2t.y += sy * p2t.z;
-        let e0 = difference_of_products(p1t.x, p2t.y, p1t.y, p2t.x);
-        let e1 = difference_of_products(p2t.x, p0t.y, p2t.y, p0t.x);
-        let e2 = difference_of_products(p0t.x, p1t.y, p0t.y, p1t.x);
+        let mut e0 = p1t.x * p2t.y - p1t.y * p2t.x;
+        let mut e1 = p2t.x * p0t.y - p2t.y * p0t.x;
+        let mut e2 = p0t.x * p1t.y - p0t.y * p1t.x;
+        if e0 == 0.0 || e1 == 0.0 || e2 == 0.0 {
+            e0 = difference_of_products_f64(p1t.x, p2t.y, p1t.y, p2t.x);
+            e1 = difference_of_products_f64(p2t.x, p0t.y, p2t.y, p0t.x);
+            e2 = difference_of_products_f64(p0t.x, p1t.y, p0t.y, p1t.x);
+        }
         if (e0 < 0.0 || e1 < 0.0 || e2 < 0.0) && (e0 > 0.0 || e1 > 0.0 || e2 > 0.0) {
             return None;
         }
