@@ -488,3 +488,32 @@ fn compare_refuses_other_sizes_and_corrupt_files() {
     assert_eq!(status, 2, "{text}");
     assert!(text.contains("reference"), "{text}");
 }
+
+#[test]
+fn bench_refuses_impossible_settings() {
+    for (args, says) in [
+        (&["--threads", "0"][..], "--threads must be at least 1"),
+        (&["--seconds=0"][..], "--seconds must be more than 0"),
+        (&["--seconds=nan"][..], "--seconds must be more than 0"),
+        (
+            &["--reference-spp", "0"][..],
+            "--reference-spp must be between",
+        ),
+        (&["--rays", "0"][..], "--rays at least 1"),
+        (
+            &["--only", "no-such-scene"][..],
+            "matches none of the suite's scenes",
+        ),
+    ] {
+        let cache = folder(&format!("bench-{}", args.join("").replace(['-', '='], "")));
+        let mut all = vec!["bench", "--shared", "/nonexistent", "--cache"];
+        all.push(cache.to_str().unwrap());
+        all.extend_from_slice(args);
+        let (status, text) = prism(&all);
+        assert_eq!(status, 2, "{args:?}: {text}");
+        assert!(
+            text.contains(says) && !text.contains("panicked"),
+            "{args:?}: {text}"
+        );
+    }
+}

@@ -35,20 +35,32 @@ pub struct BenchScene {
 /// The fixed suite: the bundled Cornell box (256 × 256), Veach's MIS and bidirectional scenes
 /// from `shared` (at 320 × 180 and 256 × 256, a twentieth and a sixteenth of their pixels, so
 /// that references take minutes), and the generated million-triangle scene (256 × 256), written
-/// into `cache` on first use. Scenes missing from `shared` are left out with a warning.
-pub fn suite(repository: &Path, shared: &Path, cache: &Path) -> Result<Vec<BenchScene>> {
+/// into `cache` on first use. Only the scenes `wanted` accepts are set up; scenes missing from
+/// `shared` are left out with a warning.
+pub fn suite(
+    repository: &Path,
+    shared: &Path,
+    cache: &Path,
+    wanted: impl Fn(&str) -> bool,
+) -> Result<Vec<BenchScene>> {
     let resolution = |x: u32, y: u32| {
         vec![
             ("resx".to_string(), x.to_string()),
             ("resy".to_string(), y.to_string()),
         ]
     };
-    let mut scenes = vec![BenchScene {
-        name: "cornell-box",
-        path: repository.join("scenes/cornell-box/scene.xml"),
-        defines: resolution(256, 256),
-    }];
+    let mut scenes = Vec::new();
+    if wanted("cornell-box") {
+        scenes.push(BenchScene {
+            name: "cornell-box",
+            path: repository.join("scenes/cornell-box/scene.xml"),
+            defines: resolution(256, 256),
+        });
+    }
     for (name, x, y) in [("veach-mis", 320, 180), ("veach-bidir", 256, 256)] {
+        if !wanted(name) {
+            continue;
+        }
         let path = shared.join("scenes").join(name).join("scene.xml");
         if path.exists() {
             scenes.push(BenchScene {
@@ -63,11 +75,13 @@ pub fn suite(repository: &Path, shared: &Path, cache: &Path) -> Result<Vec<Bench
             );
         }
     }
-    scenes.push(BenchScene {
-        name: "million-triangles",
-        path: generated::write_million_triangle_scene(cache)?,
-        defines: resolution(256, 256),
-    });
+    if wanted("million-triangles") {
+        scenes.push(BenchScene {
+            name: "million-triangles",
+            path: generated::write_million_triangle_scene(cache)?,
+            defines: resolution(256, 256),
+        });
+    }
     Ok(scenes)
 }
 
@@ -172,6 +186,8 @@ fn reference(
             scene,
             &RenderOptions::fixed(options.reference_spp, seed, Some(threads)),
         )?;
+        std::fs::create_dir_all(&options.cache)
+            .map_err(|e| Error::io(&options.cache, &e, "create the directory"))?;
         let partial = path.with_extension("partial.exr");
         write_images(&output.film, &partial, &path.with_extension("png"))?;
         std::fs::rename(&partial, &path).map_err(|e| Error::io(&path, &e, "write"))?;

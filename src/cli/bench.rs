@@ -68,11 +68,9 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     } else {
         PathBuf::from(env!("CARGO_MANIFEST_DIR"))
     };
-    let scenes = suite(&repository, &args.shared, &args.cache)?;
-    let scenes: Vec<_> = scenes
-        .into_iter()
-        .filter(|s| args.only.is_empty() || args.only.iter().any(|o| s.name.contains(o)))
-        .collect();
+    let scenes = suite(&repository, &args.shared, &args.cache, |name| {
+        args.only.is_empty() || args.only.iter().any(|o| name.contains(o.as_str()))
+    })?;
     if scenes.is_empty() {
         return Err(Error::usage("--only matches none of the suite's scenes")
             .with_help("the scenes are cornell-box, veach-mis, veach-bidir, million-triangles"));
