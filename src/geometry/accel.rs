@@ -92,7 +92,7 @@ enum Primitive {
 pub struct Geometry {
     pub shapes: Vec<Shape>,
     bvh: Option<CwBvh>,
-    /// Primitives in BVH leaf order (`bvh.primitive_indices` applied).
+    /// Primitives in BVH leaf order (the builder's index map applied, then dropped).
     primitives: Vec<Primitive>,
     /// The same shapes in Embree, which then answers the queries instead of `bvh`.
     #[cfg(feature = "embree")]
@@ -232,6 +232,31 @@ impl Geometry {
         obvhs::ray::Ray::new(to_obvhs(ray.o), to_obvhs(ray.d), 0.0, ray.t_max)
     }
 
+    /// The hit of the ray with leaf primitive `id` in (0, t_max); barycentrics are zero for
+    /// analytic shapes.
+    #[inline]
+    fn hit_primitive(
+        &self,
+        id: usize,
+        ray: &Ray,
+        watertight: &WatertightRay,
+        t_max: f32,
+    ) -> Option<TriangleHit> {
+        match &self.primitives[id] {
+            Primitive::Triangle { vertices, .. } => {
+                watertight.intersect(t_max, vertices[0], vertices[1], vertices[2])
+            }
+            Primitive::Analytic { shape } => self.shapes[*shape as usize]
+                .intersect_analytic(ray, t_max)
+                .map(|t| TriangleHit {
+                    t,
+                    b0: 0.0,
+                    b1: 0.0,
+                    b2: 0.0,
+                }),
+        }
+    }
+
     /// The closest hit in (0, t_max), found by the chosen structure.
     pub fn closest_hit(&self, ray: &Ray) -> Option<Hit> {
         #[cfg(feature = "embree")]
@@ -248,20 +273,7 @@ impl Geometry {
         let watertight = WatertightRay::new(ray.o, ray.d);
         bvh.ray_traverse(Self::bvh_ray(ray), &mut hit, |bvh_ray, id| {
             let t_max = bvh_ray.tmax;
-            let found = match &self.primitives[id] {
-                Primitive::Triangle { vertices, .. } => {
-                    watertight.intersect(t_max, vertices[0], vertices[1], vertices[2])
-                }
-                Primitive::Analytic { shape } => self.shapes[*shape as usize]
-                    .intersect_analytic(ray, t_max)
-                    .map(|t| TriangleHit {
-                        t,
-                        b0: 0.0,
-                        b1: 0.0,
-                        b2: 0.0,
-                    }),
-            };
-            match found {
+            match self.hit_primitive(id, ray, &watertight, t_max) {
                 Some(h) if h.t < t_max => {
                     closest = Some((id, h));
                     h.t
@@ -307,16 +319,8 @@ impl Geometry {
         };
         let watertight = WatertightRay::new(ray.o, ray.d);
         !bvh.ray_traverse_miss(Self::bvh_ray(ray), |bvh_ray, id| {
-            let t_max = bvh_ray.tmax;
-            let t = match &self.primitives[id] {
-                Primitive::Triangle { vertices, .. } => watertight
-                    .intersect(t_max, vertices[0], vertices[1], vertices[2])
-                    .map(|h| h.t),
-                Primitive::Analytic { shape } => {
-                    self.shapes[*shape as usize].intersect_analytic(ray, t_max)
-                }
-            };
-            t.unwrap_or(f32::INFINITY)
+            self.hit_primitive(id, ray, &watertight, bvh_ray.tmax)
+                .map_or(f32::INFINITY, |h| h.t)
         })
     }
 }
