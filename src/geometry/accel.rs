@@ -1,27 +1,20 @@
-//! Ray queries against all shapes of a scene through a compressed 8-wide BVH, or through Embree
-//! for comparison (cargo feature `embree`, see [`super::embree`]).
+//! Ray queries against all shapes of a scene through our 4-wide BVH ([`super::bvh`]), or
+//! through Embree for comparison (cargo feature `embree`, see [`super::embree`]).
 //!
-//! The hierarchy is built by the `obvhs` crate: PLOC clustering (Meister & Bittner 2018) refined
-//! by parallel reinsertion under the SAH cost (Meister & Bittner 2017), then collapsed into the
-//! compressed wide BVH of Ylitie et al. 2017 with 8 children per node, traversed four children at
-//! a time with SIMD. Triangles are stored with their vertices in leaf order for locality;
-//! analytic shapes (spheres, disks) and moving shapes (with their own hierarchy, see
-//! [`super::instance`]) are single primitives.
+//! Every triangle of every mesh, and every analytic shape (sphere, disk, moving shape with its
+//! own hierarchy, see [`super::instance`]), is one primitive of the hierarchy. Primitives are
+//! numbered shape after shape: shape s owns the ids `first_id[s]..first_id[s + 1]`, a triangle's
+//! id being its shape's first id plus its index in the mesh, so a hit names its shape and
+//! triangle without a table per triangle.
 
-use std::str::FromStr;
-use std::time::Duration;
-
-use glam::Vec3;
-use obvhs::BvhBuildParams;
-use obvhs::aabb::Aabb;
-use obvhs::cwbvh::CwBvh;
-use obvhs::cwbvh::builder::build_cwbvh;
-
+use super::bvh::{BuildPrimitive, Bvh, PrimitiveKind};
 use super::interaction::SurfaceInteraction;
 use super::shape::Shape;
 use super::triangle::{TriangleHit, WatertightRay};
 use crate::error::Result;
 use crate::math::Ray;
+use glam::Vec3;
+use std::str::FromStr;
 
 /// Which structure answers the ray queries.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -74,98 +67,72 @@ pub struct Hit {
     pub triangle: TriangleHit,
 }
 
-/// A BVH primitive: one triangle, or a whole analytic shape.
-#[derive(Clone, Copy, Debug)]
-enum Primitive {
-    Triangle {
-        vertices: [Vec3; 3],
-        shape: u32,
-        index: u32,
-    },
-    Analytic {
-        shape: u32,
-    },
-}
-
 /// The scene's shapes and the hierarchy over them.
 #[derive(Clone, Debug)]
 pub struct Geometry {
     pub shapes: Vec<Shape>,
-    bvh: Option<CwBvh>,
-    /// Primitives in BVH leaf order (the builder's index map applied, then dropped).
-    primitives: Vec<Primitive>,
+    bvh: Option<Bvh>,
+    /// The first primitive id of each shape, and one past the last id at the end.
+    first_id: Vec<u32>,
+    /// Primitives in the hierarchy (triangles of non-zero area, and analytic shapes).
+    primitive_count: usize,
     /// The same shapes in Embree, which then answers the queries instead of `bvh`.
     #[cfg(feature = "embree")]
     embree: Option<super::embree::EmbreeScene>,
-}
-
-fn to_obvhs(v: Vec3) -> glam::Vec3A {
-    glam::Vec3A::new(v.x, v.y, v.z)
 }
 
 impl Geometry {
     /// Builds the hierarchy over all shapes.
     pub fn new(shapes: Vec<Shape>) -> Geometry {
         let mut primitives = Vec::new();
-        let mut bounds = Vec::new();
-        for (shape_index, shape) in shapes.iter().enumerate() {
-            let shape_index = shape_index as u32;
+        let mut first_id = Vec::with_capacity(shapes.len() + 1);
+        let mut next_id = 0u64;
+        for shape in &shapes {
+            first_id.push(next_id as u32);
             match shape {
                 Shape::Mesh(mesh) => {
                     for i in 0..mesh.triangles.len() {
+                        // Degenerate triangles are left out: no ray can hit them.
                         if mesh.triangle_area(i) == 0.0 {
                             continue;
                         }
-                        let vertices = mesh.vertices(i);
-                        let mut aabb = Aabb::from_point(to_obvhs(vertices[0]));
-                        aabb.extend(to_obvhs(vertices[1]));
-                        aabb.extend(to_obvhs(vertices[2]));
-                        bounds.push(aabb);
-                        primitives.push(Primitive::Triangle {
-                            vertices,
-                            shape: shape_index,
-                            index: i as u32,
+                        primitives.push(BuildPrimitive {
+                            id: (next_id + i as u64) as u32,
+                            kind: PrimitiveKind::Triangle(mesh.vertices(i)),
                         });
                     }
+                    next_id += mesh.triangles.len() as u64;
                 }
                 Shape::Sphere(_) | Shape::Disk(_) | Shape::Instance(_) => {
                     let (lo, hi) = shape.object_bounds();
-                    bounds.push(Aabb::new(to_obvhs(lo), to_obvhs(hi)));
-                    primitives.push(Primitive::Analytic { shape: shape_index });
+                    primitives.push(BuildPrimitive {
+                        id: next_id as u32,
+                        kind: PrimitiveKind::Analytic { lo, hi },
+                    });
+                    next_id += 1;
                 }
             }
+            assert!(
+                next_id < u32::MAX as u64,
+                "more than 2³² primitives in one scene"
+            );
         }
-        if primitives.is_empty() {
-            return Geometry {
-                shapes,
-                bvh: None,
-                primitives,
-                #[cfg(feature = "embree")]
-                embree: None,
-            };
-        }
-        let bvh = build_cwbvh(
-            &bounds,
-            BvhBuildParams::medium_build(),
-            &mut Duration::default(),
-        );
-        let mut bvh = bvh;
-        let primitives = bvh
-            .primitive_indices
-            .iter()
-            .map(|&i| primitives[i as usize])
-            .collect();
-        // Leaves now address `primitives` directly: the index map is not needed any more, and
-        // the builder's spare capacity is given back.
-        bvh.primitive_indices = Vec::new();
-        bvh.nodes.shrink_to_fit();
+        first_id.push(next_id as u32);
         Geometry {
             shapes,
-            bvh: Some(bvh),
-            primitives,
+            bvh: Bvh::build(&primitives),
+            first_id,
+            primitive_count: primitives.len(),
             #[cfg(feature = "embree")]
             embree: None,
         }
+    }
+
+    /// The shape and, for a mesh, the triangle of primitive `id`.
+    #[inline]
+    fn shape_of(&self, id: u32) -> (u32, u32) {
+        let shape = self.first_id.partition_point(|&first| first <= id) - 1;
+        (shape as u32, id - self.first_id[shape])
     }
 
     /// Chooses the structure that answers the queries; Embree's is built here (the BVH is kept,
@@ -195,11 +162,11 @@ impl Geometry {
 
     /// The number of BVH primitives (triangles plus analytic shapes).
     pub fn primitive_count(&self) -> usize {
-        self.primitives.len()
+        self.primitive_count
     }
 
     /// Bytes of memory held by the shapes and the hierarchy: meshes' vertex attributes and
-    /// indices, the BVH nodes, and the primitives in leaf order. Counted from the data
+    /// indices, and the BVH's nodes and triangle packs. Counted from the data
     /// structures' capacities, so it does not depend on the allocator.
     pub fn memory_bytes(&self) -> usize {
         use std::mem::size_of;
@@ -215,46 +182,20 @@ impl Geometry {
                     }
             })
             .sum();
-        let bvh = self.bvh.as_ref().map_or(0, |bvh| {
-            bvh.nodes.capacity() * size_of::<obvhs::cwbvh::node::CwBvhNode>()
-                + bvh.primitive_indices.capacity() * size_of::<u32>()
-        });
-        size_of::<Geometry>() + shapes + bvh + self.primitives.capacity() * size_of::<Primitive>()
+        let bvh = self.bvh.as_ref().map_or(0, Bvh::memory_bytes);
+        size_of::<Geometry>() + shapes + bvh + self.first_id.capacity() * size_of::<u32>()
     }
 
     /// The axis-aligned box (min, max) around all shapes; None for an empty scene.
     pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
-        let aabb = self.bvh.as_ref()?.total_aabb;
-        Some((Vec3::from(aabb.min), Vec3::from(aabb.max)))
+        self.bvh.as_ref().map(Bvh::bounds)
     }
 
-    fn bvh_ray(ray: &Ray) -> obvhs::ray::Ray {
-        obvhs::ray::Ray::new(to_obvhs(ray.o), to_obvhs(ray.d), 0.0, ray.t_max)
-    }
-
-    /// The hit of the ray with leaf primitive `id` in (0, t_max); barycentrics are zero for
-    /// analytic shapes.
+    /// Intersects the analytic shape of primitive `id` (its whole shape) in (0, t_max).
     #[inline]
-    fn hit_primitive(
-        &self,
-        id: usize,
-        ray: &Ray,
-        watertight: &WatertightRay,
-        t_max: f32,
-    ) -> Option<TriangleHit> {
-        match &self.primitives[id] {
-            Primitive::Triangle { vertices, .. } => {
-                watertight.intersect(t_max, vertices[0], vertices[1], vertices[2])
-            }
-            Primitive::Analytic { shape } => self.shapes[*shape as usize]
-                .intersect_analytic(ray, t_max)
-                .map(|t| TriangleHit {
-                    t,
-                    b0: 0.0,
-                    b1: 0.0,
-                    b2: 0.0,
-                }),
-        }
+    fn analytic_hit(&self, ray: &Ray, id: u32, t_max: f32) -> Option<f32> {
+        let (shape, _) = self.shape_of(id);
+        self.shapes[shape as usize].intersect_analytic(ray, t_max)
     }
 
     /// The closest hit in (0, t_max), found by the chosen structure.
@@ -268,24 +209,11 @@ impl Geometry {
 
     fn bvh_closest_hit(&self, ray: &Ray) -> Option<Hit> {
         let bvh = self.bvh.as_ref()?;
-        let mut closest: Option<(usize, TriangleHit)> = None;
-        let mut hit = obvhs::ray::RayHit::none();
         let watertight = WatertightRay::new(ray.o, ray.d);
-        bvh.ray_traverse(Self::bvh_ray(ray), &mut hit, |bvh_ray, id| {
-            let t_max = bvh_ray.tmax;
-            match self.hit_primitive(id, ray, &watertight, t_max) {
-                Some(h) if h.t < t_max => {
-                    closest = Some((id, h));
-                    h.t
-                }
-                _ => f32::INFINITY,
-            }
-        });
-        let (id, triangle) = closest?;
-        let (shape, primitive) = match self.primitives[id] {
-            Primitive::Triangle { shape, index, .. } => (shape, index),
-            Primitive::Analytic { shape } => (shape, 0),
-        };
+        let (id, triangle) = bvh.closest_hit(ray, &watertight, |id, t_max| {
+            self.analytic_hit(ray, id, t_max)
+        })?;
+        let (shape, primitive) = self.shape_of(id);
         Some(Hit {
             shape,
             primitive,
@@ -318,9 +246,8 @@ impl Geometry {
             return false;
         };
         let watertight = WatertightRay::new(ray.o, ray.d);
-        !bvh.ray_traverse_miss(Self::bvh_ray(ray), |bvh_ray, id| {
-            self.hit_primitive(id, ray, &watertight, bvh_ray.tmax)
-                .map_or(f32::INFINITY, |h| h.t)
+        bvh.occluded(ray, &watertight, |id, t_max| {
+            self.analytic_hit(ray, id, t_max)
         })
     }
 }

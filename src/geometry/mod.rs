@@ -2,9 +2,11 @@
 //! ray offsets.
 
 pub mod accel;
+pub mod bvh;
 pub mod disk;
 #[cfg(feature = "embree")]
 pub mod embree;
+mod huge_pages;
 pub mod instance;
 pub mod interaction;
 pub mod mesh;
@@ -12,6 +14,7 @@ pub mod offset;
 pub mod shape;
 pub mod sphere;
 pub mod triangle;
+pub mod triangle_pack;
 
 pub use accel::{Accel, Geometry, Hit};
 pub use interaction::SurfaceInteraction;

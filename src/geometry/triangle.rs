@@ -23,7 +23,7 @@ pub struct TriangleHit {
 
 /// γ(n) = nε/(1 − nε), the bound on accumulated relative rounding error (pbrt-v4 §6.8.1).
 #[inline]
-fn gamma(n: i32) -> f32 {
+pub(super) fn gamma(n: i32) -> f32 {
     let e = f32::EPSILON * 0.5;
     (n as f32 * e) / (1.0 - n as f32 * e)
 }
@@ -44,11 +44,11 @@ fn permute(v: Vec3, x: usize, y: usize, z: usize) -> Vec3 {
 /// and shared by every triangle the traversal visits.
 #[derive(Clone, Copy, Debug)]
 pub struct WatertightRay {
-    origin: Vec3,
+    pub(super) origin: Vec3,
     /// The axes that become x, y and z.
-    permutation: [usize; 3],
+    pub(super) permutation: [usize; 3],
     /// (−d_x/d_z, −d_y/d_z, 1/d_z) in permuted coordinates.
-    shear: Vec3,
+    pub(super) shear: Vec3,
 }
 
 impl WatertightRay {

@@ -1,0 +1,712 @@
+//! Our bounding volume hierarchy: four children per node, tested against a ray at once in 4-wide
+//! SIMD, and leaves of up to four triangles intersected at once ([`TrianglePack`]), the layout of
+//! Embree's `BVH4` with `Triangle4` leaves (Wald et al. 2014, "Embree: A Kernel Framework for
+//! Efficient CPU Ray Tracing", §3–4).
+//!
+//! **Build.** A binary hierarchy is built by the `obvhs` crate: PLOC clustering of Morton-ordered
+//! boxes (Meister & Bittner 2018) refined by reinsertion under the surface area heuristic
+//! (Meister & Bittner 2017). It is then collapsed top-down into the 4-wide tree: a node's two
+//! children are opened, largest surface area first, until it has four (Wald, Benthin &
+//! Boulos 2008, "Getting Rid of Packets"); a subtree of at most four triangles becomes a leaf.
+//! Leaves are packed into [`TrianglePack`]s in depth-first order, several small sibling leaves
+//! sharing one pack (each leaf knows its lanes), so that packs are nearly full and siblings lie
+//! together in memory. Analytic shapes (spheres, disks, moving shapes) are leaves of their own.
+//!
+//! **Traversal.** Front to back: the children a ray enters are visited nearest first and the
+//! others pushed on a stack with their entry distance, which is skipped when popped beyond the
+//! nearest hit found so far. The slab test is pbrt-v4's (§6.1.2): (bound − o)·(1/d) per axis,
+//! the exit distance enlarged by 1 + 2γ(3) so that rounding never culls a box the ray touches
+//! (pbrt-v4 §6.8.2), and zero direction components replaced by tiny ones so that no 0·∞ appears.
+
+use glam::Vec3;
+use obvhs::aabb::Aabb;
+use obvhs::bvh2::Bvh2;
+use obvhs::bvh2::reinsertion::ReinsertionOptimizer;
+use obvhs::ploc::{PlocBuilder, PlocSearchDistance, SortPrecision};
+use wide::{CmpLe, f32x4};
+
+use super::huge_pages;
+use super::triangle::{TriangleHit, WatertightRay, gamma};
+use super::triangle_pack::{PACK_WIDTH, TrianglePack};
+use crate::math::Ray;
+
+/// A primitive to build the hierarchy over: a triangle, or an analytic shape given by its box.
+#[derive(Clone, Copy, Debug)]
+pub struct BuildPrimitive {
+    /// The caller's number for the primitive, reported with its hits.
+    pub id: u32,
+    pub kind: PrimitiveKind,
+}
+
+#[derive(Clone, Copy, Debug)]
+pub enum PrimitiveKind {
+    Triangle([Vec3; 3]),
+    /// Intersected by the caller (see [`Bvh::closest_hit`]); the box bounds it.
+    Analytic {
+        lo: Vec3,
+        hi: Vec3,
+    },
+}
+
+impl BuildPrimitive {
+    fn aabb(&self) -> Aabb {
+        let (lo, hi) = match self.kind {
+            PrimitiveKind::Triangle([a, b, c]) => (a.min(b).min(c), a.max(b).max(c)),
+            PrimitiveKind::Analytic { lo, hi } => (lo, hi),
+        };
+        Aabb::new(lo.into(), hi.into())
+    }
+}
+
+/// A child of a node: an inner node, a leaf of triangles (a pack and its lanes), or an analytic
+/// primitive. Bit 31 clear: inner node index. Bits 31 and 30 set: analytic primitive id in bits
+/// 0–29. Bit 31 set and 30 clear: pack index in bits 0–25 and the leaf's lanes in bits 26–29.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct NodeRef(u32);
+
+const LEAF: u32 = 1 << 31;
+const ANALYTIC: u32 = 1 << 30;
+const LANES_SHIFT: u32 = 26;
+const PACK_INDEX_MASK: u32 = (1 << LANES_SHIFT) - 1;
+
+impl NodeRef {
+    fn inner(index: usize) -> NodeRef {
+        assert!(index < LEAF as usize, "more BVH nodes than 2³¹");
+        NodeRef(index as u32)
+    }
+
+    fn triangles(pack: usize, lanes: u32) -> NodeRef {
+        assert!(
+            pack <= PACK_INDEX_MASK as usize,
+            "more than 2²⁶ triangle packs (2.7·10⁸ triangles) in one hierarchy"
+        );
+        NodeRef(LEAF | (lanes << LANES_SHIFT) | pack as u32)
+    }
+
+    fn analytic(id: u32) -> NodeRef {
+        assert!(id < ANALYTIC, "analytic primitive id beyond 2³⁰");
+        NodeRef(LEAF | ANALYTIC | id)
+    }
+
+    #[inline]
+    fn is_inner(self) -> bool {
+        self.0 & LEAF == 0
+    }
+}
+
+/// Four children's boxes, structure-of-arrays: `bounds[axis]` the lower and `bounds[3 + axis]`
+/// the upper bounds of the four children. Empty slots have inverted bounds (+∞ below, −∞ above),
+/// which no ray enters.
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(64))]
+struct Node {
+    bounds: [f32x4; 6],
+    children: [NodeRef; 4],
+}
+
+/// Stack entries a query can hold without going to the heap; deeper trees use a heap stack.
+const INLINE_STACK: usize = 128;
+
+/// The hierarchy.
+#[derive(Clone, Debug)]
+pub struct Bvh {
+    nodes: Vec<Node>,
+    packs: Vec<TrianglePack>,
+    root: NodeRef,
+    lo: Vec3,
+    hi: Vec3,
+    /// Stack entries a query needs at most: three per level below the root.
+    stack_size: usize,
+}
+
+/// A ray prepared for the slab tests: origin and reciprocal direction splatted, and which bound
+/// of each axis is entered first.
+struct SlabRay {
+    origin: [f32x4; 3],
+    inv_dir: [f32x4; 3],
+    /// Index into [`Node::bounds`] of the near and far bound per axis.
+    near: [usize; 3],
+    far: [usize; 3],
+}
+
+impl SlabRay {
+    #[inline]
+    fn new(ray: &Ray) -> SlabRay {
+        let d = ray.d.to_array();
+        let o = ray.o.to_array();
+        // A zero component would make (bound − o)/d a 0·∞; a tiny one keeps the test finite.
+        let inv = d.map(|c| {
+            let c = if c.abs() < 1e-30 {
+                1e-30f32.copysign(c)
+            } else {
+                c
+            };
+            1.0 / c
+        });
+        let near = [0, 1, 2].map(|a| if d[a] >= 0.0 { a } else { 3 + a });
+        SlabRay {
+            origin: o.map(f32x4::splat),
+            inv_dir: inv.map(f32x4::splat),
+            near,
+            far: near.map(|n| if n < 3 { n + 3 } else { n - 3 }),
+        }
+    }
+
+    /// Entry distances of the four children, and the mask of those entered within (0, t_max).
+    #[inline]
+    fn test(&self, node: &Node, t_max: f32) -> (f32x4, u32) {
+        let slab =
+            |i: usize, axis: usize| (node.bounds[i] - self.origin[axis]) * self.inv_dir[axis];
+        let t_near = slab(self.near[0], 0)
+            .fast_max(slab(self.near[1], 1))
+            .fast_max(slab(self.near[2], 2))
+            .fast_max(f32x4::ZERO);
+        let t_far = slab(self.far[0], 0)
+            .fast_min(slab(self.far[1], 1))
+            .fast_min(slab(self.far[2], 2))
+            * f32x4::splat(1.0 + 2.0 * gamma(3));
+        let t_far = t_far.fast_min(f32x4::splat(t_max));
+        (t_near, t_near.cmp_le(t_far).move_mask() as u32)
+    }
+}
+
+impl Bvh {
+    /// Builds the hierarchy; None for no primitives.
+    pub fn build(primitives: &[BuildPrimitive]) -> Option<Bvh> {
+        if primitives.is_empty() {
+            return None;
+        }
+        let boxes: Vec<Aabb> = primitives.iter().map(BuildPrimitive::aabb).collect();
+        let mut binary = PlocBuilder::with_capacity(boxes.len()).build(
+            PlocSearchDistance::Medium,
+            &boxes,
+            (0..boxes.len() as u32).collect(),
+            SortPrecision::U64,
+            3,
+        );
+        ReinsertionOptimizer::default().run(&mut binary, 0.05, None);
+        Some(Collapse::new(&binary, primitives).run())
+    }
+
+    /// The box around everything.
+    pub fn bounds(&self) -> (Vec3, Vec3) {
+        (self.lo, self.hi)
+    }
+
+    /// Bytes held by nodes and packs.
+    pub fn memory_bytes(&self) -> usize {
+        std::mem::size_of::<Bvh>()
+            + self.nodes.capacity() * std::mem::size_of::<Node>()
+            + self.packs.capacity() * std::mem::size_of::<TrianglePack>()
+    }
+
+    /// The nearest hit in (0, ray.t_max): the primitive's id and the hit (barycentrics zero for
+    /// analytic primitives, which `analytic(id, t_max)` intersects).
+    #[inline]
+    pub fn closest_hit(
+        &self,
+        ray: &Ray,
+        watertight: &WatertightRay,
+        analytic: impl FnMut(u32, f32) -> Option<f32>,
+    ) -> Option<(u32, TriangleHit)> {
+        if self.stack_size <= INLINE_STACK {
+            let mut stack = [(NodeRef(0), 0.0f32); INLINE_STACK];
+            self.closest_hit_with(&mut stack, ray, watertight, analytic)
+        } else {
+            let mut stack = vec![(NodeRef(0), 0.0f32); self.stack_size];
+            self.closest_hit_with(&mut stack, ray, watertight, analytic)
+        }
+    }
+
+    #[inline]
+    fn closest_hit_with(
+        &self,
+        stack: &mut [(NodeRef, f32)],
+        ray: &Ray,
+        watertight: &WatertightRay,
+        mut analytic: impl FnMut(u32, f32) -> Option<f32>,
+    ) -> Option<(u32, TriangleHit)> {
+        let slab = SlabRay::new(ray);
+        let mut t_max = ray.t_max;
+        let mut nearest = None;
+        let mut depth = 0usize;
+        let mut node = self.root;
+        loop {
+            // Down the tree to a leaf, nearest child first.
+            'descend: while node.is_inner() {
+                let n = &self.nodes[node.0 as usize];
+                let (t_near, mut mask) = slab.test(n, t_max);
+                if mask == 0 {
+                    break 'descend;
+                }
+                let t_near = t_near.to_array();
+                let first = mask.trailing_zeros() as usize;
+                mask &= mask - 1;
+                if mask == 0 {
+                    node = n.children[first];
+                    self.prefetch(node);
+                    continue;
+                }
+                // Two to four children: sorted by entry distance, the nearest visited now.
+                let mut hits = [(NodeRef(0), 0.0f32); 4];
+                hits[0] = (n.children[first], t_near[first]);
+                let mut count = 1;
+                while mask != 0 {
+                    let i = mask.trailing_zeros() as usize;
+                    mask &= mask - 1;
+                    let entry = (n.children[i], t_near[i]);
+                    let mut j = count;
+                    while j > 0 && hits[j - 1].1 < entry.1 {
+                        hits[j] = hits[j - 1];
+                        j -= 1;
+                    }
+                    hits[j] = entry;
+                    count += 1;
+                }
+                // `hits` is farthest first: push all but the last, descend into the last. The
+                // pushed nodes are fetched into the cache meanwhile.
+                for &(pending, _) in &hits[..count - 1] {
+                    self.prefetch(pending);
+                }
+                stack[depth..depth + count - 1].copy_from_slice(&hits[..count - 1]);
+                depth += count - 1;
+                node = hits[count - 1].0;
+                self.prefetch(node);
+            }
+            if !node.is_inner()
+                && let Some((id, hit)) = self.leaf_hit(node, watertight, t_max, &mut analytic)
+            {
+                t_max = hit.t;
+                nearest = Some((id, hit));
+            }
+            // Back up to the nearest pending child the ray can still reach first.
+            loop {
+                if depth == 0 {
+                    return nearest;
+                }
+                depth -= 1;
+                let (pending, t_entry) = stack[depth];
+                if t_entry <= t_max {
+                    node = pending;
+                    break;
+                }
+            }
+        }
+    }
+
+    /// Asks the processor to start loading a child: an inner node or a leaf's triangle pack.
+    #[inline(always)]
+    fn prefetch(&self, node: NodeRef) {
+        #[cfg(target_arch = "x86_64")]
+        {
+            use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
+            let (start, bytes) = if node.is_inner() {
+                let p = self.nodes.as_ptr().wrapping_add(node.0 as usize);
+                (p as *const i8, std::mem::size_of::<Node>())
+            } else if node.0 & ANALYTIC == 0 {
+                let p = self
+                    .packs
+                    .as_ptr()
+                    .wrapping_add((node.0 & PACK_INDEX_MASK) as usize);
+                (p as *const i8, std::mem::size_of::<TrianglePack>())
+            } else {
+                return;
+            };
+            for offset in (0..bytes).step_by(64) {
+                // SAFETY: prefetching is a hint; it never faults, whatever the address.
+                unsafe { _mm_prefetch::<_MM_HINT_T0>(start.wrapping_add(offset)) };
+            }
+        }
+    }
+
+    /// Whether any primitive is hit in (0, ray.t_max).
+    #[inline]
+    pub fn occluded(
+        &self,
+        ray: &Ray,
+        watertight: &WatertightRay,
+        analytic: impl FnMut(u32, f32) -> Option<f32>,
+    ) -> bool {
+        if self.stack_size <= INLINE_STACK {
+            let mut stack = [NodeRef(0); INLINE_STACK];
+            self.occluded_with(&mut stack, ray, watertight, analytic)
+        } else {
+            let mut stack = vec![NodeRef(0); self.stack_size];
+            self.occluded_with(&mut stack, ray, watertight, analytic)
+        }
+    }
+
+    #[inline]
+    fn occluded_with(
+        &self,
+        stack: &mut [NodeRef],
+        ray: &Ray,
+        watertight: &WatertightRay,
+        mut analytic: impl FnMut(u32, f32) -> Option<f32>,
+    ) -> bool {
+        let slab = SlabRay::new(ray);
+        let t_max = ray.t_max;
+        stack[0] = self.root;
+        let mut depth = 1usize;
+        while depth > 0 {
+            depth -= 1;
+            let node = stack[depth];
+            if node.is_inner() {
+                let n = &self.nodes[node.0 as usize];
+                let (_, mut mask) = slab.test(n, t_max);
+                while mask != 0 {
+                    stack[depth] = n.children[mask.trailing_zeros() as usize];
+                    depth += 1;
+                    mask &= mask - 1;
+                }
+            } else if self
+                .leaf_hit(node, watertight, t_max, &mut analytic)
+                .is_some()
+            {
+                return true;
+            }
+        }
+        false
+    }
+
+    #[inline]
+    fn leaf_hit(
+        &self,
+        leaf: NodeRef,
+        watertight: &WatertightRay,
+        t_max: f32,
+        analytic: &mut impl FnMut(u32, f32) -> Option<f32>,
+    ) -> Option<(u32, TriangleHit)> {
+        if leaf.0 & ANALYTIC != 0 {
+            let id = leaf.0 & !(LEAF | ANALYTIC);
+            return analytic(id, t_max).filter(|&t| t < t_max).map(|t| {
+                (
+                    id,
+                    TriangleHit {
+                        t,
+                        b0: 0.0,
+                        b1: 0.0,
+                        b2: 0.0,
+                    },
+                )
+            });
+        }
+        let pack = &self.packs[(leaf.0 & PACK_INDEX_MASK) as usize];
+        let lanes = (leaf.0 >> LANES_SHIFT) & 0xF;
+        pack.intersect(watertight, lanes, t_max)
+            .map(|(lane, hit)| (pack.id[lane], hit))
+    }
+}
+
+/// The collapse of a binary hierarchy into the 4-wide one.
+struct Collapse<'a> {
+    binary: &'a Bvh2,
+    primitives: &'a [BuildPrimitive],
+    /// Per binary node: the number of primitives below it, and whether all are triangles.
+    count: Vec<u32>,
+    all_triangles: Vec<bool>,
+    nodes: Vec<Node>,
+    packs: Vec<TrianglePack>,
+    /// The most recent packs with free lanes, and how many lanes of each are taken.
+    open_packs: Vec<(usize, usize)>,
+}
+
+/// How many recent packs a new leaf may go into (first fit): more fill packs better, fewer keep
+/// a leaf's triangles near its siblings'.
+const OPEN_PACKS: usize = 8;
+
+impl<'a> Collapse<'a> {
+    fn new(binary: &'a Bvh2, primitives: &'a [BuildPrimitive]) -> Collapse<'a> {
+        let n = binary.nodes.len();
+        let mut collapse = Collapse {
+            binary,
+            primitives,
+            count: vec![0; n],
+            all_triangles: vec![true; n],
+            nodes: Vec::new(),
+            packs: Vec::new(),
+            open_packs: Vec::new(),
+        };
+        // Children before parents: a depth-first order, walked backwards.
+        let mut order = Vec::with_capacity(n);
+        let mut stack = vec![0usize];
+        while let Some(i) = stack.pop() {
+            order.push(i);
+            let node = &binary.nodes[i];
+            if node.prim_count == 0 {
+                stack.push(node.first_index as usize);
+                stack.push(node.first_index as usize + 1);
+            }
+        }
+        for &i in order.iter().rev() {
+            let node = &binary.nodes[i];
+            if node.prim_count == 0 {
+                let (a, b) = (node.first_index as usize, node.first_index as usize + 1);
+                collapse.count[i] = collapse.count[a] + collapse.count[b];
+                collapse.all_triangles[i] = collapse.all_triangles[a] && collapse.all_triangles[b];
+            } else {
+                collapse.count[i] = node.prim_count;
+                collapse.all_triangles[i] = collapse
+                    .leaf_primitives(i)
+                    .iter()
+                    .all(|&p| matches!(primitives[p as usize].kind, PrimitiveKind::Triangle(_)));
+            }
+        }
+        collapse
+    }
+
+    fn leaf_primitives(&self, i: usize) -> &'a [u32] {
+        let node = &self.binary.nodes[i];
+        let first = node.first_index as usize;
+        &self.binary.primitive_indices[first..first + node.prim_count as usize]
+    }
+
+    /// Whether binary node `i` becomes a leaf of triangles.
+    fn is_triangle_leaf(&self, i: usize) -> bool {
+        self.all_triangles[i] && self.count[i] as usize <= PACK_WIDTH
+    }
+
+    /// Whether binary node `i` is opened into its children when collapsing.
+    fn can_open(&self, i: usize) -> bool {
+        self.binary.nodes[i].prim_count == 0 && !self.is_triangle_leaf(i)
+    }
+
+    fn run(mut self) -> Bvh {
+        let root_box = self.binary.nodes[0].aabb();
+        let mut max_depth = 0;
+        let root = self.reference(0, 0, &mut max_depth);
+        let nodes = huge_pages::copy(&self.nodes);
+        let packs = huge_pages::copy(&self.packs);
+        Bvh {
+            nodes,
+            packs,
+            root,
+            lo: Vec3::from(root_box.min),
+            hi: Vec3::from(root_box.max),
+            stack_size: 3 * max_depth + 1,
+        }
+    }
+
+    /// The child reference for binary node `i` at `depth`, building what lies below it.
+    fn reference(&mut self, i: usize, depth: usize, max_depth: &mut usize) -> NodeRef {
+        *max_depth = (*max_depth).max(depth);
+        if self.is_triangle_leaf(i) {
+            return self.triangle_leaf(i);
+        }
+        let node = &self.binary.nodes[i];
+        if node.prim_count > 0 {
+            // A binary leaf holding an analytic primitive (the builder puts one per leaf).
+            let p = self.leaf_primitives(i)[0] as usize;
+            return NodeRef::analytic(self.primitives[p].id);
+        }
+        // Open the largest openable child until there are four.
+        let mut children = vec![node.first_index as usize, node.first_index as usize + 1];
+        while children.len() < 4 {
+            let largest = children
+                .iter()
+                .enumerate()
+                .filter(|&(_, &c)| self.can_open(c))
+                .max_by(|a, b| {
+                    let area = |c: usize| self.binary.nodes[c].aabb().half_area();
+                    area(*a.1).total_cmp(&area(*b.1))
+                })
+                .map(|(k, _)| k);
+            let Some(k) = largest else { break };
+            let c = children.swap_remove(k);
+            let first = self.binary.nodes[c].first_index as usize;
+            children.push(first);
+            children.push(first + 1);
+        }
+        let index = self.nodes.len();
+        let mut bounds = [
+            f32x4::splat(f32::INFINITY),
+            f32x4::splat(f32::INFINITY),
+            f32x4::splat(f32::INFINITY),
+            f32x4::splat(f32::NEG_INFINITY),
+            f32x4::splat(f32::NEG_INFINITY),
+            f32x4::splat(f32::NEG_INFINITY),
+        ]
+        .map(|b| b.to_array());
+        for (slot, &c) in children.iter().enumerate() {
+            let aabb = self.binary.nodes[c].aabb();
+            for axis in 0..3 {
+                bounds[axis][slot] = aabb.min[axis];
+                bounds[3 + axis][slot] = aabb.max[axis];
+            }
+        }
+        self.nodes.push(Node {
+            bounds: bounds.map(f32x4::new),
+            children: [NodeRef(0); 4],
+        });
+        for (slot, &c) in children.iter().enumerate() {
+            let child = self.reference(c, depth + 1, max_depth);
+            self.nodes[index].children[slot] = child;
+        }
+        NodeRef::inner(index)
+    }
+
+    /// A leaf of the (at most four) triangles below binary node `i`, in the current pack if
+    /// they fit there, else in a new one.
+    fn triangle_leaf(&mut self, i: usize) -> NodeRef {
+        let mut triangles = Vec::with_capacity(PACK_WIDTH);
+        let mut stack = vec![i];
+        while let Some(j) = stack.pop() {
+            let node = &self.binary.nodes[j];
+            if node.prim_count == 0 {
+                stack.push(node.first_index as usize + 1);
+                stack.push(node.first_index as usize);
+            } else {
+                triangles.extend_from_slice(self.leaf_primitives(j));
+            }
+        }
+        let fits = self
+            .open_packs
+            .iter()
+            .position(|&(_, used)| used + triangles.len() <= PACK_WIDTH);
+        let slot = fits.unwrap_or_else(|| {
+            if self.open_packs.len() == OPEN_PACKS {
+                self.open_packs.remove(0);
+            }
+            self.packs.push(TrianglePack::empty());
+            self.open_packs.push((self.packs.len() - 1, 0));
+            self.open_packs.len() - 1
+        });
+        let (pack_index, used) = &mut self.open_packs[slot];
+        let mut lanes = 0;
+        for &p in &triangles {
+            let primitive = &self.primitives[p as usize];
+            let PrimitiveKind::Triangle(vertices) = primitive.kind else {
+                unreachable!("a triangle leaf holds triangles only");
+            };
+            self.packs[*pack_index].set(*used, vertices, primitive.id);
+            lanes |= 1 << *used;
+            *used += 1;
+        }
+        let leaf = NodeRef::triangles(*pack_index, lanes);
+        if *used == PACK_WIDTH {
+            self.open_packs.remove(slot);
+        }
+        leaf
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sampling::rng::Pcg32;
+
+    fn random_unit(rng: &mut Pcg32) -> Vec3 {
+        Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 2.0 - 1.0
+    }
+
+    /// Random small triangles in a cube, and some analytic "spheres" given by their boxes.
+    fn scene(rng: &mut Pcg32, triangles: usize) -> (Vec<BuildPrimitive>, Vec<(Vec3, f32)>) {
+        let mut primitives = Vec::new();
+        for id in 0..triangles {
+            let c = random_unit(rng);
+            let v = [0, 1, 2].map(|_| c + random_unit(rng) * 0.1);
+            primitives.push(BuildPrimitive {
+                id: id as u32,
+                kind: PrimitiveKind::Triangle(v),
+            });
+        }
+        let mut spheres = Vec::new();
+        for k in 0..5 {
+            let c = random_unit(rng);
+            let r = 0.05 + 0.1 * rng.next_f32();
+            spheres.push((c, r));
+            primitives.push(BuildPrimitive {
+                id: (triangles + k) as u32,
+                kind: PrimitiveKind::Analytic {
+                    lo: c - r,
+                    hi: c + r,
+                },
+            });
+        }
+        (primitives, spheres)
+    }
+
+    fn sphere_hit(ray: &Ray, (c, r): (Vec3, f32), t_max: f32) -> Option<f32> {
+        let oc = ray.o - c;
+        let a = ray.d.length_squared();
+        let b = oc.dot(ray.d);
+        let disc = b * b - a * (oc.length_squared() - r * r);
+        if disc < 0.0 {
+            return None;
+        }
+        let s = disc.sqrt();
+        [(-b - s) / a, (-b + s) / a]
+            .into_iter()
+            .find(|&t| t > 0.0 && t < t_max)
+    }
+
+    /// The nearest hit and occlusion agree with testing every primitive, on random rays.
+    #[test]
+    fn agrees_with_brute_force() {
+        let mut rng = Pcg32::seeded(5);
+        for triangles in [1, 3, 4, 5, 17, 2000] {
+            let (primitives, spheres) = scene(&mut rng, triangles);
+            let bvh = Bvh::build(&primitives).unwrap();
+            let analytic_of = |ray: Ray| {
+                let spheres = spheres.clone();
+                move |id: u32, t_max: f32| sphere_hit(&ray, spheres[id as usize - triangles], t_max)
+            };
+            let mut hits = 0;
+            for k in 0..4000 {
+                let o = random_unit(&mut rng) * 2.0;
+                // Most rays aim at a primitive; some are axis-aligned (zero direction
+                // components), some go anywhere.
+                let aim = match primitives[k % primitives.len()].kind {
+                    PrimitiveKind::Triangle(v) => (v[0] + v[1] + v[2]) / 3.0,
+                    PrimitiveKind::Analytic { lo, hi } => (lo + hi) / 2.0,
+                };
+                let d = match k % 10 {
+                    0 => Vec3::new(0.0, 0.0, if k % 20 == 0 { 1.0 } else { -1.0 }),
+                    1 => random_unit(&mut rng),
+                    _ => aim + random_unit(&mut rng) * 0.02 - o,
+                };
+                let t_max = if k % 2 == 0 { f32::INFINITY } else { 2.0 };
+                let ray = Ray::new(o, d, t_max, 0.0);
+                let watertight = WatertightRay::new(o, d);
+                let mut expected: Option<(u32, f32)> = None;
+                for p in &primitives {
+                    let limit = expected.map_or(t_max, |e| e.1);
+                    let t = match p.kind {
+                        PrimitiveKind::Triangle(v) => {
+                            watertight.intersect(limit, v[0], v[1], v[2]).map(|h| h.t)
+                        }
+                        PrimitiveKind::Analytic { .. } => {
+                            sphere_hit(&ray, spheres[p.id as usize - triangles], limit)
+                        }
+                    };
+                    if let Some(t) = t.filter(|&t| t < limit) {
+                        expected = Some((p.id, t));
+                    }
+                }
+                let found = bvh.closest_hit(&ray, &watertight, analytic_of(ray));
+                assert_eq!(
+                    found.map(|(_, h)| h.t),
+                    expected.map(|e| e.1),
+                    "{triangles} triangles, ray {k}"
+                );
+                assert_eq!(
+                    bvh.occluded(&ray, &watertight, analytic_of(ray)),
+                    expected.is_some()
+                );
+                hits += usize::from(expected.is_some());
+            }
+            assert!(hits > 1000, "{triangles} triangles: only {hits} hits");
+        }
+    }
+
+    /// Packs are shared by small leaves: a large mesh needs few more packs than a quarter of its
+    /// triangles.
+    #[test]
+    fn packs_are_nearly_full() {
+        let mut rng = Pcg32::seeded(6);
+        let (primitives, _) = scene(&mut rng, 20_000);
+        let bvh = Bvh::build(&primitives[..20_000]).unwrap();
+        let fill = 20_000.0 / (bvh.packs.len() * PACK_WIDTH) as f64;
+        assert!(fill > 0.8, "packs are only {:.0} % full", fill * 100.0);
+    }
+}
