@@ -176,8 +176,8 @@ fn beckmann_slope_cdf(x: f64, tan_theta: f64) -> f64 {
 }
 
 /// Visible slopes of the α = 1 Beckmann distribution seen at cos θ: x by inverting the CDF
-/// (bisection safeguarded Newton on the bracket (−∞, cot θ], to full double precision), y by
-/// the inverse error function.
+/// (bisection safeguarded Newton on the bracket (−∞, cot θ], to full double precision: until
+/// the bracket or a Newton step is below 10⁻¹³ relative), y by the inverse error function.
 fn beckmann_visible_slopes(cos_theta: f64, u: Vec2) -> (f64, f64) {
     let u1 = f64::from(u.x).clamp(1e-12, 1.0 - 1e-12);
     let u2 = f64::from(u.y).clamp(1e-12, 1.0 - 1e-12);
@@ -208,11 +208,15 @@ fn beckmann_visible_slopes(cos_theta: f64, u: Vec2) -> (f64, f64) {
         }
         let derivative = (-x * x).exp() * (1.0 - x * tan_theta) / std::f64::consts::PI.sqrt();
         let newton = x - value / derivative;
-        x = if derivative > 0.0 && newton > lo && newton < hi {
-            newton
+        if derivative > 0.0 && newton > lo && newton < hi {
+            let step = (newton - x).abs();
+            x = newton;
+            if step < 1e-13 * (1.0 + x.abs()) {
+                break;
+            }
         } else {
-            0.5 * (lo + hi)
-        };
+            x = 0.5 * (lo + hi);
+        }
     }
     (x, y)
 }

@@ -22,7 +22,14 @@ pub struct ExactSum<const FRACTION_BITS: i32>(pub i128);
 impl<const FRACTION_BITS: i32> ExactSum<FRACTION_BITS> {
     #[inline]
     pub fn add(&mut self, v: f64) {
-        let scaled = (v * 2f64.powi(FRACTION_BITS)).round() as i128;
+        let scaled = (v * 2f64.powi(FRACTION_BITS)).round();
+        // Through i64 where it fits: the processor converts that in one instruction, whereas a
+        // float-to-i128 conversion is a library call. Both give the same integer.
+        let scaled = if scaled.abs() < 9.0e18 {
+            i128::from(scaled as i64)
+        } else {
+            scaled as i128
+        };
         self.0 = self.0.saturating_add(scaled);
     }
 

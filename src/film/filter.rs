@@ -149,6 +149,13 @@ impl FilterSampler {
     /// One coordinate of an offset, with density ∝ |k|, and its weight k(x) / (p(x) ∫k).
     #[inline]
     pub fn sample_1d(&self, u: f32) -> (f32, f32) {
+        match self.filter {
+            // The box and the tent are sampled exactly (their densities are k/∫k), so every
+            // weight is 1; other kernels through the tabulated |k|.
+            Filter::Box { radius } => return ((2.0 * u - 1.0) * radius, 1.0),
+            Filter::Tent { radius } => return (radius * sample_tent(u), 1.0),
+            _ => {}
+        }
         let (x, _) = self.distribution.sample(u);
         let p = self.distribution.pdf(x);
         let weight = if p > 0.0 {
@@ -170,12 +177,28 @@ impl FilterSampler {
 
     /// Density of an offset (per unit area of the film): the product of the per-axis densities.
     pub fn pdf(&self, offset: Vec2) -> f32 {
-        self.distribution.pdf(offset.x) * self.distribution.pdf(offset.y)
+        self.pdf_1d(offset.x) * self.pdf_1d(offset.y)
     }
 
     /// Density of one coordinate of an offset (both axes are sampled alike and independently).
     pub fn pdf_1d(&self, x: f32) -> f32 {
-        self.distribution.pdf(x)
+        match self.filter {
+            Filter::Box { radius } | Filter::Tent { radius } if x.abs() > radius => 0.0,
+            Filter::Box { radius } => 0.5 / radius,
+            Filter::Tent { radius } => (1.0 - x.abs() / radius) / radius,
+            _ => self.distribution.pdf(x),
+        }
+    }
+}
+
+/// The tent on [−1, 1], density 1 − |x|, by inverting its CDF: u < ½ is the left half, where
+/// the CDF is (1 + x)²/2.
+#[inline]
+fn sample_tent(u: f32) -> f32 {
+    if u < 0.5 {
+        (2.0 * u).sqrt() - 1.0
+    } else {
+        1.0 - (2.0 - 2.0 * u).sqrt()
     }
 }
 
