@@ -23,7 +23,7 @@ pub struct TriangleHit {
 
 /// γ(n) = nε/(1 − nε), the bound on accumulated relative rounding error (pbrt-v4 §6.8.1).
 #[inline]
-pub(super) fn gamma(n: i32) -> f32 {
+pub(super) const fn gamma(n: i32) -> f32 {
     let e = f32::EPSILON * 0.5;
     (n as f32 * e) / (1.0 - n as f32 * e)
 }
