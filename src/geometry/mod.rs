@@ -6,7 +6,6 @@ pub mod bvh;
 pub mod disk;
 #[cfg(feature = "embree")]
 pub mod embree;
-mod huge_pages;
 pub mod instance;
 pub mod interaction;
 pub mod mesh;
