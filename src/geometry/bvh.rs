@@ -596,7 +596,28 @@ impl<'a> Collapse<'a> {
     fn run(mut self) -> Bvh {
         let root_box = self.binary.nodes[0].aabb();
         let mut max_depth = 0;
-        let root = self.reference(0, 0, &mut max_depth);
+        let mut root = NodeRef(0);
+        // Depth first, with an explicit stack (binary trees can be deep): each entry is a
+        // binary node, where its reference goes (None for the root, else node and slot), and
+        // its depth. Children are pushed last first, so nodes and packs are laid out in order.
+        let mut work: Vec<(usize, Option<(usize, usize)>, usize)> = vec![(0, None, 0)];
+        while let Some((i, parent, depth)) = work.pop() {
+            max_depth = max_depth.max(depth);
+            let reference = match self.node_children(i) {
+                None => self.leaf(i),
+                Some((children, count)) => {
+                    let index = self.push_node(&children[..count]);
+                    for slot in (0..count).rev() {
+                        work.push((children[slot], Some((index, slot)), depth + 1));
+                    }
+                    NodeRef::inner(index)
+                }
+            };
+            match parent {
+                None => root = reference,
+                Some((node, slot)) => self.nodes[node].children[slot] = reference,
+            }
+        }
         let mut nodes = self.nodes;
         nodes.shrink_to_fit();
         let mut packs = self.packs;
@@ -612,37 +633,49 @@ impl<'a> Collapse<'a> {
         }
     }
 
-    /// The child reference for binary node `i` at `depth`, building what lies below it.
-    fn reference(&mut self, i: usize, depth: usize, max_depth: &mut usize) -> NodeRef {
-        *max_depth = (*max_depth).max(depth);
-        if self.is_triangle_leaf(i) {
-            return self.triangle_leaf(i);
-        }
+    /// The binary nodes that become the children of binary node `i` when it is an inner node
+    /// of the wide tree, and how many; None where `i` becomes a leaf. The largest openable
+    /// child is opened until there are NODE_WIDTH.
+    fn node_children(&self, i: usize) -> Option<([usize; NODE_WIDTH], usize)> {
         let node = &self.binary.nodes[i];
-        if node.prim_count > 0 {
-            // A binary leaf holding an analytic primitive (the builder puts one per leaf).
-            let p = self.leaf_primitives(i)[0] as usize;
-            return NodeRef::analytic(self.primitives[p].id);
+        if self.is_triangle_leaf(i) || node.prim_count > 0 {
+            return None;
         }
-        // Open the largest openable child until there are four.
-        let mut children = vec![node.first_index as usize, node.first_index as usize + 1];
-        while children.len() < NODE_WIDTH {
-            let largest = children
+        let mut children = [0usize; NODE_WIDTH];
+        let mut areas = [0f32; NODE_WIDTH];
+        let mut count = 0;
+        let add = |c: usize, children: &mut [usize], areas: &mut [f32], slot: usize| {
+            children[slot] = c;
+            areas[slot] = if self.can_open(c) {
+                self.binary.nodes[c].aabb().half_area()
+            } else {
+                f32::NEG_INFINITY
+            };
+        };
+        for c in [node.first_index as usize, node.first_index as usize + 1] {
+            add(c, &mut children, &mut areas, count);
+            count += 1;
+        }
+        while count < NODE_WIDTH {
+            let (k, &area) = areas[..count]
                 .iter()
                 .enumerate()
-                .filter(|&(_, &c)| self.can_open(c))
-                .max_by(|a, b| {
-                    let area = |c: usize| self.binary.nodes[c].aabb().half_area();
-                    area(*a.1).total_cmp(&area(*b.1))
-                })
-                .map(|(k, _)| k);
-            let Some(k) = largest else { break };
-            let c = children.swap_remove(k);
-            let first = self.binary.nodes[c].first_index as usize;
-            children.push(first);
-            children.push(first + 1);
+                .max_by(|a, b| a.1.total_cmp(b.1))
+                .expect("a node has children");
+            if area == f32::NEG_INFINITY {
+                break;
+            }
+            let first = self.binary.nodes[children[k]].first_index as usize;
+            add(first, &mut children, &mut areas, k);
+            add(first + 1, &mut children, &mut areas, count);
+            count += 1;
         }
-        let index = self.nodes.len();
+        Some((children, count))
+    }
+
+    /// Appends a wide node over the boxes of binary nodes `children` (its references are set
+    /// later); returns its index.
+    fn push_node(&mut self, children: &[usize]) -> usize {
         let mut bounds = [
             [f32::INFINITY; NODE_WIDTH],
             [f32::INFINITY; NODE_WIDTH],
@@ -662,27 +695,43 @@ impl<'a> Collapse<'a> {
             bounds: bounds.map(Lanes::new),
             children: [NodeRef(0); NODE_WIDTH],
         });
-        for (slot, &c) in children.iter().enumerate() {
-            let child = self.reference(c, depth + 1, max_depth);
-            self.nodes[index].children[slot] = child;
+        self.nodes.len() - 1
+    }
+
+    /// The leaf for binary node `i`: its triangles, or the analytic primitive of a binary leaf
+    /// (the builder puts one primitive per leaf).
+    fn leaf(&mut self, i: usize) -> NodeRef {
+        if self.is_triangle_leaf(i) {
+            return self.triangle_leaf(i);
         }
-        NodeRef::inner(index)
+        let p = self.leaf_primitives(i)[0] as usize;
+        NodeRef::analytic(self.primitives[p].id)
     }
 
     /// A leaf of the (at most four) triangles below binary node `i`, in the current pack if
     /// they fit there, else in a new one.
     fn triangle_leaf(&mut self, i: usize) -> NodeRef {
-        let mut triangles = Vec::with_capacity(PACK_WIDTH);
-        let mut stack = vec![i];
-        while let Some(j) = stack.pop() {
-            let node = &self.binary.nodes[j];
+        // The subtree has at most PACK_WIDTH leaves, so its walk needs that much stack.
+        let mut triangles = [0u32; PACK_WIDTH];
+        let mut found = 0;
+        let mut stack = [0usize; PACK_WIDTH];
+        let mut depth = 1;
+        stack[0] = i;
+        while depth > 0 {
+            depth -= 1;
+            let node = &self.binary.nodes[stack[depth]];
             if node.prim_count == 0 {
-                stack.push(node.first_index as usize + 1);
-                stack.push(node.first_index as usize);
+                stack[depth] = node.first_index as usize + 1;
+                stack[depth + 1] = node.first_index as usize;
+                depth += 2;
             } else {
-                triangles.extend_from_slice(self.leaf_primitives(j));
+                for &p in self.leaf_primitives(stack[depth]) {
+                    triangles[found] = p;
+                    found += 1;
+                }
             }
         }
+        let triangles = &triangles[..found];
         let fits = self
             .open_packs
             .iter()
@@ -697,7 +746,7 @@ impl<'a> Collapse<'a> {
         });
         let (pack_index, used) = &mut self.open_packs[slot];
         let mut lanes = 0;
-        for &p in &triangles {
+        for &p in triangles {
             let primitive = &self.primitives[p as usize];
             let PrimitiveKind::Triangle(vertices) = primitive.kind else {
                 unreachable!("a triangle leaf holds triangles only");
