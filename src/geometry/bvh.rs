@@ -520,6 +520,14 @@ fn has_avx() -> bool {
     false
 }
 
+/// A binary node waiting to become a child of the wide tree.
+struct Pending {
+    binary: usize,
+    /// Where its reference goes: None for the root, else the wide node and slot.
+    parent: Option<(usize, usize)>,
+    depth: usize,
+}
+
 /// The collapse of a binary hierarchy into the 8-wide one.
 struct Collapse<'a> {
     binary: &'a Bvh2,
@@ -597,18 +605,30 @@ impl<'a> Collapse<'a> {
         let root_box = self.binary.nodes[0].aabb();
         let mut max_depth = 0;
         let mut root = NodeRef(0);
-        // Depth first, with an explicit stack (binary trees can be deep): each entry is a
-        // binary node, where its reference goes (None for the root, else node and slot), and
-        // its depth. Children are pushed last first, so nodes and packs are laid out in order.
-        let mut work: Vec<(usize, Option<(usize, usize)>, usize)> = vec![(0, None, 0)];
-        while let Some((i, parent, depth)) = work.pop() {
+        // Depth first, with an explicit stack (binary trees can be deep). Children are pushed
+        // last first, so nodes and packs are laid out in depth-first order.
+        let mut work = vec![Pending {
+            binary: 0,
+            parent: None,
+            depth: 0,
+        }];
+        while let Some(Pending {
+            binary: i,
+            parent,
+            depth,
+        }) = work.pop()
+        {
             max_depth = max_depth.max(depth);
             let reference = match self.node_children(i) {
                 None => self.leaf(i),
                 Some((children, count)) => {
                     let index = self.push_node(&children[..count]);
                     for slot in (0..count).rev() {
-                        work.push((children[slot], Some((index, slot)), depth + 1));
+                        work.push(Pending {
+                            binary: children[slot],
+                            parent: Some((index, slot)),
+                            depth: depth + 1,
+                        });
                     }
                     NodeRef::inner(index)
                 }
