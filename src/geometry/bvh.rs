@@ -280,6 +280,21 @@ impl Bvh {
         watertight: &WatertightRay,
         analytic: impl FnMut(u32, f32) -> Option<f32>,
     ) -> Option<(u32, TriangleHit)> {
+        self.with_stack(|stack| {
+            #[cfg(target_arch = "x86_64")]
+            if self.avx {
+                // SAFETY: `avx` is set only where the processor has AVX.
+                return unsafe { self.closest_hit_avx(stack, ray, watertight, analytic) };
+            }
+            self.closest_hit_with::<false>(stack, ray, watertight, analytic)
+        })
+    }
+
+    /// Runs `query` with an uninitialised traversal stack of [`Self::stack_size`] entries: on the
+    /// machine stack where that is small enough (every hierarchy but pathological ones), else on
+    /// the heap.
+    #[inline(always)]
+    fn with_stack<T: Copy, R>(&self, query: impl FnOnce(&mut [MaybeUninit<T>]) -> R) -> R {
         let mut inline_stack = [MaybeUninit::uninit(); INLINE_STACK];
         let mut heap_stack = Vec::new();
         let stack = if self.stack_size <= INLINE_STACK {
@@ -288,12 +303,7 @@ impl Bvh {
             heap_stack.resize(self.stack_size, MaybeUninit::uninit());
             &mut heap_stack[..]
         };
-        #[cfg(target_arch = "x86_64")]
-        if self.avx {
-            // SAFETY: `avx` is set only where the processor has AVX.
-            return unsafe { self.closest_hit_avx(stack, ray, watertight, analytic) };
-        }
-        self.closest_hit_with::<false>(stack, ray, watertight, analytic)
+        query(stack)
     }
 
     /// [`Self::closest_hit_with`] compiled for AVX; the processor must have it.
@@ -420,20 +430,14 @@ impl Bvh {
         watertight: &WatertightRay,
         analytic: impl FnMut(u32, f32) -> Option<f32>,
     ) -> bool {
-        let mut inline_stack = [MaybeUninit::uninit(); INLINE_STACK];
-        let mut heap_stack = Vec::new();
-        let stack = if self.stack_size <= INLINE_STACK {
-            &mut inline_stack[..]
-        } else {
-            heap_stack.resize(self.stack_size, MaybeUninit::uninit());
-            &mut heap_stack[..]
-        };
-        #[cfg(target_arch = "x86_64")]
-        if self.avx {
-            // SAFETY: `avx` is set only where the processor has AVX.
-            return unsafe { self.occluded_avx(stack, ray, watertight, analytic) };
-        }
-        self.occluded_with::<false>(stack, ray, watertight, analytic)
+        self.with_stack(|stack| {
+            #[cfg(target_arch = "x86_64")]
+            if self.avx {
+                // SAFETY: `avx` is set only where the processor has AVX.
+                return unsafe { self.occluded_avx(stack, ray, watertight, analytic) };
+            }
+            self.occluded_with::<false>(stack, ray, watertight, analytic)
+        })
     }
 
     /// [`Self::occluded_with`] compiled for AVX; the processor must have it.
