@@ -94,17 +94,26 @@ impl Filter {
 /// Cells per unit of filter radius in the tabulated density.
 const CELLS_PER_UNIT_RADIUS: f32 = 64.0;
 
-/// Draws film offsets for a filter by inverting the CDF of |k| tabulated per axis.
+/// Draws film offsets for a filter: the box and the tent by inverting their CDFs exactly, other
+/// kernels by inverting the CDF of |k| tabulated per axis.
 #[derive(Clone, Debug)]
 pub struct FilterSampler {
     filter: Filter,
-    distribution: PiecewiseConstant1D,
-    /// ∫ k(x) dx over the support.
-    integral: f32,
+    /// The table of |k| and ∫ k(x) dx over the support; None for the box and the tent.
+    table: Option<(PiecewiseConstant1D, f32)>,
 }
 
 impl FilterSampler {
     pub fn new(filter: Filter) -> FilterSampler {
+        let table = match filter {
+            Filter::Box { .. } | Filter::Tent { .. } => None,
+            _ => Some(Self::table(filter)),
+        };
+        FilterSampler { filter, table }
+    }
+
+    /// The tabulated density of |k| and the integral of k.
+    fn table(filter: Filter) -> (PiecewiseConstant1D, f32) {
         let r = filter.radius();
         let cells = ((CELLS_PER_UNIT_RADIUS * r).ceil() as usize).max(1) * 2;
         let width = 2.0 * r / cells as f32;
@@ -135,31 +144,27 @@ impl FilterSampler {
         let integral: f64 = (0..cells)
             .map(|i| cell_integral(i, &|x| filter.eval(x)))
             .sum();
-        FilterSampler {
-            filter,
-            distribution: PiecewiseConstant1D::new(&weights, -r, r),
-            integral: integral as f32,
-        }
+        (PiecewiseConstant1D::new(&weights, -r, r), integral as f32)
     }
 
     pub fn filter(&self) -> Filter {
         self.filter
     }
 
-    /// One coordinate of an offset, with density ∝ |k|, and its weight k(x) / (p(x) ∫k).
+    /// One coordinate of an offset, with density ∝ |k|, and its weight k(x) / (p(x) ∫k): 1 for
+    /// the box and the tent, whose densities are exactly k/∫k.
     #[inline]
     pub fn sample_1d(&self, u: f32) -> (f32, f32) {
-        match self.filter {
-            // The box and the tent are sampled exactly (their densities are k/∫k), so every
-            // weight is 1; other kernels through the tabulated |k|.
-            Filter::Box { radius } => return ((2.0 * u - 1.0) * radius, 1.0),
-            Filter::Tent { radius } => return (radius * sample_tent(u), 1.0),
-            _ => {}
-        }
-        let (x, _) = self.distribution.sample(u);
-        let p = self.distribution.pdf(x);
+        let Some((distribution, integral)) = &self.table else {
+            return match self.filter {
+                Filter::Tent { radius } => (radius * sample_tent(u), 1.0),
+                _ => ((2.0 * u - 1.0) * self.filter.radius(), 1.0),
+            };
+        };
+        let (x, _) = distribution.sample(u);
+        let p = distribution.pdf(x);
         let weight = if p > 0.0 {
-            self.filter.eval(x) / (p * self.integral)
+            self.filter.eval(x) / (p * integral)
         } else {
             0.0
         };
@@ -182,11 +187,14 @@ impl FilterSampler {
 
     /// Density of one coordinate of an offset (both axes are sampled alike and independently).
     pub fn pdf_1d(&self, x: f32) -> f32 {
+        if let Some((distribution, _)) = &self.table {
+            return distribution.pdf(x);
+        }
+        let r = self.filter.radius();
         match self.filter {
-            Filter::Box { radius } | Filter::Tent { radius } if x.abs() > radius => 0.0,
-            Filter::Box { radius } => 0.5 / radius,
-            Filter::Tent { radius } => (1.0 - x.abs() / radius) / radius,
-            _ => self.distribution.pdf(x),
+            _ if x.abs() > r => 0.0,
+            Filter::Tent { .. } => (1.0 - x.abs() / r) / r,
+            _ => 0.5 / r,
         }
     }
 }

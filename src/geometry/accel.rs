@@ -1,4 +1,4 @@
-//! Ray queries against all shapes of a scene through our 4-wide BVH ([`super::bvh`]), or
+//! Ray queries against all shapes of a scene through our 8-wide BVH ([`super::bvh`]), or
 //! through Embree for comparison (cargo feature `embree`, see [`super::embree`]).
 //!
 //! Every triangle of every mesh, and every analytic shape (sphere, disk, moving shape with its
@@ -19,7 +19,7 @@ use std::str::FromStr;
 /// Which structure answers the ray queries.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Accel {
-    /// Our compressed wide BVH.
+    /// Our wide BVH ([`super::bvh`]).
     #[default]
     Bvh,
     /// Embree 3's BVH (only in builds with the cargo feature `embree`).
@@ -82,7 +82,9 @@ pub struct Geometry {
 }
 
 impl Geometry {
-    /// Builds the hierarchy over all shapes.
+    /// Builds the hierarchy over all shapes. Panics beyond 2³² primitives, 2³⁰ for the id of
+    /// an analytic shape, or 2.7·10⁸ triangles (2²⁶ packs of the BVH): far more than fits in
+    /// memory.
     pub fn new(shapes: Vec<Shape>) -> Geometry {
         let mut primitives = Vec::new();
         let mut first_id = Vec::with_capacity(shapes.len() + 1);

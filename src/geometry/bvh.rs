@@ -105,8 +105,8 @@ impl NodeRef {
     }
 }
 
-/// Four children's boxes, structure-of-arrays: `bounds[axis]` the lower and `bounds[3 + axis]`
-/// the upper bounds of the four children. Empty slots have inverted bounds (+∞ below, −∞ above),
+/// The boxes of a node's [`NODE_WIDTH`] children, structure-of-arrays: `bounds[axis]` holds the
+/// lower and `bounds[3 + axis]` the upper bounds. Empty slots have inverted bounds (+∞ below, −∞ above),
 /// which no ray enters.
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(64))]
@@ -132,7 +132,7 @@ pub struct Bvh {
     root: NodeRef,
     lo: Vec3,
     hi: Vec3,
-    /// Stack entries a query needs at most: three per level below the root.
+    /// Stack entries a query needs at most: NODE_WIDTH − 1 per level below the root, and one.
     stack_size: usize,
     /// Whether the processor has AVX, so that queries test eight boxes per instruction.
     avx: bool,
@@ -164,7 +164,9 @@ impl SlabRay {
             };
             1.0 / c
         });
-        let near = [0, 1, 2].map(|a| if d[a] >= 0.0 { a } else { 3 + a });
+        // The near bound follows the sign of 1/d (so a direction component of −0 enters
+        // through the upper bound, as its −10³⁰ reciprocal says).
+        let near = [0, 1, 2].map(|a| if inv_dir[a] > 0.0 { a } else { 3 + a });
         SlabRay {
             origin: ray.o.to_array(),
             inv_dir,
@@ -264,10 +266,9 @@ impl Bvh {
         (self.lo, self.hi)
     }
 
-    /// Bytes held by nodes and packs.
+    /// Bytes of heap memory held by nodes and packs.
     pub fn memory_bytes(&self) -> usize {
-        std::mem::size_of::<Bvh>()
-            + self.nodes.capacity() * std::mem::size_of::<Node>()
+        self.nodes.capacity() * std::mem::size_of::<Node>()
             + self.packs.capacity() * std::mem::size_of::<TrianglePack>()
     }
 
@@ -347,7 +348,7 @@ impl Bvh {
                     self.prefetch(node);
                     continue;
                 }
-                // Two to four children: sorted by entry distance, the nearest visited now.
+                // Two or more children: sorted by entry distance, the nearest visited now.
                 let mut hits = [(NodeRef(0), 0.0f32); NODE_WIDTH];
                 hits[0] = (n.children[first], t_near[first]);
                 let mut count = 1;
@@ -473,7 +474,9 @@ impl Bvh {
                 let n = &self.nodes[node.0 as usize];
                 let (_, mut mask) = slab.test::<AVX>(n, t_max);
                 while mask != 0 {
-                    stack[depth].write(n.children[mask.trailing_zeros() as usize]);
+                    let child = n.children[mask.trailing_zeros() as usize];
+                    self.prefetch(child);
+                    stack[depth].write(child);
                     depth += 1;
                     mask &= mask - 1;
                 }
@@ -728,6 +731,10 @@ impl<'a> Collapse<'a> {
         if self.is_triangle_leaf(i) {
             return self.triangle_leaf(i);
         }
+        debug_assert_eq!(
+            self.binary.nodes[i].prim_count, 1,
+            "PLOC leaves hold one primitive"
+        );
         let p = self.leaf_primitives(i)[0] as usize;
         NodeRef::analytic(self.primitives[p].id)
     }
@@ -858,7 +865,10 @@ mod tests {
                     PrimitiveKind::Analytic { lo, hi } => (lo + hi) / 2.0,
                 };
                 let d = match k % 10 {
-                    0 => Vec3::new(0.0, 0.0, if k % 20 == 0 { 1.0 } else { -1.0 }),
+                    // Zero components of either sign (−Z is (−0, −0, −1)).
+                    0 if k % 20 == 0 => Vec3::Z,
+                    0 => -Vec3::Z,
+                    5 => Vec3::new(-0.0, random_unit(&mut rng).y, 0.0),
                     1 => random_unit(&mut rng),
                     _ => aim + random_unit(&mut rng) * 0.02 - o,
                 };
@@ -896,7 +906,8 @@ mod tests {
         }
     }
 
-    /// The portable and the AVX node tests find the same hits, bit for bit.
+    /// The portable and the AVX node tests find the same hits, bit for bit (on a processor
+    /// without AVX both run the portable test).
     #[test]
     fn portable_and_avx_queries_agree() {
         let mut rng = Pcg32::seeded(7);

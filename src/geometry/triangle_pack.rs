@@ -20,7 +20,8 @@ use super::triangle::{TriangleHit, WatertightRay, gamma};
 pub struct TrianglePack {
     /// `vertex[i][axis]`: coordinate `axis` of vertex i of each lane's triangle.
     vertex: [[f32x4; 3]; 3],
-    /// The scene's index of each lane's triangle (see [`super::bvh`]); `u32::MAX` where empty.
+    /// The caller's id of each lane's triangle (see [`super::bvh::BuildPrimitive`]); `u32::MAX`
+    /// where empty.
     pub id: [u32; 4],
 }
 
@@ -250,6 +251,20 @@ mod tests {
             hits > 20_000,
             "only {hits} hits: the test exercises too little"
         );
+    }
+
+    /// A ray through a vertex makes two edge functions exactly zero, which sends the pack to
+    /// the scalar test (its double-precision retest): the vertex is hit, as the scalar test says.
+    #[test]
+    fn exact_zero_edges_take_the_scalar_path() {
+        let v = [Vec3::ZERO, Vec3::X, Vec3::Y];
+        let mut pack = TrianglePack::empty();
+        pack.set(2, v, 7);
+        let ray = WatertightRay::new(Vec3::Z, -Vec3::Z);
+        let scalar = ray.intersect(f32::INFINITY, v[0], v[1], v[2]).unwrap();
+        let (lane, hit) = pack.intersect(&ray, 0b100, f32::INFINITY).unwrap();
+        assert_eq!((lane, hit), (2, scalar));
+        assert_eq!(hit.t, 1.0);
     }
 
     /// Lanes outside the mask are never reported.
