@@ -106,8 +106,8 @@ impl NodeRef {
 }
 
 /// The boxes of a node's [`NODE_WIDTH`] children, structure-of-arrays: `bounds[axis]` holds the
-/// lower and `bounds[3 + axis]` the upper bounds. Empty slots have inverted bounds (+∞ below, −∞ above),
-/// which no ray enters.
+/// lower and `bounds[3 + axis]` the upper bounds. Empty slots have inverted bounds (+∞ below,
+/// −∞ above), which no ray enters.
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(64))]
 struct Node {

@@ -208,17 +208,12 @@ impl PiecewiseLinear {
             return SampledSpectrum::from_fn(|i| self.value(wavelengths.lambda(i)));
         };
         let (first, last) = (self.lambdas[0], self.lambdas[self.lambdas.len() - 1]);
-        let values = &self.values[..];
-        let cells = values.len() - 2;
         SampledSpectrum::from_fn(|k| {
             let lambda = wavelengths.lambda(k);
             if !(lambda >= first && lambda <= last) {
                 return 0.0;
             }
-            let x = (lambda - first) * inverse;
-            let i = (x as usize).min(cells);
-            let (a, b) = (values[i], values[i + 1]);
-            a + (x - i as f32) * (b - a)
+            interpolate_regular(&self.values, (lambda - first) * inverse)
         })
     }
 
@@ -231,31 +226,31 @@ impl PiecewiseLinear {
         if n == 1 {
             return self.values[0];
         }
-        let (i, t) = match self.inverse_spacing {
-            Some(inverse) => {
-                let x = (lambda - self.lambdas[0]) * inverse;
-                let i = (x as usize).min(n - 2);
-                (i, x - i as f32)
-            }
-            None => {
-                let i = self
-                    .lambdas
-                    .partition_point(|&l| l <= lambda)
-                    .clamp(1, n - 1)
-                    - 1;
-                (
-                    i,
-                    (lambda - self.lambdas[i]) / (self.lambdas[i + 1] - self.lambdas[i]),
-                )
-            }
-        };
+        if let Some(inverse) = self.inverse_spacing {
+            return interpolate_regular(&self.values, (lambda - self.lambdas[0]) * inverse);
+        }
+        let i = self
+            .lambdas
+            .partition_point(|&l| l <= lambda)
+            .clamp(1, n - 1)
+            - 1;
+        let t = (lambda - self.lambdas[i]) / (self.lambdas[i + 1] - self.lambdas[i]);
         self.values[i] + t * (self.values[i + 1] - self.values[i])
     }
+}
+
+/// Linear interpolation in a regular table of at least two values at x = (λ − λ₀)/spacing, for
+/// λ inside the table.
+#[inline(always)]
+fn interpolate_regular(values: &[f32], x: f32) -> f32 {
+    let i = (x as usize).min(values.len() - 2);
+    values[i] + (x - i as f32) * (values[i + 1] - values[i])
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::spectrum::{N_SPECTRUM_SAMPLES, WavelengthSampling};
 
     #[test]
     fn piecewise_linear_interpolates_and_is_zero_outside() {
@@ -292,10 +287,15 @@ mod tests {
             if !(416.0..=424.0).contains(&l) {
                 assert!((b.value(l) - expected).abs() < 1e-5, "{l}");
             }
-            // Four wavelengths at once give exactly the single lookups.
-            let lambdas = SampledWavelengths::single(l);
+        }
+        // Four wavelengths at once give exactly the single lookups.
+        for k in 0..200 {
+            let lambdas = SampledWavelengths::sample(k as f32 / 200.0, WavelengthSampling::Uniform);
             for table in [&a, &b] {
-                assert_eq!(table.sample(&lambdas)[0], table.value(l), "{l}");
+                let values = table.sample(&lambdas);
+                for i in 0..N_SPECTRUM_SAMPLES {
+                    assert_eq!(values[i], table.value(lambdas.lambda(i)), "{lambdas:?}");
+                }
             }
         }
     }
