@@ -5,7 +5,7 @@
 use std::process::Command;
 
 use glam::Vec3;
-use prism::bench::rays::incoherent_rays;
+use prism::bench::rays::{incoherent_rays, shadow_rays};
 use prism::geometry::{Geometry, Shape, TriangleMesh};
 use prism::scene::mitsuba::load_scene;
 
@@ -47,6 +47,7 @@ fn bench_prints_one_consistent_json_object_per_scene() {
         "bvh_build_seconds",
         "geometry_bytes",
         "rays_per_second",
+        "shadow_rays_per_second",
         "samples_per_second",
         "spp",
         "render_seconds",
@@ -127,4 +128,47 @@ fn benchmark_rays_leave_surfaces_in_all_directions() {
     // of 1/sqrt(3n).
     let standard_error = 1.0 / (3.0 * n as f32).sqrt();
     assert!(mean.abs().max_element() < 4.0 * standard_error, "{mean}");
+}
+
+#[test]
+fn shadow_rays_join_visible_surfaces_to_the_lights() {
+    let scene_path = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/cornell-box/scene.xml");
+    let defines = [
+        ("resx".to_string(), "64".to_string()),
+        ("resy".to_string(), "64".to_string()),
+    ];
+    let scene = load_scene(std::path::Path::new(scene_path), &defines)
+        .unwrap()
+        .scene;
+    let n = 5_000;
+    let rays = shadow_rays(&scene, n, 4);
+    assert_eq!(rays.len(), n);
+    assert_eq!(rays, shadow_rays(&scene, n, 4), "seeded");
+    // The box's one light is on the ceiling: every segment ends on it (the ray's parameter
+    // stops just short of 1, at the point sampled on the light).
+    let (lights, _): (Vec<_>, Vec<_>) = scene
+        .geometry
+        .shapes
+        .iter()
+        .zip(&scene.shape_info)
+        .partition(|(_, info)| info.light.is_some());
+    assert_eq!(lights.len(), 1);
+    let (lo, hi) = lights[0].0.object_bounds();
+    let slack = 1e-3 * (hi - lo).length();
+    let mut occluded = 0;
+    for ray in &rays {
+        let end = ray.o + ray.d;
+        assert!(
+            end.cmpge(lo - slack).all() && end.cmple(hi + slack).all(),
+            "{end} is not on the light"
+        );
+        assert!(ray.t_max < 1.0 && ray.t_max > 0.99);
+        occluded += usize::from(scene.geometry.occluded(ray));
+    }
+    // The two boxes hide the light from part of the floor and walls, but not from most of
+    // what the camera sees.
+    assert!(
+        occluded > 0 && occluded < n / 2,
+        "{occluded} of {n} occluded"
+    );
 }

@@ -114,6 +114,11 @@ pub struct Measurement {
     pub rays_per_second: f64,
     /// The same with Embree on the same rays (builds with the cargo feature `embree` only).
     pub embree_rays_per_second: Option<f64>,
+    /// Occlusion queries per second on shadow rays ([`rays::shadow_rays`]); 0 for a scene
+    /// without lights to sample.
+    pub shadow_rays_per_second: f64,
+    /// The same with Embree.
+    pub embree_shadow_rays_per_second: Option<f64>,
     pub samples_per_second: f64,
     /// Samples per pixel rendered in the budget.
     pub spp: u32,
@@ -139,12 +144,13 @@ fn pool(threads: usize) -> Result<rayon::ThreadPool> {
         .map_err(|e| Error::usage(format!("could not start the worker threads: {e}")))
 }
 
-/// Closest-hit queries per second over `rays`, traced in parallel, repeated for at least a
-/// second; returns (rays/s, number of hits).
+/// Queries per second over `rays` (a closest hit or an occlusion test: `query` says whether
+/// the ray hit), traced in parallel, repeated for at least a second; returns (rays/s, number
+/// of hits).
 pub fn trace_rate(
     threads: usize,
     rays: &[Ray],
-    closest_hit: impl Fn(&Ray) -> bool + Sync,
+    query: impl Fn(&Ray) -> bool + Sync,
 ) -> Result<(f64, usize)> {
     use rayon::prelude::*;
     let pool = pool(threads)?;
@@ -153,7 +159,7 @@ pub fn trace_rate(
     while traced == 0 || start.elapsed() < Duration::from_secs(1) {
         hits = pool.install(|| {
             rays.par_chunks(1024)
-                .map(|chunk| chunk.iter().filter(|ray| closest_hit(ray)).count())
+                .map(|chunk| chunk.iter().filter(|ray| query(ray)).count())
                 .sum()
         });
         traced += rays.len();
@@ -209,26 +215,45 @@ pub fn measure(bench: &BenchScene, options: &BenchOptions) -> Result<Measurement
     drop(rebuilt);
 
     let rays = rays::incoherent_rays(&scene, options.ray_count, 1);
-    let (rays_per_second, hits) = trace_rate(options.threads, &rays, |ray| {
-        scene.geometry.closest_hit(ray).is_some()
-    })?;
-    let embree_rays_per_second = if cfg!(feature = "embree") {
+    let shadow_rays = rays::shadow_rays(&scene, options.ray_count, 2);
+    let closest_hit = |geometry: &Geometry, ray: &Ray| geometry.closest_hit(ray).is_some();
+    let occluded = |geometry: &Geometry, ray: &Ray| geometry.occluded(ray);
+    let ours = &scene.geometry;
+    let (rays_per_second, hits) = trace_rate(options.threads, &rays, |r| closest_hit(ours, r))?;
+    let (shadow_rays_per_second, occluded_count) = if shadow_rays.is_empty() {
+        (0.0, 0)
+    } else {
+        trace_rate(options.threads, &shadow_rays, |r| occluded(ours, r))?
+    };
+    let (embree_rays_per_second, embree_shadow_rays_per_second) = if cfg!(feature = "embree") {
         let mut embree = scene.geometry.clone();
         embree.set_accel(crate::geometry::accel::Accel::Embree)?;
-        let (rate, embree_hits) = trace_rate(options.threads, &rays, |ray| {
-            embree.closest_hit(ray).is_some()
-        })?;
+        let (rate, embree_hits) = trace_rate(options.threads, &rays, |r| closest_hit(&embree, r))?;
+        let (shadow_rate, embree_occluded) = if shadow_rays.is_empty() {
+            (0.0, 0)
+        } else {
+            trace_rate(options.threads, &shadow_rays, |r| occluded(&embree, r))?
+        };
         // The two structures must agree, or the comparison means nothing (a ray grazing an
         // edge may rarely go either way).
-        if embree_hits.abs_diff(hits) > rays.len() / 10_000 {
-            return Err(Error::usage(format!(
-                "Embree hit {embree_hits} of the {} rays and our BVH {hits}",
-                rays.len()
-            )));
+        for (what, theirs, ours, count) in [
+            ("hit", embree_hits, hits, rays.len()),
+            (
+                "found occluded",
+                embree_occluded,
+                occluded_count,
+                shadow_rays.len(),
+            ),
+        ] {
+            if theirs.abs_diff(ours) > count / 10_000 {
+                return Err(Error::usage(format!(
+                    "Embree {what} {theirs} of the {count} rays and our BVH {ours}"
+                )));
+            }
         }
-        Some(rate)
+        (Some(rate), Some(shadow_rate))
     } else {
-        None
+        (None, None)
     };
 
     let reference = reference(&scene, bench, options)?;
@@ -247,6 +272,8 @@ pub fn measure(bench: &BenchScene, options: &BenchOptions) -> Result<Measurement
         geometry_bytes,
         rays_per_second,
         embree_rays_per_second,
+        shadow_rays_per_second,
+        embree_shadow_rays_per_second,
         samples_per_second: output.sample_count as f64 / render_seconds,
         spp,
         render_seconds,

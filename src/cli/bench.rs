@@ -126,12 +126,22 @@ pub fn run(args: &BenchArgs) -> Result<()> {
                 m.rel_mse,
                 m.efficiency
             );
-            if let Some(rate) = m.embree_rays_per_second {
+            println!(
+                "{:<18} shadow rays: {:.3} Mrays/s",
+                "",
+                m.shadow_rays_per_second / 1e6
+            );
+            if let (Some(rate), Some(shadow_rate)) =
+                (m.embree_rays_per_second, m.embree_shadow_rays_per_second)
+            {
                 println!(
-                    "{:<18} Embree {:.3} Mrays/s on the same rays: ours are {:.2}x",
+                    "{:<18} Embree {:.3} Mrays/s on the same rays: ours are {:.2}x; \
+                     shadow rays {:.3} Mrays/s: ours are {:.2}x",
                     "",
                     rate / 1e6,
-                    m.rays_per_second / rate
+                    m.rays_per_second / rate,
+                    shadow_rate / 1e6,
+                    m.shadow_rays_per_second / shadow_rate
                 );
             }
         }
@@ -146,7 +156,8 @@ fn json(m: &Measurement, threads: usize) -> String {
             "{{\"scene\":\"{}\",\"threads\":{},\"primitives\":{},\"bvh_build_seconds\":{:.6},",
             "\"geometry_bytes\":{},\"bytes_per_primitive\":{:.2},\"rays_per_second\":{:.1},",
             "\"samples_per_second\":{:.1},\"spp\":{},\"render_seconds\":{:.4},",
-            "\"rel_mse\":{:.6e},\"efficiency\":{:.4},\"embree_rays_per_second\":{}}}"
+            "\"rel_mse\":{:.6e},\"efficiency\":{:.4},\"embree_rays_per_second\":{},",
+            "\"shadow_rays_per_second\":{:.1},\"embree_shadow_rays_per_second\":{}}}"
         ),
         m.scene,
         threads,
@@ -161,6 +172,9 @@ fn json(m: &Measurement, threads: usize) -> String {
         m.rel_mse,
         m.efficiency,
         m.embree_rays_per_second
+            .map_or("null".to_string(), |r| format!("{r:.1}")),
+        m.shadow_rays_per_second,
+        m.embree_shadow_rays_per_second
             .map_or("null".to_string(), |r| format!("{r:.1}"))
     )
 }

@@ -13,15 +13,19 @@
 //! full and siblings lie together in memory. Analytic shapes (spheres, disks, moving shapes) are
 //! leaves of their own.
 //!
-//! **Traversal.** Front to back: the children a ray enters are visited nearest first and the
-//! others pushed on a stack with their entry distance, which is skipped when popped beyond the
-//! nearest hit found so far. The slab test is pbrt-v4's (§6.1.2): (bound − o)·(1/d) per axis,
+//! **Traversal.** Front to back, for closest hits and shadow rays alike: the children a ray
+//! enters are visited nearest first and the others pushed on a stack with their entry
+//! distance, which is skipped when popped beyond the nearest hit found so far; a shadow ray
+//! stops at its first hit. The slab test is pbrt-v4's (§6.1.2): (bound − o)·(1/d) per axis,
 //! the exit distance enlarged by 1 + 2γ(3) so that rounding never culls a box the ray touches
 //! (pbrt-v4 §6.8.2), and zero direction components replaced by tiny ones so that no 0·∞ appears.
 //! The eight boxes take one AVX instruction per step where the processor has AVX (detected at
 //! run time, so the default build runs everywhere), else two SSE or NEON instructions. Every
 //! child about to be visited is prefetched whole, so that its cache lines arrive together:
-//! on large scenes traversal waits mostly for memory.
+//! on large scenes traversal waits mostly for memory. The triangle test of a leaf is inlined
+//! into the traversal (so that it, too, runs in AVX's three-operand instructions) with the
+//! ray's constants prepared once per ray ([`PackRay`]): that took 26 % of the instructions of
+//! veach-bidir's shadow rays and made its renders 1.3–1.6× as fast.
 //! (Backing the arrays with 2 MiB pages, as Embree does, made no measurable difference.)
 //!
 //! Measured (`prism bench`, 1,024,000 triangles, 2 threads, incoherent rays): 4-wide nodes
@@ -38,7 +42,7 @@ use obvhs::ploc::{PlocBuilder, PlocSearchDistance, SortPrecision};
 use wide::{CmpLe, f32x8};
 
 use super::triangle::{TriangleHit, WatertightRay, gamma};
-use super::triangle_pack::{PACK_WIDTH, TrianglePack};
+use super::triangle_pack::{PACK_WIDTH, PackRay, TrianglePack};
 use crate::math::Ray;
 
 /// A primitive to build the hierarchy over: a triangle, or an analytic shape given by its box.
@@ -287,7 +291,7 @@ impl Bvh {
                 // SAFETY: `avx` is set only where the processor has AVX.
                 return unsafe { self.closest_hit_avx(stack, ray, watertight, analytic) };
             }
-            self.closest_hit_with::<false>(stack, ray, watertight, analytic)
+            self.nearest_first::<false, false>(stack, ray, watertight, analytic)
         })
     }
 
@@ -307,7 +311,8 @@ impl Bvh {
         query(stack)
     }
 
-    /// [`Self::closest_hit_with`] compiled for AVX; the processor must have it.
+    /// [`Self::nearest_first`] looking for the closest hit, compiled for AVX; the processor must
+    /// have it.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx")]
     unsafe fn closest_hit_avx(
@@ -317,11 +322,16 @@ impl Bvh {
         watertight: &WatertightRay,
         analytic: impl FnMut(u32, f32) -> Option<f32>,
     ) -> Option<(u32, TriangleHit)> {
-        self.closest_hit_with::<true>(stack, ray, watertight, analytic)
+        self.nearest_first::<true, false>(stack, ray, watertight, analytic)
     }
 
+    /// The front-to-back traversal of both queries: the nearest hit, or with `ANY_HIT` the first
+    /// one found. Shadow rays go nearest first too: on veach-bidir, where they cross the lamps
+    /// to reach the lights, that tests 40 % fewer triangle packs than taking the children in any
+    /// order (12 against 20 per ray) and traces 1.15–1.25× the shadow rays per second; on the
+    /// million triangles it costs 1 % more instructions.
     #[inline(always)]
-    fn closest_hit_with<const AVX: bool>(
+    fn nearest_first<const AVX: bool, const ANY_HIT: bool>(
         &self,
         stack: &mut [MaybeUninit<(NodeRef, f32)>],
         ray: &Ray,
@@ -329,6 +339,7 @@ impl Bvh {
         mut analytic: impl FnMut(u32, f32) -> Option<f32>,
     ) -> Option<(u32, TriangleHit)> {
         let slab = SlabRay::new(ray);
+        let pack_ray = PackRay::new(watertight);
         let mut t_max = ray.t_max;
         let mut nearest = None;
         let mut depth = 0usize;
@@ -377,10 +388,13 @@ impl Bvh {
                 self.prefetch(node);
             }
             if !node.is_inner()
-                && let Some((id, hit)) = self.leaf_hit(node, watertight, t_max, &mut analytic)
+                && let Some((id, hit)) = self.leaf_hit(node, &pack_ray, t_max, &mut analytic)
             {
                 t_max = hit.t;
                 nearest = Some((id, hit));
+                if ANY_HIT {
+                    return nearest;
+                }
             }
             // Back up to the nearest pending child the ray can still reach first.
             loop {
@@ -437,64 +451,30 @@ impl Bvh {
                 // SAFETY: `avx` is set only where the processor has AVX.
                 return unsafe { self.occluded_avx(stack, ray, watertight, analytic) };
             }
-            self.occluded_with::<false>(stack, ray, watertight, analytic)
+            self.nearest_first::<false, true>(stack, ray, watertight, analytic)
+                .is_some()
         })
     }
 
-    /// [`Self::occluded_with`] compiled for AVX; the processor must have it.
+    /// [`Self::nearest_first`] looking for any hit, compiled for AVX; the processor must have it.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx")]
     unsafe fn occluded_avx(
         &self,
-        stack: &mut [MaybeUninit<NodeRef>],
+        stack: &mut [MaybeUninit<(NodeRef, f32)>],
         ray: &Ray,
         watertight: &WatertightRay,
         analytic: impl FnMut(u32, f32) -> Option<f32>,
     ) -> bool {
-        self.occluded_with::<true>(stack, ray, watertight, analytic)
+        self.nearest_first::<true, true>(stack, ray, watertight, analytic)
+            .is_some()
     }
 
     #[inline(always)]
-    fn occluded_with<const AVX: bool>(
-        &self,
-        stack: &mut [MaybeUninit<NodeRef>],
-        ray: &Ray,
-        watertight: &WatertightRay,
-        mut analytic: impl FnMut(u32, f32) -> Option<f32>,
-    ) -> bool {
-        let slab = SlabRay::new(ray);
-        let t_max = ray.t_max;
-        stack[0].write(self.root);
-        let mut depth = 1usize;
-        while depth > 0 {
-            depth -= 1;
-            // SAFETY: the entries below `depth` have all been written.
-            let node = unsafe { stack[depth].assume_init() };
-            if node.is_inner() {
-                let n = &self.nodes[node.0 as usize];
-                let (_, mut mask) = slab.test::<AVX>(n, t_max);
-                while mask != 0 {
-                    let child = n.children[mask.trailing_zeros() as usize];
-                    self.prefetch(child);
-                    stack[depth].write(child);
-                    depth += 1;
-                    mask &= mask - 1;
-                }
-            } else if self
-                .leaf_hit(node, watertight, t_max, &mut analytic)
-                .is_some()
-            {
-                return true;
-            }
-        }
-        false
-    }
-
-    #[inline]
     fn leaf_hit(
         &self,
         leaf: NodeRef,
-        watertight: &WatertightRay,
+        ray: &PackRay,
         t_max: f32,
         analytic: &mut impl FnMut(u32, f32) -> Option<f32>,
     ) -> Option<(u32, TriangleHit)> {
@@ -514,7 +494,7 @@ impl Bvh {
         }
         let pack = &self.packs[(leaf.0 & PACK_INDEX_MASK) as usize];
         let lanes = (leaf.0 >> LANES_SHIFT) & 0xF;
-        pack.intersect(watertight, lanes, t_max)
+        pack.intersect(ray, lanes, t_max)
             .map(|(lane, hit)| (pack.id[lane], hit))
     }
 }
