@@ -11,7 +11,8 @@ use glam::Vec2;
 /// search starts next to the answer and usually takes one or two steps.
 #[derive(Clone, Debug)]
 pub struct PiecewiseConstant1D {
-    weights: Vec<f32>,
+    /// The normalised density in each cell.
+    density: Vec<f32>,
     /// cdf[i] = integral of the normalised density over the first i cells; cdf[n] = 1.
     cdf: Vec<f64>,
     /// guide[j] = the cell containing u = j / guide.len().
@@ -57,8 +58,18 @@ impl PiecewiseConstant1D {
             }
             guide.push(cell as u32);
         }
+        let density = weights
+            .iter()
+            .map(|&w| {
+                if integral > 0.0 {
+                    (f64::from(w) / integral) as f32
+                } else {
+                    1.0 / (max - min)
+                }
+            })
+            .collect();
         PiecewiseConstant1D {
-            weights,
+            density,
             cdf,
             guide,
             integral,
@@ -73,11 +84,11 @@ impl PiecewiseConstant1D {
     }
 
     pub fn len(&self) -> usize {
-        self.weights.len()
+        self.density.len()
     }
 
     pub fn is_empty(&self) -> bool {
-        self.weights.is_empty()
+        self.density.is_empty()
     }
 
     pub fn domain(&self) -> (f32, f32) {
@@ -87,7 +98,7 @@ impl PiecewiseConstant1D {
     /// Maps `u` in [0, 1) to a point of the domain with density [`Self::pdf`]. Returns the point
     /// and the index of its cell.
     pub fn sample(&self, u: f32) -> (f32, usize) {
-        let n = self.weights.len();
+        let n = self.density.len();
         // The last cell whose start cdf[i] is at most u, searched from the guide's cell on.
         let slot = ((u * self.guide.len() as f32) as usize).min(self.guide.len() - 1);
         let u = f64::from(u);
@@ -108,18 +119,15 @@ impl PiecewiseConstant1D {
         if !(x >= self.min && x < self.max) {
             return 0.0;
         }
-        let n = self.weights.len();
+        let n = self.density.len();
         let index = (((x - self.min) / (self.max - self.min) * n as f32) as usize).min(n - 1);
         self.cell_pdf(index)
     }
 
     /// Density within cell `index`.
+    #[inline]
     pub fn cell_pdf(&self, index: usize) -> f32 {
-        if self.integral > 0.0 {
-            (f64::from(self.weights[index]) / self.integral) as f32
-        } else {
-            1.0 / (self.max - self.min)
-        }
+        self.density[index]
     }
 
     /// The `u` that [`Self::sample`] maps to `x`: the normalised CDF at `x`.
@@ -127,7 +135,7 @@ impl PiecewiseConstant1D {
         if !(x >= self.min && x < self.max) {
             return None;
         }
-        let n = self.weights.len();
+        let n = self.density.len();
         let t = f64::from((x - self.min) / (self.max - self.min)) * n as f64;
         let index = (t as usize).min(n - 1);
         let frac = t - index as f64;

@@ -160,14 +160,31 @@ impl WavelengthSampling {
 
     /// Draws one wavelength in [360, 830) nm from `u` in [0, 1).
     pub fn sample(self, u: f32) -> f32 {
-        let lambda = match self {
-            WavelengthSampling::CieSum => Self::cie_sum_distribution().sample(u).0,
-            WavelengthSampling::Visible => {
-                VISIBLE_CENTER - (0.856_910_6 - 1.827_502 * u).atanh() * (1.0 / VISIBLE_SLOPE)
+        self.sample_with_pdf(u).0
+    }
+
+    /// [`Self::sample`] and the density of the wavelength drawn: for the tabulated density that
+    /// of the cell the inversion chose, which saves looking it up again.
+    #[inline]
+    pub fn sample_with_pdf(self, u: f32) -> (f32, f32) {
+        let clamp = |lambda: f32| lambda.clamp(LAMBDA_MIN, LAMBDA_MAX.next_down());
+        match self {
+            WavelengthSampling::CieSum => {
+                let table = Self::cie_sum_distribution();
+                let (lambda, cell) = table.sample(u);
+                (clamp(lambda), table.cell_pdf(cell))
             }
-            WavelengthSampling::Uniform => LAMBDA_MIN + u * (LAMBDA_MAX - LAMBDA_MIN),
-        };
-        lambda.clamp(LAMBDA_MIN, LAMBDA_MAX.next_down())
+            WavelengthSampling::Visible => {
+                let lambda = clamp(
+                    VISIBLE_CENTER - (0.856_910_6 - 1.827_502 * u).atanh() * (1.0 / VISIBLE_SLOPE),
+                );
+                (lambda, self.pdf(lambda))
+            }
+            WavelengthSampling::Uniform => {
+                let lambda = clamp(LAMBDA_MIN + u * (LAMBDA_MAX - LAMBDA_MIN));
+                (lambda, self.pdf(lambda))
+            }
+        }
     }
 
     /// Density of [`Self::sample`] at `lambda` (per nm).
@@ -203,16 +220,16 @@ pub struct SampledWavelengths {
 impl SampledWavelengths {
     /// Four wavelengths from one uniform number `u`.
     pub fn sample(u: f32, sampling: WavelengthSampling) -> Self {
-        let lambda: [f32; N_SPECTRUM_SAMPLES] = std::array::from_fn(|k| {
+        let drawn: [(f32, f32); N_SPECTRUM_SAMPLES] = std::array::from_fn(|k| {
             let mut uk = u + k as f32 / N_SPECTRUM_SAMPLES as f32;
             if uk >= 1.0 {
                 uk -= 1.0;
             }
-            sampling.sample(uk)
+            sampling.sample_with_pdf(uk)
         });
         SampledWavelengths {
-            lambda,
-            pdf: lambda.map(|l| sampling.pdf(l)),
+            lambda: drawn.map(|(lambda, _)| lambda),
+            pdf: drawn.map(|(_, pdf)| pdf),
         }
     }
 
@@ -302,6 +319,24 @@ mod tests {
         for (k, u) in [0.3f32, 0.55, 0.8, 0.05].into_iter().enumerate() {
             assert!((w.lambda(k) - sampling.sample(u)).abs() < 1e-3);
             assert_eq!(w.pdf(k), sampling.pdf(w.lambda(k)));
+        }
+    }
+
+    /// The density returned with a sample is the density of the wavelength drawn.
+    #[test]
+    fn samples_carry_their_density() {
+        let mut rng = Pcg32::seeded(9);
+        for sampling in [
+            WavelengthSampling::CieSum,
+            WavelengthSampling::Visible,
+            WavelengthSampling::Uniform,
+        ] {
+            for _ in 0..10_000 {
+                let u = rng.next_f32();
+                let (lambda, pdf) = sampling.sample_with_pdf(u);
+                assert_eq!(lambda, sampling.sample(u));
+                assert_eq!(pdf, sampling.pdf(lambda), "{sampling:?} at {lambda}");
+            }
         }
     }
 
