@@ -1,9 +1,12 @@
 //! Evaluation of the CIE tables: colour matching functions and D65 at any wavelength, and the
 //! conversions between CIE XYZ and linear sRGB.
 
+use wide::{CmpGe, CmpLe, f32x4};
+
 use super::cie_tables::{
     CIE_X, CIE_Y, CIE_Y_INTEGRAL, CIE_Z, D65, D65_LUMINANCE, TABLE_LAMBDA_MIN,
 };
+use super::spectra::interpolate_regular4;
 
 /// Linear interpolation in a 1 nm table starting at 360 nm; zero outside 360..=830 nm.
 #[inline]
@@ -17,6 +20,14 @@ fn lookup(table: &[f32; 471], lambda: f32) -> f32 {
     table[i] + f * (table[i + 1] - table[i])
 }
 
+/// [`lookup`] at four wavelengths at once, with the same numbers.
+#[inline]
+fn lookup4(table: &[f32; 471], lambda: f32x4) -> f32x4 {
+    let t = lambda - f32x4::splat(TABLE_LAMBDA_MIN);
+    let inside = t.cmp_ge(f32x4::ZERO) & t.cmp_le(f32x4::splat(470.0));
+    interpolate_regular4(table, t) & inside
+}
+
 /// The CIE 1931 2° colour matching functions (x̄, ȳ, z̄) at `lambda` nm.
 #[inline]
 pub fn cie_xyz(lambda: f32) -> [f32; 3] {
@@ -24,6 +35,16 @@ pub fn cie_xyz(lambda: f32) -> [f32; 3] {
         lookup(&CIE_X, lambda),
         lookup(&CIE_Y, lambda),
         lookup(&CIE_Z, lambda),
+    ]
+}
+
+/// [`cie_xyz`] at four wavelengths at once: x̄, ȳ and z̄ each for the four.
+#[inline]
+pub fn cie_xyz4(lambda: f32x4) -> [f32x4; 3] {
+    [
+        lookup4(&CIE_X, lambda),
+        lookup4(&CIE_Y, lambda),
+        lookup4(&CIE_Z, lambda),
     ]
 }
 
@@ -42,6 +63,12 @@ pub const CIE_Y_INTEGRAL_F32: f32 = CIE_Y_INTEGRAL as f32;
 #[inline]
 pub fn d65_normalized(lambda: f32) -> f32 {
     lookup(&D65, lambda) * (1.0 / D65_LUMINANCE as f32)
+}
+
+/// [`d65_normalized`] at four wavelengths at once.
+#[inline]
+pub fn d65_normalized4(lambda: f32x4) -> f32x4 {
+    lookup4(&D65, lambda) * f32x4::splat(1.0 / D65_LUMINANCE as f32)
 }
 
 /// XYZ → linear sRGB (IEC 61966-2-1, D65 white), rows applied to (X, Y, Z).

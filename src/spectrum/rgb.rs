@@ -10,6 +10,8 @@
 
 use std::sync::OnceLock;
 
+use wide::{CmpEq, CmpGt, f32x4};
+
 use super::cie::{LINEAR_SRGB_TO_XYZ, cie_xyz, d65_normalized, mul3};
 use super::cie_tables::CIE_Y_INTEGRAL;
 use super::{LAMBDA_MAX, LAMBDA_MIN};
@@ -29,6 +31,16 @@ pub fn sigmoid(x: f32) -> f32 {
         return if x > 0.0 { 1.0 } else { 0.0 };
     }
     0.5 + x / (2.0 * (1.0 + x * x).sqrt())
+}
+
+/// [`sigmoid`] in four lanes, with the same numbers.
+#[inline]
+fn sigmoid4(x: f32x4) -> f32x4 {
+    let finite = f32x4::splat(0.5) + x / (f32x4::splat(2.0) * (f32x4::ONE + x * x).sqrt());
+    let limit = x.cmp_gt(f32x4::ZERO).blend(f32x4::ONE, f32x4::ZERO);
+    x.abs()
+        .cmp_eq(f32x4::splat(f32::INFINITY))
+        .blend(limit, finite)
 }
 
 impl RgbSigmoidPolynomial {
@@ -54,6 +66,20 @@ impl RgbSigmoidPolynomial {
             return sigmoid(self.c2);
         }
         sigmoid((self.c0 * lambda + self.c1) * lambda + self.c2)
+    }
+
+    /// [`Self::eval`] at four wavelengths at once, with the same numbers.
+    #[inline]
+    pub fn eval4(&self, lambda: f32x4) -> f32x4 {
+        if self.c0 == 0.0 && self.c1 == 0.0 {
+            return f32x4::splat(sigmoid(self.c2));
+        }
+        let (c0, c1, c2) = (
+            f32x4::splat(self.c0),
+            f32x4::splat(self.c1),
+            f32x4::splat(self.c2),
+        );
+        sigmoid4((c0 * lambda + c1) * lambda + c2)
     }
 
     /// The linear sRGB colour of this reflectance under D65 (1 nm trapezoid rule), the inverse
@@ -464,6 +490,31 @@ fn solve3(a: [[f64; 3]; 3], b: [f64; 3]) -> Option<[f64; 3]> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The sigmoid in four lanes is the scalar one, its limits at ±∞ included.
+    #[test]
+    fn sigmoid_in_four_lanes_is_the_scalar_one() {
+        let xs = [
+            f32::NEG_INFINITY,
+            -1e10,
+            -3.0,
+            -1e-20,
+            0.0,
+            0.7,
+            42.0,
+            1e10,
+            f32::INFINITY,
+            -0.0,
+            5e-3,
+            -7.5,
+        ];
+        for chunk in xs.chunks(4) {
+            let four = sigmoid4(f32x4::from([chunk[0], chunk[1], chunk[2], chunk[3]])).to_array();
+            for (x, value) in chunk.iter().zip(four) {
+                assert_eq!(value.to_bits(), sigmoid(*x).to_bits(), "{x}");
+            }
+        }
+    }
 
     #[test]
     fn fits_reproduce_their_colours() {

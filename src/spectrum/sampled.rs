@@ -5,7 +5,9 @@
 use std::ops::{Add, AddAssign, Div, Index, IndexMut, Mul, MulAssign, Sub};
 use std::sync::OnceLock;
 
-use super::cie::{CIE_Y_INTEGRAL_F32, cie_xyz};
+use wide::f32x4;
+
+use super::cie::{CIE_Y_INTEGRAL_F32, cie_xyz, cie_xyz4};
 use super::{LAMBDA_MAX, LAMBDA_MIN};
 use crate::sampling::distribution::PiecewiseConstant1D;
 
@@ -275,15 +277,17 @@ impl SampledWavelengths {
     /// The Monte Carlo estimate of CIE XYZ for radiance `l` at these wavelengths:
     /// X = (1/4) Σ_i L(λ_i) x̄(λ_i) / pdf_i / ∫ȳ (likewise Y, Z).
     pub fn to_xyz(&self, l: &SampledSpectrum) -> [f32; 3] {
+        // The matching functions at all four wavelengths at once; the sum over wavelengths
+        // in their order, skipping the terminated ones.
+        let cmf = cie_xyz4(f32x4::from(self.lambda)).map(f32x4::to_array);
         let mut xyz = [0.0f32; 3];
         for i in 0..N_SPECTRUM_SAMPLES {
             if self.pdf[i] == 0.0 {
                 continue;
             }
             let w = l.0[i] / self.pdf[i];
-            let cmf = cie_xyz(self.lambda[i]);
             for c in 0..3 {
-                xyz[c] += w * cmf[c];
+                xyz[c] += w * cmf[c][i];
             }
         }
         let scale = 1.0 / (N_SPECTRUM_SAMPLES as f32 * CIE_Y_INTEGRAL_F32);

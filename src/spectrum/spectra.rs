@@ -3,7 +3,7 @@
 use wide::{CmpGe, CmpLe, f32x4};
 
 use super::blackbody::Blackbody;
-use super::cie::{cie_y, d65_normalized};
+use super::cie::{cie_y, d65_normalized, d65_normalized4};
 use super::rgb::RgbSigmoidPolynomial;
 use super::sampled::{SampledSpectrum, SampledWavelengths};
 use super::{LAMBDA_MAX, LAMBDA_MIN};
@@ -105,13 +105,25 @@ impl Spectrum {
         }
     }
 
-    /// The values at the wavelengths of a path.
+    /// The values at the wavelengths of a path: tables and RGB models four at once in SIMD, with
+    /// the numbers of [`Self::value`].
     #[inline]
     pub fn sample(&self, wavelengths: &SampledWavelengths) -> SampledSpectrum {
         match self {
             Spectrum::Constant(v) => SampledSpectrum::splat(*v),
             Spectrum::PiecewiseLinear(table) => table.sample(wavelengths),
-            _ => SampledSpectrum::from_fn(|i| self.value(wavelengths.lambda(i))),
+            Spectrum::Rgb { polynomial, scale } => {
+                let lambda = f32x4::from(*wavelengths.lambdas());
+                SampledSpectrum((f32x4::splat(*scale) * polynomial.eval4(lambda)).to_array())
+            }
+            Spectrum::RgbIlluminant { polynomial, scale } => {
+                let lambda = f32x4::from(*wavelengths.lambdas());
+                let value = f32x4::splat(*scale) * polynomial.eval4(lambda);
+                SampledSpectrum((value * d65_normalized4(lambda)).to_array())
+            }
+            Spectrum::Blackbody(_) => {
+                SampledSpectrum::from_fn(|i| self.value(wavelengths.lambda(i)))
+            }
         }
     }
 
@@ -214,19 +226,7 @@ impl PiecewiseLinear {
         let lambda = f32x4::from(*wavelengths.lambdas());
         let inside = lambda.cmp_ge(f32x4::splat(first)) & lambda.cmp_le(f32x4::splat(last));
         let x = (lambda - f32x4::splat(first)) * f32x4::splat(inverse);
-        // The cell of each lane, as in `interpolate_regular`: min(⌊x⌋, n − 2) is ⌊min(x, n − 2)⌋
-        // for x ≥ 0. Lanes outside the table (and a NaN, which the maximum turns into 0) are
-        // clamped into it and masked out at the end.
-        let last_cell = (self.values.len() - 2) as f32;
-        let cell = x
-            .fast_max(f32x4::ZERO)
-            .fast_min(f32x4::splat(last_cell))
-            .fast_trunc_int();
-        let index = cell.to_array().map(|i| i as usize);
-        let below = f32x4::from(index.map(|i| self.values[i]));
-        let above = f32x4::from(index.map(|i| self.values[i + 1]));
-        let value = below + (x - cell.round_float()) * (above - below);
-        SampledSpectrum((value & inside).to_array())
+        SampledSpectrum((interpolate_regular4(&self.values, x) & inside).to_array())
     }
 
     #[inline]
@@ -254,9 +254,25 @@ impl PiecewiseLinear {
 /// Linear interpolation in a regular table of at least two values at x = (λ − λ₀)/spacing, for
 /// λ inside the table.
 #[inline(always)]
-fn interpolate_regular(values: &[f32], x: f32) -> f32 {
+pub(super) fn interpolate_regular(values: &[f32], x: f32) -> f32 {
     let i = (x as usize).min(values.len() - 2);
     values[i] + (x - i as f32) * (values[i + 1] - values[i])
+}
+
+/// [`interpolate_regular`] at four points at once, with the same numbers. The cell
+/// min(⌊x⌋, n − 2) is computed as ⌊min(x, n − 2)⌋ (equal for x ≥ 0); a lane outside the table
+/// (or a NaN, which the maximum turns into 0) is clamped into it, for the caller to mask out.
+#[inline(always)]
+pub(super) fn interpolate_regular4(values: &[f32], x: f32x4) -> f32x4 {
+    let last_cell = (values.len() - 2) as f32;
+    let cell = x
+        .fast_max(f32x4::ZERO)
+        .fast_min(f32x4::splat(last_cell))
+        .fast_trunc_int();
+    let index = cell.to_array().map(|i| i as usize);
+    let below = f32x4::from(index.map(|i| values[i]));
+    let above = f32x4::from(index.map(|i| values[i + 1]));
+    below + (x - cell.round_float()) * (above - below)
 }
 
 #[cfg(test)]
@@ -307,6 +323,54 @@ mod tests {
                 let values = table.sample(&lambdas);
                 for i in 0..N_SPECTRUM_SAMPLES {
                     assert_eq!(values[i], table.value(lambdas.lambda(i)), "{lambdas:?}");
+                }
+            }
+        }
+    }
+
+    /// Every kind of spectrum gives at four wavelengths at once exactly its single values, at
+    /// random wavelengths and at the ends of the range (the RGB models and the CIE tables are
+    /// evaluated in SIMD there).
+    #[test]
+    fn four_wavelengths_at_once_equal_single_values() {
+        let table = PiecewiseLinear::new(&[(360.0, 0.2), (600.0, 0.9), (830.0, 0.4)]).unwrap();
+        let spectra = [
+            Spectrum::Constant(0.3),
+            Spectrum::PiecewiseLinear(table),
+            Spectrum::from_rgb([0.8, 0.2, 0.1], RgbIntent::Albedo),
+            Spectrum::from_rgb([0.0, 1.0, 0.0], RgbIntent::Albedo),
+            Spectrum::from_rgb([3.0, 0.5, 0.2], RgbIntent::Unbounded),
+            Spectrum::from_rgb([12048.2, 8605.84, 6196.21], RgbIntent::Illuminant),
+            Spectrum::from_rgb([0.2, 0.2, 0.2], RgbIntent::Illuminant),
+        ];
+        let mut rng = crate::sampling::rng::Pcg32::seeded(3);
+        let mut draws: Vec<SampledWavelengths> = (0..500)
+            .map(|_| SampledWavelengths::sample(rng.next_f32(), WavelengthSampling::CieSum))
+            .collect();
+        draws.push(SampledWavelengths::sample(0.0, WavelengthSampling::Uniform));
+        draws.push(SampledWavelengths::sample(
+            1.0f32.next_down(),
+            WavelengthSampling::Uniform,
+        ));
+        for spectrum in &spectra {
+            for lambdas in &draws {
+                let values = spectrum.sample(lambdas);
+                for i in 0..N_SPECTRUM_SAMPLES {
+                    let single = spectrum.value(lambdas.lambda(i));
+                    assert_eq!(
+                        values[i].to_bits(),
+                        single.to_bits(),
+                        "{spectrum:?} {lambdas:?}"
+                    );
+                }
+            }
+        }
+        for lambdas in &draws {
+            let four = crate::spectrum::cie::cie_xyz4(f32x4::from(*lambdas.lambdas()));
+            for i in 0..N_SPECTRUM_SAMPLES {
+                let single = crate::spectrum::cie::cie_xyz(lambdas.lambda(i));
+                for c in 0..3 {
+                    assert_eq!(four[c].to_array()[i], single[c], "{lambdas:?}");
                 }
             }
         }
