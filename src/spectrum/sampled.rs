@@ -281,13 +281,13 @@ impl SampledWavelengths {
         // in their order, skipping the terminated ones.
         let cmf = cie_xyz4(f32x4::from(self.lambda)).map(f32x4::to_array);
         let mut xyz = [0.0f32; 3];
-        for i in 0..N_SPECTRUM_SAMPLES {
-            if self.pdf[i] == 0.0 {
+        for (i, (&radiance, &pdf)) in l.0.iter().zip(&self.pdf).enumerate() {
+            if pdf == 0.0 {
                 continue;
             }
-            let w = l.0[i] / self.pdf[i];
-            for c in 0..3 {
-                xyz[c] += w * cmf[c][i];
+            let w = radiance / pdf;
+            for (sum, matching) in xyz.iter_mut().zip(&cmf) {
+                *sum += w * matching[i];
             }
         }
         let scale = 1.0 / (N_SPECTRUM_SAMPLES as f32 * CIE_Y_INTEGRAL_F32);
