@@ -12,8 +12,9 @@
 //! F(cos θ, η(λ), k(λ)) · specular_reflectance; `eval` and `pdf` are zero. One-sided.
 
 use glam::{Vec2, Vec3};
+use wide::f32x4;
 
-use super::fresnel::{fresnel_conductor, reflect_z};
+use super::fresnel::{fresnel_conductor4, reflect_z};
 use super::{BsdfFlags, BsdfSample, ShadingPoint, Texture};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 
@@ -35,7 +36,8 @@ pub(crate) fn conductor_reflectance(
     lambda: &SampledWavelengths,
 ) -> SampledSpectrum {
     let (eta, k) = (eta.eval(uv, lambda), k.eval(uv, lambda));
-    SampledSpectrum::from_fn(|i| fresnel_conductor(cos_theta, eta[i], k[i]))
+    let reflectance = fresnel_conductor4(cos_theta, f32x4::from(eta.0), f32x4::from(k.0));
+    SampledSpectrum(reflectance.to_array())
 }
 
 impl Conductor {

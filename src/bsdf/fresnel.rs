@@ -4,6 +4,7 @@
 //! refraction η = η_interior / η_exterior, where the exterior is the side the normal points to.
 
 use glam::Vec3;
+use wide::f32x4;
 
 /// The Fresnel reflectance of a dielectric interface and the refraction it implies.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -76,24 +77,38 @@ pub fn fresnel_dielectric(cos_theta_i: f32, eta: f32) -> DielectricFresnel {
 /// (Mitsuba's default) is a perfect mirror.
 #[inline]
 pub fn fresnel_conductor(cos_theta_i: f32, eta: f32, k: f32) -> f32 {
+    fresnel_conductor4(cos_theta_i, f32x4::splat(eta), f32x4::splat(k)).to_array()[0]
+}
+
+/// [`fresnel_conductor`] for four (η, k) at once, one per wavelength of a path, in SIMD; a
+/// result that is not finite (from an infinite or NaN index) is 1.
+#[inline]
+pub fn fresnel_conductor4(cos_theta_i: f32, eta: f32x4, k: f32x4) -> f32x4 {
     let cos2 = cos_theta_i * cos_theta_i;
     let sin2 = (1.0 - cos2).max(0.0);
     let sin4 = sin2 * sin2;
+    let (cos, cos2, sin2, sin4) = (
+        f32x4::splat(cos_theta_i),
+        f32x4::splat(cos2),
+        f32x4::splat(sin2),
+        f32x4::splat(sin4),
+    );
     let t0 = eta * eta - k * k - sin2;
-    let a2_plus_b2 = (t0 * t0 + 4.0 * eta * eta * k * k).max(0.0).sqrt();
-    let a = (0.5 * (a2_plus_b2 + t0)).max(0.0).sqrt();
+    let a2_plus_b2 = (t0 * t0 + f32x4::splat(4.0) * eta * eta * k * k)
+        .max(f32x4::ZERO)
+        .sqrt();
+    let a = (f32x4::splat(0.5) * (a2_plus_b2 + t0))
+        .max(f32x4::ZERO)
+        .sqrt();
     let t1 = a2_plus_b2 + cos2;
-    let t2 = 2.0 * cos_theta_i * a;
+    let t2 = f32x4::splat(2.0) * cos * a;
     let r_s = (t1 - t2) / (t1 + t2);
     let t3 = a2_plus_b2 * cos2 + sin4;
     let t4 = t2 * sin2;
     let r_p = r_s * (t3 - t4) / (t3 + t4);
-    let f = 0.5 * (r_s + r_p);
-    if f.is_finite() {
-        f.clamp(0.0, 1.0)
-    } else {
-        1.0
-    }
+    let f = f32x4::splat(0.5) * (r_s + r_p);
+    f.is_finite()
+        .blend(f.max(f32x4::ZERO).min(f32x4::ONE), f32x4::ONE)
 }
 
 /// The hemispherical average of the dielectric Fresnel reflectance for light arriving from
@@ -141,6 +156,34 @@ pub fn refract(w: Vec3, m: Vec3, cos_theta_t: f32, eta_ti: f32) -> Vec3 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The four lanes are four independent evaluations: each equals the one-index formula
+    /// (itself the first lane of a splat), including a NaN index, whose reflectance is 1.
+    #[test]
+    fn conductor_lanes_are_independent() {
+        let mut rng = crate::sampling::rng::Pcg32::seeded(8);
+        for _ in 0..1000 {
+            let cos = rng.next_f32();
+            let eta: [f32; 4] = std::array::from_fn(|_| 4.0 * rng.next_f32());
+            let mut k: [f32; 4] = std::array::from_fn(|_| 5.0 * rng.next_f32());
+            k[3] = f32::NAN;
+            let four = fresnel_conductor4(cos, f32x4::from(eta), f32x4::from(k)).to_array();
+            for i in 0..4 {
+                assert_eq!(
+                    four[i].to_bits(),
+                    fresnel_conductor(cos, eta[i], k[i]).to_bits()
+                );
+            }
+            assert_eq!(four[3], 1.0);
+            // Normal incidence: ((η − 1)² + k²) / ((η + 1)² + k²).
+            let normal = fresnel_conductor4(1.0, f32x4::from(eta), f32x4::from(k)).to_array();
+            for i in 0..3 {
+                let expected =
+                    ((eta[i] - 1.0).powi(2) + k[i] * k[i]) / ((eta[i] + 1.0).powi(2) + k[i] * k[i]);
+                assert!((normal[i] - expected).abs() < 1e-5, "{} {}", eta[i], k[i]);
+            }
+        }
+    }
 
     #[test]
     fn normal_incidence_matches_the_closed_forms() {
