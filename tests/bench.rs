@@ -7,6 +7,7 @@ use std::process::Command;
 use glam::Vec3;
 use prism::bench::rays::{incoherent_rays, shadow_rays};
 use prism::geometry::{Geometry, Shape, TriangleMesh};
+use prism::scene::Scene;
 use prism::scene::mitsuba::load_scene;
 
 /// The number after `"key":` in a one-line JSON object.
@@ -103,16 +104,21 @@ fn geometry_memory_is_at_most_100_bytes_per_triangle() {
     assert!(per_triangle <= 100.0, "{per_triangle} bytes per triangle");
 }
 
-#[test]
-fn benchmark_rays_leave_surfaces_in_all_directions() {
+/// The bundled Cornell box at 64 × 64 pixels.
+fn small_cornell_box() -> Scene {
     let scene_path = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/cornell-box/scene.xml");
     let defines = [
         ("resx".to_string(), "64".to_string()),
         ("resy".to_string(), "64".to_string()),
     ];
-    let scene = load_scene(std::path::Path::new(scene_path), &defines)
+    load_scene(std::path::Path::new(scene_path), &defines)
         .unwrap()
-        .scene;
+        .scene
+}
+
+#[test]
+fn benchmark_rays_leave_surfaces_in_all_directions() {
+    let scene = small_cornell_box();
     let n = 20_000;
     let rays = incoherent_rays(&scene, n, 3);
     assert_eq!(rays.len(), n);
@@ -132,14 +138,7 @@ fn benchmark_rays_leave_surfaces_in_all_directions() {
 
 #[test]
 fn shadow_rays_join_visible_surfaces_to_the_lights() {
-    let scene_path = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/cornell-box/scene.xml");
-    let defines = [
-        ("resx".to_string(), "64".to_string()),
-        ("resy".to_string(), "64".to_string()),
-    ];
-    let scene = load_scene(std::path::Path::new(scene_path), &defines)
-        .unwrap()
-        .scene;
+    let scene = small_cornell_box();
     let n = 5_000;
     let rays = shadow_rays(&scene, n, 4);
     assert_eq!(rays.len(), n);
