@@ -24,8 +24,8 @@
 //! child about to be visited is prefetched whole, so that its cache lines arrive together:
 //! on large scenes traversal waits mostly for memory. The triangle test of a leaf is inlined
 //! into the traversal (so that it, too, runs in AVX's three-operand instructions) with the
-//! ray's constants prepared once per ray ([`PackRay`]): that took 26 % of the instructions of
-//! veach-bidir's shadow rays and made its renders 1.3–1.6× as fast.
+//! ray's constants prepared once per ray ([`PackRay`]): that took 22 % of the instructions of
+//! a mix of veach-bidir's shadow and bounce rays and made its renders 1.3–1.65× as fast.
 //! (Backing the arrays with 2 MiB pages, as Embree does, made no measurable difference.)
 //!
 //! Measured (`prism bench`, 1,024,000 triangles, 2 threads, incoherent rays): 4-wide nodes

@@ -290,23 +290,10 @@ mod tests {
         let v = [Vec3::ZERO, Vec3::X, Vec3::Y];
         pack.set(0, v, 0);
         pack.set(1, v.map(|p| p + Vec3::Z * 0.5), 1);
-        let ray = WatertightRay::new(Vec3::new(0.2, 0.2, 1.0), -Vec3::Z);
-        assert_eq!(
-            pack.intersect(&PackRay::new(&ray), 0b11, f32::INFINITY)
-                .unwrap()
-                .0,
-            1
-        );
-        assert_eq!(
-            pack.intersect(&PackRay::new(&ray), 0b01, f32::INFINITY)
-                .unwrap()
-                .0,
-            0
-        );
-        assert!(
-            pack.intersect(&PackRay::new(&ray), 0b00, f32::INFINITY)
-                .is_none()
-        );
-        assert!(pack.intersect(&PackRay::new(&ray), 0b11, 0.4).is_none());
+        let ray = PackRay::new(&WatertightRay::new(Vec3::new(0.2, 0.2, 1.0), -Vec3::Z));
+        assert_eq!(pack.intersect(&ray, 0b11, f32::INFINITY).unwrap().0, 1);
+        assert_eq!(pack.intersect(&ray, 0b01, f32::INFINITY).unwrap().0, 0);
+        assert!(pack.intersect(&ray, 0b00, f32::INFINITY).is_none());
+        assert!(pack.intersect(&ray, 0b11, 0.4).is_none());
     }
 }
