@@ -285,21 +285,30 @@ impl Bvh {
         watertight: &WatertightRay,
         analytic: impl FnMut(u32, f32) -> Option<f32>,
     ) -> Option<(u32, TriangleHit)> {
-        self.with_stack(|stack| {
-            #[cfg(target_arch = "x86_64")]
-            if self.avx {
-                // SAFETY: `avx` is set only where the processor has AVX.
-                return unsafe { self.closest_hit_avx(stack, ray, watertight, analytic) };
-            }
-            self.nearest_first::<false, false>(stack, ray, watertight, analytic)
-        })
+        self.traverse::<false>(ray, watertight, analytic)
     }
 
-    /// Runs `query` with an uninitialised traversal stack of [`Self::stack_size`] entries: on the
-    /// machine stack where that is small enough (every hierarchy but pathological ones), else on
-    /// the heap.
+    /// Whether any primitive is hit in (0, ray.t_max).
+    #[inline]
+    pub fn occluded(
+        &self,
+        ray: &Ray,
+        watertight: &WatertightRay,
+        analytic: impl FnMut(u32, f32) -> Option<f32>,
+    ) -> bool {
+        self.traverse::<true>(ray, watertight, analytic).is_some()
+    }
+
+    /// [`Self::nearest_first`] with an uninitialised traversal stack of [`Self::stack_size`]
+    /// entries (on the machine stack where that is small enough, every hierarchy but
+    /// pathological ones, else on the heap), in AVX where the processor has it.
     #[inline(always)]
-    fn with_stack<T: Copy, R>(&self, query: impl FnOnce(&mut [MaybeUninit<T>]) -> R) -> R {
+    fn traverse<const ANY_HIT: bool>(
+        &self,
+        ray: &Ray,
+        watertight: &WatertightRay,
+        analytic: impl FnMut(u32, f32) -> Option<f32>,
+    ) -> Option<(u32, TriangleHit)> {
         let mut inline_stack = [MaybeUninit::uninit(); INLINE_STACK];
         let mut heap_stack = Vec::new();
         let stack = if self.stack_size <= INLINE_STACK {
@@ -308,21 +317,25 @@ impl Bvh {
             heap_stack.resize(self.stack_size, MaybeUninit::uninit());
             &mut heap_stack[..]
         };
-        query(stack)
+        #[cfg(target_arch = "x86_64")]
+        if self.avx {
+            // SAFETY: `avx` is set only where the processor has AVX.
+            return unsafe { self.nearest_first_avx::<ANY_HIT>(stack, ray, watertight, analytic) };
+        }
+        self.nearest_first::<false, ANY_HIT>(stack, ray, watertight, analytic)
     }
 
-    /// [`Self::nearest_first`] looking for the closest hit, compiled for AVX; the processor must
-    /// have it.
+    /// [`Self::nearest_first`] compiled for AVX; the processor must have it.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx")]
-    unsafe fn closest_hit_avx(
+    unsafe fn nearest_first_avx<const ANY_HIT: bool>(
         &self,
         stack: &mut [MaybeUninit<(NodeRef, f32)>],
         ray: &Ray,
         watertight: &WatertightRay,
         analytic: impl FnMut(u32, f32) -> Option<f32>,
     ) -> Option<(u32, TriangleHit)> {
-        self.nearest_first::<true, false>(stack, ray, watertight, analytic)
+        self.nearest_first::<true, ANY_HIT>(stack, ray, watertight, analytic)
     }
 
     /// The front-to-back traversal of both queries: the nearest hit, or with `ANY_HIT` the first
@@ -435,39 +448,6 @@ impl Bvh {
                 unsafe { _mm_prefetch::<_MM_HINT_T0>(start.wrapping_add(offset)) };
             }
         }
-    }
-
-    /// Whether any primitive is hit in (0, ray.t_max).
-    #[inline]
-    pub fn occluded(
-        &self,
-        ray: &Ray,
-        watertight: &WatertightRay,
-        analytic: impl FnMut(u32, f32) -> Option<f32>,
-    ) -> bool {
-        self.with_stack(|stack| {
-            #[cfg(target_arch = "x86_64")]
-            if self.avx {
-                // SAFETY: `avx` is set only where the processor has AVX.
-                return unsafe { self.occluded_avx(stack, ray, watertight, analytic) };
-            }
-            self.nearest_first::<false, true>(stack, ray, watertight, analytic)
-                .is_some()
-        })
-    }
-
-    /// [`Self::nearest_first`] looking for any hit, compiled for AVX; the processor must have it.
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx")]
-    unsafe fn occluded_avx(
-        &self,
-        stack: &mut [MaybeUninit<(NodeRef, f32)>],
-        ray: &Ray,
-        watertight: &WatertightRay,
-        analytic: impl FnMut(u32, f32) -> Option<f32>,
-    ) -> bool {
-        self.nearest_first::<true, true>(stack, ray, watertight, analytic)
-            .is_some()
     }
 
     #[inline(always)]
