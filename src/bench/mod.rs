@@ -105,12 +105,12 @@ pub struct Measurement {
     pub scene: String,
     /// Triangles in the BVH (after dropping degenerate ones) plus analytic shapes.
     pub primitives: usize,
-    /// Building the BVH over all shapes (scene loading excluded).
+    /// Building the BVH over all shapes (scene loading excluded), the fastest of three builds.
     pub bvh_build_seconds: f64,
     /// Shapes plus BVH, from [`Geometry::memory_bytes`].
     pub geometry_bytes: usize,
     /// Closest-hit queries per second on incoherent rays ([`rays::incoherent_rays`]), without
-    /// building surface interactions.
+    /// building surface interactions: the fastest pass over them ([`trace_rates`]).
     pub rays_per_second: f64,
     /// The same with Embree on the same rays (builds with the cargo feature `embree` only).
     pub embree_rays_per_second: Option<f64>,
@@ -144,27 +144,36 @@ fn pool(threads: usize) -> Result<rayon::ThreadPool> {
         .map_err(|e| Error::usage(format!("could not start the worker threads: {e}")))
 }
 
-/// Queries per second over `rays` (a closest hit or an occlusion test: `query` says whether
-/// the ray hit), traced in parallel, repeated for at least a second; returns (rays/s, number
-/// of hits).
-pub fn trace_rate(
+/// Queries per second of each of `queries` over the same `rays` (a closest hit or an
+/// occlusion test: a query says whether the ray hit), traced in parallel, and each one's number
+/// of hits. The queries take turns, one pass over the rays each, for at least a second per
+/// query and three turns, and each one's rate is that of its fastest pass: on a machine whose
+/// speed drifts by tens of percent within seconds (a shared virtual machine), one after the
+/// other for a second each made the ratio of two unchanged structures vary by ±15 %.
+pub fn trace_rates(
     threads: usize,
     rays: &[Ray],
-    query: impl Fn(&Ray) -> bool + Sync,
-) -> Result<(f64, usize)> {
+    queries: &[&(dyn Fn(&Ray) -> bool + Sync)],
+) -> Result<Vec<(f64, usize)>> {
     use rayon::prelude::*;
     let pool = pool(threads)?;
+    let mut results = vec![(0.0f64, 0usize); queries.len()];
+    let budget = Duration::from_secs(queries.len() as u64);
     let start = Instant::now();
-    let (mut traced, mut hits) = (0usize, 0usize);
-    while traced == 0 || start.elapsed() < Duration::from_secs(1) {
-        hits = pool.install(|| {
-            rays.par_chunks(1024)
-                .map(|chunk| chunk.iter().filter(|ray| query(ray)).count())
-                .sum()
-        });
-        traced += rays.len();
+    let mut turns = 0;
+    while turns < 3 || start.elapsed() < budget {
+        for (query, (rate, hits)) in queries.iter().zip(&mut results) {
+            let pass = Instant::now();
+            *hits = pool.install(|| {
+                rays.par_chunks(1024)
+                    .map(|chunk| chunk.iter().filter(|ray| query(ray)).count())
+                    .sum()
+            });
+            *rate = rate.max(rays.len() as f64 / pass.elapsed().as_secs_f64());
+        }
+        turns += 1;
     }
-    Ok((traced as f64 / start.elapsed().as_secs_f64(), hits))
+    Ok(results)
 }
 
 /// The reference image of `scene` at `spp`, read from the cache or rendered (once) into it.
@@ -205,35 +214,54 @@ fn reference(
 pub fn measure(bench: &BenchScene, options: &BenchOptions) -> Result<Measurement> {
     let scene = load_scene(&bench.path, &bench.defines)?.scene;
 
-    // The BVH again, timed alone (the scene's own was built while loading).
-    let shapes = scene.geometry.shapes.clone();
-    let start = Instant::now();
-    let rebuilt = pool(options.threads)?.install(|| Geometry::new(shapes));
-    let bvh_build_seconds = start.elapsed().as_secs_f64();
-    let primitives = rebuilt.primitive_count();
-    let geometry_bytes = rebuilt.memory_bytes();
-    drop(rebuilt);
+    // The BVH again, timed alone (the scene's own was built while loading): the fastest of
+    // three builds, for the reason given at `trace_rates`.
+    let pool = pool(options.threads)?;
+    let mut bvh_build_seconds = f64::INFINITY;
+    let (mut primitives, mut geometry_bytes) = (0, 0);
+    for _ in 0..3 {
+        let shapes = scene.geometry.shapes.clone();
+        let start = Instant::now();
+        let rebuilt = pool.install(|| Geometry::new(shapes));
+        bvh_build_seconds = bvh_build_seconds.min(start.elapsed().as_secs_f64());
+        primitives = rebuilt.primitive_count();
+        geometry_bytes = rebuilt.memory_bytes();
+    }
 
     let rays = rays::incoherent_rays(&scene, options.ray_count, 1);
     let shadow_rays = rays::shadow_rays(&scene, options.ray_count, 2);
-    let closest_hit = |geometry: &Geometry, ray: &Ray| geometry.closest_hit(ray).is_some();
-    let occluded = |geometry: &Geometry, ray: &Ray| geometry.occluded(ray);
     let ours = &scene.geometry;
-    let (rays_per_second, hits) = trace_rate(options.threads, &rays, |r| closest_hit(ours, r))?;
-    let (shadow_rays_per_second, occluded_count) = if shadow_rays.is_empty() {
-        (0.0, 0)
-    } else {
-        trace_rate(options.threads, &shadow_rays, |r| occluded(ours, r))?
-    };
-    let (embree_rays_per_second, embree_shadow_rays_per_second) = if cfg!(feature = "embree") {
+    let embree = if cfg!(feature = "embree") {
         let mut embree = scene.geometry.clone();
         embree.set_accel(crate::geometry::accel::Accel::Embree)?;
-        let (rate, embree_hits) = trace_rate(options.threads, &rays, |r| closest_hit(&embree, r))?;
-        let (shadow_rate, embree_occluded) = if shadow_rays.is_empty() {
-            (0.0, 0)
-        } else {
-            trace_rate(options.threads, &shadow_rays, |r| occluded(&embree, r))?
-        };
+        Some(embree)
+    } else {
+        None
+    };
+    fn closest_hit(geometry: &Geometry) -> impl Fn(&Ray) -> bool + Sync + '_ {
+        move |ray| geometry.closest_hit(ray).is_some()
+    }
+    fn occluded(geometry: &Geometry) -> impl Fn(&Ray) -> bool + Sync + '_ {
+        move |ray| geometry.occluded(ray)
+    }
+    let (ours_closest, ours_occluded) = (closest_hit(ours), occluded(ours));
+    let mut closest: Vec<&(dyn Fn(&Ray) -> bool + Sync)> = vec![&ours_closest];
+    let mut shadow: Vec<&(dyn Fn(&Ray) -> bool + Sync)> = vec![&ours_occluded];
+    let embree_queries = embree.as_ref().map(|e| (closest_hit(e), occluded(e)));
+    if let Some((embree_closest, embree_occluded)) = &embree_queries {
+        closest.push(embree_closest);
+        shadow.push(embree_occluded);
+    }
+    let closest = trace_rates(options.threads, &rays, &closest)?;
+    let shadow = if shadow_rays.is_empty() {
+        vec![(0.0, 0); closest.len()]
+    } else {
+        trace_rates(options.threads, &shadow_rays, &shadow)?
+    };
+    let (rays_per_second, hits) = closest[0];
+    let (shadow_rays_per_second, occluded_count) = shadow[0];
+    let (embree_rays_per_second, embree_shadow_rays_per_second) = if embree.is_some() {
+        let ((rate, embree_hits), (shadow_rate, embree_occluded)) = (closest[1], shadow[1]);
         // The two structures must agree, or the comparison means nothing (a ray grazing an
         // edge may rarely go either way).
         for (what, theirs, ours, count) in [

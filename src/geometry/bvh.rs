@@ -497,10 +497,11 @@ struct Pending {
 }
 
 /// The collapse of a binary hierarchy into the 8-wide one. The root's children are collapsed
-/// in parallel, each into a [`WideTree`] of its own, and the trees are then laid end to end (so
-/// nodes and packs stay in depth-first order). No pass over the whole binary tree comes first:
-/// whether a subtree becomes a leaf (at most four triangles) is found by a walk that stops at
-/// the fifth primitive. On the million triangles of `prism bench` (2 threads, five interleaved
+/// in parallel (in trees of [`PARALLEL_COLLAPSE_NODES`] binary nodes or more), each into a
+/// [`WideTree`] of its own, and the trees are then laid end to end (so nodes and packs stay in
+/// depth-first order). No pass over the whole binary tree comes first: whether a subtree
+/// becomes a leaf (at most four triangles) is found by a walk that stops at the fifth
+/// primitive. On the million triangles of `prism bench` (2 threads, five interleaved
 /// runs each) that took the whole build from 0.89–1.07 s to 0.71–0.81 s, the trees being the
 /// same but for the packs shared across the root's children.
 struct Collapse<'a> {
@@ -522,6 +523,10 @@ struct WideTree {
     /// Depth of the deepest node or leaf below the subtree's root (0 for the root itself).
     max_depth: usize,
 }
+
+/// Binary nodes from which the root's subtrees are collapsed in parallel: below, handing them
+/// to the thread pool costs more than it saves (it made the Cornell box's build 49 → 76 µs).
+const PARALLEL_COLLAPSE_NODES: usize = 1 << 15;
 
 /// How many recent packs a new leaf may go into (first fit): more fill packs better, fewer keep
 /// a leaf's triangles near its siblings'.
@@ -592,7 +597,12 @@ impl<'a> Collapse<'a> {
 
     fn run(self) -> Bvh {
         let root_box = self.binary.nodes[0].aabb();
-        let (root, nodes, packs, max_depth) = match self.node_children(0) {
+        let children = if self.binary.nodes.len() < PARALLEL_COLLAPSE_NODES {
+            None
+        } else {
+            self.node_children(0)
+        };
+        let (root, nodes, packs, max_depth) = match children {
             None => {
                 let mut tree = WideTree::default();
                 let root = tree.collapse(&self, 0);
