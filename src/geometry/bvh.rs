@@ -876,7 +876,7 @@ mod tests {
         let mut rng = Pcg32::seeded(5);
         // 20,000 triangles make a binary tree above PARALLEL_COLLAPSE_NODES, collapsed in
         // parallel; the others are collapsed in one piece.
-        assert!(2 * 20_000 - 1 >= PARALLEL_COLLAPSE_NODES);
+        const { assert!(2 * 20_000 > PARALLEL_COLLAPSE_NODES) };
         for (triangles, rays) in [
             (1, 4000),
             (3, 4000),
