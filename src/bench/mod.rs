@@ -176,6 +176,16 @@ pub fn trace_rates(
     Ok(results)
 }
 
+/// The closest-hit query of `geometry`, as [`trace_rates`] takes it.
+fn closest_hit(geometry: &Geometry) -> impl Fn(&Ray) -> bool + Sync + '_ {
+    move |ray| geometry.closest_hit(ray).is_some()
+}
+
+/// The occlusion query of `geometry`, as [`trace_rates`] takes it.
+fn occluded(geometry: &Geometry) -> impl Fn(&Ray) -> bool + Sync + '_ {
+    move |ray| geometry.occluded(ray)
+}
+
 /// The reference image of `scene` at `spp`, read from the cache or rendered (once) into it.
 fn reference(
     scene: &Scene,
@@ -238,12 +248,6 @@ pub fn measure(bench: &BenchScene, options: &BenchOptions) -> Result<Measurement
     } else {
         None
     };
-    fn closest_hit(geometry: &Geometry) -> impl Fn(&Ray) -> bool + Sync + '_ {
-        move |ray| geometry.closest_hit(ray).is_some()
-    }
-    fn occluded(geometry: &Geometry) -> impl Fn(&Ray) -> bool + Sync + '_ {
-        move |ray| geometry.occluded(ray)
-    }
     let (ours_closest, ours_occluded) = (closest_hit(ours), occluded(ours));
     let mut closest: Vec<&(dyn Fn(&Ray) -> bool + Sync)> = vec![&ours_closest];
     let mut shadow: Vec<&(dyn Fn(&Ray) -> bool + Sync)> = vec![&ours_occluded];
