@@ -30,11 +30,16 @@
 //! into the traversal (so that it, too, runs in AVX's three-operand instructions) with the
 //! ray's constants prepared once per ray ([`PackRay`]): that took 22 % of the instructions of
 //! a mix of veach-bidir's shadow and bounce rays and made its renders 1.3–1.65× as fast.
-//! (Backing the arrays with 2 MiB pages, as Embree does, made no measurable difference.)
+//! (Backing the arrays with 2 MiB pages, as Embree does, made no measurable difference; nor
+//! did prefetching only the nearest pending child instead of all.)
 //!
-//! Measured (`prism bench`, 1,024,000 triangles, 2 threads, incoherent rays): 4-wide nodes
-//! traced 0.59–0.62× Embree 3's rays/s, 8-wide nodes with SSE 0.55–0.60×, 8-wide with AVX and
-//! whole-node prefetching 0.78–0.85×.
+//! Measured (`prism bench`, 1,024,000 triangles, 2 threads, incoherent rays, ratio to Embree
+//! 3's rays/s): 4-wide nodes 0.59–0.62×, 8-wide nodes with SSE 0.55–0.60×, 8-wide with AVX and
+//! whole-node prefetching 0.66–0.80× (the range over several sessions on a drifting virtual
+//! machine), the SAH-optimal collapse 0.76–0.89× (15 runs). Child boxes quantised to 8 bits
+//! in the node's box (Ylitie et al. 2017, §3.2: two cache lines per node instead of four,
+//! 68 instead of 76.5 bytes per triangle) were slightly slower, 0.78–0.80× against 0.81–0.85×
+//! in turns, so the nodes keep f32 boxes.
 
 use std::mem::MaybeUninit;
 
