@@ -345,7 +345,8 @@ impl Bvh {
     /// one found. Shadow rays go nearest first too: on veach-bidir, where they cross the lamps
     /// to reach the lights, that tests 40 % fewer triangle packs than taking the children in any
     /// order (12 against 20 per ray) and traces 1.15–1.25× the shadow rays per second; on the
-    /// million triangles it costs 1 % more instructions.
+    /// million triangles it costs 1 % more instructions. (With the SAH-optimal collapse it is
+    /// 7.6 packs per ray there; farthest first, in case the occluders lie by the lights, 22.)
     #[inline(always)]
     fn nearest_first<const AVX: bool, const ANY_HIT: bool>(
         &self,
