@@ -1231,7 +1231,7 @@ mod tests {
     /// The collapse is the cheapest by the SAH: the built tree costs what an exhaustive search
     /// over all collapses of the same binary tree finds (to f32 rounding), on small scenes with
     /// and without analytic primitives. (The greedy collapse that came before, the largest child
-    /// opened until there were eight, cost up to 61 % more on these, 12–22 % from 100
+    /// opened until there were eight, cost up to 61 % more on these, 13–22 % from 100
     /// primitives on.)
     #[test]
     fn collapse_is_sah_optimal() {
