@@ -689,13 +689,14 @@ impl<'a> Collapse<'a> {
         let area = self.binary.nodes[i].aabb().half_area();
         let triangles = (left.triangles + right.triangles).min(NOT_A_PACK);
         // The cheapest way to spread the subtree over up to `slots` children (index slots − 1),
-        // and the slots its left half gets for that.
+        // and the slots its left half gets for that (some split even where every cost is
+        // infinite: boxes of huge coordinates have infinite areas).
         let mut spread = [f32::INFINITY; NODE_WIDTH];
         let mut left_slots = [0u8; NODE_WIDTH];
         for slots in 2..=NODE_WIDTH {
             for k in 1..slots {
                 let cost = left.cost[k - 1] + right.cost[slots - k - 1];
-                if cost < spread[slots - 1] {
+                if k == 1 || cost < spread[slots - 1] {
                     spread[slots - 1] = cost;
                     left_slots[slots - 1] = k as u8;
                 }
@@ -708,7 +709,8 @@ impl<'a> Collapse<'a> {
         };
         let node = area * NODE_COST + spread[NODE_WIDTH - 1];
         let mut plan = Plan {
-            node: node < leaf,
+            // A subtree that cannot be a leaf is a node, whatever the (perhaps infinite) costs.
+            node: usize::from(triangles) > PACK_WIDTH || node < leaf,
             left_slots: [0; NODE_WIDTH],
         };
         let one_child = node.min(leaf);
@@ -718,6 +720,12 @@ impl<'a> Collapse<'a> {
                 cost[slots - 1] = spread[slots - 1];
                 plan.left_slots[slots - 1] = left_slots[slots - 1];
             }
+        }
+        // A node's own children are its halves' spread over eight, even where a NaN cost (the
+        // area of a flat box of infinite extent) compared false above. (No parent gives a child
+        // all eight slots, so this entry is read for nodes only.)
+        if plan.node {
+            plan.left_slots[NODE_WIDTH - 1] = left_slots[NODE_WIDTH - 1];
         }
         self.plans[i].store(plan.to_bits(), Ordering::Relaxed);
         SubtreeCost { cost, triangles }
@@ -1249,6 +1257,57 @@ mod tests {
                 );
             }
         }
+    }
+
+    /// Boxes so large that their surface areas overflow to infinity (a few triangles with
+    /// coordinates near 10²⁰ among small ones), or are NaN (a flat box of infinite extent),
+    /// still give a valid tree: every small triangle is found where testing them all finds it.
+    /// (The huge ones overflow the triangle test itself, so no ray hits them.)
+    #[test]
+    fn infinite_surface_areas_give_a_valid_tree() {
+        let mut rng = Pcg32::seeded(17);
+        let (mut primitives, _) = scene(&mut rng, 60);
+        primitives.truncate(60);
+        for (k, p) in primitives.iter_mut().enumerate().take(3) {
+            let PrimitiveKind::Triangle(v) = p.kind else {
+                unreachable!("the first primitives are triangles")
+            };
+            p.kind = PrimitiveKind::Triangle(v.map(|x| x * 1e20 * (k + 1) as f32));
+        }
+        // A flat one whose box is infinitely wide: its area is ∞ · 0, NaN.
+        primitives[3].kind = PrimitiveKind::Triangle([
+            Vec3::new(-2e38, 0.0, 0.0),
+            Vec3::new(2e38, 1.0, 0.0),
+            Vec3::new(0.0, 2.0, 0.0),
+        ]);
+        let bvh = Bvh::build(&primitives).unwrap();
+        let mut hits = 0;
+        for p in &primitives[4..] {
+            let PrimitiveKind::Triangle(v) = p.kind else {
+                unreachable!("all primitives are triangles")
+            };
+            let o = Vec3::new(0.1, 0.2, 3.0);
+            let d = (v[0] + v[1] + v[2]) / 3.0 - o;
+            let (ray, watertight) = (Ray::new(o, d, f32::INFINITY, 0.0), WatertightRay::new(o, d));
+            let expected = primitives
+                .iter()
+                .filter_map(|q| match q.kind {
+                    PrimitiveKind::Triangle(w) => {
+                        watertight.intersect(f32::INFINITY, w[0], w[1], w[2])
+                    }
+                    PrimitiveKind::Analytic { .. } => None,
+                })
+                .map(|h| h.t)
+                .reduce(f32::min);
+            let found = bvh.closest_hit(&ray, &watertight, |_, _| None);
+            assert_eq!(found.map(|(_, h)| h.t), expected);
+            hits += usize::from(found.is_some());
+        }
+        assert_eq!(
+            hits,
+            primitives.len() - 4,
+            "every aimed ray hits a triangle"
+        );
     }
 
     /// Packs are shared by small leaves: a large mesh needs few more packs than a quarter of its
