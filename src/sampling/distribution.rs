@@ -13,14 +13,23 @@ use glam::Vec2;
 pub struct PiecewiseConstant1D {
     /// The normalised density in each cell.
     density: Vec<f32>,
-    /// cdf[i] = integral of the normalised density over the first i cells; cdf[n] = 1.
-    cdf: Vec<f64>,
+    /// cdf[i] = integral of the normalised density over the first i cells; cdf[n] = 1. Summed
+    /// in f64 and rounded to f32: u is an f32, so its resolution, not the table's, limits
+    /// which cells can be told apart.
+    cdf: Vec<f32>,
+    /// 1 / (cdf[i + 1] − cdf[i]), or 0 for a cell of zero probability: the position of u within
+    /// its cell is then a product, not a division.
+    inverse_width: Vec<f32>,
     /// guide[j] = the cell containing u = j / guide.len().
     guide: Vec<u32>,
     /// Integral of the (unnormalised) weights over the domain.
     integral: f64,
     min: f32,
     max: f32,
+    /// The width of a cell, (max − min) / n.
+    cell_width: f32,
+    /// The largest f32 below `max`, the largest point a sample may return.
+    last: f32,
 }
 
 impl PiecewiseConstant1D {
@@ -53,10 +62,21 @@ impl PiecewiseConstant1D {
         // cell for large ones (the rows of an environment map), whose memory matters more.
         let per_cell = if n <= 1024 { 4 } else { 1 };
         let guide_len = (per_cell * n).next_power_of_two().max(16);
+        let cdf: Vec<f32> = cdf.iter().map(|&c| c as f32).collect();
+        let inverse_width = cdf
+            .windows(2)
+            .map(|w| {
+                if w[1] > w[0] {
+                    1.0 / (w[1] - w[0])
+                } else {
+                    0.0
+                }
+            })
+            .collect();
         let mut guide = Vec::with_capacity(guide_len);
         let mut cell = 0usize;
         for j in 0..guide_len {
-            let u = j as f64 / guide_len as f64;
+            let u = j as f32 / guide_len as f32;
             while cell + 1 < n && cdf[cell + 1] <= u {
                 cell += 1;
             }
@@ -75,10 +95,13 @@ impl PiecewiseConstant1D {
         PiecewiseConstant1D {
             density,
             cdf,
+            inverse_width,
             guide,
             integral,
             min,
             max,
+            cell_width: (max - min) / n as f32,
+            last: max.next_down(),
         }
     }
 
@@ -105,17 +128,13 @@ impl PiecewiseConstant1D {
         let n = self.density.len();
         // The last cell whose start cdf[i] is at most u, searched from the guide's cell on.
         let slot = ((u * self.guide.len() as f32) as usize).min(self.guide.len() - 1);
-        let u = f64::from(u);
         let mut index = self.guide[slot] as usize;
         while index + 1 < n && self.cdf[index + 1] <= u {
             index += 1;
         }
-        let lo = self.cdf[index];
-        let width = self.cdf[index + 1] - lo;
-        let offset = if width > 0.0 { (u - lo) / width } else { 0.0 };
-        let cell = (self.max - self.min) / n as f32;
-        let x = self.min + (index as f32 + offset as f32) * cell;
-        (x.min(self.max.next_down()).max(self.min), index)
+        let offset = (u - self.cdf[index]) * self.inverse_width[index];
+        let x = self.min + (index as f32 + offset) * self.cell_width;
+        (x.min(self.last).max(self.min), index)
     }
 
     /// Density of [`Self::sample`] at `x` (zero outside the domain).
@@ -143,7 +162,8 @@ impl PiecewiseConstant1D {
         let t = f64::from((x - self.min) / (self.max - self.min)) * n as f64;
         let index = (t as usize).min(n - 1);
         let frac = t - index as f64;
-        Some((self.cdf[index] + frac * (self.cdf[index + 1] - self.cdf[index])) as f32)
+        let (lo, hi) = (f64::from(self.cdf[index]), f64::from(self.cdf[index + 1]));
+        Some((lo + frac * (hi - lo)) as f32)
     }
 }
 

@@ -172,9 +172,10 @@ impl WavelengthSampling {
         let clamp = |lambda: f32| lambda.clamp(LAMBDA_MIN, LAMBDA_MAX.next_down());
         match self {
             WavelengthSampling::CieSum => {
+                // The table's samples lie in its domain, [LAMBDA_MIN, LAMBDA_MAX).
                 let table = Self::cie_sum_distribution();
                 let (lambda, cell) = table.sample(u);
-                (clamp(lambda), table.cell_pdf(cell))
+                (lambda, table.cell_pdf(cell))
             }
             WavelengthSampling::Visible => {
                 let lambda = clamp(
