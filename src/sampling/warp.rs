@@ -13,12 +13,30 @@ pub fn sample_uniform_disk_concentric(u: Vec2) -> Vec2 {
     if offset == Vec2::ZERO {
         return Vec2::ZERO;
     }
-    let (r, theta) = if offset.x.abs() > offset.y.abs() {
-        (offset.x, FRAC_PI_4 * (offset.y / offset.x))
+    // θ = π/4 · y/x in the wedges about ±x, π/2 − π/4 · x/y in those about ±y, whose cosine
+    // and sine are the sine and cosine of π/4 · x/y.
+    if offset.x.abs() > offset.y.abs() {
+        let (cos, sin) = cos_sin_within_quarter_pi(FRAC_PI_4 * (offset.y / offset.x));
+        offset.x * Vec2::new(cos, sin)
     } else {
-        (offset.y, FRAC_PI_2 - FRAC_PI_4 * (offset.x / offset.y))
-    };
-    r * Vec2::new(theta.cos(), theta.sin())
+        let (cos, sin) = cos_sin_within_quarter_pi(FRAC_PI_4 * (offset.x / offset.y));
+        offset.y * Vec2::new(sin, cos)
+    }
+}
+
+/// (cos a, sin a) for |a| ≤ π/4 by their Taylor series to a⁸ and a⁹, whose remainders there,
+/// a¹⁰/10! ≤ 2.5·10⁻⁸ and a¹¹/11! ≤ 1.8·10⁻⁹, are under half an f32 ulp of the results: no range
+/// reduction is needed, which makes this several times cheaper than the library's `sin_cos`.
+#[inline]
+fn cos_sin_within_quarter_pi(a: f32) -> (f32, f32) {
+    let a2 = a * a;
+    let cos =
+        1.0 + a2 * (-1.0 / 2.0 + a2 * (1.0 / 24.0 + a2 * (-1.0 / 720.0 + a2 * (1.0 / 40_320.0))));
+    let sin = a
+        * (1.0
+            + a2 * (-1.0 / 6.0
+                + a2 * (1.0 / 120.0 + a2 * (-1.0 / 5_040.0 + a2 * (1.0 / 362_880.0)))));
+    (cos, sin)
 }
 
 /// Density of [`sample_uniform_disk_concentric`] per unit area.
@@ -141,6 +159,25 @@ pub fn invert_uniform_triangle(b: Vec2) -> Vec2 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The polynomial cosine and sine agree with the exact values over the whole range they
+    /// serve, |a| ≤ π/4, to the f32 rounding of their five Horner steps (each at most 2⁻²⁴ of
+    /// a value ≤ 1) plus the series' remainder, 2.5·10⁻⁸: 3.3·10⁻⁷. Dropping the a⁸ term
+    /// (3.6·10⁻⁶ at π/4) or any lower one fails it.
+    #[test]
+    fn quarter_pi_cosine_and_sine_match_the_library() {
+        let n = 100_000;
+        let mut worst = 0.0f64;
+        for i in 0..=n {
+            let a = FRAC_PI_4 * (2.0 * i as f32 / n as f32 - 1.0);
+            let (cos, sin) = cos_sin_within_quarter_pi(a);
+            let a64 = f64::from(a);
+            worst = worst
+                .max((f64::from(cos) - a64.cos()).abs())
+                .max((f64::from(sin) - a64.sin()).abs());
+        }
+        assert!(worst < 3.3e-7, "largest error {worst}");
+    }
     use crate::sampling::rng::Pcg32;
 
     fn random_points(n: usize) -> Vec<Vec2> {
