@@ -79,6 +79,13 @@ impl Pcg32 {
     /// Moves the generator `delta` steps ahead (or back, for negative values) in O(log delta)
     /// (Brown 1994, "Random Number Generation with Arbitrary Strides").
     pub fn advance(&mut self, delta: i64) {
+        let stride = self.stride(delta);
+        self.jump(stride);
+    }
+
+    /// The affine map that moves this stream `delta` steps: `delta` steps of the LCG
+    /// s ↦ a·s + c compose to s ↦ A·s + C, found by repeated squaring (Brown 1994).
+    pub fn stride(&self, delta: i64) -> Stride {
         let mut cur_mult = PCG32_MULTIPLIER;
         let mut cur_plus = self.increment;
         let mut acc_mult = 1u64;
@@ -93,8 +100,27 @@ impl Pcg32 {
             cur_mult = cur_mult.wrapping_mul(cur_mult);
             delta >>= 1;
         }
-        self.state = acc_mult.wrapping_mul(self.state).wrapping_add(acc_plus);
+        Stride {
+            multiplier: acc_mult,
+            increment: acc_plus,
+        }
     }
+
+    /// Applies a stride of this stream (from [`Self::stride`]) in one multiply-add.
+    #[inline]
+    pub fn jump(&mut self, stride: Stride) {
+        self.state = stride
+            .multiplier
+            .wrapping_mul(self.state)
+            .wrapping_add(stride.increment);
+    }
+}
+
+/// A jump of a fixed number of steps along one PCG32 stream (see [`Pcg32::stride`]).
+#[derive(Clone, Copy, Debug)]
+pub struct Stride {
+    multiplier: u64,
+    increment: u64,
 }
 
 /// A 64-bit finaliser with good avalanche (the "mix13" variant of SplitMix64's finaliser,

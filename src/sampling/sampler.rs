@@ -30,7 +30,7 @@
 
 use glam::{UVec2, Vec2};
 
-use super::rng::{Pcg32, hash_u64s};
+use super::rng::{Pcg32, Stride, hash_u64s};
 
 /// The kinds of per-pixel sampler.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -92,6 +92,22 @@ pub struct Sampler {
     index: u32,
     dimension: u32,
     rng: Pcg32,
+    /// What the render loop's order (a pixel's samples one after another) lets us keep from
+    /// one sample to the next, None before the first sample.
+    stream: Option<PixelStream>,
+}
+
+/// A pixel's random stream, as far as [`Sampler::start_pixel_sample`] has gone along it.
+#[derive(Clone, Debug)]
+struct PixelStream {
+    pixel: UVec2,
+    /// The stream's start, for samples that do not follow the last one.
+    start: Pcg32,
+    /// NUMBERS_PER_SAMPLE steps along the stream: from one sample's start to the next's.
+    sample_stride: Stride,
+    /// The last sample started (its index in the pixel, not in its block) and the generator at
+    /// its start.
+    last: (u32, Pcg32),
 }
 
 /// Numbers reserved per pixel sample in the pixel's random stream.
@@ -116,6 +132,7 @@ impl Sampler {
             index: 0,
             dimension: 0,
             rng: Pcg32::default(),
+            stream: None,
         }
     }
 
@@ -137,9 +154,37 @@ impl Sampler {
         ]);
         self.index = index % self.sample_count;
         self.dimension = 0;
-        let stream = hash_u64s(&[u64::from(pixel.x), u64::from(pixel.y), self.seed]);
-        self.rng = Pcg32::new(hash_u64s(&[self.seed]), stream);
-        self.rng.advance(i64::from(index) * NUMBERS_PER_SAMPLE);
+        // The sample's numbers start NUMBERS_PER_SAMPLE · index steps into the pixel's stream:
+        // one multiply-add on from the previous sample's start when it is the next one, as in
+        // the render loop, else a jump of O(log index) steps from the stream's start.
+        match &mut self.stream {
+            Some(stream) if stream.pixel == pixel => {
+                let (last_index, last_start) = &stream.last;
+                let mut rng;
+                if last_index.checked_add(1) == Some(index) {
+                    rng = last_start.clone();
+                    rng.jump(stream.sample_stride);
+                } else {
+                    rng = stream.start.clone();
+                    rng.advance(i64::from(index) * NUMBERS_PER_SAMPLE);
+                }
+                stream.last = (index, rng.clone());
+                self.rng = rng;
+            }
+            _ => {
+                let id = hash_u64s(&[u64::from(pixel.x), u64::from(pixel.y), self.seed]);
+                let start = Pcg32::new(hash_u64s(&[self.seed]), id);
+                let mut rng = start.clone();
+                rng.advance(i64::from(index) * NUMBERS_PER_SAMPLE);
+                self.stream = Some(PixelStream {
+                    pixel,
+                    sample_stride: start.stride(NUMBERS_PER_SAMPLE),
+                    start,
+                    last: (index, rng.clone()),
+                });
+                self.rng = rng;
+            }
+        }
     }
 
     /// The primary dimensions of the current sample; call once, first, per pixel sample.
@@ -310,6 +355,43 @@ mod tests {
                     assert!(!seen[p as usize], "length {length} seed {seed}: {p} twice");
                     seen[p as usize] = true;
                 }
+            }
+        }
+    }
+
+    /// Starting a pixel's samples one after another (each a multiply-add on from the last)
+    /// gives the numbers of starting each one on its own, for every sampler kind, across
+    /// blocks of N and after going back; the same after another pixel's samples.
+    #[test]
+    fn consecutive_samples_match_samples_started_alone() {
+        let kinds = [
+            SamplerKind::Independent,
+            SamplerKind::NRooks,
+            SamplerKind::Stratified { jitter: true },
+            SamplerKind::MultiJitter { jitter: true },
+        ];
+        let numbers = |sampler: &mut Sampler| -> Vec<f32> {
+            let c = sampler.camera_sample();
+            let mut v = vec![c.wavelength, c.time, c.film.x, c.film.y, c.lens.x, c.lens.y];
+            v.extend((0..6).map(|_| sampler.next_1d()));
+            v
+        };
+        for kind in kinds {
+            let mut running = Sampler::new(kind, 9, 3);
+            let order = (0..20).chain([4, 5, 19, 20]).collect::<Vec<u32>>();
+            for (step, &index) in order.iter().enumerate() {
+                if step == 10 {
+                    running.start_pixel_sample(UVec2::new(6, 1), 2);
+                    running.next_1d();
+                }
+                running.start_pixel_sample(UVec2::new(5, 2), index);
+                let mut alone = Sampler::new(kind, 9, 3);
+                alone.start_pixel_sample(UVec2::new(5, 2), index);
+                assert_eq!(
+                    numbers(&mut running),
+                    numbers(&mut alone),
+                    "{kind:?} {index}"
+                );
             }
         }
     }
