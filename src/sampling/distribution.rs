@@ -13,13 +13,8 @@ use glam::Vec2;
 pub struct PiecewiseConstant1D {
     /// The normalised density in each cell.
     density: Vec<f32>,
-    /// cdf[i] = integral of the normalised density over the first i cells; cdf[n] = 1. Summed
-    /// in f64 and rounded to f32: u is an f32, so its resolution, not the table's, limits
-    /// which cells can be told apart.
-    cdf: Vec<f32>,
-    /// 1 / (cdf[i + 1] − cdf[i]), or 0 for a cell of zero probability: the position of u within
-    /// its cell is then a product, not a division.
-    inverse_width: Vec<f32>,
+    /// Where each cell starts in the CDF, and the reciprocal of its width there.
+    cells: Vec<CdfCell>,
     /// guide[j] = the cell containing u = j / guide.len().
     guide: Vec<u32>,
     /// Integral of the (unnormalised) weights over the domain.
@@ -30,6 +25,18 @@ pub struct PiecewiseConstant1D {
     cell_width: f32,
     /// The largest f32 below `max`, the largest point a sample may return.
     last: f32,
+}
+
+/// One cell of a [`PiecewiseConstant1D`] as its CDF sees it.
+#[derive(Clone, Copy, Debug)]
+struct CdfCell {
+    /// cdf(i) = integral of the normalised density over the cells before this one (the CDF
+    /// ends at 1 after the last). Summed in f64 and rounded to f32: u is an f32, so its
+    /// resolution, not the table's, limits which cells can be told apart.
+    start: f32,
+    /// 1 / (cdf(i + 1) − cdf(i)), or 0 for a cell of zero probability: the position of u
+    /// within its cell is then a product, not a division.
+    inverse_width: f32,
 }
 
 impl PiecewiseConstant1D {
@@ -63,14 +70,15 @@ impl PiecewiseConstant1D {
         let per_cell = if n <= 1024 { 4 } else { 1 };
         let guide_len = (per_cell * n).next_power_of_two().max(16);
         let cdf: Vec<f32> = cdf.iter().map(|&c| c as f32).collect();
-        let inverse_width = cdf
+        let cells = cdf
             .windows(2)
-            .map(|w| {
-                if w[1] > w[0] {
+            .map(|w| CdfCell {
+                start: w[0],
+                inverse_width: if w[1] > w[0] {
                     1.0 / (w[1] - w[0])
                 } else {
                     0.0
-                }
+                },
             })
             .collect();
         let mut guide = Vec::with_capacity(guide_len);
@@ -94,8 +102,7 @@ impl PiecewiseConstant1D {
             .collect();
         PiecewiseConstant1D {
             density,
-            cdf,
-            inverse_width,
+            cells,
             guide,
             integral,
             min,
@@ -125,16 +132,18 @@ impl PiecewiseConstant1D {
     /// Maps `u` in [0, 1) to a point of the domain with density [`Self::pdf`]. Returns the point
     /// and the index of its cell.
     pub fn sample(&self, u: f32) -> (f32, usize) {
-        let n = self.density.len();
-        // The last cell whose start cdf[i] is at most u, searched from the guide's cell on.
-        let slot = ((u * self.guide.len() as f32) as usize).min(self.guide.len() - 1);
+        // The last cell whose start is at most u, searched from the guide's cell on.
+        let slot = ((u * self.guide.len() as f32) as u32 as usize).min(self.guide.len() - 1);
         let mut index = self.guide[slot] as usize;
-        while index + 1 < n && self.cdf[index + 1] <= u {
+        while let Some(next) = self.cells.get(index + 1)
+            && next.start <= u
+        {
             index += 1;
         }
-        let offset = (u - self.cdf[index]) * self.inverse_width[index];
-        let x = self.min + (index as f32 + offset) * self.cell_width;
-        (x.min(self.last).max(self.min), index)
+        let cell = self.cells[index];
+        let offset = (u - cell.start) * cell.inverse_width;
+        let x = self.min + (index as u32 as f32 + offset) * self.cell_width;
+        (x.clamp(self.min, self.last), index)
     }
 
     /// Density of [`Self::sample`] at `x` (zero outside the domain).
@@ -162,7 +171,8 @@ impl PiecewiseConstant1D {
         let t = f64::from((x - self.min) / (self.max - self.min)) * n as f64;
         let index = (t as usize).min(n - 1);
         let frac = t - index as f64;
-        let (lo, hi) = (f64::from(self.cdf[index]), f64::from(self.cdf[index + 1]));
+        let cdf = |i: usize| self.cells.get(i).map_or(1.0, |c| f64::from(c.start));
+        let (lo, hi) = (cdf(index), cdf(index + 1));
         Some((lo + frac * (hi - lo)) as f32)
     }
 }
