@@ -100,7 +100,7 @@ fn kind(scene: &Scene, light: &Light) -> &'static str {
     match light {
         Light::Area(area) => match &scene.geometry.shapes[area.shape as usize] {
             Shape::Sphere(_) => "sphere",
-            Shape::Mesh(mesh) if mesh.triangles.len() == 2 => "rectangle",
+            Shape::Mesh(mesh) if mesh.triangles().len() == 2 => "rectangle",
             _ => "mesh",
         },
         Light::Point(_) => "point",

@@ -93,7 +93,7 @@ impl Geometry {
             first_id.push(next_id as u32);
             match shape {
                 Shape::Mesh(mesh) => {
-                    for i in 0..mesh.triangles.len() {
+                    for i in 0..mesh.triangles().len() {
                         // Degenerate triangles are left out: no ray can hit them.
                         if mesh.triangle_area(i) == 0.0 {
                             continue;
@@ -103,7 +103,7 @@ impl Geometry {
                             kind: PrimitiveKind::Triangle(mesh.vertices(i)),
                         });
                     }
-                    next_id += mesh.triangles.len() as u64;
+                    next_id += mesh.triangles().len() as u64;
                 }
                 Shape::Sphere(_) | Shape::Disk(_) | Shape::Instance(_) => {
                     let (lo, hi) = shape.object_bounds();

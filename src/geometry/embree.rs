@@ -286,7 +286,7 @@ impl EmbreeScene {
             for (index, shape) in shapes.iter().enumerate() {
                 let geometry = match shape {
                     Shape::Mesh(mesh) => {
-                        let kept: Vec<u32> = (0..mesh.triangles.len())
+                        let kept: Vec<u32> = (0..mesh.triangles().len())
                             .filter(|&i| mesh.triangle_area(i) > 0.0)
                             .map(|i| i as u32)
                             .collect();
@@ -299,19 +299,19 @@ impl EmbreeScene {
                             geometry,
                             RTCBufferType::VERTEX,
                             RTCFormat::FLOAT3,
-                            mesh.positions.iter().map(|p| [p.x, p.y, p.z]),
+                            mesh.positions().iter().map(|p| [p.x, p.y, p.z]),
                         ) && fill_buffer(
                             geometry,
                             RTCBufferType::INDEX,
                             RTCFormat::UINT3,
-                            kept.iter().map(|&i| mesh.triangles[i as usize]),
+                            kept.iter().map(|&i| mesh.triangles()[i as usize]),
                         );
                         if !filled {
                             rtcReleaseGeometry(geometry);
                             device_error(device, "copying a mesh")?;
                             return Err(Error::usage("Embree could not allocate a mesh"));
                         }
-                        let all = kept.len() == mesh.triangles.len();
+                        let all = kept.len() == mesh.triangles().len();
                         result.kinds.push(Kind::Triangles {
                             triangles: (!all).then_some(kept),
                         });

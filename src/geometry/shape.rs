@@ -31,7 +31,7 @@ impl Shape {
     /// Bounds of the shape in its own coordinates (for a moving shape: its sweep).
     pub fn object_bounds(&self) -> (Vec3, Vec3) {
         match self {
-            Shape::Mesh(mesh) => mesh.positions.iter().fold(
+            Shape::Mesh(mesh) => mesh.positions().iter().fold(
                 (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
                 |(lo, hi), &p| (lo.min(p), hi.max(p)),
             ),

@@ -252,7 +252,7 @@ mod tests {
     #[test]
     fn cube_faces_point_outwards() {
         let mesh = transform_mesh(cube(), &Transform::IDENTITY, false, true);
-        assert_eq!(mesh.triangles.len(), 12);
+        assert_eq!(mesh.triangles().len(), 12);
         assert!((mesh.area() - 24.0).abs() < 1e-5);
         for t in 0..12 {
             let [p0, p1, p2] = mesh.vertices(t);
