@@ -104,7 +104,9 @@ struct PixelStream {
     /// The stream's start, for samples that do not follow the last one.
     start: Pcg32,
     /// NUMBERS_PER_SAMPLE steps along the stream: from one sample's start to the next's.
-    sample_stride: Stride,
+    /// Found when a sample first follows another, so that passes of one sample per pixel do
+    /// not pay for it.
+    sample_stride: Option<Stride>,
     /// The last sample started (its index in the pixel, not in its block) and the generator at
     /// its start.
     last: (u32, Pcg32),
@@ -162,8 +164,12 @@ impl Sampler {
                 let (last_index, last_start) = &stream.last;
                 let mut rng;
                 if last_index.checked_add(1) == Some(index) {
+                    let start = &stream.start;
+                    let stride = *stream
+                        .sample_stride
+                        .get_or_insert_with(|| start.stride(NUMBERS_PER_SAMPLE));
                     rng = last_start.clone();
-                    rng.jump(stream.sample_stride);
+                    rng.jump(stride);
                 } else {
                     rng = stream.start.clone();
                     rng.advance(i64::from(index) * NUMBERS_PER_SAMPLE);
@@ -178,7 +184,7 @@ impl Sampler {
                 rng.advance(i64::from(index) * NUMBERS_PER_SAMPLE);
                 self.stream = Some(PixelStream {
                     pixel,
-                    sample_stride: start.stride(NUMBERS_PER_SAMPLE),
+                    sample_stride: None,
                     start,
                     last: (index, rng.clone()),
                 });
