@@ -21,8 +21,8 @@ use std::time::Duration;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use glam::{Vec2, Vec3};
-use prism::film::output::{ChannelImage, write_exr};
 use prism::geometry::Shape;
+use prism::image::{ChannelImage, write_exr};
 use prism::light::Light;
 use prism::sampling::rng::Pcg32;
 use prism::scene::Scene;

@@ -40,6 +40,7 @@ pub mod cli;
 pub mod error;
 pub mod film;
 pub mod geometry;
+pub mod image;
 pub mod integrator;
 pub mod light;
 pub mod math;

@@ -12,6 +12,7 @@ use common::scenes::{Object, build, camera};
 use glam::{DMat4, DVec3, Mat3, UVec2, Vec2, Vec3};
 use prism::geometry::Shape;
 use prism::geometry::sphere::Sphere;
+use prism::image::{Bitmap, Encoding};
 use prism::integrator::PathIntegrator;
 use prism::light::{
     AreaLight, ConstantLight, DirectionalLight, EnvironmentMap, Light, LightSelection, PointLight,
@@ -19,7 +20,6 @@ use prism::light::{
 };
 use prism::math::{Frame, Transform};
 use prism::sampling::rng::Pcg32;
-use prism::scene::image_file::{Bitmap, Encoding};
 use prism::scene::mitsuba::factory::shapes::{rectangle, transform_mesh};
 use prism::spectrum::{SampledWavelengths, Spectrum};
 

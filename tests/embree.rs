@@ -4,8 +4,8 @@
 
 use std::path::Path;
 
+use prism::film::stats::variance_of_mean;
 use prism::geometry::Accel;
-use prism::render::stats::variance_of_mean;
 use prism::render::{RenderOptions, render};
 use prism::scene::mitsuba::load_scene;
 

@@ -9,8 +9,8 @@ use common::chi2::regularized_gamma_q;
 use common::scenes::{disk_light_over_plane, pixel_mean_and_variance, render_film};
 use glam::UVec2;
 use prism::film::Film;
+use prism::film::stats::variance_of_mean;
 use prism::integrator::{DistributionIntegrator, Integrator};
-use prism::render::stats::variance_of_mean;
 use prism::scene::Scene;
 use prism::scene::mitsuba::load_scene;
 

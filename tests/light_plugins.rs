@@ -159,8 +159,8 @@ fn environment_map_from_a_png() {
     let folder = std::env::temp_dir().join(format!("prism-light-plugins-{}", std::process::id()));
     std::fs::create_dir_all(&folder).unwrap();
     // The linear value whose sRGB code is exactly 128, so that the 8-bit file is exact.
-    let linear = prism::scene::image_file::srgb_decode(128.0 / 255.0);
-    prism::film::output::write_png_srgb(&folder.join("sky.png"), 4, 3, &[linear; 36]).unwrap();
+    let linear = prism::image::srgb::decode(128.0 / 255.0);
+    prism::image::write_png_srgb(&folder.join("sky.png"), 4, 3, &[linear; 36]).unwrap();
     let scene = load(
         &folder,
         r#"<emitter type="envmap"><string name="filename" value="sky.png"/><float name="scale" value="2"/></emitter>"#,

@@ -17,6 +17,7 @@ use prism::camera::Camera;
 use prism::film::Film;
 use prism::geometry::Shape;
 use prism::geometry::sphere::Sphere;
+use prism::image::{Bitmap, Encoding};
 use prism::integrator::{DistributionIntegrator, Integrator, PathIntegrator};
 use prism::light::{
     AreaLight, BoundingSphere, ConstantLight, DirectionalLight, EnvironmentMap, Light,
@@ -25,7 +26,6 @@ use prism::light::{
 use prism::math::{Ray, Transform};
 use prism::sampling::rng::Pcg32;
 use prism::sampling::warp::sample_uniform_sphere;
-use prism::scene::image_file::{Bitmap, Encoding};
 use prism::scene::mitsuba::factory::shapes::{rectangle, transform_mesh};
 use prism::spectrum::{SampledWavelengths, Spectrum};
 

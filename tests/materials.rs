@@ -347,7 +347,7 @@ fn textures_vary_with_uv() {
     // A 2 × 1 PNG, left texel grey, right texel red: decoded to linear and upsampled.
     let dir = temp_dir("bitmap");
     let png = dir.join("t.png");
-    prism::film::output::write_png_srgb(&png, 2, 1, &[0.5, 0.5, 0.5, 1.0, 0.0, 0.0]).unwrap();
+    prism::image::write_png_srgb(&png, 2, 1, &[0.5, 0.5, 0.5, 1.0, 0.0, 0.0]).unwrap();
     let xml = |raw: bool, filter: &str| {
         format!(
             r#"<bsdf type="diffuse"><texture type="bitmap" name="reflectance">

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
-use prism::film::output::read_exr;
+use prism::image::read_exr;
 use prism::sampling::rng::Pcg32;
 
 fn folder(name: &str) -> PathBuf {

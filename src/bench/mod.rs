@@ -14,11 +14,11 @@ pub mod rays;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
-use crate::cli::compare::rel_mse_rgb;
-use crate::cli::render::write_images;
 use crate::error::{Error, Result};
-use crate::film::output::read_exr;
+use crate::film::write_images;
 use crate::geometry::Geometry;
+use crate::image::compare::rel_mse_rgb;
+use crate::image::read_exr;
 use crate::math::Ray;
 use crate::render::{RenderOptions, render};
 use crate::scene::Scene;
@@ -191,7 +191,7 @@ fn reference(
     scene: &Scene,
     bench: &BenchScene,
     options: &BenchOptions,
-) -> Result<crate::film::output::ChannelImage> {
+) -> Result<crate::image::ChannelImage> {
     // The scene's fingerprint covers its files and -D values: an edited scene gets a new one.
     let path = options.cache.join(format!(
         "{}-{:016x}-{}spp.exr",

@@ -13,9 +13,9 @@ use std::time::Instant;
 use clap::Args;
 use plotters::prelude::*;
 
-use super::compare::rel_mse_rgb;
 use crate::error::{Error, Result};
-use crate::film::output::read_exr;
+use crate::image::compare::rel_mse_rgb;
+use crate::image::read_exr;
 use crate::integrator::{DistributionIntegrator, Integrator, PathIntegrator};
 use crate::render::{RenderOptions, render};
 use crate::sampling::sampler::SamplerKind;

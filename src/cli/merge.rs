@@ -6,9 +6,10 @@ use std::path::PathBuf;
 
 use clap::Args;
 
-use super::render::{rejected_report, write_images};
 use crate::error::{Error, Result};
 use crate::film::Film;
+use crate::film::stats::rejected_report;
+use crate::film::write_images;
 use crate::render::state::RenderState;
 
 #[derive(Args, Debug)]

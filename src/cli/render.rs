@@ -18,12 +18,12 @@ use clap::Args;
 use glam::UVec2;
 
 use crate::error::{Error, Result};
-use crate::film::output::{ChannelImage, write_exr, write_png_srgb};
-use crate::film::{CropWindow, Film, FilterSampler, PixelSums};
+use crate::film::stats::rejected_report;
+use crate::film::write_images;
+use crate::film::{CropWindow, FilterSampler, PixelSums};
 use crate::geometry::Accel;
 use crate::integrator::RayCount;
 use crate::render::state::{RenderIdentity, RenderState};
-use crate::render::stats::{pixel_relative_error, variance_of_mean};
 use crate::render::{
     Checkpoints, RenderOptions, Snapshot, StopReason, StopRule, estimate_sample,
     render_with_checkpoints,
@@ -459,35 +459,6 @@ fn report(
     }
 }
 
-/// Says how many samples were dropped as non-finite and in which pixels most of them were.
-pub fn rejected_report(film: &Film) -> Option<String> {
-    let total: u64 = film.pixels.iter().map(|p| p.rejected).sum();
-    if total == 0 {
-        return None;
-    }
-    let width = film.crop.size.x;
-    let mut worst: Vec<(u64, u32, u32)> = film
-        .pixels
-        .iter()
-        .enumerate()
-        .filter(|(_, p)| p.rejected > 0)
-        .map(|(i, p)| {
-            let (x, y) = (i as u32 % width, i as u32 / width);
-            (p.rejected, film.crop.offset.x + x, film.crop.offset.y + y)
-        })
-        .collect();
-    worst.sort_by(|a, b| b.0.cmp(&a.0).then(a.1.cmp(&b.1)).then(a.2.cmp(&b.2)));
-    let listed: Vec<String> = worst
-        .iter()
-        .take(5)
-        .map(|(n, x, y)| format!("({x}, {y}) ×{n}"))
-        .collect();
-    Some(format!(
-        "prism: {total} samples were NaN or infinite and were dropped; worst pixels: {}; inspect one with --pixel x,y",
-        listed.join(", ")
-    ))
-}
-
 /// `--pixel x,y`: renders one pixel and prints every sample, marking the non-finite ones.
 fn trace_pixel(
     scene: &Scene,
@@ -524,45 +495,4 @@ fn trace_pixel(
         mean[0], mean[1], mean[2], sums.rejected, sums.samples
     );
     Ok(())
-}
-
-/// Writes the film as an EXR and as an sRGB PNG. The EXR's channels are `R`, `G`, `B` (linear
-/// sRGB), `X`, `Y`, `Z` (CIE 1931), `variance.X`, `variance.Y`, `variance.Z` (the estimated
-/// variance of each pixel's mean, see [`crate::render::stats`]) and `relative_error.Y` (the
-/// pixel's relative standard error of luminance).
-pub fn write_images(film: &Film, exr_path: &Path, png_path: &Path) -> Result<()> {
-    let xyz = film.xyz();
-    let rgb = film.linear_srgb();
-    let channel = |values: &[[f32; 3]], c: usize| values.iter().map(|v| v[c]).collect::<Vec<f32>>();
-    let variance = |c: usize| {
-        film.pixels
-            .iter()
-            .map(|p| variance_of_mean(p, c) as f32)
-            .collect::<Vec<f32>>()
-    };
-    let image = ChannelImage {
-        width: film.crop.size.x as usize,
-        height: film.crop.size.y as usize,
-        channels: vec![
-            ("R".to_string(), channel(&rgb, 0)),
-            ("G".to_string(), channel(&rgb, 1)),
-            ("B".to_string(), channel(&rgb, 2)),
-            ("X".to_string(), channel(&xyz, 0)),
-            ("Y".to_string(), channel(&xyz, 1)),
-            ("Z".to_string(), channel(&xyz, 2)),
-            ("variance.X".to_string(), variance(0)),
-            ("variance.Y".to_string(), variance(1)),
-            ("variance.Z".to_string(), variance(2)),
-            (
-                "relative_error.Y".to_string(),
-                film.pixels
-                    .iter()
-                    .map(|p| pixel_relative_error(p) as f32)
-                    .collect(),
-            ),
-        ],
-    };
-    write_exr(exr_path, &image)?;
-    let interleaved: Vec<f32> = rgb.iter().flatten().copied().collect();
-    write_png_srgb(png_path, image.width, image.height, &interleaved)
 }

@@ -36,9 +36,9 @@ use std::f32::consts::PI;
 use glam::{Vec2, Vec3};
 
 use super::{BoundingSphere, LightSample};
+use crate::image::Bitmap;
 use crate::math::Transform;
 use crate::sampling::distribution::PiecewiseConstant2D;
-use crate::scene::image_file::Bitmap;
 use crate::spectrum::cie::{LINEAR_SRGB_TO_XYZ, d65_normalized};
 use crate::spectrum::rgb::RgbSigmoidPolynomial;
 use crate::spectrum::rgb_table::RgbTable;
@@ -266,7 +266,7 @@ impl EnvironmentMap {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::image_file::Encoding;
+    use crate::image::Encoding;
 
     fn bitmap(width: usize, height: usize, f: impl Fn(usize, usize) -> [f32; 3]) -> Bitmap {
         let data = (0..height)

@@ -16,7 +16,6 @@
 //! interruption from outside (a signal).
 
 pub mod state;
-pub mod stats;
 
 use std::ops::Range;
 use std::sync::Arc;
@@ -28,12 +27,12 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
 
 use crate::error::{Error, Result};
+pub use crate::film::stats::relative_error;
 use crate::film::{Film, FilterSampler, PixelSums};
 use crate::integrator::RayCount;
 use crate::sampling::sampler::Sampler;
 use crate::scene::Scene;
 use crate::spectrum::SampledWavelengths;
-pub use stats::relative_error;
 
 /// Edge length of the square tiles the image is divided into.
 const TILE_SIZE: u32 = 16;

@@ -2,7 +2,6 @@
 //! factory that build it.
 
 pub mod fingerprint;
-pub mod image_file;
 pub mod mesh;
 pub mod mitsuba;
 

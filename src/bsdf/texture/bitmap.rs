@@ -23,7 +23,7 @@
 use glam::{Vec2, Vec3};
 
 use super::UvTransform;
-use crate::scene::image_file::Bitmap;
+use crate::image::Bitmap;
 use crate::spectrum::rgb::{RgbSigmoidPolynomial, RgbToSpectrumTable};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 
@@ -264,7 +264,7 @@ impl BitmapTexture {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::image_file::Encoding;
+    use crate::image::Encoding;
 
     fn grey(width: usize, height: usize, data: Vec<f32>) -> Bitmap {
         Bitmap {

@@ -18,6 +18,7 @@ use super::description::SpectrumValue;
 use super::element::{Attribute, Element, parse_finite, quote, tokens};
 use super::reader::find_file;
 use crate::error::{Error, Result, SourceLocation};
+use crate::image::srgb;
 
 /// The value of an `<rgb>` element.
 pub(super) fn rgb(element: &Element) -> Result<[f64; 3]> {
@@ -46,21 +47,14 @@ fn hex_rgb(element: &Element, value: &Attribute, hex: &str) -> Result<[f64; 3]> 
         None
     };
     match bytes.as_deref() {
-        Some(&[r, g, b]) => Ok([r, g, b].map(|byte| srgb_to_linear(f64::from(byte) / 255.0))),
+        Some(&[r, g, b]) => {
+            Ok([r, g, b].map(|byte| f64::from(srgb::decode(f32::from(byte) / 255.0))))
+        }
         _ => Err(element.invalid_value(
             value,
             "is not a colour",
             "write value=\"#rrggbb\" with six hexadecimal digits, or value=\"r, g, b\"",
         )),
-    }
-}
-
-/// The sRGB transfer curve (IEC 61966-2-1), from encoded to linear values.
-fn srgb_to_linear(v: f64) -> f64 {
-    if v <= 0.04045 {
-        v / 12.92
-    } else {
-        ((v + 0.055) / 1.055).powf(2.4)
     }
 }
 

@@ -9,11 +9,11 @@ use glam::{DMat4, DVec3, Vec3};
 use super::spectra::{Range, spectrum_param};
 use crate::bsdf::{Bsdf, Diffuse, Material};
 use crate::error::{Error, Result, SourceLocation};
+use crate::image::read_bitmap;
 use crate::light::{
     AreaLight, ConstantLight, DirectionalLight, EnvironmentMap, Light, PointLight, SpotLight,
 };
 use crate::math::Transform;
-use crate::scene::image_file::read_bitmap;
 use crate::scene::mitsuba::description::{PluginClass, PluginNode};
 use crate::scene::mitsuba::params::Params;
 use crate::spectrum::blackbody::Blackbody;

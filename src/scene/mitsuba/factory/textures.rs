@@ -15,7 +15,7 @@ use crate::bsdf::texture::{
     BitmapTexture, Checkerboard, FilterType, TextureUse, UvTransform, WrapMode,
 };
 use crate::error::{Error, Result};
-use crate::scene::image_file::{Encoding, read_bitmap};
+use crate::image::{Encoding, read_bitmap};
 use crate::scene::mitsuba::description::{PluginClass, PluginNode, PropertyValue, SpectrumValue};
 use crate::scene::mitsuba::params::Params;
 

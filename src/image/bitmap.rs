@@ -1,10 +1,11 @@
-//! Image files that scenes reference (bitmap textures, environment maps): PNG, JPEG, OpenEXR and
+//! Images that scenes reference (bitmap textures, environment maps): PNG, JPEG, OpenEXR and
 //! Radiance HDR, decoded with the `image` crate into floating-point pixels.
 
 use std::path::Path;
 
 use image::{DynamicImage, ImageDecoder, ImageReader, Limits};
 
+use super::srgb;
 use crate::error::{Error, ErrorKind, Result};
 
 /// Largest image accepted, in pixels; larger declared sizes are refused before decoding.
@@ -45,19 +46,10 @@ impl Bitmap {
         let colour_channels = if self.channels == 4 { 3 } else { self.channels };
         for pixel in self.data.chunks_mut(self.channels) {
             for v in &mut pixel[..colour_channels] {
-                *v = srgb_decode(*v);
+                *v = srgb::decode(*v);
             }
         }
         self.encoding = Encoding::Linear;
-    }
-}
-
-/// The sRGB transfer function's inverse (encoded → linear).
-pub fn srgb_decode(v: f32) -> f32 {
-    if v <= 0.04045 {
-        v / 12.92
-    } else {
-        ((v + 0.055) / 1.055).powf(2.4)
     }
 }
 
@@ -127,7 +119,7 @@ pub fn read_bitmap(path: &Path) -> Result<Bitmap> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::film::output::{ChannelImage, write_exr, write_png_srgb};
+    use crate::image::{ChannelImage, write_exr, write_png_srgb};
 
     fn temp(name: &str) -> std::path::PathBuf {
         std::env::temp_dir().join(format!("prism-image-file-{}-{name}", std::process::id()))

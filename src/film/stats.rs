@@ -10,10 +10,8 @@
 //! denominator as the relative MSE of `prism compare` (and of Mitsuba's and pbrt's tools), so that
 //! black pixels do not dominate. The image's error is the mean over pixels.
 
-use crate::film::PixelSums;
-
-/// Added to the squared mean in relative errors (as in relMSE = (a − b)² / (b² + 0.01)).
-pub const RELATIVE_EPSILON: f64 = 0.01;
+use super::{Film, PixelSums};
+use crate::image::compare::RELATIVE_EPSILON;
 
 /// Variance of the pixel mean of channel `c` (0 = X, 1 = Y, 2 = Z); infinite with fewer than two
 /// samples.
@@ -38,6 +36,35 @@ pub fn relative_error<'a>(pixels: impl Iterator<Item = &'a PixelSums>) -> f64 {
         (s + pixel_relative_error(p), n + 1)
     });
     if count == 0 { 0.0 } else { sum / count as f64 }
+}
+
+/// Says how many samples were dropped as non-finite and in which pixels most of them were.
+pub fn rejected_report(film: &Film) -> Option<String> {
+    let total: u64 = film.pixels.iter().map(|p| p.rejected).sum();
+    if total == 0 {
+        return None;
+    }
+    let width = film.crop.size.x;
+    let mut worst: Vec<(u64, u32, u32)> = film
+        .pixels
+        .iter()
+        .enumerate()
+        .filter(|(_, p)| p.rejected > 0)
+        .map(|(i, p)| {
+            let (x, y) = (i as u32 % width, i as u32 / width);
+            (p.rejected, film.crop.offset.x + x, film.crop.offset.y + y)
+        })
+        .collect();
+    worst.sort_by(|a, b| b.0.cmp(&a.0).then(a.1.cmp(&b.1)).then(a.2.cmp(&b.2)));
+    let listed: Vec<String> = worst
+        .iter()
+        .take(5)
+        .map(|(n, x, y)| format!("({x}, {y}) ×{n}"))
+        .collect();
+    Some(format!(
+        "prism: {total} samples were NaN or infinite and were dropped; worst pixels: {}; inspect one with --pixel x,y",
+        listed.join(", ")
+    ))
 }
 
 #[cfg(test)]

@@ -1,0 +1,116 @@
+//! 8-bit sRGB PNG files, for viewing renders.
+
+use std::io;
+use std::path::Path;
+
+use super::srgb::encode_u8;
+use super::write_atomically;
+use crate::error::{Error, Result};
+
+/// with an sRGB chunk: each value is clamped to [0, 1], encoded by [`super::srgb::encode`] and rounded to
+/// the nearest of 0..=255; NaN is written as 0.
+pub fn write_png_srgb(path: &Path, width: usize, height: usize, rgb: &[f32]) -> Result<()> {
+    let invalid = |message: String| Error::io(path, &io::Error::other(message), "write");
+    if rgb.len() != 3 * width * height {
+        return Err(invalid(format!(
+            "{} values given for {width}x{height} RGB pixels",
+            rgb.len()
+        )));
+    }
+    let (Ok(png_width), Ok(png_height)) = (u32::try_from(width), u32::try_from(height)) else {
+        return Err(invalid(format!("{width}x{height} is too large for PNG")));
+    };
+    let bytes: Vec<u8> = rgb.iter().map(|&value| encode_u8(value)).collect();
+    write_atomically(path, |writer| {
+        let mut encoder = png::Encoder::new(writer, png_width, png_height);
+        encoder.set_color(png::ColorType::Rgb);
+        encoder.set_depth(png::BitDepth::Eight);
+        encoder.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
+        let mut png_writer = encoder.write_header().map_err(png_to_io)?;
+        png_writer.write_image_data(&bytes).map_err(png_to_io)?;
+        png_writer.finish().map_err(png_to_io)
+    })
+}
+
+/// A png error as an I/O error.
+fn png_to_io(err: png::EncodingError) -> io::Error {
+    match err {
+        png::EncodingError::IoError(err) => err,
+        other => io::Error::other(other.to_string()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::fs::{self, File};
+
+    use super::*;
+    use crate::image::test_support::scratch_dir;
+
+    #[test]
+    fn png_holds_the_expected_srgb_bytes() {
+        // Expected bytes from the exact formula in f64.
+        let encode = |x: f64| {
+            let v = if x <= 0.0031308 {
+                12.92 * x
+            } else {
+                1.055 * x.powf(1.0 / 2.4) - 0.055
+            };
+            (v * 255.0).round() as u8
+        };
+        assert_eq!(encode(0.5), 188);
+        assert_eq!(encode(0.0031308), 10);
+        assert_eq!(encode(0.18), 118);
+
+        let linear = [
+            0.0,
+            1.0,
+            0.5,
+            0.0031308,
+            0.18,
+            0.01,
+            -1.0,
+            7.0,
+            f32::NAN,
+            f32::INFINITY,
+            0.75,
+            0.9,
+        ];
+        let expected = [
+            0,
+            255,
+            188,
+            10,
+            118,
+            encode(0.01),
+            0,
+            255,
+            0,
+            255,
+            encode(0.75),
+            encode(0.9),
+        ];
+        let dir = scratch_dir("png");
+        let path = dir.join("pixels.png");
+        write_png_srgb(&path, 2, 2, &linear).unwrap();
+
+        let decoder = png::Decoder::new(io::BufReader::new(File::open(&path).unwrap()));
+        let mut reader = decoder.read_info().unwrap();
+        let mut buffer = vec![0; reader.output_buffer_size().unwrap()];
+        let info = reader.next_frame(&mut buffer).unwrap();
+        assert_eq!((info.width, info.height), (2, 2));
+        assert_eq!(info.color_type, png::ColorType::Rgb);
+        assert_eq!(info.bit_depth, png::BitDepth::Eight);
+        assert_eq!(&buffer[..info.buffer_size()], &expected);
+        fs::remove_dir_all(dir).unwrap();
+    }
+
+    #[test]
+    fn png_write_to_a_missing_directory_is_an_error_naming_the_file() {
+        let dir = scratch_dir("png-missing");
+        let path = dir.join("no-such-dir").join("out.png");
+        let err = write_png_srgb(&path, 1, 1, &[0.0; 3]).unwrap_err();
+        assert!(err.to_string().contains("out.png"), "{err}");
+        fs::remove_dir_all(dir).unwrap();
+    }
+}
