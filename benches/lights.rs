@@ -98,7 +98,7 @@ fn load_scene() -> Scene {
 /// The benchmark's name for a light of the scene.
 fn kind(scene: &Scene, light: &Light) -> &'static str {
     match light {
-        Light::Area(area) => match &scene.geometry.shapes[area.shape as usize] {
+        Light::Area(area) => match &scene.geometry.primitives[area.shape as usize] {
             Shape::Sphere(_) => "sphere",
             Shape::Mesh(mesh) if mesh.triangles().len() == 2 => "rectangle",
             _ => "mesh",
@@ -134,7 +134,7 @@ fn queries() -> Vec<Query> {
 fn lights(c: &mut Criterion) {
     let scene = load_scene();
     let queries = queries();
-    let shapes = &scene.geometry.shapes;
+    let shapes = &scene.geometry.primitives;
     let mut group = c.benchmark_group("lights");
     group.throughput(Throughput::Elements(POINTS as u64));
     for light in &scene.lights {

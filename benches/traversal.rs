@@ -85,7 +85,7 @@ impl Fixture {
             if shadow.len() < wanted
                 && let Some((light, _)) = scene.light_sampler.sample(u_light)
                 && let Some(ls) = scene.lights[light].sample_incident(
-                    &scene.geometry.shapes,
+                    &scene.geometry.primitives,
                     si.p,
                     si.time,
                     u_choice,
@@ -179,7 +179,7 @@ fn bvh_build(c: &mut Criterion) {
     for (name, fixture) in SCENES {
         group.bench_function(name, |b| {
             let fixture: &Fixture = fixture;
-            let shapes = &fixture.scene.geometry.shapes;
+            let shapes = &fixture.scene.geometry.primitives;
             b.iter_batched(|| shapes.clone(), Geometry::new, BatchSize::PerIteration);
         });
     }

@@ -48,3 +48,4 @@ pub mod render;
 pub mod sampling;
 pub mod scene;
 pub mod spectrum;
+pub mod texture;

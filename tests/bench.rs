@@ -6,7 +6,7 @@ use std::process::Command;
 
 use glam::Vec3;
 use prism::bench::rays::{incoherent_rays, shadow_rays};
-use prism::geometry::{Geometry, Shape, TriangleMesh};
+use prism::geometry::{AggregateElement, Geometry, Shape, TriangleMesh};
 use prism::scene::Scene;
 use prism::scene::mitsuba::load_scene;
 
@@ -95,7 +95,7 @@ fn geometry_memory_is_at_most_100_bytes_per_triangle() {
     }
     let count = triangles.len();
     let mesh = TriangleMesh::new(positions, Some(normals), Some(uvs), triangles, false);
-    let geometry = Geometry::new(vec![Shape::Mesh(mesh)]);
+    let geometry = Geometry::new(vec![Shape::Mesh(mesh).into()]);
     assert_eq!(geometry.primitive_count(), count);
     let per_triangle = geometry.memory_bytes() as f64 / count as f64;
     // At least the triangles' own data (three 12-byte vertices in the leaves, indices) ...
@@ -147,12 +147,12 @@ fn shadow_rays_join_visible_surfaces_to_the_lights() {
     // stops just short of 1, at the point sampled on the light).
     let (lights, _): (Vec<_>, Vec<_>) = scene
         .geometry
-        .shapes
+        .primitives
         .iter()
         .zip(&scene.shape_info)
         .partition(|(_, info)| info.light.is_some());
     assert_eq!(lights.len(), 1);
-    let (lo, hi) = lights[0].0.object_bounds();
+    let (lo, hi) = lights[0].0.bounds();
     let slack = 1e-3 * (hi - lo).length();
     let mut occluded = 0;
     for ray in &rays {

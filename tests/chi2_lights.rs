@@ -11,7 +11,7 @@ use common::chi2::{assert_passes, chi2_discrete, chi2_from_counts, chi2_rectangl
 use common::scenes::{Object, build, camera};
 use glam::{DMat4, DVec3, Mat3, UVec2, Vec2, Vec3};
 use prism::geometry::Shape;
-use prism::geometry::sphere::Sphere;
+use prism::geometry::Sphere;
 use prism::image::{Bitmap, Encoding};
 use prism::integrator::PathIntegrator;
 use prism::light::{
@@ -99,12 +99,7 @@ fn mesh_light_sampling_is_uniform_in_area() {
             * DMat4::from_scale(DVec3::new(1.0, 0.6, 1.0)),
     )
     .unwrap();
-    let shapes = vec![Shape::Mesh(transform_mesh(
-        rectangle(),
-        &to_world,
-        true,
-        true,
-    ))];
+    let shapes = vec![Shape::Mesh(transform_mesh(rectangle(), &to_world, true, true)).into()];
     let light = Light::Area(AreaLight {
         shape: 0,
         radiance: Spectrum::Constant(1.0),
@@ -240,7 +235,7 @@ fn every_kind_of_light(selection: LightSelection) -> (prism::scene::Scene, Vec<f
     let floor = Transform::new(DMat4::from_scale(DVec3::new(2.0, 2.0, 1.0))).unwrap();
     let objects = vec![
         Object {
-            shape: Shape::Mesh(transform_mesh(rectangle(), &floor, false, true)),
+            shape: Shape::Mesh(transform_mesh(rectangle(), &floor, false, true)).into(),
             reflectance: 0.5,
             emission: Some(0.25),
         },
@@ -250,7 +245,8 @@ fn every_kind_of_light(selection: LightSelection) -> (prism::scene::Scene, Vec<f
                 radius: 0.5,
                 rotation: Mat3::IDENTITY,
                 flip_normals: false,
-            }),
+            })
+            .into(),
             reflectance: 0.0,
             emission: Some(3.0),
         },

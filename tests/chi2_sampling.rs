@@ -7,8 +7,8 @@ use std::f64::consts::PI;
 
 use common::chi2::{assert_passes, chi2_discrete, chi2_interval, chi2_rectangle, chi2_sphere};
 use glam::{Mat3, Vec2, Vec3};
+use prism::geometry::Sphere;
 use prism::geometry::TriangleMesh;
-use prism::geometry::sphere::Sphere;
 use prism::light::LightSampler;
 use prism::sampling::rng::Pcg32;
 use prism::sampling::warp;

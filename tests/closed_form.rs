@@ -11,7 +11,7 @@ use common::scenes::{
 };
 use glam::{DMat4, DVec3, Mat3, UVec2, Vec2, Vec3};
 use prism::geometry::Shape;
-use prism::geometry::sphere::Sphere;
+use prism::geometry::Sphere;
 use prism::integrator::{DistributionIntegrator, Integrator, PathIntegrator};
 use prism::light::{Light, PointLight};
 use prism::math::Transform;
@@ -54,7 +54,7 @@ fn furnace(
     );
     let scene = build(
         vec![Object {
-            shape,
+            shape: shape.into(),
             reflectance: rho,
             emission: Some(le),
         }],
@@ -229,7 +229,7 @@ fn point_light_over_a_diffuse_plane_with(integrator: Integrator, seed: u64) {
     let plane = Transform::new(DMat4::from_scale(DVec3::splat(50.0))).unwrap();
     let scene = build(
         vec![Object {
-            shape: Shape::Mesh(transform_mesh(rectangle(), &plane, false, true)),
+            shape: Shape::Mesh(transform_mesh(rectangle(), &plane, false, true)).into(),
             reflectance: rho,
             emission: None,
         }],

@@ -5,7 +5,7 @@ mod common;
 use common::scenes::{Object, build, camera, render_film};
 use glam::{DMat4, DVec3, Mat3, UVec2, Vec3};
 use prism::geometry::Shape;
-use prism::geometry::sphere::Sphere;
+use prism::geometry::Sphere;
 use prism::integrator::PathIntegrator;
 use prism::math::Transform;
 use prism::scene::mitsuba::factory::shapes::{cube, transform_mesh};
@@ -17,7 +17,7 @@ fn one_and_two_threads_give_identical_films() {
     let scene = build(
         vec![
             Object {
-                shape: Shape::Mesh(transform_mesh(cube(), &room, true, true)),
+                shape: Shape::Mesh(transform_mesh(cube(), &room, true, true)).into(),
                 reflectance: 0.6,
                 emission: None,
             },
@@ -27,7 +27,8 @@ fn one_and_two_threads_give_identical_films() {
                     radius: 0.3,
                     rotation: Mat3::IDENTITY,
                     flip_normals: false,
-                }),
+                })
+                .into(),
                 reflectance: 0.0,
                 emission: Some(5.0),
             },

@@ -11,10 +11,7 @@ use common::scenes::{
 use glam::{DMat4, DVec3, Mat3, UVec2, Vec2, Vec3};
 use prism::camera::{Camera, PerspectiveCamera, Shutter};
 use prism::film::{Film, Filter};
-use prism::geometry::Shape;
-use prism::geometry::disk::Disk;
-use prism::geometry::instance::Instance;
-use prism::geometry::sphere::Sphere;
+use prism::geometry::{Disk, Instance, Primitive, Shape, Sphere};
 use prism::integrator::PathIntegrator;
 use prism::math::{AnimatedTransform, Transform};
 use prism::sampling::sampler::SamplerKind;
@@ -64,7 +61,8 @@ fn a_constant_image_stays_constant_under_every_filter() {
                     radius: 1.0,
                     rotation: Mat3::IDENTITY,
                     flip_normals: true,
-                }),
+                })
+                .into(),
                 reflectance: 0.0,
                 emission: Some(1.0),
             }],
@@ -148,7 +146,7 @@ fn defocus_blur_has_the_thin_lens_circle_of_confusion() {
     let scale = pixels_per_tan(size.x, fov);
     let mut scene = build(
         vec![Object {
-            shape: facing_disk(disk_radius, depth),
+            shape: facing_disk(disk_radius, depth).into(),
             reflectance: 0.0,
             emission: Some(1.0),
         }],
@@ -204,7 +202,7 @@ fn a_moving_emitter_smears_into_a_box_of_the_right_length() {
     let disk = Shape::Disk(Disk::new(Transform::IDENTITY, false));
     let mut scene: Scene = build(
         vec![Object {
-            shape: Shape::Instance(Instance::new(disk, motion)),
+            shape: Primitive::Instance(Instance::new(disk, motion)),
             reflectance: 0.0,
             emission: Some(1.0),
         }],
@@ -287,7 +285,7 @@ fn nrooks_sampling_has_less_error_than_independent_sampling() {
     let size = UVec2::new(24, 24);
     let mut scene = build(
         vec![Object {
-            shape: facing_disk(0.1, 4.0),
+            shape: facing_disk(0.1, 4.0).into(),
             reflectance: 0.0,
             emission: Some(1.0),
         }],
@@ -350,7 +348,7 @@ fn a_moving_camera_smears_a_still_emitter() {
     });
     let mut scene = build(
         vec![Object {
-            shape: facing_disk(radius, depth),
+            shape: facing_disk(radius, depth).into(),
             reflectance: 0.0,
             emission: Some(1.0),
         }],

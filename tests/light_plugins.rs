@@ -31,7 +31,7 @@ fn load(folder: &Path, body: &str) -> Scene {
 fn emission_at(scene: &Scene, light: usize, reference: Vec3, lambda: f32) -> f32 {
     let ls = scene.lights[light]
         .sample_incident(
-            &scene.geometry.shapes,
+            &scene.geometry.primitives,
             reference,
             0.0,
             0.5,
@@ -102,7 +102,7 @@ fn spot_defaults_follow_mitsuba() {
     let scene = load(Path::new("."), r#"<emitter type="spot"/>"#);
     let (c, b) = (20f32.to_radians(), 15f32.to_radians());
     let expected = 2.0 * PI * (1.0 - (c.sin() - b.sin()) / (c - b));
-    let power = scene.lights[0].power(&scene.geometry.shapes);
+    let power = scene.lights[0].power(&scene.geometry.primitives);
     assert!(
         (power / expected - 1.0).abs() < 1e-3,
         "{power} vs {expected}"

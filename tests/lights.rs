@@ -15,8 +15,8 @@ use common::scenes::{
 use glam::{DMat4, DVec3, Mat3, UVec2, Vec2, Vec3};
 use prism::camera::Camera;
 use prism::film::Film;
-use prism::geometry::Shape;
-use prism::geometry::sphere::Sphere;
+use prism::geometry::Sphere;
+use prism::geometry::{Primitive, Shape};
 use prism::image::{Bitmap, Encoding};
 use prism::integrator::{DistributionIntegrator, Integrator, PathIntegrator};
 use prism::light::{
@@ -33,19 +33,19 @@ use prism::spectrum::{SampledWavelengths, Spectrum};
 fn floor(rho: f32) -> Object {
     let plane = Transform::new(DMat4::from_scale(DVec3::splat(50.0))).unwrap();
     Object {
-        shape: Shape::Mesh(transform_mesh(rectangle(), &plane, false, true)),
+        shape: Shape::Mesh(transform_mesh(rectangle(), &plane, false, true)).into(),
         reflectance: rho,
         emission: None,
     }
 }
 
-fn sphere(center: Vec3, radius: f32) -> Shape {
-    Shape::Sphere(Sphere {
+fn sphere(center: Vec3, radius: f32) -> Primitive {
+    Primitive::Shape(Shape::Sphere(Sphere {
         center,
         radius,
         rotation: Mat3::IDENTITY,
         flip_normals: false,
-    })
+    }))
 }
 
 /// The average over pixel (x, y)'s footprint of `exact` along the camera rays (32 × 32 points).
@@ -200,7 +200,7 @@ fn rectangle_light_by_lamberts_formula() {
         vec![
             floor(rho as f32),
             Object {
-                shape: Shape::Mesh(light),
+                shape: Shape::Mesh(light).into(),
                 reflectance: 0.0,
                 emission: Some(radiance as f32),
             },
@@ -397,7 +397,7 @@ fn light_selection_does_not_change_the_answer() {
 /// inside S, `outward` = true) or inwards (lights at infinity). Returns (mean, standard error).
 fn flux_through_sphere(
     light: &Light,
-    shapes: &[Shape],
+    shapes: &[Primitive],
     s: BoundingSphere,
     outward: bool,
     seed: u64,
@@ -436,7 +436,7 @@ fn flux_through_sphere(
 fn assert_flux(
     name: &str,
     light: &Light,
-    shapes: &[Shape],
+    shapes: &[Primitive],
     s: BoundingSphere,
     outward: bool,
     closed_form: f64,
@@ -503,12 +503,7 @@ fn flux_of_point_spot_and_area_lights() {
     let to_world =
         Transform::new(DMat4::from_rotation_y(0.4) * DMat4::from_scale(DVec3::new(0.8, 0.5, 1.0)))
             .unwrap();
-    let panel = [Shape::Mesh(transform_mesh(
-        rectangle(),
-        &to_world,
-        false,
-        true,
-    ))];
+    let panel = [Shape::Mesh(transform_mesh(rectangle(), &to_world, false, true)).into()];
     assert_flux(
         "rectangle light",
         &area,

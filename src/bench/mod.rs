@@ -230,7 +230,7 @@ pub fn measure(bench: &BenchScene, options: &BenchOptions) -> Result<Measurement
     let mut bvh_build_seconds = f64::INFINITY;
     let (mut primitives, mut geometry_bytes) = (0, 0);
     for _ in 0..3 {
-        let shapes = scene.geometry.shapes.clone();
+        let shapes = scene.geometry.primitives.clone();
         let start = Instant::now();
         let rebuilt = pool.install(|| Geometry::new(shapes));
         bvh_build_seconds = bvh_build_seconds.min(start.elapsed().as_secs_f64());
@@ -243,7 +243,7 @@ pub fn measure(bench: &BenchScene, options: &BenchOptions) -> Result<Measurement
     let ours = &scene.geometry;
     let embree = if cfg!(feature = "embree") {
         let mut embree = scene.geometry.clone();
-        embree.set_accel(crate::geometry::accel::Accel::Embree)?;
+        crate::cli::accel::Accel::Embree.apply(&mut embree)?;
         Some(embree)
     } else {
         None

@@ -35,7 +35,7 @@ pub fn shadow_rays(scene: &Scene, count: usize, seed: u64) -> Vec<Ray> {
         let (light, _) = scene.light_sampler.sample(rng.next_f32())?;
         let (u_choice, u) = (rng.next_f32(), Vec2::new(rng.next_f32(), rng.next_f32()));
         let sample = scene.lights[light].sample_incident(
-            &scene.geometry.shapes,
+            &scene.geometry.primitives,
             hit.p,
             hit.time,
             u_choice,

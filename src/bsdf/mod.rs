@@ -49,12 +49,13 @@ pub mod roughconductor;
 pub mod roughdielectric;
 pub mod roughdiffuse;
 pub mod roughplastic;
-pub mod texture;
+
 pub mod thindielectric;
 pub mod twosided;
 
 use glam::{Vec2, Vec3};
 
+pub use crate::texture::Texture;
 pub use blend::Blend;
 pub use bumpmap::BumpMap;
 pub use conductor::Conductor;
@@ -68,7 +69,6 @@ pub use roughconductor::RoughConductor;
 pub use roughdielectric::RoughDielectric;
 pub use roughdiffuse::RoughDiffuse;
 pub use roughplastic::RoughPlastic;
-pub use texture::Texture;
 pub use thindielectric::ThinDielectric;
 pub use twosided::TwoSided;
 

@@ -17,11 +17,11 @@ use std::time::Duration;
 use clap::Args;
 use glam::UVec2;
 
+use crate::cli::accel::Accel;
 use crate::error::{Error, Result};
 use crate::film::stats::rejected_report;
 use crate::film::write_images;
 use crate::film::{CropWindow, FilterSampler, PixelSums};
-use crate::geometry::Accel;
 use crate::integrator::RayCount;
 use crate::render::state::{RenderIdentity, RenderState};
 use crate::render::{
@@ -248,7 +248,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     args.accel.check_available()?;
     let loaded = load_scene(&args.scene, &args.defines)?;
     let mut scene = loaded.scene;
-    scene.geometry.set_accel(args.accel)?;
+    args.accel.apply(&mut scene.geometry)?;
     let crop = match (args.crop, args.pixel) {
         (Some(_), Some(_)) => return Err(Error::usage("give either --crop or --pixel, not both")),
         (Some([x0, y0, x1, y1]), None) => Some([x0, y0, x1, y1]),
@@ -443,7 +443,7 @@ fn report(
         scene.film.crop.size.x,
         scene.film.crop.size.y,
         output.film.pixels.first().map_or(0, |p| p.samples),
-        match scene.geometry.accel() {
+        match Accel::of(&scene.geometry) {
             Accel::Bvh => "",
             Accel::Embree => ", traced by Embree",
         },

@@ -1,23 +1,23 @@
-//! Moving shapes: a shape in its object space, placed in the world by an animated transform.
+//! Instances: shapes in their own object space, with their own hierarchy, placed in the world by
+//! a transform that may change while the shutter is open (motion blur).
 //!
-//! Rays are brought into object space at their time, intersected with the object's own BVH and
-//! the hit is carried back to the world; the scene's BVH holds the object as a single primitive
-//! bounded by its sweep over the animation. Shapes whose transform does not change are baked
-//! into world space instead, so static geometry pays nothing for motion blur.
+//! Rays are brought into object space at their time, intersected with the object's hierarchy
+//! and the hit is carried back to the world; the scene's BVH holds the instance as a single
+//! primitive bounded by its sweep over the animation. Shapes whose transform does not change
+//! are baked into world space instead, so static geometry pays nothing for motion blur.
 
 use glam::{Vec2, Vec3};
 
-use super::accel::Geometry;
+use super::aggregate::Aggregate;
 use super::interaction::SurfaceInteraction;
-use super::mesh::SurfaceSample;
-use super::shape::Shape;
+use super::shape::{Shape, SurfaceSample};
 use crate::math::{AnimatedTransform, Frame, Ray};
 
-/// A shape moving along an animated transform.
+/// A shape placed by an animated transform.
 #[derive(Clone, Debug)]
 pub struct Instance {
     /// The shape in object space, alone in its own hierarchy.
-    pub object: Box<Geometry>,
+    pub object: Box<Aggregate<Shape>>,
     pub to_world: AnimatedTransform,
     /// World-space bounds of the object over the whole animation.
     pub swept_bounds: (Vec3, Vec3),
@@ -30,7 +30,7 @@ impl Instance {
         let (t0, t1) = (times[0], times[times.len() - 1]);
         let swept_bounds = to_world.swept_bounds(lo, hi, t0, t1);
         Instance {
-            object: Box::new(Geometry::new(vec![shape])),
+            object: Box::new(Aggregate::new(vec![shape])),
             to_world,
             swept_bounds,
         }
@@ -38,7 +38,7 @@ impl Instance {
 
     /// The object's shape.
     pub fn shape(&self) -> &Shape {
-        &self.object.shapes[0]
+        &self.object.primitives[0]
     }
 
     fn local_ray(&self, ray: &Ray) -> Ray {
@@ -58,10 +58,6 @@ impl Instance {
             ..self.local_ray(ray)
         };
         self.object.closest_hit(&local).map(|hit| hit.triangle.t)
-    }
-
-    pub fn occluded(&self, ray: &Ray) -> bool {
-        self.object.occluded(&self.local_ray(ray))
     }
 
     /// The world-space interaction of the nearest hit, recorded as shape `shape`.
@@ -96,7 +92,7 @@ impl Instance {
         let transform = self.to_world.at(time);
         let s = self
             .shape()
-            .sample_from(transform.inverse_point(reference), time, u_choice, u)?;
+            .sample_from(transform.inverse_point(reference), u_choice, u)?;
         Some(SurfaceSample {
             p: transform.point(s.p),
             n: transform.normal(s.n).normalize(),
@@ -117,7 +113,6 @@ impl Instance {
         .normalize_or(n);
         self.shape().pdf_from(
             transform.inverse_point(reference),
-            time,
             transform.inverse_point(p),
             local_n,
         )

@@ -1,21 +1,20 @@
-//! Geometry: shapes (triangle meshes, spheres, disks), ray intersection, the BVH, and robust
-//! ray offsets.
+//! Geometry, in layers: ray–triangle tests, surface interactions and robust ray offsets at the
+//! bottom; the shapes (triangle meshes, spheres, disks) above them; then the BVH, the
+//! aggregates built with it, instances (shapes in their own space, placed by a moving
+//! transform) and the scene's primitives.
 
-pub mod accel;
+pub mod aggregate;
 pub mod bvh;
-pub mod disk;
-#[cfg(feature = "embree")]
-pub mod embree;
 pub mod instance;
 pub mod interaction;
-pub mod mesh;
 pub mod offset;
+pub mod primitive;
 pub mod shape;
-pub mod sphere;
 pub mod triangle;
 pub mod triangle_pack;
 
-pub use accel::{Accel, Geometry, Hit};
+pub use aggregate::{Aggregate, AggregateElement, ExternalRayQueries, Hit};
+pub use instance::Instance;
 pub use interaction::SurfaceInteraction;
-pub use mesh::{SurfaceSample, TriangleMesh};
-pub use shape::Shape;
+pub use primitive::{Geometry, Primitive};
+pub use shape::{Disk, Shape, Sphere, SurfaceSample, TriangleMesh};

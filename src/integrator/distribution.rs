@@ -257,7 +257,7 @@ impl DistributionIntegrator {
                 let u_choice = sampler.next_1d();
                 let u = sampler.next_2d();
                 let Some(ls) = light.sample_incident(
-                    &scene.geometry.shapes,
+                    &scene.geometry.primitives,
                     si.p,
                     si.time,
                     u_choice,

@@ -132,7 +132,7 @@ impl PathIntegrator {
                 if !emitted.is_black() {
                     let weight = match &previous {
                         Some(prev) if !prev.specular => {
-                            let shape = &scene.geometry.shapes[si.shape as usize];
+                            let shape = &scene.geometry.primitives[si.shape as usize];
                             let light_pdf = scene.light_sampler.pmf(light_index as usize)
                                 * shape.pdf_from(prev.interaction.p, si.time, si.p, si.n);
                             power_heuristic(prev.pdf, light_pdf)
@@ -263,9 +263,14 @@ impl PathIntegrator {
             return SampledSpectrum::ZERO;
         };
         let light = &scene.lights[light_index];
-        let Some(ls) =
-            light.sample_incident(&scene.geometry.shapes, si.p, si.time, u_choice, u, lambda)
-        else {
+        let Some(ls) = light.sample_incident(
+            &scene.geometry.primitives,
+            si.p,
+            si.time,
+            u_choice,
+            u,
+            lambda,
+        ) else {
             return SampledSpectrum::ZERO;
         };
         let wi = sp.frame.to_local(ls.wi);

@@ -7,7 +7,7 @@
 //!     </emitter>
 //! </shape>
 //! ```
-//! Light samples come from the shape ([`crate::geometry::Shape::sample_from`]): spheres by the
+//! Light samples come from the shape ([`crate::geometry::Primitive::sample_from`]): spheres by the
 //! cone of directions they subtend (uniform in solid angle, so no sample is wasted on the far
 //! side; the lecture's "Direct Light Sampling"), other shapes uniformly by area, triangle meshes
 //! choosing a triangle by area through an alias table. As in Mitsuba, an emitting shape that
@@ -18,7 +18,7 @@ use std::f32::consts::PI;
 use glam::{Vec2, Vec3};
 
 use super::LightSample;
-use crate::geometry::Shape;
+use crate::geometry::Primitive;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths, Spectrum};
 
 #[derive(Clone, Debug)]
@@ -41,7 +41,7 @@ impl AreaLight {
 
     pub fn sample_incident(
         &self,
-        shapes: &[Shape],
+        shapes: &[Primitive],
         reference: Vec3,
         time: f32,
         u_choice: f32,
@@ -71,7 +71,7 @@ impl AreaLight {
     }
 
     /// Φ = π · A · L for a one-sided Lambertian emitter, with L the luminance of the radiance.
-    pub fn power(&self, shapes: &[Shape]) -> f32 {
+    pub fn power(&self, shapes: &[Primitive]) -> f32 {
         PI * shapes[self.shape as usize].area() * self.radiance.luminance()
     }
 }

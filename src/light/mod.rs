@@ -26,7 +26,7 @@ pub mod spot;
 
 use glam::{Vec2, Vec3};
 
-use crate::geometry::Shape;
+use crate::geometry::Primitive;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 pub use area::AreaLight;
 pub use constant::ConstantLight;
@@ -117,7 +117,7 @@ impl Light {
     #[allow(clippy::too_many_arguments)]
     pub fn sample_incident(
         &self,
-        shapes: &[Shape],
+        shapes: &[Primitive],
         reference: Vec3,
         time: f32,
         u_choice: f32,
@@ -139,7 +139,7 @@ impl Light {
     /// Emitted power Φ, summarised as a luminance-weighted scalar (watts weighted by ȳ): the
     /// light sampler chooses lights in proportion to it. Lights at infinity count the flux they
     /// send into the scene's bounding sphere, so [`Self::set_scene_bounds`] must come first.
-    pub fn power(&self, shapes: &[Shape]) -> f32 {
+    pub fn power(&self, shapes: &[Primitive]) -> f32 {
         match self {
             Light::Area(light) => light.power(shapes),
             Light::Point(light) => light.power(),

@@ -83,7 +83,10 @@ impl Scene {
         for light in &mut lights {
             light.set_scene_bounds(bounds);
         }
-        let powers: Vec<f32> = lights.iter().map(|l| l.power(&geometry.shapes)).collect();
+        let powers: Vec<f32> = lights
+            .iter()
+            .map(|l| l.power(&geometry.primitives))
+            .collect();
         let selection = match &integrator {
             Integrator::Path(path) => path.light_selection,
             Integrator::Distribution(distrib) => match distrib.lights {

@@ -5,7 +5,7 @@ use glam::{DMat4, DVec3, UVec2, Vec2};
 use prism::bsdf::{Bsdf, Diffuse, Material};
 use prism::camera::{Camera, PerspectiveCamera};
 use prism::film::{CropWindow, Film, Filter};
-use prism::geometry::{Geometry, Shape};
+use prism::geometry::{Geometry, Primitive, Shape};
 use prism::integrator::{Integrator, PathIntegrator};
 use prism::light::{AreaLight, Light};
 use prism::math::transform::look_at;
@@ -16,7 +16,7 @@ use prism::spectrum::Spectrum;
 
 /// A shape with a one-sided diffuse material and, optionally, constant emitted radiance.
 pub struct Object {
-    pub shape: Shape,
+    pub shape: Primitive,
     pub reflectance: f32,
     pub emission: Option<f32>,
 }
@@ -51,7 +51,7 @@ pub fn build(
     for (i, object) in objects.into_iter().enumerate() {
         materials.push(Material {
             front: Bsdf::Diffuse(Diffuse {
-                reflectance: prism::bsdf::Texture::constant(object.reflectance),
+                reflectance: prism::texture::Texture::constant(object.reflectance),
             }),
             back: None,
         });
@@ -144,7 +144,7 @@ pub struct DiskOverPlane {
 }
 
 pub fn disk_light_over_plane(size: UVec2) -> DiskOverPlane {
-    use prism::geometry::disk::Disk;
+    use prism::geometry::Disk;
     use prism::scene::mitsuba::factory::shapes::{rectangle, transform_mesh};
     let (rho, radiance, radius, height) = (0.5f64, 4.0f64, 0.5f64, 1.0f64);
     let camera = camera(
@@ -164,12 +164,12 @@ pub fn disk_light_over_plane(size: UVec2) -> DiskOverPlane {
     let scene = build(
         vec![
             Object {
-                shape: Shape::Mesh(transform_mesh(rectangle(), &plane, false, true)),
+                shape: Shape::Mesh(transform_mesh(rectangle(), &plane, false, true)).into(),
                 reflectance: rho as f32,
                 emission: None,
             },
             Object {
-                shape: Shape::Disk(Disk::new(disk, false)),
+                shape: Shape::Disk(Disk::new(disk, false)).into(),
                 reflectance: 0.0,
                 emission: Some(radiance as f32),
             },

@@ -51,7 +51,7 @@ pub fn build_area_light(node: &PluginNode, shape: u32) -> Result<Light> {
 pub fn default_emitter_material() -> Material {
     Material {
         front: Bsdf::Diffuse(Diffuse {
-            reflectance: crate::bsdf::Texture::constant(0.0),
+            reflectance: crate::texture::Texture::constant(0.0),
         }),
         back: None,
     }

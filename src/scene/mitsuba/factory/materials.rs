@@ -10,7 +10,6 @@ use super::textures::{
     TextureCache, build_texture, float_texture, optional_spectrum_texture, spectrum_texture,
 };
 use crate::bsdf::microfacet::MicrofacetKind;
-use crate::bsdf::texture::TextureUse;
 use crate::bsdf::{
     Blend, Bsdf, BsdfFlags, BumpMap, Conductor, Dielectric, Diffuse, Mask, Material, NormalMap,
     Phong, Plastic, RoughConductor, RoughDielectric, RoughDiffuse, RoughPlastic, Texture,
@@ -22,6 +21,7 @@ use crate::scene::mitsuba::params::Params;
 use crate::spectrum::conductors::CONDUCTORS;
 use crate::spectrum::ior::{Ior, NAMED_IORS, RelativeIor, named_ior, sellmeier_glass};
 use crate::spectrum::{LAMBDA_MAX, LAMBDA_MIN, PiecewiseLinear, RgbIntent, Spectrum};
+use crate::texture::TextureUse;
 
 /// The BSDF types this factory knows.
 pub const SUPPORTED_BSDFS: &[&str] = &[

@@ -20,7 +20,7 @@ use super::description::{PluginClass, PluginNode};
 use super::params::Params;
 use crate::bsdf::Material;
 use crate::error::{Error, Result};
-use crate::geometry::{Geometry, Shape};
+use crate::geometry::{Geometry, Primitive};
 use crate::integrator::{Integrator, PathIntegrator};
 use crate::scene::{Scene, ShapeInfo};
 
@@ -94,7 +94,7 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
         };
         let light = match emitter {
             Some(emitter) => {
-                if let Shape::Instance(instance) = &shape
+                if let Primitive::Instance(instance) = &shape
                     && !instance.to_world.is_similarity()
                 {
                     return Err(Error::input(
@@ -139,7 +139,7 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
         if !textures.contains(&child.node) {
             textures::build_texture(
                 &child.node,
-                crate::bsdf::texture::TextureUse::Scalar,
+                crate::texture::TextureUse::Scalar,
                 &mut textures,
             )?;
         }

@@ -7,10 +7,7 @@
 use glam::{DVec3, Mat3, Vec2, Vec3};
 
 use crate::error::{Error, Result};
-use crate::geometry::disk::Disk;
-use crate::geometry::instance::Instance;
-use crate::geometry::sphere::Sphere;
-use crate::geometry::{Shape, TriangleMesh};
+use crate::geometry::{Disk, Instance, Primitive, Shape, Sphere, TriangleMesh};
 use crate::math::Transform;
 use crate::scene::mesh::{MeshData, load_obj, load_ply};
 use crate::scene::mitsuba::description::PluginNode;
@@ -22,13 +19,13 @@ pub const SUPPORTED_SHAPES: &[&str] = &["obj", "ply", "rectangle", "cube", "sphe
 /// Builds a shape (its BSDF and emitter are the caller's business: it marks them used). A shape
 /// whose `to_world` is an `<animation>` is built in object space and placed by an [`Instance`];
 /// a fixed `to_world` is applied to the shape once.
-pub fn build_shape(params: &Params) -> Result<Shape> {
+pub fn build_shape(params: &Params) -> Result<Primitive> {
     let to_world = params.animated_transform("to_world")?;
     if to_world.is_animated() {
         let shape = build_static_shape(params, &Transform::IDENTITY)?;
-        return Ok(Shape::Instance(Instance::new(shape, to_world)));
+        return Ok(Primitive::Instance(Instance::new(shape, to_world)));
     }
-    build_static_shape(params, to_world.first())
+    build_static_shape(params, to_world.first()).map(Primitive::Shape)
 }
 
 /// Builds a shape placed by the fixed transform `to_world`.

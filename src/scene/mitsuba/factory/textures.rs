@@ -10,14 +10,12 @@ use std::collections::HashMap;
 use std::sync::Arc;
 
 use super::spectra::{Range, spectrum_param};
-use crate::bsdf::Texture;
-use crate::bsdf::texture::{
-    BitmapTexture, Checkerboard, FilterType, TextureUse, UvTransform, WrapMode,
-};
 use crate::error::{Error, Result};
 use crate::image::{Encoding, read_bitmap};
 use crate::scene::mitsuba::description::{PluginClass, PluginNode, PropertyValue, SpectrumValue};
 use crate::scene::mitsuba::params::Params;
+use crate::texture::Texture;
+use crate::texture::{BitmapTexture, Checkerboard, FilterType, TextureUse, UvTransform, WrapMode};
 
 /// The texture types this factory knows.
 pub const SUPPORTED_TEXTURES: &[&str] = &["bitmap", "checkerboard"];

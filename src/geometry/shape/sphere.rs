@@ -4,8 +4,8 @@ use std::f32::consts::PI;
 
 use glam::{DVec3, Mat3, Vec2, Vec3};
 
-use super::interaction::SurfaceInteraction;
 use super::mesh::SurfaceSample;
+use crate::geometry::interaction::SurfaceInteraction;
 use crate::math::Frame;
 use crate::sampling::warp::sample_uniform_sphere;
 

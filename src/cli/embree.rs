@@ -24,10 +24,9 @@ use std::ptr;
 
 use embree::sys::*;
 
-use super::accel::Hit;
-use super::shape::Shape;
-use super::triangle::TriangleHit;
 use crate::error::{Error, Result};
+use crate::geometry::triangle::TriangleHit;
+use crate::geometry::{AggregateElement, ExternalRayQueries, Hit, Primitive};
 use crate::math::Ray;
 
 /// Embree's "no geometry" ID (`RTC_INVALID_GEOMETRY_ID`).
@@ -45,7 +44,7 @@ enum Kind {
     Absent,
 }
 
-/// An Embree device and a committed scene holding all shapes of a [`super::Geometry`].
+/// An Embree device and a committed scene holding all primitives of a [`crate::geometry::Geometry`].
 pub struct EmbreeScene {
     device: RTCDevice,
     scene: RTCScene,
@@ -100,13 +99,13 @@ impl Drop for EmbreeScene {
 #[repr(C)]
 struct QueryContext<'a> {
     rtc: RTCIntersectContext,
-    shapes: &'a [Shape],
+    shapes: &'a [Primitive],
     ray: &'a Ray,
 }
 
 impl<'a> QueryContext<'a> {
     /// As `rtcInitIntersectContext` (an inline function of the header, not in the library).
-    fn new(shapes: &'a [Shape], ray: &'a Ray) -> QueryContext<'a> {
+    fn new(shapes: &'a [Primitive], ray: &'a Ray) -> QueryContext<'a> {
         QueryContext {
             rtc: RTCIntersectContext {
                 flags: RTCIntersectContextFlags::INCOHERENT,
@@ -164,7 +163,7 @@ unsafe extern "C" fn analytic_intersect(args: *const RTCIntersectFunctionNArgume
             return;
         };
         let t_max = rayhit.ray.tfar;
-        if let Some(t) = shape.intersect_analytic(context.ray, t_max)
+        if let Some(t) = shape.intersect_whole(context.ray, t_max)
             && t < t_max
         {
             rayhit.ray.tfar = t;
@@ -196,7 +195,7 @@ unsafe extern "C" fn analytic_occluded(args: *const RTCOccludedFunctionNArgument
         let Some(shape) = context.shapes.get(args.geomID as usize) else {
             return;
         };
-        if shape.intersect_analytic(context.ray, ray.tfar).is_some() {
+        if shape.intersect_whole(context.ray, ray.tfar).is_some() {
             ray.tfar = f32::NEG_INFINITY;
         }
     }
@@ -243,8 +242,8 @@ unsafe fn fill_buffer<T: Copy>(
 }
 
 impl EmbreeScene {
-    /// Builds and commits the Embree scene of the shapes.
-    pub fn new(shapes: &[Shape]) -> Result<EmbreeScene> {
+    /// Builds and commits the Embree scene of the primitives.
+    pub fn new(shapes: &[Primitive]) -> Result<EmbreeScene> {
         // SAFETY: a null configuration asks for the defaults.
         let device = unsafe { rtcNewDevice(ptr::null()) };
         if device.is_null() {
@@ -264,7 +263,7 @@ impl EmbreeScene {
         let bounds: Vec<RTCBounds> = shapes
             .iter()
             .map(|shape| {
-                let (lo, hi) = shape.object_bounds();
+                let (lo, hi) = shape.bounds();
                 RTCBounds {
                     lower_x: lo.x,
                     lower_y: lo.y,
@@ -284,8 +283,8 @@ impl EmbreeScene {
             rtcSetSceneBuildQuality(scene, RTCBuildQuality::HIGH);
             rtcSetSceneFlags(scene, RTCSceneFlags::NONE);
             for (index, shape) in shapes.iter().enumerate() {
-                let geometry = match shape {
-                    Shape::Mesh(mesh) => {
+                let geometry = match shape.mesh() {
+                    Some(mesh) => {
                         let kept: Vec<u32> = (0..mesh.triangles().len())
                             .filter(|&i| mesh.triangle_area(i) > 0.0)
                             .map(|i| i as u32)
@@ -317,7 +316,7 @@ impl EmbreeScene {
                         });
                         geometry
                     }
-                    Shape::Sphere(_) | Shape::Disk(_) | Shape::Instance(_) => {
+                    None => {
                         let geometry = rtcNewGeometry(device, RTCGeometryType::USER);
                         rtcSetGeometryUserPrimitiveCount(geometry, 1);
                         rtcSetGeometryUserData(geometry, &bounds[index] as *const _ as *mut c_void);
@@ -342,11 +341,13 @@ impl EmbreeScene {
         device_error(device, "building the scene")?;
         Ok(result)
     }
+}
 
+impl ExternalRayQueries<Primitive> for EmbreeScene {
     /// The closest hit in (0, t_max] of `ray` among `shapes`, which must be those the scene was
     /// built from. Embree's barycentrics (u, v) weigh the second and third vertex, so the point
     /// is (1 − u − v)·p0 + u·p1 + v·p2.
-    pub fn closest_hit(&self, shapes: &[Shape], ray: &Ray) -> Option<Hit> {
+    fn closest_hit(&self, shapes: &[Primitive], ray: &Ray) -> Option<Hit> {
         let mut context = QueryContext::new(shapes, ray);
         let mut rayhit = RTCRayHit {
             ray: embree_ray(ray),
@@ -401,12 +402,16 @@ impl EmbreeScene {
 
     /// Whether anything among `shapes` (those the scene was built from) blocks the ray in
     /// (0, t_max].
-    pub fn occluded(&self, shapes: &[Shape], ray: &Ray) -> bool {
+    fn occluded(&self, shapes: &[Primitive], ray: &Ray) -> bool {
         let mut context = QueryContext::new(shapes, ray);
         let mut embree = embree_ray(ray);
         // SAFETY: as in `closest_hit`.
         unsafe { rtcOccluded1(self.scene, &mut context.rtc, &mut embree) };
         embree.tfar == f32::NEG_INFINITY
+    }
+
+    fn name(&self) -> &'static str {
+        "Embree"
     }
 }
 
@@ -415,11 +420,8 @@ mod tests {
     use glam::{DMat4, DVec3, Mat3, Vec3};
 
     use super::*;
-    use crate::geometry::Geometry;
-    use crate::geometry::disk::Disk;
-    use crate::geometry::instance::Instance;
-    use crate::geometry::mesh::TriangleMesh;
-    use crate::geometry::sphere::Sphere;
+    use crate::cli::accel::Accel;
+    use crate::geometry::{Disk, Geometry, Instance, Shape, Sphere, TriangleMesh};
     use crate::math::{AnimatedTransform, Transform};
     use crate::sampling::rng::Pcg32;
     use crate::sampling::warp::sample_uniform_sphere;
@@ -454,7 +456,7 @@ mod tests {
     }
 
     /// A room (cube), a bumpy mesh sphere, an analytic sphere, a disk and a moving sphere.
-    fn shapes() -> Vec<Shape> {
+    fn shapes() -> Vec<Primitive> {
         let room = Transform::new(DMat4::from_scale(DVec3::new(3.0, 2.0, 4.0))).unwrap();
         let disk = Transform::new(
             DMat4::from_translation(DVec3::new(-1.0, -1.0, 1.0))
@@ -474,11 +476,11 @@ mod tests {
         ])
         .unwrap();
         vec![
-            Shape::Mesh(transform_mesh(cube(), &room, true, true)),
-            Shape::Mesh(bumpy_sphere(Vec3::new(1.0, 0.5, 1.0), 0.9, 60, 90)),
-            Shape::Sphere(sphere(Vec3::new(-1.2, 0.6, -1.0), 0.7)),
-            Shape::Disk(Disk::new(disk, false)),
-            Shape::Instance(Instance::new(
+            Shape::Mesh(transform_mesh(cube(), &room, true, true)).into(),
+            Shape::Mesh(bumpy_sphere(Vec3::new(1.0, 0.5, 1.0), 0.9, 60, 90)).into(),
+            Shape::Sphere(sphere(Vec3::new(-1.2, 0.6, -1.0), 0.7)).into(),
+            Shape::Disk(Disk::new(disk, false)).into(),
+            Primitive::Instance(Instance::new(
                 Shape::Sphere(sphere(Vec3::ZERO, 0.4)),
                 moving,
             )),
@@ -507,7 +509,7 @@ mod tests {
         let mut geometry = Geometry::new(shapes());
         let rays = random_rays(100_000, 7);
         let ours: Vec<Option<Hit>> = rays.iter().map(|r| geometry.closest_hit(r)).collect();
-        geometry.set_accel(crate::geometry::Accel::Embree).unwrap();
+        Accel::Embree.apply(&mut geometry).unwrap();
         let (mut disagreements, mut other_triangle, mut hits) = (0, 0, 0);
         let mut shapes_hit = [0usize; 5];
         for (ray, ours) in rays.iter().zip(&ours) {
@@ -565,7 +567,7 @@ mod tests {
             .collect();
         let occluded: Vec<bool> = rays.iter().map(|r| geometry.occluded(r)).collect();
         let interactions: Vec<_> = rays.iter().map(|r| geometry.intersect(r)).collect();
-        geometry.set_accel(crate::geometry::Accel::Embree).unwrap();
+        Accel::Embree.apply(&mut geometry).unwrap();
         let blocked = occluded.iter().filter(|&&o| o).count();
         assert!(blocked > 5_000 && blocked < 15_000, "{blocked} blocked");
         let mut disagreements = 0;
@@ -599,10 +601,10 @@ mod tests {
             vec![[0, 1, 2]],
             false,
         );
-        for shapes in [vec![], vec![Shape::Mesh(flat)]] {
+        for shapes in [vec![], vec![Shape::Mesh(flat).into()]] {
             let mut geometry = Geometry::new(shapes);
-            geometry.set_accel(crate::geometry::Accel::Embree).unwrap();
-            assert_eq!(geometry.accel(), crate::geometry::Accel::Embree);
+            Accel::Embree.apply(&mut geometry).unwrap();
+            assert_eq!(Accel::of(&geometry), Accel::Embree);
             for ray in random_rays(100, 1) {
                 assert!(geometry.closest_hit(&ray).is_none() && !geometry.occluded(&ray));
             }

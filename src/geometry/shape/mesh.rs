@@ -4,8 +4,8 @@ use std::sync::OnceLock;
 
 use glam::{Vec2, Vec3};
 
-use super::interaction::SurfaceInteraction;
-use super::triangle::TriangleHit;
+use crate::geometry::interaction::SurfaceInteraction;
+use crate::geometry::triangle::TriangleHit;
 use crate::math::Frame;
 use crate::sampling::distribution::AliasTable;
 use crate::sampling::warp::sample_uniform_triangle;

@@ -1,0 +1,244 @@
+//! Ray queries against a set of primitives through our 8-wide BVH ([`super::bvh`]), or through
+//! another structure plugged in from outside (the command line's Embree comparison).
+//!
+//! An aggregate holds either shapes (the object space of an instance) or the scene's
+//! primitives (shapes and instances); what it needs of them is [`AggregateElement`]. Every
+//! triangle of every mesh, and every element intersected as a whole (sphere, disk, instance),
+//! is one primitive of the hierarchy. Primitives are numbered element after element: element s
+//! owns the ids `first_id[s]..first_id[s + 1]`, a triangle's id being its element's first id
+//! plus its index in the mesh, so a hit names its element and triangle without a table per
+//! triangle.
+
+use std::fmt::Debug;
+use std::sync::Arc;
+
+use glam::Vec3;
+
+use super::bvh::{BuildPrimitive, Bvh, PrimitiveKind};
+use super::interaction::SurfaceInteraction;
+use super::shape::{Shape, TriangleMesh};
+use super::triangle::{TriangleHit, WatertightRay};
+use crate::math::Ray;
+
+/// What an aggregate needs to know of the things it holds.
+pub trait AggregateElement {
+    /// The mesh whose triangles enter the hierarchy one by one; None for an element that is
+    /// intersected as a whole by [`Self::intersect_whole`].
+    fn mesh(&self) -> Option<&TriangleMesh>;
+    /// The bounds of an element intersected as a whole (for a moving one: its sweep).
+    fn bounds(&self) -> (Vec3, Vec3);
+    /// Distance to the nearest hit in (0, t_max) of an element intersected as a whole.
+    fn intersect_whole(&self, ray: &Ray, t_max: f32) -> Option<f32>;
+    /// The surface interaction of a hit on this element, recorded as element `hit.shape`.
+    fn interaction(&self, ray: &Ray, hit: &Hit) -> Option<SurfaceInteraction>;
+    /// Bytes of heap memory the element holds.
+    fn heap_bytes(&self) -> usize;
+}
+
+/// Ray queries answered by a structure other than our BVH, over the same elements.
+pub trait ExternalRayQueries<P>: Send + Sync + Debug {
+    /// The closest hit in (0, t_max) among `elements`, those the structure was built from.
+    fn closest_hit(&self, elements: &[P], ray: &Ray) -> Option<Hit>;
+    /// Whether anything among `elements` blocks the ray in (0, t_max).
+    fn occluded(&self, elements: &[P], ray: &Ray) -> bool;
+    /// The structure's name, for messages ("Embree").
+    fn name(&self) -> &'static str;
+}
+
+/// The closest hit along a ray, before its surface interaction is built.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Hit {
+    /// Index into [`Aggregate::primitives`].
+    pub shape: u32,
+    /// Index of the triangle in its mesh; 0 for elements intersected as a whole.
+    pub primitive: u32,
+    /// The ray parameter, and for triangles the barycentric coordinates of the point (zero for
+    /// elements intersected as a whole).
+    pub triangle: TriangleHit,
+}
+
+/// Elements and the hierarchy over them.
+#[derive(Clone, Debug)]
+pub struct Aggregate<P> {
+    pub primitives: Vec<P>,
+    bvh: Option<Bvh>,
+    /// The first primitive id of each element, and one past the last id at the end.
+    first_id: Vec<u32>,
+    /// Primitives in the hierarchy (triangles of non-zero area, and whole elements).
+    primitive_count: usize,
+    /// Another structure that answers the queries instead of `bvh`.
+    external: Option<Arc<dyn ExternalRayQueries<P>>>,
+}
+
+impl<P: AggregateElement> Aggregate<P> {
+    /// Builds the hierarchy over all elements. Panics beyond 2³² primitives, 2³⁰ for the id of
+    /// an element intersected whole, or 2.7·10⁸ triangles (2²⁶ packs of the BVH): far more
+    /// than fits in memory.
+    pub fn new(primitives: Vec<P>) -> Aggregate<P> {
+        let mut build = Vec::new();
+        let mut first_id = Vec::with_capacity(primitives.len() + 1);
+        let mut next_id = 0u64;
+        for element in &primitives {
+            first_id.push(next_id as u32);
+            match element.mesh() {
+                Some(mesh) => {
+                    for i in 0..mesh.triangles().len() {
+                        // Degenerate triangles are left out: no ray can hit them.
+                        if mesh.triangle_area(i) == 0.0 {
+                            continue;
+                        }
+                        build.push(BuildPrimitive {
+                            id: (next_id + i as u64) as u32,
+                            kind: PrimitiveKind::Triangle(mesh.vertices(i)),
+                        });
+                    }
+                    next_id += mesh.triangles().len() as u64;
+                }
+                None => {
+                    let (lo, hi) = element.bounds();
+                    build.push(BuildPrimitive {
+                        id: next_id as u32,
+                        kind: PrimitiveKind::Analytic { lo, hi },
+                    });
+                    next_id += 1;
+                }
+            }
+            assert!(
+                next_id < u32::MAX as u64,
+                "more than 2³² primitives in one scene"
+            );
+        }
+        first_id.push(next_id as u32);
+        Aggregate {
+            primitives,
+            bvh: Bvh::build(&build),
+            first_id,
+            primitive_count: build.len(),
+            external: None,
+        }
+    }
+
+    /// The element and, for a mesh, the triangle of primitive `id`.
+    #[inline]
+    fn element_of(&self, id: u32) -> (u32, u32) {
+        let element = self.first_id.partition_point(|&first| first <= id) - 1;
+        (element as u32, id - self.first_id[element])
+    }
+
+    /// Lets another structure answer the queries (the BVH is kept, so that both can be
+    /// compared on the same elements); None goes back to the BVH.
+    pub fn set_external(&mut self, external: Option<Arc<dyn ExternalRayQueries<P>>>) {
+        self.external = external;
+    }
+
+    /// The name of the structure answering the queries when it is not our BVH.
+    pub fn external_name(&self) -> Option<&'static str> {
+        self.external.as_ref().map(|e| e.name())
+    }
+
+    /// The number of BVH primitives (triangles plus elements intersected whole).
+    pub fn primitive_count(&self) -> usize {
+        self.primitive_count
+    }
+
+    /// Bytes of memory held by the elements and the hierarchy: meshes' vertex attributes and
+    /// indices, and the BVH's nodes and triangle packs. Counted from the data structures'
+    /// capacities, so it does not depend on the allocator.
+    pub fn memory_bytes(&self) -> usize {
+        use std::mem::size_of;
+        let elements: usize = self
+            .primitives
+            .iter()
+            .map(|element| size_of::<P>() + element.heap_bytes())
+            .sum();
+        let bvh = self.bvh.as_ref().map_or(0, Bvh::memory_bytes);
+        size_of::<Self>() + elements + bvh + self.first_id.capacity() * size_of::<u32>()
+    }
+
+    /// The axis-aligned box (min, max) around all elements; None when there are none.
+    pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
+        self.bvh.as_ref().map(Bvh::bounds)
+    }
+
+    /// Intersects the element of primitive `id` as a whole in (0, t_max).
+    #[inline]
+    fn whole_hit(&self, ray: &Ray, id: u32, t_max: f32) -> Option<f32> {
+        let (element, _) = self.element_of(id);
+        self.primitives[element as usize].intersect_whole(ray, t_max)
+    }
+
+    /// The closest hit in (0, t_max), found by the structure answering the queries.
+    pub fn closest_hit(&self, ray: &Ray) -> Option<Hit> {
+        if let Some(external) = &self.external {
+            return external.closest_hit(&self.primitives, ray);
+        }
+        self.bvh_closest_hit(ray)
+    }
+
+    fn bvh_closest_hit(&self, ray: &Ray) -> Option<Hit> {
+        let bvh = self.bvh.as_ref()?;
+        let watertight = WatertightRay::new(ray.o, ray.d);
+        let (id, triangle) =
+            bvh.closest_hit(ray, &watertight, |id, t_max| self.whole_hit(ray, id, t_max))?;
+        let (shape, primitive) = self.element_of(id);
+        Some(Hit {
+            shape,
+            primitive,
+            triangle,
+        })
+    }
+
+    /// The closest surface the ray meets in (0, t_max).
+    pub fn intersect(&self, ray: &Ray) -> Option<SurfaceInteraction> {
+        let hit = self.closest_hit(ray)?;
+        let mut si = self.primitives[hit.shape as usize].interaction(ray, &hit)?;
+        si.time = ray.time;
+        Some(si)
+    }
+
+    /// Whether anything blocks the ray in (0, t_max).
+    pub fn occluded(&self, ray: &Ray) -> bool {
+        if let Some(external) = &self.external {
+            return external.occluded(&self.primitives, ray);
+        }
+        let Some(bvh) = self.bvh.as_ref() else {
+            return false;
+        };
+        let watertight = WatertightRay::new(ray.o, ray.d);
+        bvh.occluded(ray, &watertight, |id, t_max| self.whole_hit(ray, id, t_max))
+    }
+}
+
+impl AggregateElement for Shape {
+    #[inline]
+    fn mesh(&self) -> Option<&TriangleMesh> {
+        match self {
+            Shape::Mesh(mesh) => Some(mesh),
+            _ => None,
+        }
+    }
+
+    fn bounds(&self) -> (Vec3, Vec3) {
+        self.object_bounds()
+    }
+
+    #[inline]
+    fn intersect_whole(&self, ray: &Ray, t_max: f32) -> Option<f32> {
+        self.intersect_analytic(ray, t_max)
+    }
+
+    #[inline]
+    fn interaction(&self, ray: &Ray, hit: &Hit) -> Option<SurfaceInteraction> {
+        Some(Shape::interaction(
+            self,
+            ray,
+            hit.primitive,
+            &hit.triangle,
+            hit.shape,
+        ))
+    }
+
+    fn heap_bytes(&self) -> usize {
+        Shape::heap_bytes(self)
+    }
+}

@@ -1,0 +1,124 @@
+//! The shapes a scene is made of: triangle meshes, spheres and disks, in world space (or in the
+//! object space of an [`super::instance::Instance`]), dispatched by `match` (DESIGN.md §3.1).
+//! Shapes know their own intersection, surface points and sampling; the hierarchies over them
+//! ([`super::aggregate`]) and the shapes placed by transforms ([`super::primitive`]) sit above.
+
+pub mod disk;
+pub mod mesh;
+pub mod sphere;
+
+use glam::{Vec2, Vec3};
+
+pub use disk::Disk;
+pub use mesh::{SurfaceSample, TriangleMesh};
+pub use sphere::{Sphere, area_to_solid_angle};
+
+use crate::geometry::interaction::SurfaceInteraction;
+use crate::geometry::triangle::TriangleHit;
+use crate::math::Ray;
+
+/// A shape of the scene.
+#[derive(Clone, Debug)]
+pub enum Shape {
+    Mesh(TriangleMesh),
+    Sphere(Sphere),
+    Disk(Disk),
+}
+
+impl Shape {
+    pub fn area(&self) -> f32 {
+        match self {
+            Shape::Mesh(mesh) => mesh.area(),
+            Shape::Sphere(sphere) => sphere.area(),
+            Shape::Disk(disk) => disk.area(),
+        }
+    }
+
+    /// Bounds of the shape in its own coordinates.
+    pub fn object_bounds(&self) -> (Vec3, Vec3) {
+        match self {
+            Shape::Mesh(mesh) => mesh.positions().iter().fold(
+                (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+                |(lo, hi), &p| (lo.min(p), hi.max(p)),
+            ),
+            Shape::Sphere(sphere) => (sphere.center - sphere.radius, sphere.center + sphere.radius),
+            Shape::Disk(disk) => [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]
+                .into_iter()
+                .map(|(x, y)| disk.to_world.point(Vec3::new(x, y, 0.0)))
+                .fold(
+                    (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+                    |(lo, hi), p| (lo.min(p), hi.max(p)),
+                ),
+        }
+    }
+
+    /// Distance to the nearest hit in (0, t_max) of an analytic shape (sphere, disk); None for
+    /// meshes, whose triangles are intersected one by one by the hierarchy.
+    pub fn intersect_analytic(&self, ray: &Ray, t_max: f32) -> Option<f32> {
+        match self {
+            Shape::Sphere(sphere) => sphere.intersect(ray.o, ray.d, t_max),
+            Shape::Disk(disk) => disk.intersect(ray.o, ray.d, t_max),
+            Shape::Mesh(_) => None,
+        }
+    }
+
+    /// The surface interaction of a hit found by the hierarchy: for a mesh, at triangle
+    /// `primitive` with the hit's barycentrics; for an analytic shape, at distance `hit.t`.
+    /// Recorded as shape `index`.
+    #[inline]
+    pub fn interaction(
+        &self,
+        ray: &Ray,
+        primitive: u32,
+        hit: &TriangleHit,
+        index: u32,
+    ) -> SurfaceInteraction {
+        match self {
+            Shape::Mesh(mesh) => mesh.interaction(primitive as usize, hit, index),
+            Shape::Sphere(sphere) => sphere.interaction(ray.o, ray.d, hit.t, index),
+            Shape::Disk(disk) => disk.interaction(ray.o, ray.d, hit.t, index),
+        }
+    }
+
+    /// A point uniformly distributed over the surface, pdf per unit area; None for a shape of
+    /// zero area. `u_choice` picks the triangle of a mesh.
+    pub fn sample_area(&self, u_choice: f32, u: Vec2) -> Option<SurfaceSample> {
+        match self {
+            Shape::Mesh(mesh) => mesh.sample_area(u_choice, u),
+            Shape::Sphere(sphere) => Some(sphere.sample_area(u)),
+            Shape::Disk(disk) => Some(disk.sample_area(u)),
+        }
+    }
+
+    /// A point of the surface as seen from `reference`, with its density per unit solid angle.
+    /// Spheres sample the cone they subtend; other shapes sample their area uniformly.
+    pub fn sample_from(&self, reference: Vec3, u_choice: f32, u: Vec2) -> Option<SurfaceSample> {
+        match self {
+            Shape::Sphere(sphere) => sphere.sample_from(reference, u),
+            Shape::Mesh(_) | Shape::Disk(_) => {
+                let s = self.sample_area(u_choice, u)?;
+                let pdf = area_to_solid_angle(s.pdf, reference, s.p, s.n)?;
+                Some(SurfaceSample { pdf, ..s })
+            }
+        }
+    }
+
+    /// Density of [`Self::sample_from`] for the surface point `p` with geometric normal `n`, per
+    /// unit solid angle at `reference`.
+    pub fn pdf_from(&self, reference: Vec3, p: Vec3, n: Vec3) -> f32 {
+        match self {
+            Shape::Sphere(sphere) => sphere.pdf_from(reference, p, n),
+            Shape::Mesh(_) | Shape::Disk(_) => {
+                area_to_solid_angle(1.0 / self.area(), reference, p, n).unwrap_or(0.0)
+            }
+        }
+    }
+
+    /// Bytes of heap memory the shape holds (a mesh's vertex attributes and indices).
+    pub fn heap_bytes(&self) -> usize {
+        match self {
+            Shape::Mesh(mesh) => mesh.heap_bytes(),
+            Shape::Sphere(_) | Shape::Disk(_) => 0,
+        }
+    }
+}
