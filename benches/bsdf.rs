@@ -1,6 +1,7 @@
-//! BSDF queries per second: `sample` (choose a lobe, draw a direction, return weight and pdf)
-//! and `eval` followed by `pdf` (what next-event estimation asks of the BSDF for a light
-//! sample's direction), for the materials a path tracer meets most: diffuse, the GGX
+//! BSDF queries per second: the lobes at a point (textures evaluated) followed by `sample`
+//! (choose a lobe, draw a direction, return weight and pdf) or by `eval` (value and pdf
+//! together, what next-event estimation asks of the BSDF for a light sample's direction), for
+//! the materials a path tracer meets most: diffuse, the GGX
 //! microfacet models at α = 0.3 (roughconductor with gold's spectral indices, roughdielectric,
 //! roughplastic) and the smooth dielectric and plastic, whose delta lobes are only sampled.
 //!
@@ -17,7 +18,7 @@ use std::time::Duration;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use glam::{Vec2, Vec3};
-use prism::bsdf::{Bsdf, BsdfFlags, ShadingPoint};
+use prism::bsdf::{Bsdf, BsdfFlags, BsdfModel, ShadingPoint};
 use prism::sampling::rng::Pcg32;
 use prism::sampling::warp::{sample_cosine_hemisphere, sample_uniform_sphere};
 use prism::scene::mitsuba::description::PluginClass;
@@ -115,7 +116,7 @@ fn bsdfs(c: &mut Criterion) {
         group.bench_function("sample", |b| {
             b.iter(|| {
                 for q in &queries {
-                    black_box(bsdf.sample(&sp, q.wo, q.u_lobe, q.u, &q.lambda));
+                    black_box(bsdf.at(&sp, q.wo, &q.lambda).sample(q.u_lobe, q.u));
                 }
             });
         });
@@ -124,8 +125,7 @@ fn bsdfs(c: &mut Criterion) {
             group.bench_function("eval_pdf", |b| {
                 b.iter(|| {
                     for q in &queries {
-                        black_box(bsdf.eval(&sp, q.wo, q.wi, &q.lambda));
-                        black_box(bsdf.pdf(&sp, q.wo, q.wi, &q.lambda));
+                        black_box(bsdf.at(&sp, q.wo, &q.lambda).eval(q.wi));
                     }
                 });
             });

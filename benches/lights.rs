@@ -21,7 +21,7 @@ use std::time::Duration;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use glam::{Vec2, Vec3};
-use prism::geometry::Shape;
+use prism::geometry::{Primitive, Shape};
 use prism::image::{ChannelImage, write_exr};
 use prism::light::Light;
 use prism::sampling::rng::Pcg32;
@@ -98,9 +98,9 @@ fn load_scene() -> Scene {
 /// The benchmark's name for a light of the scene.
 fn kind(scene: &Scene, light: &Light) -> &'static str {
     match light {
-        Light::Area(area) => match &scene.geometry.primitives[area.shape as usize] {
-            Shape::Sphere(_) => "sphere",
-            Shape::Mesh(mesh) if mesh.triangles().len() == 2 => "rectangle",
+        Light::Area(area) => match &scene.world.geometry.primitives[area.shape as usize] {
+            Primitive::Shape(Shape::Sphere(_)) => "sphere",
+            Primitive::Shape(Shape::Mesh(mesh)) if mesh.triangles().len() == 2 => "rectangle",
             _ => "mesh",
         },
         Light::Point(_) => "point",
@@ -133,11 +133,13 @@ fn queries() -> Vec<Query> {
 
 fn lights(c: &mut Criterion) {
     let scene = load_scene();
+    let integrator = scene.integrator.prepare(&scene.world);
+    let light_sampler = integrator.light_sampler();
     let queries = queries();
-    let shapes = &scene.geometry.primitives;
+    let shapes = &scene.world.geometry.primitives;
     let mut group = c.benchmark_group("lights");
     group.throughput(Throughput::Elements(POINTS as u64));
-    for light in &scene.lights {
+    for light in &scene.world.lights {
         group.bench_function(kind(&scene, light), |b| {
             b.iter(|| {
                 for q in &queries {
@@ -149,8 +151,8 @@ fn lights(c: &mut Criterion) {
     group.bench_function("select_and_sample", |b| {
         b.iter(|| {
             for q in &queries {
-                if let Some((index, pmf)) = scene.light_sampler.sample(q.u_light) {
-                    let light = &scene.lights[index];
+                if let Some((index, pmf)) = light_sampler.sample(q.u_light) {
+                    let light = &scene.world.lights[index];
                     black_box(pmf);
                     black_box(light.sample_incident(shapes, q.p, 0.0, q.u_choice, q.u, &q.lambda));
                 }

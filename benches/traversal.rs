@@ -64,11 +64,13 @@ impl Fixture {
         // (with new random numbers) until both sets are full.
         let (mut bounce, mut shadow) = (Vec::new(), Vec::new());
         let wanted = camera.len();
+        let integrator = scene.integrator.prepare(&scene.world);
+        let light_sampler = integrator.light_sampler();
         for ray in camera.iter().cycle().take(16 * wanted) {
             if bounce.len() == wanted && shadow.len() == wanted {
                 break;
             }
-            let Some(si) = scene.geometry.intersect(ray) else {
+            let Some(si) = scene.world.geometry.intersect(ray) else {
                 continue;
             };
             if bounce.len() < wanted {
@@ -83,9 +85,9 @@ impl Fixture {
             let lambda = SampledWavelengths::sample(rng.next_f32(), WavelengthSampling::CieSum);
             let (u_light, u_choice) = (rng.next_f32(), rng.next_f32());
             if shadow.len() < wanted
-                && let Some((light, _)) = scene.light_sampler.sample(u_light)
-                && let Some(ls) = scene.lights[light].sample_incident(
-                    &scene.geometry.primitives,
+                && let Some((light, _)) = light_sampler.sample(u_light)
+                && let Some(ls) = scene.world.lights[light].sample_incident(
+                    &scene.world.geometry.primitives,
                     si.p,
                     si.time,
                     u_choice,
@@ -160,7 +162,7 @@ fn traversal(c: &mut Criterion) {
             group.bench_function(id, |b| {
                 let fixture: &Fixture = fixture;
                 let rays = rays_of(fixture);
-                b.iter(|| query(&fixture.scene.geometry, rays));
+                b.iter(|| query(&fixture.scene.world.geometry, rays));
             });
         }
         group.finish();
@@ -179,7 +181,7 @@ fn bvh_build(c: &mut Criterion) {
     for (name, fixture) in SCENES {
         group.bench_function(name, |b| {
             let fixture: &Fixture = fixture;
-            let shapes = &fixture.scene.geometry.primitives;
+            let shapes = &fixture.scene.world.geometry.primitives;
             b.iter_batched(|| shapes.clone(), Geometry::new, BatchSize::PerIteration);
         });
     }

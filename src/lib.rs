@@ -49,3 +49,4 @@ pub mod sampling;
 pub mod scene;
 pub mod spectrum;
 pub mod texture;
+pub mod world;

@@ -123,7 +123,7 @@ fn benchmark_rays_leave_surfaces_in_all_directions() {
     let rays = incoherent_rays(&scene, n, 3);
     assert_eq!(rays.len(), n);
     assert_eq!(rays, incoherent_rays(&scene, n, 3), "seeded");
-    let (lo, hi) = scene.geometry.bounds().unwrap();
+    let (lo, hi) = scene.world.geometry.bounds().unwrap();
     let slack = 1e-3 * (hi - lo).length();
     let mut mean = Vec3::ZERO;
     for ray in &rays {
@@ -146,10 +146,11 @@ fn shadow_rays_join_visible_surfaces_to_the_lights() {
     // The box's one light is on the ceiling: every segment ends on it (the ray's parameter
     // stops just short of 1, at the point sampled on the light).
     let (lights, _): (Vec<_>, Vec<_>) = scene
+        .world
         .geometry
         .primitives
         .iter()
-        .zip(&scene.shape_info)
+        .zip(&scene.world.shape_info)
         .partition(|(_, info)| info.light.is_some());
     assert_eq!(lights.len(), 1);
     let (lo, hi) = lights[0].0.bounds();
@@ -162,7 +163,7 @@ fn shadow_rays_join_visible_surfaces_to_the_lights() {
             "{end} is not on the light"
         );
         assert!(ray.t_max < 1.0 && ray.t_max > 0.99);
-        occluded += usize::from(scene.geometry.occluded(ray));
+        occluded += usize::from(scene.world.geometry.occluded(ray));
     }
     // The two boxes hide the light from part of the floor and walls, but not from most of
     // what the camera sees.

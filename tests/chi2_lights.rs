@@ -291,23 +291,25 @@ fn every_kind_of_light(selection: LightSelection) -> (prism::scene::Scene, Vec<f
 
 fn selection_chi2(selection: LightSelection, seed: u64) {
     let (scene, powers) = every_kind_of_light(selection);
+    let integrator = scene.integrator.prepare(&scene.world);
+    let light_sampler = integrator.light_sampler();
     let total: f64 = powers.iter().sum();
     let probabilities: Vec<f64> = match selection {
         LightSelection::Power => powers.iter().map(|p| p / total).collect(),
         LightSelection::Uniform => vec![1.0 / powers.len() as f64; powers.len()],
     };
     for (i, p) in probabilities.iter().enumerate() {
-        let reported = f64::from(scene.light_sampler.pmf(i));
+        let reported = f64::from(light_sampler.pmf(i));
         assert!(
             (reported / p - 1.0).abs() < 1e-4,
             "{selection:?}: light {i} has pmf {reported}, not {p}"
         );
     }
     let outcome = chi2_discrete(SAMPLES, &probabilities, seed, |rng| {
-        let (index, pmf) = scene.light_sampler.sample(rng.next_f32()).unwrap();
+        let (index, pmf) = light_sampler.sample(rng.next_f32()).unwrap();
         assert_eq!(
             pmf,
-            scene.light_sampler.pmf(index),
+            light_sampler.pmf(index),
             "the pmf returned with a sample is the reported pmf"
         );
         index

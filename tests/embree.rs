@@ -16,8 +16,8 @@ fn cornell_box_mean(accel: Accel, seed: u64) -> (f64, f64) {
     let defines = [("resx", "64"), ("resy", "64"), ("spp", "16")]
         .map(|(name, value)| (name.to_string(), value.to_string()));
     let mut scene = load_scene(&path, &defines).unwrap().scene;
-    scene.geometry.set_accel(accel).unwrap();
-    assert_eq!(scene.geometry.accel(), accel);
+    scene.world.geometry.set_accel(accel).unwrap();
+    assert_eq!(scene.world.geometry.accel(), accel);
     let film = render(&scene, &RenderOptions::fixed(16, seed, Some(2)))
         .unwrap()
         .film;

@@ -29,9 +29,9 @@ fn load(folder: &Path, body: &str) -> Scene {
 /// The radiance (or intensity, irradiance) a light delivers at `lambda` along a sample from
 /// `reference`, undoing the distance falloff of point and spot lights.
 fn emission_at(scene: &Scene, light: usize, reference: Vec3, lambda: f32) -> f32 {
-    let ls = scene.lights[light]
+    let ls = scene.world.lights[light]
         .sample_incident(
-            &scene.geometry.primitives,
+            &scene.world.geometry.primitives,
             reference,
             0.0,
             0.5,
@@ -39,7 +39,7 @@ fn emission_at(scene: &Scene, light: usize, reference: Vec3, lambda: f32) -> f32
             &SampledWavelengths::single(lambda),
         )
         .unwrap();
-    match scene.lights[light] {
+    match scene.world.lights[light] {
         Light::Point(_) | Light::Spot(_) => ls.radiance[0] * (ls.p - reference).length_squared(),
         _ => ls.radiance[0],
     }
@@ -55,7 +55,7 @@ fn default_emission_is_d65_of_luminance_one() {
     <emitter type="directional"/>
     <emitter type="constant"/>"#,
     );
-    assert_eq!(scene.lights.len(), 5);
+    assert_eq!(scene.world.lights.len(), 5);
     for lambda in [400.0, 550.0, 700.0] {
         let d65 = d65_normalized(lambda);
         for (light, reference) in [
@@ -84,7 +84,7 @@ fn emitting_shapes_without_a_bsdf_are_black() {
     <shape type="sphere"><point name="center" x="3" y="0" z="0"/></shape>"#,
     );
     let reflectance = |shape: usize| {
-        let material = &scene.materials[scene.shape_info[shape].material as usize];
+        let material = &scene.world.materials[scene.world.shape_info[shape].material as usize];
         #[allow(unreachable_patterns)] // other BSDFs come with the materials issue
         match &material.front {
             Bsdf::Diffuse(diffuse) => diffuse.reflectance.eval_1(glam::Vec2::ZERO),
@@ -102,7 +102,7 @@ fn spot_defaults_follow_mitsuba() {
     let scene = load(Path::new("."), r#"<emitter type="spot"/>"#);
     let (c, b) = (20f32.to_radians(), 15f32.to_radians());
     let expected = 2.0 * PI * (1.0 - (c.sin() - b.sin()) / (c - b));
-    let power = scene.lights[0].power(&scene.geometry.primitives);
+    let power = scene.world.lights[0].power(&scene.world.geometry.primitives);
     assert!(
         (power / expected - 1.0).abs() < 1e-3,
         "{power} vs {expected}"
@@ -118,7 +118,7 @@ fn directional_light_placement() {
     <emitter type="directional"><transform name="to_world"><rotate x="1" angle="90"/></transform></emitter>"#,
     );
     let wi = |light: usize| {
-        scene.lights[light]
+        scene.world.lights[light]
             .sample_incident(
                 &[],
                 Vec3::ZERO,
@@ -145,12 +145,13 @@ fn blackbody_radiance_and_uniform_emitter_sampling() {
     );
     let value = emission_at(&scene, 0, Vec3::ZERO, 555.0);
     assert!((value / 399.639 - 1.0).abs() < 1e-4, "{value}");
+    let integrator = scene.integrator.prepare(&scene.world);
     assert!(matches!(
-        scene.light_sampler,
+        integrator.light_sampler(),
         LightSampler::Uniform { count: 2 }
     ));
-    assert_eq!(scene.light_sampler.pmf(1), 0.5);
-    assert_eq!(scene.environment, Some(0));
+    assert_eq!(integrator.light_sampler().pmf(1), 0.5);
+    assert_eq!(scene.world.environment, Some(0));
 }
 
 /// A PNG environment map is decoded from sRGB, and scaled.
@@ -165,7 +166,7 @@ fn environment_map_from_a_png() {
         &folder,
         r#"<emitter type="envmap"><string name="filename" value="sky.png"/><float name="scale" value="2"/></emitter>"#,
     );
-    let value = scene.lights[0].environment_radiance(
+    let value = scene.world.lights[0].environment_radiance(
         Vec3::new(0.3, 0.5, -0.8).normalize(),
         &SampledWavelengths::single(600.0),
     )[0];

@@ -102,7 +102,8 @@ fn microfacet_distributions_are_normalised_and_pass_the_weak_white_furnace() {
 /// The probability with which a delta-only BSDF reflects at wo (from its samples' pdfs).
 fn reflection_probability(bsdf: &Bsdf, wo: Vec3) -> f32 {
     let s = bsdf
-        .sample(&point(), wo, 0.0, Vec2::splat(0.5), &wavelengths())
+        .at(&point(), wo, &wavelengths())
+        .sample(0.0, Vec2::splat(0.5))
         .unwrap();
     assert!(s.flags.contains(BsdfFlags::REFLECTION));
     s.pdf
@@ -129,7 +130,8 @@ fn fresnel_at_normal_incidence() {
     for lambda in [420.0f32, 550.0, 680.0] {
         let w = SampledWavelengths::single(lambda);
         let s = gold
-            .sample(&point(), Vec3::Z, 0.5, Vec2::splat(0.5), &w)
+            .at(&point(), Vec3::Z, &w)
+            .sample(0.5, Vec2::splat(0.5))
             .unwrap();
         let i = table.partition_point(|s| s.0 <= lambda) - 1;
         let t = (lambda - table[i].0) / (table[i + 1].0 - table[i].0);
@@ -168,7 +170,8 @@ fn smooth_dielectric_lobes() {
             k as u64,
             |rng| {
                 let s = bsdf
-                    .sample(&point(), wo, rng.next_f32(), Vec2::ZERO, &lambda)
+                    .at(&point(), wo, &lambda)
+                    .sample(rng.next_f32(), Vec2::ZERO)
                     .unwrap();
                 usize::from(s.flags.contains(BsdfFlags::TRANSMISSION))
             },
@@ -180,7 +183,8 @@ fn smooth_dielectric_lobes() {
         let mut rng = Pcg32::seeded(10 + k as u64);
         for _ in 0..1000 {
             let s = bsdf
-                .sample(&point(), wo, rng.next_f32(), Vec2::ZERO, &lambda)
+                .at(&point(), wo, &lambda)
+                .sample(rng.next_f32(), Vec2::ZERO)
                 .unwrap();
             // Energy: weight · η² (the radiance compression undone) is 1 for either lobe.
             assert!((s.weight[0] * s.eta * s.eta - 1.0).abs() < 1e-5, "{s:?}");
@@ -206,23 +210,27 @@ fn thin_dielectric_and_conductor_lobes() {
     let r = prism::bsdf::fresnel::fresnel_dielectric(wo.z, 1.5).reflectance;
     let r2 = 2.0 * r / (1.0 + r);
     let reflected = thin
-        .sample(&point(), wo, 0.0, Vec2::ZERO, &wavelengths())
+        .at(&point(), wo, &wavelengths())
+        .sample(0.0, Vec2::ZERO)
         .unwrap();
     assert!((reflected.pdf - r2).abs() < 1e-6);
     let passed = thin
-        .sample(&point(), -wo, 0.999, Vec2::ZERO, &wavelengths())
+        .at(&point(), -wo, &wavelengths())
+        .sample(0.999, Vec2::ZERO)
         .unwrap();
     assert!(passed.flags.contains(BsdfFlags::NULL) && passed.wi == wo);
     assert!((passed.weight[0] * passed.pdf - (1.0 - r2)).abs() < 1e-6);
     let mirror = bsdf_from_xml(r#"<bsdf type="conductor"/>"#);
     let s = mirror
-        .sample(&point(), wo, 0.3, Vec2::ZERO, &wavelengths())
+        .at(&point(), wo, &wavelengths())
+        .sample(0.3, Vec2::ZERO)
         .unwrap();
     assert_eq!(s.weight, prism::spectrum::SampledSpectrum::ONE);
     assert!((s.wi - Vec3::new(-wo.x, -wo.y, wo.z)).length() < 1e-6);
     assert!(
         mirror
-            .sample(&point(), -wo, 0.3, Vec2::ZERO, &wavelengths())
+            .at(&point(), -wo, &wavelengths())
+            .sample(0.3, Vec2::ZERO)
             .is_none()
     );
 }

@@ -230,7 +230,7 @@ pub fn measure(bench: &BenchScene, options: &BenchOptions) -> Result<Measurement
     let mut bvh_build_seconds = f64::INFINITY;
     let (mut primitives, mut geometry_bytes) = (0, 0);
     for _ in 0..3 {
-        let shapes = scene.geometry.primitives.clone();
+        let shapes = scene.world.geometry.primitives.clone();
         let start = Instant::now();
         let rebuilt = pool.install(|| Geometry::new(shapes));
         bvh_build_seconds = bvh_build_seconds.min(start.elapsed().as_secs_f64());
@@ -240,9 +240,9 @@ pub fn measure(bench: &BenchScene, options: &BenchOptions) -> Result<Measurement
 
     let rays = rays::incoherent_rays(&scene, options.ray_count, 1);
     let shadow_rays = rays::shadow_rays(&scene, options.ray_count, 2);
-    let ours = &scene.geometry;
+    let ours = &scene.world.geometry;
     let embree = if cfg!(feature = "embree") {
-        let mut embree = scene.geometry.clone();
+        let mut embree = scene.world.geometry.clone();
         crate::cli::accel::Accel::Embree.apply(&mut embree)?;
         Some(embree)
     } else {

@@ -31,11 +31,12 @@ pub fn incoherent_rays(scene: &Scene, count: usize, seed: u64) -> Vec<Ray> {
 /// scene has no light that can be sampled, or camera rays never hit anything).
 pub fn shadow_rays(scene: &Scene, count: usize, seed: u64) -> Vec<Ray> {
     let wavelengths = SampledWavelengths::sample(0.5, WavelengthSampling::default());
+    let integrator = scene.integrator.prepare(&scene.world);
     rays_from_visible_surfaces(scene, count, seed, |hit, rng| {
-        let (light, _) = scene.light_sampler.sample(rng.next_f32())?;
+        let (light, _) = integrator.light_sampler().sample(rng.next_f32())?;
         let (u_choice, u) = (rng.next_f32(), Vec2::new(rng.next_f32(), rng.next_f32()));
-        let sample = scene.lights[light].sample_incident(
-            &scene.geometry.primitives,
+        let sample = scene.world.lights[light].sample_incident(
+            &scene.world.geometry.primitives,
             hit.p,
             hit.time,
             u_choice,
@@ -63,6 +64,7 @@ fn rays_from_visible_surfaces(
         let film = Vec2::new(rng.next_f32(), rng.next_f32()) * size;
         let camera_ray = scene.camera.generate_ray(film, Vec2::splat(0.5), 0.0);
         match scene
+            .world
             .geometry
             .intersect(&camera_ray)
             .and_then(|hit| ray_from(&hit, &mut rng))

@@ -13,8 +13,11 @@
 
 use glam::{Vec2, Vec3};
 
-use super::{Bsdf, BsdfFlags, BsdfSample, ShadingPoint, Texture};
-use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+use super::{
+    Bsdf, BsdfEval, BsdfFlags, BsdfModel, BsdfSample, Bxdf, BxdfTree, NodeId, ShadingPoint,
+};
+use crate::spectrum::SampledWavelengths;
+use crate::texture::Texture;
 
 #[derive(Clone, Debug)]
 pub struct Blend {
@@ -22,60 +25,72 @@ pub struct Blend {
     pub nested: [Box<Bsdf>; 2],
 }
 
-impl Blend {
-    pub fn flags(&self) -> BsdfFlags {
+impl BsdfModel for Blend {
+    fn flags(&self) -> BsdfFlags {
         self.nested[0].flags().union(self.nested[1].flags())
     }
 
+    fn is_dispersive(&self) -> bool {
+        self.nested[0].is_dispersive() || self.nested[1].is_dispersive()
+    }
+
+    fn node_count(&self) -> usize {
+        1 + self.nested[0].node_count() + self.nested[1].node_count()
+    }
+
     #[inline]
-    fn weight(&self, sp: &ShadingPoint) -> f32 {
-        self.weight.eval_1(sp.uv).clamp(0.0, 1.0)
-    }
-
-    pub fn eval(
-        &self,
-        sp: &ShadingPoint,
+    fn resolve<'a>(
+        &'a self,
+        point: &ShadingPoint,
         wo: Vec3,
-        wi: Vec3,
         lambda: &SampledWavelengths,
-    ) -> SampledSpectrum {
-        let w = self.weight(sp);
-        self.nested[0].eval(sp, wo, wi, lambda) * (1.0 - w)
-            + self.nested[1].eval(sp, wo, wi, lambda) * w
+        tree: &mut BxdfTree<'a>,
+    ) -> NodeId {
+        let first = self.nested[0].resolve(point, wo, lambda, tree);
+        let second = self.nested[1].resolve(point, wo, lambda, tree);
+        tree.push(BlendLobes {
+            weight: self.weight.eval_1(point.uv).clamp(0.0, 1.0),
+            nested: [first, second],
+        })
+    }
+}
+
+/// Both nested BSDFs' lobes, weighted 1 − w and w, at a point.
+#[derive(Clone, Copy, Debug)]
+pub struct BlendLobes {
+    pub weight: f32,
+    pub nested: [NodeId; 2],
+}
+
+impl Bxdf for BlendLobes {
+    fn eval(&self, tree: &BxdfTree, wo: Vec3, wi: Vec3) -> BsdfEval {
+        let w = self.weight;
+        let first = tree.eval(self.nested[0], wo, wi);
+        let second = tree.eval(self.nested[1], wo, wi);
+        BsdfEval {
+            value: first.value * (1.0 - w) + second.value * w,
+            pdf: (1.0 - w) * first.pdf + w * second.pdf,
+        }
     }
 
-    pub fn pdf(&self, sp: &ShadingPoint, wo: Vec3, wi: Vec3, lambda: &SampledWavelengths) -> f32 {
-        let w = self.weight(sp);
-        (1.0 - w) * self.nested[0].pdf(sp, wo, wi, lambda)
-            + w * self.nested[1].pdf(sp, wo, wi, lambda)
-    }
-
-    pub fn sample(
-        &self,
-        sp: &ShadingPoint,
-        wo: Vec3,
-        u_lobe: f32,
-        u: Vec2,
-        lambda: &SampledWavelengths,
-    ) -> Option<BsdfSample> {
-        let w = self.weight(sp);
+    fn sample(&self, tree: &BxdfTree, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<BsdfSample> {
+        let w = self.weight;
         let (chosen, probability, u_lobe) = if u_lobe < w {
             (1, w, u_lobe / w)
         } else {
             (0, 1.0 - w, (u_lobe - w) / (1.0 - w))
         };
-        let mut s =
-            self.nested[chosen].sample(sp, wo, u_lobe.min(1.0 - f32::EPSILON), u, lambda)?;
+        let mut s = tree.sample(self.nested[chosen], wo, u_lobe.min(1.0 - f32::EPSILON), u)?;
         if s.flags.is_delta() {
             s.pdf *= probability;
             return Some(s);
         }
-        let pdf = self.pdf(sp, wo, s.wi, lambda);
-        if !(pdf > 0.0) {
+        let blend = self.eval(tree, wo, s.wi);
+        if !(blend.pdf > 0.0) {
             return None;
         }
-        s.weight = self.eval(sp, wo, s.wi, lambda) * (1.0 / pdf);
-        s.pdf = pdf;
+        s.weight = blend.value * (1.0 / blend.pdf);
+        s.pdf = blend.pdf;
         Some(s)
     }
 }

@@ -9,14 +9,15 @@
 //! </bsdf>
 //! ```
 //! A single specular lobe: `sample` returns the mirror direction with weight
-//! F(cos θ, η(λ), k(λ)) · specular_reflectance; `eval` and `pdf` are zero. One-sided.
+//! F(cos θ, η(λ), k(λ)) · specular_reflectance; nothing to evaluate. One-sided.
 
 use glam::{Vec2, Vec3};
 use wide::f32x4;
 
 use super::fresnel::{fresnel_conductor4, reflect_z};
-use super::{BsdfFlags, BsdfSample, ShadingPoint, Texture};
+use super::{BsdfFlags, BsdfModel, BsdfSample, Bxdf, BxdfTree, NodeId, ShadingPoint};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+use crate::texture::Texture;
 
 #[derive(Clone, Debug)]
 pub struct Conductor {
@@ -25,53 +26,76 @@ pub struct Conductor {
     pub specular_reflectance: Texture,
 }
 
-/// The Fresnel reflectance of a conductor at cos θ for each wavelength, η and k read from
-/// textures at `uv` (shared by `conductor` and `roughconductor`).
-#[inline]
-pub(crate) fn conductor_reflectance(
-    eta: &Texture,
-    k: &Texture,
-    uv: Vec2,
-    cos_theta: f32,
-    lambda: &SampledWavelengths,
-) -> SampledSpectrum {
-    let (eta, k) = (eta.eval(uv, lambda), k.eval(uv, lambda));
-    let reflectance = fresnel_conductor4(cos_theta, f32x4::from(eta.0), f32x4::from(k.0));
-    SampledSpectrum(reflectance.to_array())
+/// A conductor's complex index of refraction at a point, at each of a path's wavelengths
+/// (shared by `conductor` and `roughconductor`).
+#[derive(Clone, Copy, Debug)]
+pub struct ConductorIor {
+    pub eta: SampledSpectrum,
+    pub k: SampledSpectrum,
 }
 
-impl Conductor {
-    pub fn flags(&self) -> BsdfFlags {
-        BsdfFlags::SPECULAR.union(BsdfFlags::REFLECTION)
+impl ConductorIor {
+    /// η and k read from textures at `uv`.
+    #[inline]
+    pub fn at(eta: &Texture, k: &Texture, uv: Vec2, lambda: &SampledWavelengths) -> ConductorIor {
+        ConductorIor {
+            eta: eta.eval(uv, lambda),
+            k: k.eval(uv, lambda),
+        }
     }
 
-    pub fn eval(
-        &self,
-        _sp: &ShadingPoint,
+    /// The Fresnel reflectance at cos θ for each wavelength.
+    #[inline]
+    pub fn reflectance(&self, cos_theta: f32) -> SampledSpectrum {
+        let reflectance =
+            fresnel_conductor4(cos_theta, f32x4::from(self.eta.0), f32x4::from(self.k.0));
+        SampledSpectrum(reflectance.to_array())
+    }
+}
+
+const FLAGS: BsdfFlags = BsdfFlags::SPECULAR.union(BsdfFlags::REFLECTION);
+
+impl BsdfModel for Conductor {
+    fn flags(&self) -> BsdfFlags {
+        FLAGS
+    }
+
+    fn is_dispersive(&self) -> bool {
+        false
+    }
+
+    fn node_count(&self) -> usize {
+        1
+    }
+
+    #[inline]
+    fn resolve<'a>(
+        &'a self,
+        point: &ShadingPoint,
         _wo: Vec3,
-        _wi: Vec3,
-        _lambda: &SampledWavelengths,
-    ) -> SampledSpectrum {
-        SampledSpectrum::ZERO
-    }
-
-    pub fn pdf(&self, _sp: &ShadingPoint, _wo: Vec3, _wi: Vec3, _l: &SampledWavelengths) -> f32 {
-        0.0
-    }
-
-    pub fn sample(
-        &self,
-        sp: &ShadingPoint,
-        wo: Vec3,
-        _u_lobe: f32,
-        _u: Vec2,
         lambda: &SampledWavelengths,
-    ) -> Option<BsdfSample> {
+        tree: &mut BxdfTree<'a>,
+    ) -> NodeId {
+        tree.push(ConductorLobes {
+            ior: ConductorIor::at(&self.eta, &self.k, point.uv, lambda),
+            specular_reflectance: self.specular_reflectance.eval(point.uv, lambda),
+        })
+    }
+}
+
+/// The mirror lobe at a point.
+#[derive(Clone, Copy, Debug)]
+pub struct ConductorLobes {
+    pub ior: ConductorIor,
+    pub specular_reflectance: SampledSpectrum,
+}
+
+impl Bxdf for ConductorLobes {
+    fn sample(&self, _tree: &BxdfTree, wo: Vec3, _u_lobe: f32, _u: Vec2) -> Option<BsdfSample> {
         if !(wo.z > 0.0) {
             return None;
         }
-        let f = conductor_reflectance(&self.eta, &self.k, sp.uv, wo.z, lambda);
-        let weight = f * self.specular_reflectance.eval(sp.uv, lambda);
-        Some(BsdfSample::new(reflect_z(wo), weight, 1.0, self.flags()))
+        let weight = self.ior.reflectance(wo.z) * self.specular_reflectance;
+        Some(BsdfSample::new(reflect_z(wo), weight, 1.0, FLAGS))
     }
 }

@@ -22,9 +22,10 @@
 use glam::{Vec2, Vec3};
 
 use super::fresnel::{fresnel_dielectric, reflect_z, refract_z};
-use super::{BsdfFlags, BsdfSample, ShadingPoint, Texture};
+use super::{BsdfFlags, BsdfModel, BsdfSample, Bxdf, BxdfTree, NodeId, ShadingPoint};
 use crate::spectrum::ior::RelativeIor;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+use crate::texture::Texture;
 
 #[derive(Clone, Debug)]
 pub struct Dielectric {
@@ -47,45 +48,86 @@ pub(crate) fn optional_factor(
     }
 }
 
-impl Dielectric {
-    pub fn flags(&self) -> BsdfFlags {
-        BsdfFlags::SPECULAR
-            .union(BsdfFlags::REFLECTION)
-            .union(BsdfFlags::TRANSMISSION)
+/// A relative index of refraction at a path's wavelengths: η(λᵢ) for each when it is
+/// dispersive, else the one value everywhere.
+#[derive(Clone, Copy, Debug)]
+pub struct SampledIor {
+    pub eta: SampledSpectrum,
+    pub dispersive: bool,
+}
+
+impl SampledIor {
+    #[inline]
+    pub fn at(eta: &RelativeIor, lambda: &SampledWavelengths) -> SampledIor {
+        let dispersive = eta.is_dispersive();
+        SampledIor {
+            eta: if dispersive {
+                SampledSpectrum::from_fn(|i| eta.at(lambda.lambda(i)))
+            } else {
+                SampledSpectrum::splat(eta.at(lambda.lambda(0)))
+            },
+            dispersive,
+        }
     }
 
-    pub fn eval(
-        &self,
-        _sp: &ShadingPoint,
+    /// η at the hero wavelength.
+    #[inline]
+    pub fn hero(&self) -> f32 {
+        self.eta[0]
+    }
+}
+
+const FLAGS: BsdfFlags = BsdfFlags::SPECULAR
+    .union(BsdfFlags::REFLECTION)
+    .union(BsdfFlags::TRANSMISSION);
+
+impl BsdfModel for Dielectric {
+    fn flags(&self) -> BsdfFlags {
+        FLAGS
+    }
+
+    fn is_dispersive(&self) -> bool {
+        self.eta.is_dispersive()
+    }
+
+    fn node_count(&self) -> usize {
+        1
+    }
+
+    #[inline]
+    fn resolve<'a>(
+        &'a self,
+        point: &ShadingPoint,
         _wo: Vec3,
-        _wi: Vec3,
-        _lambda: &SampledWavelengths,
-    ) -> SampledSpectrum {
-        SampledSpectrum::ZERO
-    }
-
-    pub fn pdf(&self, _sp: &ShadingPoint, _wo: Vec3, _wi: Vec3, _l: &SampledWavelengths) -> f32 {
-        0.0
-    }
-
-    pub fn sample(
-        &self,
-        sp: &ShadingPoint,
-        wo: Vec3,
-        u_lobe: f32,
-        _u: Vec2,
         lambda: &SampledWavelengths,
-    ) -> Option<BsdfSample> {
+        tree: &mut BxdfTree<'a>,
+    ) -> NodeId {
+        tree.push(DielectricLobes {
+            eta: SampledIor::at(&self.eta, lambda),
+            specular_reflectance: optional_factor(&self.specular_reflectance, point.uv, lambda),
+            specular_transmittance: optional_factor(&self.specular_transmittance, point.uv, lambda),
+        })
+    }
+}
+
+/// The reflected and refracted lobes at a point.
+#[derive(Clone, Copy, Debug)]
+pub struct DielectricLobes {
+    pub eta: SampledIor,
+    pub specular_reflectance: SampledSpectrum,
+    pub specular_transmittance: SampledSpectrum,
+}
+
+impl Bxdf for DielectricLobes {
+    fn sample(&self, _tree: &BxdfTree, wo: Vec3, u_lobe: f32, _u: Vec2) -> Option<BsdfSample> {
         let cos_o = wo.z;
         if cos_o == 0.0 || !cos_o.is_finite() {
             return None;
         }
-        let hero = fresnel_dielectric(cos_o, self.eta.at(lambda.lambda(0)));
-        let dispersive = self.eta.is_dispersive();
+        let hero = fresnel_dielectric(cos_o, self.eta.hero());
+        let dispersive = self.eta.dispersive;
         let reflectance = if dispersive {
-            SampledSpectrum::from_fn(|i| {
-                fresnel_dielectric(cos_o, self.eta.at(lambda.lambda(i))).reflectance
-            })
+            SampledSpectrum::from_fn(|i| fresnel_dielectric(cos_o, self.eta.eta[i]).reflectance)
         } else {
             SampledSpectrum::splat(hero.reflectance)
         };
@@ -95,9 +137,7 @@ impl Dielectric {
             hero.reflectance
         };
         if u_lobe < p_reflect {
-            let weight = reflectance
-                * (1.0 / p_reflect)
-                * optional_factor(&self.specular_reflectance, sp.uv, lambda);
+            let weight = reflectance * (1.0 / p_reflect) * self.specular_reflectance;
             return Some(BsdfSample::new(
                 reflect_z(wo),
                 weight,
@@ -112,9 +152,7 @@ impl Dielectric {
         let p_transmit = 1.0 - p_reflect;
         let transmittance = (SampledSpectrum::ONE - reflectance) * (1.0 / p_transmit);
         let radiance_scale = hero.eta_ti * hero.eta_ti;
-        let weight = transmittance
-            * radiance_scale
-            * optional_factor(&self.specular_transmittance, sp.uv, lambda);
+        let weight = transmittance * radiance_scale * self.specular_transmittance;
         Some(BsdfSample {
             wi: refract_z(wo, hero.cos_theta_t, hero.eta_ti),
             weight,

@@ -12,51 +12,65 @@ use std::f32::consts::FRAC_1_PI;
 
 use glam::{Vec2, Vec3};
 
-use super::{BsdfFlags, BsdfSample, ShadingPoint, Texture};
+use super::{BsdfEval, BsdfFlags, BsdfModel, BsdfSample, Bxdf, BxdfTree, NodeId, ShadingPoint};
 use crate::sampling::warp::{cosine_hemisphere_pdf, sample_cosine_hemisphere};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+use crate::texture::Texture;
 
 #[derive(Clone, Debug)]
 pub struct Diffuse {
     pub reflectance: Texture,
 }
 
-impl Diffuse {
-    pub fn flags(&self) -> BsdfFlags {
-        BsdfFlags::DIFFUSE.union(BsdfFlags::REFLECTION)
+const FLAGS: BsdfFlags = BsdfFlags::DIFFUSE.union(BsdfFlags::REFLECTION);
+
+impl BsdfModel for Diffuse {
+    fn flags(&self) -> BsdfFlags {
+        FLAGS
+    }
+
+    fn is_dispersive(&self) -> bool {
+        false
+    }
+
+    fn node_count(&self) -> usize {
+        1
     }
 
     #[inline]
-    pub fn eval(
-        &self,
-        sp: &ShadingPoint,
-        wo: Vec3,
-        wi: Vec3,
+    fn resolve<'a>(
+        &'a self,
+        point: &ShadingPoint,
+        _wo: Vec3,
         lambda: &SampledWavelengths,
-    ) -> SampledSpectrum {
+        tree: &mut BxdfTree<'a>,
+    ) -> NodeId {
+        tree.push(DiffuseLobes {
+            reflectance: self.reflectance.eval(point.uv, lambda),
+        })
+    }
+}
+
+/// The diffuse lobe at a point.
+#[derive(Clone, Copy, Debug)]
+pub struct DiffuseLobes {
+    pub reflectance: SampledSpectrum,
+}
+
+impl Bxdf for DiffuseLobes {
+    #[inline]
+    fn eval(&self, _tree: &BxdfTree, wo: Vec3, wi: Vec3) -> BsdfEval {
         if wo.z <= 0.0 || wi.z <= 0.0 {
-            return SampledSpectrum::ZERO;
+            return BsdfEval::ZERO;
         }
-        self.reflectance.eval(sp.uv, lambda) * (FRAC_1_PI * wi.z)
+        BsdfEval {
+            value: self.reflectance * (FRAC_1_PI * wi.z),
+            pdf: cosine_hemisphere_pdf(wi),
+        }
     }
 
     #[inline]
-    pub fn pdf(&self, _sp: &ShadingPoint, wo: Vec3, wi: Vec3, _lambda: &SampledWavelengths) -> f32 {
-        if wo.z <= 0.0 || wi.z <= 0.0 {
-            return 0.0;
-        }
-        cosine_hemisphere_pdf(wi)
-    }
-
-    #[inline]
-    pub fn sample(
-        &self,
-        sp: &ShadingPoint,
-        wo: Vec3,
-        _u_lobe: f32,
-        u: Vec2,
-        lambda: &SampledWavelengths,
-    ) -> Option<BsdfSample> {
+    fn sample(&self, _tree: &BxdfTree, wo: Vec3, _u_lobe: f32, u: Vec2) -> Option<BsdfSample> {
         if wo.z <= 0.0 {
             return None;
         }
@@ -65,11 +79,6 @@ impl Diffuse {
         if !(pdf > 0.0) {
             return None;
         }
-        Some(BsdfSample::new(
-            wi,
-            self.reflectance.eval(sp.uv, lambda),
-            pdf,
-            self.flags(),
-        ))
+        Some(BsdfSample::new(wi, self.reflectance, pdf, FLAGS))
     }
 }

@@ -14,8 +14,11 @@
 
 use glam::{Vec2, Vec3};
 
-use super::{Bsdf, BsdfFlags, BsdfSample, ShadingPoint, Texture};
+use super::{
+    Bsdf, BsdfEval, BsdfFlags, BsdfModel, BsdfSample, Bxdf, BxdfTree, NodeId, ShadingPoint,
+};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+use crate::texture::Texture;
 
 #[derive(Clone, Debug)]
 pub struct Mask {
@@ -23,42 +26,57 @@ pub struct Mask {
     pub nested: Box<Bsdf>,
 }
 
-impl Mask {
-    pub fn flags(&self) -> BsdfFlags {
+impl BsdfModel for Mask {
+    fn flags(&self) -> BsdfFlags {
         self.nested.flags().union(BsdfFlags::NULL)
     }
 
+    fn is_dispersive(&self) -> bool {
+        self.nested.is_dispersive()
+    }
+
+    fn node_count(&self) -> usize {
+        1 + self.nested.node_count()
+    }
+
     #[inline]
-    fn opacity(&self, sp: &ShadingPoint) -> f32 {
-        self.opacity.eval_1(sp.uv).clamp(0.0, 1.0)
-    }
-
-    pub fn eval(
-        &self,
-        sp: &ShadingPoint,
+    fn resolve<'a>(
+        &'a self,
+        point: &ShadingPoint,
         wo: Vec3,
-        wi: Vec3,
         lambda: &SampledWavelengths,
-    ) -> SampledSpectrum {
-        self.nested.eval(sp, wo, wi, lambda) * self.opacity(sp)
+        tree: &mut BxdfTree<'a>,
+    ) -> NodeId {
+        let nested = self.nested.resolve(point, wo, lambda, tree);
+        tree.push(MaskLobes {
+            opacity: self.opacity.eval_1(point.uv).clamp(0.0, 1.0),
+            nested,
+        })
+    }
+}
+
+/// The nested lobes weighted by the opacity α, and the null lobe, at a point.
+#[derive(Clone, Copy, Debug)]
+pub struct MaskLobes {
+    pub opacity: f32,
+    pub nested: NodeId,
+}
+
+impl Bxdf for MaskLobes {
+    #[inline]
+    fn eval(&self, tree: &BxdfTree, wo: Vec3, wi: Vec3) -> BsdfEval {
+        let nested = tree.eval(self.nested, wo, wi);
+        BsdfEval {
+            value: nested.value * self.opacity,
+            pdf: nested.pdf * self.opacity,
+        }
     }
 
-    pub fn pdf(&self, sp: &ShadingPoint, wo: Vec3, wi: Vec3, lambda: &SampledWavelengths) -> f32 {
-        self.nested.pdf(sp, wo, wi, lambda) * self.opacity(sp)
-    }
-
-    pub fn sample(
-        &self,
-        sp: &ShadingPoint,
-        wo: Vec3,
-        u_lobe: f32,
-        u: Vec2,
-        lambda: &SampledWavelengths,
-    ) -> Option<BsdfSample> {
-        let opacity = self.opacity(sp);
+    fn sample(&self, tree: &BxdfTree, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<BsdfSample> {
+        let opacity = self.opacity;
         if u_lobe < opacity {
             // The nested lobes' values and densities both carry the factor α: weights unchanged.
-            let mut s = self.nested.sample(sp, wo, u_lobe / opacity, u, lambda)?;
+            let mut s = tree.sample(self.nested, wo, u_lobe / opacity, u)?;
             s.pdf *= opacity;
             Some(s)
         } else {

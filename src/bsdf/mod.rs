@@ -1,10 +1,21 @@
-//! Scattering at surfaces: the BSDF interface, Mitsuba's BSDFs, their textures, and materials
-//! that choose a BSDF for each side of a surface.
+//! Scattering at surfaces: the BSDF interface, Mitsuba's BSDFs, and materials that choose a BSDF
+//! for each side of a surface.
 //!
+//! # Two forms of a BSDF
+//! A scene describes a BSDF by its parameters, any of which may vary over the surface
+//! ([`Bsdf`], whose variants implement [`BsdfModel`]). At a path vertex the material evaluates
+//! those textures once, at the hit and for the path's wavelengths, and gets the lobes there: a
+//! small tree of [`Bxdf`]s in fixed storage ([`BxdfTree`]; adapters such as `mask` and
+//! `blendbsdf` are inner nodes). [`Scattering`] holds that tree with its shading frame and the
+//! outgoing direction; both integrators evaluate and sample only through it (pbrt-v4's
+//! `GetBSDF`, Pharr et al. 2023, §10.5).
+//!
+//! # Conventions
 //! BSDFs work in the local shading frame (normal = +z). Following pbrt's naming, `wo` points
 //! towards where the light goes (the camera side of the path) and `wi` towards where it comes
 //! from; both point away from the surface. `eval` returns f(wo, wi)·|cos θi| (the cosine is part
-//! of the BSDF's value, as in Mitsuba 3), and `sample` returns that value divided by its pdf.
+//! of the BSDF's value, as in Mitsuba 3) together with the density of sampling `wi`, and
+//! `sample` returns the value divided by its pdf.
 //!
 //! The lecture's "Importance Sampling of the Reflection Integral" splits a BRDF into diffuse,
 //! glossy and mirror parts and adapts the sampling to each: every BSDF here is a sum of lobes
@@ -16,6 +27,11 @@
 //! can only be sampled, and their `pdf` is the probability of choosing them. For a sample of a
 //! smooth lobe the returned pdf and weight are those of the whole BSDF (all smooth lobes'
 //! densities summed), so that MIS sees the density the direction was really drawn with.
+//!
+//! # Adding a BSDF
+//! Write one file with the description (implementing [`BsdfModel`]) and its lobes
+//! (implementing [`Bxdf`]), add its two types to the `bsdfs!` lists below, and register its
+//! plugin and parameters with the scene reader (docs/architecture.md).
 //!
 //! | plugin | file | lobes |
 //! | --- | --- | --- |
@@ -41,27 +57,29 @@ pub mod dielectric;
 pub mod diffuse;
 pub mod fresnel;
 pub mod mask;
+pub mod material;
 pub mod microfacet;
 pub mod normalmap;
+pub mod perturbed;
 pub mod phong;
 pub mod plastic;
 pub mod roughconductor;
 pub mod roughdielectric;
 pub mod roughdiffuse;
 pub mod roughplastic;
-
 pub mod thindielectric;
 pub mod twosided;
 
+use arrayvec::ArrayVec;
 use glam::{Vec2, Vec3};
 
-pub use crate::texture::Texture;
 pub use blend::Blend;
 pub use bumpmap::BumpMap;
 pub use conductor::Conductor;
 pub use dielectric::Dielectric;
 pub use diffuse::Diffuse;
 pub use mask::Mask;
+pub use material::{Material, Scattering};
 pub use normalmap::NormalMap;
 pub use phong::Phong;
 pub use plastic::Plastic;
@@ -113,7 +131,8 @@ impl BsdfFlags {
 /// A direction drawn by a BSDF.
 #[derive(Clone, Copy, Debug)]
 pub struct BsdfSample {
-    /// The sampled direction, in the local frame.
+    /// The sampled direction: in the local frame when a [`Bxdf`] returns it, in world space when
+    /// [`Scattering::sample`] does.
     pub wi: Vec3,
     /// f(wo, wi)·|cos θi| / pdf.
     pub weight: SampledSpectrum,
@@ -144,7 +163,40 @@ impl BsdfSample {
     }
 }
 
-/// The surface point a BSDF is evaluated at: texture coordinates for textures, and the local
+/// The value of a BSDF for a pair of directions, f(wo, wi)·|cos θi| over its smooth lobes, and
+/// the density with which sampling from `wo` returns `wi`: what light sampling and multiple
+/// importance sampling need, computed together.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BsdfEval {
+    pub value: SampledSpectrum,
+    pub pdf: f32,
+}
+
+impl BsdfEval {
+    /// No light and no density: the value of every delta lobe, and of directions a BSDF does not
+    /// scatter into.
+    pub const ZERO: BsdfEval = BsdfEval {
+        value: SampledSpectrum::ZERO,
+        pdf: 0.0,
+    };
+}
+
+/// For a BSDF that is a mixture of lobes: the sample of one smooth lobe turned into a sample of
+/// the whole mixture, whose density at `wi` is `pdf` and whose value there is `value`.
+#[inline]
+pub(crate) fn mixture_sample(
+    wi: Vec3,
+    value: SampledSpectrum,
+    pdf: f32,
+    flags: BsdfFlags,
+) -> Option<BsdfSample> {
+    if !(pdf > 0.0) || !pdf.is_finite() {
+        return None;
+    }
+    Some(BsdfSample::new(wi, value * (1.0 / pdf), pdf, flags))
+}
+
+/// The surface point a BSDF's textures are evaluated at: texture coordinates, and the local
 /// geometry for the BSDFs that perturb the shading frame (bump and normal maps).
 #[derive(Clone, Copy, Debug)]
 pub struct ShadingPoint {
@@ -176,135 +228,207 @@ impl ShadingPoint {
     }
 }
 
-/// A BSDF (one side of a surface, unless it is two-sided by nature, as dielectrics are).
-#[derive(Clone, Debug)]
-pub enum Bsdf {
-    Diffuse(Diffuse),
-    RoughDiffuse(RoughDiffuse),
-    Conductor(Conductor),
-    RoughConductor(RoughConductor),
-    Dielectric(Dielectric),
-    RoughDielectric(RoughDielectric),
-    ThinDielectric(ThinDielectric),
-    Plastic(Plastic),
-    RoughPlastic(RoughPlastic),
-    Phong(Phong),
-    TwoSided(TwoSided),
-    Mask(Mask),
-    Blend(Blend),
-    BumpMap(BumpMap),
-    NormalMap(NormalMap),
+/// A BSDF as a scene describes it: parameters that may be textures.
+pub trait BsdfModel {
+    /// The union of the lobes' flags.
+    fn flags(&self) -> BsdfFlags;
+    /// Whether some index of refraction varies with wavelength, so that refracted directions
+    /// depend on it (see [`BsdfSample::terminates_secondary`]).
+    fn is_dispersive(&self) -> bool;
+    /// The nodes its lobes take in a [`BxdfTree`] (1 for a BSDF that nests none).
+    fn node_count(&self) -> usize;
+    /// Evaluates the textures at `point` for the wavelengths `lambda` and adds the lobes there
+    /// to `tree`, for the outgoing direction `wo` (local to `point.frame`), which adapters need
+    /// to choose a side or tilt a frame. Returns the index of the node added last, its root.
+    fn resolve<'a>(
+        &'a self,
+        point: &ShadingPoint,
+        wo: Vec3,
+        lambda: &SampledWavelengths,
+        tree: &mut BxdfTree<'a>,
+    ) -> NodeId;
 }
 
-/// Calls the same method on whichever BSDF `$self` is.
-macro_rules! dispatch {
-    ($self:expr, $b:ident => $call:expr) => {
-        match $self {
-            Bsdf::Diffuse($b) => $call,
-            Bsdf::RoughDiffuse($b) => $call,
-            Bsdf::Conductor($b) => $call,
-            Bsdf::RoughConductor($b) => $call,
-            Bsdf::Dielectric($b) => $call,
-            Bsdf::RoughDielectric($b) => $call,
-            Bsdf::ThinDielectric($b) => $call,
-            Bsdf::Plastic($b) => $call,
-            Bsdf::RoughPlastic($b) => $call,
-            Bsdf::Phong($b) => $call,
-            Bsdf::TwoSided($b) => $call,
-            Bsdf::Mask($b) => $call,
-            Bsdf::Blend($b) => $call,
-            Bsdf::BumpMap($b) => $call,
-            Bsdf::NormalMap($b) => $call,
+/// A BSDF's lobes at one point for one path's wavelengths, in the local frame. Adapters reach
+/// the lobes they nest through `tree`; other BSDFs ignore it.
+pub trait Bxdf {
+    /// f(wo, wi)·|cos θi| of the smooth lobes and the density of sampling `wi`. A BSDF made only
+    /// of delta lobes keeps this default: nothing to evaluate.
+    fn eval(&self, tree: &BxdfTree, wo: Vec3, wi: Vec3) -> BsdfEval {
+        let _ = (tree, wo, wi);
+        BsdfEval::ZERO
+    }
+    /// Draws `wi` given `wo`: `u_lobe` chooses a lobe, `u` the direction within it.
+    fn sample(&self, tree: &BxdfTree, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<BsdfSample>;
+}
+
+/// Index of a node in a [`BxdfTree`].
+pub type NodeId = u8;
+
+/// The most nodes a BSDF's lobes may take (a BSDF and the adapters around it); the scene reader
+/// refuses BSDFs nested deeper.
+pub const MAX_NODES: usize = 16;
+
+/// The lobes of one vertex: the nodes of a tree in fixed storage, children before parents, so
+/// that a vertex allocates nothing.
+pub struct BxdfTree<'a> {
+    nodes: ArrayVec<Node<'a>, MAX_NODES>,
+}
+
+impl<'a> BxdfTree<'a> {
+    /// The lobes of `bsdf` at `point` for `wo` and `lambda`; returns the tree and its root.
+    #[inline]
+    pub fn new(
+        bsdf: &'a Bsdf,
+        point: &ShadingPoint,
+        wo: Vec3,
+        lambda: &SampledWavelengths,
+    ) -> (BxdfTree<'a>, NodeId) {
+        let mut tree = BxdfTree {
+            nodes: ArrayVec::new(),
+        };
+        let root = bsdf.resolve(point, wo, lambda, &mut tree);
+        (tree, root)
+    }
+
+    /// Adds a node; its index. The scene reader keeps BSDFs within [`MAX_NODES`].
+    #[inline]
+    pub fn push(&mut self, node: impl Into<Node<'a>>) -> NodeId {
+        self.nodes.push(node.into());
+        (self.nodes.len() - 1) as NodeId
+    }
+
+    /// [`Bxdf::eval`] of node `id`.
+    #[inline]
+    pub fn eval(&self, id: NodeId, wo: Vec3, wi: Vec3) -> BsdfEval {
+        self.nodes[id as usize].eval(self, wo, wi)
+    }
+
+    /// [`Bxdf::sample`] of node `id`.
+    #[inline]
+    pub fn sample(&self, id: NodeId, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<BsdfSample> {
+        self.nodes[id as usize].sample(self, wo, u_lobe, u)
+    }
+}
+
+/// Declares the BSDFs: the description enum [`Bsdf`], one variant per plugin, and the lobe enum
+/// [`Node`], one variant per kind of lobes (bump and normal maps share theirs), dispatched to
+/// [`BsdfModel`] and [`Bxdf`] by `match` (no dynamic dispatch in the hot path, DESIGN.md §3.1).
+macro_rules! bsdfs {
+    (
+        descriptions { $($variant:ident($model:ty),)+ }
+        lobes { $($node:ident($lobes:ty),)+ }
+    ) => {
+        /// A BSDF as the scene describes it (one side of a surface, unless it is two-sided by
+        /// nature, as dielectrics are).
+        #[derive(Clone, Debug)]
+        pub enum Bsdf {
+            $($variant($model),)+
         }
+
+        impl BsdfModel for Bsdf {
+            #[inline]
+            fn flags(&self) -> BsdfFlags {
+                match self {
+                    $(Bsdf::$variant(b) => b.flags(),)+
+                }
+            }
+
+            #[inline]
+            fn is_dispersive(&self) -> bool {
+                match self {
+                    $(Bsdf::$variant(b) => b.is_dispersive(),)+
+                }
+            }
+
+            fn node_count(&self) -> usize {
+                match self {
+                    $(Bsdf::$variant(b) => b.node_count(),)+
+                }
+            }
+
+            #[inline]
+            fn resolve<'a>(
+                &'a self,
+                point: &ShadingPoint,
+                wo: Vec3,
+                lambda: &SampledWavelengths,
+                tree: &mut BxdfTree<'a>,
+            ) -> NodeId {
+                match self {
+                    $(Bsdf::$variant(b) => b.resolve(point, wo, lambda, tree),)+
+                }
+            }
+        }
+
+        $(impl From<$model> for Bsdf {
+            fn from(bsdf: $model) -> Bsdf {
+                Bsdf::$variant(bsdf)
+            }
+        })+
+
+        /// One node of a [`BxdfTree`]: a BSDF's lobes with their textures evaluated.
+        #[derive(Clone, Copy, Debug)]
+        pub enum Node<'a> {
+            $($node($lobes),)+
+        }
+
+        impl Bxdf for Node<'_> {
+            #[inline]
+            fn eval(&self, tree: &BxdfTree, wo: Vec3, wi: Vec3) -> BsdfEval {
+                match self {
+                    $(Node::$node(b) => b.eval(tree, wo, wi),)+
+                }
+            }
+
+            #[inline]
+            fn sample(&self, tree: &BxdfTree, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<BsdfSample> {
+                match self {
+                    $(Node::$node(b) => b.sample(tree, wo, u_lobe, u),)+
+                }
+            }
+        }
+
+        $(impl<'a> From<$lobes> for Node<'a> {
+            fn from(lobes: $lobes) -> Node<'a> {
+                Node::$node(lobes)
+            }
+        })+
     };
 }
 
-impl Bsdf {
-    /// The union of the lobes' flags.
-    pub fn flags(&self) -> BsdfFlags {
-        dispatch!(self, b => b.flags())
+bsdfs! {
+    descriptions {
+        Diffuse(Diffuse),
+        RoughDiffuse(RoughDiffuse),
+        Conductor(Conductor),
+        RoughConductor(RoughConductor),
+        Dielectric(Dielectric),
+        RoughDielectric(RoughDielectric),
+        ThinDielectric(ThinDielectric),
+        Plastic(Plastic),
+        RoughPlastic(RoughPlastic),
+        Phong(Phong),
+        TwoSided(TwoSided),
+        Mask(Mask),
+        Blend(Blend),
+        BumpMap(BumpMap),
+        NormalMap(NormalMap),
     }
-
-    /// Whether some index of refraction varies with wavelength, so that refracted directions
-    /// depend on it (see [`BsdfSample::terminates_secondary`]).
-    pub fn is_dispersive(&self) -> bool {
-        match self {
-            Bsdf::Dielectric(b) => b.eta.is_dispersive(),
-            Bsdf::RoughDielectric(b) => b.eta.is_dispersive(),
-            Bsdf::TwoSided(b) => b.front.is_dispersive() || b.back.is_dispersive(),
-            Bsdf::Mask(b) => b.nested.is_dispersive(),
-            Bsdf::Blend(b) => b.nested[0].is_dispersive() || b.nested[1].is_dispersive(),
-            Bsdf::BumpMap(b) => b.nested.is_dispersive(),
-            Bsdf::NormalMap(b) => b.nested.is_dispersive(),
-            _ => false,
-        }
-    }
-
-    /// f(wo, wi)·|cos θi| of the smooth lobes.
-    #[inline]
-    pub fn eval(
-        &self,
-        sp: &ShadingPoint,
-        wo: Vec3,
-        wi: Vec3,
-        lambda: &SampledWavelengths,
-    ) -> SampledSpectrum {
-        dispatch!(self, b => b.eval(sp, wo, wi, lambda))
-    }
-
-    /// Density with which [`Bsdf::sample`] returns `wi` given `wo` (smooth lobes only).
-    #[inline]
-    pub fn pdf(&self, sp: &ShadingPoint, wo: Vec3, wi: Vec3, lambda: &SampledWavelengths) -> f32 {
-        dispatch!(self, b => b.pdf(sp, wo, wi, lambda))
-    }
-
-    /// Draws `wi` given `wo`: `u_lobe` chooses a lobe, `u` the direction within it.
-    #[inline]
-    pub fn sample(
-        &self,
-        sp: &ShadingPoint,
-        wo: Vec3,
-        u_lobe: f32,
-        u: Vec2,
-        lambda: &SampledWavelengths,
-    ) -> Option<BsdfSample> {
-        dispatch!(self, b => b.sample(sp, wo, u_lobe, u, lambda))
-    }
-}
-
-/// For a BSDF that is a mixture of lobes: the sample of one smooth lobe turned into a sample of
-/// the whole mixture, whose density at `wi` is `pdf` and whose value there is `value`.
-#[inline]
-pub(crate) fn mixture_sample(
-    wi: Vec3,
-    value: SampledSpectrum,
-    pdf: f32,
-    flags: BsdfFlags,
-) -> Option<BsdfSample> {
-    if !(pdf > 0.0) || !pdf.is_finite() {
-        return None;
-    }
-    Some(BsdfSample::new(wi, value * (1.0 / pdf), pdf, flags))
-}
-
-/// What a surface is made of: a BSDF for the front (the side of the shading normal) and, for
-/// top-level `twosided` materials, one for the back. Mitsuba's reflecting BSDFs are one-sided
-/// (black from behind) unless wrapped in `twosided`; dielectrics handle both sides themselves.
-#[derive(Clone, Debug)]
-pub struct Material {
-    pub front: Bsdf,
-    pub back: Option<Bsdf>,
-}
-
-impl Material {
-    /// The BSDF that applies when the outgoing direction has local z-component `cos_theta_o`,
-    /// and whether the frame must be flipped to use it (back side of a two-sided material).
-    /// Without a back BSDF the front one is used from both sides: it decides what its back is.
-    #[inline]
-    pub fn side(&self, cos_theta_o: f32) -> (&Bsdf, bool) {
-        match &self.back {
-            Some(back) if cos_theta_o < 0.0 => (back, true),
-            _ => (&self.front, false),
-        }
+    lobes {
+        Diffuse(diffuse::DiffuseLobes),
+        RoughDiffuse(roughdiffuse::RoughDiffuseLobes),
+        Conductor(conductor::ConductorLobes),
+        RoughConductor(roughconductor::RoughConductorLobes),
+        Dielectric(dielectric::DielectricLobes),
+        RoughDielectric(roughdielectric::RoughDielectricLobes),
+        ThinDielectric(thindielectric::ThinDielectricLobes),
+        Plastic(plastic::PlasticLobes<'a>),
+        RoughPlastic(roughplastic::RoughPlasticLobes<'a>),
+        Phong(phong::PhongLobes),
+        BackSide(twosided::BackSideLobes),
+        Mask(mask::MaskLobes),
+        Blend(blend::BlendLobes),
+        Perturbed(perturbed::PerturbedLobes),
     }
 }

@@ -13,13 +13,14 @@
 //! </bsdf>
 //! ```
 //! The texture must be read raw (no sRGB decoding), as in Mitsuba 3. The tilted frame is built
-//! as for `bumpmap` ([`super::bumpmap::Perturbation`]), as Mitsuba 3.9's `perturbed_bsdf.h`.
+//! as for `bumpmap` ([`super::perturbed`]), as Mitsuba 3.9's `perturbed_bsdf.h`.
 
-use glam::{Vec2, Vec3};
+use glam::Vec3;
 
-use super::bumpmap::Perturbation;
-use super::{Bsdf, BsdfFlags, BsdfSample, ShadingPoint, Texture};
-use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+use super::perturbed::{Tilt, resolve_perturbed};
+use super::{Bsdf, BsdfFlags, BsdfModel, BxdfTree, NodeId, ShadingPoint};
+use crate::spectrum::SampledWavelengths;
+use crate::texture::Texture;
 
 #[derive(Clone, Debug)]
 pub struct NormalMap {
@@ -29,45 +30,32 @@ pub struct NormalMap {
     pub use_shadowing_function: bool,
 }
 
-impl NormalMap {
-    pub fn flags(&self) -> BsdfFlags {
+impl BsdfModel for NormalMap {
+    fn flags(&self) -> BsdfFlags {
         self.nested.flags()
     }
 
+    fn is_dispersive(&self) -> bool {
+        self.nested.is_dispersive()
+    }
+
+    fn node_count(&self) -> usize {
+        1 + self.nested.node_count()
+    }
+
     #[inline]
-    fn perturbation(&self, sp: &ShadingPoint, wo: Vec3) -> Perturbation {
-        Perturbation::new(
-            sp,
-            self.normals.eval_3(sp.uv) * 2.0 - Vec3::ONE,
-            wo,
-            self.flip_invalid_normals,
-            self.use_shadowing_function,
-        )
-    }
-
-    pub fn eval(
-        &self,
-        sp: &ShadingPoint,
+    fn resolve<'a>(
+        &'a self,
+        point: &ShadingPoint,
         wo: Vec3,
-        wi: Vec3,
         lambda: &SampledWavelengths,
-    ) -> SampledSpectrum {
-        self.perturbation(sp, wo).eval(&self.nested, wo, wi, lambda)
-    }
-
-    pub fn pdf(&self, sp: &ShadingPoint, wo: Vec3, wi: Vec3, lambda: &SampledWavelengths) -> f32 {
-        self.perturbation(sp, wo).pdf(&self.nested, wo, wi, lambda)
-    }
-
-    pub fn sample(
-        &self,
-        sp: &ShadingPoint,
-        wo: Vec3,
-        u_lobe: f32,
-        u: Vec2,
-        lambda: &SampledWavelengths,
-    ) -> Option<BsdfSample> {
-        self.perturbation(sp, wo)
-            .sample(&self.nested, wo, u_lobe, u, lambda)
+        tree: &mut BxdfTree<'a>,
+    ) -> NodeId {
+        let tilt = Tilt {
+            normal: self.normals.eval_3(point.uv) * 2.0 - Vec3::ONE,
+            flip_invalid_normals: self.flip_invalid_normals,
+            use_shadowing_function: self.use_shadowing_function,
+        };
+        resolve_perturbed(&self.nested, tilt, point, wo, lambda, tree)
     }
 }

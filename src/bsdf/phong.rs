@@ -20,10 +20,14 @@ use std::f32::consts::{FRAC_1_PI, PI};
 use glam::{Vec2, Vec3};
 
 use super::fresnel::reflect_z;
-use super::{BsdfFlags, BsdfSample, ShadingPoint, Texture, mixture_sample};
+use super::{
+    BsdfEval, BsdfFlags, BsdfModel, BsdfSample, Bxdf, BxdfTree, NodeId, ShadingPoint,
+    mixture_sample,
+};
 use crate::math::Frame;
 use crate::sampling::warp::{cosine_hemisphere_pdf, sample_cosine_hemisphere};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+use crate::texture::Texture;
 
 #[derive(Clone, Debug)]
 pub struct Phong {
@@ -34,93 +38,95 @@ pub struct Phong {
     pub scale: f32,
 }
 
-impl Phong {
-    pub fn flags(&self) -> BsdfFlags {
-        BsdfFlags::GLOSSY
-            .union(BsdfFlags::DIFFUSE)
-            .union(BsdfFlags::REFLECTION)
+const FLAGS: BsdfFlags = BsdfFlags::GLOSSY
+    .union(BsdfFlags::DIFFUSE)
+    .union(BsdfFlags::REFLECTION);
+
+impl BsdfModel for Phong {
+    fn flags(&self) -> BsdfFlags {
+        FLAGS
     }
 
-    /// The reflectances at the point and the probability of sampling the glossy lobe.
+    fn is_dispersive(&self) -> bool {
+        false
+    }
+
+    fn node_count(&self) -> usize {
+        1
+    }
+
     #[inline]
-    fn lobes(
-        &self,
-        sp: &ShadingPoint,
+    fn resolve<'a>(
+        &'a self,
+        point: &ShadingPoint,
+        _wo: Vec3,
         lambda: &SampledWavelengths,
-    ) -> (SampledSpectrum, SampledSpectrum, f32) {
-        let specular = self.specular_reflectance.eval(sp.uv, lambda) * self.scale;
-        let diffuse = self.diffuse_reflectance.eval(sp.uv, lambda) * self.scale;
+        tree: &mut BxdfTree<'a>,
+    ) -> NodeId {
+        let specular = self.specular_reflectance.eval(point.uv, lambda) * self.scale;
+        let diffuse = self.diffuse_reflectance.eval(point.uv, lambda) * self.scale;
         let (s, d) = (specular.average(), diffuse.average());
-        let p_glossy = if s + d > 0.0 { s / (s + d) } else { 1.0 };
-        (specular, diffuse, p_glossy)
+        tree.push(PhongLobes {
+            exponent: self.exponent.eval_1(point.uv),
+            specular,
+            diffuse,
+            p_glossy: if s + d > 0.0 { s / (s + d) } else { 1.0 },
+        })
     }
+}
 
+/// The glossy and diffuse lobes at a point.
+#[derive(Clone, Copy, Debug)]
+pub struct PhongLobes {
+    pub exponent: f32,
+    pub specular: SampledSpectrum,
+    pub diffuse: SampledSpectrum,
+    /// The probability of sampling the glossy lobe.
+    pub p_glossy: f32,
+}
+
+impl PhongLobes {
     #[inline]
-    fn value(
-        wo: Vec3,
-        wi: Vec3,
-        exponent: f32,
-        specular: &SampledSpectrum,
-        diffuse: &SampledSpectrum,
-    ) -> SampledSpectrum {
+    fn value(&self, wo: Vec3, wi: Vec3) -> SampledSpectrum {
         let cos_alpha = reflect_z(wo).dot(wi);
         let glossy = if cos_alpha > 0.0 {
-            (exponent + 2.0) / (2.0 * PI) * cos_alpha.powf(exponent)
+            (self.exponent + 2.0) / (2.0 * PI) * cos_alpha.powf(self.exponent)
         } else {
             0.0
         };
-        (*specular * glossy + *diffuse * FRAC_1_PI) * wi.z
+        (self.specular * glossy + self.diffuse * FRAC_1_PI) * wi.z
     }
 
     #[inline]
-    fn mixture_pdf(wo: Vec3, wi: Vec3, exponent: f32, p_glossy: f32) -> f32 {
+    fn mixture_pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         let cos_alpha = reflect_z(wo).dot(wi);
         let glossy = if cos_alpha > 0.0 {
-            (exponent + 1.0) / (2.0 * PI) * cos_alpha.powf(exponent)
+            (self.exponent + 1.0) / (2.0 * PI) * cos_alpha.powf(self.exponent)
         } else {
             0.0
         };
-        p_glossy * glossy + (1.0 - p_glossy) * cosine_hemisphere_pdf(wi)
+        self.p_glossy * glossy + (1.0 - self.p_glossy) * cosine_hemisphere_pdf(wi)
     }
+}
 
-    pub fn eval(
-        &self,
-        sp: &ShadingPoint,
-        wo: Vec3,
-        wi: Vec3,
-        lambda: &SampledWavelengths,
-    ) -> SampledSpectrum {
+impl Bxdf for PhongLobes {
+    fn eval(&self, _tree: &BxdfTree, wo: Vec3, wi: Vec3) -> BsdfEval {
         if !(wo.z > 0.0 && wi.z > 0.0) {
-            return SampledSpectrum::ZERO;
+            return BsdfEval::ZERO;
         }
-        let (specular, diffuse, _) = self.lobes(sp, lambda);
-        Self::value(wo, wi, self.exponent.eval_1(sp.uv), &specular, &diffuse)
+        BsdfEval {
+            value: self.value(wo, wi),
+            pdf: self.mixture_pdf(wo, wi),
+        }
     }
 
-    pub fn pdf(&self, sp: &ShadingPoint, wo: Vec3, wi: Vec3, lambda: &SampledWavelengths) -> f32 {
-        if !(wo.z > 0.0 && wi.z > 0.0) {
-            return 0.0;
-        }
-        let (_, _, p_glossy) = self.lobes(sp, lambda);
-        Self::mixture_pdf(wo, wi, self.exponent.eval_1(sp.uv), p_glossy)
-    }
-
-    pub fn sample(
-        &self,
-        sp: &ShadingPoint,
-        wo: Vec3,
-        u_lobe: f32,
-        u: Vec2,
-        lambda: &SampledWavelengths,
-    ) -> Option<BsdfSample> {
+    fn sample(&self, _tree: &BxdfTree, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<BsdfSample> {
         if !(wo.z > 0.0) {
             return None;
         }
-        let (specular, diffuse, p_glossy) = self.lobes(sp, lambda);
-        let exponent = self.exponent.eval_1(sp.uv);
-        let (wi, flags) = if u_lobe < p_glossy {
+        let (wi, flags) = if u_lobe < self.p_glossy {
             // cos α = u^(1/(n+1)) around the mirror direction.
-            let cos_alpha = u.y.powf(1.0 / (exponent + 1.0));
+            let cos_alpha = u.y.powf(1.0 / (self.exponent + 1.0));
             let sin_alpha = (1.0 - cos_alpha * cos_alpha).max(0.0).sqrt();
             let phi = 2.0 * PI * u.x;
             let local = Vec3::new(sin_alpha * phi.cos(), sin_alpha * phi.sin(), cos_alpha);
@@ -137,11 +143,6 @@ impl Phong {
         if !(wi.z > 0.0) {
             return None;
         }
-        mixture_sample(
-            wi,
-            Self::value(wo, wi, exponent, &specular, &diffuse),
-            Self::mixture_pdf(wo, wi, exponent, p_glossy),
-            flags,
-        )
+        mixture_sample(wi, self.value(wo, wi), self.mixture_pdf(wo, wi), flags)
     }
 }

@@ -27,9 +27,13 @@ use glam::{Vec2, Vec3};
 
 use super::dielectric::optional_factor;
 use super::fresnel::{fresnel_dielectric, fresnel_diffuse_reflectance, reflect_z};
-use super::{BsdfFlags, BsdfSample, ShadingPoint, Texture, mixture_sample};
+use super::{
+    BsdfEval, BsdfFlags, BsdfModel, BsdfSample, Bxdf, BxdfTree, NodeId, ShadingPoint,
+    mixture_sample,
+};
 use crate::sampling::warp::{cosine_hemisphere_pdf, sample_cosine_hemisphere};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+use crate::texture::Texture;
 
 #[derive(Clone, Debug)]
 pub struct Plastic {
@@ -60,38 +64,67 @@ impl Plastic {
             fdr_external: fresnel_diffuse_reflectance(eta),
         }
     }
+}
 
-    pub fn flags(&self) -> BsdfFlags {
-        BsdfFlags::SPECULAR
-            .union(BsdfFlags::DIFFUSE)
-            .union(BsdfFlags::REFLECTION)
+const FLAGS: BsdfFlags = BsdfFlags::SPECULAR
+    .union(BsdfFlags::DIFFUSE)
+    .union(BsdfFlags::REFLECTION);
+
+impl BsdfModel for Plastic {
+    fn flags(&self) -> BsdfFlags {
+        FLAGS
     }
 
-    /// ρ / (1 − F_dr) or, nonlinear, ρ / (1 − ρ F_dr).
+    fn is_dispersive(&self) -> bool {
+        false
+    }
+
+    fn node_count(&self) -> usize {
+        1
+    }
+
     #[inline]
-    fn effective_diffuse(&self, sp: &ShadingPoint, lambda: &SampledWavelengths) -> SampledSpectrum {
-        let rho = self.diffuse_reflectance.eval(sp.uv, lambda);
-        SampledSpectrum::from_fn(|i| {
+    fn resolve<'a>(
+        &'a self,
+        point: &ShadingPoint,
+        _wo: Vec3,
+        lambda: &SampledWavelengths,
+        tree: &mut BxdfTree<'a>,
+    ) -> NodeId {
+        // ρ / (1 − F_dr) or, nonlinear, ρ / (1 − ρ F_dr).
+        let rho = self.diffuse_reflectance.eval(point.uv, lambda);
+        let diffuse = SampledSpectrum::from_fn(|i| {
             let bounce = if self.nonlinear {
                 rho[i] * self.fdr_internal
             } else {
                 self.fdr_internal
             };
             rho[i] / (1.0 - bounce)
+        });
+        tree.push(PlasticLobes {
+            plastic: self,
+            diffuse,
+            specular_reflectance: optional_factor(&self.specular_reflectance, point.uv, lambda),
         })
     }
+}
 
+/// The coating's mirror and the base under it, at a point.
+#[derive(Clone, Copy, Debug)]
+pub struct PlasticLobes<'a> {
+    plastic: &'a Plastic,
+    /// The effective diffuse reflectance of the base.
+    diffuse: SampledSpectrum,
+    specular_reflectance: SampledSpectrum,
+}
+
+impl PlasticLobes<'_> {
     /// Probability of choosing the mirror lobe at wo (with F = F(cos θo)).
     #[inline]
-    fn specular_probability(
-        &self,
-        sp: &ShadingPoint,
-        f_o: f32,
-        diffuse: &SampledSpectrum,
-        lambda: &SampledWavelengths,
-    ) -> f32 {
-        let specular = f_o * optional_factor(&self.specular_reflectance, sp.uv, lambda).average();
-        let base = (1.0 - f_o) * diffuse.average() * (1.0 - self.fdr_external) * self.inv_eta2;
+    fn specular_probability(&self, f_o: f32) -> f32 {
+        let p = self.plastic;
+        let specular = f_o * self.specular_reflectance.average();
+        let base = (1.0 - f_o) * self.diffuse.average() * (1.0 - p.fdr_external) * p.inv_eta2;
         if specular + base > 0.0 {
             specular / (specular + base)
         } else {
@@ -99,48 +132,35 @@ impl Plastic {
         }
     }
 
-    pub fn eval(
-        &self,
-        sp: &ShadingPoint,
-        wo: Vec3,
-        wi: Vec3,
-        lambda: &SampledWavelengths,
-    ) -> SampledSpectrum {
+    /// The base's f cos θi given F(cos θo) and the sampled direction.
+    #[inline]
+    fn base_value(&self, f_o: f32, wi: Vec3) -> SampledSpectrum {
+        let p = self.plastic;
+        let f_i = fresnel_dielectric(wi.z, p.eta).reflectance;
+        self.diffuse * ((1.0 - f_o) * (1.0 - f_i) * p.inv_eta2 * FRAC_1_PI * wi.z)
+    }
+}
+
+impl Bxdf for PlasticLobes<'_> {
+    fn eval(&self, _tree: &BxdfTree, wo: Vec3, wi: Vec3) -> BsdfEval {
         if !(wo.z > 0.0 && wi.z > 0.0) {
-            return SampledSpectrum::ZERO;
+            return BsdfEval::ZERO;
         }
-        let f_o = fresnel_dielectric(wo.z, self.eta).reflectance;
-        let f_i = fresnel_dielectric(wi.z, self.eta).reflectance;
-        self.effective_diffuse(sp, lambda)
-            * ((1.0 - f_o) * (1.0 - f_i) * self.inv_eta2 * FRAC_1_PI * wi.z)
+        let f_o = fresnel_dielectric(wo.z, self.plastic.eta).reflectance;
+        BsdfEval {
+            value: self.base_value(f_o, wi),
+            pdf: (1.0 - self.specular_probability(f_o)) * cosine_hemisphere_pdf(wi),
+        }
     }
 
-    pub fn pdf(&self, sp: &ShadingPoint, wo: Vec3, wi: Vec3, lambda: &SampledWavelengths) -> f32 {
-        if !(wo.z > 0.0 && wi.z > 0.0) {
-            return 0.0;
-        }
-        let f_o = fresnel_dielectric(wo.z, self.eta).reflectance;
-        let diffuse = self.effective_diffuse(sp, lambda);
-        (1.0 - self.specular_probability(sp, f_o, &diffuse, lambda)) * cosine_hemisphere_pdf(wi)
-    }
-
-    pub fn sample(
-        &self,
-        sp: &ShadingPoint,
-        wo: Vec3,
-        u_lobe: f32,
-        u: Vec2,
-        lambda: &SampledWavelengths,
-    ) -> Option<BsdfSample> {
+    fn sample(&self, _tree: &BxdfTree, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<BsdfSample> {
         if !(wo.z > 0.0) {
             return None;
         }
-        let f_o = fresnel_dielectric(wo.z, self.eta).reflectance;
-        let diffuse = self.effective_diffuse(sp, lambda);
-        let p_specular = self.specular_probability(sp, f_o, &diffuse, lambda);
+        let f_o = fresnel_dielectric(wo.z, self.plastic.eta).reflectance;
+        let p_specular = self.specular_probability(f_o);
         if u_lobe < p_specular {
-            let weight =
-                optional_factor(&self.specular_reflectance, sp.uv, lambda) * (f_o / p_specular);
+            let weight = self.specular_reflectance * (f_o / p_specular);
             return Some(BsdfSample::new(
                 reflect_z(wo),
                 weight,
@@ -149,11 +169,9 @@ impl Plastic {
             ));
         }
         let wi = sample_cosine_hemisphere(u);
-        let f_i = fresnel_dielectric(wi.z, self.eta).reflectance;
-        let value = diffuse * ((1.0 - f_o) * (1.0 - f_i) * self.inv_eta2 * FRAC_1_PI * wi.z);
         mixture_sample(
             wi,
-            value,
+            self.base_value(f_o, wi),
             (1.0 - p_specular) * cosine_hemisphere_pdf(wi),
             BsdfFlags::DIFFUSE.union(BsdfFlags::REFLECTION),
         )

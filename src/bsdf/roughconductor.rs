@@ -17,11 +17,12 @@
 
 use glam::{Vec2, Vec3};
 
-use super::conductor::conductor_reflectance;
+use super::conductor::ConductorIor;
 use super::fresnel::reflect;
 use super::microfacet::{Microfacet, MicrofacetKind};
-use super::{BsdfFlags, BsdfSample, ShadingPoint, Texture};
+use super::{BsdfEval, BsdfFlags, BsdfModel, BsdfSample, Bxdf, BxdfTree, NodeId, ShadingPoint};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+use crate::texture::Texture;
 
 #[derive(Clone, Debug)]
 pub struct RoughConductor {
@@ -33,75 +34,88 @@ pub struct RoughConductor {
     pub specular_reflectance: Texture,
 }
 
-impl RoughConductor {
-    pub fn flags(&self) -> BsdfFlags {
-        BsdfFlags::GLOSSY.union(BsdfFlags::REFLECTION)
+const FLAGS: BsdfFlags = BsdfFlags::GLOSSY.union(BsdfFlags::REFLECTION);
+
+impl BsdfModel for RoughConductor {
+    fn flags(&self) -> BsdfFlags {
+        FLAGS
     }
 
-    /// The microfacet distribution at the shading point.
+    fn is_dispersive(&self) -> bool {
+        false
+    }
+
+    fn node_count(&self) -> usize {
+        1
+    }
+
     #[inline]
-    fn microfacet(&self, sp: &ShadingPoint) -> Microfacet {
-        Microfacet::new(
-            self.distribution,
-            self.alpha_u.eval_1(sp.uv),
-            self.alpha_v.eval_1(sp.uv),
-        )
-    }
-
-    pub fn eval(
-        &self,
-        sp: &ShadingPoint,
-        wo: Vec3,
-        wi: Vec3,
+    fn resolve<'a>(
+        &'a self,
+        point: &ShadingPoint,
+        _wo: Vec3,
         lambda: &SampledWavelengths,
-    ) -> SampledSpectrum {
-        if !(wo.z > 0.0 && wi.z > 0.0) {
-            return SampledSpectrum::ZERO;
-        }
-        let h = (wo + wi).normalize();
-        let distribution = self.microfacet(sp);
-        let d = distribution.d(h);
-        if d == 0.0 {
-            return SampledSpectrum::ZERO;
-        }
-        let g = distribution.g(wo, wi, h);
-        let f = conductor_reflectance(&self.eta, &self.k, sp.uv, wo.dot(h), lambda);
-        f * self.specular_reflectance.eval(sp.uv, lambda) * (d * g / (4.0 * wo.z))
+        tree: &mut BxdfTree<'a>,
+    ) -> NodeId {
+        tree.push(RoughConductorLobes {
+            distribution: Microfacet::new(
+                self.distribution,
+                self.alpha_u.eval_1(point.uv),
+                self.alpha_v.eval_1(point.uv),
+            ),
+            ior: ConductorIor::at(&self.eta, &self.k, point.uv, lambda),
+            specular_reflectance: self.specular_reflectance.eval(point.uv, lambda),
+        })
     }
+}
 
-    pub fn pdf(&self, sp: &ShadingPoint, wo: Vec3, wi: Vec3, _lambda: &SampledWavelengths) -> f32 {
+/// The glossy lobe at a point.
+#[derive(Clone, Copy, Debug)]
+pub struct RoughConductorLobes {
+    pub distribution: Microfacet,
+    pub ior: ConductorIor,
+    pub specular_reflectance: SampledSpectrum,
+}
+
+impl Bxdf for RoughConductorLobes {
+    fn eval(&self, _tree: &BxdfTree, wo: Vec3, wi: Vec3) -> BsdfEval {
         if !(wo.z > 0.0 && wi.z > 0.0) {
-            return 0.0;
+            return BsdfEval::ZERO;
         }
         let h = (wo + wi).normalize();
         // The visible-normal density, times the Jacobian 1/(4 wo·h) of the reflection map.
-        self.microfacet(sp).pdf_visible(wo, h) / (4.0 * wo.dot(h))
+        let pdf = self.distribution.pdf_visible(wo, h) / (4.0 * wo.dot(h));
+        let d = self.distribution.d(h);
+        if d == 0.0 {
+            return BsdfEval {
+                value: SampledSpectrum::ZERO,
+                pdf,
+            };
+        }
+        let g = self.distribution.g(wo, wi, h);
+        let f = self.ior.reflectance(wo.dot(h));
+        BsdfEval {
+            value: f * self.specular_reflectance * (d * g / (4.0 * wo.z)),
+            pdf,
+        }
     }
 
-    pub fn sample(
-        &self,
-        sp: &ShadingPoint,
-        wo: Vec3,
-        _u_lobe: f32,
-        u: Vec2,
-        lambda: &SampledWavelengths,
-    ) -> Option<BsdfSample> {
+    fn sample(&self, _tree: &BxdfTree, wo: Vec3, _u_lobe: f32, u: Vec2) -> Option<BsdfSample> {
         if !(wo.z > 0.0) {
             return None;
         }
-        let distribution = self.microfacet(sp);
-        let m = distribution.sample_visible(wo, u);
+        let m = self.distribution.sample_visible(wo, u);
         let wi = reflect(wo, m);
         let cos_om = wo.dot(m);
         if !(wi.z > 0.0 && cos_om > 0.0) {
             return None;
         }
-        let pdf = distribution.pdf_visible(wo, m) / (4.0 * cos_om);
+        let pdf = self.distribution.pdf_visible(wo, m) / (4.0 * cos_om);
         if !(pdf > 0.0) {
             return None;
         }
-        let f = conductor_reflectance(&self.eta, &self.k, sp.uv, cos_om, lambda);
-        let weight = f * self.specular_reflectance.eval(sp.uv, lambda) * distribution.g1(wi, m);
-        Some(BsdfSample::new(wi, weight, pdf, self.flags()))
+        let f = self.ior.reflectance(cos_om);
+        let weight = f * self.specular_reflectance * self.distribution.g1(wi, m);
+        Some(BsdfSample::new(wi, weight, pdf, FLAGS))
     }
 }

@@ -28,9 +28,10 @@ use glam::{Vec2, Vec3};
 use super::dielectric::optional_factor;
 use super::fresnel::{fresnel_dielectric, reflect, refract};
 use super::microfacet::{Microfacet, MicrofacetKind};
-use super::{BsdfFlags, BsdfSample, ShadingPoint, Texture};
+use super::{BsdfEval, BsdfFlags, BsdfModel, BsdfSample, Bxdf, BxdfTree, NodeId, ShadingPoint};
 use crate::spectrum::ior::RelativeIor;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+use crate::texture::Texture;
 
 #[derive(Clone, Debug)]
 pub struct RoughDielectric {
@@ -42,6 +43,56 @@ pub struct RoughDielectric {
     pub specular_transmittance: Option<Texture>,
 }
 
+const FLAGS: BsdfFlags = BsdfFlags::GLOSSY
+    .union(BsdfFlags::REFLECTION)
+    .union(BsdfFlags::TRANSMISSION);
+
+impl BsdfModel for RoughDielectric {
+    fn flags(&self) -> BsdfFlags {
+        FLAGS
+    }
+
+    fn is_dispersive(&self) -> bool {
+        self.eta.is_dispersive()
+    }
+
+    fn node_count(&self) -> usize {
+        1
+    }
+
+    #[inline]
+    fn resolve<'a>(
+        &'a self,
+        point: &ShadingPoint,
+        _wo: Vec3,
+        lambda: &SampledWavelengths,
+        tree: &mut BxdfTree<'a>,
+    ) -> NodeId {
+        tree.push(RoughDielectricLobes {
+            eta_hero: self.eta.at(lambda.lambda(0)),
+            dispersive: self.eta.is_dispersive(),
+            distribution: Microfacet::new(
+                self.distribution,
+                self.alpha_u.eval_1(point.uv),
+                self.alpha_v.eval_1(point.uv),
+            ),
+            specular_reflectance: optional_factor(&self.specular_reflectance, point.uv, lambda),
+            specular_transmittance: optional_factor(&self.specular_transmittance, point.uv, lambda),
+        })
+    }
+}
+
+/// The glossy reflection and transmission at a point.
+#[derive(Clone, Copy, Debug)]
+pub struct RoughDielectricLobes {
+    /// η at the hero wavelength, which all lobes use.
+    pub eta_hero: f32,
+    pub dispersive: bool,
+    pub distribution: Microfacet,
+    pub specular_reflectance: SampledSpectrum,
+    pub specular_transmittance: SampledSpectrum,
+}
+
 /// The half vector of a pair of directions and what goes with it.
 struct HalfVector {
     m: Vec3,
@@ -50,30 +101,19 @@ struct HalfVector {
     eta: f32,
 }
 
-impl RoughDielectric {
-    pub fn flags(&self) -> BsdfFlags {
-        BsdfFlags::GLOSSY
-            .union(BsdfFlags::REFLECTION)
-            .union(BsdfFlags::TRANSMISSION)
-    }
-
-    #[inline]
-    fn microfacet(&self, sp: &ShadingPoint) -> Microfacet {
-        Microfacet::new(
-            self.distribution,
-            self.alpha_u.eval_1(sp.uv),
-            self.alpha_v.eval_1(sp.uv),
-        )
-    }
-
+impl RoughDielectricLobes {
     /// The half vector for (wo, wi), on the upper side; None for a grazing wo or a degenerate pair.
     #[inline]
-    fn half_vector(eta_hero: f32, wo: Vec3, wi: Vec3) -> Option<HalfVector> {
+    fn half_vector(&self, wo: Vec3, wi: Vec3) -> Option<HalfVector> {
         if wo.z == 0.0 {
             return None;
         }
         let reflect = wo.z * wi.z > 0.0;
-        let eta = if wo.z > 0.0 { eta_hero } else { 1.0 / eta_hero };
+        let eta = if wo.z > 0.0 {
+            self.eta_hero
+        } else {
+            1.0 / self.eta_hero
+        };
         let m = (wo + wi * if reflect { 1.0 } else { eta }).normalize_or_zero();
         if m == Vec3::ZERO {
             return None;
@@ -85,40 +125,30 @@ impl RoughDielectric {
         })
     }
 
-    pub fn eval(
-        &self,
-        sp: &ShadingPoint,
-        wo: Vec3,
-        wi: Vec3,
-        lambda: &SampledWavelengths,
-    ) -> SampledSpectrum {
-        let eta_hero = self.eta.at(lambda.lambda(0));
-        let Some(HalfVector { m, reflect, eta }) = Self::half_vector(eta_hero, wo, wi) else {
-            return SampledSpectrum::ZERO;
-        };
-        let distribution = self.microfacet(sp);
-        let d = distribution.d(m);
-        let g = distribution.g(wo, wi, m);
+    /// f(wo, wi)·|cos θi| for the half vector of the pair.
+    #[inline]
+    fn value(&self, wo: Vec3, wi: Vec3, half: &HalfVector) -> SampledSpectrum {
+        let HalfVector { m, reflect, eta } = *half;
+        let d = self.distribution.d(m);
+        let g = self.distribution.g(wo, wi, m);
         if d == 0.0 || g == 0.0 {
             return SampledSpectrum::ZERO;
         }
-        let f = fresnel_dielectric(wo.dot(m), eta_hero).reflectance;
+        let f = fresnel_dielectric(wo.dot(m), self.eta_hero).reflectance;
         if reflect {
-            optional_factor(&self.specular_reflectance, sp.uv, lambda)
-                * (f * d * g / (4.0 * wo.z.abs()))
+            self.specular_reflectance * (f * d * g / (4.0 * wo.z.abs()))
         } else {
             let (om, im) = (wo.dot(m), wi.dot(m));
             let denominator = om + eta * im;
             let value = ((1.0 - f) * d * g * om * im / (wo.z * denominator * denominator)).abs();
-            optional_factor(&self.specular_transmittance, sp.uv, lambda) * value
+            self.specular_transmittance * value
         }
     }
 
-    pub fn pdf(&self, sp: &ShadingPoint, wo: Vec3, wi: Vec3, lambda: &SampledWavelengths) -> f32 {
-        let eta_hero = self.eta.at(lambda.lambda(0));
-        let Some(HalfVector { m, reflect, eta }) = Self::half_vector(eta_hero, wo, wi) else {
-            return 0.0;
-        };
+    /// The density of sampling wi, for the half vector of the pair.
+    #[inline]
+    fn pdf(&self, wo: Vec3, wi: Vec3, half: &HalfVector) -> f32 {
+        let HalfVector { m, reflect, eta } = *half;
         let (om, im) = (wo.dot(m), wi.dot(m));
         // The microsurface must agree with the macrosurface about the sides (as G₁ does).
         if !(om * wo.z > 0.0 && im * wi.z > 0.0) {
@@ -131,40 +161,42 @@ impl RoughDielectric {
             eta * eta * im / (denominator * denominator)
         };
         let wo_up = if wo.z > 0.0 { wo } else { -wo };
-        let f = fresnel_dielectric(om, eta_hero).reflectance;
+        let f = fresnel_dielectric(om, self.eta_hero).reflectance;
         let choice = if reflect { f } else { 1.0 - f };
-        (self.microfacet(sp).pdf_visible(wo_up, m) * choice * jacobian).abs()
+        (self.distribution.pdf_visible(wo_up, m) * choice * jacobian).abs()
+    }
+}
+
+impl Bxdf for RoughDielectricLobes {
+    fn eval(&self, _tree: &BxdfTree, wo: Vec3, wi: Vec3) -> BsdfEval {
+        let Some(half) = self.half_vector(wo, wi) else {
+            return BsdfEval::ZERO;
+        };
+        BsdfEval {
+            value: self.value(wo, wi, &half),
+            pdf: self.pdf(wo, wi, &half),
+        }
     }
 
-    pub fn sample(
-        &self,
-        sp: &ShadingPoint,
-        wo: Vec3,
-        u_lobe: f32,
-        u: Vec2,
-        lambda: &SampledWavelengths,
-    ) -> Option<BsdfSample> {
+    fn sample(&self, _tree: &BxdfTree, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<BsdfSample> {
         if wo.z == 0.0 || !wo.z.is_finite() {
             return None;
         }
-        let eta_hero = self.eta.at(lambda.lambda(0));
-        let distribution = self.microfacet(sp);
         let wo_up = if wo.z > 0.0 { wo } else { -wo };
-        let m = distribution.sample_visible(wo_up, u);
-        let pdf_m = distribution.pdf_visible(wo_up, m);
+        let m = self.distribution.sample_visible(wo_up, u);
+        let pdf_m = self.distribution.pdf_visible(wo_up, m);
         if !(pdf_m > 0.0) {
             return None;
         }
         let om = wo.dot(m);
-        let fresnel = fresnel_dielectric(om, eta_hero);
+        let fresnel = fresnel_dielectric(om, self.eta_hero);
         let f = fresnel.reflectance;
         let mut sample = if u_lobe < f {
             let wi = reflect(wo, m);
-            let weight = optional_factor(&self.specular_reflectance, sp.uv, lambda);
             let pdf = pdf_m * f / (4.0 * wi.dot(m)).abs();
             BsdfSample::new(
                 wi,
-                weight,
+                self.specular_reflectance,
                 pdf,
                 BsdfFlags::GLOSSY.union(BsdfFlags::REFLECTION),
             )
@@ -176,18 +208,17 @@ impl RoughDielectric {
             let im = wi.dot(m);
             let denominator = om + fresnel.eta_it * im;
             let jacobian = fresnel.eta_it * fresnel.eta_it * im / (denominator * denominator);
-            let weight = optional_factor(&self.specular_transmittance, sp.uv, lambda)
-                * (fresnel.eta_ti * fresnel.eta_ti);
+            let weight = self.specular_transmittance * (fresnel.eta_ti * fresnel.eta_ti);
             BsdfSample {
                 wi,
                 weight,
                 pdf: (pdf_m * (1.0 - f) * jacobian).abs(),
                 flags: BsdfFlags::GLOSSY.union(BsdfFlags::TRANSMISSION),
                 eta: fresnel.eta_it,
-                terminates_secondary: self.eta.is_dispersive(),
+                terminates_secondary: self.dispersive,
             }
         };
-        let g1 = distribution.g1(sample.wi, m);
+        let g1 = self.distribution.g1(sample.wi, m);
         if !(g1 > 0.0 && sample.pdf > 0.0 && sample.pdf.is_finite()) {
             return None;
         }

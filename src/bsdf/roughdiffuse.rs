@@ -18,9 +18,13 @@ use std::f32::consts::{FRAC_1_PI, FRAC_1_SQRT_2};
 
 use glam::{Vec2, Vec3};
 
-use super::{BsdfFlags, BsdfSample, ShadingPoint, Texture, mixture_sample};
+use super::{
+    BsdfEval, BsdfFlags, BsdfModel, BsdfSample, Bxdf, BxdfTree, NodeId, ShadingPoint,
+    mixture_sample,
+};
 use crate::sampling::warp::{cosine_hemisphere_pdf, sample_cosine_hemisphere};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+use crate::texture::Texture;
 
 #[derive(Clone, Debug)]
 pub struct RoughDiffuse {
@@ -29,24 +33,53 @@ pub struct RoughDiffuse {
     pub use_fast_approx: bool,
 }
 
-impl RoughDiffuse {
-    pub fn flags(&self) -> BsdfFlags {
-        BsdfFlags::DIFFUSE.union(BsdfFlags::REFLECTION)
+const FLAGS: BsdfFlags = BsdfFlags::DIFFUSE.union(BsdfFlags::REFLECTION);
+
+impl BsdfModel for RoughDiffuse {
+    fn flags(&self) -> BsdfFlags {
+        FLAGS
     }
 
-    pub fn eval(
-        &self,
-        sp: &ShadingPoint,
-        wo: Vec3,
-        wi: Vec3,
+    fn is_dispersive(&self) -> bool {
+        false
+    }
+
+    fn node_count(&self) -> usize {
+        1
+    }
+
+    #[inline]
+    fn resolve<'a>(
+        &'a self,
+        point: &ShadingPoint,
+        _wo: Vec3,
         lambda: &SampledWavelengths,
-    ) -> SampledSpectrum {
-        if wo.z <= 0.0 || wi.z <= 0.0 {
-            return SampledSpectrum::ZERO;
-        }
-        let sigma = self.alpha.eval_1(sp.uv) * FRAC_1_SQRT_2;
+        tree: &mut BxdfTree<'a>,
+    ) -> NodeId {
+        tree.push(RoughDiffuseLobes {
+            reflectance: self.reflectance.eval(point.uv, lambda),
+            sigma: self.alpha.eval_1(point.uv) * FRAC_1_SQRT_2,
+            use_fast_approx: self.use_fast_approx,
+        })
+    }
+}
+
+/// The Oren–Nayar lobe at a point.
+#[derive(Clone, Copy, Debug)]
+pub struct RoughDiffuseLobes {
+    pub reflectance: SampledSpectrum,
+    /// The slope deviation σ = α/√2.
+    pub sigma: f32,
+    pub use_fast_approx: bool,
+}
+
+impl RoughDiffuseLobes {
+    /// f(wo, wi) cos θi for directions above the surface.
+    #[inline]
+    fn value(&self, wo: Vec3, wi: Vec3) -> SampledSpectrum {
+        let sigma = self.sigma;
         let sigma2 = sigma * sigma;
-        let rho = self.reflectance.eval(sp.uv, lambda);
+        let rho = self.reflectance;
         let sin_o = (1.0 - wo.z * wo.z).max(0.0).sqrt();
         let sin_i = (1.0 - wi.z * wi.z).max(0.0).sqrt();
         // cos(φo − φi).
@@ -92,31 +125,29 @@ impl RoughDiffuse {
         };
         value * (FRAC_1_PI * wi.z)
     }
+}
 
-    pub fn pdf(&self, _sp: &ShadingPoint, wo: Vec3, wi: Vec3, _lambda: &SampledWavelengths) -> f32 {
+impl Bxdf for RoughDiffuseLobes {
+    fn eval(&self, _tree: &BxdfTree, wo: Vec3, wi: Vec3) -> BsdfEval {
         if wo.z <= 0.0 || wi.z <= 0.0 {
-            return 0.0;
+            return BsdfEval::ZERO;
         }
-        cosine_hemisphere_pdf(wi)
+        BsdfEval {
+            value: self.value(wo, wi),
+            pdf: cosine_hemisphere_pdf(wi),
+        }
     }
 
-    pub fn sample(
-        &self,
-        sp: &ShadingPoint,
-        wo: Vec3,
-        _u_lobe: f32,
-        u: Vec2,
-        lambda: &SampledWavelengths,
-    ) -> Option<BsdfSample> {
+    fn sample(&self, _tree: &BxdfTree, wo: Vec3, _u_lobe: f32, u: Vec2) -> Option<BsdfSample> {
         if wo.z <= 0.0 {
             return None;
         }
         let wi = sample_cosine_hemisphere(u);
-        mixture_sample(
-            wi,
-            self.eval(sp, wo, wi, lambda),
-            cosine_hemisphere_pdf(wi),
-            self.flags(),
-        )
+        let value = if wi.z <= 0.0 {
+            SampledSpectrum::ZERO
+        } else {
+            self.value(wo, wi)
+        };
+        mixture_sample(wi, value, cosine_hemisphere_pdf(wi), FLAGS)
     }
 }

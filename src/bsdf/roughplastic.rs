@@ -30,9 +30,13 @@ use rayon::prelude::*;
 use super::dielectric::optional_factor;
 use super::fresnel::{fresnel_dielectric, reflect, refract};
 use super::microfacet::{GaussLegendre, Microfacet, MicrofacetKind};
-use super::{BsdfFlags, BsdfSample, ShadingPoint, Texture, mixture_sample};
+use super::{
+    BsdfEval, BsdfFlags, BsdfModel, BsdfSample, Bxdf, BxdfTree, NodeId, ShadingPoint,
+    mixture_sample,
+};
 use crate::sampling::warp::{cosine_hemisphere_pdf, sample_cosine_hemisphere};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+use crate::texture::Texture;
 
 /// Entries of the transmittance table (Mitsuba's MI_ROUGH_TRANSMITTANCE_RES).
 const TABLE_SIZE: usize = 64;
@@ -134,12 +138,6 @@ impl RoughPlastic {
         }
     }
 
-    pub fn flags(&self) -> BsdfFlags {
-        BsdfFlags::GLOSSY
-            .union(BsdfFlags::DIFFUSE)
-            .union(BsdfFlags::REFLECTION)
-    }
-
     /// T(μ) by linear interpolation in the table.
     #[inline]
     fn transmittance(&self, mu: f32) -> f32 {
@@ -148,32 +146,67 @@ impl RoughPlastic {
         let t = x - i as f32;
         self.external_transmittance[i] * (1.0 - t) + self.external_transmittance[i + 1] * t
     }
+}
+
+const FLAGS: BsdfFlags = BsdfFlags::GLOSSY
+    .union(BsdfFlags::DIFFUSE)
+    .union(BsdfFlags::REFLECTION);
+
+impl BsdfModel for RoughPlastic {
+    fn flags(&self) -> BsdfFlags {
+        FLAGS
+    }
+
+    fn is_dispersive(&self) -> bool {
+        false
+    }
+
+    fn node_count(&self) -> usize {
+        1
+    }
 
     #[inline]
-    fn effective_diffuse(&self, sp: &ShadingPoint, lambda: &SampledWavelengths) -> SampledSpectrum {
-        let rho = self.diffuse_reflectance.eval(sp.uv, lambda);
-        SampledSpectrum::from_fn(|i| {
+    fn resolve<'a>(
+        &'a self,
+        point: &ShadingPoint,
+        _wo: Vec3,
+        lambda: &SampledWavelengths,
+        tree: &mut BxdfTree<'a>,
+    ) -> NodeId {
+        // ρ / (1 − R_i) or, nonlinear, ρ / (1 − ρ R_i).
+        let rho = self.diffuse_reflectance.eval(point.uv, lambda);
+        let diffuse = SampledSpectrum::from_fn(|i| {
             let bounce = if self.nonlinear {
                 rho[i] * self.internal_reflectance
             } else {
                 self.internal_reflectance
             };
             rho[i] / (1.0 - bounce)
+        });
+        tree.push(RoughPlasticLobes {
+            plastic: self,
+            diffuse,
+            specular_reflectance: optional_factor(&self.specular_reflectance, point.uv, lambda),
         })
     }
+}
 
+/// The glossy coating and the base under it, at a point.
+#[derive(Clone, Copy, Debug)]
+pub struct RoughPlasticLobes<'a> {
+    plastic: &'a RoughPlastic,
+    /// The effective diffuse reflectance of the base.
+    diffuse: SampledSpectrum,
+    specular_reflectance: SampledSpectrum,
+}
+
+impl RoughPlasticLobes<'_> {
     /// The probability of sampling the glossy lobe at wo.
     #[inline]
-    fn glossy_probability(
-        &self,
-        sp: &ShadingPoint,
-        t_o: f32,
-        diffuse: &SampledSpectrum,
-        lambda: &SampledWavelengths,
-    ) -> f32 {
-        let glossy =
-            (1.0 - t_o) * optional_factor(&self.specular_reflectance, sp.uv, lambda).average();
-        let base = t_o * diffuse.average() * self.mean_transmittance * self.inv_eta2;
+    fn glossy_probability(&self, t_o: f32) -> f32 {
+        let p = self.plastic;
+        let glossy = (1.0 - t_o) * self.specular_reflectance.average();
+        let base = t_o * self.diffuse.average() * p.mean_transmittance * p.inv_eta2;
         if glossy + base > 0.0 {
             glossy / (glossy + base)
         } else {
@@ -181,79 +214,50 @@ impl RoughPlastic {
         }
     }
 
-    /// The value of both lobes, given the effective diffuse reflectance.
+    /// The value of both lobes.
     #[inline]
-    fn value(
-        &self,
-        sp: &ShadingPoint,
-        wo: Vec3,
-        wi: Vec3,
-        diffuse: &SampledSpectrum,
-        lambda: &SampledWavelengths,
-    ) -> SampledSpectrum {
+    fn value(&self, wo: Vec3, wi: Vec3) -> SampledSpectrum {
+        let p = self.plastic;
         let h = (wo + wi).normalize();
-        let d = self.distribution.d(h);
+        let d = p.distribution.d(h);
         let glossy = if d > 0.0 {
-            let f = fresnel_dielectric(wo.dot(h), self.eta).reflectance;
-            optional_factor(&self.specular_reflectance, sp.uv, lambda)
-                * (f * d * self.distribution.g(wo, wi, h) / (4.0 * wo.z))
+            let f = fresnel_dielectric(wo.dot(h), p.eta).reflectance;
+            self.specular_reflectance * (f * d * p.distribution.g(wo, wi, h) / (4.0 * wo.z))
         } else {
             SampledSpectrum::ZERO
         };
-        let base = *diffuse
-            * (self.inv_eta2
-                * FRAC_1_PI
-                * wi.z
-                * self.transmittance(wo.z)
-                * self.transmittance(wi.z));
+        let base = self.diffuse
+            * (p.inv_eta2 * FRAC_1_PI * wi.z * p.transmittance(wo.z) * p.transmittance(wi.z));
         glossy + base
     }
 
     #[inline]
     fn mixture_pdf(&self, wo: Vec3, wi: Vec3, p_glossy: f32) -> f32 {
         let h = (wo + wi).normalize();
-        let glossy = self.distribution.pdf_visible(wo, h) / (4.0 * wo.dot(h));
+        let glossy = self.plastic.distribution.pdf_visible(wo, h) / (4.0 * wo.dot(h));
         p_glossy * glossy.max(0.0) + (1.0 - p_glossy) * cosine_hemisphere_pdf(wi)
     }
+}
 
-    pub fn eval(
-        &self,
-        sp: &ShadingPoint,
-        wo: Vec3,
-        wi: Vec3,
-        lambda: &SampledWavelengths,
-    ) -> SampledSpectrum {
+impl Bxdf for RoughPlasticLobes<'_> {
+    fn eval(&self, _tree: &BxdfTree, wo: Vec3, wi: Vec3) -> BsdfEval {
         if !(wo.z > 0.0 && wi.z > 0.0) {
-            return SampledSpectrum::ZERO;
+            return BsdfEval::ZERO;
         }
-        let diffuse = self.effective_diffuse(sp, lambda);
-        self.value(sp, wo, wi, &diffuse, lambda)
+        let p_glossy = self.glossy_probability(self.plastic.transmittance(wo.z));
+        BsdfEval {
+            value: self.value(wo, wi),
+            pdf: self.mixture_pdf(wo, wi, p_glossy),
+        }
     }
 
-    pub fn pdf(&self, sp: &ShadingPoint, wo: Vec3, wi: Vec3, lambda: &SampledWavelengths) -> f32 {
-        if !(wo.z > 0.0 && wi.z > 0.0) {
-            return 0.0;
-        }
-        let diffuse = self.effective_diffuse(sp, lambda);
-        let p_glossy = self.glossy_probability(sp, self.transmittance(wo.z), &diffuse, lambda);
-        self.mixture_pdf(wo, wi, p_glossy)
-    }
-
-    pub fn sample(
-        &self,
-        sp: &ShadingPoint,
-        wo: Vec3,
-        u_lobe: f32,
-        u: Vec2,
-        lambda: &SampledWavelengths,
-    ) -> Option<BsdfSample> {
+    fn sample(&self, _tree: &BxdfTree, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<BsdfSample> {
         if !(wo.z > 0.0) {
             return None;
         }
-        let diffuse = self.effective_diffuse(sp, lambda);
-        let p_glossy = self.glossy_probability(sp, self.transmittance(wo.z), &diffuse, lambda);
+        let p_glossy = self.glossy_probability(self.plastic.transmittance(wo.z));
         let (wi, flags) = if u_lobe < p_glossy {
-            let m = self.distribution.sample_visible(wo, u);
+            let m = self.plastic.distribution.sample_visible(wo, u);
             (
                 reflect(wo, m),
                 BsdfFlags::GLOSSY.union(BsdfFlags::REFLECTION),
@@ -269,7 +273,7 @@ impl RoughPlastic {
         }
         mixture_sample(
             wi,
-            self.value(sp, wo, wi, &diffuse, lambda),
+            self.value(wo, wi),
             self.mixture_pdf(wo, wi, p_glossy),
             flags,
         )

@@ -17,11 +17,12 @@
 
 use glam::{Vec2, Vec3};
 
-use super::dielectric::optional_factor;
+use super::dielectric::{SampledIor, optional_factor};
 use super::fresnel::{fresnel_dielectric, reflect_z};
-use super::{BsdfFlags, BsdfSample, ShadingPoint, Texture};
+use super::{BsdfFlags, BsdfModel, BsdfSample, Bxdf, BxdfTree, NodeId, ShadingPoint};
 use crate::spectrum::ior::RelativeIor;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+use crate::texture::Texture;
 
 #[derive(Clone, Debug)]
 pub struct ThinDielectric {
@@ -30,52 +31,67 @@ pub struct ThinDielectric {
     pub specular_transmittance: Option<Texture>,
 }
 
-impl ThinDielectric {
-    pub fn flags(&self) -> BsdfFlags {
-        BsdfFlags::SPECULAR
-            .union(BsdfFlags::REFLECTION)
-            .union(BsdfFlags::NULL)
+const FLAGS: BsdfFlags = BsdfFlags::SPECULAR
+    .union(BsdfFlags::REFLECTION)
+    .union(BsdfFlags::NULL);
+
+impl BsdfModel for ThinDielectric {
+    fn flags(&self) -> BsdfFlags {
+        FLAGS
     }
 
-    pub fn eval(
-        &self,
-        _sp: &ShadingPoint,
+    /// The pane does not bend light, so a dispersive index changes only how much each
+    /// wavelength reflects, never its direction.
+    fn is_dispersive(&self) -> bool {
+        false
+    }
+
+    fn node_count(&self) -> usize {
+        1
+    }
+
+    #[inline]
+    fn resolve<'a>(
+        &'a self,
+        point: &ShadingPoint,
         _wo: Vec3,
-        _wi: Vec3,
-        _lambda: &SampledWavelengths,
-    ) -> SampledSpectrum {
-        SampledSpectrum::ZERO
-    }
-
-    pub fn pdf(&self, _sp: &ShadingPoint, _wo: Vec3, _wi: Vec3, _l: &SampledWavelengths) -> f32 {
-        0.0
-    }
-
-    pub fn sample(
-        &self,
-        sp: &ShadingPoint,
-        wo: Vec3,
-        u_lobe: f32,
-        _u: Vec2,
         lambda: &SampledWavelengths,
-    ) -> Option<BsdfSample> {
+        tree: &mut BxdfTree<'a>,
+    ) -> NodeId {
+        tree.push(ThinDielectricLobes {
+            eta: SampledIor::at(&self.eta, lambda),
+            specular_reflectance: optional_factor(&self.specular_reflectance, point.uv, lambda),
+            specular_transmittance: optional_factor(&self.specular_transmittance, point.uv, lambda),
+        })
+    }
+}
+
+/// The reflected and passing lobes at a point.
+#[derive(Clone, Copy, Debug)]
+pub struct ThinDielectricLobes {
+    pub eta: SampledIor,
+    pub specular_reflectance: SampledSpectrum,
+    pub specular_transmittance: SampledSpectrum,
+}
+
+impl Bxdf for ThinDielectricLobes {
+    fn sample(&self, _tree: &BxdfTree, wo: Vec3, u_lobe: f32, _u: Vec2) -> Option<BsdfSample> {
         let cos_o = wo.z.abs();
         if !(cos_o > 0.0) {
             return None;
         }
-        let reflectance = |l: f32| {
-            let r = fresnel_dielectric(cos_o, self.eta.at(l)).reflectance;
+        let reflectance = |eta: f32| {
+            let r = fresnel_dielectric(cos_o, eta).reflectance;
             2.0 * r / (1.0 + r)
         };
-        let r = if self.eta.is_dispersive() {
-            SampledSpectrum::from_fn(|i| reflectance(lambda.lambda(i)))
+        let r = if self.eta.dispersive {
+            SampledSpectrum::from_fn(|i| reflectance(self.eta.eta[i]))
         } else {
-            SampledSpectrum::splat(reflectance(lambda.lambda(0)))
+            SampledSpectrum::splat(reflectance(self.eta.hero()))
         };
         let p_reflect = r.average();
         if u_lobe < p_reflect {
-            let weight =
-                r * (1.0 / p_reflect) * optional_factor(&self.specular_reflectance, sp.uv, lambda);
+            let weight = r * (1.0 / p_reflect) * self.specular_reflectance;
             Some(BsdfSample::new(
                 reflect_z(wo),
                 weight,
@@ -84,9 +100,8 @@ impl ThinDielectric {
             ))
         } else {
             let p_transmit = 1.0 - p_reflect;
-            let weight = (SampledSpectrum::ONE - r)
-                * (1.0 / p_transmit)
-                * optional_factor(&self.specular_transmittance, sp.uv, lambda);
+            let weight =
+                (SampledSpectrum::ONE - r) * (1.0 / p_transmit) * self.specular_transmittance;
             Some(BsdfSample::new(-wo, weight, p_transmit, BsdfFlags::NULL))
         }
     }

@@ -11,9 +11,11 @@
 
 use glam::{Vec2, Vec3};
 
-use super::{Bsdf, BsdfFlags, BsdfSample, ShadingPoint};
+use super::{
+    Bsdf, BsdfEval, BsdfFlags, BsdfModel, BsdfSample, Bxdf, BxdfTree, NodeId, ShadingPoint,
+};
 use crate::math::Frame;
-use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+use crate::spectrum::SampledWavelengths;
 
 #[derive(Clone, Debug)]
 pub struct TwoSided {
@@ -41,49 +43,53 @@ fn back_side(sp: &ShadingPoint) -> ShadingPoint {
     }
 }
 
-impl TwoSided {
-    pub fn flags(&self) -> BsdfFlags {
+impl BsdfModel for TwoSided {
+    fn flags(&self) -> BsdfFlags {
         self.front.flags().union(self.back.flags())
     }
 
-    pub fn eval(
-        &self,
-        sp: &ShadingPoint,
-        wo: Vec3,
-        wi: Vec3,
-        lambda: &SampledWavelengths,
-    ) -> SampledSpectrum {
-        if wo.z >= 0.0 {
-            self.front.eval(sp, wo, wi, lambda)
-        } else {
-            self.back.eval(&back_side(sp), flip(wo), flip(wi), lambda)
-        }
+    fn is_dispersive(&self) -> bool {
+        self.front.is_dispersive() || self.back.is_dispersive()
     }
 
-    pub fn pdf(&self, sp: &ShadingPoint, wo: Vec3, wi: Vec3, lambda: &SampledWavelengths) -> f32 {
-        if wo.z >= 0.0 {
-            self.front.pdf(sp, wo, wi, lambda)
-        } else {
-            self.back.pdf(&back_side(sp), flip(wo), flip(wi), lambda)
-        }
+    fn node_count(&self) -> usize {
+        1 + self.front.node_count().max(self.back.node_count())
     }
 
-    pub fn sample(
-        &self,
-        sp: &ShadingPoint,
+    /// The side that `wo` sees: the front BSDF's lobes as they are, or the back BSDF's with
+    /// mirrored directions.
+    #[inline]
+    fn resolve<'a>(
+        &'a self,
+        point: &ShadingPoint,
         wo: Vec3,
-        u_lobe: f32,
-        u: Vec2,
         lambda: &SampledWavelengths,
-    ) -> Option<BsdfSample> {
+        tree: &mut BxdfTree<'a>,
+    ) -> NodeId {
         if wo.z >= 0.0 {
-            self.front.sample(sp, wo, u_lobe, u, lambda)
-        } else {
-            let mut s = self
-                .back
-                .sample(&back_side(sp), flip(wo), u_lobe, u, lambda)?;
-            s.wi = flip(s.wi);
-            Some(s)
+            return self.front.resolve(point, wo, lambda, tree);
         }
+        let nested = self.back.resolve(&back_side(point), flip(wo), lambda, tree);
+        tree.push(BackSideLobes { nested })
+    }
+}
+
+/// The back BSDF's lobes seen from the back: every direction mirrored through the surface.
+#[derive(Clone, Copy, Debug)]
+pub struct BackSideLobes {
+    pub nested: NodeId,
+}
+
+impl Bxdf for BackSideLobes {
+    #[inline]
+    fn eval(&self, tree: &BxdfTree, wo: Vec3, wi: Vec3) -> BsdfEval {
+        tree.eval(self.nested, flip(wo), flip(wi))
+    }
+
+    #[inline]
+    fn sample(&self, tree: &BxdfTree, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<BsdfSample> {
+        let mut s = tree.sample(self.nested, flip(wo), u_lobe, u)?;
+        s.wi = flip(s.wi);
+        Some(s)
     }
 }

@@ -21,11 +21,11 @@ use crate::cli::accel::Accel;
 use crate::error::{Error, Result};
 use crate::film::stats::rejected_report;
 use crate::film::write_images;
-use crate::film::{CropWindow, FilterSampler, PixelSums};
+use crate::film::{CropWindow, PixelSums};
 use crate::integrator::RayCount;
 use crate::render::state::{RenderIdentity, RenderState};
 use crate::render::{
-    Checkpoints, RenderOptions, Snapshot, StopReason, StopRule, estimate_sample,
+    Checkpoints, RenderOptions, SampleEstimator, Snapshot, StopReason, StopRule,
     render_with_checkpoints,
 };
 use crate::sampling::sampler::{Sampler, SamplerKind};
@@ -248,7 +248,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     args.accel.check_available()?;
     let loaded = load_scene(&args.scene, &args.defines)?;
     let mut scene = loaded.scene;
-    args.accel.apply(&mut scene.geometry)?;
+    args.accel.apply(&mut scene.world.geometry)?;
     let crop = match (args.crop, args.pixel) {
         (Some(_), Some(_)) => return Err(Error::usage("give either --crop or --pixel, not both")),
         (Some([x0, y0, x1, y1]), None) => Some([x0, y0, x1, y1]),
@@ -443,7 +443,7 @@ fn report(
         scene.film.crop.size.x,
         scene.film.crop.size.y,
         output.film.pixels.first().map_or(0, |p| p.samples),
-        match Accel::of(&scene.geometry) {
+        match Accel::of(&scene.world.geometry) {
             Accel::Bvh => "",
             Accel::Embree => ", traced by Embree",
         },
@@ -467,7 +467,7 @@ fn trace_pixel(
     seed: u64,
     args: &RenderArgs,
 ) -> Result<()> {
-    let filter = FilterSampler::new(scene.film.filter);
+    let estimator = SampleEstimator::new(scene);
     let mut sampler = Sampler::new(scene.sampler.kind, strata, seed);
     let mut count = RayCount::default();
     let range = args.sample_range.clone().unwrap_or(0..strata);
@@ -478,7 +478,7 @@ fn trace_pixel(
     );
     println!("{:>8} {:>14} {:>14} {:>14}", "sample", "X", "Y", "Z");
     for index in range {
-        let xyz = estimate_sample(scene, &filter, &mut sampler, pixel, index, &mut count);
+        let xyz = estimator.estimate(&mut sampler, pixel, index, &mut count);
         let bad = !xyz.iter().all(|v| v.is_finite());
         println!(
             "{index:>8} {:>14.6e} {:>14.6e} {:>14.6e}{}",

@@ -119,8 +119,6 @@ pub fn read_exr(path: &Path) -> Result<ChannelImage> {
     })
 }
 
-/// Writes linear-sRGB RGB (interleaved r, g, b per pixel, top row first) as an 8-bit sRGB PNG
-
 /// An exr error as an I/O error: file-system errors pass through, format errors become
 /// `InvalidData` or `Unsupported`.
 fn exr_to_io(err: exr::error::Error) -> io::Error {

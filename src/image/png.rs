@@ -7,8 +7,9 @@ use super::srgb::encode_u8;
 use super::write_atomically;
 use crate::error::{Error, Result};
 
-/// with an sRGB chunk: each value is clamped to [0, 1], encoded by [`super::srgb::encode`] and rounded to
-/// the nearest of 0..=255; NaN is written as 0.
+/// Writes linear-sRGB RGB (interleaved r, g, b per pixel, top row first) as an 8-bit sRGB PNG
+/// with an sRGB chunk: each value is clamped to [0, 1], encoded by [`super::srgb::encode`] and
+/// rounded to the nearest of 0..=255; NaN is written as 0.
 pub fn write_png_srgb(path: &Path, width: usize, height: usize, rgb: &[f32]) -> Result<()> {
     let invalid = |message: String| Error::io(path, &io::Error::other(message), "write");
     if rgb.len() != 3 * width * height {

@@ -18,12 +18,19 @@
 //! wavelengths). From it the estimator chooses, as the slides' `choose_s`, `choose_N` and
 //! `estimate_nr_shadow_rays` do:
 //! * s = min(1, potential / `rr_threshold`): paths that matter little are ended with high
-//!   probability, never by a fixed depth;
+//!   probability, never by a fixed depth (from depth 128 on, s is at most 0.95, so that a path
+//!   caught between mirrors or glass ends too);
 //! * N = clamp(round(`bounce_samples` · potential), 1, `bounce_samples`) bounce samples;
 //! * N_l = clamp(round(`shadow_rays` · potential), 1, `shadow_rays`) shadow rays per light.
 //!
 //! At the camera's first hit (potential 1) the estimator splits the most; deeper down it falls
 //! back to path tracing. Every choice only redistributes effort, so the estimate stays unbiased.
+//!
+//! Dispersion is handled as in the path tracer: a vertex whose evaluable BSDF is dispersive, and
+//! every bounce sample that refracts through a dispersive interface, continue with the hero
+//! wavelength alone, and their estimate enters the vertex's as N times the hero's radiance
+//! (the hero-only estimator of the same integral), so each branch of the split decides for
+//! itself.
 //!
 //! ```xml
 //! <integrator type="distrib">
@@ -38,20 +45,19 @@
 
 use glam::Vec3;
 
-use crate::bsdf::{Bsdf, ShadingPoint};
+use crate::bsdf::Scattering;
 use crate::geometry::SurfaceInteraction;
-use crate::integrator::RayCount;
-use crate::light::{Light, LightSample, LightSelection};
+use crate::integrator::{PreparedIntegrator, RayCount, hero_only, unoccluded};
+use crate::light::{Light, LightSelection};
 use crate::math::Ray;
 use crate::sampling::sampler::Sampler;
-use crate::scene::Scene;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 
 /// Which lights a vertex sends shadow rays to.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum DirectLights {
-    /// One light per shading point, drawn by the scene's light sampler (∝ power, or uniformly)
-    /// and the estimate divided by its probability.
+    /// One light per shading point, drawn by the integrator's light sampler (∝ power, or
+    /// uniformly) and the estimate divided by its probability.
     One(LightSelection),
     /// Every light, each with its own shadow rays (the slides' loop over the lights).
     All,
@@ -80,15 +86,26 @@ impl Default for DistributionIntegrator {
     }
 }
 
+/// The depth below which the roulette may let a path survive with certainty.
+pub const CERTAIN_SURVIVAL_DEPTH: i32 = 128;
+
 /// A count from the potential: clamp(round(maximum · potential), 1, maximum).
 fn count_from_potential(maximum: u32, potential: f32) -> u32 {
     ((maximum as f32 * potential).round() as u32).clamp(1, maximum.max(1))
 }
 
 impl DistributionIntegrator {
-    /// The slides' `choose_s`: the survival probability of Russian roulette.
-    pub fn choose_s(&self, potential: f32) -> f32 {
-        (potential / self.rr_threshold).min(1.0)
+    /// The slides' `choose_s`: the survival probability of Russian roulette at `depth`. From
+    /// depth [`CERTAIN_SURVIVAL_DEPTH`] on it is at most 0.95, as in the path tracer: the slides'
+    /// rule alone never ends a path whose potential stays above the threshold, such as one
+    /// caught between glass surfaces, and the recursion would have no bound.
+    pub fn choose_s(&self, potential: f32, depth: i32) -> f32 {
+        let survival = (potential / self.rr_threshold).min(1.0);
+        if depth >= CERTAIN_SURVIVAL_DEPTH {
+            survival.min(0.95)
+        } else {
+            survival
+        }
     }
 
     /// The slides' `choose_N`: bounce samples at a vertex.
@@ -101,13 +118,22 @@ impl DistributionIntegrator {
         count_from_potential(self.shadow_rays, potential)
     }
 
+    /// How its light sampler weighs the lights (power when every light gets shadow rays: the
+    /// sampler is then not used).
+    pub(super) fn light_selection(&self) -> LightSelection {
+        match self.lights {
+            DirectLights::One(selection) => selection,
+            DirectLights::All => LightSelection::Power,
+        }
+    }
+
     fn depth_allows_next_vertex(&self, depth: i32) -> bool {
         self.max_depth < 0 || depth + 1 < self.max_depth
     }
 
-    pub fn radiance(
+    pub(super) fn radiance(
         &self,
-        scene: &Scene,
+        prepared: &PreparedIntegrator,
         ray: Ray,
         lambda: &SampledWavelengths,
         sampler: &mut Sampler,
@@ -116,148 +142,150 @@ impl DistributionIntegrator {
         if self.max_depth == 0 {
             return SampledSpectrum::ZERO;
         }
-        self.incoming(
-            scene,
-            ray,
-            0,
-            1.0,
-            !self.hide_emitters,
-            lambda,
+        let mut estimate = Estimate {
+            integrator: self,
+            prepared,
             sampler,
             count,
-        )
+        };
+        estimate.incoming(ray, 0, 1.0, !self.hide_emitters, lambda)
     }
+}
 
+/// One camera sample's recursive estimate: the integrator, its world and light sampler, and the
+/// sample's random numbers and ray count.
+struct Estimate<'a, 's> {
+    integrator: &'a DistributionIntegrator,
+    prepared: &'a PreparedIntegrator<'a>,
+    sampler: &'s mut Sampler,
+    count: &'s mut RayCount,
+}
+
+impl Estimate<'_, '_> {
     /// Radiance arriving along `ray` (the slides' `incoming_radiance`); emission at the hit is
     /// counted only when `with_emission`.
-    #[allow(clippy::too_many_arguments)]
     fn incoming(
-        &self,
-        scene: &Scene,
+        &mut self,
         ray: Ray,
         depth: i32,
         potential: f32,
         with_emission: bool,
         lambda: &SampledWavelengths,
-        sampler: &mut Sampler,
-        count: &mut RayCount,
     ) -> SampledSpectrum {
-        count.rays += 1;
-        let Some(si) = scene.geometry.intersect(&ray) else {
+        let world = self.prepared.world;
+        self.count.rays += 1;
+        let Some(si) = world.geometry.intersect(&ray) else {
             // Leaving the scene: the environment is a light like any other, counted here only
             // where no shadow ray could have found it (camera rays, specular bounces).
-            return match scene.environment {
+            return match world.environment {
                 Some(env) if with_emission => {
-                    scene.lights[env as usize].environment_radiance(ray.d.normalize(), lambda)
+                    world.lights[env as usize].environment_radiance(ray.d.normalize(), lambda)
                 }
                 _ => SampledSpectrum::ZERO,
             };
         };
         let wo_world = -ray.d.normalize();
-        let info = scene.shape_info[si.shape as usize];
+        let info = world.shape_info[si.shape as usize];
         let mut result = SampledSpectrum::ZERO;
         if with_emission
             && let Some(light_index) = info.light
-            && let Light::Area(light) = &scene.lights[light_index as usize]
+            && let Light::Area(light) = &world.lights[light_index as usize]
         {
             result += light.emitted(si.shading.n, wo_world, lambda);
         }
-        if self.depth_allows_next_vertex(depth) {
-            result += self.reflected(
-                scene, &si, wo_world, depth, potential, lambda, sampler, count,
-            );
+        if self.integrator.depth_allows_next_vertex(depth) {
+            result += self.reflected(&si, wo_world, depth, potential, lambda);
         }
         result
     }
 
     /// Reflected radiance at `si` towards `wo_world` (the slides' `reflected_radiance`).
-    #[allow(clippy::too_many_arguments)]
     fn reflected(
-        &self,
-        scene: &Scene,
+        &mut self,
         si: &SurfaceInteraction,
         wo_world: Vec3,
         depth: i32,
         potential: f32,
         lambda: &SampledWavelengths,
-        sampler: &mut Sampler,
-        count: &mut RayCount,
     ) -> SampledSpectrum {
-        let survival = self.choose_s(potential);
-        if !(sampler.next_1d() < survival) {
+        let world = self.prepared.world;
+        let survival = self.integrator.choose_s(potential, depth);
+        if !(self.sampler.next_1d() < survival) {
             return SampledSpectrum::ZERO;
         }
-        let material = &scene.materials[scene.shape_info[si.shape as usize].material as usize];
-        let (bsdf, flip) = material.side(si.shading.to_local(wo_world).z);
-        let frame = if flip {
-            si.shading.flipped()
-        } else {
-            si.shading
-        };
-        let sp = ShadingPoint {
-            uv: si.uv,
-            frame,
-            ng: if si.n.dot(frame.n) < 0.0 { -si.n } else { si.n },
-            dp_du: si.dp_du,
-            dp_dv: si.dp_dv,
-        };
-        let wo = frame.to_local(wo_world);
+        let material = &world.materials[world.shape_info[si.shape as usize].material as usize];
+        let scattering = material.scattering(si, wo_world, lambda);
+        let smooth = scattering.flags().has_smooth_lobe();
+        // A dispersive BSDF that can be evaluated uses the hero's index for all its lobes
+        // (roughdielectric): the whole vertex continues with the hero alone.
+        if smooth && scattering.is_dispersive() && !lambda.secondary_terminated() {
+            let mut hero = *lambda;
+            hero.terminate_secondary();
+            let estimate = self.scatter(si, &scattering, depth, potential, survival, &hero);
+            return hero_only(estimate);
+        }
+        self.scatter(si, &scattering, depth, potential, survival, lambda)
+    }
 
+    /// The direct and split indirect estimate at a vertex that survived roulette with
+    /// probability `survival`.
+    fn scatter(
+        &mut self,
+        si: &SurfaceInteraction,
+        scattering: &Scattering,
+        depth: i32,
+        potential: f32,
+        survival: f32,
+        lambda: &SampledWavelengths,
+    ) -> SampledSpectrum {
         let mut result = SampledSpectrum::ZERO;
-        if bsdf.flags().has_smooth_lobe() {
-            result += self.direct(scene, si, &sp, bsdf, wo, potential, lambda, sampler, count);
+        if scattering.flags().has_smooth_lobe() {
+            result += self.direct(si, scattering, potential, lambda);
         }
 
-        let n = self.choose_n(potential);
+        let n = self.integrator.choose_n(potential);
         let mut indirect = SampledSpectrum::ZERO;
         for _ in 0..n {
-            let u_lobe = sampler.next_1d();
-            let u = sampler.next_2d();
-            let Some(bs) = bsdf.sample(&sp, wo, u_lobe, u, lambda) else {
+            let u_lobe = self.sampler.next_1d();
+            let u = self.sampler.next_2d();
+            let Some(bs) = scattering.sample(u_lobe, u) else {
                 continue;
             };
             let specular = bs.flags.is_delta();
             let next_potential = potential * bs.weight.max_value() / (n as f32 * survival);
-            let ray = si.spawn_ray(frame.to_world(bs.wi));
-            let arriving = self.incoming(
-                scene,
-                ray,
-                depth + 1,
-                next_potential,
-                specular,
-                lambda,
-                sampler,
-                count,
-            );
+            let ray = si.spawn_ray(bs.wi);
+            let arriving = if bs.terminates_secondary && !lambda.secondary_terminated() {
+                // This direction is the hero's alone: so is what arrives along it.
+                let mut hero = *lambda;
+                hero.terminate_secondary();
+                hero_only(self.incoming(ray, depth + 1, next_potential, specular, &hero))
+            } else {
+                self.incoming(ray, depth + 1, next_potential, specular, lambda)
+            };
             indirect += bs.weight * arriving;
         }
         result += indirect * (1.0 / n as f32);
         result * (1.0 / survival)
     }
 
-    /// Direct light by shadow rays: N_l per light, over every light or one drawn by the scene's
-    /// light sampler.
-    #[allow(clippy::too_many_arguments)]
+    /// Direct light by shadow rays: N_l per light, over every light or one drawn by the light
+    /// sampler.
     fn direct(
-        &self,
-        scene: &Scene,
+        &mut self,
         si: &SurfaceInteraction,
-        sp: &ShadingPoint,
-        bsdf: &Bsdf,
-        wo: Vec3,
+        scattering: &Scattering,
         potential: f32,
         lambda: &SampledWavelengths,
-        sampler: &mut Sampler,
-        count: &mut RayCount,
     ) -> SampledSpectrum {
-        let rays = self.shadow_rays_for(potential);
+        let world = self.prepared.world;
+        let rays = self.integrator.shadow_rays_for(potential);
         let estimate_light = |light: &Light, sampler: &mut Sampler, count: &mut RayCount| {
             let mut sum = SampledSpectrum::ZERO;
             for _ in 0..rays {
                 let u_choice = sampler.next_1d();
                 let u = sampler.next_2d();
                 let Some(ls) = light.sample_incident(
-                    &scene.geometry.primitives,
+                    &world.geometry.primitives,
                     si.p,
                     si.time,
                     u_choice,
@@ -266,50 +294,28 @@ impl DistributionIntegrator {
                 ) else {
                     continue;
                 };
-                sum += self.shadow_ray(scene, si, sp, bsdf, wo, &ls, lambda, count);
+                if let Some(f) = unoccluded(world, si, scattering, &ls, count) {
+                    sum += f.value * ls.radiance * (1.0 / ls.pdf);
+                }
             }
             sum * (1.0 / rays as f32)
         };
-        match self.lights {
+        match self.integrator.lights {
             DirectLights::All => {
                 let mut total = SampledSpectrum::ZERO;
-                for light in &scene.lights {
-                    total += estimate_light(light, sampler, count);
+                for light in &world.lights {
+                    total += estimate_light(light, self.sampler, self.count);
                 }
                 total
             }
             DirectLights::One(_) => {
-                let Some((index, pmf)) = scene.light_sampler.sample(sampler.next_1d()) else {
+                let Some((index, pmf)) = self.prepared.light_sampler.sample(self.sampler.next_1d())
+                else {
                     return SampledSpectrum::ZERO;
                 };
-                estimate_light(&scene.lights[index], sampler, count) * (1.0 / pmf)
+                estimate_light(&world.lights[index], self.sampler, self.count) * (1.0 / pmf)
             }
         }
-    }
-
-    /// One shadow ray's contribution f L / p.
-    #[allow(clippy::too_many_arguments)]
-    fn shadow_ray(
-        &self,
-        scene: &Scene,
-        si: &SurfaceInteraction,
-        sp: &ShadingPoint,
-        bsdf: &Bsdf,
-        wo: Vec3,
-        ls: &LightSample,
-        lambda: &SampledWavelengths,
-        count: &mut RayCount,
-    ) -> SampledSpectrum {
-        let wi = sp.frame.to_local(ls.wi);
-        let f = bsdf.eval(sp, wo, wi, lambda);
-        if f.is_black() {
-            return SampledSpectrum::ZERO;
-        }
-        count.rays += 1;
-        if scene.geometry.occluded(&si.spawn_ray_to(ls.p, ls.n)) {
-            return SampledSpectrum::ZERO;
-        }
-        f * ls.radiance * (1.0 / ls.pdf)
     }
 }
 
@@ -324,7 +330,8 @@ mod tests {
         assert_eq!(integrator.choose_n(0.3), 1);
         assert_eq!(integrator.choose_n(0.0), 1);
         assert_eq!(integrator.shadow_rays_for(0.6), 2);
-        assert_eq!(integrator.choose_s(1.0), 1.0);
-        assert!((integrator.choose_s(0.05) - 0.5).abs() < 1e-6);
+        assert_eq!(integrator.choose_s(1.0, 0), 1.0);
+        assert!((integrator.choose_s(0.05, 0) - 0.5).abs() < 1e-6);
+        assert_eq!(integrator.choose_s(1.0, CERTAIN_SURVIVAL_DEPTH), 0.95);
     }
 }

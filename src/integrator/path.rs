@@ -28,14 +28,13 @@
 //!   wavelength from there on (`SampledWavelengths::terminate_secondary`).
 //! * Depth follows Mitsuba: the camera ray's hit is depth 0; a path of depth d has d bounces.
 
-use crate::bsdf::{Bsdf, ShadingPoint};
+use crate::bsdf::Scattering;
 use crate::geometry::SurfaceInteraction;
-use crate::integrator::RayCount;
+use crate::integrator::{PreparedIntegrator, RayCount, hero_only, unoccluded};
 use crate::light::{Light, LightSelection};
 use crate::math::Ray;
 use crate::sampling::sampler::Sampler;
-use crate::scene::Scene;
-use crate::spectrum::{N_SPECTRUM_SAMPLES, SampledSpectrum, SampledWavelengths};
+use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 
 #[derive(Clone, Debug)]
 pub struct PathIntegrator {
@@ -86,14 +85,15 @@ impl PathIntegrator {
         self.max_depth < 0 || depth + 1 < self.max_depth
     }
 
-    pub fn radiance(
+    pub(super) fn radiance(
         &self,
-        scene: &Scene,
+        prepared: &PreparedIntegrator,
         mut ray: Ray,
         wavelengths: &SampledWavelengths,
         sampler: &mut Sampler,
         count: &mut RayCount,
     ) -> SampledSpectrum {
+        let world = prepared.world;
         // The path's own copy: a dispersive interface may drop the companion wavelengths.
         let mut lambda = *wavelengths;
         let lambda_was_whole = !wavelengths.secondary_terminated();
@@ -108,32 +108,33 @@ impl PathIntegrator {
         }
         loop {
             count.rays += 1;
-            let Some(si) = scene.geometry.intersect(&ray) else {
+            let Some(si) = world.geometry.intersect(&ray) else {
                 // The ray leaves the scene: the environment's emission, weighted like an area
                 // light's against the light sample that could have found it.
-                if let Some(env) = scene.environment
+                if let Some(env) = world.environment
                     && !(self.hide_emitters && depth == 0)
                 {
-                    result += throughput * self.environment(scene, env, &ray, &previous, &lambda);
+                    result +=
+                        throughput * Self::environment(prepared, env, &ray, &previous, &lambda);
                 }
                 break;
             };
             let wo_world = -ray.d.normalize();
-            let info = scene.shape_info[si.shape as usize];
+            let info = world.shape_info[si.shape as usize];
 
             // Emission found by the previous BSDF sample (or by the camera ray).
             if let Some(light_index) = info.light
                 && !(self.hide_emitters && depth == 0)
             {
-                let Light::Area(light) = &scene.lights[light_index as usize] else {
+                let Light::Area(light) = &world.lights[light_index as usize] else {
                     unreachable!("only area lights are attached to shapes");
                 };
                 let emitted = light.emitted(si.shading.n, wo_world, &lambda);
                 if !emitted.is_black() {
                     let weight = match &previous {
                         Some(prev) if !prev.specular => {
-                            let shape = &scene.geometry.primitives[si.shape as usize];
-                            let light_pdf = scene.light_sampler.pmf(light_index as usize)
+                            let shape = &world.geometry.primitives[si.shape as usize];
+                            let light_pdf = prepared.light_sampler.pmf(light_index as usize)
                                 * shape.pdf_from(prev.interaction.p, si.time, si.p, si.n);
                             power_heuristic(prev.pdf, light_pdf)
                         }
@@ -147,40 +148,26 @@ impl PathIntegrator {
                 break;
             }
 
-            // The BSDF of the side the path arrives on, in its local frame.
-            let material = &scene.materials[info.material as usize];
-            let wo_shading = si.shading.to_local(wo_world);
-            let (bsdf, flip) = material.side(wo_shading.z);
-            let frame = if flip {
-                si.shading.flipped()
-            } else {
-                si.shading
-            };
-            let sp = ShadingPoint {
-                uv: si.uv,
-                frame,
-                ng: if si.n.dot(frame.n) < 0.0 { -si.n } else { si.n },
-                dp_du: si.dp_du,
-                dp_dv: si.dp_dv,
-            };
-            let wo = frame.to_local(wo_world);
-            let smooth = bsdf.flags().has_smooth_lobe();
+            // The BSDF of the side the path arrives on, with its textures evaluated here.
+            let scattering =
+                world.materials[info.material as usize].scattering(&si, wo_world, &lambda);
+            let smooth = scattering.flags().has_smooth_lobe();
             // A dispersive BSDF that can be evaluated uses the hero wavelength's index for all
             // its lobes (roughdielectric), so only the hero may see it.
-            if smooth && bsdf.is_dispersive() {
+            if smooth && scattering.is_dispersive() {
                 lambda.terminate_secondary();
             }
 
             // Direct light sampling.
             if smooth {
                 result += throughput
-                    * self.sample_direct(scene, &si, &sp, bsdf, wo, &lambda, sampler, count);
+                    * Self::sample_direct(prepared, &si, &scattering, &lambda, sampler, count);
             }
 
             // BSDF sampling for the next direction.
             let u_lobe = sampler.next_1d();
             let u = sampler.next_2d();
-            let Some(bs) = bsdf.sample(&sp, wo, u_lobe, u, &lambda) else {
+            let Some(bs) = scattering.sample(u_lobe, u) else {
                 break;
             };
             if bs.terminates_secondary {
@@ -191,8 +178,7 @@ impl PathIntegrator {
             if throughput.is_black() {
                 break;
             }
-            let direction = frame.to_world(bs.wi);
-            ray = si.spawn_ray(direction);
+            ray = si.spawn_ray(bs.wi);
             previous = Some(PreviousBounce {
                 interaction: si,
                 pdf: bs.pdf,
@@ -210,31 +196,25 @@ impl PathIntegrator {
             }
         }
         if lambda_was_whole && lambda.secondary_terminated() {
-            // The hero carries the whole estimate, with a quarter of its density
-            // (`terminate_secondary`); expressed for the caller's wavelengths, whose `to_xyz`
-            // divides by the full density, that is N times its radiance.
-            let mut hero_only = SampledSpectrum::ZERO;
-            hero_only[0] = result[0] * N_SPECTRUM_SAMPLES as f32;
-            return hero_only;
+            return hero_only(result);
         }
         result
     }
 
     /// The MIS-weighted radiance of environment light `env` along the escaped `ray`.
     fn environment(
-        &self,
-        scene: &Scene,
+        prepared: &PreparedIntegrator,
         env: u32,
         ray: &Ray,
         previous: &Option<PreviousBounce>,
         lambda: &SampledWavelengths,
     ) -> SampledSpectrum {
-        let light = &scene.lights[env as usize];
+        let light = &prepared.world.lights[env as usize];
         let d = ray.d.normalize();
         let emitted = light.environment_radiance(d, lambda);
         let weight = match previous {
             Some(prev) if !prev.specular && !emitted.is_black() => {
-                let light_pdf = scene.light_sampler.pmf(env as usize) * light.environment_pdf(d);
+                let light_pdf = prepared.light_sampler.pmf(env as usize) * light.environment_pdf(d);
                 power_heuristic(prev.pdf, light_pdf)
             }
             _ => 1.0,
@@ -242,29 +222,26 @@ impl PathIntegrator {
         emitted * weight
     }
 
-    /// One light sample at `si`: a light chosen ∝ power, a point on it, the shadow ray, and the
-    /// MIS-weighted contribution f·L·w / (p_light · p_choice).
-    #[allow(clippy::too_many_arguments)]
+    /// One light sample at `si`: a light chosen by the light sampler, a point on it, the shadow
+    /// ray, and the MIS-weighted contribution f·L·w / (p_light · p_choice).
     fn sample_direct(
-        &self,
-        scene: &Scene,
+        prepared: &PreparedIntegrator,
         si: &SurfaceInteraction,
-        sp: &ShadingPoint,
-        bsdf: &Bsdf,
-        wo: glam::Vec3,
+        scattering: &Scattering,
         lambda: &SampledWavelengths,
         sampler: &mut Sampler,
         count: &mut RayCount,
     ) -> SampledSpectrum {
+        let world = prepared.world;
         let u_light = sampler.next_1d();
         let u_choice = sampler.next_1d();
         let u = sampler.next_2d();
-        let Some((light_index, choice_pmf)) = scene.light_sampler.sample(u_light) else {
+        let Some((light_index, choice_pmf)) = prepared.light_sampler.sample(u_light) else {
             return SampledSpectrum::ZERO;
         };
-        let light = &scene.lights[light_index];
+        let light = &world.lights[light_index];
         let Some(ls) = light.sample_incident(
-            &scene.geometry.primitives,
+            &world.geometry.primitives,
             si.p,
             si.time,
             u_choice,
@@ -273,21 +250,15 @@ impl PathIntegrator {
         ) else {
             return SampledSpectrum::ZERO;
         };
-        let wi = sp.frame.to_local(ls.wi);
-        let f = bsdf.eval(sp, wo, wi, lambda);
-        if f.is_black() {
+        let Some(f) = unoccluded(world, si, scattering, &ls, count) else {
             return SampledSpectrum::ZERO;
-        }
-        count.rays += 1;
-        if scene.geometry.occluded(&si.spawn_ray_to(ls.p, ls.n)) {
-            return SampledSpectrum::ZERO;
-        }
+        };
         let light_pdf = choice_pmf * ls.pdf;
         let weight = if ls.is_delta {
             1.0
         } else {
-            power_heuristic(light_pdf, bsdf.pdf(sp, wo, wi, lambda))
+            power_heuristic(light_pdf, f.pdf)
         };
-        f * ls.radiance * (weight / light_pdf)
+        f.value * ls.radiance * (weight / light_pdf)
     }
 }

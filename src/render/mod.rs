@@ -29,10 +29,15 @@ use rayon::prelude::*;
 use crate::error::{Error, Result};
 pub use crate::film::stats::relative_error;
 use crate::film::{Film, FilterSampler, PixelSums};
-use crate::integrator::RayCount;
+use crate::integrator::{PreparedIntegrator, RayCount};
 use crate::sampling::sampler::Sampler;
 use crate::scene::Scene;
 use crate::spectrum::SampledWavelengths;
+
+/// Stack of each worker thread: the distribution ray tracer recurses once per bounce, with a
+/// vertex's BSDF on the stack (about 2 KiB a level), and its roulette lets long specular chains
+/// run to depths of a few hundred. Only the pages used are ever touched.
+const WORKER_STACK_BYTES: usize = 64 << 20;
 
 /// Edge length of the square tiles the image is divided into.
 const TILE_SIZE: u32 = 16;
@@ -189,40 +194,56 @@ impl Cancel<'_> {
     }
 }
 
-/// The filter-weighted CIE XYZ of sample `index` of `pixel` (full-film coordinates).
-pub fn estimate_sample(
-    scene: &Scene,
-    filter: &FilterSampler,
-    sampler: &mut Sampler,
-    pixel: UVec2,
-    index: u32,
-    count: &mut RayCount,
-) -> [f32; 3] {
-    sampler.start_pixel_sample(pixel, index);
-    let primary = sampler.camera_sample();
-    let lambda = SampledWavelengths::sample(primary.wavelength, scene.wavelength_sampling);
-    let (offset, filter_weight) = filter.sample(primary.film);
-    let (time, time_weight) = scene.shutter.sample(primary.time);
-    let film_position = pixel.as_vec2() + Vec2::splat(0.5) + offset;
-    let ray = scene.camera.generate_ray(film_position, primary.lens, time);
-    let radiance = scene
-        .integrator
-        .radiance(scene, ray, &lambda, sampler, count);
-    let weight = filter_weight * time_weight;
-    lambda.to_xyz(&radiance).map(|v| v * weight)
+/// What every camera sample of a render uses: the scene, its integrator prepared for the
+/// scene's world, and the sampler of the reconstruction filter.
+pub struct SampleEstimator<'a> {
+    scene: &'a Scene,
+    integrator: PreparedIntegrator<'a>,
+    filter: FilterSampler,
+}
+
+impl<'a> SampleEstimator<'a> {
+    pub fn new(scene: &'a Scene) -> SampleEstimator<'a> {
+        SampleEstimator {
+            scene,
+            integrator: scene.integrator.prepare(&scene.world),
+            filter: FilterSampler::new(scene.film.filter),
+        }
+    }
+
+    /// The filter-weighted CIE XYZ of sample `index` of `pixel` (full-film coordinates).
+    pub fn estimate(
+        &self,
+        sampler: &mut Sampler,
+        pixel: UVec2,
+        index: u32,
+        count: &mut RayCount,
+    ) -> [f32; 3] {
+        let scene = self.scene;
+        sampler.start_pixel_sample(pixel, index);
+        let primary = sampler.camera_sample();
+        let lambda = SampledWavelengths::sample(primary.wavelength, scene.wavelength_sampling);
+        let (offset, filter_weight) = self.filter.sample(primary.film);
+        let (time, time_weight) = scene.shutter.sample(primary.time);
+        let film_position = pixel.as_vec2() + Vec2::splat(0.5) + offset;
+        let ray = scene.camera.generate_ray(film_position, primary.lens, time);
+        let radiance = self.integrator.radiance(ray, &lambda, sampler, count);
+        let weight = filter_weight * time_weight;
+        lambda.to_xyz(&radiance).map(|v| v * weight)
+    }
 }
 
 /// Adds the samples `range` of every pixel of a tile to a copy of its sums; None when the pass
 /// was cancelled before the tile was done.
 fn render_tile(
-    scene: &Scene,
-    filter: &FilterSampler,
+    estimator: &SampleEstimator,
     tile: Tile,
     sums: &[PixelSums],
     range: Range<u32>,
     options: &RenderOptions,
     cancel: &Cancel,
 ) -> Option<(Vec<PixelSums>, u64)> {
+    let scene = estimator.scene;
     let mut sampler = Sampler::new(scene.sampler.kind, options.samples_per_pixel, options.seed);
     let mut count = RayCount::default();
     let mut pixels = sums.to_vec();
@@ -235,14 +256,7 @@ fn render_tile(
             let pixel = crop_offset + tile.origin + UVec2::new(x, y);
             let pixel_sums = &mut pixels[(y * tile.size.x + x) as usize];
             for index in range.clone() {
-                pixel_sums.add(estimate_sample(
-                    scene,
-                    filter,
-                    &mut sampler,
-                    pixel,
-                    index,
-                    &mut count,
-                ));
+                pixel_sums.add(estimator.estimate(&mut sampler, pixel, index, &mut count));
             }
         }
     }
@@ -297,7 +311,7 @@ pub fn render_with_checkpoints(
     mut checkpoints: Option<Checkpoints>,
 ) -> Result<RenderOutput> {
     let crop = scene.film.crop;
-    let filter = FilterSampler::new(scene.film.filter);
+    let estimator = SampleEstimator::new(scene);
     let tiles = tiles(crop.size);
     let pixel_count = u64::from(crop.size.x) * u64::from(crop.size.y);
     let options = RenderOptions {
@@ -307,7 +321,7 @@ pub fn render_with_checkpoints(
     let stop = options.stop;
     let in_passes = options.in_passes(checkpoints.is_some());
 
-    let mut builder = rayon::ThreadPoolBuilder::new();
+    let mut builder = rayon::ThreadPoolBuilder::new().stack_size(WORKER_STACK_BYTES);
     if let Some(threads) = options.threads {
         builder = builder.num_threads(threads);
     }
@@ -362,8 +376,7 @@ pub fn render_with_checkpoints(
                 .zip(&sums)
                 .map(|(&tile, tile_sums)| {
                     let result = render_tile(
-                        scene,
-                        &filter,
+                        &estimator,
                         tile,
                         tile_sums,
                         range.clone(),

@@ -1,5 +1,6 @@
-//! Scenes: the renderable [`Scene`], the mesh readers, and the Mitsuba XML reader and plugin
-//! factory that build it.
+//! A scene as a file describes it: the world (geometry, materials, lights), the camera and its
+//! film, the sampler, and the integrator; the Mitsuba XML reader that builds it, and the mesh
+//! readers.
 
 pub mod fingerprint;
 pub mod mesh;
@@ -7,24 +8,12 @@ pub mod mitsuba;
 
 use glam::UVec2;
 
-use crate::bsdf::Material;
 use crate::camera::{Camera, Shutter};
 use crate::film::{CropWindow, Filter};
-use crate::geometry::Geometry;
 use crate::integrator::Integrator;
-use crate::integrator::distribution::DirectLights;
-use crate::light::{BoundingSphere, Light, LightSampler, LightSelection};
 pub use crate::sampling::sampler::SamplerKind;
 use crate::spectrum::WavelengthSampling;
-
-/// What a shape is made of and whether it emits.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct ShapeInfo {
-    /// Index into [`Scene::materials`].
-    pub material: u32,
-    /// Index into [`Scene::lights`] of the area light on this shape.
-    pub light: Option<u32>,
-}
+use crate::world::World;
 
 /// Film settings: size, crop window and reconstruction filter.
 #[derive(Clone, Debug)]
@@ -43,18 +32,12 @@ pub struct SamplerSettings {
 
 /// Everything needed to render an image.
 pub struct Scene {
-    pub geometry: Geometry,
-    /// One entry per shape of `geometry`.
-    pub shape_info: Vec<ShapeInfo>,
-    pub materials: Vec<Material>,
-    pub lights: Vec<Light>,
-    pub light_sampler: LightSampler,
-    /// Index into `lights` of the environment (`constant` or `envmap`), which rays that leave
-    /// the scene see; a scene has at most one.
-    pub environment: Option<u32>,
+    pub world: World,
     pub camera: Camera,
     pub film: FilmSettings,
     pub sampler: SamplerSettings,
+    /// The estimator and its parameters; it builds its light sampler from the world when a
+    /// render starts.
     pub integrator: Integrator,
     pub wavelength_sampling: WavelengthSampling,
     /// When camera rays are taken (the sensor's shutter interval and temporal filter).
@@ -65,45 +48,17 @@ pub struct Scene {
 }
 
 impl Scene {
-    /// A scene from its parts. Lights at infinity learn the scene's bounding sphere; the light
-    /// sampler is built from the lights' powers as the integrator's light selection asks; the
-    /// first environment light (the factory allows only one) is the one escaped rays see.
-    #[allow(clippy::too_many_arguments)]
+    /// A scene from its parts, with an instantaneous shutter and the lecture's wavelength
+    /// density.
     pub fn new(
-        geometry: Geometry,
-        shape_info: Vec<ShapeInfo>,
-        materials: Vec<Material>,
-        mut lights: Vec<Light>,
+        world: World,
         camera: Camera,
         film: FilmSettings,
         sampler: SamplerSettings,
         integrator: Integrator,
     ) -> Scene {
-        let bounds = BoundingSphere::around_box(geometry.bounds());
-        for light in &mut lights {
-            light.set_scene_bounds(bounds);
-        }
-        let powers: Vec<f32> = lights
-            .iter()
-            .map(|l| l.power(&geometry.primitives))
-            .collect();
-        let selection = match &integrator {
-            Integrator::Path(path) => path.light_selection,
-            Integrator::Distribution(distrib) => match distrib.lights {
-                DirectLights::One(selection) => selection,
-                DirectLights::All => LightSelection::Power,
-            },
-        };
         Scene {
-            light_sampler: LightSampler::with_selection(&powers, selection),
-            environment: lights
-                .iter()
-                .position(Light::is_environment)
-                .map(|i| i as u32),
-            geometry,
-            shape_info,
-            materials,
-            lights,
+            world,
             camera,
             film,
             sampler,

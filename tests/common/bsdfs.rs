@@ -56,10 +56,10 @@ pub fn chi2_bsdf(bsdf: &Bsdf, wo: Vec3, seed: u64) -> Result<Chi2Outcome, String
         seed,
         |rng| {
             let u_lobe = rng.next_f32();
-            let s = bsdf.sample(&sp, wo, u_lobe, u2(rng), &lambda)?;
+            let s = bsdf.at(&sp, wo, &lambda).sample(u_lobe, u2(rng))?;
             (!s.flags.is_delta()).then_some(s.wi)
         },
-        |wi| f64::from(bsdf.pdf(&sp, wo, wi, &lambda)),
+        |wi| f64::from(bsdf.at(&sp, wo, &lambda).eval(wi).pdf),
     )
 }
 
@@ -83,7 +83,7 @@ pub fn check_samples(bsdf: &Bsdf, wo: Vec3, n: usize, seed: u64) -> SampleStats 
     let mut smooth = 0;
     for _ in 0..n {
         let u_lobe = rng.next_f32();
-        let Some(s) = bsdf.sample(&sp, wo, u_lobe, u2(&mut rng), &lambda) else {
+        let Some(s) = bsdf.at(&sp, wo, &lambda).sample(u_lobe, u2(&mut rng)) else {
             continue;
         };
         assert!(
@@ -107,14 +107,14 @@ pub fn check_samples(bsdf: &Bsdf, wo: Vec3, n: usize, seed: u64) -> SampleStats 
             continue;
         }
         smooth += 1;
-        let pdf = bsdf.pdf(&sp, wo, s.wi, &lambda);
+        let pdf = bsdf.at(&sp, wo, &lambda).eval(s.wi).pdf;
         assert!(
             (pdf - s.pdf).abs() <= 2e-3 * s.pdf + 1e-6,
             "sample pdf {} but pdf() {pdf} at wi = {} (wo = {wo})",
             s.pdf,
             s.wi
         );
-        let f = bsdf.eval(&sp, wo, s.wi, &lambda);
+        let f = bsdf.at(&sp, wo, &lambda).eval(s.wi).value;
         for c in 0..4 {
             let expected = f[c] / s.pdf;
             assert!(
@@ -159,8 +159,8 @@ pub fn assert_reciprocal(name: &str, bsdf: &Bsdf, seed: u64) {
         if a.z < 1e-3 || b.z < 1e-3 {
             continue;
         }
-        let fab = bsdf.eval(&sp, a, b, &lambda) * (1.0 / b.z);
-        let fba = bsdf.eval(&sp, b, a, &lambda) * (1.0 / a.z);
+        let fab = bsdf.at(&sp, a, &lambda).eval(b).value * (1.0 / b.z);
+        let fba = bsdf.at(&sp, b, &lambda).eval(a).value * (1.0 / a.z);
         for c in 0..4 {
             assert!(
                 (fab[c] - fba[c]).abs() <= 1e-3 * fab[c].abs().max(fba[c].abs()) + 1e-6,
@@ -183,7 +183,7 @@ pub fn integrate_eval(bsdf: &Bsdf, wo: Vec3, n_cos: usize, n_phi: usize) -> [f64
         for j in 0..n_phi {
             let phi = (j as f64 + 0.5) * 2.0 * PI / n_phi as f64;
             let wi = Vec3::new((r * phi.cos()) as f32, (r * phi.sin()) as f32, z as f32);
-            let f = bsdf.eval(&sp, wo, wi, &lambda);
+            let f = bsdf.at(&sp, wo, &lambda).eval(wi).value;
             for c in 0..4 {
                 sum[c] += f64::from(f[c]) * cell;
             }

@@ -11,8 +11,9 @@ use prism::light::{AreaLight, Light};
 use prism::math::transform::look_at;
 use prism::math::{AnimatedTransform, Transform};
 use prism::render::{RenderOptions, render};
-use prism::scene::{FilmSettings, SamplerKind, SamplerSettings, Scene, ShapeInfo};
+use prism::scene::{FilmSettings, SamplerKind, SamplerSettings, Scene};
 use prism::spectrum::Spectrum;
+use prism::world::{ShapeInfo, World};
 
 /// A shape with a one-sided diffuse material and, optionally, constant emitted radiance.
 pub struct Object {
@@ -70,10 +71,7 @@ pub fn build(
     }
     lights.extend(extra_lights);
     Scene::new(
-        Geometry::new(shapes),
-        info,
-        materials,
-        lights,
+        World::new(Geometry::new(shapes), info, materials, lights),
         camera,
         FilmSettings {
             size,

@@ -11,9 +11,9 @@ use super::textures::{
 };
 use crate::bsdf::microfacet::MicrofacetKind;
 use crate::bsdf::{
-    Blend, Bsdf, BsdfFlags, BumpMap, Conductor, Dielectric, Diffuse, Mask, Material, NormalMap,
-    Phong, Plastic, RoughConductor, RoughDielectric, RoughDiffuse, RoughPlastic, Texture,
-    ThinDielectric, TwoSided,
+    Blend, Bsdf, BsdfFlags, BsdfModel, BumpMap, Conductor, Dielectric, Diffuse, MAX_NODES, Mask,
+    Material, NormalMap, Phong, Plastic, RoughConductor, RoughDielectric, RoughDiffuse,
+    RoughPlastic, ThinDielectric, TwoSided,
 };
 use crate::error::{Error, Result};
 use crate::scene::mitsuba::description::{PluginClass, PluginNode, PropertyValue, SpectrumValue};
@@ -21,6 +21,7 @@ use crate::scene::mitsuba::params::Params;
 use crate::spectrum::conductors::CONDUCTORS;
 use crate::spectrum::ior::{Ior, NAMED_IORS, RelativeIor, named_ior, sellmeier_glass};
 use crate::spectrum::{LAMBDA_MAX, LAMBDA_MIN, PiecewiseLinear, RgbIntent, Spectrum};
+use crate::texture::Texture;
 use crate::texture::TextureUse;
 
 /// The BSDF types this factory knows.
@@ -44,28 +45,35 @@ pub const SUPPORTED_BSDFS: &[&str] = &[
 
 /// Mitsuba's default material for a shape without a BSDF: one-sided diffuse, reflectance 0.5.
 pub fn default_material() -> Material {
-    Material {
-        front: Bsdf::Diffuse(Diffuse {
-            reflectance: Texture::constant(0.5),
-        }),
-        back: None,
-    }
+    Material::new(Diffuse {
+        reflectance: Texture::constant(0.5),
+    })
 }
 
 /// Builds the material a `<bsdf>` element describes: a top-level `twosided` gives the front
 /// and back BSDFs, anything else the front one.
 pub fn build_material(node: &PluginNode, textures: &mut TextureCache) -> Result<Material> {
-    if node.plugin_type == "twosided" {
+    let material = if node.plugin_type == "twosided" {
         let (front, back) = twosided_pair(node, textures)?;
-        return Ok(Material {
+        Material {
             front,
             back: Some(back),
-        });
+        }
+    } else {
+        Material::new(build_bsdf(node, textures)?)
+    };
+    if material.node_count() > MAX_NODES {
+        return Err(Error::input(
+            &node.location,
+            format!(
+                "{} nests {} BSDFs and adapters, more than the {MAX_NODES} Prism supports",
+                node.describe(),
+                material.node_count()
+            ),
+        )
+        .with_help("flatten the nesting: blend fewer BSDFs, or wrap fewer adapters around them"));
     }
-    Ok(Material {
-        front: build_bsdf(node, textures)?,
-        back: None,
-    })
+    Ok(material)
 }
 
 /// The front and back BSDFs of a `twosided` element.

@@ -22,7 +22,8 @@ use crate::bsdf::Material;
 use crate::error::{Error, Result};
 use crate::geometry::{Geometry, Primitive};
 use crate::integrator::{Integrator, PathIntegrator};
-use crate::scene::{Scene, ShapeInfo};
+use crate::scene::Scene;
+use crate::world::{ShapeInfo, World};
 
 /// A renderable scene and the settings its file gives for rendering it.
 pub struct LoadedScene {
@@ -146,11 +147,9 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
     }
     params.finish()?;
 
+    let world = World::new(Geometry::new(shapes), shape_info, materials, lights);
     let mut scene = Scene::new(
-        Geometry::new(shapes),
-        shape_info,
-        materials,
-        lights,
+        world,
         sensor.camera,
         sensor.film,
         sensor.sampler,

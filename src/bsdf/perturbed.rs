@@ -1,0 +1,111 @@
+//! A BSDF seen in a tilted shading frame, as Mitsuba 3.9's `PerturbedBSDF` builds it for bump
+//! and normal maps (`perturbed_bsdf.h`):
+//! * with `flip_invalid_normals`, a normal that wo sees from behind is mirrored about the
+//!   shading normal, (x, y, z) ↦ (−x, −y, z), so that it faces wo (Schüssler et al. 2017,
+//!   "Microfacet-based Normal Mapping for Robust Monte Carlo Path Tracing");
+//! * the first tangent is the local x axis (the direction of ∂p/∂u) made orthogonal to it;
+//! * directions on different sides of the two frames get no light;
+//! * with `use_shadowing_function`, values are attenuated by the shadowing term of Conty
+//!   Estevez et al. 2019 ("A Microfacet-Based Shadowing Function to Solve the Bump Terminator
+//!   Problem", Ray Tracing Gems ch. 12): G = 2 / (1 + √(1 + α² tan²θi)) with
+//!   α² = min(tan²θ_n / 8, 1), θ_n the tilt of the normal and θi the light direction's angle.
+
+use glam::{Vec2, Vec3};
+
+use super::{Bsdf, BsdfEval, BsdfModel, BsdfSample, Bxdf, BxdfTree, NodeId, ShadingPoint};
+use crate::math::Frame;
+use crate::spectrum::SampledWavelengths;
+
+/// How a bump or normal map tilts the frame at a point.
+#[derive(Clone, Copy, Debug)]
+pub struct Tilt {
+    /// The new normal in the local shading frame (not necessarily of unit length).
+    pub normal: Vec3,
+    pub flip_invalid_normals: bool,
+    pub use_shadowing_function: bool,
+}
+
+/// Adds the lobes of `nested` seen in the frame tilted by `tilt` for the outgoing direction
+/// `wo`, and the node that carries directions into that frame.
+pub(crate) fn resolve_perturbed<'a>(
+    nested: &'a Bsdf,
+    tilt: Tilt,
+    point: &ShadingPoint,
+    wo: Vec3,
+    lambda: &SampledWavelengths,
+    tree: &mut BxdfTree<'a>,
+) -> NodeId {
+    let mut n = tilt.normal;
+    if tilt.flip_invalid_normals && wo.z * wo.dot(n) <= 0.0 {
+        n = Vec3::new(-n.x, -n.y, n.z);
+    }
+    let n = n.try_normalize().unwrap_or(Vec3::Z);
+    let s = (Vec3::X - n * n.x).try_normalize().unwrap_or(Vec3::Y);
+    let local = Frame {
+        s,
+        t: n.cross(s),
+        n,
+    };
+    let tilted = ShadingPoint {
+        frame: Frame {
+            s: point.frame.to_world(local.s),
+            t: point.frame.to_world(local.t),
+            n: point.frame.to_world(local.n),
+        },
+        ..*point
+    };
+    let nested = nested.resolve(&tilted, local.to_local(wo), lambda, tree);
+    tree.push(PerturbedLobes {
+        local,
+        shadowing: tilt.use_shadowing_function,
+        nested,
+    })
+}
+
+/// The nested lobes in a tilted frame.
+#[derive(Clone, Copy, Debug)]
+pub struct PerturbedLobes {
+    /// The tilted frame in the local coordinates of the original one.
+    pub local: Frame,
+    pub shadowing: bool,
+    pub nested: NodeId,
+}
+
+impl PerturbedLobes {
+    /// The shadowing term for the light direction `wi` (1 when disabled).
+    #[inline]
+    fn shadowing(&self, wi: Vec3) -> f32 {
+        if !self.shadowing {
+            return 1.0;
+        }
+        let tan2 = |v: Vec3| (1.0 - v.z * v.z).max(0.0) / (v.z * v.z);
+        let alpha2 = (0.125 * tan2(self.local.n)).min(1.0);
+        let g = 2.0 / (1.0 + (1.0 + alpha2 * tan2(wi)).sqrt());
+        if g.is_finite() { g } else { 0.0 }
+    }
+}
+
+impl Bxdf for PerturbedLobes {
+    fn eval(&self, tree: &BxdfTree, wo: Vec3, wi: Vec3) -> BsdfEval {
+        let wi_p = self.local.to_local(wi);
+        if !(wi.z * wi_p.z > 0.0) {
+            return BsdfEval::ZERO;
+        }
+        let nested = tree.eval(self.nested, self.local.to_local(wo), wi_p);
+        BsdfEval {
+            value: nested.value * self.shadowing(wi),
+            pdf: nested.pdf,
+        }
+    }
+
+    fn sample(&self, tree: &BxdfTree, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<BsdfSample> {
+        let mut s = tree.sample(self.nested, self.local.to_local(wo), u_lobe, u)?;
+        let wi = self.local.to_world(s.wi);
+        if !(wi.z * s.wi.z > 0.0) {
+            return None;
+        }
+        s.wi = wi;
+        s.weight *= self.shadowing(wi);
+        Some(s)
+    }
+}

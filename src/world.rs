@@ -1,0 +1,62 @@
+//! The world an integrator renders: the geometry, what each shape is made of, and the lights.
+//! It knows nothing of cameras, films or integrators; [`crate::scene::Scene`] adds those.
+
+use crate::bsdf::Material;
+use crate::geometry::Geometry;
+use crate::light::{BoundingSphere, Light};
+
+/// What a shape is made of and whether it emits.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ShapeInfo {
+    /// Index into [`World::materials`].
+    pub material: u32,
+    /// Index into [`World::lights`] of the area light on this shape.
+    pub light: Option<u32>,
+}
+
+/// The geometry, materials and lights of a scene.
+pub struct World {
+    pub geometry: Geometry,
+    /// One entry per primitive of `geometry`.
+    pub shape_info: Vec<ShapeInfo>,
+    pub materials: Vec<Material>,
+    pub lights: Vec<Light>,
+    /// Each light's power (see [`Light::power`]), from which integrators build their light
+    /// samplers.
+    pub light_powers: Vec<f32>,
+    /// Index into `lights` of the environment (`constant` or `envmap`), which rays that leave
+    /// the scene see; a scene has at most one.
+    pub environment: Option<u32>,
+}
+
+impl World {
+    /// A world from its parts. Lights at infinity learn the geometry's bounding sphere (before
+    /// their powers are taken, which depend on it); the first environment light (the factory
+    /// allows only one) is the one escaped rays see.
+    pub fn new(
+        geometry: Geometry,
+        shape_info: Vec<ShapeInfo>,
+        materials: Vec<Material>,
+        mut lights: Vec<Light>,
+    ) -> World {
+        let bounds = BoundingSphere::around_box(geometry.bounds());
+        for light in &mut lights {
+            light.set_scene_bounds(bounds);
+        }
+        let light_powers = lights
+            .iter()
+            .map(|l| l.power(&geometry.primitives))
+            .collect();
+        World {
+            environment: lights
+                .iter()
+                .position(Light::is_environment)
+                .map(|i| i as u32),
+            geometry,
+            shape_info,
+            materials,
+            lights,
+            light_powers,
+        }
+    }
+}
