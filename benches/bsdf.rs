@@ -18,14 +18,14 @@ use std::time::Duration;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use glam::{Vec2, Vec3};
-use prism::bsdf::{Bsdf, BsdfFlags, BsdfModel, ShadingPoint};
-use prism::sampling::rng::Pcg32;
-use prism::sampling::warp::{sample_cosine_hemisphere, sample_uniform_sphere};
-use prism::scene::mitsuba::description::PluginClass;
-use prism::scene::mitsuba::factory::materials::build_bsdf;
-use prism::scene::mitsuba::factory::textures::TextureCache;
-use prism::scene::mitsuba::reader::read_scene_str;
-use prism::spectrum::{SampledWavelengths, WavelengthSampling};
+use prism_core::bsdf::{Bsdf, BsdfFlags, BsdfModel, BxdfTree, Scattering, ShadingPoint};
+use prism_core::sampling::rng::Pcg32;
+use prism_core::sampling::warp::{sample_cosine_hemisphere, sample_uniform_sphere};
+use prism_core::spectrum::{SampledWavelengths, WavelengthSampling};
+use prism_mitsuba::description::PluginClass;
+use prism_mitsuba::factory::materials::build_bsdf;
+use prism_mitsuba::factory::textures::TextureCache;
+use prism_mitsuba::reader::read_scene_str;
 
 /// Queries per iteration.
 const QUERIES: usize = 4096;
@@ -116,7 +116,9 @@ fn bsdfs(c: &mut Criterion) {
         group.bench_function("sample", |b| {
             b.iter(|| {
                 for q in &queries {
-                    black_box(bsdf.at(&sp, q.wo, &q.lambda).sample(q.u_lobe, q.u));
+                    let mut lobes = BxdfTree::empty();
+                    let scattering = Scattering::new(&bsdf, &sp, q.wo, &q.lambda, &mut lobes);
+                    black_box(scattering.sample(q.u_lobe, q.u));
                 }
             });
         });
@@ -125,7 +127,9 @@ fn bsdfs(c: &mut Criterion) {
             group.bench_function("eval_pdf", |b| {
                 b.iter(|| {
                     for q in &queries {
-                        black_box(bsdf.at(&sp, q.wo, &q.lambda).eval(q.wi));
+                        let mut lobes = BxdfTree::empty();
+                        let scattering = Scattering::new(&bsdf, &sp, q.wo, &q.lambda, &mut lobes);
+                        black_box(scattering.eval(q.wi));
                     }
                 });
             });

@@ -21,14 +21,14 @@ use std::time::Duration;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use glam::{Vec2, Vec3};
-use prism::geometry::{Primitive, Shape};
-use prism::image::{ChannelImage, write_exr};
-use prism::light::Light;
-use prism::sampling::rng::Pcg32;
-use prism::scene::Scene;
-use prism::scene::mitsuba::factory::build_scene;
-use prism::scene::mitsuba::reader::read_scene_str;
-use prism::spectrum::{SampledWavelengths, WavelengthSampling};
+use prism_core::geometry::{Primitive, Shape};
+use prism_core::image::{ChannelImage, write_exr};
+use prism_core::light::Light;
+use prism_core::sampling::rng::Pcg32;
+use prism_core::scene::Scene;
+use prism_core::spectrum::{SampledWavelengths, WavelengthSampling};
+use prism_mitsuba::factory::build_scene;
+use prism_mitsuba::reader::read_scene_str;
 
 /// Samples per iteration.
 const POINTS: usize = 4096;

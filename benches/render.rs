@@ -1,6 +1,6 @@
 //! Full-scene throughput: the bundled Cornell box rendered at 64 × 64 pixels and 16 samples per
 //! pixel (the scene's path integrator, unbounded depth with Russian roulette, independent
-//! sampler) through [`prism::render::render`], as `prism render` does it but without writing
+//! sampler) through [`prism_core::render::render`], as `prism render` does it but without writing
 //! images. One iteration is one whole render of 65,536 camera samples; Criterion reports
 //! samples (elements) per second, once on one thread (the cost of a sample) and once on all
 //! cores (the scaling of the tile scheduler).
@@ -9,8 +9,8 @@ use std::path::Path;
 use std::time::Duration;
 
 use criterion::{Criterion, SamplingMode, Throughput, criterion_group, criterion_main};
-use prism::render::{RenderOptions, render};
-use prism::scene::mitsuba::load_scene;
+use prism_core::render::{RenderOptions, render};
+use prism_mitsuba::load_scene;
 
 const RESOLUTION: u32 = 64;
 const SPP: u32 = 16;

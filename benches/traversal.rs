@@ -1,4 +1,4 @@
-//! Ray traversal through the scene's BVH ([`prism::geometry::Geometry`]): closest-hit queries
+//! Ray traversal through the scene's BVH ([`prism_core::geometry::Geometry`]): closest-hit queries
 //! (`intersect`, which also builds the surface interaction) and shadow queries (`occluded`, any
 //! hit) per second, and the time to build the hierarchy.
 //!
@@ -25,13 +25,13 @@ use std::time::Duration;
 
 use criterion::{BatchSize, Criterion, SamplingMode, Throughput, criterion_group, criterion_main};
 use glam::{UVec2, Vec2};
-use prism::geometry::Geometry;
-use prism::math::{Frame, Ray};
-use prism::sampling::rng::Pcg32;
-use prism::sampling::warp::sample_cosine_hemisphere;
-use prism::scene::Scene;
-use prism::scene::mitsuba::load_scene;
-use prism::spectrum::{SampledWavelengths, WavelengthSampling};
+use prism_core::geometry::Geometry;
+use prism_core::math::{Frame, Ray};
+use prism_core::sampling::rng::Pcg32;
+use prism_core::sampling::warp::sample_cosine_hemisphere;
+use prism_core::scene::Scene;
+use prism_core::spectrum::{SampledWavelengths, WavelengthSampling};
+use prism_mitsuba::load_scene;
 
 /// Rays per set: GRID² (2¹⁶) camera rays, and as many bounce and shadow rays.
 const GRID: u32 = 256;

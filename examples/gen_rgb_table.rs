@@ -1,12 +1,12 @@
 //! Generates the Jakob–Hanika coefficient table shipped as `src/spectrum/srgb_to_spectrum.bin`
-//! with Prism's own fitter (`prism::spectrum::rgb`), and reports how well it reproduces colours.
+//! with Prism's own fitter (`prism_core::spectrum::rgb`), and reports how well it reproduces colours.
 //!
 //!     cargo run --release --example gen_rgb_table [-- RESOLUTION [OUTPUT]]
 //!
 //! The default resolution is `TABLE_RESOLUTION`; the default output is the shipped file.
 
-use prism::sampling::rng::Pcg32;
-use prism::spectrum::rgb::{RgbSigmoidPolynomial, RgbToSpectrumTable, TABLE_RESOLUTION};
+use prism_core::sampling::rng::Pcg32;
+use prism_core::spectrum::rgb::{RgbSigmoidPolynomial, RgbToSpectrumTable, TABLE_RESOLUTION};
 
 fn main() -> std::io::Result<()> {
     let mut args = std::env::args().skip(1);
@@ -17,7 +17,7 @@ fn main() -> std::io::Result<()> {
     let output = args.next().unwrap_or_else(|| {
         concat!(
             env!("CARGO_MANIFEST_DIR"),
-            "/src/spectrum/srgb_to_spectrum.bin"
+            "/crates/prism-core/src/spectrum/srgb_to_spectrum.bin"
         )
         .into()
     });

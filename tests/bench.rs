@@ -6,9 +6,9 @@ use std::process::Command;
 
 use glam::Vec3;
 use prism::bench::rays::{incoherent_rays, shadow_rays};
-use prism::geometry::{AggregateElement, Geometry, Shape, TriangleMesh};
-use prism::scene::Scene;
-use prism::scene::mitsuba::load_scene;
+use prism_core::geometry::{AggregateElement, Geometry, Shape, TriangleMesh};
+use prism_core::scene::Scene;
+use prism_mitsuba::load_scene;
 
 /// The number after `"key":` in a one-line JSON object.
 fn field(json: &str, key: &str) -> f64 {

@@ -188,7 +188,7 @@ fn bumpmap() {
         .map(|i| 0.5 + 0.5 * ((i % w) as f32 * 0.7).sin() * ((i / w) as f32 * 0.4).cos())
         .collect();
     let path = std::env::temp_dir().join(format!("prism-bump-{}.exr", std::process::id()));
-    let image = prism::image::ChannelImage {
+    let image = prism_core::image::ChannelImage {
         width: w,
         height: h,
         channels: ["R", "G", "B"]
@@ -196,7 +196,7 @@ fn bumpmap() {
             .map(|c| (c.to_string(), heights.clone()))
             .collect(),
     };
-    prism::image::write_exr(&path, &image).unwrap();
+    prism_core::image::write_exr(&path, &image).unwrap();
     let xml = format!(
         r#"<bsdf type="bumpmap"><texture type="bitmap"><string name="filename" value="{}"/>
             <boolean name="raw" value="true"/></texture><float name="scale" value="0.05"/>

@@ -12,7 +12,7 @@ use common::chi2::{
     chi2_sphere, regularized_gamma_q, sidak_significance,
 };
 use glam::{Vec2, Vec3};
-use prism::sampling::rng::Pcg32;
+use prism_core::sampling::rng::Pcg32;
 
 /// Samples per test, as DESIGN.md §6 asks.
 const SAMPLES: usize = 1_000_000;

@@ -9,9 +9,9 @@ mod common;
 
 use common::chi2::{assert_passes, chi2_from_counts};
 use glam::Vec2;
-use prism::camera::Shutter;
-use prism::film::{Filter, FilterSampler};
-use prism::sampling::rng::Pcg32;
+use prism_core::camera::Shutter;
+use prism_core::film::{Filter, FilterSampler};
+use prism_core::sampling::rng::Pcg32;
 
 const SAMPLES: usize = 1_000_000;
 /// Number of chi-square tests in this file, for Šidák's correction.

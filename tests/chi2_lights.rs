@@ -10,18 +10,18 @@ use std::f64::consts::PI;
 use common::chi2::{assert_passes, chi2_discrete, chi2_from_counts, chi2_rectangle};
 use common::scenes::{Object, build, camera};
 use glam::{DMat4, DVec3, Mat3, UVec2, Vec2, Vec3};
-use prism::geometry::Shape;
-use prism::geometry::Sphere;
-use prism::image::{Bitmap, Encoding};
-use prism::integrator::PathIntegrator;
-use prism::light::{
+use prism_core::geometry::Shape;
+use prism_core::geometry::Sphere;
+use prism_core::image::{Bitmap, Encoding};
+use prism_core::integrator::PathIntegrator;
+use prism_core::light::{
     AreaLight, ConstantLight, DirectionalLight, EnvironmentMap, Light, LightSelection, PointLight,
     SpotLight,
 };
-use prism::math::{Frame, Transform};
-use prism::sampling::rng::Pcg32;
-use prism::scene::mitsuba::factory::shapes::{rectangle, transform_mesh};
-use prism::spectrum::{SampledWavelengths, Spectrum};
+use prism_core::math::{Frame, Transform};
+use prism_core::sampling::rng::Pcg32;
+use prism_core::spectrum::{SampledWavelengths, Spectrum};
+use prism_mitsuba::factory::shapes::{rectangle, transform_mesh};
 
 /// Number of chi-square tests in this file, for Šidák's correction.
 const TESTS: usize = 6;
@@ -228,7 +228,7 @@ fn environment_map_sampling_follows_luminance_times_sin_theta() {
 }
 
 /// A scene with one light of every kind; returns it and the lights' closed-form powers.
-fn every_kind_of_light(selection: LightSelection) -> (prism::scene::Scene, Vec<f64>) {
+fn every_kind_of_light(selection: LightSelection) -> (prism_core::scene::Scene, Vec<f64>) {
     let size = UVec2::new(4, 4);
     let camera = camera(DVec3::new(0.0, 0.0, 5.0), DVec3::ZERO, DVec3::Y, 40.0, size);
     // A floor of 4 × 4 and a sphere light of radius 0.5 with radiance 3 above it.

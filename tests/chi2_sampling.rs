@@ -7,12 +7,12 @@ use std::f64::consts::PI;
 
 use common::chi2::{assert_passes, chi2_discrete, chi2_interval, chi2_rectangle, chi2_sphere};
 use glam::{Mat3, Vec2, Vec3};
-use prism::geometry::Sphere;
-use prism::geometry::TriangleMesh;
-use prism::light::LightSampler;
-use prism::sampling::rng::Pcg32;
-use prism::sampling::warp;
-use prism::spectrum::WavelengthSampling;
+use prism_core::geometry::Sphere;
+use prism_core::geometry::TriangleMesh;
+use prism_core::light::LightSampler;
+use prism_core::sampling::rng::Pcg32;
+use prism_core::sampling::warp;
+use prism_core::spectrum::WavelengthSampling;
 
 /// Number of chi-square tests in this file, for Šidák's correction.
 const TESTS: usize = 9;
@@ -87,7 +87,7 @@ fn wavelength_sampling_follows_the_sum_of_the_colour_matching_functions() {
     .unwrap();
     assert_passes("wavelengths p ~ x+y+z", &outcome, TESTS);
     // The tabulated density is x̄+ȳ+z̄ normalised: compare a few points with the CIE tables.
-    let sum = |l: f32| prism::spectrum::cie::cie_xyz(l).iter().sum::<f32>();
+    let sum = |l: f32| prism_core::spectrum::cie::cie_xyz(l).iter().sum::<f32>();
     let normalisation = sampling.pdf(555.5) / (0.5 * (sum(555.0) + sum(556.0)));
     for l in [400.5f32, 450.5, 600.5, 700.5] {
         let expected = 0.5 * (sum(l - 0.5) + sum(l + 0.5)) * normalisation;
@@ -180,7 +180,7 @@ fn sphere_cone_sampling_is_uniform_over_the_visible_cone() {
     let s = sphere();
     let reference = Vec3::ZERO;
     let cos_max = (1.0 - 1.0 / 9.0f64).sqrt();
-    let frame = prism::math::Frame::from_normal(Vec3::Z);
+    let frame = prism_core::math::Frame::from_normal(Vec3::Z);
     let outcome = chi2_rectangle(
         SAMPLES,
         (cos_max, 1.0),

@@ -7,7 +7,7 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use prism::image::{ChannelImage, write_exr, write_png_srgb};
+use prism_core::image::{ChannelImage, write_exr, write_png_srgb};
 
 /// A fresh folder for one test's files.
 fn folder(name: &str) -> PathBuf {

@@ -10,13 +10,13 @@ use common::scenes::{
     render_film,
 };
 use glam::{DMat4, DVec3, Mat3, UVec2, Vec2, Vec3};
-use prism::geometry::Shape;
-use prism::geometry::Sphere;
-use prism::integrator::{DistributionIntegrator, Integrator, PathIntegrator};
-use prism::light::{Light, PointLight};
-use prism::math::Transform;
-use prism::scene::mitsuba::factory::shapes::{cube, rectangle, transform_mesh};
-use prism::spectrum::Spectrum;
+use prism_core::geometry::Shape;
+use prism_core::geometry::Sphere;
+use prism_core::integrator::{DistributionIntegrator, Integrator, PathIntegrator};
+use prism_core::light::{Light, PointLight};
+use prism_core::math::Transform;
+use prism_core::spectrum::Spectrum;
+use prism_mitsuba::factory::shapes::{cube, rectangle, transform_mesh};
 
 /// The inside of a unit sphere: normals point inwards, so the inner face is the front.
 fn inner_sphere() -> Shape {
@@ -43,7 +43,7 @@ fn furnace(
     integrator: impl Into<Integrator>,
     spp: u32,
     seed: u64,
-) -> prism::film::Film {
+) -> prism_core::film::Film {
     let size = UVec2::new(8, 8);
     let camera = camera(
         DVec3::new(0.1, 0.2, -0.3),
@@ -110,7 +110,7 @@ fn distribution_ray_tracer_in_a_bright_sphere_furnace() {
 /// roulette starting at once: the same answer.
 #[test]
 fn distribution_estimator_variants_keep_the_furnace_answer() {
-    use prism::integrator::distribution::DirectLights;
+    use prism_core::integrator::distribution::DirectLights;
     let variants = [
         DistributionIntegrator {
             lights: DirectLights::All,

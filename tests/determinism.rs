@@ -4,11 +4,11 @@ mod common;
 
 use common::scenes::{Object, build, camera, render_film};
 use glam::{DMat4, DVec3, Mat3, UVec2, Vec3};
-use prism::geometry::Shape;
-use prism::geometry::Sphere;
-use prism::integrator::PathIntegrator;
-use prism::math::Transform;
-use prism::scene::mitsuba::factory::shapes::{cube, transform_mesh};
+use prism_core::geometry::Shape;
+use prism_core::geometry::Sphere;
+use prism_core::integrator::PathIntegrator;
+use prism_core::math::Transform;
+use prism_mitsuba::factory::shapes::{cube, transform_mesh};
 
 #[test]
 fn one_and_two_threads_give_identical_films() {

@@ -4,10 +4,10 @@
 
 use std::path::Path;
 
-use prism::film::stats::variance_of_mean;
-use prism::geometry::Accel;
-use prism::render::{RenderOptions, render};
-use prism::scene::mitsuba::load_scene;
+use prism_core::film::stats::variance_of_mean;
+use prism_core::geometry::Accel;
+use prism_core::render::{RenderOptions, render};
+use prism_mitsuba::load_scene;
 
 /// The image's mean luminance and the variance of that mean, for the Cornell box rendered at
 /// 64×64, 16 spp with `seed`, traced by `accel`.

@@ -8,13 +8,13 @@ use std::path::Path;
 use common::chi2::regularized_gamma_q;
 use common::scenes::{disk_light_over_plane, pixel_mean_and_variance, render_film};
 use glam::UVec2;
-use prism::film::Film;
-use prism::film::stats::variance_of_mean;
-use prism::integrator::{DistributionIntegrator, Integrator};
-use prism::scene::Scene;
-use prism::scene::mitsuba::factory::build_scene;
-use prism::scene::mitsuba::load_scene;
-use prism::scene::mitsuba::reader::read_scene_str;
+use prism_core::film::Film;
+use prism_core::film::stats::variance_of_mean;
+use prism_core::integrator::{DistributionIntegrator, Integrator};
+use prism_core::scene::Scene;
+use prism_mitsuba::factory::build_scene;
+use prism_mitsuba::load_scene;
+use prism_mitsuba::reader::read_scene_str;
 
 /// relMSE of the pixels' Y against exact values: mean of (a − b)² / (b² + 0.01).
 fn rel_mse(film: &Film, exact: &[f64]) -> f64 {

@@ -9,13 +9,13 @@ use common::scenes::{
     Object, assert_mean_luminance, build, camera, pixel_mean_and_variance, render_film,
 };
 use glam::{DMat4, DVec3, Mat3, UVec2, Vec2, Vec3};
-use prism::camera::{Camera, PerspectiveCamera, Shutter};
-use prism::film::{Film, Filter};
-use prism::geometry::{Disk, Instance, Primitive, Shape, Sphere};
-use prism::integrator::PathIntegrator;
-use prism::math::{AnimatedTransform, Transform};
-use prism::sampling::sampler::SamplerKind;
-use prism::scene::Scene;
+use prism_core::camera::{Camera, PerspectiveCamera, Shutter};
+use prism_core::film::{Film, Filter};
+use prism_core::geometry::{Disk, Instance, Primitive, Shape, Sphere};
+use prism_core::integrator::PathIntegrator;
+use prism_core::math::{AnimatedTransform, Transform};
+use prism_core::sampling::sampler::SamplerKind;
+use prism_core::scene::Scene;
 
 /// Pixels per unit of tan(angle) for a film `width` pixels wide with horizontal field of view
 /// `fov` degrees.
@@ -337,8 +337,12 @@ fn a_moving_camera_smears_a_still_emitter() {
     let (depth, radius, travel) = (4.0f64, 0.02f64, 0.6f64);
     let scale = pixels_per_tan(size.x, fov);
     let key = |x: f64| {
-        prism::math::transform::look_at(DVec3::new(x, 0.0, 0.0), DVec3::new(x, 0.0, 1.0), DVec3::Y)
-            .unwrap()
+        prism_core::math::transform::look_at(
+            DVec3::new(x, 0.0, 0.0),
+            DVec3::new(x, 0.0, 1.0),
+            DVec3::Y,
+        )
+        .unwrap()
     };
     let Camera::Perspective(still) = camera(DVec3::ZERO, DVec3::Z, DVec3::Y, fov, size);
     let moving = Camera::Perspective(PerspectiveCamera {

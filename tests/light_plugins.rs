@@ -6,13 +6,13 @@ use std::f32::consts::PI;
 use std::path::Path;
 
 use glam::{Vec2, Vec3};
-use prism::bsdf::Bsdf;
-use prism::light::{Light, LightSampler};
-use prism::scene::Scene;
-use prism::scene::mitsuba::factory::build_scene;
-use prism::scene::mitsuba::reader::read_scene_str;
-use prism::spectrum::SampledWavelengths;
-use prism::spectrum::cie::d65_normalized;
+use prism_core::bsdf::Bsdf;
+use prism_core::light::{Light, LightSampler};
+use prism_core::scene::Scene;
+use prism_core::spectrum::SampledWavelengths;
+use prism_core::spectrum::cie::d65_normalized;
+use prism_mitsuba::factory::build_scene;
+use prism_mitsuba::reader::read_scene_str;
 
 /// Builds a scene from XML placed after a minimal sensor, in `folder` (for files it names).
 fn load(folder: &Path, body: &str) -> Scene {
@@ -160,8 +160,8 @@ fn environment_map_from_a_png() {
     let folder = std::env::temp_dir().join(format!("prism-light-plugins-{}", std::process::id()));
     std::fs::create_dir_all(&folder).unwrap();
     // The linear value whose sRGB code is exactly 128, so that the 8-bit file is exact.
-    let linear = prism::image::srgb::decode(128.0 / 255.0);
-    prism::image::write_png_srgb(&folder.join("sky.png"), 4, 3, &[linear; 36]).unwrap();
+    let linear = prism_core::image::srgb::decode(128.0 / 255.0);
+    prism_core::image::write_png_srgb(&folder.join("sky.png"), 4, 3, &[linear; 36]).unwrap();
     let scene = load(
         &folder,
         r#"<emitter type="envmap"><string name="filename" value="sky.png"/><float name="scale" value="2"/></emitter>"#,

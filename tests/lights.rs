@@ -13,21 +13,21 @@ use common::scenes::{
     Object, build, camera, image_mean_and_standard_error, pixel_mean_and_variance, render_film,
 };
 use glam::{DMat4, DVec3, Mat3, UVec2, Vec2, Vec3};
-use prism::camera::Camera;
-use prism::film::Film;
-use prism::geometry::Sphere;
-use prism::geometry::{Primitive, Shape};
-use prism::image::{Bitmap, Encoding};
-use prism::integrator::{DistributionIntegrator, Integrator, PathIntegrator};
-use prism::light::{
+use prism_core::camera::Camera;
+use prism_core::film::Film;
+use prism_core::geometry::Sphere;
+use prism_core::geometry::{Primitive, Shape};
+use prism_core::image::{Bitmap, Encoding};
+use prism_core::integrator::{DistributionIntegrator, Integrator, PathIntegrator};
+use prism_core::light::{
     AreaLight, BoundingSphere, ConstantLight, DirectionalLight, EnvironmentMap, Light,
     LightSelection, PointLight, SpotLight,
 };
-use prism::math::{Ray, Transform};
-use prism::sampling::rng::Pcg32;
-use prism::sampling::warp::sample_uniform_sphere;
-use prism::scene::mitsuba::factory::shapes::{rectangle, transform_mesh};
-use prism::spectrum::{SampledWavelengths, Spectrum};
+use prism_core::math::{Ray, Transform};
+use prism_core::sampling::rng::Pcg32;
+use prism_core::sampling::warp::sample_uniform_sphere;
+use prism_core::spectrum::{SampledWavelengths, Spectrum};
+use prism_mitsuba::factory::shapes::{rectangle, transform_mesh};
 
 /// The plane z = 0, 100 × 100, diffuse `rho`, facing +z.
 fn floor(rho: f32) -> Object {
@@ -573,7 +573,7 @@ fn flux_of_lights_at_infinity() {
     let closed_form = PI * r2 * integral;
     // The map's grey is D65 of that luminance: at 550 nm the samples carry D65(550).
     let (mean, se) = flux_through_sphere(&map, &[], bounds, false, 47);
-    let d65 = f64::from(prism::spectrum::cie::d65_normalized(550.0));
+    let d65 = f64::from(prism_core::spectrum::cie::d65_normalized(550.0));
     let (mean, se) = (mean / d65, se / d65);
     assert!(se < 0.0025 * closed_form);
     assert!(

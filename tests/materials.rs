@@ -11,16 +11,16 @@ mod common;
 use std::f64::consts::PI;
 use std::path::{Path, PathBuf};
 
-use bsdfs::{bsdf_from_xml, direction, integrate_eval, point, try_bsdf_from_xml, wavelengths};
+use bsdfs::{At, bsdf_from_xml, direction, integrate_eval, point, try_bsdf_from_xml, wavelengths};
 use common::chi2::{assert_passes, chi2_discrete};
 use common::scenes::{image_mean_and_standard_error, render_film};
 use glam::{Vec2, Vec3};
-use prism::bsdf::fresnel::fresnel_conductor;
-use prism::bsdf::microfacet::{Microfacet, MicrofacetKind};
-use prism::bsdf::{Bsdf, BsdfFlags};
-use prism::sampling::rng::Pcg32;
-use prism::spectrum::SampledWavelengths;
-use prism::spectrum::conductors::CONDUCTORS;
+use prism_core::bsdf::fresnel::fresnel_conductor;
+use prism_core::bsdf::microfacet::{Microfacet, MicrofacetKind};
+use prism_core::bsdf::{Bsdf, BsdfFlags};
+use prism_core::sampling::rng::Pcg32;
+use prism_core::spectrum::SampledWavelengths;
+use prism_core::spectrum::conductors::CONDUCTORS;
 
 fn temp_dir(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("prism-materials-{}-{name}", std::process::id()));
@@ -163,7 +163,7 @@ fn smooth_dielectric_lobes() {
     .into_iter()
     .enumerate()
     {
-        let f = prism::bsdf::fresnel::fresnel_dielectric(wo.z, 1.5).reflectance;
+        let f = prism_core::bsdf::fresnel::fresnel_dielectric(wo.z, 1.5).reflectance;
         let outcome = chi2_discrete(
             100_000,
             &[f64::from(f), f64::from(1.0 - f)],
@@ -207,7 +207,7 @@ fn thin_dielectric_and_conductor_lobes() {
         r#"<bsdf type="thindielectric"><float name="int_ior" value="1.5"/><float name="ext_ior" value="1"/></bsdf>"#,
     );
     let wo = direction(45.0, 60.0);
-    let r = prism::bsdf::fresnel::fresnel_dielectric(wo.z, 1.5).reflectance;
+    let r = prism_core::bsdf::fresnel::fresnel_dielectric(wo.z, 1.5).reflectance;
     let r2 = 2.0 * r / (1.0 + r);
     let reflected = thin
         .at(&point(), wo, &wavelengths())
@@ -225,7 +225,7 @@ fn thin_dielectric_and_conductor_lobes() {
         .at(&point(), wo, &wavelengths())
         .sample(0.3, Vec2::ZERO)
         .unwrap();
-    assert_eq!(s.weight, prism::spectrum::SampledSpectrum::ONE);
+    assert_eq!(s.weight, prism_core::spectrum::SampledSpectrum::ONE);
     assert!((s.wi - Vec3::new(-wo.x, -wo.y, wo.z)).length() < 1e-6);
     assert!(
         mirror
@@ -263,9 +263,8 @@ fn furnace_scene(bsdf: &str) -> String {
 
 /// Renders `xml` and returns the image's mean luminance and its standard error.
 fn render_mean(xml: &str, spp: u32, seed: u64) -> (f64, f64) {
-    let root =
-        prism::scene::mitsuba::reader::read_scene_str(xml, Path::new("furnace.xml"), &[]).unwrap();
-    let loaded = prism::scene::mitsuba::factory::build_scene(&root).unwrap();
+    let root = prism_mitsuba::reader::read_scene_str(xml, Path::new("furnace.xml"), &[]).unwrap();
+    let loaded = prism_mitsuba::factory::build_scene(&root).unwrap();
     let film = render_film(&loaded.scene, spp, seed, None);
     image_mean_and_standard_error(&film, 1)
 }
@@ -355,7 +354,7 @@ fn textures_vary_with_uv() {
     // A 2 × 1 PNG, left texel grey, right texel red: decoded to linear and upsampled.
     let dir = temp_dir("bitmap");
     let png = dir.join("t.png");
-    prism::image::write_png_srgb(&png, 2, 1, &[0.5, 0.5, 0.5, 1.0, 0.0, 0.0]).unwrap();
+    prism_core::image::write_png_srgb(&png, 2, 1, &[0.5, 0.5, 0.5, 1.0, 0.0, 0.0]).unwrap();
     let xml = |raw: bool, filter: &str| {
         format!(
             r#"<bsdf type="diffuse"><texture type="bitmap" name="reflectance">

@@ -6,8 +6,8 @@ use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
-use prism::image::read_exr;
-use prism::sampling::rng::Pcg32;
+use prism_core::image::read_exr;
+use prism_core::sampling::rng::Pcg32;
 
 fn folder(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("prism-reliability-{}-{name}", std::process::id()));

@@ -6,5 +6,5 @@ use std::path::Path;
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {
-    let _ = prism::scene::mesh::obj::parse_obj(data, Path::new("fuzz.obj"));
+    let _ = prism_mitsuba::mesh::obj::parse_obj(data, Path::new("fuzz.obj"));
 });

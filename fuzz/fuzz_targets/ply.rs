@@ -7,5 +7,5 @@ use std::path::Path;
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {
-    let _ = prism::scene::mesh::ply::parse_ply(data, Path::new("fuzz.ply"));
+    let _ = prism_mitsuba::mesh::ply::parse_ply(data, Path::new("fuzz.ply"));
 });

@@ -7,7 +7,7 @@
 use std::path::Path;
 
 use libfuzzer_sys::fuzz_target;
-use prism::render::state::RenderState;
+use prism_core::render::state::RenderState;
 
 fuzz_target!(|data: &[u8]| {
     let path = Path::new("fuzz.state");

@@ -12,7 +12,7 @@ fuzz_target!(|data: &[u8]| {
         return;
     };
     let path = Path::new("/nonexistent-prism-fuzz/scene.xml");
-    if let Ok(root) = prism::scene::mitsuba::reader::read_scene_str(text, path, &[]) {
-        let _ = prism::scene::mitsuba::factory::build_scene(&root);
+    if let Ok(root) = prism_mitsuba::reader::read_scene_str(text, path, &[]) {
+        let _ = prism_mitsuba::factory::build_scene(&root);
     }
 });

@@ -11,7 +11,7 @@
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-use crate::error::{Error, Result};
+use prism_core::error::{Error, Result};
 
 /// Latitude bands of the generated sphere.
 const BANDS: usize = 641;

@@ -14,15 +14,15 @@ pub mod rays;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
-use crate::error::{Error, Result};
-use crate::film::write_images;
-use crate::geometry::Geometry;
-use crate::image::compare::rel_mse_rgb;
-use crate::image::read_exr;
-use crate::math::Ray;
-use crate::render::{RenderOptions, render};
-use crate::scene::Scene;
-use crate::scene::mitsuba::load_scene;
+use prism_core::error::{Error, Result};
+use prism_core::film::write_images;
+use prism_core::geometry::Geometry;
+use prism_core::image::compare::rel_mse_rgb;
+use prism_core::image::read_exr;
+use prism_core::math::Ray;
+use prism_core::render::{RenderOptions, render};
+use prism_core::scene::Scene;
+use prism_mitsuba::load_scene;
 
 /// One scene of the suite: a file and the `-D` values that set its resolution.
 #[derive(Clone, Debug)]
@@ -191,7 +191,7 @@ fn reference(
     scene: &Scene,
     bench: &BenchScene,
     options: &BenchOptions,
-) -> Result<crate::image::ChannelImage> {
+) -> Result<prism_core::image::ChannelImage> {
     // The scene's fingerprint covers its files and -D values: an edited scene gets a new one.
     let path = options.cache.join(format!(
         "{}-{:016x}-{}spp.exr",

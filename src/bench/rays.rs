@@ -12,12 +12,12 @@
 
 use glam::Vec2;
 
-use crate::geometry::SurfaceInteraction;
-use crate::math::Ray;
-use crate::sampling::rng::Pcg32;
-use crate::sampling::warp::sample_uniform_sphere;
-use crate::scene::Scene;
-use crate::spectrum::{SampledWavelengths, WavelengthSampling};
+use prism_core::geometry::SurfaceInteraction;
+use prism_core::math::Ray;
+use prism_core::sampling::rng::Pcg32;
+use prism_core::sampling::warp::sample_uniform_sphere;
+use prism_core::scene::Scene;
+use prism_core::spectrum::{SampledWavelengths, WavelengthSampling};
 
 /// `count` incoherent rays of `scene` (fewer only if camera rays never hit anything: then none).
 pub fn incoherent_rays(scene: &Scene, count: usize, seed: u64) -> Vec<Ray> {

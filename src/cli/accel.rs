@@ -4,13 +4,13 @@
 use std::str::FromStr;
 use std::sync::Arc;
 
-use crate::error::{Error, Result};
-use crate::geometry::{ExternalRayQueries, Geometry, Primitive};
+use prism_core::error::{Error, Result};
+use prism_core::geometry::{ExternalRayQueries, Geometry, Primitive};
 
 /// Which structure answers the ray queries.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Accel {
-    /// Our wide BVH ([`crate::geometry::bvh`]).
+    /// Our wide BVH ([`prism_core::geometry::bvh`]).
     #[default]
     Bvh,
     /// Embree 3's BVH (only in builds with the cargo feature `embree`).

@@ -7,7 +7,7 @@ use std::time::Duration;
 use clap::Args;
 
 use crate::bench::{BenchOptions, Measurement, measure, suite};
-use crate::error::{Error, Result};
+use prism_core::error::{Error, Result};
 
 #[derive(Args, Debug)]
 pub struct BenchArgs {

@@ -1,16 +1,16 @@
 //! `prism compare`: how two EXR images differ, channel by channel, and whether the difference is
 //! consistent with their noise.
 //!
-//! The statistics are [`crate::image::compare`]'s; this prints them, and `--diff out.png` writes
+//! The statistics are [`prism_core::image::compare`]'s; this prints them, and `--diff out.png` writes
 //! its false-colour difference image.
 
 use std::path::{Path, PathBuf};
 
 use clap::Args;
 
-use crate::error::{Error, ErrorKind, Result};
-use crate::image::compare::{compare, difference_image};
-use crate::image::{ChannelImage, read_exr, write_png_srgb};
+use prism_core::error::{Error, ErrorKind, Result};
+use prism_core::image::compare::{compare, difference_image};
+use prism_core::image::{ChannelImage, read_exr, write_png_srgb};
 
 #[derive(Args, Debug)]
 pub struct CompareArgs {

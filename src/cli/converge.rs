@@ -13,14 +13,14 @@ use std::time::Instant;
 use clap::Args;
 use plotters::prelude::*;
 
-use crate::error::{Error, Result};
-use crate::image::compare::rel_mse_rgb;
-use crate::image::read_exr;
-use crate::integrator::{DistributionIntegrator, Integrator, PathIntegrator};
-use crate::render::{RenderOptions, render};
-use crate::sampling::sampler::SamplerKind;
-use crate::scene::Scene;
-use crate::scene::mitsuba::load_scene;
+use prism_core::error::{Error, Result};
+use prism_core::image::compare::rel_mse_rgb;
+use prism_core::image::read_exr;
+use prism_core::integrator::{DistributionIntegrator, Integrator, PathIntegrator};
+use prism_core::render::{RenderOptions, render};
+use prism_core::sampling::sampler::SamplerKind;
+use prism_core::scene::Scene;
+use prism_mitsuba::load_scene;
 
 #[derive(Args, Debug)]
 pub struct ConvergeArgs {
@@ -138,7 +138,7 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
         return Err(Error::usage("--threads must be at least 1"));
     }
     let reference = read_exr(&args.reference).map_err(|mut e| {
-        e.kind = crate::error::ErrorKind::Input;
+        e.kind = prism_core::error::ErrorKind::Input;
         e
     })?;
     let mut scene = load_scene(&args.scene, &args.defines)?.scene;

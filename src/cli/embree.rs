@@ -24,10 +24,10 @@ use std::ptr;
 
 use embree::sys::*;
 
-use crate::error::{Error, Result};
-use crate::geometry::triangle::TriangleHit;
-use crate::geometry::{AggregateElement, ExternalRayQueries, Hit, Primitive};
-use crate::math::Ray;
+use prism_core::error::{Error, Result};
+use prism_core::geometry::triangle::TriangleHit;
+use prism_core::geometry::{AggregateElement, ExternalRayQueries, Hit, Primitive};
+use prism_core::math::Ray;
 
 /// Embree's "no geometry" ID (`RTC_INVALID_GEOMETRY_ID`).
 const INVALID_ID: u32 = u32::MAX;
@@ -44,7 +44,7 @@ enum Kind {
     Absent,
 }
 
-/// An Embree device and a committed scene holding all primitives of a [`crate::geometry::Geometry`].
+/// An Embree device and a committed scene holding all primitives of a [`prism_core::geometry::Geometry`].
 pub struct EmbreeScene {
     device: RTCDevice,
     scene: RTCScene,
@@ -421,11 +421,11 @@ mod tests {
 
     use super::*;
     use crate::cli::accel::Accel;
-    use crate::geometry::{Disk, Geometry, Instance, Shape, Sphere, TriangleMesh};
-    use crate::math::{AnimatedTransform, Transform};
-    use crate::sampling::rng::Pcg32;
-    use crate::sampling::warp::sample_uniform_sphere;
-    use crate::scene::mitsuba::factory::shapes::{cube, transform_mesh};
+    use prism_core::geometry::{Disk, Geometry, Instance, Shape, Sphere, TriangleMesh};
+    use prism_core::math::{AnimatedTransform, Transform};
+    use prism_core::sampling::rng::Pcg32;
+    use prism_core::sampling::warp::sample_uniform_sphere;
+    use prism_mitsuba::factory::shapes::{cube, transform_mesh};
 
     /// A bumpy latitude–longitude sphere; its pole rows are zero-area triangles.
     fn bumpy_sphere(center: Vec3, radius: f32, rings: u32, segments: u32) -> TriangleMesh {

@@ -6,11 +6,11 @@ use std::path::PathBuf;
 
 use clap::Args;
 
-use crate::error::{Error, Result};
-use crate::film::Film;
-use crate::film::stats::rejected_report;
-use crate::film::write_images;
-use crate::render::state::RenderState;
+use prism_core::error::{Error, Result};
+use prism_core::film::Film;
+use prism_core::film::stats::rejected_report;
+use prism_core::film::write_images;
+use prism_core::render::state::RenderState;
 
 #[derive(Args, Debug)]
 pub struct MergeArgs {

@@ -18,19 +18,19 @@ use clap::Args;
 use glam::UVec2;
 
 use crate::cli::accel::Accel;
-use crate::error::{Error, Result};
-use crate::film::stats::rejected_report;
-use crate::film::write_images;
-use crate::film::{CropWindow, PixelSums};
-use crate::integrator::RayCount;
-use crate::render::state::{RenderIdentity, RenderState};
-use crate::render::{
+use prism_core::error::{Error, Result};
+use prism_core::film::stats::rejected_report;
+use prism_core::film::write_images;
+use prism_core::film::{CropWindow, PixelSums};
+use prism_core::integrator::RayCount;
+use prism_core::render::state::{RenderIdentity, RenderState};
+use prism_core::render::{
     Checkpoints, RenderOptions, SampleEstimator, Snapshot, StopReason, StopRule,
     render_with_checkpoints,
 };
-use crate::sampling::sampler::{Sampler, SamplerKind};
-use crate::scene::Scene;
-use crate::scene::mitsuba::load_scene;
+use prism_core::sampling::sampler::{Sampler, SamplerKind};
+use prism_core::scene::Scene;
+use prism_mitsuba::load_scene;
 
 #[derive(Args, Debug)]
 pub struct RenderArgs {
@@ -426,7 +426,7 @@ fn resume_arguments(args: &RenderArgs) -> String {
 fn report(
     args: &RenderArgs,
     scene: &Scene,
-    output: &crate::render::RenderOutput,
+    output: &prism_core::render::RenderOutput,
     exr: &Path,
     png: &Path,
 ) {

@@ -9,9 +9,9 @@
 use std::f64::consts::PI;
 
 use glam::{Vec2, Vec3};
-use prism::bsdf::{Bsdf, ShadingPoint};
-use prism::sampling::rng::Pcg32;
-use prism::spectrum::{SampledWavelengths, WavelengthSampling};
+use prism_core::bsdf::{Bsdf, BsdfEval, BsdfSample, BxdfTree, Scattering, ShadingPoint};
+use prism_core::sampling::rng::Pcg32;
+use prism_core::spectrum::{SampledWavelengths, WavelengthSampling};
 
 use crate::common::chi2::{Chi2Outcome, chi2_sphere};
 
@@ -38,6 +38,42 @@ pub fn direction(theta_degrees: f32, phi_degrees: f32) -> Vec3 {
 
 fn u2(rng: &mut Pcg32) -> Vec2 {
     Vec2::new(rng.next_f32(), rng.next_f32())
+}
+
+/// A BSDF queried at one point, for one `wo` and wavelengths, outside a scene.
+pub struct Query<'b> {
+    bsdf: &'b Bsdf,
+    point: ShadingPoint,
+    wo: Vec3,
+    lambda: SampledWavelengths,
+}
+
+impl Query<'_> {
+    pub fn eval(&self, wi: Vec3) -> BsdfEval {
+        let mut lobes = BxdfTree::empty();
+        Scattering::new(self.bsdf, &self.point, self.wo, &self.lambda, &mut lobes).eval(wi)
+    }
+
+    pub fn sample(&self, u_lobe: f32, u: Vec2) -> Option<BsdfSample> {
+        let mut lobes = BxdfTree::empty();
+        Scattering::new(self.bsdf, &self.point, self.wo, &self.lambda, &mut lobes).sample(u_lobe, u)
+    }
+}
+
+/// `bsdf.at(point, wo, lambda)`: the BSDF's scattering at a point, for the tests.
+pub trait At {
+    fn at(&self, point: &ShadingPoint, wo: Vec3, lambda: &SampledWavelengths) -> Query<'_>;
+}
+
+impl At for Bsdf {
+    fn at(&self, point: &ShadingPoint, wo: Vec3, lambda: &SampledWavelengths) -> Query<'_> {
+        Query {
+            bsdf: self,
+            point: *point,
+            wo,
+            lambda: *lambda,
+        }
+    }
 }
 
 /// The shading point used by the tests (world frame, uv in the middle of the unit square).
@@ -154,8 +190,8 @@ pub fn assert_reciprocal(name: &str, bsdf: &Bsdf, seed: u64) {
     let (sp, lambda) = (point(), wavelengths());
     let mut rng = Pcg32::seeded(seed);
     for _ in 0..2000 {
-        let a = prism::sampling::warp::sample_cosine_hemisphere(u2(&mut rng));
-        let b = prism::sampling::warp::sample_cosine_hemisphere(u2(&mut rng));
+        let a = prism_core::sampling::warp::sample_cosine_hemisphere(u2(&mut rng));
+        let b = prism_core::sampling::warp::sample_cosine_hemisphere(u2(&mut rng));
         if a.z < 1e-3 || b.z < 1e-3 {
             continue;
         }
@@ -193,22 +229,18 @@ pub fn integrate_eval(bsdf: &Bsdf, wo: Vec3, n_cos: usize, n_phi: usize) -> [f64
 }
 
 /// The BSDF a `<bsdf>` element describes, built by the scene factory (a `twosided` wrapper
-/// becomes a [`prism::bsdf::TwoSided`]). Panics on invalid XML: the tests' own input.
+/// becomes a [`prism_core::bsdf::TwoSided`]). Panics on invalid XML: the tests' own input.
 pub fn bsdf_from_xml(xml: &str) -> Bsdf {
     try_bsdf_from_xml(xml).unwrap_or_else(|e| panic!("{e}"))
 }
 
 /// As [`bsdf_from_xml`], returning the factory's error.
-pub fn try_bsdf_from_xml(xml: &str) -> prism::error::Result<Bsdf> {
-    use prism::scene::mitsuba::description::PluginClass;
-    use prism::scene::mitsuba::factory::materials::build_bsdf;
-    use prism::scene::mitsuba::factory::textures::TextureCache;
+pub fn try_bsdf_from_xml(xml: &str) -> prism_core::error::Result<Bsdf> {
+    use prism_mitsuba::description::PluginClass;
+    use prism_mitsuba::factory::materials::build_bsdf;
+    use prism_mitsuba::factory::textures::TextureCache;
     let text = format!("<scene version=\"3.0.0\">{xml}</scene>");
-    let root = prism::scene::mitsuba::reader::read_scene_str(
-        &text,
-        std::path::Path::new("test.xml"),
-        &[],
-    )?;
+    let root = prism_mitsuba::reader::read_scene_str(&text, std::path::Path::new("test.xml"), &[])?;
     let child = root
         .children
         .iter()

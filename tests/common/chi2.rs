@@ -18,8 +18,8 @@
 use std::f64::consts::PI;
 
 use glam::Vec3;
-pub use prism::math::special::regularized_gamma_q;
-use prism::sampling::rng::Pcg32;
+pub use prism_core::math::special::regularized_gamma_q;
+use prism_core::sampling::rng::Pcg32;
 
 /// Cells expected to hold fewer samples than this are pooled (the usual rule of thumb for the
 /// chi-square approximation to hold).

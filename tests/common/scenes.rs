@@ -2,18 +2,18 @@
 //! films.
 
 use glam::{DMat4, DVec3, UVec2, Vec2};
-use prism::bsdf::{Bsdf, Diffuse, Material};
-use prism::camera::{Camera, PerspectiveCamera};
-use prism::film::{CropWindow, Film, Filter};
-use prism::geometry::{Geometry, Primitive, Shape};
-use prism::integrator::{Integrator, PathIntegrator};
-use prism::light::{AreaLight, Light};
-use prism::math::transform::look_at;
-use prism::math::{AnimatedTransform, Transform};
-use prism::render::{RenderOptions, render};
-use prism::scene::{FilmSettings, SamplerKind, SamplerSettings, Scene};
-use prism::spectrum::Spectrum;
-use prism::world::{ShapeInfo, World};
+use prism_core::bsdf::{Bsdf, Diffuse, Material};
+use prism_core::camera::{Camera, PerspectiveCamera};
+use prism_core::film::{CropWindow, Film, Filter};
+use prism_core::geometry::{Geometry, Primitive, Shape};
+use prism_core::integrator::{Integrator, PathIntegrator};
+use prism_core::light::{AreaLight, Light};
+use prism_core::math::transform::look_at;
+use prism_core::math::{AnimatedTransform, Transform};
+use prism_core::render::{RenderOptions, render};
+use prism_core::scene::{FilmSettings, SamplerKind, SamplerSettings, Scene};
+use prism_core::spectrum::Spectrum;
+use prism_core::world::{ShapeInfo, World};
 
 /// A shape with a one-sided diffuse material and, optionally, constant emitted radiance.
 pub struct Object {
@@ -52,7 +52,7 @@ pub fn build(
     for (i, object) in objects.into_iter().enumerate() {
         materials.push(Material {
             front: Bsdf::Diffuse(Diffuse {
-                reflectance: prism::texture::Texture::constant(object.reflectance),
+                reflectance: prism_core::texture::Texture::constant(object.reflectance),
             }),
             back: None,
         });
@@ -142,8 +142,8 @@ pub struct DiskOverPlane {
 }
 
 pub fn disk_light_over_plane(size: UVec2) -> DiskOverPlane {
-    use prism::geometry::Disk;
-    use prism::scene::mitsuba::factory::shapes::{rectangle, transform_mesh};
+    use prism_core::geometry::Disk;
+    use prism_mitsuba::factory::shapes::{rectangle, transform_mesh};
     let (rho, radiance, radius, height) = (0.5f64, 4.0f64, 0.5f64, 1.0f64);
     let camera = camera(
         DVec3::new(0.0, -1.2, 0.8),

@@ -1,0 +1,138 @@
+//! Materials, and the scattering at a path vertex that both integrators use.
+
+use glam::{Vec2, Vec3};
+
+use super::{Bsdf, BsdfEval, BsdfFlags, BsdfModel, BsdfSample, BxdfTree, NodeId, ShadingPoint};
+use crate::geometry::SurfaceInteraction;
+use crate::math::Frame;
+use crate::spectrum::SampledWavelengths;
+
+/// What a surface is made of: a BSDF for the front (the side of the shading normal) and, for
+/// top-level `twosided` materials, one for the back. Mitsuba's reflecting BSDFs are one-sided
+/// (black from behind) unless wrapped in `twosided`; dielectrics handle both sides themselves.
+#[derive(Clone, Debug)]
+pub struct Material {
+    pub front: Bsdf,
+    pub back: Option<Bsdf>,
+}
+
+impl Material {
+    /// A material with one BSDF for both sides (the BSDF decides what its back is).
+    pub fn new(bsdf: impl Into<Bsdf>) -> Material {
+        Material {
+            front: bsdf.into(),
+            back: None,
+        }
+    }
+
+    /// The BSDF that applies when the outgoing direction has local z-component `cos_theta_o`,
+    /// and whether the frame must be flipped to use it (back side of a two-sided material).
+    /// Without a back BSDF the front one is used from both sides: it decides what its back is.
+    #[inline]
+    pub fn side(&self, cos_theta_o: f32) -> (&Bsdf, bool) {
+        match &self.back {
+            Some(back) if cos_theta_o < 0.0 => (back, true),
+            _ => (&self.front, false),
+        }
+    }
+
+    /// The scattering at the hit `si` towards `wo` (world space, unit): the BSDF of the side
+    /// `wo` sees, in the shading frame of that side, with its textures evaluated at the hit for
+    /// the wavelengths `lambda`; its lobes are written into `tree`.
+    #[inline]
+    pub fn scattering<'t, 'm>(
+        &'m self,
+        si: &SurfaceInteraction,
+        wo: Vec3,
+        lambda: &SampledWavelengths,
+        tree: &'t mut BxdfTree<'m>,
+    ) -> Scattering<'t, 'm> {
+        let (bsdf, flip) = self.side(si.shading.to_local(wo).z);
+        let frame = if flip {
+            si.shading.flipped()
+        } else {
+            si.shading
+        };
+        let point = ShadingPoint {
+            uv: si.uv,
+            frame,
+            ng: if si.n.dot(frame.n) < 0.0 { -si.n } else { si.n },
+            dp_du: si.dp_du,
+            dp_dv: si.dp_dv,
+        };
+        Scattering::new(bsdf, &point, frame.to_local(wo), lambda, tree)
+    }
+
+    /// The most [`BxdfTree`] nodes either side takes.
+    pub fn node_count(&self) -> usize {
+        let back = self.back.as_ref().map_or(0, Bsdf::node_count);
+        self.front.node_count().max(back)
+    }
+}
+
+/// The scattering at one path vertex (pbrt-v4's `BSDF`): the lobes of a BSDF with its textures
+/// evaluated, the shading frame they work in and the outgoing direction. Directions in and out
+/// are in world space.
+pub struct Scattering<'t, 'm> {
+    /// The shading frame of the side the path arrived on.
+    pub frame: Frame,
+    /// The outgoing direction, local to `frame`.
+    pub wo: Vec3,
+    flags: BsdfFlags,
+    dispersive: bool,
+    tree: &'t BxdfTree<'m>,
+    root: NodeId,
+}
+
+impl<'t, 'm> Scattering<'t, 'm> {
+    /// The scattering of `bsdf` at `point` towards `wo` (local to `point.frame`), its lobes
+    /// written into `tree` (whatever it held before is dropped). Tests and benchmarks query
+    /// BSDFs outside a scene this way, at [`ShadingPoint::local`].
+    #[inline]
+    pub fn new(
+        bsdf: &'m Bsdf,
+        point: &ShadingPoint,
+        wo: Vec3,
+        lambda: &SampledWavelengths,
+        tree: &'t mut BxdfTree<'m>,
+    ) -> Scattering<'t, 'm> {
+        tree.clear();
+        let root = bsdf.resolve(point, wo, lambda, tree);
+        Scattering {
+            frame: point.frame,
+            wo,
+            flags: bsdf.flags(),
+            dispersive: bsdf.is_dispersive(),
+            tree,
+            root,
+        }
+    }
+
+    /// The union of the BSDF's lobes' flags.
+    #[inline]
+    pub fn flags(&self) -> BsdfFlags {
+        self.flags
+    }
+
+    /// Whether some index of refraction of the BSDF varies with wavelength (see
+    /// [`BsdfSample::terminates_secondary`]).
+    #[inline]
+    pub fn is_dispersive(&self) -> bool {
+        self.dispersive
+    }
+
+    /// f(wo, wi)·|cos θi| of the smooth lobes and the density of sampling `wi` (world space).
+    #[inline]
+    pub fn eval(&self, wi: Vec3) -> BsdfEval {
+        self.tree.eval(self.root, self.wo, self.frame.to_local(wi))
+    }
+
+    /// Draws an incident direction: `u_lobe` chooses a lobe, `u` the direction within it; the
+    /// sample's `wi` is in world space.
+    #[inline]
+    pub fn sample(&self, u_lobe: f32, u: Vec2) -> Option<BsdfSample> {
+        let mut s = self.tree.sample(self.root, self.wo, u_lobe, u)?;
+        s.wi = self.frame.to_world(s.wi);
+        Some(s)
+    }
+}

@@ -1,0 +1,435 @@
+//! Scattering at surfaces: the BSDF interface, Mitsuba's BSDFs, and materials that choose a BSDF
+//! for each side of a surface.
+//!
+//! # Two forms of a BSDF
+//! A scene describes a BSDF by its parameters, any of which may vary over the surface
+//! ([`Bsdf`], whose variants implement [`BsdfModel`]). At a path vertex the material evaluates
+//! those textures once, at the hit and for the path's wavelengths, and gets the lobes there: a
+//! small tree of [`Bxdf`]s in fixed storage ([`BxdfTree`]; adapters such as `mask` and
+//! `blendbsdf` are inner nodes). [`Scattering`] holds that tree with its shading frame and the
+//! outgoing direction; both integrators evaluate and sample only through it (pbrt-v4's
+//! `GetBSDF`, Pharr et al. 2023, §10.5).
+//!
+//! # Conventions
+//! BSDFs work in the local shading frame (normal = +z). Following pbrt's naming, `wo` points
+//! towards where the light goes (the camera side of the path) and `wi` towards where it comes
+//! from; both point away from the surface. `eval` returns f(wo, wi)·|cos θi| (the cosine is part
+//! of the BSDF's value, as in Mitsuba 3) together with the density of sampling `wi`, and
+//! `sample` returns the value divided by its pdf.
+//!
+//! The lecture's "Importance Sampling of the Reflection Integral" splits a BRDF into diffuse,
+//! glossy and mirror parts and adapts the sampling to each: every BSDF here is a sum of lobes
+//! with [`BsdfFlags`] saying which kind each is. `sample` first picks a lobe with a probability
+//! proportional to an estimate of that lobe's albedo for the given `wo` (the `u_lobe` number),
+//! then a direction within it. Smooth lobes (diffuse, glossy) have a density and can be
+//! evaluated, so they take part in light sampling and multiple importance sampling; delta lobes
+//! (specular mirror and refraction, and the "null" pass-through of `mask` and `thindielectric`)
+//! can only be sampled, and their `pdf` is the probability of choosing them. For a sample of a
+//! smooth lobe the returned pdf and weight are those of the whole BSDF (all smooth lobes'
+//! densities summed), so that MIS sees the density the direction was really drawn with.
+//!
+//! # Adding a BSDF
+//! Write one file with the description (implementing [`BsdfModel`]) and its lobes
+//! (implementing [`Bxdf`]), add its two types to the `bsdfs!` lists below, and register its
+//! plugin and parameters with the scene reader (docs/architecture.md).
+//!
+//! | plugin | file | lobes |
+//! | --- | --- | --- |
+//! | `diffuse` | [`diffuse`] | diffuse reflection |
+//! | `roughdiffuse` | [`roughdiffuse`] | diffuse reflection (Oren–Nayar) |
+//! | `conductor` | [`conductor`] | specular reflection |
+//! | `roughconductor` | [`roughconductor`] | glossy reflection |
+//! | `dielectric` | [`dielectric`] | specular reflection and transmission |
+//! | `roughdielectric` | [`roughdielectric`] | glossy reflection and transmission |
+//! | `thindielectric` | [`thindielectric`] | specular reflection, null transmission |
+//! | `plastic` | [`plastic`] | specular and diffuse reflection |
+//! | `roughplastic` | [`roughplastic`] | glossy and diffuse reflection |
+//! | `phong` | [`phong`] | glossy and diffuse reflection |
+//! | `twosided` | [`twosided`] | those of the nested BSDFs, on both sides |
+//! | `mask` | [`mask`] | the nested BSDF's, and null transmission |
+//! | `blendbsdf` | [`blend`] | both nested BSDFs' |
+//! | `bumpmap`, `normalmap` | [`bumpmap`], [`normalmap`] | the nested BSDF's, in a perturbed frame |
+
+pub mod blend;
+pub mod bumpmap;
+pub mod conductor;
+pub mod dielectric;
+pub mod diffuse;
+pub mod fresnel;
+pub mod mask;
+pub mod material;
+pub mod microfacet;
+pub mod normalmap;
+pub mod perturbed;
+pub mod phong;
+pub mod plastic;
+pub mod roughconductor;
+pub mod roughdielectric;
+pub mod roughdiffuse;
+pub mod roughplastic;
+pub mod thindielectric;
+pub mod twosided;
+
+use arrayvec::ArrayVec;
+use glam::{Vec2, Vec3};
+
+pub use blend::Blend;
+pub use bumpmap::BumpMap;
+pub use conductor::Conductor;
+pub use dielectric::Dielectric;
+pub use diffuse::Diffuse;
+pub use mask::Mask;
+pub use material::{Material, Scattering};
+pub use normalmap::NormalMap;
+pub use phong::Phong;
+pub use plastic::Plastic;
+pub use roughconductor::RoughConductor;
+pub use roughdielectric::RoughDielectric;
+pub use roughdiffuse::RoughDiffuse;
+pub use roughplastic::RoughPlastic;
+pub use thindielectric::ThinDielectric;
+pub use twosided::TwoSided;
+
+use crate::math::Frame;
+use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+
+/// Which kind of lobe a sample or BSDF has (the lecture's split into diffuse, glossy and mirror
+/// parts) and whether it reflects or transmits.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct BsdfFlags(u8);
+
+impl BsdfFlags {
+    pub const DIFFUSE: BsdfFlags = BsdfFlags(1);
+    pub const GLOSSY: BsdfFlags = BsdfFlags(2);
+    /// A Dirac delta lobe (mirror or clear glass): cannot be evaluated, only sampled.
+    pub const SPECULAR: BsdfFlags = BsdfFlags(4);
+    /// Light passing straight through, unchanged in direction (Mitsuba's `Null`: the transparent
+    /// part of `mask`, the transmission of `thindielectric`); a delta lobe too.
+    pub const NULL: BsdfFlags = BsdfFlags(32);
+    pub const REFLECTION: BsdfFlags = BsdfFlags(8);
+    pub const TRANSMISSION: BsdfFlags = BsdfFlags(16);
+
+    pub const fn union(self, other: BsdfFlags) -> BsdfFlags {
+        BsdfFlags(self.0 | other.0)
+    }
+
+    pub const fn contains(self, other: BsdfFlags) -> bool {
+        self.0 & other.0 == other.0
+    }
+
+    /// Whether some lobe can be evaluated (is not a delta), so light sampling can help.
+    pub const fn has_smooth_lobe(self) -> bool {
+        self.0 & (BsdfFlags::DIFFUSE.0 | BsdfFlags::GLOSSY.0) != 0
+    }
+
+    /// Whether this is (or includes) a delta lobe: specular or null.
+    pub const fn is_delta(self) -> bool {
+        self.0 & (BsdfFlags::SPECULAR.0 | BsdfFlags::NULL.0) != 0
+    }
+}
+
+/// A direction drawn by a BSDF.
+#[derive(Clone, Copy, Debug)]
+pub struct BsdfSample {
+    /// The sampled direction: in the local frame when a [`Bxdf`] returns it, in world space when
+    /// [`Scattering::sample`] does.
+    pub wi: Vec3,
+    /// f(wo, wi)·|cos θi| / pdf.
+    pub weight: SampledSpectrum,
+    /// Density per unit solid angle (for a delta lobe: the probability of choosing it).
+    pub pdf: f32,
+    /// The lobe that produced the sample.
+    pub flags: BsdfFlags,
+    /// Relative index of refraction along the path (η_t/η_i when refracting, 1 otherwise), for
+    /// Russian roulette (Mitsuba's `bs.eta`).
+    pub eta: f32,
+    /// Whether the direction is right for the hero wavelength only (refraction through a
+    /// dispersive interface): the path must then drop its other wavelengths.
+    pub terminates_secondary: bool,
+}
+
+impl BsdfSample {
+    /// A sample with η = 1 that does not disperse.
+    #[inline]
+    pub fn new(wi: Vec3, weight: SampledSpectrum, pdf: f32, flags: BsdfFlags) -> BsdfSample {
+        BsdfSample {
+            wi,
+            weight,
+            pdf,
+            flags,
+            eta: 1.0,
+            terminates_secondary: false,
+        }
+    }
+}
+
+/// The value of a BSDF for a pair of directions, f(wo, wi)·|cos θi| over its smooth lobes, and
+/// the density with which sampling from `wo` returns `wi`: what light sampling and multiple
+/// importance sampling need, computed together.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BsdfEval {
+    pub value: SampledSpectrum,
+    pub pdf: f32,
+}
+
+impl BsdfEval {
+    /// No light and no density: the value of every delta lobe, and of directions a BSDF does not
+    /// scatter into.
+    pub const ZERO: BsdfEval = BsdfEval {
+        value: SampledSpectrum::ZERO,
+        pdf: 0.0,
+    };
+}
+
+/// For a BSDF that is a mixture of lobes: the sample of one smooth lobe turned into a sample of
+/// the whole mixture, whose density at `wi` is `pdf` and whose value there is `value`.
+#[inline]
+pub(crate) fn mixture_sample(
+    wi: Vec3,
+    value: SampledSpectrum,
+    pdf: f32,
+    flags: BsdfFlags,
+) -> Option<BsdfSample> {
+    if !(pdf > 0.0) || !pdf.is_finite() {
+        return None;
+    }
+    Some(BsdfSample::new(wi, value * (1.0 / pdf), pdf, flags))
+}
+
+/// The surface point a BSDF's textures are evaluated at: texture coordinates, and the local
+/// geometry for the BSDFs that perturb the shading frame (bump and normal maps).
+#[derive(Clone, Copy, Debug)]
+pub struct ShadingPoint {
+    pub uv: Vec2,
+    /// The shading frame that the local directions refer to (world space).
+    pub frame: Frame,
+    /// The geometric normal, on the side of `frame.n`.
+    pub ng: Vec3,
+    /// ∂p/∂u and ∂p/∂v (world space, not normalised).
+    pub dp_du: Vec3,
+    pub dp_dv: Vec3,
+}
+
+impl ShadingPoint {
+    /// A point whose shading frame is the world frame (for tests and BSDF queries out of scene
+    /// context).
+    pub fn local(uv: Vec2) -> ShadingPoint {
+        ShadingPoint {
+            uv,
+            frame: Frame {
+                s: Vec3::X,
+                t: Vec3::Y,
+                n: Vec3::Z,
+            },
+            ng: Vec3::Z,
+            dp_du: Vec3::X,
+            dp_dv: Vec3::Y,
+        }
+    }
+}
+
+/// A BSDF as a scene describes it: parameters that may be textures.
+pub trait BsdfModel {
+    /// The union of the lobes' flags.
+    fn flags(&self) -> BsdfFlags;
+    /// Whether some index of refraction varies with wavelength, so that refracted directions
+    /// depend on it (see [`BsdfSample::terminates_secondary`]).
+    fn is_dispersive(&self) -> bool;
+    /// The nodes its lobes take in a [`BxdfTree`] (1 for a BSDF that nests none).
+    fn node_count(&self) -> usize;
+    /// Evaluates the textures at `point` for the wavelengths `lambda` and adds the lobes there
+    /// to `tree`, for the outgoing direction `wo` (local to `point.frame`), which adapters need
+    /// to choose a side or tilt a frame. Returns the index of the node added last, its root.
+    fn resolve<'a>(
+        &'a self,
+        point: &ShadingPoint,
+        wo: Vec3,
+        lambda: &SampledWavelengths,
+        tree: &mut BxdfTree<'a>,
+    ) -> NodeId;
+}
+
+/// A BSDF's lobes at one point for one path's wavelengths, in the local frame. Adapters reach
+/// the lobes they nest through `tree`; other BSDFs ignore it.
+pub trait Bxdf {
+    /// f(wo, wi)·|cos θi| of the smooth lobes and the density of sampling `wi`. A BSDF made only
+    /// of delta lobes keeps this default: nothing to evaluate.
+    fn eval(&self, tree: &BxdfTree, wo: Vec3, wi: Vec3) -> BsdfEval {
+        let _ = (tree, wo, wi);
+        BsdfEval::ZERO
+    }
+    /// Draws `wi` given `wo`: `u_lobe` chooses a lobe, `u` the direction within it.
+    fn sample(&self, tree: &BxdfTree, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<BsdfSample>;
+}
+
+/// Index of a node in a [`BxdfTree`].
+pub type NodeId = u8;
+
+/// The most nodes a BSDF's lobes may take (a BSDF and the adapters around it); the scene reader
+/// refuses BSDFs nested deeper.
+pub const MAX_NODES: usize = 16;
+
+/// The lobes of one vertex: the nodes of a tree in fixed storage, children before parents, so
+/// that a vertex allocates nothing. An integrator keeps one per vertex it holds at once (the
+/// path tracer one per path, reused at every bounce; the distribution ray tracer one per level
+/// of its recursion), so the lobes are written where they are used and never copied.
+pub struct BxdfTree<'a> {
+    nodes: ArrayVec<Node<'a>, MAX_NODES>,
+}
+
+impl<'a> BxdfTree<'a> {
+    /// A tree without nodes, to be filled by [`BsdfModel::resolve`].
+    #[inline]
+    pub fn empty() -> BxdfTree<'a> {
+        BxdfTree {
+            nodes: ArrayVec::new(),
+        }
+    }
+
+    /// Removes every node.
+    #[inline]
+    pub fn clear(&mut self) {
+        self.nodes.clear();
+    }
+
+    /// Adds a node; its index. The scene reader keeps BSDFs within [`MAX_NODES`].
+    #[inline]
+    pub fn push(&mut self, node: impl Into<Node<'a>>) -> NodeId {
+        self.nodes.push(node.into());
+        (self.nodes.len() - 1) as NodeId
+    }
+
+    /// [`Bxdf::eval`] of node `id`.
+    #[inline]
+    pub fn eval(&self, id: NodeId, wo: Vec3, wi: Vec3) -> BsdfEval {
+        self.nodes[id as usize].eval(self, wo, wi)
+    }
+
+    /// [`Bxdf::sample`] of node `id`.
+    #[inline]
+    pub fn sample(&self, id: NodeId, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<BsdfSample> {
+        self.nodes[id as usize].sample(self, wo, u_lobe, u)
+    }
+}
+
+/// Declares the BSDFs: the description enum [`Bsdf`], one variant per plugin, and the lobe enum
+/// [`Node`], one variant per kind of lobes (bump and normal maps share theirs), dispatched to
+/// [`BsdfModel`] and [`Bxdf`] by `match` (no dynamic dispatch in the hot path, DESIGN.md §3.1).
+macro_rules! bsdfs {
+    (
+        descriptions { $($variant:ident($model:ty),)+ }
+        lobes { $($node:ident($lobes:ty),)+ }
+    ) => {
+        /// A BSDF as the scene describes it (one side of a surface, unless it is two-sided by
+        /// nature, as dielectrics are).
+        #[derive(Clone, Debug)]
+        pub enum Bsdf {
+            $($variant($model),)+
+        }
+
+        impl BsdfModel for Bsdf {
+            #[inline]
+            fn flags(&self) -> BsdfFlags {
+                match self {
+                    $(Bsdf::$variant(b) => b.flags(),)+
+                }
+            }
+
+            #[inline]
+            fn is_dispersive(&self) -> bool {
+                match self {
+                    $(Bsdf::$variant(b) => b.is_dispersive(),)+
+                }
+            }
+
+            fn node_count(&self) -> usize {
+                match self {
+                    $(Bsdf::$variant(b) => b.node_count(),)+
+                }
+            }
+
+            #[inline]
+            fn resolve<'a>(
+                &'a self,
+                point: &ShadingPoint,
+                wo: Vec3,
+                lambda: &SampledWavelengths,
+                tree: &mut BxdfTree<'a>,
+            ) -> NodeId {
+                match self {
+                    $(Bsdf::$variant(b) => b.resolve(point, wo, lambda, tree),)+
+                }
+            }
+        }
+
+        $(impl From<$model> for Bsdf {
+            fn from(bsdf: $model) -> Bsdf {
+                Bsdf::$variant(bsdf)
+            }
+        })+
+
+        /// One node of a [`BxdfTree`]: a BSDF's lobes with their textures evaluated.
+        #[derive(Clone, Copy, Debug)]
+        pub enum Node<'a> {
+            $($node($lobes),)+
+        }
+
+        impl Bxdf for Node<'_> {
+            #[inline]
+            fn eval(&self, tree: &BxdfTree, wo: Vec3, wi: Vec3) -> BsdfEval {
+                match self {
+                    $(Node::$node(b) => b.eval(tree, wo, wi),)+
+                }
+            }
+
+            #[inline]
+            fn sample(&self, tree: &BxdfTree, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<BsdfSample> {
+                match self {
+                    $(Node::$node(b) => b.sample(tree, wo, u_lobe, u),)+
+                }
+            }
+        }
+
+        $(impl<'a> From<$lobes> for Node<'a> {
+            fn from(lobes: $lobes) -> Node<'a> {
+                Node::$node(lobes)
+            }
+        })+
+    };
+}
+
+bsdfs! {
+    descriptions {
+        Diffuse(Diffuse),
+        RoughDiffuse(RoughDiffuse),
+        Conductor(Conductor),
+        RoughConductor(RoughConductor),
+        Dielectric(Dielectric),
+        RoughDielectric(RoughDielectric),
+        ThinDielectric(ThinDielectric),
+        Plastic(Plastic),
+        RoughPlastic(RoughPlastic),
+        Phong(Phong),
+        TwoSided(TwoSided),
+        Mask(Mask),
+        Blend(Blend),
+        BumpMap(BumpMap),
+        NormalMap(NormalMap),
+    }
+    lobes {
+        Diffuse(diffuse::DiffuseLobes),
+        RoughDiffuse(roughdiffuse::RoughDiffuseLobes),
+        Conductor(conductor::ConductorLobes),
+        RoughConductor(roughconductor::RoughConductorLobes),
+        Dielectric(dielectric::DielectricLobes),
+        RoughDielectric(roughdielectric::RoughDielectricLobes),
+        ThinDielectric(thindielectric::ThinDielectricLobes),
+        Plastic(plastic::PlasticLobes<'a>),
+        RoughPlastic(roughplastic::RoughPlasticLobes<'a>),
+        Phong(phong::PhongLobes),
+        BackSide(twosided::BackSideLobes),
+        Mask(mask::MaskLobes),
+        Blend(blend::BlendLobes),
+        Perturbed(perturbed::PerturbedLobes),
+    }
+}

@@ -1,0 +1,52 @@
+//! Prism's renderer: spectral Monte Carlo light transport, independent of any scene format.
+//!
+//! # The pipeline
+//! A [`scene::Scene`] holds the [`world::World`] (primitives in a BVH, what each is made of,
+//! the lights), the camera and film, the sampler and the integrator. The render driver
+//! ([`render`]) renders the image in passes of tiles on all cores; for each pixel sample it asks
+//! the per-pixel sampler for the primary dimensions (wavelengths, time, filter offset, lens
+//! position), builds a camera ray, and asks the integrator for the spectral radiance along it.
+//! The film converts each sample to CIE XYZ and accumulates sums and squared sums per pixel; at
+//! the end the image is written as EXR (linear) and PNG (sRGB).
+//!
+//! # Modules, lowest layer first
+//! Each module uses only those above it in this table (a test checks it; see
+//! docs/architecture.md).
+//!
+//! | module | concept |
+//! | --- | --- |
+//! | [`error`] | errors with source locations |
+//! | [`math`] | vectors, frames, transforms, rays, special functions |
+//! | [`sampling`] | random numbers, warps, tabulated distributions, the per-pixel sampler |
+//! | [`spectrum`] | wavelengths and spectral values along a path, CIE tables, RGB upsampling |
+//! | [`image`] | image files: decoding, EXR and PNG output, the sRGB curve, comparison |
+//! | [`geometry`] | shapes, intersection, the BVH, instances, the scene's primitives |
+//! | [`texture`] | values that vary over a surface |
+//! | [`bsdf`] | BSDFs, their lobes at a point, materials |
+//! | [`light`] | light sources and the light sampler |
+//! | [`world`] | geometry, materials and lights together |
+//! | [`camera`] | the thin-lens perspective camera and the shutter |
+//! | [`film`] | reconstruction filters, pixel sums and their error, the images written |
+//! | [`integrator`] | the path tracer and the lecture's distribution ray tracer |
+//! | [`scene`] | the world with camera, film, sampler and integrator |
+//! | [`render`] | passes, tiles, threads, progress, render states |
+
+// Comparisons are written `!(x > 0.0)` on purpose throughout: unlike `x <= 0.0` they also
+// reject NaN, which is what a renderer's guards are for.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
+pub mod bsdf;
+pub mod camera;
+pub mod error;
+pub mod film;
+pub mod geometry;
+pub mod image;
+pub mod integrator;
+pub mod light;
+pub mod math;
+pub mod render;
+pub mod sampling;
+pub mod scene;
+pub mod spectrum;
+pub mod texture;
+pub mod world;

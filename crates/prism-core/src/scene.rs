@@ -1,0 +1,66 @@
+//! A scene as a file describes it: the world (geometry, materials, lights), the camera and its
+//! film, the sampler, and the integrator.
+
+use glam::UVec2;
+
+use crate::camera::{Camera, Shutter};
+use crate::film::{CropWindow, Filter};
+use crate::integrator::Integrator;
+pub use crate::sampling::sampler::SamplerKind;
+use crate::spectrum::WavelengthSampling;
+use crate::world::World;
+
+/// Film settings: size, crop window and reconstruction filter.
+#[derive(Clone, Debug)]
+pub struct FilmSettings {
+    pub size: UVec2,
+    pub crop: CropWindow,
+    pub filter: Filter,
+}
+
+/// Which per-pixel sampler to use and how many samples per pixel.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SamplerSettings {
+    pub kind: SamplerKind,
+    pub samples_per_pixel: u32,
+}
+
+/// Everything needed to render an image.
+pub struct Scene {
+    pub world: World,
+    pub camera: Camera,
+    pub film: FilmSettings,
+    pub sampler: SamplerSettings,
+    /// The estimator and its parameters; it builds its light sampler from the world when a
+    /// render starts.
+    pub integrator: Integrator,
+    pub wavelength_sampling: WavelengthSampling,
+    /// When camera rays are taken (the sensor's shutter interval and temporal filter).
+    pub shutter: Shutter,
+    /// Hash of the scene's description and the files it loads, which render states record so
+    /// that a resumed render is of the same scene; 0 for scenes built in code.
+    pub fingerprint: u64,
+}
+
+impl Scene {
+    /// A scene from its parts, with an instantaneous shutter and the lecture's wavelength
+    /// density.
+    pub fn new(
+        world: World,
+        camera: Camera,
+        film: FilmSettings,
+        sampler: SamplerSettings,
+        integrator: Integrator,
+    ) -> Scene {
+        Scene {
+            world,
+            camera,
+            film,
+            sampler,
+            integrator,
+            wavelength_sampling: WavelengthSampling::default(),
+            shutter: Shutter::instant(),
+            fingerprint: 0,
+        }
+    }
+}
