@@ -22,6 +22,8 @@ enum Command {
     Merge(prism::cli::merge::MergeArgs),
     /// Run the benchmark suite: BVH build, memory, rays/s, samples/s and efficiency per scene.
     Bench(prism::cli::bench::BenchArgs),
+    /// List the plugins scene files may use, and their parameters.
+    Plugins(prism::cli::plugins::PluginsArgs),
 }
 
 fn main() {
@@ -32,6 +34,7 @@ fn main() {
         Command::Converge(args) => prism::cli::converge::run(&args),
         Command::Merge(args) => prism::cli::merge::run(&args),
         Command::Bench(args) => prism::cli::bench::run(&args),
+        Command::Plugins(args) => prism::cli::plugins::run(&args),
     };
     if let Err(error) = result {
         eprintln!("error: {error}");

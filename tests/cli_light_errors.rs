@@ -201,7 +201,7 @@ fn bad_blackbody_temperature() {
     assert_error(
         &dir,
         "scene.xml:9:9",
-        &["spectrum \"d65\"", "not supported"],
+        &["unknown spectrum type \"d65\"", "blackbody"],
     );
 }
 

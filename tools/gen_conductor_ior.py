@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
-"""Writes src/spectrum/conductors.rs: the complex indices of refraction (eta, k) of Mitsuba's
+"""Writes crates/prism-core/src/spectrum/conductors.rs: the complex indices of refraction (eta, k) of Mitsuba's
 named conductor presets, from the .spd files Mitsuba 3 ships in resources/data/ior (the
-mitsuba-data repository; the Python wheel installs them under mitsuba/data/ior).
+mitsuba-data repository; the Python wheel installs them under mitsuba/data/ior). A preset whose
+data equals another's (most `*_palik` files repeat their base material) becomes an alias of it.
 
 usage: tools/gen_conductor_ior.py [DIR_WITH_SPD_FILES]
 
@@ -14,7 +15,7 @@ import sys
 default = os.path.expanduser(
     "~/.cache/prism-peers/venv/lib/python3.11/site-packages/mitsuba/data/ior")
 src = sys.argv[1] if len(sys.argv) > 1 else default
-out = os.path.join(os.path.dirname(__file__), "..", "src", "spectrum", "conductors.rs")
+out = os.path.join(os.path.dirname(__file__), "..", "crates", "prism-core", "src", "spectrum", "conductors.rs")
 
 
 def f32(x):
@@ -41,6 +42,22 @@ def read(path):
 
 
 names = sorted(os.path.basename(p)[: -len(".eta.spd")] for p in glob.glob(os.path.join(src, "*.eta.spd")))
+data = {}
+for name in names:
+    eta = read(os.path.join(src, name + ".eta.spd"))
+    k = read(os.path.join(src, name + ".k.spd"))
+    assert [a for a, _ in eta] == [a for a, _ in k], name
+    data[name] = [(lam, e, kk) for (lam, e), (_, kk) in zip(eta, k)]
+# Shorter names first, so that "Cu" is the table and "Cu_palik" its alias.
+aliases = {}
+tables = []
+for name in sorted(names, key=lambda n: (len(n), n)):
+    same = next((t for t in tables if data[t] == data[name]), None)
+    if same is None:
+        tables.append(name)
+    else:
+        aliases[name] = same
+tables.sort()
 lines = [
     "//! Complex indices of refraction η + ik of Mitsuba's named conductor presets",
     "//! (`<string name=\"material\" value=\"Au\"/>`), tabulated over wavelength in nm.",
@@ -50,8 +67,9 @@ lines = [
     "//! from the Luxpop database (www.luxpop.com) and are based on data by Palik et al. [Handbook of",
     "//! Optical Constants of Solids, 1998] and measurements of atomic scattering factors made by the",
     "//! Center For X-Ray Optics (CXRO) at Berkeley and the Lawrence Livermore National Laboratory",
-    "//! (LLNL)\" (Mitsuba 3 documentation, `conductor`). Written by `tools/gen_conductor_ior.py`;",
-    "//! do not edit.",
+    "//! (LLNL)\" (Mitsuba 3 documentation, `conductor`). Presets whose files hold the same data as",
+    "//! another's are aliases of it ([`CONDUCTOR_ALIASES`]). Written by",
+    "//! `tools/gen_conductor_ior.py`; do not edit.",
     "",
     "// Measured values that happen to be close to π or 2π are data, not approximations of them.",
     "#![allow(clippy::approx_constant)]",
@@ -62,19 +80,37 @@ lines = [
     "    pub samples: &'static [(f32, f32, f32)],",
     "}",
     "",
-    "pub const CONDUCTORS: &[ConductorData] = &[",
+    "/// The preset called `name` (a table's name or an alias).",
+    "pub fn conductor_preset(name: &str) -> Option<&'static ConductorData> {",
+    "    let name = CONDUCTOR_ALIASES",
+    "        .iter()",
+    "        .find(|(alias, _)| *alias == name)",
+    "        .map_or(name, |(_, table)| table);",
+    "    CONDUCTORS.iter().find(|c| c.name == name)",
+    "}",
+    "",
+    "/// Every preset's name, tables and aliases, sorted.",
+    "pub fn conductor_names() -> Vec<&'static str> {",
+    "    let mut names: Vec<&str> = CONDUCTORS.iter().map(|c| c.name).collect();",
+    "    names.extend(CONDUCTOR_ALIASES.iter().map(|(alias, _)| *alias));",
+    "    names.sort_unstable();",
+    "    names",
+    "}",
+    "",
+    "/// Presets whose data equals another preset's: (alias, the preset it names).",
+    "pub const CONDUCTOR_ALIASES: &[(&str, &str)] = &[",
 ]
-for name in names:
-    eta = read(os.path.join(src, name + ".eta.spd"))
-    k = read(os.path.join(src, name + ".k.spd"))
-    assert [a for a, _ in eta] == [a for a, _ in k], name
+for alias in sorted(aliases):
+    lines.append(f"    (\"{alias}\", \"{aliases[alias]}\"),")
+lines += ["];", "", "pub const CONDUCTORS: &[ConductorData] = &["]
+for name in tables:
     lines.append("    ConductorData {")
     lines.append(f"        name: \"{name}\",")
     lines.append("        samples: &[")
-    for (lam, e), (_, kk) in zip(eta, k):
+    for lam, e, kk in data[name]:
         lines.append(f"            ({f32(lam)}, {f32(e)}, {f32(kk)}),")
     lines.append("        ],")
     lines.append("    },")
 lines.append("];")
 open(out, "w").write("\n".join(lines) + "\n")
-print(f"wrote {len(names)} presets to {out}")
+print(f"wrote {len(tables)} presets and {len(aliases)} aliases to {out}")

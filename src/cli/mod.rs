@@ -7,4 +7,5 @@ pub mod converge;
 #[cfg(feature = "embree")]
 pub mod embree;
 pub mod merge;
+pub mod plugins;
 pub mod render;

@@ -51,7 +51,7 @@ impl PluginClass {
     ];
 
     /// The XML tag of this class.
-    pub fn tag(self) -> &'static str {
+    pub const fn tag(self) -> &'static str {
         match self {
             PluginClass::Scene => "scene",
             PluginClass::Integrator => "integrator",

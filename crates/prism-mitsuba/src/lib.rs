@@ -14,6 +14,7 @@ pub mod mesh;
 pub mod params;
 mod property_values;
 pub mod reader;
+pub mod registry;
 mod substitution;
 mod transform_ops;
 

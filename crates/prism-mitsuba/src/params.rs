@@ -1,32 +1,36 @@
 //! Typed, checked access to a plugin's properties, with Mitsuba's defaults.
 //!
-//! A plugin builder asks for each parameter it understands; [`Params::finish`] then reports any
-//! property or nested plugin nobody asked for, naming the supported ones and the closest match,
-//! so that a misspelled parameter is an error with a location instead of a silent default.
+//! A plugin builder asks for each parameter by its declaration ([`crate::registry::ParamSpec`],
+//! which holds the name and the default); [`Params::finish`] then reports any property or
+//! nested plugin nobody asked for, naming the declared ones and the closest match, so that a
+//! misspelled parameter is an error with a location instead of a silent default.
 
-use std::cell::{Cell, RefCell};
+use std::cell::Cell;
 
 use glam::{DMat4, DVec3};
 
-use super::description::{NestedPlugin, PluginClass, PluginNode, Property, PropertyValue};
+use crate::description::{NestedPlugin, PluginNode, Property, PropertyValue};
+use crate::registry::{Default, ParamKind, ParamSpec};
 use prism_core::error::{Error, Result, SourceLocation};
 use prism_core::math::{AnimatedTransform, Transform};
 
-/// Reads the properties of one plugin node and remembers which were read.
+/// Reads the properties of one plugin node through its plugin's declared parameters, and
+/// remembers which were read.
 pub struct Params<'a> {
     node: &'a PluginNode,
+    declared: &'static [ParamSpec],
     used_properties: Vec<Cell<bool>>,
     used_children: Vec<Cell<bool>>,
-    asked: RefCell<Vec<&'static str>>,
 }
 
 impl<'a> Params<'a> {
-    pub fn new(node: &'a PluginNode) -> Self {
+    /// The parameters of `node`, a plugin whose parameters are `declared`.
+    pub fn new(node: &'a PluginNode, declared: &'static [ParamSpec]) -> Self {
         Params {
             node,
+            declared,
             used_properties: node.properties.iter().map(|_| Cell::new(false)).collect(),
             used_children: node.children.iter().map(|_| Cell::new(false)).collect(),
-            asked: RefCell::new(Vec::new()),
         }
     }
 
@@ -39,20 +43,40 @@ impl<'a> Params<'a> {
         &self.node.location
     }
 
-    /// The property called `name`, marked as used.
-    pub fn property(&self, name: &'static str) -> Option<&'a Property> {
-        self.asked.borrow_mut().push(name);
-        let index = self.node.properties.iter().position(|p| p.name == name)?;
+    /// Checks that a builder reads only what its plugin declares (a programming error, never
+    /// a user's).
+    fn check_declared(&self, spec: &ParamSpec) {
+        assert!(
+            self.declared.iter().any(|d| d.name == spec.name),
+            "{} reads the undeclared parameter \"{}\"",
+            self.node.describe(),
+            spec.name
+        );
+    }
+
+    /// The property of `spec`, marked as used.
+    pub fn property(&self, spec: &ParamSpec) -> Option<&'a Property> {
+        self.check_declared(spec);
+        let index = self
+            .node
+            .properties
+            .iter()
+            .position(|p| p.name == spec.name)?;
         self.used_properties[index].set(true);
         Some(&self.node.properties[index])
     }
 
-    /// Where the property `name` is written, or the plugin's location when it is absent.
-    pub fn location_of(&self, name: &str) -> &'a SourceLocation {
+    /// Whether `spec` is given, as a property or a nested plugin.
+    pub fn has(&self, spec: &ParamSpec) -> bool {
+        self.property(spec).is_some() || self.named_child(spec).is_some()
+    }
+
+    /// Where the property `spec` is written, or the plugin's location when it is absent.
+    pub fn location_of(&self, spec: &ParamSpec) -> &'a SourceLocation {
         self.node
             .properties
             .iter()
-            .find(|p| p.name == name)
+            .find(|p| p.name == spec.name)
             .map(|p| &p.location)
             .unwrap_or(&self.node.location)
     }
@@ -75,8 +99,8 @@ impl<'a> Params<'a> {
     }
 
     /// A float (an integer is accepted too), if present.
-    pub fn float_opt(&self, name: &'static str) -> Result<Option<f64>> {
-        match self.property(name) {
+    pub fn float_opt(&self, spec: &ParamSpec) -> Result<Option<f64>> {
+        match self.property(spec) {
             None => Ok(None),
             Some(p) => match p.value {
                 PropertyValue::Float(v) => Ok(Some(v)),
@@ -86,14 +110,19 @@ impl<'a> Params<'a> {
         }
     }
 
-    /// A float, or `default` when absent.
-    pub fn float(&self, name: &'static str, default: f64) -> Result<f64> {
-        Ok(self.float_opt(name)?.unwrap_or(default))
+    /// A float, or its declared default when absent.
+    pub fn float(&self, spec: &ParamSpec) -> Result<f64> {
+        let default = match spec.default {
+            Default::Float(v) => v,
+            Default::Integer(v) => v as f64,
+            other => panic!("\"{}\" has no numeric default ({other:?})", spec.name),
+        };
+        Ok(self.float_opt(spec)?.unwrap_or(default))
     }
 
     /// An integer, if present.
-    pub fn integer_opt(&self, name: &'static str) -> Result<Option<i64>> {
-        match self.property(name) {
+    pub fn integer_opt(&self, spec: &ParamSpec) -> Result<Option<i64>> {
+        match self.property(spec) {
             None => Ok(None),
             Some(p) => match p.value {
                 PropertyValue::Integer(v) => Ok(Some(v)),
@@ -102,14 +131,20 @@ impl<'a> Params<'a> {
         }
     }
 
-    /// An integer, or `default` when absent.
-    pub fn integer(&self, name: &'static str, default: i64) -> Result<i64> {
-        Ok(self.integer_opt(name)?.unwrap_or(default))
+    /// An integer, or its declared default when absent.
+    pub fn integer(&self, spec: &ParamSpec) -> Result<i64> {
+        let Default::Integer(default) = spec.default else {
+            panic!("\"{}\" has no integer default", spec.name);
+        };
+        Ok(self.integer_opt(spec)?.unwrap_or(default))
     }
 
-    /// A boolean, or `default` when absent.
-    pub fn boolean(&self, name: &'static str, default: bool) -> Result<bool> {
-        match self.property(name) {
+    /// A boolean, or its declared default when absent.
+    pub fn boolean(&self, spec: &ParamSpec) -> Result<bool> {
+        let Default::Boolean(default) = spec.default else {
+            panic!("\"{}\" has no boolean default", spec.name);
+        };
+        match self.property(spec) {
             None => Ok(default),
             Some(p) => match p.value {
                 PropertyValue::Boolean(v) => Ok(v),
@@ -119,8 +154,8 @@ impl<'a> Params<'a> {
     }
 
     /// A string, if present.
-    pub fn string_opt(&self, name: &'static str) -> Result<Option<&'a str>> {
-        match self.property(name) {
+    pub fn string_opt(&self, spec: &ParamSpec) -> Result<Option<&'a str>> {
+        match self.property(spec) {
             None => Ok(None),
             Some(p) => match &p.value {
                 PropertyValue::String(v) => Ok(Some(v.as_str())),
@@ -129,14 +164,38 @@ impl<'a> Params<'a> {
         }
     }
 
-    /// A string, or `default` when absent.
-    pub fn string(&self, name: &'static str, default: &'a str) -> Result<&'a str> {
-        Ok(self.string_opt(name)?.unwrap_or(default))
+    /// A string, or its declared default when absent.
+    pub fn string(&self, spec: &ParamSpec) -> Result<&'a str> {
+        let Default::Str(default) = spec.default else {
+            panic!("\"{}\" has no string default", spec.name);
+        };
+        Ok(self.string_opt(spec)?.unwrap_or(default))
+    }
+
+    /// One of the strings `spec` declares (compared ignoring ASCII case), or its default; the
+    /// declared spelling.
+    pub fn choice(&self, spec: &ParamSpec) -> Result<&'static str> {
+        let ParamKind::Choice(choices) = spec.kind else {
+            panic!("\"{}\" is not a choice", spec.name);
+        };
+        let value = self.string(spec)?;
+        if let Some(choice) = choices.iter().find(|c| c.eq_ignore_ascii_case(value)) {
+            return Ok(choice);
+        }
+        Err(Error::input(
+            self.location_of(spec),
+            format!(
+                "unknown value \"{value}\" for parameter \"{}\" of {}",
+                spec.name,
+                self.node.describe()
+            ),
+        )
+        .with_help(format!("use one of: {}", choices.join(", "))))
     }
 
     /// A transform, if present.
-    pub fn transform_opt(&self, name: &'static str) -> Result<Option<DMat4>> {
-        match self.property(name) {
+    pub fn transform_opt(&self, spec: &ParamSpec) -> Result<Option<DMat4>> {
+        match self.property(spec) {
             None => Ok(None),
             Some(p) => match p.value {
                 PropertyValue::Transform(m) => Ok(Some(m)),
@@ -146,24 +205,25 @@ impl<'a> Params<'a> {
     }
 
     /// A transform, or the identity when absent.
-    pub fn transform(&self, name: &'static str) -> Result<DMat4> {
-        Ok(self.transform_opt(name)?.unwrap_or(DMat4::IDENTITY))
+    pub fn transform(&self, spec: &ParamSpec) -> Result<DMat4> {
+        Ok(self.transform_opt(spec)?.unwrap_or(DMat4::IDENTITY))
     }
 
     /// A transform that may be animated (`<transform>` or `<animation>`); the identity when
     /// absent. A singular transform is an error at its location.
-    pub fn animated_transform(&self, name: &'static str) -> Result<AnimatedTransform> {
+    pub fn animated_transform(&self, spec: &ParamSpec) -> Result<AnimatedTransform> {
         let singular = |p: &Property| {
             Error::input(
                 &p.location,
                 format!(
-                    "the \"{name}\" transform of {} is singular or not affine",
+                    "the \"{}\" transform of {} is singular or not affine",
+                    spec.name,
                     self.node.describe()
                 ),
             )
             .with_help("check for a zero scale or a malformed matrix")
         };
-        match self.property(name) {
+        match self.property(spec) {
             None => Ok(AnimatedTransform::fixed(Transform::IDENTITY)),
             Some(p) => match &p.value {
                 PropertyValue::Transform(m) => Transform::new(*m)
@@ -178,8 +238,8 @@ impl<'a> Params<'a> {
     }
 
     /// A point, if present.
-    pub fn point_opt(&self, name: &'static str) -> Result<Option<DVec3>> {
-        match self.property(name) {
+    pub fn point_opt(&self, spec: &ParamSpec) -> Result<Option<DVec3>> {
+        match self.property(spec) {
             None => Ok(None),
             Some(p) => match p.value {
                 PropertyValue::Point(v) => Ok(Some(v)),
@@ -189,8 +249,8 @@ impl<'a> Params<'a> {
     }
 
     /// A vector (a point is accepted too, as Mitsuba does), if present.
-    pub fn vector_opt(&self, name: &'static str) -> Result<Option<DVec3>> {
-        match self.property(name) {
+    pub fn vector_opt(&self, spec: &ParamSpec) -> Result<Option<DVec3>> {
+        match self.property(spec) {
             None => Ok(None),
             Some(p) => match p.value {
                 PropertyValue::Vector(v) | PropertyValue::Point(v) => Ok(Some(v)),
@@ -199,14 +259,16 @@ impl<'a> Params<'a> {
         }
     }
 
-    /// A float that must lie in `[min, max]` (inclusive); an error names the range otherwise.
-    pub fn float_in(&self, name: &'static str, default: f64, min: f64, max: f64) -> Result<f64> {
-        let value = self.float(name, default)?;
+    /// A float that must lie in `[min, max]` (inclusive), or its default; an error names the
+    /// range otherwise.
+    pub fn float_in(&self, spec: &ParamSpec, default: f64, min: f64, max: f64) -> Result<f64> {
+        let value = self.float_opt(spec)?.unwrap_or(default);
         if !(value >= min && value <= max) {
             return Err(Error::input(
-                self.location_of(name),
+                self.location_of(spec),
                 format!(
-                    "parameter \"{name}\" of {} is {value}, outside the valid range [{min}, {max}]",
+                    "parameter \"{}\" of {} is {value}, outside the valid range [{min}, {max}]",
+                    spec.name,
                     self.node.describe()
                 ),
             ));
@@ -214,8 +276,12 @@ impl<'a> Params<'a> {
         Ok(value)
     }
 
-    /// The nested plugins of one class, marked as used, in document order.
-    pub fn children(&self, class: PluginClass) -> Vec<&'a NestedPlugin> {
+    /// The nested plugins of the class `spec` declares, marked as used, in document order.
+    pub fn children(&self, spec: &ParamSpec) -> Vec<&'a NestedPlugin> {
+        self.check_declared(spec);
+        let ParamKind::Nested(class) = spec.kind else {
+            panic!("\"{}\" is not a nested plugin", spec.name);
+        };
         let mut found = Vec::new();
         for (index, child) in self.node.children.iter().enumerate() {
             if child.node.class == class {
@@ -226,9 +292,9 @@ impl<'a> Params<'a> {
         found
     }
 
-    /// At most one nested plugin of a class; two or more are an error.
-    pub fn single_child(&self, class: PluginClass) -> Result<Option<&'a NestedPlugin>> {
-        let children = self.children(class);
+    /// At most one nested plugin of the class `spec` declares; two or more are an error.
+    pub fn single_child(&self, spec: &ParamSpec) -> Result<Option<&'a NestedPlugin>> {
+        let children = self.children(spec);
         match children.as_slice() {
             [] => Ok(None),
             [one] => Ok(Some(*one)),
@@ -237,35 +303,41 @@ impl<'a> Params<'a> {
                 format!(
                     "{} takes at most one nested {}, but several were given",
                     self.node.describe(),
-                    class.tag()
+                    second.node.class.tag()
                 ),
             )
             .with_help("remove all but one of them")),
         }
     }
 
-    /// The nested plugin given for parameter `name` (`<texture name="reflectance" .../>`), if any.
-    pub fn named_child(&self, name: &'static str) -> Option<&'a NestedPlugin> {
-        self.asked.borrow_mut().push(name);
+    /// The nested plugin given for parameter `spec` (`<texture name="reflectance" .../>`), if
+    /// any.
+    pub fn named_child(&self, spec: &ParamSpec) -> Option<&'a NestedPlugin> {
+        self.check_declared(spec);
         let index = self
             .node
             .children
             .iter()
-            .position(|c| c.name.as_deref() == Some(name))?;
+            .position(|c| c.name.as_deref() == Some(spec.name))?;
         self.used_children[index].set(true);
         Some(&self.node.children[index])
     }
 
     /// Reports the first property or nested plugin that no one asked for.
     pub fn finish(self) -> Result<()> {
-        let asked = self.asked.borrow();
+        let declared: Vec<&str> = self
+            .declared
+            .iter()
+            .filter(|d| !matches!(d.kind, ParamKind::Nested(_)))
+            .map(|d| d.name)
+            .collect();
         for (property, used) in self.node.properties.iter().zip(&self.used_properties) {
             if !used.get() {
                 return Err(unknown_parameter(
                     self.node,
                     &property.name,
                     &property.location,
-                    &asked,
+                    &declared,
                 ));
             }
         }
@@ -289,7 +361,7 @@ fn unknown_parameter(
     node: &PluginNode,
     name: &str,
     location: &SourceLocation,
-    supported: &[&'static str],
+    supported: &[&str],
 ) -> Error {
     let mut names: Vec<&str> = supported.to_vec();
     names.sort_unstable();

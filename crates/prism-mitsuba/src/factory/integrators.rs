@@ -1,21 +1,113 @@
-//! Integrator plugins: `path` (with Prism's `emitter_sampling`, see [`prism_core::light::sampler`])
-//! and the lecture's `distrib`.
+//! Integrator plugins: `path` (with Prism's `emitter_sampling`, see
+//! [`prism_core::light::sampler`]) and the lecture's `distrib`.
 
-use crate::description::PluginNode;
+use crate::description::{PluginClass, PluginNode};
 use crate::params::Params;
+use crate::registry::{Default, Origin, ParamKind, ParamSpec, Plugin, Registry};
 use prism_core::error::{Error, Result};
 use prism_core::integrator::distribution::DirectLights;
 use prism_core::integrator::{DistributionIntegrator, Integrator, PathIntegrator};
 use prism_core::light::LightSelection;
 
-pub const SUPPORTED_INTEGRATORS: &[&str] = &["path", "distrib"];
+type Build = fn(&Params) -> Result<Integrator>;
+
+pub static INTEGRATORS: Registry<Build> = Registry {
+    class: PluginClass::Integrator,
+    plugins: &[
+        Plugin {
+            name: "path",
+            origin: Origin::Mitsuba3,
+            summary: "Path tracing with next-event estimation, multiple importance sampling \
+                      (power heuristic) and Russian roulette on the path's potential.",
+            params: &[MAX_DEPTH, RR_DEPTH, HIDE_EMITTERS, EMITTER_SAMPLING],
+            build: build_path,
+        },
+        Plugin {
+            name: "distrib",
+            origin: Origin::Prism,
+            summary: "The lecture's distribution ray tracer: at a vertex N = clamp(round(\
+                      bounce_samples · potential), 1, bounce_samples) bounce samples and as \
+                      many shadow rays per light, Russian roulette with survival \
+                      s = min(1, potential / rr_threshold), where the potential is the factor \
+                      the vertex's estimate carries into the pixel.",
+            params: &[
+                MAX_DEPTH,
+                BOUNCE_SAMPLES,
+                SHADOW_RAYS,
+                LIGHTS,
+                RR_THRESHOLD,
+                HIDE_EMITTERS,
+            ],
+            build: build_distrib,
+        },
+    ],
+};
+
+const MAX_DEPTH: ParamSpec = ParamSpec::new(
+    "max_depth",
+    ParamKind::Integer,
+    Default::Integer(-1),
+    "longest path: −1 unbounded, 1 emitters only, 2 direct light",
+);
+const RR_DEPTH: ParamSpec = ParamSpec::new(
+    "rr_depth",
+    ParamKind::Integer,
+    Default::Integer(5),
+    "depth from which Russian roulette may end paths",
+);
+const HIDE_EMITTERS: ParamSpec = ParamSpec::new(
+    "hide_emitters",
+    ParamKind::Boolean,
+    Default::Boolean(false),
+    "leave emitters seen directly by the camera black",
+);
+const EMITTER_SAMPLING: ParamSpec = ParamSpec::new(
+    "emitter_sampling",
+    ParamKind::Choice(&["power", "uniform"]),
+    Default::Str("power"),
+    "Prism only (Mitsuba rejects it): one light per shading point chosen ∝ its power, or \
+     uniformly (as Mitsuba's default equal `sampling_weight`s)",
+);
+const BOUNCE_SAMPLES: ParamSpec = ParamSpec::new(
+    "bounce_samples",
+    ParamKind::Integer,
+    Default::Integer(4),
+    "bounce samples at potential 1 (1 to 1024)",
+);
+const SHADOW_RAYS: ParamSpec = ParamSpec::new(
+    "shadow_rays",
+    ParamKind::Integer,
+    Default::Integer(4),
+    "shadow rays per light at potential 1 (1 to 1024)",
+);
+const LIGHTS: ParamSpec = ParamSpec::new(
+    "lights",
+    ParamKind::Choice(&["power", "uniform", "all"]),
+    Default::Str("power"),
+    "one light per vertex chosen ∝ power or uniformly, or every light",
+);
+const RR_THRESHOLD: ParamSpec = ParamSpec::new(
+    "rr_threshold",
+    ParamKind::Float,
+    Default::Float(0.1),
+    "potential below which Russian roulette starts",
+);
+
+/// Builds the integrator a node describes.
+pub fn build_integrator(node: &PluginNode) -> Result<Integrator> {
+    let plugin = INTEGRATORS.find(node)?;
+    let params = Params::new(node, plugin.params);
+    let integrator = (plugin.build)(&params)?;
+    params.finish()?;
+    Ok(integrator)
+}
 
 /// `max_depth`: −1 (unbounded) or at least 0.
 fn max_depth(params: &Params) -> Result<i32> {
-    let max_depth = params.integer("max_depth", -1)?;
+    let max_depth = params.integer(&MAX_DEPTH)?;
     if max_depth < -1 || max_depth > i64::from(i32::MAX) {
         return Err(Error::input(
-            params.location_of("max_depth"),
+            params.location_of(&MAX_DEPTH),
             format!("max_depth must be -1 (unbounded) or at least 0, not {max_depth}"),
         ));
     }
@@ -23,97 +115,57 @@ fn max_depth(params: &Params) -> Result<i32> {
 }
 
 /// A count that must be at least 1 (and sensible).
-fn count(params: &Params, name: &'static str, default: i64) -> Result<u32> {
-    let value = params.integer(name, default)?;
+fn count(params: &Params, spec: &ParamSpec) -> Result<u32> {
+    let value = params.integer(spec)?;
     if !(1..=1024).contains(&value) {
         return Err(Error::input(
-            params.location_of(name),
-            format!("\"{name}\" must be between 1 and 1024, not {value}"),
+            params.location_of(spec),
+            format!("\"{}\" must be between 1 and 1024, not {value}", spec.name),
         ));
     }
     Ok(value as u32)
 }
 
-pub fn build_integrator(node: &PluginNode) -> Result<Integrator> {
-    let params = Params::new(node);
-    let integrator = match node.plugin_type.as_str() {
-        "path" => {
-            let max_depth = max_depth(&params)?;
-            let rr_depth = params.integer("rr_depth", 5)?;
-            if rr_depth < 1 || rr_depth > i64::from(i32::MAX) {
-                return Err(Error::input(
-                    params.location_of("rr_depth"),
-                    format!("rr_depth must be at least 1, not {rr_depth}"),
-                ));
-            }
-            let hide_emitters = params.boolean("hide_emitters", false)?;
-            let light_selection = match params.string("emitter_sampling", "power")? {
-                "power" => LightSelection::Power,
-                "uniform" => LightSelection::Uniform,
-                other => {
-                    return Err(Error::input(
-                        params.location_of("emitter_sampling"),
-                        format!("unknown emitter_sampling \"{other}\""),
-                    )
-                    .with_help(
-                        "use \"power\" (lights chosen in proportion to their power) or \"uniform\"",
-                    ));
-                }
-            };
-            Integrator::Path(PathIntegrator {
-                max_depth,
-                rr_depth: rr_depth as i32,
-                hide_emitters,
-                light_selection,
-            })
-        }
-        "distrib" => {
-            let defaults = DistributionIntegrator::default();
-            let lights = match params.string("lights", "power")? {
-                "power" => DirectLights::One(LightSelection::Power),
-                "uniform" => DirectLights::One(LightSelection::Uniform),
-                "all" => DirectLights::All,
-                other => {
-                    return Err(Error::input(
-                        params.location_of("lights"),
-                        format!("unknown light selection \"{other}\""),
-                    )
-                    .with_help(
-                        "use \"power\" (one light chosen in proportion to its power), \"uniform\" or \"all\"",
-                    ));
-                }
-            };
-            let rr_threshold = params.float("rr_threshold", f64::from(defaults.rr_threshold))?;
-            if !(rr_threshold > 0.0 && rr_threshold.is_finite()) {
-                return Err(Error::input(
-                    params.location_of("rr_threshold"),
-                    format!("rr_threshold must be positive, not {rr_threshold}"),
-                ));
-            }
-            Integrator::Distribution(DistributionIntegrator {
-                max_depth: max_depth(&params)?,
-                bounce_samples: count(
-                    &params,
-                    "bounce_samples",
-                    i64::from(defaults.bounce_samples),
-                )?,
-                shadow_rays: count(&params, "shadow_rays", i64::from(defaults.shadow_rays))?,
-                lights,
-                rr_threshold: rr_threshold as f32,
-                hide_emitters: params.boolean("hide_emitters", false)?,
-            })
-        }
-        other => {
-            return Err(Error::input(
-                &node.location,
-                format!("unknown integrator type \"{other}\""),
-            )
-            .with_help(format!(
-                "supported integrator types: {}",
-                SUPPORTED_INTEGRATORS.join(", ")
-            )));
-        }
+fn build_path(params: &Params) -> Result<Integrator> {
+    let max_depth = max_depth(params)?;
+    let rr_depth = params.integer(&RR_DEPTH)?;
+    if rr_depth < 1 || rr_depth > i64::from(i32::MAX) {
+        return Err(Error::input(
+            params.location_of(&RR_DEPTH),
+            format!("rr_depth must be at least 1, not {rr_depth}"),
+        ));
+    }
+    let light_selection = match params.choice(&EMITTER_SAMPLING)? {
+        "uniform" => LightSelection::Uniform,
+        _ => LightSelection::Power,
     };
-    params.finish()?;
-    Ok(integrator)
+    Ok(Integrator::Path(PathIntegrator {
+        max_depth,
+        rr_depth: rr_depth as i32,
+        hide_emitters: params.boolean(&HIDE_EMITTERS)?,
+        light_selection,
+    }))
+}
+
+fn build_distrib(params: &Params) -> Result<Integrator> {
+    let lights = match params.choice(&LIGHTS)? {
+        "uniform" => DirectLights::One(LightSelection::Uniform),
+        "all" => DirectLights::All,
+        _ => DirectLights::One(LightSelection::Power),
+    };
+    let rr_threshold = params.float(&RR_THRESHOLD)?;
+    if !(rr_threshold > 0.0 && rr_threshold.is_finite()) {
+        return Err(Error::input(
+            params.location_of(&RR_THRESHOLD),
+            format!("rr_threshold must be positive, not {rr_threshold}"),
+        ));
+    }
+    Ok(Integrator::Distribution(DistributionIntegrator {
+        max_depth: max_depth(params)?,
+        bounce_samples: count(params, &BOUNCE_SAMPLES)?,
+        shadow_rays: count(params, &SHADOW_RAYS)?,
+        lights,
+        rr_threshold: rr_threshold as f32,
+        hide_emitters: params.boolean(&HIDE_EMITTERS)?,
+    }))
 }

@@ -6,31 +6,154 @@
 
 use glam::{DMat4, DVec3, Vec3};
 
-use super::spectra::{Range, spectrum_param};
+use super::spectra::{NestedSpectrum, Range, build_nested_spectrum, spectrum_param};
 use crate::description::{PluginClass, PluginNode};
 use crate::params::Params;
-use prism_core::bsdf::{Bsdf, Diffuse, Material};
+use crate::registry::{Default, Origin, ParamKind, ParamSpec, Plugin, Registry};
+use prism_core::bsdf::{Diffuse, Material};
 use prism_core::error::{Error, Result, SourceLocation};
 use prism_core::image::read_bitmap;
 use prism_core::light::{
     AreaLight, ConstantLight, DirectionalLight, EnvironmentMap, Light, PointLight, SpotLight,
 };
 use prism_core::math::Transform;
-use prism_core::spectrum::blackbody::Blackbody;
 use prism_core::spectrum::{RgbIntent, Spectrum};
 
-/// The emitter types this factory knows.
-pub const SUPPORTED_EMITTERS: &[&str] =
-    &["area", "point", "spot", "directional", "constant", "envmap"];
+/// Builds an emitter: nested in the shape with this index (`Some`), or at the top level.
+type Build = fn(&Params, Option<u32>) -> Result<Light>;
+
+pub static EMITTERS: Registry<Build> = Registry {
+    class: PluginClass::Emitter,
+    plugins: &[
+        Plugin {
+            name: "area",
+            origin: Origin::Mitsuba3,
+            summary: "Nested in a shape: emits `radiance` from the side the normal points to.                       Spheres are sampled by the cone they subtend, other shapes by area.",
+            params: &[RADIANCE],
+            build: |params, shape| {
+                Ok(Light::Area(AreaLight {
+                    shape: shape.unwrap_or(0),
+                    radiance: emission_param(params, &RADIANCE)?,
+                }))
+            },
+        },
+        Plugin {
+            name: "point",
+            origin: Origin::Mitsuba3,
+            summary: "A point light.",
+            params: &[INTENSITY, POSITION, TO_WORLD],
+            build: |params, _| build_point(params),
+        },
+        Plugin {
+            name: "spot",
+            origin: Origin::Mitsuba3,
+            summary: "A spot light shining along its +z: full intensity within the beam, linear in                       angle to zero at the cutoff. No projected texture.",
+            params: &[INTENSITY, CUTOFF_ANGLE, BEAM_WIDTH, TO_WORLD],
+            build: |params, _| build_spot(params),
+        },
+        Plugin {
+            name: "directional",
+            origin: Origin::Mitsuba3,
+            summary: "Light from one direction, at infinity.",
+            params: &[IRRADIANCE, DIRECTION, TO_WORLD],
+            build: |params, _| build_directional(params),
+        },
+        Plugin {
+            name: "constant",
+            origin: Origin::Mitsuba3,
+            summary: "Uniform light from every direction, at infinity.",
+            params: &[RADIANCE],
+            build: |params, _| {
+                Ok(Light::Constant(ConstantLight::new(emission_param(
+                    params, &RADIANCE,
+                )?)))
+            },
+        },
+        Plugin {
+            name: "envmap",
+            origin: Origin::Mitsuba3,
+            summary: "An environment map: a latitude–longitude image with Mitsuba's orientation                       (+y up, u = 0 looks along −z), pixel-node bilinear lookup and spectral                       upsampling; importance sampled ∝ luminance · sin θ.",
+            params: &[ENVMAP_FILENAME, ENVMAP_SCALE, TO_WORLD],
+            build: |params, _| build_envmap(params),
+        },
+    ],
+};
+
+const D65: Default = Default::Text("D65 of luminance 1");
+const RADIANCE: ParamSpec = ParamSpec::new(
+    "radiance",
+    ParamKind::Spectrum {
+        range: Range::Emission,
+        textured: false,
+    },
+    D65,
+    "emitted radiance; or a nested `<spectrum type=\"blackbody\">`",
+);
+const INTENSITY: ParamSpec = ParamSpec::new(
+    "intensity",
+    ParamKind::Spectrum {
+        range: Range::Emission,
+        textured: false,
+    },
+    D65,
+    "radiant intensity (on the axis, for a spot); or a nested blackbody",
+);
+const IRRADIANCE: ParamSpec = ParamSpec::new(
+    "irradiance",
+    ParamKind::Spectrum {
+        range: Range::Emission,
+        textured: false,
+    },
+    D65,
+    "irradiance on a surface facing the light; or a nested blackbody",
+);
+const POSITION: ParamSpec = ParamSpec::new(
+    "position",
+    ParamKind::Point,
+    Default::Text("the origin"),
+    "where the light is (or give `to_world`)",
+);
+const DIRECTION: ParamSpec = ParamSpec::new(
+    "direction",
+    ParamKind::Vector,
+    Default::Text("+z"),
+    "where the light travels (or give `to_world`: its +z)",
+);
+const TO_WORLD: ParamSpec = ParamSpec::new(
+    "to_world",
+    ParamKind::Transform,
+    Default::Text("identity"),
+    "the emitter's placement",
+);
+const CUTOFF_ANGLE: ParamSpec = ParamSpec::new(
+    "cutoff_angle",
+    ParamKind::Float,
+    Default::Float(20.0),
+    "angle from the axis, in degrees, beyond which there is no light",
+);
+const BEAM_WIDTH: ParamSpec = ParamSpec::new(
+    "beam_width",
+    ParamKind::Float,
+    Default::Text("¾ `cutoff_angle`"),
+    "angle, in degrees, within which the intensity is full",
+);
+const ENVMAP_FILENAME: ParamSpec = ParamSpec::new(
+    "filename",
+    ParamKind::String,
+    Default::Required,
+    "the image: OpenEXR, Radiance HDR, PNG or JPEG, at least 2 × 3 pixels",
+);
+const ENVMAP_SCALE: ParamSpec = ParamSpec::new(
+    "scale",
+    ParamKind::Float,
+    Default::Float(1.0),
+    "factor on the image's values",
+);
 
 /// Builds the area light nested in the shape with index `shape`.
 pub fn build_area_light(node: &PluginNode, shape: u32) -> Result<Light> {
-    if node.plugin_type != "area" {
-        let help = if SUPPORTED_EMITTERS.contains(&node.plugin_type.as_str()) {
-            "only an \"area\" emitter can be nested in a shape; declare other emitters at the top level of the scene".to_string()
-        } else {
-            format!("supported emitter types: {}", SUPPORTED_EMITTERS.join(", "))
-        };
+    let plugin = EMITTERS.find(node)?;
+    if plugin.name != "area" {
         return Err(Error::input(
             &node.location,
             format!(
@@ -38,111 +161,102 @@ pub fn build_area_light(node: &PluginNode, shape: u32) -> Result<Light> {
                 node.plugin_type
             ),
         )
-        .with_help(help));
+        .with_help(
+            "only an \"area\" emitter can be nested in a shape; declare other emitters at the top level of the scene",
+        ));
     }
-    let params = Params::new(node);
-    let radiance = emission_param(&params, "radiance")?;
+    let params = Params::new(node, plugin.params);
+    let light = (plugin.build)(&params, Some(shape))?;
     params.finish()?;
-    Ok(Light::Area(AreaLight { shape, radiance }))
+    Ok(light)
 }
 
 /// The material of an emitting shape that names no BSDF: Mitsuba 3 gives such shapes a black
 /// diffuse BSDF (not the usual 50 % grey), so an area light does not reflect other lights.
 pub fn default_emitter_material() -> Material {
-    Material {
-        front: Bsdf::Diffuse(Diffuse {
-            reflectance: prism_core::texture::Texture::constant(0.0),
-        }),
-        back: None,
-    }
+    Material::new(Diffuse {
+        reflectance: prism_core::texture::Texture::constant(0.0),
+    })
 }
 
 /// Builds an emitter declared at the top level of the scene.
 pub fn build_scene_light(node: &PluginNode) -> Result<Light> {
-    let params = Params::new(node);
-    let light = match node.plugin_type.as_str() {
-        "point" => {
-            let intensity = emission_param(&params, "intensity")?;
-            let position = match exclusive(&params, "position", "to_world")? {
-                Placement::Given(_) => params.point_opt("position")?.unwrap_or_default(),
-                Placement::Transform(m) => m.transform_point3(DVec3::ZERO),
-                Placement::Default => DVec3::ZERO,
-            }
-            .as_vec3();
-            if !position.is_finite() {
-                return Err(Error::input(
-                    params.location(),
-                    "the point emitter's position is not finite",
-                ));
-            }
-            Light::Point(PointLight {
-                position,
-                intensity,
-            })
-        }
-        "spot" => {
-            let intensity = emission_param(&params, "intensity")?;
-            let cutoff = params.float_in("cutoff_angle", 20.0, 0.0, 180.0)?;
-            if cutoff == 0.0 {
-                return Err(Error::input(
-                    params.location_of("cutoff_angle"),
-                    "the spot emitter's cutoff_angle must be greater than 0",
-                ));
-            }
-            let beam = params.float_in("beam_width", 0.75 * cutoff, 0.0, cutoff)?;
-            let to_world = invertible(&params, "to_world")?;
-            Light::Spot(SpotLight::new(
-                to_world,
-                intensity,
-                cutoff.to_radians() as f32,
-                beam.to_radians() as f32,
-            ))
-        }
-        "directional" => {
-            let irradiance = emission_param(&params, "irradiance")?;
-            let direction = match exclusive(&params, "direction", "to_world")? {
-                Placement::Given(location) => {
-                    let d = params.vector_opt("direction")?.unwrap_or(DVec3::Z);
-                    if !(d.length() > 0.0 && d.is_finite()) {
-                        return Err(Error::input(
-                            location,
-                            "the directional emitter's direction must be a finite, non-zero vector",
-                        ));
-                    }
-                    d
-                }
-                Placement::Transform(_) => {
-                    let to_world = invertible(&params, "to_world")?;
-                    to_world.vector(Vec3::Z).as_dvec3()
-                }
-                Placement::Default => DVec3::Z,
-            };
-            Light::Directional(DirectionalLight::new(
-                direction.normalize().as_vec3(),
-                irradiance,
-            ))
-        }
-        "constant" => Light::Constant(ConstantLight::new(emission_param(&params, "radiance")?)),
-        "envmap" => build_envmap(&params)?,
-        "area" => {
-            return Err(Error::input(
-                &node.location,
-                "an \"area\" emitter must be nested in a shape",
-            )
-            .with_help("move it inside the <shape> that should emit light"));
-        }
-        other => {
-            return Err(
-                Error::input(&node.location, format!("unknown emitter type \"{other}\""))
-                    .with_help(format!(
-                        "supported emitter types: {}",
-                        SUPPORTED_EMITTERS.join(", ")
-                    )),
-            );
-        }
-    };
+    let plugin = EMITTERS.find(node)?;
+    if plugin.name == "area" {
+        return Err(Error::input(
+            &node.location,
+            "an \"area\" emitter must be nested in a shape",
+        )
+        .with_help("move it inside the <shape> that should emit light"));
+    }
+    let params = Params::new(node, plugin.params);
+    let light = (plugin.build)(&params, None)?;
     params.finish()?;
     Ok(light)
+}
+
+fn build_point(params: &Params) -> Result<Light> {
+    let intensity = emission_param(params, &INTENSITY)?;
+    let position = match exclusive(params, &POSITION)? {
+        Placement::Given(_) => params.point_opt(&POSITION)?.unwrap_or_default(),
+        Placement::Transform(m) => m.transform_point3(DVec3::ZERO),
+        Placement::Default => DVec3::ZERO,
+    }
+    .as_vec3();
+    if !position.is_finite() {
+        return Err(Error::input(
+            params.location(),
+            "the point emitter's position is not finite",
+        ));
+    }
+    Ok(Light::Point(PointLight {
+        position,
+        intensity,
+    }))
+}
+
+fn build_spot(params: &Params) -> Result<Light> {
+    let intensity = emission_param(params, &INTENSITY)?;
+    let cutoff = params.float_in(&CUTOFF_ANGLE, 20.0, 0.0, 180.0)?;
+    if cutoff == 0.0 {
+        return Err(Error::input(
+            params.location_of(&CUTOFF_ANGLE),
+            "the spot emitter's cutoff_angle must be greater than 0",
+        ));
+    }
+    let beam = params.float_in(&BEAM_WIDTH, 0.75 * cutoff, 0.0, cutoff)?;
+    let to_world = invertible(params, &TO_WORLD)?;
+    Ok(Light::Spot(SpotLight::new(
+        to_world,
+        intensity,
+        cutoff.to_radians() as f32,
+        beam.to_radians() as f32,
+    )))
+}
+
+fn build_directional(params: &Params) -> Result<Light> {
+    let irradiance = emission_param(params, &IRRADIANCE)?;
+    let direction = match exclusive(params, &DIRECTION)? {
+        Placement::Given(location) => {
+            let d = params.vector_opt(&DIRECTION)?.unwrap_or(DVec3::Z);
+            if !(d.length() > 0.0 && d.is_finite()) {
+                return Err(Error::input(
+                    location,
+                    "the directional emitter's direction must be a finite, non-zero vector",
+                ));
+            }
+            d
+        }
+        Placement::Transform(_) => {
+            let to_world = invertible(params, &TO_WORLD)?;
+            to_world.vector(Vec3::Z).as_dvec3()
+        }
+        Placement::Default => DVec3::Z,
+    };
+    Ok(Light::Directional(DirectionalLight::new(
+        direction.normalize().as_vec3(),
+        irradiance,
+    )))
 }
 
 /// Checks that a scene has at most one environment emitter (`constant` or `envmap`), as
@@ -167,19 +281,16 @@ enum Placement<'a> {
 }
 
 /// Reads the pair of mutually exclusive placement parameters `own` and `to_world`.
-fn exclusive<'a>(
-    params: &Params<'a>,
-    own: &'static str,
-    to_world: &'static str,
-) -> Result<Placement<'a>> {
+fn exclusive<'a>(params: &Params<'a>, own: &ParamSpec) -> Result<Placement<'a>> {
     let has_own = params.property(own).is_some();
-    let transform = params.transform_opt(to_world)?;
+    let transform = params.transform_opt(&TO_WORLD)?;
     match (has_own, transform) {
         (true, Some(_)) => Err(Error::input(
             params.location_of(own),
             format!(
-                "{} takes either \"{own}\" or \"{to_world}\", not both",
-                params.node().describe()
+                "{} takes either \"{}\" or \"to_world\", not both",
+                params.node().describe(),
+                own.name
             ),
         )),
         (true, None) => Ok(Placement::Given(params.location_of(own))),
@@ -189,12 +300,13 @@ fn exclusive<'a>(
 }
 
 /// An invertible transform parameter (identity when absent).
-fn invertible(params: &Params, name: &'static str) -> Result<Transform> {
-    Transform::new(params.transform(name)?).ok_or_else(|| {
+fn invertible(params: &Params, spec: &ParamSpec) -> Result<Transform> {
+    Transform::new(params.transform(spec)?).ok_or_else(|| {
         Error::input(
-            params.location_of(name),
+            params.location_of(spec),
             format!(
-                "the \"{name}\" transform of {} is singular or not affine",
+                "the \"{}\" transform of {} is singular or not affine",
+                spec.name,
                 params.node().describe()
             ),
         )
@@ -202,61 +314,47 @@ fn invertible(params: &Params, name: &'static str) -> Result<Transform> {
     })
 }
 
-/// The emitted radiance, intensity or irradiance given for parameter `name` (default: D65 of
+/// The emitted radiance, intensity or irradiance given for parameter `spec` (default: D65 of
 /// luminance 1, as Mitsuba's `Texture::D65(1)`): a value, or a nested blackbody spectrum.
-fn emission_param(params: &Params, name: &'static str) -> Result<Spectrum> {
-    let Some(child) = params.named_child(name) else {
-        if params.property(name).is_none() {
+fn emission_param(params: &Params, spec: &ParamSpec) -> Result<Spectrum> {
+    let Some(child) = params.named_child(spec) else {
+        if params.property(spec).is_none() {
             return Ok(Spectrum::from_rgb([1.0; 3], RgbIntent::Illuminant));
         }
-        return spectrum_param(params, name, 1.0, Range::Emission);
+        return spectrum_param(params, spec);
     };
-    if child.node.class != PluginClass::Spectrum || child.node.plugin_type != "blackbody" {
-        return Err(Error::input(
+    let unsupported = || {
+        Error::input(
             &child.location,
             format!(
-                "{} for parameter \"{name}\" of {} is not supported",
+                "{} for parameter \"{}\" of {} is not supported",
                 child.node.describe(),
+                spec.name,
                 params.node().describe()
             ),
         )
-        .with_help(
-            "give the value as <rgb>, <spectrum>, <float> or <spectrum type=\"blackbody\">",
-        ));
-    }
-    let blackbody = Params::new(&child.node);
-    let Some(temperature) = blackbody.float_opt("temperature")? else {
-        return Err(Error::input(
-            &child.node.location,
-            "the blackbody spectrum needs a \"temperature\" (in kelvin)",
-        )
-        .with_help("add <float name=\"temperature\" value=\"5000\"/>"));
+        .with_help("give the value as <rgb>, <spectrum>, <float> or <spectrum type=\"blackbody\">")
     };
-    if !(temperature > 0.0 && temperature.is_finite() && temperature < f64::from(f32::MAX)) {
-        return Err(Error::input(
-            blackbody.location_of("temperature"),
-            format!(
-                "the blackbody temperature must be a positive number of kelvin, not {temperature}"
-            ),
-        ));
+    if child.node.class != PluginClass::Spectrum {
+        return Err(unsupported());
     }
-    blackbody.finish()?;
-    Ok(Spectrum::Blackbody(Blackbody {
-        temperature: temperature as f32,
-    }))
+    match build_nested_spectrum(&child.node)? {
+        NestedSpectrum::Emission(spectrum) => Ok(spectrum),
+        NestedSpectrum::Ior(_) => Err(unsupported()),
+    }
 }
 
-/// Mitsuba's `envmap`: `filename` (required), `scale` (1), `to_world` (identity).
+/// Mitsuba's `envmap`.
 fn build_envmap(params: &Params) -> Result<Light> {
     let node = params.node();
-    let Some(filename) = params.string_opt("filename")? else {
+    let Some(filename) = params.string_opt(&ENVMAP_FILENAME)? else {
         return Err(Error::input(
             &node.location,
             format!("{} needs a \"filename\"", node.describe()),
         )
         .with_help("add <string name=\"filename\" value=\"sky.exr\"/>"));
     };
-    let location = params.location_of("filename");
+    let location = params.location_of(&ENVMAP_FILENAME);
     let path = node.resolve_file(filename, location)?;
     let bitmap = read_bitmap(&path).map_err(|e| e.at(location))?;
     if bitmap.width < 2 || bitmap.height < 3 {
@@ -280,14 +378,14 @@ fn build_envmap(params: &Params) -> Result<Light> {
         )
         .with_help("radiance cannot be negative: clamp the image to 0"));
     }
-    let scale = params.float("scale", 1.0)?;
+    let scale = params.float(&ENVMAP_SCALE)?;
     if !(scale >= 0.0 && scale.is_finite() && scale <= f64::from(f32::MAX)) {
         return Err(Error::input(
-            params.location_of("scale"),
+            params.location_of(&ENVMAP_SCALE),
             format!("the environment map's scale must be finite and at least 0, not {scale}"),
         ));
     }
-    let to_world = invertible(params, "to_world")?;
+    let to_world = invertible(params, &TO_WORLD)?;
     Ok(Light::Envmap(EnvironmentMap::new(
         bitmap,
         scale as f32,

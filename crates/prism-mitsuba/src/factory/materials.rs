@@ -1,16 +1,15 @@
-//! BSDF plugins: `diffuse`, `roughdiffuse`, `conductor`, `roughconductor`, `dielectric`,
-//! `roughdielectric`, `thindielectric`, `plastic`, `roughplastic`, `phong`, `twosided`, `mask`,
-//! `blendbsdf`, `bumpmap` and `normalmap`, with Mitsuba 3's parameters and defaults (Mitsuba
-//! 0.6's for `roughdiffuse` and `phong`, which Mitsuba 3 dropped). Each BSDF's module documents
-//! its parameters; the checks here follow Mitsuba's and add the ones it leaves to chance
-//! (non-positive roughness or index, opacity outside [0, 1]).
+//! BSDF plugins, with Mitsuba 3's parameters and defaults (Mitsuba 0.6's for `roughdiffuse` and
+//! `phong`, which Mitsuba 3 dropped). The checks follow Mitsuba's and add the ones it leaves to
+//! chance (non-positive roughness or index, opacity outside [0, 1]).
 
-use super::spectra::Range;
+use super::spectra::{NestedSpectrum, Range, build_nested_spectrum};
 use super::textures::{
-    TextureCache, build_texture, float_texture, optional_spectrum_texture, spectrum_texture,
+    TextureCache, build_texture, float_texture, float_value, optional_spectrum_texture,
+    spectrum_texture,
 };
 use crate::description::{PluginClass, PluginNode, PropertyValue, SpectrumValue};
 use crate::params::Params;
+use crate::registry::{Bounds, Default, Origin, ParamKind, ParamSpec, Plugin, Registry};
 use prism_core::bsdf::microfacet::MicrofacetKind;
 use prism_core::bsdf::{
     Blend, Bsdf, BsdfFlags, BsdfModel, BumpMap, Conductor, Dielectric, Diffuse, MAX_NODES, Mask,
@@ -18,30 +17,496 @@ use prism_core::bsdf::{
     RoughPlastic, ThinDielectric, TwoSided,
 };
 use prism_core::error::{Error, Result};
-use prism_core::spectrum::conductors::CONDUCTORS;
-use prism_core::spectrum::ior::{Ior, NAMED_IORS, RelativeIor, named_ior, sellmeier_glass};
+use prism_core::spectrum::conductors::{conductor_names, conductor_preset};
+use prism_core::spectrum::ior::{Ior, NAMED_IORS, RelativeIor, named_ior};
 use prism_core::spectrum::{LAMBDA_MAX, LAMBDA_MIN, PiecewiseLinear, RgbIntent, Spectrum};
 use prism_core::texture::Texture;
 use prism_core::texture::TextureUse;
 
-/// The BSDF types this factory knows.
-pub const SUPPORTED_BSDFS: &[&str] = &[
-    "blendbsdf",
-    "bumpmap",
-    "conductor",
-    "dielectric",
-    "diffuse",
-    "mask",
+type Build = fn(&Params, &mut TextureCache) -> Result<Bsdf>;
+
+pub static BSDFS: Registry<Build> = Registry {
+    class: PluginClass::Bsdf,
+    plugins: &[
+        Plugin {
+            name: "diffuse",
+            origin: Origin::Mitsuba3,
+            summary: "The ideal Lambertian reflector, f = ρ/π, sampled by the cosine. One-sided.",
+            params: &[REFLECTANCE],
+            build: |params, t| {
+                Ok(Bsdf::Diffuse(Diffuse {
+                    reflectance: spectrum_texture(params, &REFLECTANCE, t)?,
+                }))
+            },
+        },
+        Plugin {
+            name: "roughdiffuse",
+            origin: Origin::Mitsuba06,
+            summary: "Oren–Nayar's rough diffuse reflector (σ = α/√2), with its interreflection \
+                      term. One-sided.",
+            params: &[REFLECTANCE, OREN_NAYAR_ALPHA, USE_FAST_APPROX],
+            build: |params, t| {
+                Ok(Bsdf::RoughDiffuse(RoughDiffuse {
+                    reflectance: spectrum_texture(params, &REFLECTANCE, t)?,
+                    alpha: float_texture(params, &OREN_NAYAR_ALPHA, t)?,
+                    use_fast_approx: params.boolean(&USE_FAST_APPROX)?,
+                }))
+            },
+        },
+        Plugin {
+            name: "conductor",
+            origin: Origin::Mitsuba3,
+            summary: "A smooth metal: a mirror with the Fresnel reflectance of η + ik. One-sided.",
+            params: &[MATERIAL, ETA, K, CONDUCTOR_SPECULAR],
+            build: |params, t| {
+                let (eta, k) = conductor_ior(params, t)?;
+                Ok(Bsdf::Conductor(Conductor {
+                    eta,
+                    k,
+                    specular_reflectance: spectrum_texture(params, &CONDUCTOR_SPECULAR, t)?,
+                }))
+            },
+        },
+        Plugin {
+            name: "roughconductor",
+            origin: Origin::Mitsuba3,
+            summary: "A rough metal: the microfacet model of Walter et al. 2007, sampled by \
+                      visible normals. One-sided.",
+            params: &[
+                MATERIAL,
+                ETA,
+                K,
+                CONDUCTOR_SPECULAR,
+                DISTRIBUTION,
+                ALPHA,
+                ALPHA_U,
+                ALPHA_V,
+                SAMPLE_VISIBLE,
+            ],
+            build: |params, t| {
+                let (eta, k) = conductor_ior(params, t)?;
+                let distribution = distribution(params)?;
+                let (alpha_u, alpha_v) = roughness(params, t)?;
+                Ok(Bsdf::RoughConductor(RoughConductor {
+                    distribution,
+                    alpha_u,
+                    alpha_v,
+                    eta,
+                    k,
+                    specular_reflectance: spectrum_texture(params, &CONDUCTOR_SPECULAR, t)?,
+                }))
+            },
+        },
+        Plugin {
+            name: "dielectric",
+            origin: Origin::Mitsuba3,
+            summary: "A smooth interface between two dielectrics (glass, water), from both sides. \
+                      Behind a dispersive index each wavelength refracts its own way.",
+            params: &[
+                INT_IOR,
+                EXT_IOR,
+                SPECULAR_REFLECTANCE,
+                SPECULAR_TRANSMITTANCE,
+            ],
+            build: |params, t| {
+                Ok(Bsdf::Dielectric(Dielectric {
+                    eta: relative_ior(params, &INT_IOR, false)?,
+                    specular_reflectance: optional_spectrum_texture(
+                        params,
+                        &SPECULAR_REFLECTANCE,
+                        t,
+                    )?,
+                    specular_transmittance: optional_spectrum_texture(
+                        params,
+                        &SPECULAR_TRANSMITTANCE,
+                        t,
+                    )?,
+                }))
+            },
+        },
+        Plugin {
+            name: "roughdielectric",
+            origin: Origin::Mitsuba3,
+            summary: "A rough interface between two dielectrics (frosted glass), Walter et al. 2007.",
+            params: &[
+                INT_IOR,
+                EXT_IOR,
+                SPECULAR_REFLECTANCE,
+                SPECULAR_TRANSMITTANCE,
+                DISTRIBUTION,
+                ALPHA,
+                ALPHA_U,
+                ALPHA_V,
+                SAMPLE_VISIBLE,
+            ],
+            build: |params, t| {
+                let eta = relative_ior(params, &INT_IOR, true)?;
+                let distribution = distribution(params)?;
+                let (alpha_u, alpha_v) = roughness(params, t)?;
+                Ok(Bsdf::RoughDielectric(RoughDielectric {
+                    eta,
+                    distribution,
+                    alpha_u,
+                    alpha_v,
+                    specular_reflectance: optional_spectrum_texture(
+                        params,
+                        &SPECULAR_REFLECTANCE,
+                        t,
+                    )?,
+                    specular_transmittance: optional_spectrum_texture(
+                        params,
+                        &SPECULAR_TRANSMITTANCE,
+                        t,
+                    )?,
+                }))
+            },
+        },
+        Plugin {
+            name: "thindielectric",
+            origin: Origin::Mitsuba3,
+            summary: "A thin pane of glass: reflects R' = 2R/(1 + R) and lets the rest through \
+                      undeflected.",
+            params: &[
+                INT_IOR,
+                EXT_IOR,
+                SPECULAR_REFLECTANCE,
+                SPECULAR_TRANSMITTANCE,
+            ],
+            build: |params, t| {
+                Ok(Bsdf::ThinDielectric(ThinDielectric {
+                    eta: relative_ior(params, &INT_IOR, false)?,
+                    specular_reflectance: optional_spectrum_texture(
+                        params,
+                        &SPECULAR_REFLECTANCE,
+                        t,
+                    )?,
+                    specular_transmittance: optional_spectrum_texture(
+                        params,
+                        &SPECULAR_TRANSMITTANCE,
+                        t,
+                    )?,
+                }))
+            },
+        },
+        Plugin {
+            name: "plastic",
+            origin: Origin::Mitsuba3,
+            summary: "A diffuse base under a smooth dielectric coating (Weidlich & Wilkie 2007). \
+                      One-sided.",
+            params: &[
+                DIFFUSE_REFLECTANCE,
+                COATING_INT_IOR,
+                EXT_IOR,
+                SPECULAR_REFLECTANCE,
+                NONLINEAR,
+            ],
+            build: |params, t| {
+                let eta = constant_relative_ior(params, false)?;
+                Ok(Bsdf::Plastic(Plastic::new(
+                    eta,
+                    spectrum_texture(params, &DIFFUSE_REFLECTANCE, t)?,
+                    optional_spectrum_texture(params, &SPECULAR_REFLECTANCE, t)?,
+                    params.boolean(&NONLINEAR)?,
+                )))
+            },
+        },
+        Plugin {
+            name: "roughplastic",
+            origin: Origin::Mitsuba3,
+            summary: "A diffuse base under a rough dielectric coating, with Mitsuba 3's tabulated \
+                      coating transmittance. One-sided.",
+            params: &[
+                DIFFUSE_REFLECTANCE,
+                COATING_INT_IOR,
+                EXT_IOR,
+                SPECULAR_REFLECTANCE,
+                NONLINEAR,
+                DISTRIBUTION,
+                PLASTIC_ALPHA,
+                ALPHA_U,
+                ALPHA_V,
+                SAMPLE_VISIBLE,
+            ],
+            build: build_roughplastic,
+        },
+        Plugin {
+            name: "phong",
+            origin: Origin::Mitsuba06,
+            summary: "The energy-normalised modified Phong model (Lafortune & Willems 1994); \
+                      reflectances summing above 1 are scaled down, as Mitsuba 0.6 does. One-sided.",
+            params: &[EXPONENT, PHONG_SPECULAR, DIFFUSE_REFLECTANCE],
+            build: |params, t| {
+                let exponent = float_texture(params, &EXPONENT, t)?;
+                let specular = spectrum_texture(params, &PHONG_SPECULAR, t)?;
+                let diffuse = spectrum_texture(params, &DIFFUSE_REFLECTANCE, t)?;
+                let total = largest_sum(&specular, &diffuse);
+                Ok(Bsdf::Phong(Phong {
+                    exponent,
+                    specular_reflectance: specular,
+                    diffuse_reflectance: diffuse,
+                    scale: if total > 1.0 { 1.0 / total } else { 1.0 },
+                }))
+            },
+        },
+        Plugin {
+            name: "twosided",
+            origin: Origin::Mitsuba3,
+            summary: "A reflecting BSDF on both sides of the surface, or one for the front and one \
+                      for the back.",
+            params: &[TWOSIDED_BSDFS],
+            build: |params, t| {
+                let (front, back) = twosided_pair(params, t)?;
+                Ok(Bsdf::TwoSided(TwoSided {
+                    front: Box::new(front),
+                    back: Box::new(back),
+                }))
+            },
+        },
+        Plugin {
+            name: "mask",
+            origin: Origin::Mitsuba3,
+            summary: "A partly transparent surface: light passes straight through with \
+                      probability 1 − α. Shadow rays see it as opaque.",
+            params: &[OPACITY, NESTED_BSDF],
+            build: |params, t| {
+                Ok(Bsdf::Mask(Mask {
+                    opacity: float_texture(params, &OPACITY, t)?,
+                    nested: Box::new(single_nested_bsdf(params, t)?),
+                }))
+            },
+        },
+        Plugin {
+            name: "blendbsdf",
+            origin: Origin::Mitsuba3,
+            summary: "The linear blend (1 − w) f₀ + w f₁ of two nested BSDFs.",
+            params: &[WEIGHT, BLENDED_BSDFS],
+            build: build_blend,
+        },
+        Plugin {
+            name: "bumpmap",
+            origin: Origin::Mitsuba3,
+            summary: "The nested BSDF in a shading frame tilted by the gradient of a height \
+                      texture (Blinn 1978).",
+            params: &[
+                HEIGHTS,
+                BUMP_SCALE,
+                FLIP_INVALID_NORMALS,
+                USE_SHADOWING_FUNCTION,
+                NESTED_BSDF,
+            ],
+            build: build_bumpmap,
+        },
+        Plugin {
+            name: "normalmap",
+            origin: Origin::Mitsuba3,
+            summary: "The nested BSDF in a shading frame whose normal is read from an RGB texture, \
+                      n = 2 rgb − 1.",
+            params: &[
+                NORMALMAP,
+                FLIP_INVALID_NORMALS,
+                USE_SHADOWING_FUNCTION,
+                NESTED_BSDF,
+            ],
+            build: build_normalmap,
+        },
+    ],
+};
+
+const fn colour(name: &'static str, range: Range, default: f64, doc: &'static str) -> ParamSpec {
+    ParamSpec::new(
+        name,
+        ParamKind::Spectrum {
+            range,
+            textured: true,
+        },
+        Default::Float(default),
+        doc,
+    )
+}
+
+const REFLECTANCE: ParamSpec = colour("reflectance", Range::Albedo, 0.5, "the reflectance ρ");
+const OREN_NAYAR_ALPHA: ParamSpec = ParamSpec::new(
+    "alpha",
+    ParamKind::FloatTexture(Bounds::NON_NEGATIVE),
+    Default::Float(0.2),
+    "RMS slope of the surface; 0 is Lambert's law",
+);
+const USE_FAST_APPROX: ParamSpec = ParamSpec::new(
+    "use_fast_approx",
+    ParamKind::Boolean,
+    Default::Boolean(false),
+    "use the qualitative model of the paper's eq. 30",
+);
+const MATERIAL: ParamSpec = ParamSpec::new(
+    "material",
+    ParamKind::String,
+    Default::Str("none"),
+    "a measured preset (`Au`, `Ag`, `Cu`, `Al`, `Cr`, … the 71 of Mitsuba's table), or `none`: \
+     a 100 % mirror",
+);
+const ETA: ParamSpec = colour(
+    "eta",
+    Range::Unbounded,
+    0.0,
+    "real part of the index (instead of `material`); an `<rgb>` is upsampled without bounds",
+);
+const K: ParamSpec = colour(
+    "k",
+    Range::Unbounded,
+    1.0,
+    "imaginary part of the index (instead of `material`)",
+);
+const CONDUCTOR_SPECULAR: ParamSpec = colour(
+    "specular_reflectance",
+    Range::Albedo,
+    1.0,
+    "a factor on the reflectance",
+);
+const DISTRIBUTION: ParamSpec = ParamSpec::new(
+    "distribution",
+    ParamKind::Choice(&["beckmann", "ggx"]),
+    Default::Str("beckmann"),
+    "the microfacet distribution",
+);
+const ALPHA: ParamSpec = ParamSpec::new(
+    "alpha",
+    ParamKind::FloatTexture(Bounds::POSITIVE),
+    Default::Float(0.1),
+    "roughness α (RMS slope for Beckmann)",
+);
+const ALPHA_U: ParamSpec = ParamSpec::new(
+    "alpha_u",
+    ParamKind::FloatTexture(Bounds::POSITIVE),
+    Default::Text("`alpha`"),
+    "roughness along ∂p/∂u (with `alpha_v`, instead of `alpha`)",
+);
+const ALPHA_V: ParamSpec = ParamSpec::new(
+    "alpha_v",
+    ParamKind::FloatTexture(Bounds::POSITIVE),
+    Default::Text("`alpha`"),
+    "roughness along ∂p/∂v",
+);
+const SAMPLE_VISIBLE: ParamSpec = ParamSpec::new(
+    "sample_visible",
+    ParamKind::Boolean,
+    Default::Boolean(true),
+    "accepted; visible normals are always sampled",
+);
+const INT_IOR: ParamSpec = ParamSpec::new(
+    "int_ior",
+    ParamKind::Ior,
+    Default::Str("bk7"),
+    "index of refraction inside: a number, a name (`bk7`, `water`, …), a `<spectrum>`, or \
+     (Prism) a dispersive `<spectrum type=\"sellmeier\">` or `cauchy`",
+);
+const COATING_INT_IOR: ParamSpec = ParamSpec::new(
+    "int_ior",
+    ParamKind::Ior,
+    Default::Str("polypropylene"),
+    "index of refraction of the coating: a number or a name",
+);
+const EXT_IOR: ParamSpec = ParamSpec::new(
+    "ext_ior",
+    ParamKind::Ior,
+    Default::Str("air"),
+    "index of refraction outside",
+);
+const SPECULAR_REFLECTANCE: ParamSpec = colour(
+    "specular_reflectance",
+    Range::Albedo,
+    1.0,
+    "a factor on the reflected light",
+);
+const SPECULAR_TRANSMITTANCE: ParamSpec = colour(
+    "specular_transmittance",
+    Range::Albedo,
+    1.0,
+    "a factor on the transmitted light",
+);
+const DIFFUSE_REFLECTANCE: ParamSpec = colour(
+    "diffuse_reflectance",
+    Range::Albedo,
+    0.5,
+    "reflectance of the diffuse base",
+);
+const NONLINEAR: ParamSpec = ParamSpec::new(
+    "nonlinear",
+    ParamKind::Boolean,
+    Default::Boolean(false),
+    "let the bounces between base and coating be modulated by the base colour (darker, more \
+     saturated colours)",
+);
+const PLASTIC_ALPHA: ParamSpec = ParamSpec::new(
+    "alpha",
+    ParamKind::Float,
+    Default::Float(0.1),
+    "roughness α of the coating: a number greater than 0 (isotropic only, no texture, as Mitsuba)",
+);
+const EXPONENT: ParamSpec = ParamSpec::new(
+    "exponent",
+    ParamKind::FloatTexture(Bounds::POSITIVE),
+    Default::Float(30.0),
+    "the Phong exponent n",
+);
+const PHONG_SPECULAR: ParamSpec = colour(
+    "specular_reflectance",
+    Range::Albedo,
+    0.2,
+    "reflectance of the glossy lobe",
+);
+const TWOSIDED_BSDFS: ParamSpec = ParamSpec::nested(
+    PluginClass::Bsdf,
+    Default::Required,
+    "one reflecting BSDF for both sides, or two: front, then back",
+);
+const NESTED_BSDF: ParamSpec =
+    ParamSpec::nested(PluginClass::Bsdf, Default::Required, "the BSDF adapted");
+const OPACITY: ParamSpec = ParamSpec::new(
+    "opacity",
+    ParamKind::FloatTexture(Bounds::UNIT),
+    Default::Float(0.5),
+    "the opacity α",
+);
+const WEIGHT: ParamSpec = ParamSpec::new(
+    "weight",
+    ParamKind::FloatTexture(Bounds::UNIT),
+    Default::Required,
+    "the share w of the second BSDF",
+);
+const BLENDED_BSDFS: ParamSpec = ParamSpec::nested(
+    PluginClass::Bsdf,
+    Default::Required,
+    "two BSDFs: f₀, then f₁",
+);
+const HEIGHTS: ParamSpec = ParamSpec::nested(
+    PluginClass::Texture,
+    Default::Required,
+    "the height texture (read as numbers; give `raw` for 8-bit images)",
+);
+const BUMP_SCALE: ParamSpec = ParamSpec::new(
+    "scale",
+    ParamKind::Float,
+    Default::Float(1.0),
+    "factor on the heights",
+);
+const FLIP_INVALID_NORMALS: ParamSpec = ParamSpec::new(
+    "flip_invalid_normals",
+    ParamKind::Boolean,
+    Default::Boolean(true),
+    "mirror a normal that the outgoing direction sees from behind",
+);
+const USE_SHADOWING_FUNCTION: ParamSpec = ParamSpec::new(
+    "use_shadowing_function",
+    ParamKind::Boolean,
+    Default::Boolean(true),
+    "attenuate by Conty Estevez et al.'s shadowing term (the bump terminator)",
+);
+const NORMALMAP: ParamSpec = ParamSpec::new(
     "normalmap",
-    "phong",
-    "plastic",
-    "roughconductor",
-    "roughdielectric",
-    "roughdiffuse",
-    "roughplastic",
-    "thindielectric",
-    "twosided",
-];
+    ParamKind::Nested(PluginClass::Texture),
+    Default::Required,
+    "a texture named `normalmap`, read raw: the normals in the shading frame",
+);
 
 /// Mitsuba's default material for a shape without a BSDF: one-sided diffuse, reflectance 0.5.
 pub fn default_material() -> Material {
@@ -54,7 +519,9 @@ pub fn default_material() -> Material {
 /// and back BSDFs, anything else the front one.
 pub fn build_material(node: &PluginNode, textures: &mut TextureCache) -> Result<Material> {
     let material = if node.plugin_type == "twosided" {
-        let (front, back) = twosided_pair(node, textures)?;
+        let params = Params::new(node, &[TWOSIDED_BSDFS]);
+        let (front, back) = twosided_pair(&params, textures)?;
+        params.finish()?;
         Material {
             front,
             back: Some(back),
@@ -76,10 +543,19 @@ pub fn build_material(node: &PluginNode, textures: &mut TextureCache) -> Result<
     Ok(material)
 }
 
+/// Builds a BSDF (a `twosided` here is one nested in another adapter).
+pub fn build_bsdf(node: &PluginNode, textures: &mut TextureCache) -> Result<Bsdf> {
+    let plugin = BSDFS.find(node)?;
+    let params = Params::new(node, plugin.params);
+    let bsdf = (plugin.build)(&params, textures)?;
+    params.finish()?;
+    Ok(bsdf)
+}
+
 /// The front and back BSDFs of a `twosided` element.
-fn twosided_pair(node: &PluginNode, textures: &mut TextureCache) -> Result<(Bsdf, Bsdf)> {
-    let params = Params::new(node);
-    let nested = params.children(PluginClass::Bsdf);
+fn twosided_pair(params: &Params, textures: &mut TextureCache) -> Result<(Bsdf, Bsdf)> {
+    let node = params.node();
+    let nested = params.children(&TWOSIDED_BSDFS);
     let one_sided = |child: &PluginNode, textures: &mut TextureCache| -> Result<Bsdf> {
         if child.plugin_type == "twosided" {
             return Err(Error::input(
@@ -127,268 +603,122 @@ fn twosided_pair(node: &PluginNode, textures: &mut TextureCache) -> Result<(Bsdf
             ));
         }
     };
-    params.finish()?;
     Ok(pair)
 }
 
-/// Builds a BSDF (a `twosided` here is one nested in another adapter).
-pub fn build_bsdf(node: &PluginNode, textures: &mut TextureCache) -> Result<Bsdf> {
-    if node.plugin_type == "twosided" {
-        let (front, back) = twosided_pair(node, textures)?;
-        return Ok(Bsdf::TwoSided(TwoSided {
-            front: Box::new(front),
-            back: Box::new(back),
-        }));
+fn build_roughplastic(params: &Params, t: &mut TextureCache) -> Result<Bsdf> {
+    let eta = constant_relative_ior(params, true)?;
+    let distribution = distribution(params)?;
+    for spec in [&ALPHA_U, &ALPHA_V] {
+        if params.has(spec) {
+            return Err(Error::input(
+                params.location_of(spec),
+                "bsdf \"roughplastic\" supports only isotropic roughness",
+            )
+            .with_help("give a single <float name=\"alpha\" .../>, as Mitsuba 3 requires"));
+        }
     }
-    let params = Params::new(node);
-    let t = textures;
-    let bsdf = match node.plugin_type.as_str() {
-        "diffuse" => Bsdf::Diffuse(Diffuse {
-            reflectance: spectrum_texture(&params, "reflectance", 0.5, Range::Albedo, t)?,
-        }),
-        "roughdiffuse" => Bsdf::RoughDiffuse(RoughDiffuse {
-            reflectance: spectrum_texture(&params, "reflectance", 0.5, Range::Albedo, t)?,
-            alpha: float_texture(&params, "alpha", 0.2, 0.0, false, f32::INFINITY, t)?,
-            use_fast_approx: params.boolean("use_fast_approx", false)?,
-        }),
-        "conductor" => {
-            let (eta, k) = conductor_ior(&params, t)?;
-            Bsdf::Conductor(Conductor {
-                eta,
-                k,
-                specular_reflectance: spectrum_texture(
-                    &params,
-                    "specular_reflectance",
-                    1.0,
-                    Range::Albedo,
-                    t,
-                )?,
-            })
-        }
-        "roughconductor" => {
-            let (eta, k) = conductor_ior(&params, t)?;
-            let distribution = distribution(&params)?;
-            let (alpha_u, alpha_v) = roughness(&params, t)?;
-            Bsdf::RoughConductor(RoughConductor {
-                distribution,
-                alpha_u,
-                alpha_v,
-                eta,
-                k,
-                specular_reflectance: spectrum_texture(
-                    &params,
-                    "specular_reflectance",
-                    1.0,
-                    Range::Albedo,
-                    t,
-                )?,
-            })
-        }
-        "dielectric" => Bsdf::Dielectric(Dielectric {
-            eta: relative_ior(&params, "bk7", false)?,
-            specular_reflectance: optional_spectrum_texture(
-                &params,
-                "specular_reflectance",
-                Range::Albedo,
-                t,
-            )?,
-            specular_transmittance: optional_spectrum_texture(
-                &params,
-                "specular_transmittance",
-                Range::Albedo,
-                t,
-            )?,
-        }),
-        "roughdielectric" => {
-            let eta = relative_ior(&params, "bk7", true)?;
-            let distribution = distribution(&params)?;
-            let (alpha_u, alpha_v) = roughness(&params, t)?;
-            Bsdf::RoughDielectric(RoughDielectric {
-                eta,
-                distribution,
-                alpha_u,
-                alpha_v,
-                specular_reflectance: optional_spectrum_texture(
-                    &params,
-                    "specular_reflectance",
-                    Range::Albedo,
-                    t,
-                )?,
-                specular_transmittance: optional_spectrum_texture(
-                    &params,
-                    "specular_transmittance",
-                    Range::Albedo,
-                    t,
-                )?,
-            })
-        }
-        "thindielectric" => Bsdf::ThinDielectric(ThinDielectric {
-            eta: relative_ior(&params, "bk7", false)?,
-            specular_reflectance: optional_spectrum_texture(
-                &params,
-                "specular_reflectance",
-                Range::Albedo,
-                t,
-            )?,
-            specular_transmittance: optional_spectrum_texture(
-                &params,
-                "specular_transmittance",
-                Range::Albedo,
-                t,
-            )?,
-        }),
-        "plastic" => {
-            let eta = constant_relative_ior(&params, false)?;
-            Bsdf::Plastic(Plastic::new(
-                eta,
-                spectrum_texture(&params, "diffuse_reflectance", 0.5, Range::Albedo, t)?,
-                optional_spectrum_texture(&params, "specular_reflectance", Range::Albedo, t)?,
-                params.boolean("nonlinear", false)?,
-            ))
-        }
-        "roughplastic" => {
-            let eta = constant_relative_ior(&params, true)?;
-            let distribution = distribution(&params)?;
-            for name in ["alpha_u", "alpha_v"] {
-                if params.property(name).is_some() || params.named_child(name).is_some() {
-                    return Err(Error::input(
-                        params.location_of(name),
-                        "bsdf \"roughplastic\" supports only isotropic roughness",
-                    )
-                    .with_help(
-                        "give a single <float name=\"alpha\" .../>, as Mitsuba 3 requires",
-                    ));
-                }
-            }
-            let alpha = match params.named_child("alpha") {
-                Some(child) => {
-                    return Err(Error::input(
-                        &child.location,
-                        "the roughness of \"roughplastic\" must be a number, not a texture",
-                    )
-                    .with_help("Mitsuba 3's roughplastic precomputes its tables for one alpha"));
-                }
-                None => float_texture(&params, "alpha", 0.1, 0.0, true, f32::INFINITY, t)?
-                    .eval_1(glam::Vec2::ZERO),
-            };
-            params.boolean("sample_visible", true)?;
-            Bsdf::RoughPlastic(RoughPlastic::new(
-                eta,
-                distribution,
-                alpha,
-                spectrum_texture(&params, "diffuse_reflectance", 0.5, Range::Albedo, t)?,
-                optional_spectrum_texture(&params, "specular_reflectance", Range::Albedo, t)?,
-                params.boolean("nonlinear", false)?,
-            ))
-        }
-        "phong" => {
-            let exponent = float_texture(&params, "exponent", 30.0, 0.0, true, f32::INFINITY, t)?;
-            let specular =
-                spectrum_texture(&params, "specular_reflectance", 0.2, Range::Albedo, t)?;
-            let diffuse = spectrum_texture(&params, "diffuse_reflectance", 0.5, Range::Albedo, t)?;
-            let total = largest_sum(&specular, &diffuse);
-            Bsdf::Phong(Phong {
-                exponent,
-                specular_reflectance: specular,
-                diffuse_reflectance: diffuse,
-                scale: if total > 1.0 { 1.0 / total } else { 1.0 },
-            })
-        }
-        "mask" => Bsdf::Mask(Mask {
-            opacity: float_texture(&params, "opacity", 0.5, 0.0, false, 1.0, t)?,
-            nested: Box::new(single_nested_bsdf(&params, t)?),
-        }),
-        "blendbsdf" => {
-            if params.property("weight").is_none() && params.named_child("weight").is_none() {
-                return Err(
-                    Error::input(&node.location, "bsdf \"blendbsdf\" needs a \"weight\"")
-                        .with_help(
-                            "add <float name=\"weight\" value=\"0.5\"/> (the second BSDF's share)",
-                        ),
-                );
-            }
-            let weight = float_texture(&params, "weight", 0.5, 0.0, false, 1.0, t)?;
-            let nested = params.children(PluginClass::Bsdf);
-            let [first, second] = nested.as_slice() else {
-                return Err(Error::input(
-                    &node.location,
-                    format!(
-                        "bsdf \"blendbsdf\" needs exactly two nested BSDFs, found {}",
-                        nested.len()
-                    ),
-                ));
-            };
-            Bsdf::Blend(Blend {
-                weight,
-                nested: [
-                    Box::new(build_bsdf(&first.node, t)?),
-                    Box::new(build_bsdf(&second.node, t)?),
-                ],
-            })
-        }
-        "bumpmap" => {
-            let nested_textures = params.children(PluginClass::Texture);
-            let [height] = nested_textures.as_slice() else {
-                return Err(Error::input(
-                    &node.location,
-                    format!(
-                        "bsdf \"bumpmap\" needs exactly one nested texture (the heights), found {}",
-                        nested_textures.len()
-                    ),
-                ));
-            };
-            let scale = params.float("scale", 1.0)? as f32;
-            if !scale.is_finite() {
-                return Err(Error::input(
-                    params.location_of("scale"),
-                    "the bump map's scale must be a finite number",
-                ));
-            }
-            Bsdf::BumpMap(BumpMap {
-                height: build_texture(&height.node, TextureUse::Scalar, t)?,
-                scale,
-                nested: Box::new(single_nested_bsdf(&params, t)?),
-                flip_invalid_normals: params.boolean("flip_invalid_normals", true)?,
-                use_shadowing_function: params.boolean("use_shadowing_function", true)?,
-            })
-        }
-        "normalmap" => {
-            let Some(normals) = params.named_child("normalmap") else {
-                return Err(Error::input(
-                    &node.location,
-                    "bsdf \"normalmap\" needs a texture named \"normalmap\"",
-                )
-                .with_help("nest <texture type=\"bitmap\" name=\"normalmap\"> with raw=\"true\""));
-            };
-            if normals.node.class != PluginClass::Texture {
-                return Err(Error::input(
-                    &normals.location,
-                    "the \"normalmap\" parameter must be a texture",
-                ));
-            }
-            Bsdf::NormalMap(NormalMap {
-                normals: build_texture(&normals.node, TextureUse::Rgb, t)?,
-                nested: Box::new(single_nested_bsdf(&params, t)?),
-                flip_invalid_normals: params.boolean("flip_invalid_normals", true)?,
-                use_shadowing_function: params.boolean("use_shadowing_function", true)?,
-            })
-        }
-        other => return Err(unknown_type(node, other)),
-    };
-    params.finish()?;
-    Ok(bsdf)
+    if let Some(child) = params.named_child(&PLASTIC_ALPHA) {
+        return Err(Error::input(
+            &child.location,
+            "the roughness of \"roughplastic\" must be a number, not a texture",
+        )
+        .with_help("Mitsuba 3's roughplastic precomputes its tables for one alpha"));
+    }
+    let alpha = float_value(params, &PLASTIC_ALPHA, Bounds::POSITIVE)?;
+    params.boolean(&SAMPLE_VISIBLE)?;
+    Ok(Bsdf::RoughPlastic(RoughPlastic::new(
+        eta,
+        distribution,
+        alpha,
+        spectrum_texture(params, &DIFFUSE_REFLECTANCE, t)?,
+        optional_spectrum_texture(params, &SPECULAR_REFLECTANCE, t)?,
+        params.boolean(&NONLINEAR)?,
+    )))
 }
 
-fn unknown_type(node: &PluginNode, name: &str) -> Error {
-    Error::input(&node.location, format!("unknown bsdf type \"{name}\"")).with_help(format!(
-        "supported bsdf types: {}",
-        SUPPORTED_BSDFS.join(", ")
-    ))
+fn build_blend(params: &Params, t: &mut TextureCache) -> Result<Bsdf> {
+    let node = params.node();
+    if !params.has(&WEIGHT) {
+        return Err(
+            Error::input(&node.location, "bsdf \"blendbsdf\" needs a \"weight\"")
+                .with_help("add <float name=\"weight\" value=\"0.5\"/> (the second BSDF's share)"),
+        );
+    }
+    let weight = float_texture(params, &WEIGHT, t)?;
+    let nested = params.children(&BLENDED_BSDFS);
+    let [first, second] = nested.as_slice() else {
+        return Err(Error::input(
+            &node.location,
+            format!(
+                "bsdf \"blendbsdf\" needs exactly two nested BSDFs, found {}",
+                nested.len()
+            ),
+        ));
+    };
+    Ok(Bsdf::Blend(Blend {
+        weight,
+        nested: [
+            Box::new(build_bsdf(&first.node, t)?),
+            Box::new(build_bsdf(&second.node, t)?),
+        ],
+    }))
+}
+
+fn build_bumpmap(params: &Params, t: &mut TextureCache) -> Result<Bsdf> {
+    let node = params.node();
+    let nested_textures = params.children(&HEIGHTS);
+    let [height] = nested_textures.as_slice() else {
+        return Err(Error::input(
+            &node.location,
+            format!(
+                "bsdf \"bumpmap\" needs exactly one nested texture (the heights), found {}",
+                nested_textures.len()
+            ),
+        ));
+    };
+    let scale = params.float(&BUMP_SCALE)? as f32;
+    if !scale.is_finite() {
+        return Err(Error::input(
+            params.location_of(&BUMP_SCALE),
+            "the bump map's scale must be a finite number",
+        ));
+    }
+    Ok(Bsdf::BumpMap(BumpMap {
+        height: build_texture(&height.node, TextureUse::Scalar, t)?,
+        scale,
+        nested: Box::new(single_nested_bsdf(params, t)?),
+        flip_invalid_normals: params.boolean(&FLIP_INVALID_NORMALS)?,
+        use_shadowing_function: params.boolean(&USE_SHADOWING_FUNCTION)?,
+    }))
+}
+
+fn build_normalmap(params: &Params, t: &mut TextureCache) -> Result<Bsdf> {
+    let node = params.node();
+    let Some(normals) = params.named_child(&NORMALMAP) else {
+        return Err(Error::input(
+            &node.location,
+            "bsdf \"normalmap\" needs a texture named \"normalmap\"",
+        )
+        .with_help("nest <texture type=\"bitmap\" name=\"normalmap\"> with raw=\"true\""));
+    };
+    if normals.node.class != PluginClass::Texture {
+        return Err(Error::input(
+            &normals.location,
+            "the \"normalmap\" parameter must be a texture",
+        ));
+    }
+    Ok(Bsdf::NormalMap(NormalMap {
+        normals: build_texture(&normals.node, TextureUse::Rgb, t)?,
+        nested: Box::new(single_nested_bsdf(params, t)?),
+        flip_invalid_normals: params.boolean(&FLIP_INVALID_NORMALS)?,
+        use_shadowing_function: params.boolean(&USE_SHADOWING_FUNCTION)?,
+    }))
 }
 
 /// The one BSDF nested in an adapter (`mask`, `bumpmap`, `normalmap`).
 fn single_nested_bsdf(params: &Params, textures: &mut TextureCache) -> Result<Bsdf> {
-    let nested = params.children(PluginClass::Bsdf);
+    let nested = params.children(&NESTED_BSDF);
     match nested.as_slice() {
         [one] => build_bsdf(&one.node, textures),
         _ => Err(Error::input(
@@ -416,34 +746,23 @@ fn largest_sum(a: &Texture, b: &Texture) -> f32 {
     }
 }
 
-/// Whether a parameter is given as a property or a nested plugin.
-fn has(params: &Params, name: &'static str) -> bool {
-    params.property(name).is_some() || params.named_child(name).is_some()
-}
-
 /// `distribution`: "beckmann" (the default) or "ggx", case-insensitive as in Mitsuba.
 fn distribution(params: &Params) -> Result<MicrofacetKind> {
-    let name = params.string("distribution", "beckmann")?;
-    match name.to_lowercase().as_str() {
-        "beckmann" => Ok(MicrofacetKind::Beckmann),
+    match params.choice(&DISTRIBUTION)? {
         "ggx" => Ok(MicrofacetKind::Ggx),
-        _ => Err(Error::input(
-            params.location_of("distribution"),
-            format!("unknown microfacet distribution \"{name}\""),
-        )
-        .with_help("use \"beckmann\" or \"ggx\"")),
+        _ => Ok(MicrofacetKind::Beckmann),
     }
 }
 
 /// `alpha`, or `alpha_u` and `alpha_v` (both, and not with `alpha`), numbers above 0 or
 /// textures; default 0.1. `sample_visible` is accepted: visible normals are always sampled.
 fn roughness(params: &Params, textures: &mut TextureCache) -> Result<(Texture, Texture)> {
-    params.boolean("sample_visible", true)?;
-    let (has_u, has_v) = (has(params, "alpha_u"), has(params, "alpha_v"));
+    params.boolean(&SAMPLE_VISIBLE)?;
+    let (has_u, has_v) = (params.has(&ALPHA_U), params.has(&ALPHA_V));
     if has_u || has_v {
-        if has(params, "alpha") {
+        if params.has(&ALPHA) {
             return Err(Error::input(
-                params.location_of("alpha"),
+                params.location_of(&ALPHA),
                 "give either \"alpha\" or \"alpha_u\" and \"alpha_v\", not both",
             ));
         }
@@ -458,36 +777,38 @@ fn roughness(params: &Params, textures: &mut TextureCache) -> Result<(Texture, T
             )
             .with_help("give both alpha_u and alpha_v"));
         }
-        let u = float_texture(params, "alpha_u", 0.1, 0.0, true, f32::INFINITY, textures)?;
-        let v = float_texture(params, "alpha_v", 0.1, 0.0, true, f32::INFINITY, textures)?;
+        let u = float_texture(params, &ALPHA_U, textures)?;
+        let v = float_texture(params, &ALPHA_V, textures)?;
         return Ok((u, v));
     }
-    let alpha = float_texture(params, "alpha", 0.1, 0.0, true, f32::INFINITY, textures)?;
+    let alpha = float_texture(params, &ALPHA, textures)?;
     Ok((alpha.clone(), alpha))
 }
 
 /// A conductor's η and k: `material` (a preset; "none", the default, is a perfect mirror with
 /// η = 0, k = 1), or `eta` and `k` as spectra, colours (upsampled without bounds) or textures.
 fn conductor_ior(params: &Params, textures: &mut TextureCache) -> Result<(Texture, Texture)> {
-    let material = params.string("material", "none")?;
+    let material = params.string(&MATERIAL)?;
     if material == "none" {
-        let eta = spectrum_texture(params, "eta", 0.0, Range::Unbounded, textures)?;
-        let k = spectrum_texture(params, "k", 1.0, Range::Unbounded, textures)?;
+        let eta = spectrum_texture(params, &ETA, textures)?;
+        let k = spectrum_texture(params, &K, textures)?;
         return Ok((eta, k));
     }
-    if has(params, "eta") || has(params, "k") {
+    if params.has(&ETA) || params.has(&K) {
         return Err(Error::input(
-            params.location_of("material"),
+            params.location_of(&MATERIAL),
             "give either a \"material\" preset or \"eta\" and \"k\", not both",
         ));
     }
-    let Some(preset) = CONDUCTORS.iter().find(|c| c.name == material) else {
-        let names: Vec<&str> = CONDUCTORS.iter().map(|c| c.name).collect();
+    let Some(preset) = conductor_preset(material) else {
         return Err(Error::input(
-            params.location_of("material"),
+            params.location_of(&MATERIAL),
             format!("unknown conductor material \"{material}\""),
         )
-        .with_help(format!("known materials: none, {}", names.join(", "))));
+        .with_help(format!(
+            "known materials: none, {}",
+            conductor_names().join(", ")
+        )));
     };
     let table = |column: usize| {
         let samples: Vec<(f32, f32)> = preset
@@ -502,14 +823,14 @@ fn conductor_ior(params: &Params, textures: &mut TextureCache) -> Result<(Textur
     Ok((table(1), table(2)))
 }
 
-/// `int_ior` and `ext_ior` (defaults `default_interior` and "air"). With `must_differ`, equal
-/// constant indices are refused (Mitsuba's rule for rough interfaces).
-fn relative_ior(params: &Params, default_interior: &str, must_differ: bool) -> Result<RelativeIor> {
-    let interior = ior(params, "int_ior", default_interior)?;
-    let exterior = ior(params, "ext_ior", "air")?;
+/// `int_ior` (as `interior` declares it) and `ext_ior`. With `must_differ`, equal constant
+/// indices are refused (Mitsuba's rule for rough interfaces).
+fn relative_ior(params: &Params, interior: &ParamSpec, must_differ: bool) -> Result<RelativeIor> {
+    let interior = ior(params, interior)?;
+    let exterior = ior(params, &EXT_IOR)?;
     if must_differ && interior == exterior {
         return Err(Error::input(
-            params.location_of("int_ior"),
+            params.location_of(&INT_IOR),
             format!(
                 "{} has the same index of refraction inside and outside",
                 params.node().describe()
@@ -523,11 +844,11 @@ fn relative_ior(params: &Params, default_interior: &str, must_differ: bool) -> R
 /// The constant relative index of a coating (`plastic`, `roughplastic`: default polypropylene
 /// over air).
 fn constant_relative_ior(params: &Params, must_differ: bool) -> Result<f32> {
-    let eta = relative_ior(params, "polypropylene", must_differ)?;
+    let eta = relative_ior(params, &COATING_INT_IOR, must_differ)?;
     match (&eta.interior, &eta.exterior) {
         (Ior::Constant(i), Ior::Constant(e)) => Ok(i / e),
         _ => Err(Error::input(
-            params.location_of("int_ior"),
+            params.location_of(&INT_IOR),
             format!(
                 "{} takes a constant index of refraction",
                 params.node().describe()
@@ -540,10 +861,11 @@ fn constant_relative_ior(params: &Params, must_differ: bool) -> Result<f32> {
 /// An index of refraction: a number, a name of [`NAMED_IORS`], a spectrum (`<spectrum>` values
 /// or an `<rgb>` upsampled without bounds), or a nested `<spectrum type="sellmeier">` or
 /// `<spectrum type="cauchy">`. Must be positive and finite over 360–830 nm.
-fn ior(params: &Params, name: &'static str, default: &str) -> Result<Ior> {
-    let (value, location) = if let Some(child) = params.named_child(name) {
+fn ior(params: &Params, spec: &ParamSpec) -> Result<Ior> {
+    let name = spec.name;
+    let (value, location) = if let Some(child) = params.named_child(spec) {
         (dispersion_formula(&child.node)?, &child.location)
-    } else if let Some(property) = params.property(name) {
+    } else if let Some(property) = params.property(spec) {
         let location = &property.location;
         let value = match &property.value {
             PropertyValue::Float(v) => Ior::Constant(*v as f32),
@@ -590,6 +912,9 @@ fn ior(params: &Params, name: &'static str, default: &str) -> Result<Ior> {
         };
         (value, location)
     } else {
+        let Default::Str(default) = spec.default else {
+            panic!("\"{name}\" has no named default");
+        };
         return Ok(Ior::Constant(named_ior(default).unwrap_or(1.0)));
     };
     let min = value.min_value();
@@ -609,10 +934,8 @@ fn ior(params: &Params, name: &'static str, default: &str) -> Result<Ior> {
     Ok(value)
 }
 
-/// A nested `<spectrum type="sellmeier">` (a `glass` name, or `b1`–`b3`, `c1`–`c3` with C in
-/// µm²) or `<spectrum type="cauchy">` (`a`, default 1.5; `b` in µm², `c` in µm⁴, default 0).
+/// A nested dispersion formula (`<spectrum type="sellmeier">` or `cauchy`) for an index.
 fn dispersion_formula(node: &PluginNode) -> Result<Ior> {
-    let params = Params::new(node);
     let unsupported = || {
         Error::input(
             &node.location,
@@ -623,44 +946,8 @@ fn dispersion_formula(node: &PluginNode) -> Result<Ior> {
     if node.class != PluginClass::Spectrum {
         return Err(unsupported());
     }
-    let number = |name: &'static str, default: f64| -> Result<f32> {
-        let v = params.float(name, default)?;
-        if !v.is_finite() {
-            return Err(Error::input(
-                params.location_of(name),
-                format!("\"{name}\" must be a finite number"),
-            ));
-        }
-        Ok(v as f32)
-    };
-    let ior = match node.plugin_type.as_str() {
-        "sellmeier" => match params.string_opt("glass")? {
-            Some(glass) => {
-                let (b, c) = sellmeier_glass(glass).ok_or_else(|| {
-                    let names: Vec<&str> = prism_core::spectrum::ior::SELLMEIER_GLASSES
-                        .iter()
-                        .map(|g| g.0)
-                        .collect();
-                    Error::input(
-                        params.location_of("glass"),
-                        format!("unknown glass \"{glass}\""),
-                    )
-                    .with_help(format!("known glasses: {}", names.join(", ")))
-                })?;
-                Ior::Sellmeier { b, c }
-            }
-            None => Ior::Sellmeier {
-                b: [number("b1", 0.0)?, number("b2", 0.0)?, number("b3", 0.0)?],
-                c: [number("c1", 0.0)?, number("c2", 0.0)?, number("c3", 0.0)?],
-            },
-        },
-        "cauchy" => Ior::Cauchy {
-            a: number("a", 1.5)?,
-            b: number("b", 0.0)?,
-            c: number("c", 0.0)?,
-        },
-        _ => return Err(unsupported()),
-    };
-    params.finish()?;
-    Ok(ior)
+    match build_nested_spectrum(node)? {
+        NestedSpectrum::Ior(ior) => Ok(ior),
+        NestedSpectrum::Emission(_) => Err(unsupported()),
+    }
 }

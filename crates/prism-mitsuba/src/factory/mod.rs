@@ -1,8 +1,9 @@
 //! The plugin factory: turns a parsed Mitsuba scene description into a renderable [`Scene`].
 //!
-//! Each plugin class has a builder in its own file; a builder reads its parameters through
-//! [`Params`], so that unknown or misspelled parameters are reported with their location.
-//! Objects declared once and referenced many times (a BSDF with an `id`) are built once.
+//! Each plugin class has its registry and builders in its own file (see [`crate::registry`]);
+//! a builder reads its declared parameters through [`Params`], so that unknown or misspelled
+//! parameters are reported with their location. Objects declared once and referenced many
+//! times (a BSDF with an `id`) are built once.
 
 pub mod integrators;
 pub mod lights;
@@ -16,8 +17,9 @@ use std::collections::HashMap;
 use std::collections::hash_map::Entry;
 use std::sync::Arc;
 
-use super::description::{PluginClass, PluginNode};
-use super::params::Params;
+use crate::description::{PluginClass, PluginNode};
+use crate::params::Params;
+use crate::registry::{Default, ParamSpec};
 use prism_core::bsdf::Material;
 use prism_core::error::{Error, Result};
 use prism_core::geometry::{Geometry, Primitive};
@@ -32,9 +34,34 @@ pub struct LoadedScene {
     pub seed: u64,
 }
 
+const INTEGRATOR: ParamSpec = ParamSpec::nested(
+    PluginClass::Integrator,
+    Default::Text("`path`"),
+    "the integrator",
+);
+const SENSOR: ParamSpec = ParamSpec::nested(PluginClass::Sensor, Default::Required, "the camera");
+const SHAPES: ParamSpec = ParamSpec::nested(PluginClass::Shape, Default::None, "the shapes");
+const EMITTERS: ParamSpec = ParamSpec::nested(
+    PluginClass::Emitter,
+    Default::None,
+    "lights other than area lights",
+);
+const BSDFS: ParamSpec = ParamSpec::nested(
+    PluginClass::Bsdf,
+    Default::None,
+    "BSDFs declared to be referenced by id",
+);
+const TEXTURES: ParamSpec = ParamSpec::nested(
+    PluginClass::Texture,
+    Default::None,
+    "textures declared to be referenced by id",
+);
+/// What the `<scene>` element holds.
+const SCENE: &[ParamSpec] = &[INTEGRATOR, SENSOR, SHAPES, EMITTERS, BSDFS, TEXTURES];
+
 /// Builds the scene described by the root `<scene>` node.
 pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
-    let params = Params::new(root);
+    let params = Params::new(root, SCENE);
     let mut materials: Vec<Material> = Vec::new();
     let mut material_ids: HashMap<*const PluginNode, u32> = HashMap::new();
     let mut shapes = Vec::new();
@@ -42,11 +69,11 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
     let mut lights = Vec::new();
     let mut textures = textures::TextureCache::default();
 
-    let integrator = match params.single_child(PluginClass::Integrator)? {
+    let integrator = match params.single_child(&INTEGRATOR)? {
         Some(child) => integrators::build_integrator(&child.node)?,
         None => Integrator::Path(PathIntegrator::default()),
     };
-    let sensors = params.children(PluginClass::Sensor);
+    let sensors = params.children(&SENSOR);
     let Some(sensor) = sensors.first() else {
         return Err(Error::input(&root.location, "the scene has no <sensor>")
             .with_help("add a <sensor type=\"perspective\"> with a film and a sampler"));
@@ -59,9 +86,9 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
     }
     let sensor = sensor::build_sensor(&sensor.node)?;
 
-    for child in params.children(PluginClass::Shape) {
-        let shape_params = Params::new(&child.node);
-        let shape = shapes::build_shape(&shape_params)?;
+    for child in params.children(&SHAPES) {
+        let (plugin, shape_params) = shapes::shape_params(&child.node)?;
+        let shape = shapes::build_shape(plugin, &shape_params)?;
         if shape.area() == 0.0 || !shape.area().is_finite() {
             return Err(Error::input(
                 &child.location,
@@ -70,8 +97,8 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
             .with_help("remove degenerate shapes or fix their transform"));
         }
         let shape_index = shapes.len() as u32;
-        let emitter = shape_params.single_child(PluginClass::Emitter)?;
-        let material = match shape_params.single_child(PluginClass::Bsdf)? {
+        let emitter = shape_params.single_child(&shapes::EMITTER)?;
+        let material = match shape_params.single_child(&shapes::BSDF)? {
             Some(bsdf) => {
                 let key = Arc::as_ptr(&bsdf.node);
                 match material_ids.get(&key) {
@@ -117,7 +144,7 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
     }
 
     let mut scene_lights = Vec::new();
-    for child in params.children(PluginClass::Emitter) {
+    for child in params.children(&EMITTERS) {
         scene_lights.push((
             lights::build_scene_light(&child.node)?,
             child.location.clone(),
@@ -128,7 +155,7 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
 
     // BSDFs declared at the top level (to be referenced by id) are built even when unused, so
     // that their errors are reported as Mitsuba would.
-    for child in params.children(PluginClass::Bsdf) {
+    for child in params.children(&BSDFS) {
         if let Entry::Vacant(entry) = material_ids.entry(Arc::as_ptr(&child.node)) {
             materials.push(materials::build_material(&child.node, &mut textures)?);
             entry.insert((materials.len() - 1) as u32);
@@ -136,7 +163,7 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
     }
     // Textures declared at the top level (referenced by id from BSDFs) are read even when no
     // BSDF uses them, so that a missing or corrupt image is reported.
-    for child in params.children(PluginClass::Texture) {
+    for child in params.children(&TEXTURES) {
         if !textures.contains(&child.node) {
             textures::build_texture(
                 &child.node,

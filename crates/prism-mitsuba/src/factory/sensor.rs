@@ -5,23 +5,417 @@ use glam::{UVec2, Vec2};
 
 use crate::description::{PluginClass, PluginNode};
 use crate::params::Params;
+use crate::registry::{Default, Origin, ParamKind, ParamSpec, Plugin, Registry};
 use prism_core::camera::perspective::{FovAxis, focal_length_to_diagonal_fov, horizontal_fov};
 use prism_core::camera::{Camera, PerspectiveCamera, Shutter};
 use prism_core::error::{Error, Result};
 use prism_core::film::{CropWindow, Filter};
 use prism_core::scene::{FilmSettings, SamplerKind, SamplerSettings};
 
-pub const SUPPORTED_SENSORS: &[&str] = &["perspective", "thinlens"];
-pub const SUPPORTED_FILMS: &[&str] = &["hdrfilm"];
-pub const SUPPORTED_FILTERS: &[&str] = &[
-    "box",
-    "tent",
-    "gaussian",
-    "mitchell",
-    "catmullrom",
-    "lanczos",
+/// Builds a sensor; `thinlens` says whether it has a lens.
+type SensorBuild = fn(&Params, bool) -> Result<SensorSettings>;
+
+pub static SENSORS: Registry<SensorBuild> = Registry {
+    class: PluginClass::Sensor,
+    plugins: &[
+        Plugin {
+            name: "perspective",
+            origin: Origin::Mitsuba3,
+            summary: "A pinhole camera looking along its +z axis (+y up).",
+            params: PERSPECTIVE_PARAMS,
+            build: build_sensor_of,
+        },
+        Plugin {
+            name: "thinlens",
+            origin: Origin::Mitsuba3,
+            summary: "A thin-lens camera: as `perspective`, with depth of field.",
+            params: THINLENS_PARAMS,
+            build: build_sensor_of,
+        },
+    ],
+};
+
+const FOV: ParamSpec = ParamSpec::new(
+    "fov",
+    ParamKind::Float,
+    Default::Text("from `focal_length`"),
+    "field of view in degrees, along `fov_axis`",
+);
+const FOV_AXIS: ParamSpec = ParamSpec::new(
+    "fov_axis",
+    ParamKind::Choice(&["x", "y", "diagonal", "smaller", "larger"]),
+    Default::Str("x"),
+    "the film axis `fov` is measured along",
+);
+const FOCAL_LENGTH: ParamSpec = ParamSpec::new(
+    "focal_length",
+    ParamKind::String,
+    Default::Str("50mm"),
+    "the field of view as the focal length of a lens on 35 mm film (diagonal); instead of `fov`",
+);
+const NEAR_CLIP: ParamSpec = ParamSpec::new(
+    "near_clip",
+    ParamKind::Float,
+    Default::Float(1e-2),
+    "distance before which nothing is seen",
+);
+const FAR_CLIP: ParamSpec = ParamSpec::new(
+    "far_clip",
+    ParamKind::Float,
+    Default::Float(1e4),
+    "distance beyond which nothing is seen",
+);
+const SENSOR_TO_WORLD: ParamSpec = ParamSpec::new(
+    "to_world",
+    ParamKind::AnimatedTransform,
+    Default::Text("identity"),
+    "camera to world: rotations and translations (a `lookat`), or an `<animation>` of them",
+);
+const SHUTTER_OPEN: ParamSpec = ParamSpec::new(
+    "shutter_open",
+    ParamKind::Float,
+    Default::Float(0.0),
+    "time the shutter opens",
+);
+const SHUTTER_CLOSE: ParamSpec = ParamSpec::new(
+    "shutter_close",
+    ParamKind::Float,
+    Default::Text("`shutter_open`"),
+    "time the shutter closes",
+);
+const SHUTTER_FILTER: ParamSpec = ParamSpec::new(
+    "shutter_filter",
+    ParamKind::Nested(PluginClass::Rfilter),
+    Default::Text("box"),
+    "Prism only: a nested `<rfilter name=\"shutter_filter\">` weighting time within the shutter interval",
+);
+const FILM: ParamSpec = ParamSpec::nested(
+    PluginClass::Film,
+    Default::Text("`hdrfilm`, 768 × 576, gaussian"),
+    "the film",
+);
+const SAMPLER: ParamSpec = ParamSpec::nested(
+    PluginClass::Sampler,
+    Default::Text("`independent`, 4 samples"),
+    "the sampler",
+);
+const APERTURE_RADIUS: ParamSpec = ParamSpec::new(
+    "aperture_radius",
+    ParamKind::Float,
+    Default::Required,
+    "radius of the lens (or give `aperture_area`)",
+);
+const APERTURE_AREA: ParamSpec = ParamSpec::new(
+    "aperture_area",
+    ParamKind::Float,
+    Default::None,
+    "Prism only, the lecture's form: the lens's area a, radius √(a/π)",
+);
+const FOCUS_DISTANCE: ParamSpec = ParamSpec::new(
+    "focus_distance",
+    ParamKind::Float,
+    Default::Text("`far_clip`"),
+    "distance of the plane in focus",
+);
+const FOCAL_DISTANCE: ParamSpec = ParamSpec::new(
+    "focal_distance",
+    ParamKind::Float,
+    Default::None,
+    "Prism only, the lecture's name for `focus_distance`",
+);
+
+const PERSPECTIVE_PARAMS: &[ParamSpec] = &[
+    FOV,
+    FOV_AXIS,
+    FOCAL_LENGTH,
+    NEAR_CLIP,
+    FAR_CLIP,
+    SENSOR_TO_WORLD,
+    SHUTTER_OPEN,
+    SHUTTER_CLOSE,
+    SHUTTER_FILTER,
+    FILM,
+    SAMPLER,
 ];
-pub const SUPPORTED_SAMPLERS: &[&str] = &["independent", "stratified", "multijitter", "nrooks"];
+const THINLENS_PARAMS: &[ParamSpec] = &[
+    FOV,
+    FOV_AXIS,
+    FOCAL_LENGTH,
+    NEAR_CLIP,
+    FAR_CLIP,
+    SENSOR_TO_WORLD,
+    SHUTTER_OPEN,
+    SHUTTER_CLOSE,
+    SHUTTER_FILTER,
+    FILM,
+    SAMPLER,
+    APERTURE_RADIUS,
+    APERTURE_AREA,
+    FOCUS_DISTANCE,
+    FOCAL_DISTANCE,
+];
+
+type FilmBuild = fn(&Params) -> Result<FilmSettings>;
+
+pub static FILMS: Registry<FilmBuild> = Registry {
+    class: PluginClass::Film,
+    plugins: &[Plugin {
+        name: "hdrfilm",
+        origin: Origin::Mitsuba3,
+        summary: "A high dynamic range film; Prism writes it as 32-bit OpenEXR (RGB, XYZ, per-pixel                   variance and relative error) and an sRGB PNG.",
+        params: &[
+            WIDTH,
+            HEIGHT,
+            CROP_OFFSET_X,
+            CROP_OFFSET_Y,
+            CROP_WIDTH,
+            CROP_HEIGHT,
+            FILE_FORMAT,
+            PIXEL_FORMAT,
+            COMPONENT_FORMAT,
+            RFILTER,
+        ],
+        build: build_hdrfilm,
+    }],
+};
+
+const WIDTH: ParamSpec = ParamSpec::new(
+    "width",
+    ParamKind::Integer,
+    Default::Integer(768),
+    "pixels across",
+);
+const HEIGHT: ParamSpec = ParamSpec::new(
+    "height",
+    ParamKind::Integer,
+    Default::Integer(576),
+    "pixels down",
+);
+const CROP_OFFSET_X: ParamSpec = ParamSpec::new(
+    "crop_offset_x",
+    ParamKind::Integer,
+    Default::Integer(0),
+    "first column rendered",
+);
+const CROP_OFFSET_Y: ParamSpec = ParamSpec::new(
+    "crop_offset_y",
+    ParamKind::Integer,
+    Default::Integer(0),
+    "first row rendered",
+);
+const CROP_WIDTH: ParamSpec = ParamSpec::new(
+    "crop_width",
+    ParamKind::Integer,
+    Default::Text("`width` − `crop_offset_x`"),
+    "columns rendered",
+);
+const CROP_HEIGHT: ParamSpec = ParamSpec::new(
+    "crop_height",
+    ParamKind::Integer,
+    Default::Text("`height` − `crop_offset_y`"),
+    "rows rendered",
+);
+const FILE_FORMAT: ParamSpec = ParamSpec::new(
+    "file_format",
+    ParamKind::Choice(&["openexr", "exr"]),
+    Default::Str("openexr"),
+    "accepted; the output is always OpenEXR",
+);
+const PIXEL_FORMAT: ParamSpec = ParamSpec::new(
+    "pixel_format",
+    ParamKind::Choice(&["rgb", "rgba", "xyz", "xyza", "luminance", "luminance_alpha"]),
+    Default::Str("rgb"),
+    "accepted; the output always holds RGB and XYZ",
+);
+const COMPONENT_FORMAT: ParamSpec = ParamSpec::new(
+    "component_format",
+    ParamKind::Choice(&["float16", "float32", "uint32"]),
+    Default::Str("float32"),
+    "accepted; the output is always 32-bit float",
+);
+const RFILTER: ParamSpec = ParamSpec::nested(
+    PluginClass::Rfilter,
+    Default::Text("`gaussian`"),
+    "the reconstruction filter",
+);
+
+type FilterBuild = fn(&Params) -> Result<Filter>;
+
+pub static RFILTERS: Registry<FilterBuild> = Registry {
+    class: PluginClass::Rfilter,
+    plugins: &[
+        Plugin {
+            name: "box",
+            origin: Origin::Mitsuba3,
+            summary: "The box filter.",
+            params: &[BOX_RADIUS],
+            build: |params| {
+                Ok(Filter::Box {
+                    radius: filter_size(params, &BOX_RADIUS)?,
+                })
+            },
+        },
+        Plugin {
+            name: "tent",
+            origin: Origin::Mitsuba3,
+            summary: "The tent (triangle) filter.",
+            params: &[TENT_RADIUS],
+            build: |params| {
+                Ok(Filter::Tent {
+                    radius: filter_size(params, &TENT_RADIUS)?,
+                })
+            },
+        },
+        Plugin {
+            name: "gaussian",
+            origin: Origin::Mitsuba3,
+            summary: "A Gaussian truncated at 4 standard deviations (Mitsuba's default filter).",
+            params: &[STDDEV],
+            build: |params| {
+                Ok(Filter::Gaussian {
+                    stddev: filter_size(params, &STDDEV)?,
+                })
+            },
+        },
+        Plugin {
+            name: "mitchell",
+            origin: Origin::Mitsuba3,
+            summary: "The Mitchell–Netravali filter, radius 2.",
+            params: &[MITCHELL_B, MITCHELL_C],
+            build: |params| {
+                Ok(Filter::Mitchell {
+                    b: params.float_in(&MITCHELL_B, 1.0 / 3.0, 0.0, 1.0)? as f32,
+                    c: params.float_in(&MITCHELL_C, 1.0 / 3.0, 0.0, 1.0)? as f32,
+                })
+            },
+        },
+        Plugin {
+            name: "catmullrom",
+            origin: Origin::Mitsuba3,
+            summary: "The Catmull–Rom filter: Mitchell–Netravali with B = 0, C = ½.",
+            params: &[],
+            build: |_| Ok(Filter::Mitchell { b: 0.0, c: 0.5 }),
+        },
+        Plugin {
+            name: "lanczos",
+            origin: Origin::Mitsuba3,
+            summary: "The windowed sinc filter.",
+            params: &[LOBES],
+            build: |params| {
+                let lobes = params.integer(&LOBES)?;
+                if !(1..=32).contains(&lobes) {
+                    return Err(Error::input(
+                        params.location_of(&LOBES),
+                        format!("lanczos needs between 1 and 32 lobes, not {lobes}"),
+                    ));
+                }
+                Ok(Filter::Lanczos {
+                    lobes: lobes as u32,
+                })
+            },
+        },
+    ],
+};
+
+const BOX_RADIUS: ParamSpec = ParamSpec::new(
+    "radius",
+    ParamKind::Float,
+    Default::Float(0.5),
+    "half width in pixels",
+);
+const TENT_RADIUS: ParamSpec = ParamSpec::new(
+    "radius",
+    ParamKind::Float,
+    Default::Float(1.0),
+    "half width in pixels",
+);
+const STDDEV: ParamSpec = ParamSpec::new(
+    "stddev",
+    ParamKind::Float,
+    Default::Float(0.5),
+    "standard deviation in pixels",
+);
+const MITCHELL_B: ParamSpec = ParamSpec::new(
+    "B",
+    ParamKind::Float,
+    Default::Float(1.0 / 3.0),
+    "B, in [0, 1]",
+);
+const MITCHELL_C: ParamSpec = ParamSpec::new(
+    "C",
+    ParamKind::Float,
+    Default::Float(1.0 / 3.0),
+    "C, in [0, 1]",
+);
+const LOBES: ParamSpec = ParamSpec::new(
+    "lobes",
+    ParamKind::Integer,
+    Default::Integer(3),
+    "lobes of the sinc (1 to 32)",
+);
+
+type SamplerBuild = fn(&Params) -> Result<SamplerKind>;
+
+pub static SAMPLERS: Registry<SamplerBuild> = Registry {
+    class: PluginClass::Sampler,
+    plugins: &[
+        Plugin {
+            name: "independent",
+            origin: Origin::Mitsuba3,
+            summary: "Independent uniform random numbers.",
+            params: &[SAMPLE_COUNT, SEED],
+            build: |_| Ok(SamplerKind::Independent),
+        },
+        Plugin {
+            name: "stratified",
+            origin: Origin::Mitsuba3,
+            summary: "Every dimension stratified, as Mitsuba does; `sample_count` is rounded up to a square.",
+            params: &[SAMPLE_COUNT, SEED, JITTER],
+            build: |params| {
+                Ok(SamplerKind::Stratified {
+                    jitter: params.boolean(&JITTER)?,
+                })
+            },
+        },
+        Plugin {
+            name: "multijitter",
+            origin: Origin::Mitsuba3,
+            summary: "Correlated multi-jittered sampling, as Mitsuba does; `sample_count` is rounded up to a near-square product.",
+            params: &[SAMPLE_COUNT, SEED, JITTER],
+            build: |params| {
+                Ok(SamplerKind::MultiJitter {
+                    jitter: params.boolean(&JITTER)?,
+                })
+            },
+        },
+        Plugin {
+            name: "nrooks",
+            origin: Origin::Prism,
+            summary: "The lecture's N-rooks sampling: each of the six primary dimensions (wavelength,                       time, film x and y, lens u and v) stratified into N strata, shuffled                       independently.",
+            params: &[SAMPLE_COUNT, SEED],
+            build: |_| Ok(SamplerKind::NRooks),
+        },
+    ],
+};
+
+const SAMPLE_COUNT: ParamSpec = ParamSpec::new(
+    "sample_count",
+    ParamKind::Integer,
+    Default::Integer(4),
+    "samples per pixel (1 to 2²⁴)",
+);
+const SEED: ParamSpec = ParamSpec::new(
+    "seed",
+    ParamKind::Integer,
+    Default::Integer(0),
+    "seed of every random number (`--seed` overrides it)",
+);
+const JITTER: ParamSpec = ParamSpec::new(
+    "jitter",
+    ParamKind::Boolean,
+    Default::Boolean(true),
+    "jitter samples within their strata",
+);
 
 /// Largest film side, and largest pixel count, accepted (each pixel keeps 112 bytes of sums,
 /// twice while a pass is rendered).
@@ -37,23 +431,21 @@ pub struct SensorSettings {
     pub seed: u64,
 }
 
+/// Builds the sensor a node describes.
 pub fn build_sensor(node: &PluginNode) -> Result<SensorSettings> {
-    let params = Params::new(node);
-    if node.plugin_type != "perspective" && node.plugin_type != "thinlens" {
-        return Err(Error::input(
-            &node.location,
-            format!("unknown sensor type \"{}\"", node.plugin_type),
-        )
-        .with_help(format!(
-            "supported sensor types: {}",
-            SUPPORTED_SENSORS.join(", ")
-        )));
-    }
-    let film = match params.single_child(PluginClass::Film)? {
+    let plugin = SENSORS.find(node)?;
+    let params = Params::new(node, plugin.params);
+    let sensor = (plugin.build)(&params, plugin.name == "thinlens")?;
+    params.finish()?;
+    Ok(sensor)
+}
+
+fn build_sensor_of(params: &Params, thinlens: bool) -> Result<SensorSettings> {
+    let film = match params.single_child(&FILM)? {
         Some(child) => build_film(&child.node)?,
         None => default_film(),
     };
-    let (sampler, seed) = match params.single_child(PluginClass::Sampler)? {
+    let (sampler, seed) = match params.single_child(&SAMPLER)? {
         Some(child) => build_sampler(&child.node)?,
         None => (
             SamplerSettings {
@@ -65,28 +457,20 @@ pub fn build_sensor(node: &PluginNode) -> Result<SensorSettings> {
     };
 
     let aspect = f64::from(film.size.x) / f64::from(film.size.y);
-    let fov_x = match (params.float_opt("fov")?, params.string_opt("focal_length")?) {
+    let fov_x = match (params.float_opt(&FOV)?, params.string_opt(&FOCAL_LENGTH)?) {
         (Some(_), Some(_)) => {
             return Err(Error::input(
-                params.location_of("focal_length"),
+                params.location_of(&FOCAL_LENGTH),
                 "give either \"fov\" or \"focal_length\", not both",
             ));
         }
         (Some(fov), None) => {
-            let axis_name = params.string("fov_axis", "x")?;
-            let axis = match axis_name.to_ascii_lowercase().as_str() {
-                "x" => FovAxis::X,
+            let axis = match params.choice(&FOV_AXIS)? {
                 "y" => FovAxis::Y,
                 "diagonal" => FovAxis::Diagonal,
                 "smaller" => FovAxis::Smaller,
                 "larger" => FovAxis::Larger,
-                _ => {
-                    return Err(Error::input(
-                        params.location_of("fov_axis"),
-                        format!("unknown fov_axis \"{axis_name}\""),
-                    )
-                    .with_help("use one of x, y, diagonal, smaller, larger"));
-                }
+                _ => FovAxis::X,
             };
             horizontal_fov(fov, axis, aspect)
         }
@@ -99,14 +483,14 @@ pub fn build_sensor(node: &PluginNode) -> Result<SensorSettings> {
                 .parse()
                 .map_err(|_| {
                     Error::input(
-                        params.location_of("focal_length"),
+                        params.location_of(&FOCAL_LENGTH),
                         format!("could not read the focal length \"{text}\""),
                     )
                     .with_help("write it as a number of millimetres, e.g. \"35mm\"")
                 })?;
             if !(mm > 0.0) {
                 return Err(Error::input(
-                    params.location_of("focal_length"),
+                    params.location_of(&FOCAL_LENGTH),
                     "the focal length must be positive",
                 ));
             }
@@ -115,37 +499,36 @@ pub fn build_sensor(node: &PluginNode) -> Result<SensorSettings> {
     };
     if !(fov_x > 0.0 && fov_x < 180.0) {
         return Err(Error::input(
-            params.location_of("fov"),
+            params.location_of(&FOV),
             format!(
                 "the horizontal field of view is {fov_x} degrees; it must lie strictly between 0 and 180"
             ),
         ));
     }
-    let near_clip = params.float("near_clip", 1e-2)?;
-    let far_clip = params.float("far_clip", 1e4)?;
+    let near_clip = params.float(&NEAR_CLIP)?;
+    let far_clip = params.float(&FAR_CLIP)?;
     if !(near_clip > 0.0) || !(far_clip > near_clip) || !far_clip.is_finite() {
         return Err(Error::input(
-            params.location_of("near_clip"),
+            params.location_of(&NEAR_CLIP),
             format!(
                 "near_clip ({near_clip}) must be positive and smaller than far_clip ({far_clip})"
             ),
         ));
     }
-    let to_world = params.animated_transform("to_world")?;
-    let (lens_radius, focus_distance) = if node.plugin_type == "thinlens" {
-        lens(&params, far_clip)?
+    let to_world = params.animated_transform(&SENSOR_TO_WORLD)?;
+    let (lens_radius, focus_distance) = if thinlens {
+        lens(params, far_clip)?
     } else {
         (0.0, far_clip)
     };
     if lens_radius > 0.0 && !to_world.is_similarity() || to_world.uniform_scale(0.0) > 1.0 + 1e-4 {
         return Err(Error::input(
-            params.location_of("to_world"),
+            params.location_of(&SENSOR_TO_WORLD),
             "the camera's \"to_world\" transform scales; a thin lens camera must not be scaled",
         )
         .with_help("use only rotations and translations (lookat) for cameras"));
     }
-    let shutter = shutter(&params)?;
-    params.finish()?;
+    let shutter = shutter(params)?;
 
     let camera = Camera::Perspective(PerspectiveCamera {
         to_world,
@@ -170,17 +553,17 @@ pub fn build_sensor(node: &PluginNode) -> Result<SensorSettings> {
 /// (default: the far clipping distance, as Mitsuba).
 fn lens(params: &Params, far_clip: f64) -> Result<(f64, f64)> {
     let radius = match (
-        params.float_opt("aperture_radius")?,
-        params.float_opt("aperture_area")?,
+        params.float_opt(&APERTURE_RADIUS)?,
+        params.float_opt(&APERTURE_AREA)?,
     ) {
         (Some(_), Some(_)) => {
             return Err(Error::input(
-                params.location_of("aperture_area"),
+                params.location_of(&APERTURE_AREA),
                 "give either \"aperture_radius\" or \"aperture_area\", not both",
             ));
         }
-        (Some(radius), None) => (radius, "aperture_radius"),
-        (None, Some(area)) => ((area / std::f64::consts::PI).sqrt(), "aperture_area"),
+        (Some(radius), None) => (radius, &APERTURE_RADIUS),
+        (None, Some(area)) => ((area / std::f64::consts::PI).sqrt(), &APERTURE_AREA),
         (None, None) => {
             return Err(Error::input(
                 params.location(),
@@ -196,18 +579,18 @@ fn lens(params: &Params, far_clip: f64) -> Result<(f64, f64)> {
         ));
     }
     let focus = match (
-        params.float_opt("focus_distance")?,
-        params.float_opt("focal_distance")?,
+        params.float_opt(&FOCUS_DISTANCE)?,
+        params.float_opt(&FOCAL_DISTANCE)?,
     ) {
         (Some(_), Some(_)) => {
             return Err(Error::input(
-                params.location_of("focal_distance"),
+                params.location_of(&FOCAL_DISTANCE),
                 "give either \"focus_distance\" or \"focal_distance\", not both",
             ));
         }
-        (Some(g), None) => (g, "focus_distance"),
-        (None, Some(g)) => (g, "focal_distance"),
-        (None, None) => (far_clip, "focus_distance"),
+        (Some(g), None) => (g, &FOCUS_DISTANCE),
+        (None, Some(g)) => (g, &FOCAL_DISTANCE),
+        (None, None) => (far_clip, &FOCUS_DISTANCE),
     };
     if !(focus.0 > 0.0 && focus.0.is_finite()) {
         return Err(Error::input(
@@ -221,16 +604,16 @@ fn lens(params: &Params, far_clip: f64) -> Result<(f64, f64)> {
 /// `shutter_open`, `shutter_close` (default 0 and 0) and an optional nested temporal filter
 /// `<rfilter name="shutter_filter">`.
 fn shutter(params: &Params) -> Result<Shutter> {
-    let open = params.float("shutter_open", 0.0)?;
-    let close = params.float("shutter_close", open)?;
+    let open = params.float(&SHUTTER_OPEN)?;
+    let close = params.float_opt(&SHUTTER_CLOSE)?.unwrap_or(open);
     if !open.is_finite() || !close.is_finite() || close < open {
         return Err(Error::input(
-            params.location_of("shutter_close"),
+            params.location_of(&SHUTTER_CLOSE),
             format!("the shutter closes at {close}, before it opens at {open}"),
         )
         .with_help("shutter_close must be at least shutter_open"));
     }
-    let filter = match params.named_child("shutter_filter") {
+    let filter = match params.named_child(&SHUTTER_FILTER) {
         Some(child) if child.node.class == PluginClass::Rfilter => Some(build_filter(&child.node)?),
         Some(child) => {
             return Err(Error::input(
@@ -260,35 +643,32 @@ fn default_film() -> FilmSettings {
 /// `rfilter` (Gaussian by default). `file_format`, `pixel_format` and `component_format` are
 /// accepted for compatibility; Prism always writes 32-bit linear RGB and XYZ to EXR.
 fn build_film(node: &PluginNode) -> Result<FilmSettings> {
-    let params = Params::new(node);
-    if node.plugin_type != "hdrfilm" {
-        return Err(Error::input(
-            &node.location,
-            format!("unknown film type \"{}\"", node.plugin_type),
-        )
-        .with_help(format!(
-            "supported film types: {}",
-            SUPPORTED_FILMS.join(", ")
-        )));
-    }
-    let width = params.integer("width", 768)?;
-    let height = params.integer("height", 576)?;
+    let plugin = FILMS.find(node)?;
+    let params = Params::new(node, plugin.params);
+    let film = (plugin.build)(&params)?;
+    params.finish()?;
+    Ok(film)
+}
+
+fn build_hdrfilm(params: &Params) -> Result<FilmSettings> {
+    let width = params.integer(&WIDTH)?;
+    let height = params.integer(&HEIGHT)?;
     if !(1..=MAX_FILM_SIDE).contains(&width)
         || !(1..=MAX_FILM_SIDE).contains(&height)
         || width * height > MAX_FILM_PIXELS
     {
         return Err(Error::input(
-            params.location_of(if (1..=MAX_FILM_SIDE).contains(&width) { "height" } else { "width" }),
+            params.location_of(if (1..=MAX_FILM_SIDE).contains(&width) { &HEIGHT } else { &WIDTH }),
             format!("a film of {width} × {height} pixels is not possible"),
         )
         .with_help(format!(
             "width and height must be between 1 and {MAX_FILM_SIDE}, with at most {MAX_FILM_PIXELS} pixels in all"
         )));
     }
-    let crop_x = params.integer("crop_offset_x", 0)?;
-    let crop_y = params.integer("crop_offset_y", 0)?;
-    let crop_width = params.integer("crop_width", width - crop_x)?;
-    let crop_height = params.integer("crop_height", height - crop_y)?;
+    let crop_x = params.integer(&CROP_OFFSET_X)?;
+    let crop_y = params.integer(&CROP_OFFSET_Y)?;
+    let crop_width = params.integer_opt(&CROP_WIDTH)?.unwrap_or(width - crop_x);
+    let crop_height = params.integer_opt(&CROP_HEIGHT)?.unwrap_or(height - crop_y);
     if crop_x < 0
         || crop_y < 0
         || crop_width < 1
@@ -297,35 +677,19 @@ fn build_film(node: &PluginNode) -> Result<FilmSettings> {
         || crop_y + crop_height > height
     {
         return Err(Error::input(
-            params.location_of("crop_width"),
+            params.location_of(&CROP_WIDTH),
             format!(
                 "the crop window at ({crop_x}, {crop_y}) of size {crop_width} × {crop_height} does not fit in the {width} × {height} film"
             ),
         ));
     }
-    for (name, allowed) in [
-        ("file_format", &["openexr", "exr"][..]),
-        (
-            "pixel_format",
-            &["rgb", "rgba", "xyz", "xyza", "luminance", "luminance_alpha"][..],
-        ),
-        ("component_format", &["float16", "float32", "uint32"][..]),
-    ] {
-        if let Some(value) = params.string_opt(name)?
-            && !allowed.contains(&value.to_ascii_lowercase().as_str())
-        {
-            return Err(Error::input(
-                params.location_of(name),
-                format!("unknown {name} \"{value}\""),
-            )
-            .with_help(format!("use one of {}", allowed.join(", "))));
-        }
+    for spec in [&FILE_FORMAT, &PIXEL_FORMAT, &COMPONENT_FORMAT] {
+        params.choice(spec)?;
     }
-    let filter = match params.single_child(PluginClass::Rfilter)? {
+    let filter = match params.single_child(&RFILTER)? {
         Some(child) => build_filter(&child.node)?,
         None => Filter::Gaussian { stddev: 0.5 },
     };
-    params.finish()?;
     let size = UVec2::new(width as u32, height as u32);
     Ok(FilmSettings {
         size,
@@ -338,92 +702,41 @@ fn build_film(node: &PluginNode) -> Result<FilmSettings> {
 }
 
 fn build_filter(node: &PluginNode) -> Result<Filter> {
-    let params = Params::new(node);
-    let positive = |name: &'static str, default: f64| -> Result<f32> {
-        let v = params.float(name, default)?;
-        if !(v > 0.0 && v <= 64.0) {
-            return Err(Error::input(
-                params.location_of(name),
-                format!(
-                    "the filter's \"{name}\" must be positive (and at most 64 pixels), not {v}"
-                ),
-            ));
-        }
-        Ok(v as f32)
-    };
-    let filter = match node.plugin_type.as_str() {
-        "box" => Filter::Box {
-            radius: positive("radius", 0.5)?,
-        },
-        "tent" => Filter::Tent {
-            radius: positive("radius", 1.0)?,
-        },
-        "gaussian" => Filter::Gaussian {
-            stddev: positive("stddev", 0.5)?,
-        },
-        "mitchell" => Filter::Mitchell {
-            b: params.float_in("B", 1.0 / 3.0, 0.0, 1.0)? as f32,
-            c: params.float_in("C", 1.0 / 3.0, 0.0, 1.0)? as f32,
-        },
-        "catmullrom" => Filter::Mitchell { b: 0.0, c: 0.5 },
-        "lanczos" => {
-            let lobes = params.integer("lobes", 3)?;
-            if !(1..=32).contains(&lobes) {
-                return Err(Error::input(
-                    params.location_of("lobes"),
-                    format!("lanczos needs between 1 and 32 lobes, not {lobes}"),
-                ));
-            }
-            Filter::Lanczos {
-                lobes: lobes as u32,
-            }
-        }
-        other => {
-            return Err(
-                Error::input(&node.location, format!("unknown rfilter type \"{other}\""))
-                    .with_help(format!(
-                        "supported rfilter types: {}",
-                        SUPPORTED_FILTERS.join(", ")
-                    )),
-            );
-        }
-    };
+    let plugin = RFILTERS.find(node)?;
+    let params = Params::new(node, plugin.params);
+    let filter = (plugin.build)(&params)?;
     params.finish()?;
     Ok(filter)
 }
 
-/// The sampler: `independent`, `stratified`, `multijitter` (each with `jitter`, default true) or
-/// our `nrooks`; `sample_count` (default 4) and `seed` (default 0). See [`prism_core::sampling::sampler`]
-/// for which dimensions each stratifies.
+/// A filter's size parameter: positive, and at most 64 pixels.
+fn filter_size(params: &Params, spec: &ParamSpec) -> Result<f32> {
+    let v = params.float(spec)?;
+    if !(v > 0.0 && v <= 64.0) {
+        return Err(Error::input(
+            params.location_of(spec),
+            format!(
+                "the filter's \"{}\" must be positive (and at most 64 pixels), not {v}",
+                spec.name
+            ),
+        ));
+    }
+    Ok(v as f32)
+}
+
+/// The sampler a node describes, with its seed.
 fn build_sampler(node: &PluginNode) -> Result<(SamplerSettings, u64)> {
-    let params = Params::new(node);
-    let kind = match node.plugin_type.as_str() {
-        "independent" => SamplerKind::Independent,
-        "stratified" => SamplerKind::Stratified {
-            jitter: params.boolean("jitter", true)?,
-        },
-        "multijitter" => SamplerKind::MultiJitter {
-            jitter: params.boolean("jitter", true)?,
-        },
-        "nrooks" => SamplerKind::NRooks,
-        other => {
-            return Err(
-                Error::input(&node.location, format!("unknown sampler type \"{other}\""))
-                    .with_help(format!(
-                        "supported sampler types: {}",
-                        SUPPORTED_SAMPLERS.join(", ")
-                    )),
-            );
-        }
-    };
-    let spp = params.integer("sample_count", 4)?;
+    let plugin = SAMPLERS.find(node)?;
+    let params = Params::new(node, plugin.params);
+    let kind = (plugin.build)(&params)?;
+    let spp = params.integer(&SAMPLE_COUNT)?;
     if !(1..=(1 << 24)).contains(&spp) {
         return Err(Error::input(
-            params.location_of("sample_count"),
+            params.location_of(&SAMPLE_COUNT),
             format!("sample_count must be between 1 and {}, not {spp}", 1 << 24),
         ));
     }
-    let seed = params.integer("seed", 0)?;
+    let seed = params.integer(&SEED)?;
     params.finish()?;
     Ok((
         SamplerSettings {

@@ -1,145 +1,269 @@
-//! Shape plugins: `obj`, `ply`, `rectangle`, `cube`, `sphere` and `disk`.
-//!
-//! Parameters shared by all: `to_world` (transform), `flip_normals` (bool); meshes also take
-//! `filename`, `face_normals` (bool: ignore vertex normals and shade flat) and, for OBJ,
-//! `flip_tex_coords` (bool, default true: the OBJ loader's v → 1 − v, as Mitsuba).
+//! Shape plugins: `obj`, `ply`, `rectangle`, `cube`, `sphere` and `disk`. Any shape whose
+//! `to_world` is an `<animation>` moves while the shutter is open: it is built in object space
+//! and placed by an [`Instance`].
 
 use glam::{DVec3, Mat3, Vec2, Vec3};
 
-use crate::description::PluginNode;
+use crate::description::{PluginClass, PluginNode};
 use crate::mesh::{MeshData, load_obj, load_ply};
 use crate::params::Params;
+use crate::registry::{Default, Origin, ParamKind, ParamSpec, Plugin, Registry};
 use prism_core::error::{Error, Result};
 use prism_core::geometry::{Disk, Instance, Primitive, Shape, Sphere, TriangleMesh};
 use prism_core::math::Transform;
 
-/// The shape types this factory knows.
-pub const SUPPORTED_SHAPES: &[&str] = &["obj", "ply", "rectangle", "cube", "sphere", "disk"];
+/// Builds a shape placed by a fixed transform.
+type Build = fn(&Params, &Transform) -> Result<Shape>;
+
+pub static SHAPES: Registry<Build> = Registry {
+    class: PluginClass::Shape,
+    plugins: &[
+        Plugin {
+            name: "obj",
+            origin: Origin::Mitsuba3,
+            summary: "A Wavefront OBJ mesh (polygons triangulated as fans; smooth vertex normals \
+                      computed when the file has none).",
+            params: &[
+                FILENAME,
+                FACE_NORMALS,
+                FLIP_TEX_COORDS,
+                FLIP_NORMALS,
+                TO_WORLD,
+                BSDF,
+                EMITTER,
+            ],
+            build: |params, to_world| build_mesh_file(params, to_world, true),
+        },
+        Plugin {
+            name: "ply",
+            origin: Origin::Mitsuba3,
+            summary: "A Stanford PLY mesh, ASCII or binary.",
+            params: &[
+                FILENAME,
+                FACE_NORMALS,
+                FLIP_NORMALS,
+                TO_WORLD,
+                BSDF,
+                EMITTER,
+            ],
+            build: |params, to_world| build_mesh_file(params, to_world, false),
+        },
+        Plugin {
+            name: "rectangle",
+            origin: Origin::Mitsuba3,
+            summary: "[−1, 1]² in the z = 0 plane, normal +z.",
+            params: &[FLIP_NORMALS, TO_WORLD, BSDF, EMITTER],
+            build: |params, to_world| {
+                Ok(Shape::Mesh(transform_mesh(
+                    rectangle(),
+                    to_world,
+                    params.boolean(&FLIP_NORMALS)?,
+                    true,
+                )))
+            },
+        },
+        Plugin {
+            name: "cube",
+            origin: Origin::Mitsuba3,
+            summary: "[−1, 1]³ with outward normals, each face flat.",
+            params: &[FLIP_NORMALS, TO_WORLD, BSDF, EMITTER],
+            build: |params, to_world| {
+                Ok(Shape::Mesh(transform_mesh(
+                    cube(),
+                    to_world,
+                    params.boolean(&FLIP_NORMALS)?,
+                    true,
+                )))
+            },
+        },
+        Plugin {
+            name: "sphere",
+            origin: Origin::Mitsuba3,
+            summary: "A sphere; light sampled by the cone it subtends. `to_world` may rotate, \
+                      translate and scale uniformly.",
+            params: &[CENTER, RADIUS, FLIP_NORMALS, TO_WORLD, BSDF, EMITTER],
+            build: build_sphere,
+        },
+        Plugin {
+            name: "disk",
+            origin: Origin::Mitsuba3,
+            summary: "The unit disk in the z = 0 plane, normal +z.",
+            params: &[FLIP_NORMALS, TO_WORLD, BSDF, EMITTER],
+            build: |params, to_world| {
+                Ok(Shape::Disk(Disk::new(
+                    *to_world,
+                    params.boolean(&FLIP_NORMALS)?,
+                )))
+            },
+        },
+    ],
+};
+
+const FILENAME: ParamSpec = ParamSpec::new(
+    "filename",
+    ParamKind::String,
+    Default::Required,
+    "the mesh file",
+);
+const FACE_NORMALS: ParamSpec = ParamSpec::new(
+    "face_normals",
+    ParamKind::Boolean,
+    Default::Boolean(false),
+    "ignore vertex normals and shade flat",
+);
+const FLIP_TEX_COORDS: ParamSpec = ParamSpec::new(
+    "flip_tex_coords",
+    ParamKind::Boolean,
+    Default::Boolean(true),
+    "flip texture coordinates, v → 1 − v, as Mitsuba's OBJ reader does",
+);
+const FLIP_NORMALS: ParamSpec = ParamSpec::new(
+    "flip_normals",
+    ParamKind::Boolean,
+    Default::Boolean(false),
+    "turn the normals (and the side an area light emits from) inside out",
+);
+/// The transform of every shape, whatever its type.
+pub const TO_WORLD: ParamSpec = ParamSpec::new(
+    "to_world",
+    ParamKind::AnimatedTransform,
+    Default::Text("identity"),
+    "object to world; an `<animation>` of `<transform time=\"t\">` keys (Mitsuba 0.6's syntax) \
+     moves the shape during the exposure, interpolated as translation, rotation (slerp) and scale",
+);
+/// The BSDF of every shape.
+pub const BSDF: ParamSpec = ParamSpec::nested(
+    PluginClass::Bsdf,
+    Default::Text("diffuse 0.5 (black when emitting)"),
+    "what the shape is made of",
+);
+/// The emitter of every shape.
+pub const EMITTER: ParamSpec =
+    ParamSpec::nested(PluginClass::Emitter, Default::None, "an `area` emitter");
+const CENTER: ParamSpec = ParamSpec::new(
+    "center",
+    ParamKind::Point,
+    Default::Text("the origin"),
+    "centre of the sphere",
+);
+const RADIUS: ParamSpec = ParamSpec::new(
+    "radius",
+    ParamKind::Float,
+    Default::Float(1.0),
+    "radius of the sphere",
+);
+
+/// The plugin a `<shape>` names, and its parameters.
+pub fn shape_params(node: &PluginNode) -> Result<(&'static Plugin<Build>, Params<'_>)> {
+    let plugin = SHAPES.find(node)?;
+    Ok((plugin, Params::new(node, plugin.params)))
+}
 
 /// Builds a shape (its BSDF and emitter are the caller's business: it marks them used). A shape
 /// whose `to_world` is an `<animation>` is built in object space and placed by an [`Instance`];
 /// a fixed `to_world` is applied to the shape once.
-pub fn build_shape(params: &Params) -> Result<Primitive> {
-    let to_world = params.animated_transform("to_world")?;
+pub fn build_shape(plugin: &Plugin<Build>, params: &Params) -> Result<Primitive> {
+    let to_world = params.animated_transform(&TO_WORLD)?;
     if to_world.is_animated() {
-        let shape = build_static_shape(params, &Transform::IDENTITY)?;
+        let shape = (plugin.build)(params, &Transform::IDENTITY)?;
         return Ok(Primitive::Instance(Instance::new(shape, to_world)));
     }
-    build_static_shape(params, to_world.first()).map(Primitive::Shape)
+    (plugin.build)(params, to_world.first()).map(Primitive::Shape)
 }
 
-/// Builds a shape placed by the fixed transform `to_world`.
-fn build_static_shape(params: &Params, to_world: &Transform) -> Result<Shape> {
+/// An OBJ or PLY mesh placed by `to_world`.
+fn build_mesh_file(params: &Params, to_world: &Transform, obj: bool) -> Result<Shape> {
     let node = params.node();
-    let flip_normals = params.boolean("flip_normals", false)?;
-    match node.plugin_type.as_str() {
-        "obj" | "ply" => {
-            let filename = params.string_opt("filename")?.ok_or_else(|| {
-                Error::input(
-                    &node.location,
-                    format!("{} needs a \"filename\"", node.describe()),
-                )
-                .with_help("add <string name=\"filename\" value=\"mesh.obj\"/>")
-            })?;
-            let location = params.location_of("filename");
-            let path = node.resolve_file(filename, location)?;
-            let face_normals = params.boolean("face_normals", false)?;
-            let flip_tex_coords = if node.plugin_type == "obj" {
-                params.boolean("flip_tex_coords", true)?
-            } else {
-                false
-            };
-            let loaded = if node.plugin_type == "obj" {
-                load_obj(&path)
-            } else {
-                load_ply(&path)
-            };
-            let mut data = loaded.map_err(|e| mesh_error(e, node))?;
-            data.validate(&path).map_err(|e| mesh_error(e, node))?;
-            if !flip_tex_coords && let Some(uvs) = &mut data.uvs {
-                // The OBJ reader flips v; undo it when the scene asks for raw coordinates.
-                for uv in uvs.iter_mut() {
-                    uv.y = 1.0 - uv.y;
-                }
-            }
-            if data.triangles.is_empty() {
-                return Err(Error::input(
-                    location,
-                    format!("the mesh \"{filename}\" has no triangles"),
-                ));
-            }
-            if face_normals {
-                data.normals = None;
-            } else if data.normals.is_none() {
-                data.compute_vertex_normals();
-            }
-            Ok(Shape::Mesh(transform_mesh(
-                data,
-                to_world,
-                flip_normals,
-                false,
-            )))
+    let flip_normals = params.boolean(&FLIP_NORMALS)?;
+    let filename = params.string_opt(&FILENAME)?.ok_or_else(|| {
+        Error::input(
+            &node.location,
+            format!("{} needs a \"filename\"", node.describe()),
+        )
+        .with_help("add <string name=\"filename\" value=\"mesh.obj\"/>")
+    })?;
+    let location = params.location_of(&FILENAME);
+    let path = node.resolve_file(filename, location)?;
+    let face_normals = params.boolean(&FACE_NORMALS)?;
+    let flip_tex_coords = if obj {
+        params.boolean(&FLIP_TEX_COORDS)?
+    } else {
+        false
+    };
+    let loaded = if obj {
+        load_obj(&path)
+    } else {
+        load_ply(&path)
+    };
+    let mut data = loaded.map_err(|e| mesh_error(e, node))?;
+    data.validate(&path).map_err(|e| mesh_error(e, node))?;
+    if !flip_tex_coords && let Some(uvs) = &mut data.uvs {
+        // The OBJ reader flips v; undo it when the scene asks for raw coordinates.
+        for uv in uvs.iter_mut() {
+            uv.y = 1.0 - uv.y;
         }
-        "rectangle" => Ok(Shape::Mesh(transform_mesh(
-            rectangle(),
-            to_world,
-            flip_normals,
-            true,
-        ))),
-        "cube" => Ok(Shape::Mesh(transform_mesh(
-            cube(),
-            to_world,
-            flip_normals,
-            true,
-        ))),
-        "sphere" => {
-            let center = params.point_opt("center")?.unwrap_or(DVec3::ZERO);
-            let radius = params.float("radius", 1.0)?;
-            if !(radius > 0.0 && radius.is_finite()) {
-                return Err(Error::input(
-                    params.location_of("radius"),
-                    format!("the sphere's radius must be positive, not {radius}"),
-                ));
-            }
-            let matrix = to_world.matrix.as_dmat4();
-            let axes = [
-                matrix.x_axis.truncate(),
-                matrix.y_axis.truncate(),
-                matrix.z_axis.truncate(),
-            ];
-            let scale = axes[0].length();
-            let uniform = axes
-                .iter()
-                .all(|a| (a.length() - scale).abs() <= 1e-5 * scale)
-                && axes[0].dot(axes[1]).abs() <= 1e-5 * scale * scale
-                && axes[1].dot(axes[2]).abs() <= 1e-5 * scale * scale
-                && axes[0].dot(axes[2]).abs() <= 1e-5 * scale * scale;
-            if !uniform {
-                return Err(Error::input(
-                    params.location_of("to_world"),
-                    "a sphere's \"to_world\" may only rotate, translate and scale uniformly",
-                )
-                .with_help("use a triangle mesh for ellipsoids"));
-            }
-            let rotation = Mat3::from_cols(
-                (axes[0] / scale).as_vec3(),
-                (axes[1] / scale).as_vec3(),
-                (axes[2] / scale).as_vec3(),
-            );
-            Ok(Shape::Sphere(Sphere {
-                center: matrix.transform_point3(center).as_vec3(),
-                radius: (radius * scale) as f32,
-                rotation,
-                flip_normals,
-            }))
-        }
-        "disk" => Ok(Shape::Disk(Disk::new(*to_world, flip_normals))),
-        other => Err(
-            Error::input(&node.location, format!("unknown shape type \"{other}\"")).with_help(
-                format!("supported shape types: {}", SUPPORTED_SHAPES.join(", ")),
-            ),
-        ),
     }
+    if data.triangles.is_empty() {
+        return Err(Error::input(
+            location,
+            format!("the mesh \"{filename}\" has no triangles"),
+        ));
+    }
+    if face_normals {
+        data.normals = None;
+    } else if data.normals.is_none() {
+        data.compute_vertex_normals();
+    }
+    Ok(Shape::Mesh(transform_mesh(
+        data,
+        to_world,
+        flip_normals,
+        false,
+    )))
+}
+
+/// A sphere placed by `to_world`, which may only rotate, translate and scale uniformly.
+fn build_sphere(params: &Params, to_world: &Transform) -> Result<Shape> {
+    let flip_normals = params.boolean(&FLIP_NORMALS)?;
+    let center = params.point_opt(&CENTER)?.unwrap_or(DVec3::ZERO);
+    let radius = params.float(&RADIUS)?;
+    if !(radius > 0.0 && radius.is_finite()) {
+        return Err(Error::input(
+            params.location_of(&RADIUS),
+            format!("the sphere's radius must be positive, not {radius}"),
+        ));
+    }
+    let matrix = to_world.matrix.as_dmat4();
+    let axes = [
+        matrix.x_axis.truncate(),
+        matrix.y_axis.truncate(),
+        matrix.z_axis.truncate(),
+    ];
+    let scale = axes[0].length();
+    let uniform = axes
+        .iter()
+        .all(|a| (a.length() - scale).abs() <= 1e-5 * scale)
+        && axes[0].dot(axes[1]).abs() <= 1e-5 * scale * scale
+        && axes[1].dot(axes[2]).abs() <= 1e-5 * scale * scale
+        && axes[0].dot(axes[2]).abs() <= 1e-5 * scale * scale;
+    if !uniform {
+        return Err(Error::input(
+            params.location_of(&TO_WORLD),
+            "a sphere's \"to_world\" may only rotate, translate and scale uniformly",
+        )
+        .with_help("use a triangle mesh for ellipsoids"));
+    }
+    let rotation = Mat3::from_cols(
+        (axes[0] / scale).as_vec3(),
+        (axes[1] / scale).as_vec3(),
+        (axes[2] / scale).as_vec3(),
+    );
+    Ok(Shape::Sphere(Sphere {
+        center: matrix.transform_point3(center).as_vec3(),
+        radius: (radius * scale) as f32,
+        rotation,
+        flip_normals,
+    }))
 }
 
 /// Makes a mesh reading error an input error (the scene names the file) that also says which

@@ -8,9 +8,11 @@
 //!   a float radiance of 1 renders as XYZ (0.950, 1.000, 1.088), a uniform spectrum as (1, 1, 1)).
 //! * `<spectrum value="λ:v, ..."/>` is piecewise linear in λ and zero outside the given range.
 
-use crate::description::{PropertyValue, SpectrumValue};
+use crate::description::{PluginClass, PropertyValue, SpectrumValue};
 use crate::params::Params;
+use crate::registry::{Default, Origin, ParamKind, ParamSpec, Plugin, Registry};
 use prism_core::error::{Error, Result};
+use prism_core::spectrum::ior::{Ior, SELLMEIER_GLASSES, sellmeier_glass};
 use prism_core::spectrum::{PiecewiseLinear, RgbIntent, Spectrum};
 
 /// How a spectral parameter may be valued.
@@ -26,14 +28,152 @@ pub enum Range {
     Unbounded,
 }
 
-/// The spectrum given for parameter `name`, or `default` when absent.
-pub fn spectrum_param(
-    params: &Params,
-    name: &'static str,
-    default: f32,
-    range: Range,
-) -> Result<Spectrum> {
-    if let Some(child) = params.named_child(name) {
+/// A spectrum given as a nested plugin: an emission spectrum, or an index of refraction.
+pub enum NestedSpectrum {
+    Emission(Spectrum),
+    Ior(Ior),
+}
+
+type Build = fn(&Params) -> Result<NestedSpectrum>;
+
+pub static SPECTRA: Registry<Build> = Registry {
+    class: PluginClass::Spectrum,
+    plugins: &[
+        Plugin {
+            name: "blackbody",
+            origin: Origin::Mitsuba3,
+            summary: "Planck's law in W m⁻² sr⁻¹ nm⁻¹, unnormalised as in Mitsuba 3: an emission.",
+            params: &[BLACKBODY_TEMPERATURE],
+            build: build_blackbody,
+        },
+        Plugin {
+            name: "sellmeier",
+            origin: Origin::Prism,
+            summary: "A dispersive index of refraction by Sellmeier's formula                       n² = 1 + Σ Bᵢλ²/(λ² − Cᵢ) (λ in µm): a catalogue `glass`, or the coefficients.",
+            params: &[GLASS, B1, B2, B3, C1, C2, C3],
+            build: build_sellmeier,
+        },
+        Plugin {
+            name: "cauchy",
+            origin: Origin::Prism,
+            summary: "A dispersive index of refraction by Cauchy's formula n = A + B/λ² + C/λ⁴                       (λ in µm).",
+            params: &[CAUCHY_A, CAUCHY_B, CAUCHY_C],
+            build: build_cauchy,
+        },
+    ],
+};
+
+pub const BLACKBODY_TEMPERATURE: ParamSpec = ParamSpec::new(
+    "temperature",
+    ParamKind::Float,
+    Default::Required,
+    "temperature in kelvin",
+);
+const GLASS: ParamSpec = ParamSpec::new(
+    "glass",
+    ParamKind::String,
+    Default::None,
+    "a catalogue glass: N-BK7, N-SF11, N-F2, fused silica, diamond",
+);
+const B1: ParamSpec = ParamSpec::new("b1", ParamKind::Float, Default::Float(0.0), "B₁");
+const B2: ParamSpec = ParamSpec::new("b2", ParamKind::Float, Default::Float(0.0), "B₂");
+const B3: ParamSpec = ParamSpec::new("b3", ParamKind::Float, Default::Float(0.0), "B₃");
+const C1: ParamSpec = ParamSpec::new("c1", ParamKind::Float, Default::Float(0.0), "C₁ in µm²");
+const C2: ParamSpec = ParamSpec::new("c2", ParamKind::Float, Default::Float(0.0), "C₂ in µm²");
+const C3: ParamSpec = ParamSpec::new("c3", ParamKind::Float, Default::Float(0.0), "C₃ in µm²");
+const CAUCHY_A: ParamSpec = ParamSpec::new("a", ParamKind::Float, Default::Float(1.5), "A");
+const CAUCHY_B: ParamSpec = ParamSpec::new("b", ParamKind::Float, Default::Float(0.0), "B in µm²");
+const CAUCHY_C: ParamSpec = ParamSpec::new("c", ParamKind::Float, Default::Float(0.0), "C in µm⁴");
+
+fn build_blackbody(params: &Params) -> Result<NestedSpectrum> {
+    let Some(temperature) = params.float_opt(&BLACKBODY_TEMPERATURE)? else {
+        return Err(Error::input(
+            params.location(),
+            "the blackbody spectrum needs a \"temperature\" (in kelvin)",
+        )
+        .with_help("add <float name=\"temperature\" value=\"5000\"/>"));
+    };
+    if !(temperature > 0.0 && temperature.is_finite() && temperature < f64::from(f32::MAX)) {
+        return Err(Error::input(
+            params.location_of(&BLACKBODY_TEMPERATURE),
+            format!(
+                "the blackbody temperature must be a positive number of kelvin, not {temperature}"
+            ),
+        ));
+    }
+    Ok(NestedSpectrum::Emission(Spectrum::Blackbody(
+        prism_core::spectrum::blackbody::Blackbody {
+            temperature: temperature as f32,
+        },
+    )))
+}
+
+/// A finite number parameter of a dispersion formula.
+fn coefficient(params: &Params, spec: &ParamSpec) -> Result<f32> {
+    let v = params.float(spec)?;
+    if !v.is_finite() {
+        return Err(Error::input(
+            params.location_of(spec),
+            format!("\"{}\" must be a finite number", spec.name),
+        ));
+    }
+    Ok(v as f32)
+}
+
+fn build_sellmeier(params: &Params) -> Result<NestedSpectrum> {
+    let ior = match params.string_opt(&GLASS)? {
+        Some(glass) => {
+            let (b, c) = sellmeier_glass(glass).ok_or_else(|| {
+                let names: Vec<&str> = SELLMEIER_GLASSES.iter().map(|g| g.0).collect();
+                Error::input(
+                    params.location_of(&GLASS),
+                    format!("unknown glass \"{glass}\""),
+                )
+                .with_help(format!("known glasses: {}", names.join(", ")))
+            })?;
+            Ior::Sellmeier { b, c }
+        }
+        None => Ior::Sellmeier {
+            b: [
+                coefficient(params, &B1)?,
+                coefficient(params, &B2)?,
+                coefficient(params, &B3)?,
+            ],
+            c: [
+                coefficient(params, &C1)?,
+                coefficient(params, &C2)?,
+                coefficient(params, &C3)?,
+            ],
+        },
+    };
+    Ok(NestedSpectrum::Ior(ior))
+}
+
+fn build_cauchy(params: &Params) -> Result<NestedSpectrum> {
+    Ok(NestedSpectrum::Ior(Ior::Cauchy {
+        a: coefficient(params, &CAUCHY_A)?,
+        b: coefficient(params, &CAUCHY_B)?,
+        c: coefficient(params, &CAUCHY_C)?,
+    }))
+}
+
+/// The spectrum a nested `<spectrum type="...">` describes.
+pub fn build_nested_spectrum(node: &crate::description::PluginNode) -> Result<NestedSpectrum> {
+    let plugin = SPECTRA.find(node)?;
+    let params = Params::new(node, plugin.params);
+    let spectrum = (plugin.build)(&params)?;
+    params.finish()?;
+    Ok(spectrum)
+}
+
+/// The spectrum given for parameter `spec` (its declared range), or its declared default when
+/// absent.
+pub fn spectrum_param(params: &Params, spec: &ParamSpec) -> Result<Spectrum> {
+    let name = spec.name;
+    let ParamKind::Spectrum { range, .. } = spec.kind else {
+        panic!("\"{name}\" is not a spectrum");
+    };
+    if let Some(child) = params.named_child(spec) {
         return Err(Error::input(
             &child.location,
             format!(
@@ -44,8 +184,11 @@ pub fn spectrum_param(
         )
         .with_help("give the value as <rgb>, <spectrum> or <float>"));
     }
-    let Some(property) = params.property(name) else {
-        return Ok(Spectrum::Constant(default));
+    let Some(property) = params.property(spec) else {
+        let Default::Float(default) = spec.default else {
+            panic!("\"{name}\" has no numeric default");
+        };
+        return Ok(Spectrum::Constant(default as f32));
     };
     let location = &property.location;
     let negative = || {

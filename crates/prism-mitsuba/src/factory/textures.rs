@@ -12,6 +12,7 @@ use std::sync::Arc;
 use super::spectra::{Range, spectrum_param};
 use crate::description::{PluginClass, PluginNode, PropertyValue, SpectrumValue};
 use crate::params::Params;
+use crate::registry::{Bounds, Default, Origin, ParamKind, ParamSpec, Plugin, Registry};
 use prism_core::error::{Error, Result};
 use prism_core::image::{Encoding, read_bitmap};
 use prism_core::texture::Texture;
@@ -19,8 +20,92 @@ use prism_core::texture::{
     BitmapTexture, Checkerboard, FilterType, TextureUse, UvTransform, WrapMode,
 };
 
-/// The texture types this factory knows.
-pub const SUPPORTED_TEXTURES: &[&str] = &["bitmap", "checkerboard"];
+type Build = fn(&Params, TextureUse, &mut TextureCache) -> Result<Texture>;
+
+pub static TEXTURES: Registry<Build> = Registry {
+    class: PluginClass::Texture,
+    plugins: &[
+        Plugin {
+            name: "bitmap",
+            origin: Origin::Mitsuba3,
+            summary: "An image looked up at the surface's texture coordinates, (0, 0) at its \
+                      top-left corner. 8- and 16-bit images are decoded from sRGB unless `raw`; \
+                      colours are upsampled per texel; alpha is ignored; a colour image read \
+                      as a number gives its luminance.",
+            params: &[FILENAME, FILTER_TYPE, WRAP_MODE, RAW, TO_UV, FORMAT, ACCEL],
+            build: |params, usage, _| build_bitmap(params, usage),
+        },
+        Plugin {
+            name: "checkerboard",
+            origin: Origin::Mitsuba3,
+            summary: "Two textures alternating: `color0` where frac(u) > ½ and frac(v) > ½ agree, \
+                      `color1` where they differ.",
+            params: &[COLOR0, COLOR1, TO_UV],
+            build: build_checkerboard,
+        },
+    ],
+};
+
+const FILENAME: ParamSpec = ParamSpec::new(
+    "filename",
+    ParamKind::String,
+    Default::Required,
+    "the image: PNG, JPEG, OpenEXR or Radiance HDR",
+);
+const FILTER_TYPE: ParamSpec = ParamSpec::new(
+    "filter_type",
+    ParamKind::Choice(&["bilinear", "nearest"]),
+    Default::Str("bilinear"),
+    "interpolate the four nearest texels, or take the one containing the point",
+);
+const WRAP_MODE: ParamSpec = ParamSpec::new(
+    "wrap_mode",
+    ParamKind::Choice(&["repeat", "mirror", "clamp"]),
+    Default::Str("repeat"),
+    "how coordinates outside [0, 1] map into the image",
+);
+const RAW: ParamSpec = ParamSpec::new(
+    "raw",
+    ParamKind::Boolean,
+    Default::Boolean(false),
+    "read 8- and 16-bit values as they are, without sRGB decoding (normal maps need it)",
+);
+const TO_UV: ParamSpec = ParamSpec::new(
+    "to_uv",
+    ParamKind::Transform,
+    Default::Text("identity"),
+    "an affine map of the texture coordinates",
+);
+const FORMAT: ParamSpec = ParamSpec::new(
+    "format",
+    ParamKind::Choice(&["auto", "variant", "fp16"]),
+    Default::Str("auto"),
+    "accepted; texels are always stored in full precision",
+);
+const ACCEL: ParamSpec = ParamSpec::new(
+    "accel",
+    ParamKind::Boolean,
+    Default::Boolean(true),
+    "accepted; Mitsuba's GPU texture acceleration does not apply",
+);
+const COLOR0: ParamSpec = ParamSpec::new(
+    "color0",
+    ParamKind::Spectrum {
+        range: Range::Albedo,
+        textured: true,
+    },
+    Default::Float(0.4),
+    "the first colour (a number when the texture is read as one)",
+);
+const COLOR1: ParamSpec = ParamSpec::new(
+    "color1",
+    ParamKind::Spectrum {
+        range: Range::Albedo,
+        textured: true,
+    },
+    Default::Float(0.2),
+    "the second colour",
+);
 
 /// Textures built so far, by element and use.
 #[derive(Default)]
@@ -36,54 +121,57 @@ impl TextureCache {
     }
 }
 
-/// The spectral parameter `name`: a value as [`spectrum_param`] reads it, or a nested texture
+/// The spectral parameter `spec`: a value as [`spectrum_param`] reads it, or a nested texture
 /// read as colours.
 pub fn spectrum_texture(
     params: &Params,
-    name: &'static str,
-    default: f32,
-    range: Range,
+    spec: &ParamSpec,
     cache: &mut TextureCache,
 ) -> Result<Texture> {
-    if let Some(child) = params.named_child(name) {
-        return nested_texture(params, name, &child.node, TextureUse::Spectral, cache);
+    if let Some(child) = params.named_child(spec) {
+        return nested_texture(params, spec.name, &child.node, TextureUse::Spectral, cache);
     }
-    Ok(Texture::Constant(spectrum_param(
-        params, name, default, range,
-    )?))
+    Ok(Texture::Constant(spectrum_param(params, spec)?))
 }
 
-/// The optional spectral parameter `name` (None when absent).
+/// The optional spectral parameter `spec` (None when absent).
 pub fn optional_spectrum_texture(
     params: &Params,
-    name: &'static str,
-    range: Range,
+    spec: &ParamSpec,
     cache: &mut TextureCache,
 ) -> Result<Option<Texture>> {
-    if params.property(name).is_none() && params.named_child(name).is_none() {
+    if !params.has(spec) {
         return Ok(None);
     }
-    spectrum_texture(params, name, 1.0, range, cache).map(Some)
+    spectrum_texture(params, spec, cache).map(Some)
 }
 
-/// The scalar parameter `name`: a `<float>` (or a uniform `<spectrum>`), or a nested texture
-/// read as numbers. Constants are checked to lie in [`min`, `max`] (`min_exclusive`: above
-/// `min`); textures are clamped where they are used.
-#[allow(clippy::too_many_arguments)]
+/// The scalar parameter `spec`: a `<float>` (or a uniform `<spectrum>`), or a nested texture
+/// read as numbers. Constants are checked to lie within the declared bounds; textures are
+/// clamped where they are used.
 pub fn float_texture(
     params: &Params,
-    name: &'static str,
-    default: f32,
-    min: f32,
-    min_exclusive: bool,
-    max: f32,
+    spec: &ParamSpec,
     cache: &mut TextureCache,
 ) -> Result<Texture> {
-    if let Some(child) = params.named_child(name) {
-        return nested_texture(params, name, &child.node, TextureUse::Scalar, cache);
+    let ParamKind::FloatTexture(bounds) = spec.kind else {
+        panic!("\"{}\" is not a float texture", spec.name);
+    };
+    if let Some(child) = params.named_child(spec) {
+        return nested_texture(params, spec.name, &child.node, TextureUse::Scalar, cache);
     }
-    let Some(property) = params.property(name) else {
-        return Ok(Texture::constant(default));
+    float_value(params, spec, bounds).map(Texture::constant)
+}
+
+/// The number given for `spec` as a `<float>` (or a uniform `<spectrum>`), or its declared
+/// default; it must lie within `bounds`.
+pub fn float_value(params: &Params, spec: &ParamSpec, bounds: Bounds) -> Result<f32> {
+    let name = spec.name;
+    let Some(property) = params.property(spec) else {
+        let Default::Float(default) = spec.default else {
+            panic!("\"{name}\" has no numeric default");
+        };
+        return Ok(default as f32);
     };
     let value =
         match &property.value {
@@ -102,32 +190,17 @@ pub fn float_texture(
             .with_help(format!("write it as <float name=\"{name}\" value=\"...\"/>")));
             }
         } as f32;
-    let above_min = if min_exclusive {
-        value > min
-    } else {
-        value >= min
-    };
-    if !(above_min && value <= max && value.is_finite()) {
-        let range = match (min_exclusive, max.is_finite()) {
-            (true, true) => format!("({min}, {max}]"),
-            (true, false) => format!("greater than {min}"),
-            (false, true) => format!("[{min}, {max}]"),
-            (false, false) => format!("at least {min}"),
-        };
+    if !bounds.contains(value) {
         return Err(Error::input(
             &property.location,
             format!(
-                "parameter \"{name}\" of {} is {value}, but it must be {}{range}",
+                "parameter \"{name}\" of {} is {value}, but it must be {}",
                 params.node().describe(),
-                if range.starts_with(['(', '[']) {
-                    "in "
-                } else {
-                    ""
-                }
+                bounds.describe()
             ),
         ));
     }
-    Ok(Texture::constant(value))
+    Ok(value)
 }
 
 /// A nested plugin given for parameter `name`: it must be a texture.
@@ -162,89 +235,73 @@ pub fn build_texture(
     if let Some(texture) = cache.built.get(&key) {
         return Ok(texture.clone());
     }
-    let params = Params::new(node);
-    let texture = match node.plugin_type.as_str() {
-        "bitmap" => build_bitmap(&params, usage)?,
-        "checkerboard" => {
-            let color = |name, default, cache: &mut TextureCache| match usage {
-                TextureUse::Scalar => {
-                    float_texture(&params, name, default, 0.0, false, f32::INFINITY, cache)
-                }
-                _ => spectrum_texture(&params, name, default, Range::Albedo, cache),
-            };
-            let color0 = color("color0", 0.4, cache)?;
-            let color1 = color("color1", 0.2, cache)?;
-            Texture::Checkerboard(Box::new(Checkerboard {
-                color0,
-                color1,
-                to_uv: UvTransform::from_matrix(&params.transform("to_uv")?),
-            }))
-        }
-        other => {
-            return Err(
-                Error::input(&node.location, format!("unknown texture type \"{other}\""))
-                    .with_help(format!(
-                        "supported texture types: {}",
-                        SUPPORTED_TEXTURES.join(", ")
-                    )),
-            );
-        }
-    };
+    let plugin = TEXTURES.find(node)?;
+    let params = Params::new(node, plugin.params);
+    let texture = (plugin.build)(&params, usage, cache)?;
     params.finish()?;
     cache.built.insert(key, texture.clone());
     Ok(texture)
 }
 
-/// A string parameter that must be one of `choices`.
-fn choice<'a>(
-    params: &Params<'a>,
-    name: &'static str,
-    default: &'a str,
-    choices: &[&str],
-) -> Result<&'a str> {
-    let value = params.string(name, default)?;
-    if choices.contains(&value) {
-        return Ok(value);
-    }
-    Err(Error::input(
-        params.location_of(name),
-        format!(
-            "parameter \"{name}\" of {} is \"{value}\"",
-            params.node().describe()
+/// Read as a number, a checkerboard's colours are numbers too.
+const SCALAR_COLOR0: ParamSpec = ParamSpec::new(
+    "color0",
+    ParamKind::FloatTexture(Bounds::NON_NEGATIVE),
+    Default::Float(0.4),
+    "",
+);
+const SCALAR_COLOR1: ParamSpec = ParamSpec::new(
+    "color1",
+    ParamKind::FloatTexture(Bounds::NON_NEGATIVE),
+    Default::Float(0.2),
+    "",
+);
+
+fn build_checkerboard(
+    params: &Params,
+    usage: TextureUse,
+    cache: &mut TextureCache,
+) -> Result<Texture> {
+    let (color0, color1) = match usage {
+        TextureUse::Scalar => (
+            float_texture(params, &SCALAR_COLOR0, cache)?,
+            float_texture(params, &SCALAR_COLOR1, cache)?,
         ),
-    )
-    .with_help(format!("use one of: {}", choices.join(", "))))
+        TextureUse::Spectral | TextureUse::Rgb => (
+            spectrum_texture(params, &COLOR0, cache)?,
+            spectrum_texture(params, &COLOR1, cache)?,
+        ),
+    };
+    Ok(Texture::Checkerboard(Box::new(Checkerboard {
+        color0,
+        color1,
+        to_uv: UvTransform::from_matrix(&params.transform(&TO_UV)?),
+    })))
 }
 
 fn build_bitmap(params: &Params, usage: TextureUse) -> Result<Texture> {
     let node = params.node();
-    let filename = params.string_opt("filename")?.ok_or_else(|| {
+    let filename = params.string_opt(&FILENAME)?.ok_or_else(|| {
         Error::input(
             &node.location,
             format!("{} needs a \"filename\"", node.describe()),
         )
         .with_help("add <string name=\"filename\" value=\"image.png\"/>")
     })?;
-    let location = params.location_of("filename");
-    let filter = match choice(params, "filter_type", "bilinear", &["bilinear", "nearest"])? {
+    let location = params.location_of(&FILENAME);
+    let filter = match params.choice(&FILTER_TYPE)? {
         "nearest" => FilterType::Nearest,
         _ => FilterType::Bilinear,
     };
-    let wrap = match choice(
-        params,
-        "wrap_mode",
-        "repeat",
-        &["repeat", "mirror", "clamp"],
-    )? {
+    let wrap = match params.choice(&WRAP_MODE)? {
         "mirror" => WrapMode::Mirror,
         "clamp" => WrapMode::Clamp,
         _ => WrapMode::Repeat,
     };
-    // Storage precision and GPU acceleration do not apply here; accepted for compatibility.
-    choice(params, "format", "auto", &["auto", "variant", "fp16"])?;
-    params.boolean("accel", true)?;
-    let raw = params.boolean("raw", false)?;
-    let to_uv = UvTransform::from_matrix(&params.transform("to_uv")?);
+    params.choice(&FORMAT)?;
+    params.boolean(&ACCEL)?;
+    let raw = params.boolean(&RAW)?;
+    let to_uv = UvTransform::from_matrix(&params.transform(&TO_UV)?);
     let path = node.resolve_file(filename, location)?;
     let mut bitmap = read_bitmap(&path).map_err(|e| e.at(location))?;
     if usage == TextureUse::Rgb && !raw && bitmap.encoding == Encoding::Srgb {
