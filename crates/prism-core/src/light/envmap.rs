@@ -19,7 +19,8 @@
 //! * Lookup: the pixels are the nodes of a bilinear interpolation, pixel (x, y) at
 //!   u = (x + ½)/W, v = y/(H − 1), periodic in u: the first and last rows are the poles.
 //! * Spectra (spectral variants): each pixel's linear RGB c becomes the scale f = 2 max c and the
-//!   sigmoid polynomial s of c / f (Jakob & Hanika 2019); s and f are interpolated separately
+//!   sigmoid polynomial s of c / f (Jakob & Hanika 2019, from the shared table of
+//!   [`crate::spectrum::rgb`]); s and f are interpolated separately
 //!   and L = s · f · scale · D65, with D65 of luminance 1, as for other RGB emission. PNG and JPEG
 //!   values are decoded from the sRGB curve first; alpha is ignored.
 //!
@@ -40,8 +41,7 @@ use crate::image::Bitmap;
 use crate::math::Transform;
 use crate::sampling::distribution::PiecewiseConstant2D;
 use crate::spectrum::cie::{LINEAR_SRGB_TO_XYZ, d65_normalized};
-use crate::spectrum::rgb::RgbSigmoidPolynomial;
-use crate::spectrum::rgb_table::RgbTable;
+use crate::spectrum::rgb::{RgbSigmoidPolynomial, RgbToSpectrumTable};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 
 /// One pixel's spectrum: `scale` · `polynomial`(λ) (before the map's scale and D65).
@@ -118,13 +118,13 @@ impl EnvironmentMap {
             let s = 2.0 * c[0].max(c[1]).max(c[2]);
             (c.map(|v| v / s.max(1e-8)), s)
         };
-        RgbTable::prepare(rgb.iter().map(|&c| normalise(c).0));
+        let table = RgbToSpectrumTable::srgb();
         let texels = rgb
             .iter()
             .map(|&c| {
                 let (normalised, scale) = normalise(c);
                 Texel {
-                    polynomial: RgbTable::lookup(normalised),
+                    polynomial: table.fetch(normalised),
                     scale,
                 }
             })

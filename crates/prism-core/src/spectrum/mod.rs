@@ -11,7 +11,6 @@ pub mod cie_tables;
 pub mod conductors;
 pub mod ior;
 pub mod rgb;
-pub mod rgb_table;
 pub mod sampled;
 pub mod spectra;
 

@@ -3,10 +3,14 @@
 //!
 //! A reflectance is s(c₀λ² + c₁λ + c₂) with the sigmoid s(x) = ½ + x / (2√(1 + x²)), so it is
 //! smooth and stays in [0, 1]. The coefficients for an sRGB colour are found by Gauss–Newton
-//! iterations that match the colour in CIELAB under D65 (the paper's §4 objective); we solve per
-//! colour when a scene is loaded, continuing from grey towards the target so that the iteration
-//! never starts far from its solution (the paper builds its table the same way, outward from the
-//! grey axis). Grey colours get the exact constant spectrum, so grey stays neutral.
+//! iterations that match the colour in CIELAB under D65 (the paper's §4 objective), continuing
+//! from grey towards the target so that the iteration never starts far from its solution (the
+//! paper builds its table the same way, outward from the grey axis).
+//!
+//! Every colour Prism upsamples (`<rgb>` values, texels, environment map pixels) is looked up in
+//! one table of such fits, [`RgbToSpectrumTable`], at Mitsuba 3's resolution of 64³ per part, so
+//! that the same colour gives the same spectrum wherever it is given. Grey colours get the exact
+//! constant spectrum, so grey stays neutral.
 
 use std::sync::OnceLock;
 
@@ -134,8 +138,8 @@ pub struct RgbToSpectrumTable {
     coefficients: Vec<[f32; 3]>,
 }
 
-/// Resolution of the shipped table.
-pub const TABLE_RESOLUTION: usize = 32;
+/// Resolution of the shipped table (Mitsuba 3's `srgb.coeff` has the same).
+pub const TABLE_RESOLUTION: usize = 64;
 
 const TABLE_MAGIC: &[u8; 4] = b"PJH1";
 
@@ -148,13 +152,8 @@ impl RgbToSpectrumTable {
     pub fn srgb() -> &'static RgbToSpectrumTable {
         static TABLE: OnceLock<RgbToSpectrumTable> = OnceLock::new();
         TABLE.get_or_init(|| {
-            RgbToSpectrumTable::from_bytes(include_bytes!("srgb_to_spectrum.bin")).unwrap_or_else(
-                || {
-                    // Unreachable with the shipped file (a unit test reads it); generating the
-                    // table keeps the renderer working if the data were ever damaged.
-                    RgbToSpectrumTable::generate(TABLE_RESOLUTION)
-                },
-            )
+            RgbToSpectrumTable::from_bytes(include_bytes!("srgb_to_spectrum.bin"))
+                .expect("the shipped table is well formed (a unit test reads it)")
         })
     }
 

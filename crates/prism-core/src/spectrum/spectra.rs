@@ -4,7 +4,7 @@ use wide::{CmpGe, CmpLe, f32x4};
 
 use super::blackbody::Blackbody;
 use super::cie::{cie_y, d65_normalized, d65_normalized4};
-use super::rgb::RgbSigmoidPolynomial;
+use super::rgb::{RgbSigmoidPolynomial, RgbToSpectrumTable};
 use super::sampled::{SampledSpectrum, SampledWavelengths};
 use super::{LAMBDA_MAX, LAMBDA_MIN};
 
@@ -47,8 +47,10 @@ pub enum RgbIntent {
 }
 
 impl Spectrum {
-    /// The spectrum for an RGB triple (linear sRGB, components ≥ 0).
+    /// The spectrum for an RGB triple (linear sRGB, components ≥ 0), through the shipped table
+    /// of fitted coefficients ([`RgbToSpectrumTable::srgb`]).
     pub fn from_rgb(rgb: [f32; 3], intent: RgbIntent) -> Spectrum {
+        let table = RgbToSpectrumTable::srgb();
         let max = rgb[0].max(rgb[1]).max(rgb[2]);
         match intent {
             RgbIntent::Albedo if max <= 1.0 => {
@@ -56,7 +58,7 @@ impl Spectrum {
                     Spectrum::Constant(rgb[0])
                 } else {
                     Spectrum::Rgb {
-                        polynomial: RgbSigmoidPolynomial::fit(rgb),
+                        polynomial: table.fetch(rgb),
                         scale: 1.0,
                     }
                 }
@@ -64,7 +66,7 @@ impl Spectrum {
             RgbIntent::Albedo => {
                 let scale = 2.0 * max;
                 Spectrum::Rgb {
-                    polynomial: RgbSigmoidPolynomial::fit(rgb.map(|c| c / scale)),
+                    polynomial: table.fetch(rgb.map(|c| c / scale)),
                     scale,
                 }
             }
@@ -74,7 +76,7 @@ impl Spectrum {
                 }
                 let scale = 2.0 * max;
                 Spectrum::Rgb {
-                    polynomial: RgbSigmoidPolynomial::fit(rgb.map(|c| c / scale)),
+                    polynomial: table.fetch(rgb.map(|c| c / scale)),
                     scale,
                 }
             }
@@ -84,7 +86,7 @@ impl Spectrum {
                 }
                 let scale = 2.0 * max;
                 Spectrum::RgbIlluminant {
-                    polynomial: RgbSigmoidPolynomial::fit(rgb.map(|c| c / scale)),
+                    polynomial: table.fetch(rgb.map(|c| c / scale)),
                     scale,
                 }
             }
