@@ -51,7 +51,9 @@ fn uniform_sphere_sampling_is_uniform() {
 }
 
 /// A uniform point on the disk has (r², φ) uniform on [0, 1) × [0, 2π); testing in those
-/// coordinates keeps the disk's edge, where the density jumps, off the cells' interiors.
+/// coordinates keeps the disk's edge, where the density jumps, off the cells' interiors. The
+/// claimed density is the warp's own per unit area, halved by the change of variables
+/// (dA = r dr dφ = ½ d(r²) dφ).
 #[test]
 fn concentric_disk_sampling_is_uniform() {
     let outcome = chi2_rectangle(
@@ -66,7 +68,11 @@ fn concentric_disk_sampling_is_uniform() {
             let phi = p.y.atan2(p.x).rem_euclid(2.0 * PI);
             Some((p.length_squared().min(1.0 - 1e-12), phi))
         },
-        |_, _| 1.0 / (2.0 * PI),
+        |r2, phi| {
+            let r = r2.sqrt();
+            let p = glam::DVec2::new(r * phi.cos(), r * phi.sin()).as_vec2();
+            0.5 * f64::from(warp::uniform_disk_pdf(p))
+        },
     )
     .unwrap();
     assert_passes("concentric disk", &outcome, TESTS);
@@ -174,7 +180,8 @@ fn sphere() -> Sphere {
 
 /// Directions uniform in the cone about the axis towards the centre have (cos θ, φ) uniform on
 /// [cos θmax, 1] × [0, 2π) in the cone's frame; those are the test's coordinates, so the cone's
-/// edge, where the solid-angle density jumps to zero, is the domain's edge.
+/// edge, where the solid-angle density jumps to zero, is the domain's edge. The claimed density
+/// is the cone warp's (dω = d(cos θ) dφ).
 #[test]
 fn sphere_cone_sampling_is_uniform_over_the_visible_cone() {
     let s = sphere();
@@ -198,7 +205,11 @@ fn sphere_cone_sampling_is_uniform_over_the_visible_cone() {
             let phi = w.y.atan2(w.x).rem_euclid(2.0 * PI);
             Some((w.z.clamp(cos_max, 1.0 - 1e-12), phi))
         },
-        |_, _| 1.0 / (2.0 * PI * (1.0 - cos_max)),
+        |cos_theta, phi| {
+            let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
+            let w = glam::DVec3::new(sin_theta * phi.cos(), sin_theta * phi.sin(), cos_theta);
+            f64::from(warp::uniform_cone_pdf(w.as_vec3(), cos_max as f32))
+        },
     )
     .unwrap();
     assert_passes("sphere cone", &outcome, TESTS);

@@ -98,36 +98,54 @@ fn wait(child: Child) -> (i32, String) {
     )
 }
 
+/// Samples per pixel of the interrupted renders: enough that a render of the 32 × 32 box takes
+/// seconds even on a fast machine, so it is still running when the signal comes (the tests fail
+/// if it is not).
+const LONG_SPP: u32 = 4000;
+
+/// Starts a render that checkpoints every 0.05 s and returns once its first checkpoint is
+/// written, with the render in progress.
+fn start_checkpointing(output: &Path, state: &Path) -> Child {
+    let mut arguments = render_arguments(output, LONG_SPP);
+    arguments.extend([
+        "--checkpoint".into(),
+        state.to_str().unwrap().into(),
+        "--checkpoint-every".into(),
+        "0.05".into(),
+    ]);
+    let child = spawn(&arguments);
+    let start = Instant::now();
+    while !state.exists() && start.elapsed() < Duration::from_secs(60) {
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    assert!(state.exists(), "no checkpoint was written in a minute");
+    child
+}
+
+/// Resumes the render of `output` from `state` to its end.
+fn resume(output: &Path, state: &Path) {
+    let mut arguments = render_arguments(output, LONG_SPP);
+    arguments.extend(["--resume".into(), state.to_str().unwrap().into()]);
+    let (status, text) = prism(&arguments);
+    assert_eq!(status, 0, "{text}");
+}
+
 #[test]
 fn sigint_then_resume_is_bit_identical_to_an_uninterrupted_render() {
     let dir = folder("sigint");
-    let spp = 1200;
-    let reference = reference(&dir, spp);
+    let reference = reference(&dir, LONG_SPP);
     let output = dir.join("image.exr");
     let state = dir.join("image.state");
-    let mut arguments = render_arguments(&output, spp);
-    arguments.extend(["--checkpoint".into(), state.to_str().unwrap().into()]);
-    // Interrupt at a random moment early in the render.
-    let delay = Duration::from_secs_f32(
-        0.05 + 0.4 * Pcg32::seeded(u64::from(std::process::id())).next_f32(),
-    );
-    let child = spawn(&arguments);
+    let child = start_checkpointing(&output, &state);
+    // Interrupt at a random moment in the render.
+    let delay =
+        Duration::from_secs_f32(0.3 * Pcg32::seeded(u64::from(std::process::id())).next_f32());
     std::thread::sleep(delay);
     signal(&child, "INT");
     let (status, text) = wait(child);
-    if status == 0 {
-        eprintln!("the render finished before the signal ({delay:?}); nothing to resume");
-    } else {
-        assert_eq!(status, 130, "{text}");
-        assert!(text.contains("--resume"), "{text}");
-        assert!(state.exists());
-    }
-    let mut resume = render_arguments(&output, spp);
-    resume.extend(["--resume".into(), state.to_str().unwrap().into()]);
-    if status != 0 {
-        let (status, text) = prism(&resume);
-        assert_eq!(status, 0, "{text}");
-    }
+    assert_eq!(status, 130, "{text}");
+    assert!(text.contains("--resume"), "{text}");
+    resume(&output, &state);
     assert_identical_images(&output, &reference);
 }
 
@@ -149,32 +167,15 @@ fn sigterm_exits_with_143_and_leaves_a_state() {
 #[test]
 fn kill_9_between_checkpoints_resumes_from_the_last_one() {
     let dir = folder("kill9");
-    let spp = 1200;
-    let reference = reference(&dir, spp);
+    let reference = reference(&dir, LONG_SPP);
     let output = dir.join("image.exr");
     let state = dir.join("image.state");
-    let mut arguments = render_arguments(&output, spp);
-    arguments.extend([
-        "--checkpoint".into(),
-        state.to_str().unwrap().into(),
-        "--checkpoint-every".into(),
-        "0.05".into(),
-    ]);
-    let child = spawn(&arguments);
-    let start = Instant::now();
-    while !state.exists() && start.elapsed() < Duration::from_secs(20) {
-        std::thread::sleep(Duration::from_millis(5));
-    }
+    let child = start_checkpointing(&output, &state);
     std::thread::sleep(Duration::from_millis(60));
     signal(&child, "KILL");
-    let (status, _) = wait(child);
-    assert!(state.exists(), "no checkpoint was written before the kill");
-    let mut resume = render_arguments(&output, spp);
-    resume.extend(["--resume".into(), state.to_str().unwrap().into()]);
-    if status == -1 {
-        let (status, text) = prism(&resume);
-        assert_eq!(status, 0, "{text}");
-    }
+    let (status, text) = wait(child);
+    assert_eq!(status, -1, "the render was not killed: {text}");
+    resume(&output, &state);
     assert_identical_images(&output, &reference);
 }
 

@@ -25,11 +25,6 @@ impl SourceLocation {
             column,
         }
     }
-
-    /// The start of a file, for errors about a file as a whole.
-    pub fn file_start(file: impl Into<PathBuf>) -> Self {
-        Self::new(file, 1, 1)
-    }
 }
 
 impl fmt::Display for SourceLocation {

@@ -150,13 +150,6 @@ impl Film {
     pub fn linear_srgb(&self) -> Vec<[f32; 3]> {
         self.xyz().into_iter().map(xyz_to_linear_srgb).collect()
     }
-
-    /// Total samples taken and samples rejected as non-finite.
-    pub fn sample_counts(&self) -> (u64, u64) {
-        self.pixels
-            .iter()
-            .fold((0, 0), |(s, r), p| (s + p.samples, r + p.rejected))
-    }
 }
 
 #[cfg(test)]

@@ -45,17 +45,6 @@ impl SampledSpectrum {
     pub fn is_finite(&self) -> bool {
         self.0.iter().all(|v| v.is_finite())
     }
-
-    /// Componentwise quotient, with x / 0 = 0 (for ratios of densities that vanish together).
-    pub fn safe_div(&self, other: &SampledSpectrum) -> SampledSpectrum {
-        SampledSpectrum::from_fn(|i| {
-            if other.0[i] != 0.0 {
-                self.0[i] / other.0[i]
-            } else {
-                0.0
-            }
-        })
-    }
 }
 
 impl Index<usize> for SampledSpectrum {
