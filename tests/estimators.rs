@@ -16,16 +16,6 @@ use prism_mitsuba::factory::build_scene;
 use prism_mitsuba::load_scene;
 use prism_mitsuba::reader::read_scene_str;
 
-/// relMSE of the pixels' Y against exact values: mean of (a − b)² / (b² + 0.01).
-fn rel_mse(film: &Film, exact: &[f64]) -> f64 {
-    exact
-        .iter()
-        .enumerate()
-        .map(|(i, e)| (pixel_mean_and_variance(film, i, 1).0 - e).powi(2) / (e * e + 0.01))
-        .sum::<f64>()
-        / exact.len() as f64
-}
-
 /// The standard deviation of a Monte Carlo estimate falls as σ/√N: on the disk-light scene
 /// (exact per-pixel answers) the relative squared error of a pixel rendered with N samples has
 /// expectation V/N (the estimator is unbiased and its samples independent), so N times it has
