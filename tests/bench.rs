@@ -23,6 +23,40 @@ fn field(json: &str, key: &str) -> f64 {
     json[start..end].parse().unwrap()
 }
 
+/// The suite needs nothing outside the repository: all four scenes are listed, with files that
+/// exist.
+#[test]
+fn bench_lists_its_four_scenes_from_the_repository() {
+    let cache = std::env::temp_dir().join(format!("prism-bench-list-{}", std::process::id()));
+    let output = Command::new(env!("CARGO_BIN_EXE_prism"))
+        .args(["bench", "--list", "--cache"])
+        .arg(&cache)
+        .current_dir(std::env::temp_dir())
+        .output()
+        .unwrap();
+    assert!(output.status.success(), "{output:?}");
+    let stdout = String::from_utf8(output.stdout).unwrap();
+    let names: Vec<&str> = stdout
+        .lines()
+        .map(|l| l.split('\t').next().unwrap())
+        .collect();
+    assert_eq!(
+        names,
+        [
+            "cornell-box",
+            "veach-mis",
+            "veach-bidir",
+            "million-triangles"
+        ],
+        "{stdout}"
+    );
+    for line in stdout.lines() {
+        let file = line.split('\t').nth(1).unwrap();
+        assert!(std::path::Path::new(file).is_file(), "{line}");
+    }
+    let _ = std::fs::remove_dir_all(&cache);
+}
+
 #[test]
 fn bench_prints_one_consistent_json_object_per_scene() {
     let cache = std::env::temp_dir().join(format!("prism-bench-test-{}", std::process::id()));
@@ -31,7 +65,6 @@ fn bench_prints_one_consistent_json_object_per_scene() {
         .args(["--reference-spp", "16", "--rays", "4096", "--json"])
         .arg("--cache")
         .arg(&cache)
-        .args(["--shared", "/nonexistent"])
         .current_dir(env!("CARGO_MANIFEST_DIR"))
         .output()
         .unwrap();

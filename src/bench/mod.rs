@@ -32,14 +32,13 @@ pub struct BenchScene {
     pub defines: Vec<(String, String)>,
 }
 
-/// The fixed suite: the bundled Cornell box (256 × 256), Veach's MIS and bidirectional scenes
-/// from `shared` (at 320 × 180 and 256 × 256, a twentieth and a sixteenth of their pixels, so
-/// that references take minutes), and the generated million-triangle scene (256 × 256), written
-/// into `cache` on first use. Only the scenes `wanted` accepts are set up; scenes missing from
-/// `shared` are left out with a warning.
+/// The fixed suite, of the scenes bundled in the repository's `scenes/`: the Cornell box
+/// (256 × 256), Veach's MIS and bidirectional scenes (at 320 × 180 and 256 × 256, a twentieth
+/// and a sixteenth of their pixels, so that references take minutes), and the generated
+/// million-triangle scene (256 × 256), written into `cache` on first use. Only the scenes
+/// `wanted` accepts are set up.
 pub fn suite(
     repository: &Path,
-    shared: &Path,
     cache: &Path,
     wanted: impl Fn(&str) -> bool,
 ) -> Result<Vec<BenchScene>> {
@@ -50,29 +49,17 @@ pub fn suite(
         ]
     };
     let mut scenes = Vec::new();
-    if wanted("cornell-box") {
-        scenes.push(BenchScene {
-            name: "cornell-box",
-            path: repository.join("scenes/cornell-box/scene.xml"),
-            defines: resolution(256, 256),
-        });
-    }
-    for (name, x, y) in [("veach-mis", 320, 180), ("veach-bidir", 256, 256)] {
-        if !wanted(name) {
-            continue;
-        }
-        let path = shared.join("scenes").join(name).join("scene.xml");
-        if path.exists() {
+    for (name, x, y) in [
+        ("cornell-box", 256, 256),
+        ("veach-mis", 320, 180),
+        ("veach-bidir", 256, 256),
+    ] {
+        if wanted(name) {
             scenes.push(BenchScene {
                 name,
-                path,
+                path: repository.join("scenes").join(name).join("scene.xml"),
                 defines: resolution(x, y),
             });
-        } else {
-            eprintln!(
-                "prism bench: {} not found; {name} left out (see --shared)",
-                path.display()
-            );
         }
     }
     if wanted("million-triangles") {

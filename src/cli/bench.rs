@@ -26,9 +26,6 @@ pub struct BenchArgs {
     /// Only the scenes whose names contain this (repeatable)
     #[arg(long, value_name = "NAME")]
     pub only: Vec<String>,
-    /// The shared folder holding scenes/veach-mis and scenes/veach-bidir
-    #[arg(long, value_name = "DIR", default_value = "../shared")]
-    pub shared: PathBuf,
     /// Where the generated scene and the references are kept
     #[arg(long, value_name = "DIR", default_value = "target/prism-bench")]
     pub cache: PathBuf,
@@ -62,13 +59,13 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         ray_count: args.rays,
         cache: args.cache.clone(),
     };
-    // The bundled scene, from the repository we are run in, else the one we were built from.
+    // The bundled scenes, from the repository we are run in, else the one we were built from.
     let repository = if std::path::Path::new("scenes/cornell-box/scene.xml").exists() {
         PathBuf::from(".")
     } else {
         PathBuf::from(env!("CARGO_MANIFEST_DIR"))
     };
-    let scenes = suite(&repository, &args.shared, &args.cache, |name| {
+    let scenes = suite(&repository, &args.cache, |name| {
         args.only.is_empty() || args.only.iter().any(|o| name.contains(o.as_str()))
     })?;
     if scenes.is_empty() {
