@@ -230,7 +230,7 @@ pub fn measure(bench: &BenchScene, options: &BenchOptions) -> Result<Measurement
     let ours = &scene.world.geometry;
     let embree = if cfg!(feature = "embree") {
         let mut embree = scene.world.geometry.clone();
-        crate::cli::accel::Accel::Embree.apply(&mut embree)?;
+        crate::accel::Accel::Embree.apply(&mut embree)?;
         Some(embree)
     } else {
         None

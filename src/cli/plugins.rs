@@ -4,7 +4,7 @@
 use clap::Args;
 
 use prism_core::error::Result;
-use prism_mitsuba::registry::{plugins_markdown, reference};
+use prism_mitsuba::reference::{plugins_markdown, reference};
 
 #[derive(Args, Debug)]
 pub struct PluginsArgs {

@@ -17,7 +17,7 @@ use std::time::Duration;
 use clap::Args;
 use glam::UVec2;
 
-use crate::cli::accel::Accel;
+use crate::accel::Accel;
 use prism_core::error::{Error, Result};
 use prism_core::film::stats::rejected_report;
 use prism_core::film::write_images;

@@ -11,6 +11,7 @@ use std::sync::Arc;
 
 use glam::{DMat4, DVec3};
 
+use crate::element::quote;
 use prism_core::error::{Error, Result, SourceLocation};
 
 /// The kind of object an XML element declares; the element's tag name.
@@ -177,36 +178,35 @@ impl PluginNode {
         }
     }
 
-    /// Finds a file named by this plugin: absolute paths as they are, relative ones in the
-    /// search paths, in order.
+    /// Finds a file named by this plugin (see [`find_file`]).
     pub fn resolve_file(&self, name: &str, location: &SourceLocation) -> Result<PathBuf> {
-        let path = Path::new(name);
-        if path.is_absolute() {
-            if path.exists() {
-                return Ok(path.to_path_buf());
-            }
-        } else {
-            for dir in self.search_paths.iter() {
-                let candidate = dir.join(path);
-                if candidate.exists() {
-                    return Ok(candidate);
-                }
-            }
-        }
-        let searched: Vec<String> = self
-            .search_paths
-            .iter()
-            .map(|dir| format!("\"{}\"", dir.display()))
-            .collect();
-        Err(
-            Error::input(location, format!("file \"{name}\" not found")).with_help(format!(
-                "check the file name; relative names are looked up in {}",
-                if searched.is_empty() {
-                    "the current folder".to_string()
-                } else {
-                    searched.join(", ")
-                }
-            )),
-        )
+        find_file(name, &self.search_paths, location)
     }
+}
+
+/// Finds the file `name`: an absolute path as it is, a relative one in `dirs`, in order; the
+/// error, at `location`, says where it looked.
+pub fn find_file(name: &str, dirs: &[PathBuf], location: &SourceLocation) -> Result<PathBuf> {
+    let path = Path::new(name);
+    if path.is_absolute() {
+        if path.is_file() {
+            return Ok(path.to_path_buf());
+        }
+    } else if let Some(found) = dirs.iter().map(|dir| dir.join(path)).find(|p| p.is_file()) {
+        return Ok(found);
+    }
+    let searched: Vec<String> = dirs
+        .iter()
+        .map(|dir| format!("\"{}\"", dir.display()))
+        .collect();
+    Err(
+        Error::input(location, format!("file \"{}\" not found", quote(name))).with_help(format!(
+            "check the file name; relative names are looked up in {}",
+            if searched.is_empty() {
+                "the current folder".to_string()
+            } else {
+                searched.join(", ")
+            }
+        )),
+    )
 }

@@ -8,7 +8,7 @@
 
 use glam::DVec3;
 
-use super::params::closest_match;
+use crate::suggest::closest_match;
 use prism_core::error::{Error, Result, SourceLocation};
 
 /// One attribute: its name, its value after `$name` substitution, and where it is written.
@@ -201,7 +201,7 @@ pub(super) fn tokens(text: &str) -> impl Iterator<Item = &str> {
 }
 
 /// `text` shortened for messages, so that a huge attribute cannot flood the terminal.
-pub(super) fn quote(text: &str) -> String {
+pub(crate) fn quote(text: &str) -> String {
     const LIMIT: usize = 60;
     if text.chars().count() <= LIMIT {
         text.to_string()

@@ -14,8 +14,10 @@ pub mod mesh;
 pub mod params;
 mod property_values;
 pub mod reader;
+pub mod reference;
 pub mod registry;
 mod substitution;
+pub mod suggest;
 mod transform_ops;
 
 use std::path::Path;

@@ -15,8 +15,8 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use super::description::SpectrumValue;
+use super::description::find_file;
 use super::element::{Attribute, Element, parse_finite, quote, tokens};
-use super::reader::find_file;
 use prism_core::error::{Error, Result, SourceLocation};
 use prism_core::image::srgb;
 

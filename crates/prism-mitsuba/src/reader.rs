@@ -53,12 +53,14 @@ use std::sync::Arc;
 use glam::{DMat4, DVec3};
 use roxmltree::{Node, NodeType};
 
-use super::description::{NestedPlugin, PluginClass, PluginNode, Property, PropertyValue};
+use super::description::{
+    NestedPlugin, PluginClass, PluginNode, Property, PropertyValue, find_file,
+};
 use super::element::{Attribute, Element, quote};
-use super::params::closest_match;
 use super::property_values;
 use super::substitution::{Parameters, camel_to_snake};
 use super::transform_ops;
+use crate::suggest::closest_match;
 use prism_core::error::{Error, Result, SourceLocation};
 
 /// Deepest nesting of elements accepted; deeper documents are certainly not scenes.
@@ -97,33 +99,6 @@ pub fn read_scene_str(
     let root = resolve(std::mem::take(&mut reader.drafts), &reader.ids)?;
     reader.parameters.check_defines_used()?;
     Ok(root)
-}
-
-/// Finds `name` as [`PluginNode::resolve_file`] does: an absolute path as it is, a relative one
-/// in `dirs`, in order.
-pub(super) fn find_file(
-    name: &str,
-    dirs: &[PathBuf],
-    location: &SourceLocation,
-) -> Result<PathBuf> {
-    let path = Path::new(name);
-    if path.is_absolute() {
-        if path.is_file() {
-            return Ok(path.to_path_buf());
-        }
-    } else if let Some(found) = dirs.iter().map(|dir| dir.join(path)).find(|p| p.is_file()) {
-        return Ok(found);
-    }
-    let searched: Vec<String> = dirs
-        .iter()
-        .map(|dir| format!("\"{}\"", dir.display()))
-        .collect();
-    Err(
-        Error::input(location, format!("file \"{}\" not found", quote(name))).with_help(format!(
-            "check the file name; relative names are looked up in {}",
-            searched.join(", ")
-        )),
-    )
 }
 
 /// The folder of `path`, or `.` for a bare file name.

@@ -16,7 +16,7 @@
 //! A define counts as used when a `<default>` declares it or a `$name` substitutes it.
 
 use super::element::quote;
-use super::params::closest_match;
+use crate::suggest::closest_match;
 use prism_core::error::{Error, Result, SourceLocation};
 
 /// Longest attribute value that substitution may produce, to bound memory on hostile input.

@@ -16,7 +16,7 @@
 use glam::{DMat3, DMat4, DVec3};
 
 use super::element::{Attribute, Element};
-use super::params::closest_match;
+use crate::suggest::closest_match;
 use prism_core::error::{Error, Result};
 
 /// The transform operation tags.

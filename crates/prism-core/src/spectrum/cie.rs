@@ -6,7 +6,12 @@ use wide::{CmpGe, CmpLe, f32x4};
 use super::cie_tables::{
     CIE_X, CIE_Y, CIE_Y_INTEGRAL, CIE_Z, D65, D65_LUMINANCE, TABLE_LAMBDA_MIN,
 };
-use super::spectra::interpolate_regular4;
+use super::interpolation::interpolate_regular4;
+
+/// Shortest wavelength transported, in nm (the start of the CIE 1931 tables).
+pub const LAMBDA_MIN: f32 = 360.0;
+/// Longest wavelength transported, in nm (the end of the CIE 1931 tables).
+pub const LAMBDA_MAX: f32 = 830.0;
 
 /// Linear interpolation in a 1 nm table starting at 360 nm; zero outside 360..=830 nm.
 #[inline]

@@ -9,15 +9,12 @@ pub mod blackbody;
 pub mod cie;
 pub mod cie_tables;
 pub mod conductors;
+pub mod interpolation;
 pub mod ior;
 pub mod rgb;
 pub mod sampled;
 pub mod spectra;
 
+pub use cie::{LAMBDA_MAX, LAMBDA_MIN};
 pub use sampled::{N_SPECTRUM_SAMPLES, SampledSpectrum, SampledWavelengths, WavelengthSampling};
 pub use spectra::{PiecewiseLinear, RgbIntent, Spectrum};
-
-/// Shortest wavelength transported, in nm (the start of the CIE 1931 tables).
-pub const LAMBDA_MIN: f32 = 360.0;
-/// Longest wavelength transported, in nm (the end of the CIE 1931 tables).
-pub const LAMBDA_MAX: f32 = 830.0;

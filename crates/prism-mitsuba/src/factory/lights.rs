@@ -6,9 +6,10 @@
 
 use glam::{DMat4, DVec3, Vec3};
 
-use super::spectra::{NestedSpectrum, Range, build_nested_spectrum, spectrum_param};
+use super::spectra::{NestedSpectrum, build_nested_spectrum, spectrum_param};
 use crate::description::{PluginClass, PluginNode};
 use crate::params::Params;
+use crate::registry::Range;
 use crate::registry::{Default, Origin, ParamKind, ParamSpec, Plugin, Registry};
 use prism_core::bsdf::{Diffuse, Material};
 use prism_core::error::{Error, Result, SourceLocation};

@@ -2,13 +2,14 @@
 //! `phong`, which Mitsuba 3 dropped). The checks follow Mitsuba's and add the ones it leaves to
 //! chance (non-positive roughness or index, opacity outside [0, 1]).
 
-use super::spectra::{NestedSpectrum, Range, build_nested_spectrum};
+use super::spectra::{NestedSpectrum, build_nested_spectrum};
 use super::textures::{
     TextureCache, build_texture, float_texture, float_value, optional_spectrum_texture,
     spectrum_texture,
 };
 use crate::description::{PluginClass, PluginNode, PropertyValue, SpectrumValue};
 use crate::params::Params;
+use crate::registry::Range;
 use crate::registry::{Bounds, Default, Origin, ParamKind, ParamSpec, Plugin, Registry};
 use prism_core::bsdf::microfacet::MicrofacetKind;
 use prism_core::bsdf::{

@@ -10,23 +10,10 @@
 
 use crate::description::{PluginClass, PropertyValue, SpectrumValue};
 use crate::params::Params;
-use crate::registry::{Default, Origin, ParamKind, ParamSpec, Plugin, Registry};
+use crate::registry::{Default, Origin, ParamKind, ParamSpec, Plugin, Range, Registry};
 use prism_core::error::{Error, Result};
 use prism_core::spectrum::ior::{Ior, SELLMEIER_GLASSES, sellmeier_glass};
 use prism_core::spectrum::{PiecewiseLinear, RgbIntent, Spectrum};
-
-/// How a spectral parameter may be valued.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Range {
-    /// A reflectance: every value in [0, 1] (RGB components above 1 are accepted and upsampled
-    /// as unbounded colours, as Mitsuba renders them).
-    Albedo,
-    /// Emitted radiance or intensity: non-negative.
-    Emission,
-    /// Any non-negative value, such as the real and imaginary parts of an index of refraction;
-    /// `<rgb>` is upsampled without bounds ([`RgbIntent::Unbounded`]).
-    Unbounded,
-}
 
 /// A spectrum given as a nested plugin: an emission spectrum, or an index of refraction.
 pub enum NestedSpectrum {

@@ -9,9 +9,10 @@
 use std::collections::HashMap;
 use std::sync::Arc;
 
-use super::spectra::{Range, spectrum_param};
+use super::spectra::spectrum_param;
 use crate::description::{PluginClass, PluginNode, PropertyValue, SpectrumValue};
 use crate::params::Params;
+use crate::registry::Range;
 use crate::registry::{Bounds, Default, Origin, ParamKind, ParamSpec, Plugin, Registry};
 use prism_core::error::{Error, Result};
 use prism_core::image::{Encoding, read_bitmap};

@@ -420,7 +420,7 @@ mod tests {
     use glam::{DMat4, DVec3, Mat3, Vec3};
 
     use super::*;
-    use crate::cli::accel::Accel;
+    use crate::accel::Accel;
     use prism_core::geometry::{Disk, Geometry, Instance, Shape, Sphere, TriangleMesh};
     use prism_core::math::{AnimatedTransform, Transform};
     use prism_core::sampling::rng::Pcg32;

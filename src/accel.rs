@@ -1,5 +1,5 @@
 //! `--accel`: which structure answers the renderer's ray queries, our BVH or, for comparison,
-//! Embree (in builds with the cargo feature `embree`, see [`super::embree`]).
+//! Embree (in builds with the cargo feature `embree`, whose `embree` module builds its scene).
 
 use std::str::FromStr;
 use std::sync::Arc;
@@ -55,7 +55,7 @@ fn embree_unavailable() -> Error {
 
 #[cfg(feature = "embree")]
 fn embree_queries(geometry: &Geometry) -> Result<Arc<dyn ExternalRayQueries<Primitive>>> {
-    Ok(Arc::new(super::embree::EmbreeScene::new(
+    Ok(Arc::new(crate::embree::EmbreeScene::new(
         &geometry.primitives,
     )?))
 }
