@@ -8,11 +8,9 @@
 //! (Meister & Bittner 2017). It is then collapsed into the 8-wide tree that is cheapest by the
 //! same heuristic, found by dynamic programming over the binary tree (Ylitie, Karras & Laine
 //! 2017; see [`Plan`]): which binary subtrees become wide nodes, which become leaves (of at most
-//! four triangles), and which spread their leaves into their parent's free children. On the
-//! million triangles of `prism bench` that gives 6.7 children per node instead of the 4.1 of
-//! the greedy collapse it replaced (open the largest child until there are eight; Wald, Benthin
-//! & Boulos 2008), 37 % fewer nodes, and a third fewer leaves tested per ray.
-//! Leaves are packed into [`TrianglePack`]s in depth-first order, small leaves sharing a pack
+//! four triangles), and which spread their leaves into their parent's free children: fuller
+//! nodes, and fewer leaves tested per ray, than opening the largest child until there are eight
+//! (Wald, Benthin & Boulos 2008). Leaves are packed into [`TrianglePack`]s in depth-first order, small leaves sharing a pack
 //! (each leaf knows its lanes) with one of the few packs opened last, so that packs are nearly
 //! full and siblings lie together in memory. Analytic shapes (spheres, disks, moving shapes) are
 //! leaves of their own. The subtrees under the root's children are collapsed in parallel.
@@ -28,18 +26,8 @@
 //! child about to be visited is prefetched whole, so that its cache lines arrive together:
 //! on large scenes traversal waits mostly for memory. The triangle test of a leaf is inlined
 //! into the traversal (so that it, too, runs in AVX's three-operand instructions) with the
-//! ray's constants prepared once per ray ([`PackRay`]): that took 22 % of the instructions of
-//! a mix of veach-bidir's shadow and bounce rays and made its renders 1.3–1.65× as fast.
-//! (Backing the arrays with 2 MiB pages, as Embree does, made no measurable difference; nor
-//! did prefetching only the nearest pending child instead of all.)
-//!
-//! Measured (`prism bench`, 1,024,000 triangles, 2 threads, incoherent rays, ratio to Embree
-//! 3's rays/s): 4-wide nodes 0.59–0.62×, 8-wide nodes with SSE 0.55–0.60×, 8-wide with AVX and
-//! whole-node prefetching 0.66–0.80× (the range over several sessions on a drifting virtual
-//! machine), the SAH-optimal collapse 0.76–0.89× (15 runs). Child boxes quantised to 8 bits
-//! in the node's box (Ylitie et al. 2017, §3.2: two cache lines per node instead of four,
-//! 68 instead of 76.5 bytes per triangle) were slightly slower, 0.78–0.80× against 0.81–0.85×
-//! in turns, so the nodes keep f32 boxes.
+//! ray's constants prepared once per ray ([`PackRay`]). Child boxes are f32 (not quantised).
+//! docs/performance.md has the measurements behind these choices.
 
 use std::mem::MaybeUninit;
 
@@ -342,11 +330,8 @@ impl Bvh {
     }
 
     /// The front-to-back traversal of both queries: the nearest hit, or with `ANY_HIT` the first
-    /// one found. Shadow rays go nearest first too: on veach-bidir, where they cross the lamps
-    /// to reach the lights, that tests 40 % fewer triangle packs than taking the children in any
-    /// order (12 against 20 per ray) and traces 1.15–1.25× the shadow rays per second; on the
-    /// million triangles it costs 1 % more instructions. (With the SAH-optimal collapse it is
-    /// 7.6 packs per ray there; farthest first, in case the occluders lie by the lights, 22.)
+    /// one found. Shadow rays go nearest first too, which finds the occluders near their origin
+    /// (the common case: the surroundings of the point lit) with the fewest leaves tested.
     #[inline(always)]
     fn nearest_first<const AVX: bool, const ANY_HIT: bool>(
         &self,
@@ -517,9 +502,7 @@ struct Pending {
 /// (see [`Plan`]), children before parents, the halves of the top levels in parallel. Then
 /// the root's children are collapsed in parallel (in trees of [`PARALLEL_COLLAPSE_NODES`]
 /// binary nodes or more), each into a [`WideTree`] of its own, and the trees are laid end to
-/// end (so nodes and packs stay in depth-first order). On the million triangles of `prism
-/// bench` (2 threads) the plan takes 60–110 ms and the collapse 90–230 ms of a 0.55–0.75 s
-/// build.
+/// end (so nodes and packs stay in depth-first order).
 struct Collapse<'a> {
     binary: &'a Bvh2,
     primitives: &'a [BuildPrimitive],
@@ -543,8 +526,7 @@ struct WideTree {
 }
 
 /// Binary nodes from which the tree is planned and the root's subtrees are collapsed in
-/// parallel: below, handing them to the thread pool costs more than it saves (it made the
-/// Cornell box's collapse 49 → 76 µs).
+/// parallel: below, handing them to the thread pool costs more than it saves.
 const PARALLEL_COLLAPSE_NODES: usize = 1 << 15;
 
 /// How many recent packs a new leaf may go into (first fit): more fill packs better, fewer keep
@@ -1239,9 +1221,7 @@ mod tests {
 
     /// The collapse is the cheapest by the SAH: the built tree costs what an exhaustive search
     /// over all collapses of the same binary tree finds (to f32 rounding), on small scenes with
-    /// and without analytic primitives. (The greedy collapse that came before, the largest child
-    /// opened until there were eight, cost up to 61 % more on these, 13–22 % from 100
-    /// primitives on.)
+    /// and without analytic primitives.
     #[test]
     fn collapse_is_sah_optimal() {
         let mut rng = Pcg32::seeded(11);

@@ -65,8 +65,8 @@ impl PiecewiseConstant1D {
             }
         }
         // Four guide entries per cell for small tables (the wavelength density's 470 cells: a
-        // search then rarely takes a step, which made veach-mis render 3–8 % faster), one per
-        // cell for large ones (the rows of an environment map), whose memory matters more.
+        // search then rarely takes a step), one per cell for large ones (the rows of an
+        // environment map), whose memory matters more.
         let per_cell = if n <= 1024 { 4 } else { 1 };
         let guide_len = (per_cell * n).next_power_of_two().max(16);
         let cdf: Vec<f32> = cdf.iter().map(|&c| c as f32).collect();

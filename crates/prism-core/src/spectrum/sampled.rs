@@ -200,9 +200,8 @@ impl WavelengthSampling {
 /// The hero λ₀ is drawn from p with the uniform number u; the companions are drawn with the
 /// rotated numbers u + k/4 (mod 1), λ_k = P⁻¹(u + k/4), as pbrt-v4 and Mitsuba 3 do. Each λ_k is
 /// distributed with density p on its own, so (1/4) Σ_k f(λ_k)/p(λ_k) is unbiased for ∫f, and the
-/// four are stratified over the distribution, one in each quarter of its CDF. (Rotating λ itself
-/// by 470/4 nm instead, with balance-heuristic weights, is also unbiased, but on the Cornell box
-/// it gave 2.4 times the variance in red: the companions then land where p is small.)
+/// four are stratified over the distribution, one in each quarter of its CDF (rotating λ itself
+/// instead would put companions where p is small).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SampledWavelengths {
     lambda: [f32; N_SPECTRUM_SAMPLES],

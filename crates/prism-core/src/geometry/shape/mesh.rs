@@ -20,9 +20,8 @@ pub struct TriangleMesh {
     pub uvs: Option<Vec<Vec2>>,
     triangles: Vec<[u32; 3]>,
     /// The unit geometric normal of each triangle (see [`Self::face_normal`]), kept because a
-    /// hit and a light sample each need one: computing it took a cross product, a square root
-    /// and a division on the path's critical chain, twice per bounce, 9 % of a Cornell box
-    /// sample's instructions with the shading normals.
+    /// hit and a light sample each need one, and computing it (a cross product, a square root
+    /// and a division) lies on the path's critical chain.
     face_normals: Vec<Vec3>,
     /// Whether the geometric and shading normals are reversed (Mitsuba's `flip_normals`).
     flip_normals: bool,
