@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
-"""Generates src/spectrum/cie_tables.rs from the CIE data files in ../shared/data/cie/.
+"""Generates crates/prism-core/src/spectrum/cie_tables.rs from the CIE data files in ../shared/data/cie/.
 
-usage: python3 tools/gen_cie_tables.py ../shared/data/cie > src/spectrum/cie_tables.rs
+usage: python3 tools/gen_cie_tables.py ../shared/data/cie > crates/prism-core/src/spectrum/cie_tables.rs
 
 The tables are embedded at 1 nm from 360 to 830 nm (471 values each), exactly as the CIE files
 give them (D65 is cut to the same range).

@@ -258,7 +258,7 @@ mod tests {
     }
 
     /// An EXR written by another renderer (Tungsten's reference of Bitterli's Cornell box, half
-    /// floats) reads, with the channel means its scene's README gives.
+    /// floats) reads, with the channel means the OpenEXR library's Python reader gives it.
     #[test]
     fn reads_an_exr_written_by_another_renderer() {
         let path = Path::new(env!("CARGO_MANIFEST_DIR"))
