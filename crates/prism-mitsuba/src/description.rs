@@ -189,10 +189,10 @@ impl PluginNode {
 pub fn find_file(name: &str, dirs: &[PathBuf], location: &SourceLocation) -> Result<PathBuf> {
     let path = Path::new(name);
     if path.is_absolute() {
-        if path.is_file() {
+        if path.exists() {
             return Ok(path.to_path_buf());
         }
-    } else if let Some(found) = dirs.iter().map(|dir| dir.join(path)).find(|p| p.is_file()) {
+    } else if let Some(found) = dirs.iter().map(|dir| dir.join(path)).find(|p| p.exists()) {
         return Ok(found);
     }
     let searched: Vec<String> = dirs
