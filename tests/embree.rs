@@ -4,8 +4,8 @@
 
 use std::path::Path;
 
+use prism::accel::Accel;
 use prism_core::film::stats::variance_of_mean;
-use prism_core::geometry::Accel;
 use prism_core::render::{RenderOptions, render};
 use prism_mitsuba::load_scene;
 
@@ -16,8 +16,8 @@ fn cornell_box_mean(accel: Accel, seed: u64) -> (f64, f64) {
     let defines = [("resx", "64"), ("resy", "64"), ("spp", "16")]
         .map(|(name, value)| (name.to_string(), value.to_string()));
     let mut scene = load_scene(&path, &defines).unwrap().scene;
-    scene.world.geometry.set_accel(accel).unwrap();
-    assert_eq!(scene.world.geometry.accel(), accel);
+    accel.apply(&mut scene.world.geometry).unwrap();
+    assert_eq!(Accel::of(&scene.world.geometry), accel);
     let film = render(&scene, &RenderOptions::fixed(16, seed, Some(2)))
         .unwrap()
         .film;
