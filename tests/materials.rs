@@ -17,7 +17,7 @@ use common::scenes::{image_mean_and_standard_error, render_film};
 use glam::{Vec2, Vec3};
 use prism_core::bsdf::fresnel::fresnel_conductor;
 use prism_core::bsdf::microfacet::{Microfacet, MicrofacetKind};
-use prism_core::bsdf::{Bsdf, BsdfFlags};
+use prism_core::bsdf::{Bsdf, BsdfFlags, BsdfModel};
 use prism_core::sampling::rng::Pcg32;
 use prism_core::spectrum::SampledWavelengths;
 use prism_core::spectrum::conductors::CONDUCTORS;
@@ -289,6 +289,7 @@ fn glass_and_mirror_spheres_vanish_in_a_furnace() {
             1024,
         ),
         ("thin glass", r#"<bsdf type="thindielectric"/>"#, 64),
+        ("null", r#"<bsdf type="null"/>"#, 64),
     ] {
         let (mean, se) = render_mean(&furnace_scene(bsdf), spp, 3);
         assert!(
@@ -299,6 +300,58 @@ fn glass_and_mirror_spheres_vanish_in_a_furnace() {
             se < 2.5e-3,
             "{name}: standard error {se} too large to see a 1 % bias"
         );
+    }
+}
+
+/// The `null` BSDF passes light unchanged from both sides, and nothing can be evaluated.
+#[test]
+fn null_lobe_passes_straight_through() {
+    let bsdf = bsdf_from_xml(r#"<bsdf type="null"/>"#);
+    assert_eq!(bsdf.flags(), BsdfFlags::NULL);
+    for wo in [direction(30.0, 40.0), -direction(80.0, 200.0)] {
+        let at = bsdf.at(&point(), wo, &wavelengths());
+        let s = at.sample(0.7, Vec2::new(0.2, 0.9)).unwrap();
+        assert_eq!(s.wi, -wo);
+        assert_eq!(
+            (s.weight.0, s.pdf, s.flags),
+            ([1.0; 4], 1.0, BsdfFlags::NULL)
+        );
+        assert_eq!(at.eval(-wo).pdf, 0.0);
+    }
+}
+
+/// Passing through a `null` surface counts as a bounce, as in Mitsuba 3's `path`: Mitsuba 3.9.1
+/// renders a light behind a null rectangle black at `max_depth` 1 and at its radiance at 2.
+/// Both integrators agree; shadow rays stop at the surface, so the light is found by BSDF
+/// sampling alone, with weight 1.
+#[test]
+fn a_null_surface_counts_as_a_bounce() {
+    for integrator in ["path", "distrib"] {
+        for (max_depth, expected) in [(1, 0.0), (2, 1.0), (-1, 1.0)] {
+            let xml = format!(
+                r#"<scene version="3.0.0">
+    <integrator type="{integrator}"><integer name="max_depth" value="{max_depth}"/></integrator>
+    <sensor type="perspective">
+        <float name="fov" value="10"/>
+        <transform name="to_world"><lookat origin="0, 0, 0" target="0, 0, 1" up="0, 1, 0"/></transform>
+        <film type="hdrfilm"><integer name="width" value="8"/><integer name="height" value="8"/><rfilter type="box"/></film>
+    </sensor>
+    <shape type="rectangle">
+        <transform name="to_world"><translate z="2"/></transform>
+        <bsdf type="null"/>
+    </shape>
+    <shape type="rectangle">
+        <transform name="to_world"><scale value="0.5"/><rotate y="1" angle="180"/><translate z="5"/></transform>
+        <emitter type="area"><spectrum name="radiance" value="1"/></emitter>
+    </shape>
+</scene>"#
+            );
+            let (mean, se) = render_mean(&xml, 64, 5);
+            assert!(
+                (mean - expected).abs() <= 4.0 * se,
+                "{integrator}, max_depth {max_depth}: mean Y {mean} ± {se}, expected {expected}"
+            );
+        }
     }
 }
 

@@ -48,6 +48,7 @@
 //! | `twosided` | [`twosided`] | those of the nested BSDFs, on both sides |
 //! | `mask` | [`mask`] | the nested BSDF's, and null transmission |
 //! | `blendbsdf` | [`blend`] | both nested BSDFs' |
+//! | `null` | [`null`] | null transmission |
 //! | `bumpmap`, `normalmap` | [`bumpmap`], [`normalmap`] | the nested BSDF's, in a perturbed frame |
 
 pub mod blend;
@@ -60,6 +61,7 @@ pub mod mask;
 pub mod material;
 pub mod microfacet;
 pub mod normalmap;
+pub mod null;
 pub mod perturbed;
 pub mod phong;
 pub mod plastic;
@@ -81,6 +83,7 @@ pub use diffuse::Diffuse;
 pub use mask::Mask;
 pub use material::{Material, Scattering};
 pub use normalmap::NormalMap;
+pub use null::Null;
 pub use phong::Phong;
 pub use plastic::Plastic;
 pub use roughconductor::RoughConductor;
@@ -103,8 +106,9 @@ impl BsdfFlags {
     pub const GLOSSY: BsdfFlags = BsdfFlags(2);
     /// A Dirac delta lobe (mirror or clear glass): cannot be evaluated, only sampled.
     pub const SPECULAR: BsdfFlags = BsdfFlags(4);
-    /// Light passing straight through, unchanged in direction (Mitsuba's `Null`: the transparent
-    /// part of `mask`, the transmission of `thindielectric`); a delta lobe too.
+    /// Light passing straight through, unchanged in direction (Mitsuba's `Null`: the `null`
+    /// BSDF, the transparent part of `mask`, the transmission of `thindielectric`); a delta lobe
+    /// too.
     pub const NULL: BsdfFlags = BsdfFlags(32);
     pub const REFLECTION: BsdfFlags = BsdfFlags(8);
     pub const TRANSMISSION: BsdfFlags = BsdfFlags(16);
@@ -415,6 +419,7 @@ bsdfs! {
         Blend(Blend),
         BumpMap(BumpMap),
         NormalMap(NormalMap),
+        Null(Null),
     }
     lobes {
         Diffuse(diffuse::DiffuseLobes),
@@ -431,5 +436,6 @@ bsdfs! {
         Mask(mask::MaskLobes),
         Blend(blend::BlendLobes),
         Perturbed(perturbed::PerturbedLobes),
+        Null(null::NullLobes),
     }
 }

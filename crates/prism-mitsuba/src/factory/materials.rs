@@ -14,7 +14,7 @@ use crate::registry::{Bounds, Default, Origin, ParamKind, ParamSpec, Plugin, Reg
 use prism_core::bsdf::microfacet::MicrofacetKind;
 use prism_core::bsdf::{
     Blend, Bsdf, BsdfFlags, BsdfModel, BumpMap, Conductor, Dielectric, Diffuse, MAX_NODES, Mask,
-    Material, NormalMap, Phong, Plastic, RoughConductor, RoughDielectric, RoughDiffuse,
+    Material, NormalMap, Null, Phong, Plastic, RoughConductor, RoughDielectric, RoughDiffuse,
     RoughPlastic, ThinDielectric, TwoSided,
 };
 use prism_core::error::{Error, Result};
@@ -278,6 +278,15 @@ pub static BSDFS: Registry<Build> = Registry {
                     nested: Box::new(single_nested_bsdf(params, t)?),
                 }))
             },
+        },
+        Plugin {
+            name: "null",
+            origin: Origin::Mitsuba3,
+            summary: "Light passes straight through, unchanged (an index-matched boundary, an \
+                      invisible shape); counts as a bounce, and shadow rays see it as opaque, as \
+                      in Mitsuba 3's `path`.",
+            params: &[],
+            build: |_, _| Ok(Bsdf::Null(Null)),
         },
         Plugin {
             name: "blendbsdf",
