@@ -539,6 +539,14 @@ fn bad_input_gets_clear_errors() {
         r#"<bsdf type="pplastic"><float name="int_ior" value="1"/><float name="ext_ior" value="1"/></bsdf>"#,
         &["same index of refraction"],
     );
+    assert_bsdf_error(
+        r#"<bsdf type="principled"><float name="eta" value="1.5"/><float name="specular" value="0.5"/></bsdf>"#,
+        &["either \"eta\" or \"specular\"", "not both"],
+    );
+    assert_bsdf_error(
+        r#"<bsdf type="principledthin"><float name="diff_trans" value="2.5"/></bsdf>"#,
+        &["diff_trans", "[0, 2]"],
+    );
 }
 
 /// An `<rgb>` where a number is wanted is read as Mitsuba 3's spectral variants read it: the
@@ -750,5 +758,55 @@ fn ward_duer_albedo_at_normal_incidence_is_its_closed_form() {
             (value - expected).abs() < 2e-4,
             "∫f cos = {value} but the closed form gives {expected}"
         );
+    }
+}
+
+/// `principled` with `spec_trans` 1 and a white base is Walter et al.'s rough dielectric: its
+/// diffuse, sheen and clearcoat weights vanish, √c = 1, and its lobe probabilities become F and
+/// 1 − F. Its value and density equal `roughdielectric`'s (GGX, α = roughness², the same η)
+/// from both sides, to rounding.
+#[test]
+fn transmitting_principled_is_a_rough_dielectric() {
+    let principled = bsdf_from_xml(
+        r#"<bsdf type="principled"><spectrum name="base_color" value="1"/>
+            <float name="spec_trans" value="1"/><float name="roughness" value="0.5"/>
+            <float name="eta" value="1.45"/></bsdf>"#,
+    );
+    let dielectric = bsdf_from_xml(
+        r#"<bsdf type="roughdielectric"><string name="distribution" value="ggx"/>
+            <float name="alpha" value="0.25"/><float name="int_ior" value="1.45"/>
+            <float name="ext_ior" value="1"/></bsdf>"#,
+    );
+    let (sp, lambda) = (point(), wavelengths());
+    let mut rng = Pcg32::seeded(31);
+    for _ in 0..4000 {
+        let u = |rng: &mut Pcg32| Vec2::new(rng.next_f32(), rng.next_f32());
+        let sphere = |u: Vec2| {
+            let z = 1.0 - 2.0 * u.x;
+            let r = (1.0 - z * z).max(0.0).sqrt();
+            let phi = 2.0 * std::f32::consts::PI * u.y;
+            Vec3::new(r * phi.cos(), r * phi.sin(), z)
+        };
+        let (wo, wi) = (sphere(u(&mut rng)), sphere(u(&mut rng)));
+        if wo.z.abs() < 1e-2 || wi.z.abs() < 1e-2 {
+            continue;
+        }
+        let a = principled.at(&sp, wo, &lambda).eval(wi);
+        let b = dielectric.at(&sp, wo, &lambda).eval(wi);
+        let close = |x: f32, y: f32| (x - y).abs() <= 1e-4 * x.abs().max(y.abs()) + 1e-6;
+        assert!(
+            close(a.pdf, b.pdf),
+            "pdf {} but roughdielectric's {} at wo = {wo}, wi = {wi}",
+            a.pdf,
+            b.pdf
+        );
+        for c in 0..4 {
+            assert!(
+                close(a.value[c], b.value[c]),
+                "value {} but roughdielectric's {} at wo = {wo}, wi = {wi}",
+                a.value[c],
+                b.value[c]
+            );
+        }
     }
 }

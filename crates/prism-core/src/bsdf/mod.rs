@@ -47,6 +47,8 @@
 //! | `phong` | [`phong`] | glossy and diffuse reflection |
 //! | `pplastic` | [`pplastic`] | glossy and diffuse reflection |
 //! | `ward` | [`ward`] | glossy and diffuse reflection |
+//! | `principled` | [`principled`] | diffuse, glossy reflection (two), glossy transmission |
+//! | `principledthin` | [`principledthin`] | diffuse and glossy reflection and transmission |
 //! | `twosided` | [`twosided`] | those of the nested BSDFs, on both sides |
 //! | `mask` | [`mask`] | the nested BSDF's, and null transmission |
 //! | `blendbsdf` | [`blend`] | both nested BSDFs' |
@@ -55,6 +57,7 @@
 
 pub mod blend;
 pub mod bumpmap;
+pub mod burley;
 pub mod conductor;
 pub mod dielectric;
 pub mod diffuse;
@@ -68,6 +71,8 @@ pub mod perturbed;
 pub mod phong;
 pub mod plastic;
 pub mod pplastic;
+pub mod principled;
+pub mod principledthin;
 pub mod roughconductor;
 pub mod roughdielectric;
 pub mod roughdiffuse;
@@ -91,6 +96,8 @@ pub use null::Null;
 pub use phong::Phong;
 pub use plastic::Plastic;
 pub use pplastic::PolarizedPlastic;
+pub use principled::Principled;
+pub use principledthin::PrincipledThin;
 pub use roughconductor::RoughConductor;
 pub use roughdielectric::RoughDielectric;
 pub use roughdiffuse::RoughDiffuse;
@@ -422,6 +429,8 @@ bsdfs! {
         Phong(Phong),
         PolarizedPlastic(PolarizedPlastic),
         Ward(Ward),
+        Principled(Principled),
+        PrincipledThin(PrincipledThin),
         TwoSided(TwoSided),
         Mask(Mask),
         Blend(Blend),
@@ -442,6 +451,8 @@ bsdfs! {
         Phong(phong::PhongLobes),
         PolarizedPlastic(pplastic::PolarizedPlasticLobes),
         Ward(ward::WardLobes),
+        Principled(principled::PrincipledLobes),
+        PrincipledThin(principledthin::PrincipledThinLobes),
         BackSide(twosided::BackSideLobes),
         Mask(mask::MaskLobes),
         Blend(blend::BlendLobes),
