@@ -547,6 +547,10 @@ fn bad_input_gets_clear_errors() {
         r#"<bsdf type="principledthin"><float name="diff_trans" value="2.5"/></bsdf>"#,
         &["diff_trans", "[0, 2]"],
     );
+    assert_bsdf_error(
+        r#"<bsdf type="twosided"><bsdf type="principledthin"/></bsdf>"#,
+        &["cannot be nested in \"twosided\""],
+    );
 }
 
 /// An `<rgb>` where a number is wanted is read as Mitsuba 3's spectral variants read it: the

@@ -76,15 +76,12 @@ fn optional_1(texture: &Option<Texture>, uv: Vec2) -> Option<f32> {
 }
 
 impl BsdfModel for PrincipledThin {
+    /// Always transmitting, as Mitsuba declares it (so it cannot be nested in `twosided`).
     fn flags(&self) -> BsdfFlags {
-        let reflection = BsdfFlags::DIFFUSE
+        BsdfFlags::DIFFUSE
             .union(BsdfFlags::GLOSSY)
-            .union(BsdfFlags::REFLECTION);
-        if self.spec_trans.is_some() || self.diff_trans.is_some() {
-            reflection.union(BsdfFlags::TRANSMISSION)
-        } else {
-            reflection
-        }
+            .union(BsdfFlags::REFLECTION)
+            .union(BsdfFlags::TRANSMISSION)
     }
 
     fn is_dispersive(&self) -> bool {
