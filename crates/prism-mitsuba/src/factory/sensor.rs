@@ -117,6 +117,12 @@ const FOCUS_DISTANCE: ParamSpec = ParamSpec::new(
     Default::Text("`far_clip`"),
     "distance of the plane in focus",
 );
+const PINHOLE_FOCUS_DISTANCE: ParamSpec = ParamSpec::new(
+    "focus_distance",
+    ParamKind::Float,
+    Default::Text("`far_clip`"),
+    "read as Mitsuba 3 reads it on every projective camera; a pinhole has everything in focus",
+);
 const FOCAL_DISTANCE: ParamSpec = ParamSpec::new(
     "focal_distance",
     ParamKind::Float,
@@ -136,6 +142,7 @@ const PERSPECTIVE_PARAMS: &[ParamSpec] = &[
     SHUTTER_FILTER,
     FILM,
     SAMPLER,
+    PINHOLE_FOCUS_DISTANCE,
 ];
 const THINLENS_PARAMS: &[ParamSpec] = &[
     FOV,
@@ -519,7 +526,8 @@ fn build_sensor_of(params: &Params, thinlens: bool) -> Result<SensorSettings> {
     let (lens_radius, focus_distance) = if thinlens {
         lens(params, far_clip)?
     } else {
-        (0.0, far_clip)
+        let focus_distance = params.float_opt(&PINHOLE_FOCUS_DISTANCE)?;
+        (0.0, focus_distance.unwrap_or(far_clip))
     };
     if lens_radius > 0.0 && !to_world.is_similarity() || to_world.uniform_scale(0.0) > 1.0 + 1e-4 {
         return Err(Error::input(
