@@ -324,6 +324,12 @@ fn cases() -> Vec<Case> {
             "does not fit",
         ),
         render_scene(
+            "a misspelt Mitsuba 0.6 film parameter",
+            "<scene version=\"0.6.0\">\n    <sensor type=\"perspective\"><film type=\"hdrfilm\"><integer name=\"width\" value=\"4\"/><integer name=\"height\" value=\"4\"/>\n        <boolean name=\"banerr\" value=\"false\"/></film></sensor>\n</scene>\n",
+            "scene.xml:3:9",
+            "did you mean \"banner\"",
+        ),
+        render_scene(
             "film of 10^6 × 10^6 pixels",
             "<scene version=\"3.0.0\">\n    <sensor type=\"perspective\"><film type=\"hdrfilm\"><integer name=\"width\" value=\"1000000\"/><integer name=\"height\" value=\"1000000\"/></film></sensor>\n</scene>\n",
             "scene.xml:2:",

@@ -138,3 +138,77 @@ fn focus_distance_on_a_pinhole_changes_nothing() {
     .expect("a string focus_distance is an error");
     assert!(err.to_string().contains("focus_distance"), "{err}");
 }
+
+/// A Mitsuba 0.6 film's `banner`, `attachLog`, `highQualityEdges` and an HDR film's `gamma`
+/// are read and ignored, each with one warning naming its place; the scene loads.
+#[test]
+fn mitsuba_06_film_parameters_are_ignored_with_one_warning_each() {
+    let text = r#"<scene version="0.6.0">
+    <sensor type="perspective">
+        <film type="hdrfilm">
+            <integer name="width" value="4"/><integer name="height" value="4"/>
+            <boolean name="banner" value="false"/>
+            <boolean name="attachLog" value="false"/>
+            <boolean name="highQualityEdges" value="true"/>
+            <float name="gamma" value="2.2"/>
+        </film>
+    </sensor>
+</scene>"#;
+    let path = Path::new("old").join("scene.xml");
+    let root = read_scene_str(text, &path, &[]).unwrap();
+    let loaded = build_scene(&root).unwrap();
+    let got: Vec<String> = loaded.warnings.iter().map(|w| w.to_string()).collect();
+    let file = path.display();
+    let expected_starts = [
+        format!("{file}:5:13: warning: film \"hdrfilm\" ignores \"banner\""),
+        format!("{file}:6:13: warning: film \"hdrfilm\" ignores \"attach_log\""),
+        format!("{file}:7:13: warning: film \"hdrfilm\" ignores \"high_quality_edges\""),
+        format!("{file}:8:13: warning: film \"hdrfilm\" ignores \"gamma\""),
+    ];
+    assert_eq!(got.len(), expected_starts.len(), "{got:#?}");
+    for (warning, start) in got.iter().zip(&expected_starts) {
+        assert!(
+            warning.starts_with(start.as_str()),
+            "{warning}\nexpected {start}"
+        );
+    }
+    // A scene without them has no warnings.
+    let plain = load_sensor("perspective", "", 4, 4);
+    assert!(plain.is_ok());
+}
+
+/// `prism render` prints each warning once, on stderr, and renders.
+#[test]
+fn the_command_line_prints_each_warning_once() {
+    let dir = std::env::temp_dir().join(format!("prism-sensors-warnings-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(
+        dir.join("scene.xml"),
+        r#"<scene version="0.6.0">
+    <sensor type="perspective">
+        <film type="hdrfilm">
+            <integer name="width" value="4"/><integer name="height" value="4"/>
+            <boolean name="banner" value="false"/>
+        </film>
+    </sensor>
+</scene>"#,
+    )
+    .unwrap();
+    let output = std::process::Command::new(env!("CARGO_BIN_EXE_prism"))
+        .arg("render")
+        .arg(dir.join("scene.xml"))
+        .arg("-o")
+        .arg(dir.join("out.exr"))
+        .args(["--spp", "1"])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(0), "{stderr}");
+    assert_eq!(stderr.matches("warning:").count(), 1, "{stderr}");
+    assert!(
+        stderr.contains("scene.xml:5:13: warning: film \"hdrfilm\" ignores \"banner\""),
+        "{stderr}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -141,7 +141,11 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
         e.kind = prism_core::error::ErrorKind::Input;
         e
     })?;
-    let mut scene = load_scene(&args.scene, &args.defines)?.scene;
+    let loaded = load_scene(&args.scene, &args.defines)?;
+    for warning in &loaded.warnings {
+        eprintln!("{warning}");
+    }
+    let mut scene = loaded.scene;
     let size = scene.film.crop.size;
     if (reference.width, reference.height) != (size.x as usize, size.y as usize) {
         return Err(Error::usage(format!(

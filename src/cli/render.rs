@@ -247,6 +247,9 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     }
     args.accel.check_available()?;
     let loaded = load_scene(&args.scene, &args.defines)?;
+    for warning in &loaded.warnings {
+        eprintln!("{warning}");
+    }
     let mut scene = loaded.scene;
     args.accel.apply(&mut scene.world.geometry)?;
     let crop = match (args.crop, args.pixel) {

@@ -18,7 +18,7 @@ use std::collections::hash_map::Entry;
 use std::sync::Arc;
 
 use crate::description::{PluginClass, PluginNode};
-use crate::params::Params;
+use crate::params::{Params, Warning};
 use crate::registry::{Default, ParamSpec};
 use prism_core::bsdf::Material;
 use prism_core::error::{Error, Result};
@@ -32,6 +32,9 @@ pub struct LoadedScene {
     pub scene: Scene,
     /// The sampler's `seed` parameter.
     pub seed: u64,
+    /// Parameters of the file that Prism reads but ignores (Mitsuba 0.6 forms), one warning
+    /// each, in the order they were read.
+    pub warnings: Vec<Warning>,
 }
 
 const INTEGRATOR: ParamSpec = ParamSpec::nested(
@@ -187,5 +190,6 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
     Ok(LoadedScene {
         scene,
         seed: sensor.seed,
+        warnings: sensor.warnings,
     })
 }

@@ -4,7 +4,7 @@
 use glam::{UVec2, Vec2};
 
 use crate::description::{PluginClass, PluginNode};
-use crate::params::Params;
+use crate::params::{Params, Warning};
 use crate::registry::{Default, Origin, ParamKind, ParamSpec, Plugin, Registry};
 use prism_core::camera::perspective::{FovAxis, focal_length_to_diagonal_fov, horizontal_fov};
 use prism_core::camera::{Camera, PerspectiveCamera, Shutter};
@@ -181,6 +181,10 @@ pub static FILMS: Registry<FilmBuild> = Registry {
             PIXEL_FORMAT,
             COMPONENT_FORMAT,
             RFILTER,
+            BANNER,
+            ATTACH_LOG,
+            HIGH_QUALITY_EDGES,
+            HDR_GAMMA,
         ],
         build: build_hdrfilm,
     }],
@@ -239,6 +243,30 @@ const COMPONENT_FORMAT: ParamSpec = ParamSpec::new(
     ParamKind::Choice(&["float16", "float32", "uint32"]),
     Default::Str("float32"),
     "accepted; the output is always 32-bit float",
+);
+const BANNER: ParamSpec = ParamSpec::new(
+    "banner",
+    ParamKind::Boolean,
+    Default::Ignored,
+    "Mitsuba 0.6's \"rendered by Mitsuba\" banner; Prism writes none",
+);
+const ATTACH_LOG: ParamSpec = ParamSpec::new(
+    "attach_log",
+    ParamKind::Boolean,
+    Default::Ignored,
+    "Mitsuba 0.6's render log in the image's metadata; Prism attaches none",
+);
+const HIGH_QUALITY_EDGES: ParamSpec = ParamSpec::new(
+    "high_quality_edges",
+    ParamKind::Boolean,
+    Default::Ignored,
+    "Mitsuba 0.6's sampling of a margin outside the film; Prism samples the film's pixels only",
+);
+const HDR_GAMMA: ParamSpec = ParamSpec::new(
+    "gamma",
+    ParamKind::Float,
+    Default::Ignored,
+    "a gamma on an HDR film, as Mitsuba 0.6 scenes give it; the EXR is linear",
 );
 const RFILTER: ParamSpec = ParamSpec::nested(
     PluginClass::Rfilter,
@@ -436,6 +464,8 @@ pub struct SensorSettings {
     pub film: FilmSettings,
     pub sampler: SamplerSettings,
     pub seed: u64,
+    /// The parameters read and ignored, one warning each.
+    pub warnings: Vec<Warning>,
 }
 
 /// Builds the sensor a node describes.
@@ -448,9 +478,9 @@ pub fn build_sensor(node: &PluginNode) -> Result<SensorSettings> {
 }
 
 fn build_sensor_of(params: &Params, thinlens: bool) -> Result<SensorSettings> {
-    let film = match params.single_child(&FILM)? {
+    let (film, warnings) = match params.single_child(&FILM)? {
         Some(child) => build_film(&child.node)?,
-        None => default_film(),
+        None => (default_film(), Vec::new()),
     };
     let (sampler, seed) = match params.single_child(&SAMPLER)? {
         Some(child) => build_sampler(&child.node)?,
@@ -553,6 +583,7 @@ fn build_sensor_of(params: &Params, thinlens: bool) -> Result<SensorSettings> {
         film,
         sampler,
         seed,
+        warnings,
     })
 }
 
@@ -650,12 +681,12 @@ fn default_film() -> FilmSettings {
 /// `hdrfilm`: `width` (768), `height` (576), `crop_offset_x/y`, `crop_width/height`, a nested
 /// `rfilter` (Gaussian by default). `file_format`, `pixel_format` and `component_format` are
 /// accepted for compatibility; Prism always writes 32-bit linear RGB and XYZ to EXR.
-fn build_film(node: &PluginNode) -> Result<FilmSettings> {
+fn build_film(node: &PluginNode) -> Result<(FilmSettings, Vec<Warning>)> {
     let plugin = FILMS.find(node)?;
     let params = Params::new(node, plugin.params);
     let film = (plugin.build)(&params)?;
-    params.finish()?;
-    Ok(film)
+    let warnings = params.finish_with_warnings()?;
+    Ok((film, warnings))
 }
 
 fn build_hdrfilm(params: &Params) -> Result<FilmSettings> {
