@@ -212,3 +212,155 @@ fn the_command_line_prints_each_warning_once() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// Renders `film` (the inner XML of an `ldrfilm` of 8 × 6 pixels) with `prism render` into a
+/// fresh folder; returns the folder.
+fn render_ldrfilm(name: &str, film: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("prism-sensors-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(
+        dir.join("scene.xml"),
+        format!(
+            r#"<scene version="0.6.0">
+    <sensor type="perspective">
+        <float name="fov" value="60"/>
+        <transform name="toWorld"><lookAt origin="0, 0, -3" target="0, 0, 0" up="0, 1, 0"/></transform>
+        <film type="ldrfilm">
+            <integer name="width" value="8"/><integer name="height" value="6"/>
+            {film}
+            <rfilter type="box"/>
+        </film>
+    </sensor>
+    <emitter type="constant"><rgb name="radiance" value="0.3, 0.6, 1.5"/></emitter>
+    <shape type="sphere"><bsdf type="diffuse"><rgb name="reflectance" value="0.9, 0.5, 0.1"/></bsdf></shape>
+</scene>"#
+        ),
+    )
+    .unwrap();
+    let output = std::process::Command::new(env!("CARGO_BIN_EXE_prism"))
+        .arg("render")
+        .arg(dir.join("scene.xml"))
+        .arg("-o")
+        .arg(dir.join("out.exr"))
+        .args(["--spp", "4"])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(0), "{stderr}");
+    dir
+}
+
+/// The linear sRGB pixels of the EXR Prism wrote.
+fn exr_rgb(dir: &Path) -> Vec<[f64; 3]> {
+    let image = prism_core::image::read_exr(&dir.join("out.exr")).unwrap();
+    let (r, g, b) = (
+        image.channel("R").unwrap(),
+        image.channel("G").unwrap(),
+        image.channel("B").unwrap(),
+    );
+    (0..r.len())
+        .map(|i| [f64::from(r[i]), f64::from(g[i]), f64::from(b[i])])
+        .collect()
+}
+
+/// The 8-bit values of an image file, `channels` per pixel.
+fn image_bytes(path: &Path) -> (usize, Vec<i32>) {
+    let bitmap = prism_core::image::read_bitmap(path).unwrap();
+    assert_eq!((bitmap.width, bitmap.height), (8, 6));
+    let bytes = bitmap
+        .data
+        .iter()
+        .map(|v| (v * 255.0).round() as i32)
+        .collect();
+    (bitmap.channels, bytes)
+}
+
+/// Asserts 8-bit values equal the exact ones rounded: within half a step, and 10⁻² more for
+/// the difference between Prism's f32 arithmetic and the test's f64.
+fn assert_bytes(got: &[i32], expected: &[f64]) {
+    assert_eq!(got.len(), expected.len());
+    for (i, (&g, &e)) in got.iter().zip(expected).enumerate() {
+        assert!(
+            (f64::from(g) - e).abs() <= 0.5 + 1e-2,
+            "value {i}: {g}, expected {e}"
+        );
+    }
+}
+
+/// `ldrfilm` with `gamma` tonemapping: the PNG holds 255 · clamp(2^exposure · v)^(1/γ) of the
+/// EXR's linear values.
+#[test]
+fn ldrfilm_writes_exposure_and_gamma() {
+    let dir = render_ldrfilm(
+        "ldr-gamma",
+        r#"<float name="exposure" value="-1"/><float name="gamma" value="2.2"/>"#,
+    );
+    let rgb = exr_rgb(&dir);
+    let expected: Vec<f64> = rgb
+        .iter()
+        .flatten()
+        .map(|&v| 255.0 * (0.5 * v).clamp(0.0, 1.0).powf(1.0 / 2.2))
+        .collect();
+    let (channels, bytes) = image_bytes(&dir.join("out.png"));
+    assert_eq!(channels, 3);
+    assert_bytes(&bytes, &expected);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// `ldrfilm` with Reinhard's operator, as luminance: each pixel's luminance L becomes
+/// Lp (1 + Lp / L_white²) / (1 + Lp) with Lp = L · key / exp(mean ln(10⁻³ + L)) and
+/// b = 1 − burn entering as L_white² b⁴, then the sRGB curve.
+#[test]
+fn ldrfilm_writes_reinhard_luminance() {
+    let dir = render_ldrfilm(
+        "ldr-reinhard",
+        r#"<string name="tonemapMethod" value="reinhard"/><float name="key" value="0.3"/>
+            <float name="burn" value="0.2"/><string name="pixelFormat" value="luminance"/>"#,
+    );
+    let luminance: Vec<f64> = exr_rgb(&dir)
+        .iter()
+        .map(|p| 0.212_671 * p[0] + 0.715_160 * p[1] + 0.072_169 * p[2])
+        .collect();
+    let log_average =
+        (luminance.iter().map(|l| (1e-3 + l).ln()).sum::<f64>() / luminance.len() as f64).exp();
+    let scale = 0.3 / log_average;
+    let white = luminance.iter().copied().fold(0.0, f64::max) * scale;
+    let inv_white2 = 1.0 / (white * white * 0.8f64.powi(4));
+    let srgb = |v: f64| {
+        if v <= 0.003_130_8 {
+            12.92 * v
+        } else {
+            1.055 * v.powf(1.0 / 2.4) - 0.055
+        }
+    };
+    let expected: Vec<f64> = luminance
+        .iter()
+        .map(|&l| {
+            let lp = l * scale;
+            255.0 * srgb((lp * (1.0 + lp * inv_white2) / (1.0 + lp)).clamp(0.0, 1.0))
+        })
+        .collect();
+    let (channels, bytes) = image_bytes(&dir.join("out.png"));
+    assert_eq!(channels, 1);
+    assert_bytes(&bytes, &expected);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// `fileFormat="jpeg"` writes `out.jpg` (and no PNG); an RGBA PNG has an opaque alpha.
+#[test]
+fn ldrfilm_writes_jpeg_and_rgba() {
+    let dir = render_ldrfilm("ldr-jpeg", r#"<string name="fileFormat" value="jpeg"/>"#);
+    let jpeg = std::fs::read(dir.join("out.jpg")).unwrap();
+    assert_eq!(&jpeg[..2], &[0xFF, 0xD8]);
+    assert!(!dir.join("out.png").exists());
+    let (channels, _) = image_bytes(&dir.join("out.jpg"));
+    assert_eq!(channels, 3);
+    std::fs::remove_dir_all(&dir).unwrap();
+
+    let dir = render_ldrfilm("ldr-rgba", r#"<string name="pixelFormat" value="rgba"/>"#);
+    let (channels, bytes) = image_bytes(&dir.join("out.png"));
+    assert_eq!(channels, 4);
+    assert!(bytes.chunks(4).all(|p| p[3] == 255));
+    std::fs::remove_dir_all(&dir).unwrap();
+}

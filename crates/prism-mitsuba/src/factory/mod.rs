@@ -186,6 +186,7 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
         integrator,
     );
     scene.shutter = sensor.shutter;
+    scene.ldr_output = sensor.ldr_output;
     scene.fingerprint = crate::fingerprint::scene_fingerprint(root);
     Ok(LoadedScene {
         scene,

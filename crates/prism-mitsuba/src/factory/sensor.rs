@@ -1,5 +1,5 @@
 //! The sensor and what it carries: the `perspective` and `thinlens` cameras with their shutter,
-//! the `hdrfilm` film with its `rfilter`, and the sampler.
+//! the `hdrfilm` and `ldrfilm` films with their `rfilter`, and the sampler.
 
 use glam::{UVec2, Vec2};
 
@@ -9,7 +9,8 @@ use crate::registry::{Default, Origin, ParamKind, ParamSpec, Plugin, Registry};
 use prism_core::camera::perspective::{FovAxis, focal_length_to_diagonal_fov, horizontal_fov};
 use prism_core::camera::{Camera, PerspectiveCamera, Shutter};
 use prism_core::error::{Error, Result};
-use prism_core::film::{CropWindow, Filter};
+use prism_core::film::{CropWindow, Filter, LdrFormat, LdrOutput, Tonemap, TransferCurve};
+use prism_core::image::Channels;
 use prism_core::scene::{FilmSettings, SamplerKind, SamplerSettings};
 
 /// Builds a sensor; `thinlens` says whether it has a lens.
@@ -162,32 +163,58 @@ const THINLENS_PARAMS: &[ParamSpec] = &[
     FOCAL_DISTANCE,
 ];
 
-type FilmBuild = fn(&Params) -> Result<FilmSettings>;
+type FilmBuild = fn(&Params) -> Result<(FilmSettings, LdrOutput)>;
 
 pub static FILMS: Registry<FilmBuild> = Registry {
     class: PluginClass::Film,
-    plugins: &[Plugin {
-        name: "hdrfilm",
-        origin: Origin::Mitsuba3,
-        summary: "A high dynamic range film; Prism writes it as 32-bit OpenEXR (RGB, XYZ, per-pixel                   variance and relative error) and an sRGB PNG.",
-        params: &[
-            WIDTH,
-            HEIGHT,
-            CROP_OFFSET_X,
-            CROP_OFFSET_Y,
-            CROP_WIDTH,
-            CROP_HEIGHT,
-            FILE_FORMAT,
-            PIXEL_FORMAT,
-            COMPONENT_FORMAT,
-            RFILTER,
-            BANNER,
-            ATTACH_LOG,
-            HIGH_QUALITY_EDGES,
-            HDR_GAMMA,
-        ],
-        build: build_hdrfilm,
-    }],
+    plugins: &[
+        Plugin {
+            name: "hdrfilm",
+            origin: Origin::Mitsuba3,
+            summary: "A high dynamic range film; Prism writes it as 32-bit OpenEXR (RGB, XYZ, per-pixel                   variance and relative error) and an sRGB PNG.",
+            params: &[
+                WIDTH,
+                HEIGHT,
+                CROP_OFFSET_X,
+                CROP_OFFSET_Y,
+                CROP_WIDTH,
+                CROP_HEIGHT,
+                FILE_FORMAT,
+                PIXEL_FORMAT,
+                COMPONENT_FORMAT,
+                RFILTER,
+                BANNER,
+                ATTACH_LOG,
+                HIGH_QUALITY_EDGES,
+                HDR_GAMMA,
+            ],
+            build: build_hdrfilm,
+        },
+        Plugin {
+            name: "ldrfilm",
+            origin: Origin::Mitsuba06,
+            summary: "Mitsuba 0.6's low dynamic range film: Prism writes its usual OpenEXR and, in                   place of the sRGB PNG, the 8-bit PNG or JPEG tonemapped as the film asks.",
+            params: &[
+                WIDTH,
+                HEIGHT,
+                CROP_OFFSET_X,
+                CROP_OFFSET_Y,
+                CROP_WIDTH,
+                CROP_HEIGHT,
+                LDR_FILE_FORMAT,
+                LDR_PIXEL_FORMAT,
+                TONEMAP_METHOD,
+                LDR_GAMMA,
+                EXPOSURE,
+                KEY,
+                BURN,
+                RFILTER,
+                BANNER,
+                HIGH_QUALITY_EDGES,
+            ],
+            build: build_ldrfilm,
+        },
+    ],
 };
 
 const WIDTH: ParamSpec = ParamSpec::new(
@@ -267,6 +294,48 @@ const HDR_GAMMA: ParamSpec = ParamSpec::new(
     ParamKind::Float,
     Default::Ignored,
     "a gamma on an HDR film, as Mitsuba 0.6 scenes give it; the EXR is linear",
+);
+const LDR_FILE_FORMAT: ParamSpec = ParamSpec::new(
+    "file_format",
+    ParamKind::Choice(&["png", "jpeg", "jpg"]),
+    Default::Str("png"),
+    "the 8-bit file: PNG, or JPEG of quality 100 (extension `.jpg`)",
+);
+const LDR_PIXEL_FORMAT: ParamSpec = ParamSpec::new(
+    "pixel_format",
+    ParamKind::Choice(&["rgb", "rgba", "luminance", "luminanceAlpha"]),
+    Default::Str("rgb"),
+    "the 8-bit image's channels; Prism's alpha is opaque (its film records no coverage), and a JPEG drops it, as Mitsuba 0.6 does",
+);
+const TONEMAP_METHOD: ParamSpec = ParamSpec::new(
+    "tonemap_method",
+    ParamKind::Choice(&["gamma", "reinhard"]),
+    Default::Str("gamma"),
+    "`gamma`: scale by 2^`exposure`; `reinhard`: Reinhard et al. 2002's global operator with `key` and `burn`",
+);
+const LDR_GAMMA: ParamSpec = ParamSpec::new(
+    "gamma",
+    ParamKind::Float,
+    Default::Float(-1.0),
+    "the transfer curve v^(1/γ) of the 8-bit values; −1 is the sRGB curve",
+);
+const EXPOSURE: ParamSpec = ParamSpec::new(
+    "exposure",
+    ParamKind::Float,
+    Default::Float(0.0),
+    "with `gamma` tonemapping, the exposure in f-stops: values are scaled by 2^exposure",
+);
+const KEY: ParamSpec = ParamSpec::new(
+    "key",
+    ParamKind::Float,
+    Default::Float(0.18),
+    "with `reinhard`, the value the log-average luminance maps to, in (0, 1]",
+);
+const BURN: ParamSpec = ParamSpec::new(
+    "burn",
+    ParamKind::Float,
+    Default::Float(0.0),
+    "with `reinhard`, how much highlights may burn out, in [0, 1]",
 );
 const RFILTER: ParamSpec = ParamSpec::nested(
     PluginClass::Rfilter,
@@ -464,6 +533,8 @@ pub struct SensorSettings {
     pub film: FilmSettings,
     pub sampler: SamplerSettings,
     pub seed: u64,
+    /// How the 8-bit image is written (`ldrfilm`), or the default sRGB PNG.
+    pub ldr_output: LdrOutput,
     /// The parameters read and ignored, one warning each.
     pub warnings: Vec<Warning>,
 }
@@ -478,9 +549,9 @@ pub fn build_sensor(node: &PluginNode) -> Result<SensorSettings> {
 }
 
 fn build_sensor_of(params: &Params, thinlens: bool) -> Result<SensorSettings> {
-    let (film, warnings) = match params.single_child(&FILM)? {
+    let (film, ldr_output, warnings) = match params.single_child(&FILM)? {
         Some(child) => build_film(&child.node)?,
-        None => (default_film(), Vec::new()),
+        None => (default_film(), LdrOutput::default(), Vec::new()),
     };
     let (sampler, seed) = match params.single_child(&SAMPLER)? {
         Some(child) => build_sampler(&child.node)?,
@@ -583,6 +654,7 @@ fn build_sensor_of(params: &Params, thinlens: bool) -> Result<SensorSettings> {
         film,
         sampler,
         seed,
+        ldr_output,
         warnings,
     })
 }
@@ -678,18 +750,96 @@ fn default_film() -> FilmSettings {
     }
 }
 
+/// The film a node describes, how its 8-bit image is written, and a warning for each ignored
+/// parameter it gives.
+fn build_film(node: &PluginNode) -> Result<(FilmSettings, LdrOutput, Vec<Warning>)> {
+    let plugin = FILMS.find(node)?;
+    let params = Params::new(node, plugin.params);
+    let (film, ldr) = (plugin.build)(&params)?;
+    let warnings = params.finish_with_warnings()?;
+    Ok((film, ldr, warnings))
+}
+
 /// `hdrfilm`: `width` (768), `height` (576), `crop_offset_x/y`, `crop_width/height`, a nested
 /// `rfilter` (Gaussian by default). `file_format`, `pixel_format` and `component_format` are
 /// accepted for compatibility; Prism always writes 32-bit linear RGB and XYZ to EXR.
-fn build_film(node: &PluginNode) -> Result<(FilmSettings, Vec<Warning>)> {
-    let plugin = FILMS.find(node)?;
-    let params = Params::new(node, plugin.params);
-    let film = (plugin.build)(&params)?;
-    let warnings = params.finish_with_warnings()?;
-    Ok((film, warnings))
+fn build_hdrfilm(params: &Params) -> Result<(FilmSettings, LdrOutput)> {
+    let film = film_settings(params)?;
+    for spec in [&FILE_FORMAT, &PIXEL_FORMAT, &COMPONENT_FORMAT] {
+        params.choice(spec)?;
+    }
+    Ok((film, LdrOutput::default()))
 }
 
-fn build_hdrfilm(params: &Params) -> Result<FilmSettings> {
+/// `ldrfilm` (Mitsuba 0.6's `src/films/ldrfilm.cpp`): the film of `hdrfilm`, and how its 8-bit
+/// image is tonemapped ([`prism_core::film::ldr`]).
+fn build_ldrfilm(params: &Params) -> Result<(FilmSettings, LdrOutput)> {
+    let film = film_settings(params)?;
+    let format = match params.choice(&LDR_FILE_FORMAT)? {
+        "png" => LdrFormat::Png,
+        _ => LdrFormat::Jpeg,
+    };
+    let channels = match (params.choice(&LDR_PIXEL_FORMAT)?, format) {
+        ("rgba", LdrFormat::Png) => Channels::Rgba,
+        ("luminanceAlpha", LdrFormat::Png) => Channels::LuminanceAlpha,
+        ("luminance" | "luminanceAlpha", _) => Channels::Luminance,
+        _ => Channels::Rgb,
+    };
+    let gamma = params.float(&LDR_GAMMA)?;
+    let curve = if gamma == -1.0 {
+        TransferCurve::Srgb
+    } else if gamma > 0.0 && gamma.is_finite() {
+        TransferCurve::Gamma(gamma as f32)
+    } else {
+        return Err(Error::input(
+            params.location_of(&LDR_GAMMA),
+            format!("the film's gamma must be positive, or −1 for the sRGB curve, not {gamma}"),
+        ));
+    };
+    // Mitsuba 0.6 reads all three whichever the method, so a scene may give them all.
+    let exposure = params.float(&EXPOSURE)?;
+    let key = params.float(&KEY)?;
+    let burn = params.float(&BURN)?;
+    let out_of_range = |spec: &ParamSpec, range: &str, value: f64| {
+        Error::input(
+            params.location_of(spec),
+            format!(
+                "the film's \"{}\" must lie in {range}, not {value}",
+                spec.name
+            ),
+        )
+    };
+    if !(exposure.abs() <= 100.0) {
+        return Err(out_of_range(&EXPOSURE, "[−100, 100] f-stops", exposure));
+    }
+    if !(key > 0.0 && key <= 1.0) {
+        return Err(out_of_range(&KEY, "(0, 1]", key));
+    }
+    if !(0.0..=1.0).contains(&burn) {
+        return Err(out_of_range(&BURN, "[0, 1]", burn));
+    }
+    let tonemap = match params.choice(&TONEMAP_METHOD)? {
+        "reinhard" => Tonemap::Reinhard {
+            key: key as f32,
+            burn: burn as f32,
+        },
+        _ => Tonemap::Exposure {
+            exposure: exposure as f32,
+        },
+    };
+    Ok((
+        film,
+        LdrOutput {
+            tonemap,
+            curve,
+            format,
+            channels,
+        },
+    ))
+}
+
+/// The size, crop window and filter that `hdrfilm` and `ldrfilm` share.
+fn film_settings(params: &Params) -> Result<FilmSettings> {
     let width = params.integer(&WIDTH)?;
     let height = params.integer(&HEIGHT)?;
     if !(1..=MAX_FILM_SIDE).contains(&width)
@@ -721,9 +871,6 @@ fn build_hdrfilm(params: &Params) -> Result<FilmSettings> {
                 "the crop window at ({crop_x}, {crop_y}) of size {crop_width} × {crop_height} does not fit in the {width} × {height} film"
             ),
         ));
-    }
-    for spec in [&FILE_FORMAT, &PIXEL_FORMAT, &COMPONENT_FORMAT] {
-        params.choice(spec)?;
     }
     let filter = match params.single_child(&RFILTER)? {
         Some(child) => build_filter(&child.node)?,
@@ -764,7 +911,7 @@ fn filter_size(params: &Params, spec: &ParamSpec) -> Result<f32> {
 }
 
 /// The sampler a node describes, with its seed.
-fn build_sampler(node: &PluginNode) -> Result<(SamplerSettings, u64)> {
+pub(crate) fn build_sampler(node: &PluginNode) -> Result<(SamplerSettings, u64)> {
     let plugin = SAMPLERS.find(node)?;
     let params = Params::new(node, plugin.params);
     let kind = (plugin.build)(&params)?;
