@@ -1,8 +1,13 @@
 //! The sensor plugins as the scene reader builds them from Mitsuba XML: the field of view
-//! from `fov`, `fov_axis` and `focal_length` (Mitsuba 3's `parse_fov`), and `focus_distance`,
-//! which Mitsuba 3 reads on every projective camera.
+//! from `fov`, `fov_axis` and `focal_length` (Mitsuba 3's `parse_fov`), `focus_distance`,
+//! which Mitsuba 3 reads on every projective camera, the orthographic camera against closed
+//! forms, Mitsuba 0.6's ignored film parameters and its `ldrfilm`.
+
+mod common;
 
 use std::path::Path;
+
+use common::scenes::{assert_mean_luminance, render_film};
 
 use glam::Vec2;
 use prism_core::camera::Camera;
@@ -32,8 +37,7 @@ fn load_sensor(
 fn tan_half_fov_x(scene: &Scene) -> f64 {
     match &scene.camera {
         Camera::Perspective(camera) => f64::from(camera.tan_half_fov_x),
-        #[allow(unreachable_patterns)]
-        _ => panic!("not a perspective camera"),
+        Camera::Orthographic(_) => panic!("not a perspective camera"),
     }
 }
 
@@ -363,4 +367,52 @@ fn ldrfilm_writes_jpeg_and_rgba() {
     assert_eq!(channels, 4);
     assert!(bytes.chunks(4).all(|p| p[3] == 255));
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// An orthographic scene of 64 × 48 pixels with a box filter: the camera 3 above the origin
+/// looking down, its film scaled by `scale` (covering [−s, s] × [−0.75 s, 0.75 s]), over `body`.
+fn orthographic_scene(scale: f64, body: &str) -> Scene {
+    let text = format!(
+        r#"<scene version="3.0.0">
+    <sensor type="orthographic">
+        <transform name="to_world">
+            <scale x="{scale}" y="{scale}"/>
+            <lookat origin="0, 0, 3" target="0, 0, 0" up="0, 1, 0"/>
+        </transform>
+        <film type="hdrfilm"><integer name="width" value="64"/><integer name="height" value="48"/>
+            <rfilter type="box"/></film>
+    </sensor>
+    {body}
+</scene>"#
+    );
+    let root = read_scene_str(&text, &Path::new(".").join("scene.xml"), &[]).unwrap();
+    build_scene(&root).unwrap().scene
+}
+
+/// Over an emitting plane that fills the film, every pixel of an orthographic camera measures
+/// the plane's radiance: `<rgb value="2"/>` emission is D65 of luminance 2, so Y = 2.
+#[test]
+fn an_orthographic_camera_over_an_emitting_plane_sees_its_radiance() {
+    let scene = orthographic_scene(
+        2.0,
+        r#"<shape type="rectangle"><transform name="to_world"><scale value="5"/></transform>
+        <emitter type="area"><rgb name="radiance" value="2"/></emitter></shape>"#,
+    );
+    let film = render_film(&scene, 64, 1, None);
+    assert_mean_luminance("orthographic over a plane", &film, 2.0);
+}
+
+/// The image of an emitting disk of radius 0.6 (Y = 1) on black covers its area's share of
+/// the film's 2s × 1.5s: the image's mean luminance is π 0.6² / (2s · 1.5s).
+#[test]
+fn the_orthographic_image_of_a_disk_has_the_disks_area() {
+    let s = 1.5;
+    let scene = orthographic_scene(
+        s,
+        r#"<shape type="disk"><transform name="to_world"><scale value="0.6"/></transform>
+        <emitter type="area"><rgb name="radiance" value="1"/></emitter></shape>"#,
+    );
+    let film = render_film(&scene, 256, 2, None);
+    let expected = std::f64::consts::PI * 0.36 / (2.0 * s * 1.5 * s);
+    assert_mean_luminance("orthographic image of a disk", &film, expected);
 }

@@ -59,8 +59,15 @@ const TEXTURES: ParamSpec = ParamSpec::nested(
     Default::None,
     "textures declared to be referenced by id",
 );
+const SAMPLERS: ParamSpec = ParamSpec::nested(
+    PluginClass::Sampler,
+    Default::None,
+    "samplers declared to be referenced by id from the sensor",
+);
 /// What the `<scene>` element holds.
-const SCENE: &[ParamSpec] = &[INTEGRATOR, SENSOR, SHAPES, EMITTERS, BSDFS, TEXTURES];
+const SCENE: &[ParamSpec] = &[
+    INTEGRATOR, SENSOR, SHAPES, EMITTERS, BSDFS, TEXTURES, SAMPLERS,
+];
 
 /// Builds the scene described by the root `<scene>` node.
 pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
@@ -174,6 +181,11 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
                 &mut textures,
             )?;
         }
+    }
+    // Samplers declared at the top level (to be referenced by id from the sensor) are checked
+    // even when no sensor uses them.
+    for child in params.children(&SAMPLERS) {
+        sensor::build_sampler(&child.node)?;
     }
     params.finish()?;
 

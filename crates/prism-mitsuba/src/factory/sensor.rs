@@ -1,4 +1,5 @@
-//! The sensor and what it carries: the `perspective` and `thinlens` cameras with their shutter,
+//! The sensor and what it carries: the `perspective`, `thinlens` and `orthographic` cameras with
+//! their shutter,
 //! the `hdrfilm` and `ldrfilm` films with their `rfilter`, and the sampler.
 
 use glam::{UVec2, Vec2};
@@ -7,10 +8,11 @@ use crate::description::{PluginClass, PluginNode};
 use crate::params::{Params, Warning};
 use crate::registry::{Default, Origin, ParamKind, ParamSpec, Plugin, Registry};
 use prism_core::camera::perspective::{FovAxis, focal_length_to_diagonal_fov, horizontal_fov};
-use prism_core::camera::{Camera, PerspectiveCamera, Shutter};
+use prism_core::camera::{Camera, OrthographicCamera, PerspectiveCamera, Shutter};
 use prism_core::error::{Error, Result};
 use prism_core::film::{CropWindow, Filter, LdrFormat, LdrOutput, Tonemap, TransferCurve};
 use prism_core::image::Channels;
+use prism_core::sampling::sampler::MAX_ORTHOGONAL_STRENGTH;
 use prism_core::scene::{FilmSettings, SamplerKind, SamplerSettings};
 
 /// Builds a sensor; `thinlens` says whether it has a lens.
@@ -32,6 +34,13 @@ pub static SENSORS: Registry<SensorBuild> = Registry {
             summary: "A thin-lens camera: as `perspective`, with depth of field.",
             params: THINLENS_PARAMS,
             build: build_sensor_of,
+        },
+        Plugin {
+            name: "orthographic",
+            origin: Origin::Mitsuba3,
+            summary: "Parallel rays along +z from the square [−1, 1] × [−1/a, 1/a] (a = width / height) of the camera's near plane, placed and scaled by `to_world`.",
+            params: ORTHOGRAPHIC_PARAMS,
+            build: build_orthographic,
         },
     ],
 };
@@ -131,6 +140,23 @@ const FOCAL_DISTANCE: ParamSpec = ParamSpec::new(
     "Prism only, the lecture's name for `focus_distance`",
 );
 
+const ORTHOGRAPHIC_TO_WORLD: ParamSpec = ParamSpec::new(
+    "to_world",
+    ParamKind::AnimatedTransform,
+    Default::Text("identity"),
+    "camera to world, scales included (they set the film's extent in the scene), or an `<animation>` of them",
+);
+const ORTHOGRAPHIC_PARAMS: &[ParamSpec] = &[
+    NEAR_CLIP,
+    FAR_CLIP,
+    ORTHOGRAPHIC_TO_WORLD,
+    SHUTTER_OPEN,
+    SHUTTER_CLOSE,
+    SHUTTER_FILTER,
+    FILM,
+    SAMPLER,
+    PINHOLE_FOCUS_DISTANCE,
+];
 const PERSPECTIVE_PARAMS: &[ParamSpec] = &[
     FOV,
     FOV_AXIS,
@@ -499,8 +525,43 @@ pub static SAMPLERS: Registry<SamplerBuild> = Registry {
             params: &[SAMPLE_COUNT, SEED],
             build: |_| Ok(SamplerKind::NRooks),
         },
+        Plugin {
+            name: "ldsampler",
+            origin: Origin::Mitsuba3,
+            summary: "Mitsuba 3's low-discrepancy sampler (and Mitsuba 0.6's of the same name): a scrambled (0, 2)-sequence shuffled per dimension; `sample_count` is rounded up to a square of a power of two.",
+            params: &[SAMPLE_COUNT, SEED],
+            build: |_| Ok(SamplerKind::LowDiscrepancy),
+        },
+        Plugin {
+            name: "orthogonal",
+            origin: Origin::Mitsuba3,
+            summary: "Orthogonal array sampling (Jarosz et al. 2019), as Mitsuba 3 does: `sample_count` is rounded up to p^`strength` for a prime p.",
+            params: &[SAMPLE_COUNT, SEED, JITTER, STRENGTH],
+            build: |params| {
+                let strength = params.integer(&STRENGTH)?;
+                if !(1..=i64::from(MAX_ORTHOGONAL_STRENGTH)).contains(&strength) {
+                    return Err(Error::input(
+                        params.location_of(&STRENGTH),
+                        format!(
+                            "the orthogonal array's strength must be between 1 and {MAX_ORTHOGONAL_STRENGTH}, not {strength}"
+                        ),
+                    ));
+                }
+                Ok(SamplerKind::Orthogonal {
+                    strength: strength as u32,
+                    jitter: params.boolean(&JITTER)?,
+                })
+            },
+        },
     ],
 };
+
+const STRENGTH: ParamSpec = ParamSpec::new(
+    "strength",
+    ParamKind::Integer,
+    Default::Integer(2),
+    "the orthogonal array's strength t: every t dimensions together are stratified (1 to 4)",
+);
 
 const SAMPLE_COUNT: ParamSpec = ParamSpec::new(
     "sample_count",
@@ -548,7 +609,17 @@ pub fn build_sensor(node: &PluginNode) -> Result<SensorSettings> {
     Ok(sensor)
 }
 
-fn build_sensor_of(params: &Params, thinlens: bool) -> Result<SensorSettings> {
+/// What every sensor carries: its film (with the 8-bit output and the warnings of its ignored
+/// parameters), its sampler and the sampler's seed.
+struct SensorParts {
+    film: FilmSettings,
+    ldr_output: LdrOutput,
+    warnings: Vec<Warning>,
+    sampler: SamplerSettings,
+    seed: u64,
+}
+
+fn sensor_parts(params: &Params) -> Result<SensorParts> {
     let (film, ldr_output, warnings) = match params.single_child(&FILM)? {
         Some(child) => build_film(&child.node)?,
         None => (default_film(), LdrOutput::default(), Vec::new()),
@@ -563,6 +634,62 @@ fn build_sensor_of(params: &Params, thinlens: bool) -> Result<SensorSettings> {
             0,
         ),
     };
+    Ok(SensorParts {
+        film,
+        ldr_output,
+        warnings,
+        sampler,
+        seed,
+    })
+}
+
+/// `near_clip` and `far_clip`, as Mitsuba 3's projective cameras check them.
+fn clip_distances(params: &Params) -> Result<(f64, f64)> {
+    let near_clip = params.float(&NEAR_CLIP)?;
+    let far_clip = params.float(&FAR_CLIP)?;
+    if !(near_clip > 0.0) || !(far_clip > near_clip) || !far_clip.is_finite() {
+        return Err(Error::input(
+            params.location_of(&NEAR_CLIP),
+            format!(
+                "near_clip ({near_clip}) must be positive and smaller than far_clip ({far_clip})"
+            ),
+        ));
+    }
+    Ok((near_clip, far_clip))
+}
+
+/// `orthographic` (Mitsuba 3's `orthographic.cpp`).
+fn build_orthographic(params: &Params, _thinlens: bool) -> Result<SensorSettings> {
+    let parts = sensor_parts(params)?;
+    let (near_clip, far_clip) = clip_distances(params)?;
+    params.float_opt(&PINHOLE_FOCUS_DISTANCE)?;
+    let to_world = params.animated_transform(&ORTHOGRAPHIC_TO_WORLD)?;
+    let shutter = shutter(params)?;
+    let camera = Camera::Orthographic(OrthographicCamera {
+        to_world,
+        film_size: Vec2::new(parts.film.size.x as f32, parts.film.size.y as f32),
+        near_clip: near_clip as f32,
+        far_clip: far_clip as f32,
+    });
+    Ok(SensorSettings {
+        camera,
+        shutter,
+        film: parts.film,
+        sampler: parts.sampler,
+        seed: parts.seed,
+        ldr_output: parts.ldr_output,
+        warnings: parts.warnings,
+    })
+}
+
+fn build_sensor_of(params: &Params, thinlens: bool) -> Result<SensorSettings> {
+    let SensorParts {
+        film,
+        ldr_output,
+        warnings,
+        sampler,
+        seed,
+    } = sensor_parts(params)?;
 
     let aspect = f64::from(film.size.x) / f64::from(film.size.y);
     let fov_x = match (params.float_opt(&FOV)?, params.string_opt(&FOCAL_LENGTH)?) {
@@ -613,16 +740,7 @@ fn build_sensor_of(params: &Params, thinlens: bool) -> Result<SensorSettings> {
             ),
         ));
     }
-    let near_clip = params.float(&NEAR_CLIP)?;
-    let far_clip = params.float(&FAR_CLIP)?;
-    if !(near_clip > 0.0) || !(far_clip > near_clip) || !far_clip.is_finite() {
-        return Err(Error::input(
-            params.location_of(&NEAR_CLIP),
-            format!(
-                "near_clip ({near_clip}) must be positive and smaller than far_clip ({far_clip})"
-            ),
-        ));
-    }
+    let (near_clip, far_clip) = clip_distances(params)?;
     let to_world = params.animated_transform(&SENSOR_TO_WORLD)?;
     let (lens_radius, focus_distance) = if thinlens {
         lens(params, far_clip)?
@@ -921,6 +1039,18 @@ pub(crate) fn build_sampler(node: &PluginNode) -> Result<(SamplerSettings, u64)>
             params.location_of(&SAMPLE_COUNT),
             format!("sample_count must be between 1 and {}, not {spp}", 1 << 24),
         ));
+    }
+    if kind.sample_count(spp as u32) > 1 << 24 {
+        return Err(Error::input(
+            params.location_of(&SAMPLE_COUNT),
+            format!(
+                "{} sampler rounds {spp} samples up to {}, more than {}",
+                plugin.name,
+                kind.sample_count(spp as u32),
+                1 << 24
+            ),
+        )
+        .with_help("ask for fewer samples, or a lower strength"));
     }
     let seed = params.integer(&SEED)?;
     params.finish()?;
