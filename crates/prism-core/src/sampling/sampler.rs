@@ -106,7 +106,11 @@ impl SamplerKind {
 /// The smallest prime p ≥ max(2, `strength`) with p^strength ≥ `requested` (Bush's construction
 /// needs p ≥ t).
 fn orthogonal_array_base(requested: u32, strength: u32) -> u32 {
-    let is_prime = |x: u32| (2..).take_while(|d| d * d <= x).all(|d| x % d != 0);
+    let is_prime = |x: u32| {
+        (2..)
+            .take_while(|d| d * d <= x)
+            .all(|d| !x.is_multiple_of(d))
+    };
     let mut p = strength.max(2);
     while u64::from(p).pow(strength) < u64::from(requested) || !is_prime(p) {
         p += 1;
