@@ -324,6 +324,24 @@ fn cases() -> Vec<Case> {
             "does not fit",
         ),
         render_scene(
+            "a misspelt Mitsuba 0.6 film parameter",
+            "<scene version=\"0.6.0\">\n    <sensor type=\"perspective\"><film type=\"hdrfilm\"><integer name=\"width\" value=\"4\"/><integer name=\"height\" value=\"4\"/>\n        <boolean name=\"banerr\" value=\"false\"/></film></sensor>\n</scene>\n",
+            "scene.xml:3:9",
+            "did you mean \"banner\"",
+        ),
+        render_scene(
+            "ldrfilm gamma of zero",
+            "<scene version=\"3.0.0\">\n    <sensor type=\"perspective\"><film type=\"ldrfilm\"><integer name=\"width\" value=\"4\"/><integer name=\"height\" value=\"4\"/>\n        <float name=\"gamma\" value=\"0\"/></film></sensor>\n</scene>\n",
+            "scene.xml:3:9",
+            "or −1 for the sRGB curve",
+        ),
+        render_scene(
+            "ldrfilm unknown tonemapper",
+            "<scene version=\"3.0.0\">\n    <sensor type=\"perspective\"><film type=\"ldrfilm\"><integer name=\"width\" value=\"4\"/><integer name=\"height\" value=\"4\"/>\n        <string name=\"tonemap_method\" value=\"filmic\"/></film></sensor>\n</scene>\n",
+            "scene.xml:3:9",
+            "gamma, reinhard",
+        ),
+        render_scene(
             "film of 10^6 × 10^6 pixels",
             "<scene version=\"3.0.0\">\n    <sensor type=\"perspective\"><film type=\"hdrfilm\"><integer name=\"width\" value=\"1000000\"/><integer name=\"height\" value=\"1000000\"/></film></sensor>\n</scene>\n",
             "scene.xml:2:",

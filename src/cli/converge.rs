@@ -109,8 +109,16 @@ fn sampler_named(name: &str) -> Result<SamplerKind> {
         "stratified" => Ok(SamplerKind::Stratified { jitter: true }),
         "multijitter" => Ok(SamplerKind::MultiJitter { jitter: true }),
         "nrooks" => Ok(SamplerKind::NRooks),
-        other => Err(Error::usage(format!("unknown sampler \"{other}\""))
-            .with_help("use independent, stratified, multijitter or nrooks")),
+        "ldsampler" => Ok(SamplerKind::LowDiscrepancy),
+        "orthogonal" => Ok(SamplerKind::Orthogonal {
+            strength: 2,
+            jitter: true,
+        }),
+        other => Err(
+            Error::usage(format!("unknown sampler \"{other}\"")).with_help(
+                "use independent, stratified, multijitter, nrooks, ldsampler or orthogonal",
+            ),
+        ),
     }
 }
 
@@ -127,6 +135,8 @@ fn sampler_label(kind: SamplerKind) -> &'static str {
         SamplerKind::Stratified { .. } => "stratified",
         SamplerKind::MultiJitter { .. } => "multijitter",
         SamplerKind::NRooks => "nrooks",
+        SamplerKind::LowDiscrepancy => "ldsampler",
+        SamplerKind::Orthogonal { .. } => "orthogonal",
     }
 }
 
@@ -141,7 +151,11 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
         e.kind = prism_core::error::ErrorKind::Input;
         e
     })?;
-    let mut scene = load_scene(&args.scene, &args.defines)?.scene;
+    let loaded = load_scene(&args.scene, &args.defines)?;
+    for warning in &loaded.warnings {
+        eprintln!("{warning}");
+    }
+    let mut scene = loaded.scene;
     let size = scene.film.crop.size;
     if (reference.width, reference.height) != (size.x as usize, size.y as usize) {
         return Err(Error::usage(format!(

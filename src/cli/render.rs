@@ -20,7 +20,7 @@ use glam::UVec2;
 use crate::accel::Accel;
 use prism_core::error::{Error, Result};
 use prism_core::film::stats::rejected_report;
-use prism_core::film::write_images;
+use prism_core::film::write_images_with;
 use prism_core::film::{CropWindow, PixelSums};
 use prism_core::integrator::RayCount;
 use prism_core::render::state::{RenderIdentity, RenderState};
@@ -209,6 +209,8 @@ fn sampler_name(kind: SamplerKind) -> &'static str {
         SamplerKind::Stratified { .. } => "stratified",
         SamplerKind::MultiJitter { .. } => "multijitter",
         SamplerKind::NRooks => "nrooks",
+        SamplerKind::LowDiscrepancy => "ldsampler",
+        SamplerKind::Orthogonal { .. } => "orthogonal",
     }
 }
 
@@ -247,6 +249,9 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     }
     args.accel.check_available()?;
     let loaded = load_scene(&args.scene, &args.defines)?;
+    for warning in &loaded.warnings {
+        eprintln!("{warning}");
+    }
     let mut scene = loaded.scene;
     args.accel.apply(&mut scene.world.geometry)?;
     let crop = match (args.crop, args.pixel) {
@@ -337,6 +342,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         progress: std::io::stderr().is_terminal(),
     };
     let (exr_path, png_path) = output_paths(args);
+    let png_path = png_path.with_extension(scene.ldr_output.format.extension());
     let state_path = args
         .checkpoint
         .clone()
@@ -373,7 +379,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             write: &mut write_checkpoint,
         }),
     )?;
-    write_images(&output.film, &exr_path, &png_path)?;
+    write_images_with(&output.film, &exr_path, &png_path, &scene.ldr_output)?;
     if output.stop == StopReason::Interrupted && !checkpoints {
         // An interrupted render always leaves a state to resume from.
         state_of(&Snapshot {

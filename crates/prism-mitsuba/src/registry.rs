@@ -165,6 +165,9 @@ pub enum Default {
     Required,
     /// Absent means absent (an optional factor, an optional nested plugin).
     None,
+    /// A Mitsuba 0.6 parameter whose meaning is clear but which Prism does not implement: it is
+    /// read and ignored, with a warning ([`crate::params::Warning`]).
+    Ignored,
 }
 
 impl Default {
@@ -177,6 +180,7 @@ impl Default {
             Default::Text(t) => (*t).to_string(),
             Default::Required => "required".into(),
             Default::None => "—".into(),
+            Default::Ignored => "ignored, with a warning".into(),
         }
     }
 }

@@ -1,18 +1,29 @@
 //! The film written out: an OpenEXR image of its linear RGB and CIE XYZ values and each pixel's
-//! estimated error, and an sRGB PNG beside it.
+//! estimated error, and an 8-bit image beside it ([`super::ldr`]).
 
 use std::path::Path;
 
 use super::Film;
+use super::ldr::LdrOutput;
 use super::stats::{pixel_relative_error, variance_of_mean};
 use crate::error::Result;
-use crate::image::{ChannelImage, write_exr, write_png_srgb};
+use crate::image::{ChannelImage, write_exr};
 
 /// Writes the film as an EXR and as an sRGB PNG. The EXR's channels are `R`, `G`, `B` (linear
 /// sRGB), `X`, `Y`, `Z` (CIE 1931), `variance.X`, `variance.Y`, `variance.Z` (the estimated
 /// variance of each pixel's mean, see [`super::stats`]) and `relative_error.Y` (the
 /// pixel's relative standard error of luminance).
 pub fn write_images(film: &Film, exr_path: &Path, png_path: &Path) -> Result<()> {
+    write_images_with(film, exr_path, png_path, &LdrOutput::default())
+}
+
+/// As [`write_images`], with the 8-bit image written to `ldr_path` as `ldr` says.
+pub fn write_images_with(
+    film: &Film,
+    exr_path: &Path,
+    ldr_path: &Path,
+    ldr: &LdrOutput,
+) -> Result<()> {
     let xyz = film.xyz();
     let rgb = film.linear_srgb();
     let channel = |values: &[[f32; 3]], c: usize| values.iter().map(|v| v[c]).collect::<Vec<f32>>();
@@ -45,6 +56,5 @@ pub fn write_images(film: &Film, exr_path: &Path, png_path: &Path) -> Result<()>
         ],
     };
     write_exr(exr_path, &image)?;
-    let interleaved: Vec<f32> = rgb.iter().flatten().copied().collect();
-    write_png_srgb(png_path, image.width, image.height, &interleaved)
+    ldr.write(ldr_path, film.crop.size.x, film.crop.size.y, &rgb)
 }

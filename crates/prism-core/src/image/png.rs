@@ -1,4 +1,4 @@
-//! 8-bit sRGB PNG files, for viewing renders.
+//! 8-bit PNG (and JPEG) files, for viewing renders.
 
 use std::io;
 use std::path::Path;
@@ -22,14 +22,91 @@ pub fn write_png_srgb(path: &Path, width: usize, height: usize, rgb: &[f32]) -> 
         return Err(invalid(format!("{width}x{height} is too large for PNG")));
     };
     let bytes: Vec<u8> = rgb.iter().map(|&value| encode_u8(value)).collect();
+    write_png_u8(path, png_width, png_height, Channels::Rgb, true, &bytes)
+}
+
+/// The channels of an 8-bit image, interleaved per pixel in this order.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Channels {
+    Luminance,
+    LuminanceAlpha,
+    Rgb,
+    Rgba,
+}
+
+impl Channels {
+    pub fn count(self) -> usize {
+        match self {
+            Channels::Luminance => 1,
+            Channels::LuminanceAlpha => 2,
+            Channels::Rgb => 3,
+            Channels::Rgba => 4,
+        }
+    }
+}
+
+/// Writes already encoded 8-bit values (`channels` per pixel, top row first) as a PNG; `srgb`
+/// adds the chunk saying they are sRGB-encoded.
+pub fn write_png_u8(
+    path: &Path,
+    width: u32,
+    height: u32,
+    channels: Channels,
+    srgb: bool,
+    bytes: &[u8],
+) -> Result<()> {
+    if bytes.len() != channels.count() * width as usize * height as usize {
+        let message = format!("{} bytes given for {width}x{height} pixels", bytes.len());
+        return Err(Error::io(path, &io::Error::other(message), "write"));
+    }
     write_atomically(path, |writer| {
-        let mut encoder = png::Encoder::new(writer, png_width, png_height);
-        encoder.set_color(png::ColorType::Rgb);
+        let mut encoder = png::Encoder::new(writer, width, height);
+        encoder.set_color(match channels {
+            Channels::Luminance => png::ColorType::Grayscale,
+            Channels::LuminanceAlpha => png::ColorType::GrayscaleAlpha,
+            Channels::Rgb => png::ColorType::Rgb,
+            Channels::Rgba => png::ColorType::Rgba,
+        });
         encoder.set_depth(png::BitDepth::Eight);
-        encoder.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
+        if srgb {
+            encoder.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
+        }
         let mut png_writer = encoder.write_header().map_err(png_to_io)?;
-        png_writer.write_image_data(&bytes).map_err(png_to_io)?;
+        png_writer.write_image_data(bytes).map_err(png_to_io)?;
         png_writer.finish().map_err(png_to_io)
+    })
+}
+
+/// Writes 8-bit luminance or RGB values (top row first) as a baseline JPEG of quality 100.
+pub fn write_jpeg_u8(
+    path: &Path,
+    width: u32,
+    height: u32,
+    channels: Channels,
+    bytes: &[u8],
+) -> Result<()> {
+    let color = match channels {
+        Channels::Luminance => image::ExtendedColorType::L8,
+        Channels::Rgb => image::ExtendedColorType::Rgb8,
+        other => {
+            let message = format!("JPEG has no {other:?} layout");
+            return Err(Error::io(path, &io::Error::other(message), "write"));
+        }
+    };
+    if bytes.len() != channels.count() * width as usize * height as usize
+        || width > 65535
+        || height > 65535
+    {
+        let message = format!(
+            "{} bytes given for {width}x{height} JPEG pixels (at most 65535 on a side)",
+            bytes.len()
+        );
+        return Err(Error::io(path, &io::Error::other(message), "write"));
+    }
+    write_atomically(path, |writer| {
+        image::codecs::jpeg::JpegEncoder::new_with_quality(writer, 100)
+            .encode(bytes, width, height, color)
+            .map_err(io::Error::other)
     })
 }
 

@@ -18,7 +18,7 @@ use std::collections::hash_map::Entry;
 use std::sync::Arc;
 
 use crate::description::{PluginClass, PluginNode};
-use crate::params::Params;
+use crate::params::{Params, Warning};
 use crate::registry::{Default, ParamSpec};
 use prism_core::bsdf::Material;
 use prism_core::error::{Error, Result};
@@ -32,6 +32,9 @@ pub struct LoadedScene {
     pub scene: Scene,
     /// The sampler's `seed` parameter.
     pub seed: u64,
+    /// Parameters of the file that Prism reads but ignores (Mitsuba 0.6 forms), one warning
+    /// each, in the order they were read.
+    pub warnings: Vec<Warning>,
 }
 
 const INTEGRATOR: ParamSpec = ParamSpec::nested(
@@ -56,8 +59,15 @@ const TEXTURES: ParamSpec = ParamSpec::nested(
     Default::None,
     "textures declared to be referenced by id",
 );
+const SAMPLERS: ParamSpec = ParamSpec::nested(
+    PluginClass::Sampler,
+    Default::None,
+    "samplers declared to be referenced by id from the sensor",
+);
 /// What the `<scene>` element holds.
-const SCENE: &[ParamSpec] = &[INTEGRATOR, SENSOR, SHAPES, EMITTERS, BSDFS, TEXTURES];
+const SCENE: &[ParamSpec] = &[
+    INTEGRATOR, SENSOR, SHAPES, EMITTERS, BSDFS, TEXTURES, SAMPLERS,
+];
 
 /// Builds the scene described by the root `<scene>` node.
 pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
@@ -172,6 +182,11 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
             )?;
         }
     }
+    // Samplers declared at the top level (to be referenced by id from the sensor) are checked
+    // even when no sensor uses them.
+    for child in params.children(&SAMPLERS) {
+        sensor::build_sampler(&child.node)?;
+    }
     params.finish()?;
 
     let world = World::new(Geometry::new(shapes), shape_info, materials, lights);
@@ -183,9 +198,11 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
         integrator,
     );
     scene.shutter = sensor.shutter;
+    scene.ldr_output = sensor.ldr_output;
     scene.fingerprint = crate::fingerprint::scene_fingerprint(root);
     Ok(LoadedScene {
         scene,
         seed: sensor.seed,
+        warnings: sensor.warnings,
     })
 }
