@@ -68,6 +68,13 @@ pub enum MediumKind {
         albedo: Spectrum,
         scale: f32,
     },
+    /// The same σ_a = scale·sigma_a and σ_s = scale·sigma_s everywhere (Mitsuba 0.6's form),
+    /// so σ_t = σ_a + σ_s.
+    HomogeneousAbsorbingScattering {
+        sigma_a: Spectrum,
+        sigma_s: Spectrum,
+        scale: f32,
+    },
     /// σ_t(x) = scale·sigma_t(x) and albedo(x) from volumes; outside the box of a grid
     /// `sigma_t` the medium is empty.
     Heterogeneous {
@@ -137,6 +144,17 @@ impl Medium {
                     sigma_t,
                 }
             }
+            MediumKind::HomogeneousAbsorbingScattering {
+                sigma_a,
+                sigma_s,
+                scale,
+            } => {
+                let sigma_s = sigma_s.sample(lambda) * *scale;
+                MediumCoefficients {
+                    sigma_t: sigma_a.sample(lambda) * *scale + sigma_s,
+                    sigma_s,
+                }
+            }
             MediumKind::Heterogeneous {
                 sigma_t,
                 albedo,
@@ -151,12 +169,18 @@ impl Medium {
         }
     }
 
+    /// Whether the coefficients are the same everywhere.
+    #[inline]
+    pub fn is_homogeneous(&self) -> bool {
+        !matches!(self.kind, MediumKind::Heterogeneous { .. })
+    }
+
     /// A majorant m ≥ σ_t(x, λᵢ) for every point and each of the wavelengths `lambda`.
     #[inline]
     pub fn majorant(&self, lambda: &SampledWavelengths) -> f32 {
         match &self.kind {
-            MediumKind::Homogeneous { sigma_t, scale, .. } => {
-                sigma_t.sample(lambda).max_value() * scale
+            MediumKind::Homogeneous { .. } | MediumKind::HomogeneousAbsorbingScattering { .. } => {
+                self.coefficients(Vec3::ZERO, lambda).sigma_t.max_value()
             }
             MediumKind::Heterogeneous { sigma_t, scale, .. } => sigma_t.max_value() * scale,
         }
@@ -167,7 +191,9 @@ impl Medium {
     #[inline]
     pub fn ray_extent(&self, ray: &Ray, t_max: f32) -> Option<(f32, f32)> {
         match &self.kind {
-            MediumKind::Homogeneous { .. } => Some((0.0, t_max)),
+            MediumKind::Homogeneous { .. } | MediumKind::HomogeneousAbsorbingScattering { .. } => {
+                Some((0.0, t_max))
+            }
             MediumKind::Heterogeneous { sigma_t, .. } => sigma_t.ray_extent(ray, t_max),
         }
     }
@@ -182,8 +208,8 @@ impl Medium {
         lambda: &SampledWavelengths,
         mut u: impl FnMut() -> f32,
     ) -> SampledSpectrum {
-        if let MediumKind::Homogeneous { sigma_t, scale, .. } = &self.kind {
-            let sigma_t = sigma_t.sample(lambda) * *scale;
+        if self.is_homogeneous() {
+            let sigma_t = self.coefficients(ray.o, lambda).sigma_t;
             return SampledSpectrum::from_fn(|i| (-sigma_t[i] * t_max).exp());
         }
         let Some((t0, t1)) = self.ray_extent(ray, t_max) else {

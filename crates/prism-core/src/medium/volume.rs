@@ -33,14 +33,6 @@ impl Volume {
         }
     }
 
-    /// The smallest value the volume takes at any point and wavelength.
-    pub fn min_value(&self) -> f32 {
-        match self {
-            Volume::Constant(spectrum) => spectrum.min_value(),
-            Volume::Grid(grid) => grid.min_value,
-        }
-    }
-
     /// The parameter interval of `ray` (unit direction) inside the volume's box, clipped to
     /// [0, t_max]; a constant volume fills all space.
     #[inline]
@@ -72,7 +64,6 @@ pub struct GridVolume {
     to_world: Transform,
     filter: GridFilter,
     max_value: f32,
-    min_value: f32,
 }
 
 impl std::fmt::Debug for GridVolume {
@@ -101,14 +92,12 @@ impl GridVolume {
             return None;
         }
         let max_value = data.iter().copied().fold(f32::MIN, f32::max);
-        let min_value = data.iter().copied().fold(f32::MAX, f32::min);
         Some(GridVolume {
             resolution,
             data,
             to_world,
             filter,
             max_value,
-            min_value,
         })
     }
 
@@ -182,6 +171,11 @@ impl GridVolume {
             }
         }
         (t0 < t1).then_some((t0, t1))
+    }
+
+    /// The largest voxel value.
+    pub fn max_value(&self) -> f32 {
+        self.max_value
     }
 
     pub fn resolution(&self) -> [usize; 3] {

@@ -1,6 +1,8 @@
 //! The sensor and what it carries: the `perspective` and `thinlens` cameras with their shutter,
 //! the `hdrfilm` film with its `rfilter`, and the sampler.
 
+use std::sync::Arc;
+
 use glam::{UVec2, Vec2};
 
 use crate::description::{PluginClass, PluginNode};
@@ -99,6 +101,11 @@ const SAMPLER: ParamSpec = ParamSpec::nested(
     Default::Text("`independent`, 4 samples"),
     "the sampler",
 );
+const SENSOR_MEDIUM: ParamSpec = ParamSpec::nested(
+    PluginClass::Medium,
+    Default::None,
+    "the medium the camera sits in (for `volpath`)",
+);
 const APERTURE_RADIUS: ParamSpec = ParamSpec::new(
     "aperture_radius",
     ParamKind::Float,
@@ -136,6 +143,7 @@ const PERSPECTIVE_PARAMS: &[ParamSpec] = &[
     SHUTTER_FILTER,
     FILM,
     SAMPLER,
+    SENSOR_MEDIUM,
 ];
 const THINLENS_PARAMS: &[ParamSpec] = &[
     FOV,
@@ -149,6 +157,7 @@ const THINLENS_PARAMS: &[ParamSpec] = &[
     SHUTTER_FILTER,
     FILM,
     SAMPLER,
+    SENSOR_MEDIUM,
     APERTURE_RADIUS,
     APERTURE_AREA,
     FOCUS_DISTANCE,
@@ -429,6 +438,8 @@ pub struct SensorSettings {
     pub film: FilmSettings,
     pub sampler: SamplerSettings,
     pub seed: u64,
+    /// The nested `<medium>` the camera sits in, built with the scene's other media.
+    pub medium: Option<Arc<PluginNode>>,
 }
 
 /// Builds the sensor a node describes.
@@ -545,6 +556,7 @@ fn build_sensor_of(params: &Params, thinlens: bool) -> Result<SensorSettings> {
         film,
         sampler,
         seed,
+        medium: params.single_child(&SENSOR_MEDIUM)?.map(|c| c.node.clone()),
     })
 }
 
