@@ -70,7 +70,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     })?;
     if scenes.is_empty() {
         return Err(Error::usage("--only matches none of the suite's scenes")
-            .with_help("the scenes are cornell-box, veach-mis, veach-bidir, million-triangles"));
+            .with_help("the scenes are cornell-box, veach-mis, veach-bidir, smoke-box, million-triangles"));
     }
     if args.list {
         for scene in &scenes {
