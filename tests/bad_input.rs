@@ -552,7 +552,14 @@ macro_rules! vol_header {
     ($x:literal, $y:literal, $z:literal, $c:literal) => {
         concat!(
             "VOL\x03\x01\x00\x00\x00",
-            $x, "\x00\x00\x00", $y, "\x00\x00\x00", $z, "\x00\x00\x00", $c, "\x00\x00\x00",
+            $x,
+            "\x00\x00\x00",
+            $y,
+            "\x00\x00\x00",
+            $z,
+            "\x00\x00\x00",
+            $c,
+            "\x00\x00\x00",
             "\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00",
             "\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00"
         )
@@ -569,7 +576,10 @@ const GRID_SCENE: &str = scene!(
 fn media_cases() -> Vec<Case> {
     let with_grid = |name: &'static str, bytes: &'static str, says: &'static str| Case {
         name,
-        files: Box::leak(Box::new([("scene.xml", GRID_SCENE), ("density.vol", bytes)])),
+        files: Box::leak(Box::new([
+            ("scene.xml", GRID_SCENE),
+            ("density.vol", bytes),
+        ])),
         arguments: RENDER,
         location: "scene.xml:3:",
         says,
@@ -631,20 +641,21 @@ fn media_cases() -> Vec<Case> {
             "scene.xml:4:",
             "volpath",
         ),
-        render_scene(
-            "missing grid",
-            GRID_SCENE,
-            "scene.xml:3:",
-            "not found",
-        ),
+        render_scene("missing grid", GRID_SCENE, "scene.xml:3:", "not found"),
         with_grid(
             "truncated grid",
-            concat!(vol_header!("\x02", "\x02", "\x02", "\x01"), "\x00\x00\x00\x3f"),
+            concat!(
+                vol_header!("\x02", "\x02", "\x02", "\x01"),
+                "\x00\x00\x00\x3f"
+            ),
             "truncated",
         ),
         with_grid(
             "grid longer than its header says",
-            concat!(vol_header!("\x01", "\x01", "\x01", "\x01"), "\x00\x00\x00\x00\x00\x00\x00\x00"),
+            concat!(
+                vol_header!("\x01", "\x01", "\x01", "\x01"),
+                "\x00\x00\x00\x00\x00\x00\x00\x00"
+            ),
             "bytes more",
         ),
         with_grid("not a grid", "this is not a volume", "VOL"),
@@ -655,12 +666,18 @@ fn media_cases() -> Vec<Case> {
         ),
         with_grid(
             "three-channel grid",
-            concat!(vol_header!("\x01", "\x01", "\x01", "\x03"), "\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00"),
+            concat!(
+                vol_header!("\x01", "\x01", "\x01", "\x03"),
+                "\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00"
+            ),
             "single-channel",
         ),
         with_grid(
             "negative value in a grid",
-            concat!(vol_header!("\x01", "\x01", "\x01", "\x01"), "\x00\x00\u{bf}"),
+            concat!(
+                vol_header!("\x01", "\x01", "\x01", "\x01"),
+                "\x00\x00\u{bf}"
+            ),
             "at least 0",
         ),
     ]

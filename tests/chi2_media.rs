@@ -94,10 +94,12 @@ fn free_flight_chi2(name: &str, majorant: f32, seed: u64) {
         seed,
         |rng| {
             let u = rng.next_f32();
-            Some(match sample_free_flight(t_start, t_start + length, majorant, u) {
-                Some(t) => f64::from(t),
-                None => end + f64::from(rng.next_f32()),
-            })
+            Some(
+                match sample_free_flight(t_start, t_start + length, majorant, u) {
+                    Some(t) => f64::from(t),
+                    None => end + f64::from(rng.next_f32()),
+                },
+            )
         },
         |t| {
             if t < end {

@@ -111,8 +111,11 @@ fn single_scattering(phase: PhaseFunction, seed: u64) {
     let omega_l = DVec3::new(-0.5, 0.2, 1.0).normalize();
     let mut scene = build(
         vec![Object {
-            shape: boxed(DVec3::new(200.0, 200.0, d / 2.0), DVec3::new(0.0, 0.0, d / 2.0))
-                .into(),
+            shape: boxed(
+                DVec3::new(200.0, 200.0, d / 2.0),
+                DVec3::new(0.0, 0.0, d / 2.0),
+            )
+            .into(),
             reflectance: 0.0,
             emission: None,
         }],
@@ -221,9 +224,10 @@ fn random_grid(resolution: [usize; 3], lo: f32, hi: f32, seed: u64) -> Vec<f32> 
 
 #[test]
 fn closed_furnace_with_a_heterogeneous_non_absorbing_medium() {
-    let to_world =
-        Transform::new(DMat4::from_translation(DVec3::splat(-0.8)) * DMat4::from_scale(DVec3::splat(1.6)))
-            .unwrap();
+    let to_world = Transform::new(
+        DMat4::from_translation(DVec3::splat(-0.8)) * DMat4::from_scale(DVec3::splat(1.6)),
+    )
+    .unwrap();
     let grid = GridVolume::new(
         [6, 5, 7],
         random_grid([6, 5, 7], 0.0, 3.0, 5),
@@ -234,7 +238,7 @@ fn closed_furnace_with_a_heterogeneous_non_absorbing_medium() {
     medium_furnace(
         Medium {
             kind: MediumKind::Heterogeneous {
-                sigma_t: Volume::Grid(grid),
+                sigma_t: Volume::Grid(Box::new(grid)),
                 albedo: Volume::Constant(Spectrum::Constant(1.0)),
                 scale: 1.5,
             },
@@ -292,9 +296,8 @@ fn optical_depth(grid: &GridVolume, ray: &Ray, t_max: f32, scale: f64, trilinear
     // The grid here is the unit cube placed by the identity.
     let res = grid.resolution();
     let mut breaks = vec![t0, t1];
-    for axis in 0..3 {
+    for (axis, &n) in res.iter().enumerate() {
         let (o, d) = (f64::from(ray.o[axis]), f64::from(ray.d[axis]));
-        let n = res[axis];
         for k in 0..=n {
             let plane = if trilinear {
                 (k as f64 + 0.5) / n as f64
@@ -334,13 +337,31 @@ fn optical_depth(grid: &GridVolume, ray: &Ray, t_max: f32, scale: f64, trilinear
 #[test]
 fn ratio_tracking_is_unbiased_on_generated_grids() {
     let rays = [
-        Ray::new(Vec3::new(-0.5, 0.3, 0.4), Vec3::new(1.0, 0.1, 0.05).normalize(), f32::INFINITY, 0.0),
-        Ray::new(Vec3::new(0.2, 1.4, 0.7), Vec3::new(0.3, -1.0, -0.2).normalize(), f32::INFINITY, 0.0),
-        Ray::new(Vec3::new(0.5, 0.5, 0.5), Vec3::new(-0.4, 0.5, 0.9).normalize(), 0.6, 0.0),
+        Ray::new(
+            Vec3::new(-0.5, 0.3, 0.4),
+            Vec3::new(1.0, 0.1, 0.05).normalize(),
+            f32::INFINITY,
+            0.0,
+        ),
+        Ray::new(
+            Vec3::new(0.2, 1.4, 0.7),
+            Vec3::new(0.3, -1.0, -0.2).normalize(),
+            f32::INFINITY,
+            0.0,
+        ),
+        Ray::new(
+            Vec3::new(0.5, 0.5, 0.5),
+            Vec3::new(-0.4, 0.5, 0.9).normalize(),
+            0.6,
+            0.0,
+        ),
     ];
     let lambda = prism_core::spectrum::SampledWavelengths::single(550.0);
     let runs = 40_000;
-    for (case, filter) in [GridFilter::Nearest, GridFilter::Trilinear].into_iter().enumerate() {
+    for (case, filter) in [GridFilter::Nearest, GridFilter::Trilinear]
+        .into_iter()
+        .enumerate()
+    {
         let resolution = [5, 4, 6];
         let grid = GridVolume::new(
             resolution,
@@ -352,7 +373,7 @@ fn ratio_tracking_is_unbiased_on_generated_grids() {
         let scale = 1.7f32;
         let medium = Medium {
             kind: MediumKind::Heterogeneous {
-                sigma_t: Volume::Grid(grid.clone()),
+                sigma_t: Volume::Grid(Box::new(grid.clone())),
                 albedo: Volume::Constant(Spectrum::Constant(0.5)),
                 scale,
             },
@@ -360,7 +381,11 @@ fn ratio_tracking_is_unbiased_on_generated_grids() {
             sample_emitters: true,
         };
         for (r, ray) in rays.iter().enumerate() {
-            let t_max = if ray.t_max.is_finite() { ray.t_max } else { 10.0 };
+            let t_max = if ray.t_max.is_finite() {
+                ray.t_max
+            } else {
+                10.0
+            };
             let exact = (-optical_depth(
                 &grid,
                 ray,

@@ -16,7 +16,9 @@ use plotters::prelude::*;
 use prism_core::error::{Error, Result};
 use prism_core::image::compare::rel_mse_rgb;
 use prism_core::image::read_exr;
-use prism_core::integrator::{DistributionIntegrator, Integrator, PathIntegrator, VolPathIntegrator};
+use prism_core::integrator::{
+    DistributionIntegrator, Integrator, PathIntegrator, VolPathIntegrator,
+};
 use prism_core::render::{RenderOptions, render};
 use prism_core::sampling::sampler::SamplerKind;
 use prism_core::scene::Scene;

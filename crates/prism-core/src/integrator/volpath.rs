@@ -83,7 +83,12 @@ struct Previous {
 
 /// The medium a ray leaving `si` in direction `d` travels in, when it was in `current`.
 #[inline]
-fn medium_after(world: &World, si: &SurfaceInteraction, d: Vec3, current: Option<u32>) -> Option<u32> {
+fn medium_after(
+    world: &World,
+    si: &SurfaceInteraction,
+    d: Vec3,
+    current: Option<u32>,
+) -> Option<u32> {
     let interface = world.medium_interface(si.shape);
     if interface.is_transition() {
         interface.target(si.n, d)
@@ -123,7 +128,12 @@ fn free_flight(
     loop {
         t = sample_free_flight(t, t1, majorant, sampler.next_1d())?;
         let c = medium.coefficients(ray.at(t), lambda);
-        match choose_collision(counted(*throughput, lambda), &c, majorant, sampler.next_1d()) {
+        match choose_collision(
+            counted(*throughput, lambda),
+            &c,
+            majorant,
+            sampler.next_1d(),
+        ) {
             Collision::Real(weight) => {
                 *throughput *= weight;
                 return Some(t);
@@ -141,6 +151,7 @@ fn free_flight(
 /// The transmittance from `origin` to `end` for a path in `medium` at `origin`: the product of
 /// the transmittances of the media crossed, through index-matched (`null`) boundaries; zero
 /// when another surface is in the way.
+#[allow(clippy::too_many_arguments)] // the segment, its medium and the path's state
 fn shadow_transmittance(
     world: &World,
     origin: Vec3,
@@ -189,7 +200,11 @@ fn shadow_end(origin: Vec3, ls: &LightSample) -> Vec3 {
     let target = if ls.n == Vec3::ZERO {
         ls.p
     } else {
-        let m = if (ls.p - origin).dot(ls.n) <= 0.0 { ls.n } else { -ls.n };
+        let m = if (ls.p - origin).dot(ls.n) <= 0.0 {
+            ls.n
+        } else {
+            -ls.n
+        };
         offset_ray_origin(ls.p, m)
     };
     origin + (target - origin) * (1.0 - SHADOW_EPSILON)
@@ -331,7 +346,13 @@ impl VolPathIntegrator {
             if smooth {
                 result += throughput
                     * Self::sample_direct_surface(
-                        prepared, &si, &scattering, medium, &lambda, sampler, count,
+                        prepared,
+                        &si,
+                        &scattering,
+                        medium,
+                        &lambda,
+                        sampler,
+                        count,
                     );
             }
 

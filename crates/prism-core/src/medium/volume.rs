@@ -11,8 +11,8 @@ use crate::spectrum::{SampledSpectrum, SampledWavelengths, Spectrum};
 pub enum Volume {
     /// The same spectrum everywhere (`constvolume`, or a plain value given for a volume).
     Constant(Spectrum),
-    /// A grid of numbers over a box (`gridvolume`).
-    Grid(GridVolume),
+    /// A grid of numbers over a box (`gridvolume`), boxed to keep media small.
+    Grid(Box<GridVolume>),
 }
 
 impl Volume {
@@ -269,7 +269,12 @@ pub fn parse_vol(bytes: &[u8]) -> Result<VolFile, String> {
 }
 
 /// The bytes of a `.vol` file holding `data` (channel fastest, then x, y, z).
-pub fn write_vol(resolution: [usize; 3], channels: usize, bbox: (Vec3, Vec3), data: &[f32]) -> Vec<u8> {
+pub fn write_vol(
+    resolution: [usize; 3],
+    channels: usize,
+    bbox: (Vec3, Vec3),
+    data: &[f32],
+) -> Vec<u8> {
     let mut bytes = Vec::with_capacity(VOL_HEADER_BYTES + 4 * data.len());
     bytes.extend_from_slice(b"VOL\x03");
     bytes.extend_from_slice(&1i32.to_le_bytes());

@@ -45,13 +45,7 @@ pub static MEDIA: Registry<BuildMedium> = Registry {
             summary: "σ_t(x) = scale · sigma_t(x) and albedo(x) from volumes (a `gridvolume` is \
                       empty outside its box); free flights by spectral tracking with the \
                       grid's maximum as majorant, shadow rays by ratio tracking.",
-            params: &[
-                SIGMA_T_VOLUME,
-                ALBEDO_VOLUME,
-                SCALE,
-                SAMPLE_EMITTERS,
-                PHASE,
-            ],
+            params: &[SIGMA_T_VOLUME, ALBEDO_VOLUME, SCALE, SAMPLE_EMITTERS, PHASE],
             build: build_heterogeneous,
         },
     ],
@@ -474,7 +468,10 @@ fn build_gridvolume(params: &Params, range: Range) -> Result<Volume> {
     let singular = || {
         Error::input(
             params.location_of(&VOLUME_TO_WORLD),
-            format!("the grid of {} is placed by a singular transform", node.describe()),
+            format!(
+                "the grid of {} is placed by a singular transform",
+                node.describe()
+            ),
         )
         .with_help("check to_world (and the grid's bounding box with use_grid_bbox)")
     };
@@ -496,5 +493,5 @@ fn build_gridvolume(params: &Params, range: Range) -> Result<Volume> {
         )
         .with_help("use values between 0 and 1"));
     }
-    Ok(Volume::Grid(grid))
+    Ok(Volume::Grid(Box::new(grid)))
 }

@@ -85,7 +85,16 @@ pub static SHAPES: Registry<Build> = Registry {
             origin: Origin::Mitsuba3,
             summary: "A sphere; light sampled by the cone it subtends. `to_world` may rotate, \
                       translate and scale uniformly.",
-            params: &[CENTER, RADIUS, FLIP_NORMALS, TO_WORLD, BSDF, EMITTER, INTERIOR, EXTERIOR],
+            params: &[
+                CENTER,
+                RADIUS,
+                FLIP_NORMALS,
+                TO_WORLD,
+                BSDF,
+                EMITTER,
+                INTERIOR,
+                EXTERIOR,
+            ],
             build: build_sphere,
         },
         Plugin {
