@@ -525,6 +525,7 @@ fn cases() -> Vec<Case> {
         },
     ];
     // Command-line parameters.
+    cases.extend(media_cases());
     for (name, extra, says) in [
         ("zero samples", &["--spp", "0"][..], "--spp"),
         (
@@ -561,6 +562,143 @@ fn cases() -> Vec<Case> {
         });
     }
     cases
+}
+
+/// A `.vol` header (version 3, 32-bit floats, a zero bounding box) for `resolution` voxels of
+/// `channels`, as the 48 bytes the reader checks first; ASCII-safe for these small sizes.
+macro_rules! vol_header {
+    ($x:literal, $y:literal, $z:literal, $c:literal) => {
+        concat!(
+            "VOL\x03\x01\x00\x00\x00",
+            $x,
+            "\x00\x00\x00",
+            $y,
+            "\x00\x00\x00",
+            $z,
+            "\x00\x00\x00",
+            $c,
+            "\x00\x00\x00",
+            "\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00",
+            "\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00"
+        )
+    };
+}
+
+/// A scene whose shape bounds a heterogeneous medium with the grid `density.vol`.
+const GRID_SCENE: &str = scene!(
+    "    <shape type=\"sphere\"><bsdf type=\"null\"/><medium type=\"heterogeneous\" name=\"interior\"><volume type=\"gridvolume\" name=\"sigma_t\"><string name=\"filename\" value=\"density.vol\"/></volume></medium></shape>"
+);
+
+/// Bad media: negative coefficients, albedos above 1, missing, truncated and foreign grids,
+/// phase functions out of range, misspelt parameters, and media where distrib renders.
+fn media_cases() -> Vec<Case> {
+    let with_grid = |name: &'static str, bytes: &'static str, says: &'static str| Case {
+        name,
+        files: Box::leak(Box::new([
+            ("scene.xml", GRID_SCENE),
+            ("density.vol", bytes),
+        ])),
+        arguments: RENDER,
+        location: "scene.xml:3:",
+        says,
+    };
+    vec![
+        render_scene(
+            "negative extinction",
+            scene!(
+                "    <shape type=\"sphere\"><bsdf type=\"null\"/><medium type=\"homogeneous\" name=\"interior\"><float name=\"sigma_t\" value=\"-1\"/></medium></shape>"
+            ),
+            "scene.xml:3:",
+            "negative",
+        ),
+        render_scene(
+            "albedo above 1",
+            scene!(
+                "    <shape type=\"sphere\"><medium type=\"homogeneous\" name=\"interior\"><float name=\"albedo\" value=\"1.5\"/></medium></shape>"
+            ),
+            "scene.xml:3:",
+            "above 1",
+        ),
+        render_scene(
+            "RGB albedo above 1",
+            scene!(
+                "    <medium type=\"homogeneous\" id=\"fog\"><rgb name=\"albedo\" value=\"0.5, 1.2, 0.3\"/></medium>"
+            ),
+            "scene.xml:3:",
+            "above 1",
+        ),
+        render_scene(
+            "hg asymmetry of 1",
+            scene!(
+                "    <medium type=\"homogeneous\" id=\"fog\"><phase type=\"hg\"><float name=\"g\" value=\"1\"/></phase></medium>"
+            ),
+            "scene.xml:3:",
+            "(-1, 1)",
+        ),
+        render_scene(
+            "misspelt medium parameter",
+            scene!(
+                "    <medium type=\"homogeneous\" id=\"fog\"><float name=\"sigmat\" value=\"1\"/></medium>"
+            ),
+            "scene.xml:3:",
+            "did you mean \"sigma_t\"",
+        ),
+        render_scene(
+            "sigma_a without sigma_s",
+            scene!(
+                "    <medium type=\"homogeneous\" id=\"fog\"><float name=\"sigma_a\" value=\"1\"/></medium>"
+            ),
+            "scene.xml:3:",
+            "without \"sigma_s\"",
+        ),
+        render_scene(
+            "distrib with a medium",
+            scene!(
+                "    <integrator type=\"distrib\"/>\n    <medium type=\"homogeneous\" id=\"fog\"/>"
+            ),
+            "scene.xml:4:",
+            "volpath",
+        ),
+        render_scene("missing grid", GRID_SCENE, "scene.xml:3:", "not found"),
+        with_grid(
+            "truncated grid",
+            concat!(
+                vol_header!("\x02", "\x02", "\x02", "\x01"),
+                "\x00\x00\x00\x3f"
+            ),
+            "truncated",
+        ),
+        with_grid(
+            "grid longer than its header says",
+            concat!(
+                vol_header!("\x01", "\x01", "\x01", "\x01"),
+                "\x00\x00\x00\x00\x00\x00\x00\x00"
+            ),
+            "bytes more",
+        ),
+        with_grid("not a grid", "this is not a volume", "VOL"),
+        with_grid(
+            "grid header cut short",
+            "VOL\x03\x01\x00\x00\x00\x02\x00",
+            "header",
+        ),
+        with_grid(
+            "three-channel grid",
+            concat!(
+                vol_header!("\x01", "\x01", "\x01", "\x03"),
+                "\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00"
+            ),
+            "single-channel",
+        ),
+        with_grid(
+            "negative value in a grid",
+            concat!(
+                vol_header!("\x01", "\x01", "\x01", "\x01"),
+                "\x00\x00\u{bf}"
+            ),
+            "at least 0",
+        ),
+    ]
 }
 
 fn run_case(case: &Case, dir: &Path) -> (i32, String) {

@@ -16,7 +16,9 @@ use plotters::prelude::*;
 use prism_core::error::{Error, Result};
 use prism_core::image::compare::rel_mse_rgb;
 use prism_core::image::read_exr;
-use prism_core::integrator::{DistributionIntegrator, Integrator, PathIntegrator};
+use prism_core::integrator::{
+    DistributionIntegrator, Integrator, PathIntegrator, VolPathIntegrator,
+};
 use prism_core::render::{RenderOptions, render};
 use prism_core::sampling::sampler::SamplerKind;
 use prism_core::scene::Scene;
@@ -80,6 +82,7 @@ fn integrator_named(name: &str, scene: &Scene) -> Result<Integrator> {
     let max_depth = match &scene.integrator {
         Integrator::Path(p) => p.max_depth,
         Integrator::Distribution(d) => d.max_depth,
+        Integrator::VolPath(v) => v.max_depth,
     };
     match name {
         "path" => Ok(match &scene.integrator {
@@ -98,8 +101,16 @@ fn integrator_named(name: &str, scene: &Scene) -> Result<Integrator> {
             }
             .into(),
         }),
+        "volpath" => Ok(match &scene.integrator {
+            Integrator::VolPath(v) => Integrator::VolPath(v.clone()),
+            _ => VolPathIntegrator {
+                max_depth,
+                ..VolPathIntegrator::default()
+            }
+            .into(),
+        }),
         other => Err(Error::usage(format!("unknown integrator \"{other}\""))
-            .with_help("use path or distrib")),
+            .with_help("use path, distrib or volpath")),
     }
 }
 
@@ -126,6 +137,7 @@ fn integrator_label(integrator: &Integrator) -> &'static str {
     match integrator {
         Integrator::Path(_) => "path",
         Integrator::Distribution(_) => "distrib",
+        Integrator::VolPath(_) => "volpath",
     }
 }
 

@@ -4,6 +4,7 @@
 use crate::bsdf::Material;
 use crate::geometry::Geometry;
 use crate::light::{BoundingSphere, Light};
+use crate::medium::{Medium, MediumInterface};
 
 /// What a shape is made of and whether it emits.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -27,6 +28,12 @@ pub struct World {
     /// Index into `lights` of the environment (`constant` or `envmap`), which rays that leave
     /// the scene see; a scene has at most one.
     pub environment: Option<u32>,
+    /// The participating media; shapes and the camera refer to them by index.
+    pub media: Vec<Medium>,
+    /// One entry per primitive of `geometry` when some shape bounds a medium, else empty.
+    pub medium_interfaces: Vec<MediumInterface>,
+    /// The medium the camera sits in.
+    pub camera_medium: Option<u32>,
 }
 
 impl World {
@@ -57,6 +64,23 @@ impl World {
             materials,
             lights,
             light_powers,
+            media: Vec::new(),
+            medium_interfaces: Vec::new(),
+            camera_medium: None,
         }
+    }
+
+    /// The media on the two sides of primitive `shape`.
+    #[inline]
+    pub fn medium_interface(&self, shape: u32) -> MediumInterface {
+        self.medium_interfaces
+            .get(shape as usize)
+            .copied()
+            .unwrap_or_default()
+    }
+
+    /// Whether the scene has participating media.
+    pub fn has_media(&self) -> bool {
+        !self.media.is_empty()
     }
 }

@@ -47,6 +47,7 @@
 //! | `phong` | [`phong`] | glossy and diffuse reflection |
 //! | `twosided` | [`twosided`] | those of the nested BSDFs, on both sides |
 //! | `mask` | [`mask`] | the nested BSDF's, and null transmission |
+//! | `null` | [`null`] | null transmission only (a medium's boundary) |
 //! | `blendbsdf` | [`blend`] | both nested BSDFs' |
 //! | `bumpmap`, `normalmap` | [`bumpmap`], [`normalmap`] | the nested BSDF's, in a perturbed frame |
 
@@ -60,6 +61,7 @@ pub mod mask;
 pub mod material;
 pub mod microfacet;
 pub mod normalmap;
+pub mod null;
 pub mod perturbed;
 pub mod phong;
 pub mod plastic;
@@ -81,6 +83,7 @@ pub use diffuse::Diffuse;
 pub use mask::Mask;
 pub use material::{Material, Scattering};
 pub use normalmap::NormalMap;
+pub use null::Null;
 pub use phong::Phong;
 pub use plastic::Plastic;
 pub use roughconductor::RoughConductor;
@@ -415,6 +418,7 @@ bsdfs! {
         Blend(Blend),
         BumpMap(BumpMap),
         NormalMap(NormalMap),
+        Null(Null),
     }
     lobes {
         Diffuse(diffuse::DiffuseLobes),
@@ -431,5 +435,6 @@ bsdfs! {
         Mask(mask::MaskLobes),
         Blend(blend::BlendLobes),
         Perturbed(perturbed::PerturbedLobes),
+        Null(null::NullLobes),
     }
 }

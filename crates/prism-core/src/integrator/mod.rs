@@ -1,5 +1,5 @@
 //! Integrators: estimators of the radiance arriving along a camera ray: the path tracer and the
-//! lecture's distribution ray tracer with splitting.
+//! lecture's distribution ray tracer with splitting, and the volumetric path tracer.
 //!
 //! An [`Integrator`] is what a scene asks for: an estimator and its parameters. Before a render
 //! it is prepared for the world ([`Integrator::prepare`]), which builds the light sampler it
@@ -7,9 +7,11 @@
 
 pub mod distribution;
 pub mod path;
+pub mod volpath;
 
 pub use distribution::DistributionIntegrator;
 pub use path::PathIntegrator;
+pub use volpath::VolPathIntegrator;
 
 use crate::bsdf::{BsdfEval, Scattering};
 use crate::geometry::SurfaceInteraction;
@@ -24,6 +26,13 @@ use crate::world::World;
 pub enum Integrator {
     Path(PathIntegrator),
     Distribution(DistributionIntegrator),
+    VolPath(VolPathIntegrator),
+}
+
+impl From<VolPathIntegrator> for Integrator {
+    fn from(integrator: VolPathIntegrator) -> Integrator {
+        Integrator::VolPath(integrator)
+    }
 }
 
 impl From<PathIntegrator> for Integrator {
@@ -58,6 +67,7 @@ impl Integrator {
         match self {
             Integrator::Path(path) => path.light_selection,
             Integrator::Distribution(distrib) => distrib.light_selection(),
+            Integrator::VolPath(volpath) => volpath.light_selection,
         }
     }
 
@@ -92,6 +102,9 @@ impl PreparedIntegrator<'_> {
         match self.integrator {
             Integrator::Path(integrator) => integrator.radiance(self, ray, lambda, sampler, count),
             Integrator::Distribution(integrator) => {
+                integrator.radiance(self, ray, lambda, sampler, count)
+            }
+            Integrator::VolPath(integrator) => {
                 integrator.radiance(self, ray, lambda, sampler, count)
             }
         }

@@ -1,12 +1,14 @@
 //! Integrator plugins: `path` (with Prism's `emitter_sampling`, see
-//! [`prism_core::light::sampler`]) and the lecture's `distrib`.
+//! [`prism_core::light::sampler`]), the lecture's `distrib`, and `volpath` for media.
 
 use crate::description::{PluginClass, PluginNode};
 use crate::params::Params;
 use crate::registry::{Default, Origin, ParamKind, ParamSpec, Plugin, Registry};
 use prism_core::error::{Error, Result};
 use prism_core::integrator::distribution::DirectLights;
-use prism_core::integrator::{DistributionIntegrator, Integrator, PathIntegrator};
+use prism_core::integrator::{
+    DistributionIntegrator, Integrator, PathIntegrator, VolPathIntegrator,
+};
 use prism_core::light::LightSelection;
 
 type Build = fn(&Params) -> Result<Integrator>;
@@ -39,6 +41,17 @@ pub static INTEGRATORS: Registry<Build> = Registry {
                 HIDE_EMITTERS,
             ],
             build: build_distrib,
+        },
+        Plugin {
+            name: "volpath",
+            origin: Origin::Mitsuba3,
+            summary: "Volumetric path tracing: `path` with participating media between the \
+                      surfaces, free flights by spectral tracking with one majorant for the \
+                      path's four wavelengths, shadow rays through media (closed-form or \
+                      ratio-tracking transmittance) and `null` boundaries, light and phase \
+                      samples in media combined by MIS.",
+            params: &[MAX_DEPTH, RR_DEPTH, HIDE_EMITTERS, EMITTER_SAMPLING],
+            build: build_volpath,
         },
     ],
 };
@@ -144,6 +157,18 @@ fn build_path(params: &Params) -> Result<Integrator> {
         rr_depth: rr_depth as i32,
         hide_emitters: params.boolean(&HIDE_EMITTERS)?,
         light_selection,
+    }))
+}
+
+fn build_volpath(params: &Params) -> Result<Integrator> {
+    let Integrator::Path(path) = build_path(params)? else {
+        unreachable!("build_path builds a path integrator");
+    };
+    Ok(Integrator::VolPath(VolPathIntegrator {
+        max_depth: path.max_depth,
+        rr_depth: path.rr_depth,
+        hide_emitters: path.hide_emitters,
+        light_selection: path.light_selection,
     }))
 }
 

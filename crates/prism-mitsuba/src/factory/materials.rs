@@ -14,7 +14,7 @@ use crate::registry::{Bounds, Default, Origin, ParamKind, ParamSpec, Plugin, Reg
 use prism_core::bsdf::microfacet::MicrofacetKind;
 use prism_core::bsdf::{
     Blend, Bsdf, BsdfFlags, BsdfModel, BumpMap, Conductor, Dielectric, Diffuse, MAX_NODES, Mask,
-    Material, NormalMap, Phong, Plastic, RoughConductor, RoughDielectric, RoughDiffuse,
+    Material, NormalMap, Null, Phong, Plastic, RoughConductor, RoughDielectric, RoughDiffuse,
     RoughPlastic, ThinDielectric, TwoSided,
 };
 use prism_core::error::{Error, Result};
@@ -275,6 +275,14 @@ pub static BSDFS: Registry<Build> = Registry {
                     nested: Box::new(single_nested_bsdf(params, t)?),
                 }))
             },
+        },
+        Plugin {
+            name: "null",
+            origin: Origin::Mitsuba3,
+            summary: "Light passes through unchanged: the boundary of a medium that does not \
+                      scatter (an index-matched interface).",
+            params: &[],
+            build: |_, _| Ok(Bsdf::Null(Null)),
         },
         Plugin {
             name: "blendbsdf",

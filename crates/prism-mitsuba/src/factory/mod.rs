@@ -8,6 +8,7 @@
 pub mod integrators;
 pub mod lights;
 pub mod materials;
+pub mod media;
 pub mod sensor;
 pub mod shapes;
 pub mod spectra;
@@ -64,10 +65,46 @@ const SAMPLERS: ParamSpec = ParamSpec::nested(
     Default::None,
     "samplers declared to be referenced by id from the sensor",
 );
+const MEDIA: ParamSpec = ParamSpec::nested(
+    PluginClass::Medium,
+    Default::None,
+    "media declared to be referenced by id",
+);
 /// What the `<scene>` element holds.
 const SCENE: &[ParamSpec] = &[
-    INTEGRATOR, SENSOR, SHAPES, EMITTERS, BSDFS, TEXTURES, SAMPLERS,
+    INTEGRATOR, SENSOR, SHAPES, EMITTERS, BSDFS, TEXTURES, SAMPLERS, MEDIA,
 ];
+
+/// The scene's media, each built once however often it is referenced.
+#[derive(Default)]
+struct MediaCache {
+    media: Vec<prism_core::medium::Medium>,
+    ids: HashMap<*const PluginNode, u32>,
+    /// Where the first medium is given, for the integrators that refuse media.
+    first: Option<prism_core::error::SourceLocation>,
+}
+
+impl MediaCache {
+    /// The index of the medium `child` describes (a `<medium>` or a reference to one).
+    fn index(&mut self, child: &crate::description::NestedPlugin) -> Result<u32> {
+        if child.node.class != PluginClass::Medium {
+            return Err(Error::input(
+                &child.location,
+                format!("expected a <medium> here, not a {}", child.node.describe()),
+            )
+            .with_help("interior, exterior and the sensor's medium are <medium> elements"));
+        }
+        let key = Arc::as_ptr(&child.node);
+        if let Some(&index) = self.ids.get(&key) {
+            return Ok(index);
+        }
+        self.media.push(media::build_medium(&child.node)?);
+        self.first.get_or_insert_with(|| child.location.clone());
+        let index = (self.media.len() - 1) as u32;
+        self.ids.insert(key, index);
+        Ok(index)
+    }
+}
 
 /// Builds the scene described by the root `<scene>` node.
 pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
@@ -78,6 +115,8 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
     let mut shape_info = Vec::new();
     let mut lights = Vec::new();
     let mut textures = textures::TextureCache::default();
+    let mut media = MediaCache::default();
+    let mut medium_interfaces = Vec::new();
 
     let integrator = match params.single_child(&INTEGRATOR)? {
         Some(child) => integrators::build_integrator(&child.node)?,
@@ -148,6 +187,14 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
             }
             None => None,
         };
+        let mut interface = prism_core::medium::MediumInterface::default();
+        if let Some(child) = shape_params.named_child(&shapes::INTERIOR) {
+            interface.interior = Some(media.index(child)?);
+        }
+        if let Some(child) = shape_params.named_child(&shapes::EXTERIOR) {
+            interface.exterior = Some(media.index(child)?);
+        }
+        medium_interfaces.push(interface);
         shape_params.finish()?;
         shapes.push(shape);
         shape_info.push(ShapeInfo { material, light });
@@ -187,9 +234,34 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
     for child in params.children(&SAMPLERS) {
         sensor::build_sampler(&child.node)?;
     }
+    let camera_medium = match &sensor.medium {
+        Some(node) => Some(media.index(&crate::description::NestedPlugin {
+            name: None,
+            node: node.clone(),
+            location: node.location.clone(),
+        })?),
+        None => None,
+    };
+    // Media declared at the top level are built even when unused, so that their errors are
+    // reported.
+    for child in params.children(&MEDIA) {
+        media.index(child)?;
+    }
     params.finish()?;
+    if let (Integrator::Distribution(_), Some(location)) = (&integrator, &media.first) {
+        return Err(Error::input(
+            location,
+            "the distrib integrator does not render participating media",
+        )
+        .with_help("render scenes with media with <integrator type=\"volpath\">"));
+    }
 
-    let world = World::new(Geometry::new(shapes), shape_info, materials, lights);
+    let mut world = World::new(Geometry::new(shapes), shape_info, materials, lights);
+    if medium_interfaces.iter().any(|m| m.is_transition()) {
+        world.medium_interfaces = medium_interfaces;
+    }
+    world.media = media.media;
+    world.camera_medium = camera_medium;
     let mut scene = Scene::new(
         world,
         sensor.camera,

@@ -2,6 +2,8 @@
 //! their shutter,
 //! the `hdrfilm` and `ldrfilm` films with their `rfilter`, and the sampler.
 
+use std::sync::Arc;
+
 use glam::{UVec2, Vec2};
 
 use crate::description::{PluginClass, PluginNode};
@@ -109,6 +111,11 @@ const SAMPLER: ParamSpec = ParamSpec::nested(
     Default::Text("`independent`, 4 samples"),
     "the sampler",
 );
+const SENSOR_MEDIUM: ParamSpec = ParamSpec::nested(
+    PluginClass::Medium,
+    Default::None,
+    "the medium the camera sits in (for `volpath`)",
+);
 const APERTURE_RADIUS: ParamSpec = ParamSpec::new(
     "aperture_radius",
     ParamKind::Float,
@@ -156,6 +163,7 @@ const ORTHOGRAPHIC_PARAMS: &[ParamSpec] = &[
     FILM,
     SAMPLER,
     PINHOLE_FOCUS_DISTANCE,
+    SENSOR_MEDIUM,
 ];
 const PERSPECTIVE_PARAMS: &[ParamSpec] = &[
     FOV,
@@ -170,6 +178,7 @@ const PERSPECTIVE_PARAMS: &[ParamSpec] = &[
     FILM,
     SAMPLER,
     PINHOLE_FOCUS_DISTANCE,
+    SENSOR_MEDIUM,
 ];
 const THINLENS_PARAMS: &[ParamSpec] = &[
     FOV,
@@ -183,6 +192,7 @@ const THINLENS_PARAMS: &[ParamSpec] = &[
     SHUTTER_FILTER,
     FILM,
     SAMPLER,
+    SENSOR_MEDIUM,
     APERTURE_RADIUS,
     APERTURE_AREA,
     FOCUS_DISTANCE,
@@ -598,6 +608,8 @@ pub struct SensorSettings {
     pub ldr_output: LdrOutput,
     /// The parameters read and ignored, one warning each.
     pub warnings: Vec<Warning>,
+    /// The nested `<medium>` the camera sits in, built with the scene's other media.
+    pub medium: Option<Arc<PluginNode>>,
 }
 
 /// Builds the sensor a node describes.
@@ -679,6 +691,7 @@ fn build_orthographic(params: &Params, _thinlens: bool) -> Result<SensorSettings
         seed: parts.seed,
         ldr_output: parts.ldr_output,
         warnings: parts.warnings,
+        medium: params.single_child(&SENSOR_MEDIUM)?.map(|c| c.node.clone()),
     })
 }
 
@@ -774,6 +787,7 @@ fn build_sensor_of(params: &Params, thinlens: bool) -> Result<SensorSettings> {
         seed,
         ldr_output,
         warnings,
+        medium: params.single_child(&SENSOR_MEDIUM)?.map(|c| c.node.clone()),
     })
 }
 

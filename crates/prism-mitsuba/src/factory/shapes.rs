@@ -31,6 +31,8 @@ pub static SHAPES: Registry<Build> = Registry {
                 TO_WORLD,
                 BSDF,
                 EMITTER,
+                INTERIOR,
+                EXTERIOR,
             ],
             build: |params, to_world| build_mesh_file(params, to_world, true),
         },
@@ -45,6 +47,8 @@ pub static SHAPES: Registry<Build> = Registry {
                 TO_WORLD,
                 BSDF,
                 EMITTER,
+                INTERIOR,
+                EXTERIOR,
             ],
             build: |params, to_world| build_mesh_file(params, to_world, false),
         },
@@ -52,7 +56,7 @@ pub static SHAPES: Registry<Build> = Registry {
             name: "rectangle",
             origin: Origin::Mitsuba3,
             summary: "[−1, 1]² in the z = 0 plane, normal +z.",
-            params: &[FLIP_NORMALS, TO_WORLD, BSDF, EMITTER],
+            params: &[FLIP_NORMALS, TO_WORLD, BSDF, EMITTER, INTERIOR, EXTERIOR],
             build: |params, to_world| {
                 Ok(Shape::Mesh(transform_mesh(
                     rectangle(),
@@ -66,7 +70,7 @@ pub static SHAPES: Registry<Build> = Registry {
             name: "cube",
             origin: Origin::Mitsuba3,
             summary: "[−1, 1]³ with outward normals, each face flat.",
-            params: &[FLIP_NORMALS, TO_WORLD, BSDF, EMITTER],
+            params: &[FLIP_NORMALS, TO_WORLD, BSDF, EMITTER, INTERIOR, EXTERIOR],
             build: |params, to_world| {
                 Ok(Shape::Mesh(transform_mesh(
                     cube(),
@@ -81,14 +85,23 @@ pub static SHAPES: Registry<Build> = Registry {
             origin: Origin::Mitsuba3,
             summary: "A sphere; light sampled by the cone it subtends. `to_world` may rotate, \
                       translate and scale uniformly.",
-            params: &[CENTER, RADIUS, FLIP_NORMALS, TO_WORLD, BSDF, EMITTER],
+            params: &[
+                CENTER,
+                RADIUS,
+                FLIP_NORMALS,
+                TO_WORLD,
+                BSDF,
+                EMITTER,
+                INTERIOR,
+                EXTERIOR,
+            ],
             build: build_sphere,
         },
         Plugin {
             name: "disk",
             origin: Origin::Mitsuba3,
             summary: "The unit disk in the z = 0 plane, normal +z.",
-            params: &[FLIP_NORMALS, TO_WORLD, BSDF, EMITTER],
+            params: &[FLIP_NORMALS, TO_WORLD, BSDF, EMITTER, INTERIOR, EXTERIOR],
             build: |params, to_world| {
                 Ok(Shape::Disk(Disk::new(
                     *to_world,
@@ -140,6 +153,20 @@ pub const BSDF: ParamSpec = ParamSpec::nested(
 /// The emitter of every shape.
 pub const EMITTER: ParamSpec =
     ParamSpec::nested(PluginClass::Emitter, Default::None, "an `area` emitter");
+/// The medium inside a shape (the side its normals point away from).
+pub const INTERIOR: ParamSpec = ParamSpec::new(
+    "interior",
+    ParamKind::Nested(PluginClass::Medium),
+    Default::None,
+    "a `<medium name=\"interior\">` (or `<ref name=\"interior\" id=\"...\"/>`) inside the shape",
+);
+/// The medium outside a shape.
+pub const EXTERIOR: ParamSpec = ParamSpec::new(
+    "exterior",
+    ParamKind::Nested(PluginClass::Medium),
+    Default::None,
+    "a `<medium name=\"exterior\">` outside the shape",
+);
 const CENTER: ParamSpec = ParamSpec::new(
     "center",
     ParamKind::Point,
