@@ -1,4 +1,5 @@
-//! Emitter plugins: `area` (nested in a shape), and at the top level of the scene `point`,
+//! Emitter plugins: `area` (nested in a shape, or declared with an id and referenced from one),
+//! and at the top level of the scene `point`,
 //! `spot`, `directional`, `constant` and `envmap` (see each light's module in [`prism_core::light`]
 //! for its parameters). Emission may be given as `<rgb>` (an illuminant: the upsampled colour
 //! times D65), `<float>` (D65 scaled), `<spectrum>` (as written) or a nested
@@ -29,7 +30,7 @@ pub static EMITTERS: Registry<Build> = Registry {
         Plugin {
             name: "area",
             origin: Origin::Mitsuba3,
-            summary: "Nested in a shape: emits `radiance` from the side the normal points to.                       Spheres are sampled by the cone they subtend, other shapes by area.",
+            summary: "Nested in a shape, or declared with an `id` and referenced from one shape: emits                       `radiance` from the side the normal points to.                       Spheres are sampled by the cone they subtend, other shapes by area.",
             params: &[RADIANCE],
             build: |params, shape| {
                 Ok(Light::Area(AreaLight {
@@ -180,16 +181,14 @@ pub fn default_emitter_material() -> Material {
     })
 }
 
-/// Builds an emitter declared at the top level of the scene.
+/// Whether `node` is an `area` emitter, which emits from the shape it is attached to.
+pub fn is_area(node: &PluginNode) -> bool {
+    node.class == PluginClass::Emitter && node.plugin_type == "area"
+}
+
+/// Builds an emitter declared at the top level of the scene, other than `area`.
 pub fn build_scene_light(node: &PluginNode) -> Result<Light> {
     let plugin = EMITTERS.find(node)?;
-    if plugin.name == "area" {
-        return Err(Error::input(
-            &node.location,
-            "an \"area\" emitter must be nested in a shape",
-        )
-        .with_help("move it inside the <shape> that should emit light"));
-    }
     let params = Params::new(node, plugin.params);
     let light = (plugin.build)(&params, None)?;
     params.finish()?;

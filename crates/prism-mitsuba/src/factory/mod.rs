@@ -21,7 +21,7 @@ use crate::description::{PluginClass, PluginNode};
 use crate::params::Params;
 use crate::registry::{Default, ParamSpec};
 use prism_core::bsdf::Material;
-use prism_core::error::{Error, Result};
+use prism_core::error::{Error, Result, SourceLocation};
 use prism_core::geometry::{Geometry, Primitive};
 use prism_core::integrator::{Integrator, PathIntegrator};
 use prism_core::scene::Scene;
@@ -44,7 +44,7 @@ const SHAPES: ParamSpec = ParamSpec::nested(PluginClass::Shape, Default::None, "
 const EMITTERS: ParamSpec = ParamSpec::nested(
     PluginClass::Emitter,
     Default::None,
-    "lights other than area lights",
+    "lights; an `area` emitter here is attached to the shape that references its id",
 );
 const BSDFS: ParamSpec = ParamSpec::nested(
     PluginClass::Bsdf,
@@ -68,6 +68,9 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
     let mut shape_info = Vec::new();
     let mut lights = Vec::new();
     let mut textures = textures::TextureCache::default();
+    // The area emitters attached to shapes, with where each was attached (an emitter declared
+    // at the top level with an id reaches its shape by a `<ref>`).
+    let mut attached_emitters: HashMap<*const PluginNode, &SourceLocation> = HashMap::new();
 
     let integrator = match params.single_child(&INTEGRATOR)? {
         Some(child) => integrators::build_integrator(&child.node)?,
@@ -133,6 +136,21 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
                         "animate the emitter with rotations, translations and uniform scales only",
                     ));
                 }
+                if let Some(first) =
+                    attached_emitters.insert(Arc::as_ptr(&emitter.node), &emitter.location)
+                {
+                    return Err(Error::input(
+                        &emitter.location,
+                        format!(
+                            "{} is already attached to the shape at {first}",
+                            emitter.node.describe()
+                        ),
+                    )
+                    .with_help(
+                        "an area emitter can be attached to a single shape (as in Mitsuba): \
+                         give each shape its own <emitter type=\"area\">",
+                    ));
+                }
                 lights.push(lights::build_area_light(&emitter.node, shape_index)?);
                 Some((lights.len() - 1) as u32)
             }
@@ -145,6 +163,15 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
 
     let mut scene_lights = Vec::new();
     for child in params.children(&EMITTERS) {
+        if lights::is_area(&child.node) {
+            // An area emitter declared at the top level belongs to the shape that references
+            // it; one that no shape references emits nothing (Mitsuba ignores it), but its
+            // parameters are still checked.
+            if !attached_emitters.contains_key(&Arc::as_ptr(&child.node)) {
+                lights::build_area_light(&child.node, 0)?;
+            }
+            continue;
+        }
         scene_lights.push((
             lights::build_scene_light(&child.node)?,
             child.location.clone(),
