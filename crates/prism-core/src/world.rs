@@ -24,6 +24,9 @@ pub struct World {
     /// Each light's power (see [`Light::power`]), from which integrators build their light
     /// samplers.
     pub light_powers: Vec<f32>,
+    /// Each light's `sampling_weight` (1 unless the scene says otherwise), which scales its
+    /// probability of being chosen (see [`crate::light::sampler`]).
+    pub light_sampling_weights: Vec<f32>,
     /// Index into `lights` of the environment (`constant` or `envmap`), which rays that leave
     /// the scene see; a scene has at most one.
     pub environment: Option<u32>,
@@ -47,6 +50,7 @@ impl World {
             .iter()
             .map(|l| l.power(&geometry.primitives))
             .collect();
+        let light_sampling_weights = vec![1.0; lights.len()];
         World {
             environment: lights
                 .iter()
@@ -57,6 +61,23 @@ impl World {
             materials,
             lights,
             light_powers,
+            light_sampling_weights,
         }
+    }
+
+    /// The world with the lights' sampling weights (one per light, each finite and at
+    /// least 0) in place of the default 1.
+    pub fn with_sampling_weights(mut self, weights: Vec<f32>) -> World {
+        assert_eq!(
+            weights.len(),
+            self.lights.len(),
+            "one sampling weight per light"
+        );
+        assert!(
+            weights.iter().all(|w| w.is_finite() && *w >= 0.0),
+            "sampling weights are finite and at least 0"
+        );
+        self.light_sampling_weights = weights;
+        self
     }
 }

@@ -67,6 +67,7 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
     let mut shapes = Vec::new();
     let mut shape_info = Vec::new();
     let mut lights = Vec::new();
+    let mut sampling_weights = Vec::new();
     let mut textures = textures::TextureCache::default();
     // The area emitters attached to shapes, with where each was attached (an emitter declared
     // at the top level with an id reaches its shape by a `<ref>`).
@@ -151,7 +152,9 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
                          give each shape its own <emitter type=\"area\">",
                     ));
                 }
-                lights.push(lights::build_area_light(&emitter.node, shape_index)?);
+                let (light, weight) = lights::build_area_light(&emitter.node, shape_index)?;
+                lights.push(light);
+                sampling_weights.push(weight);
                 Some((lights.len() - 1) as u32)
             }
             None => None,
@@ -172,13 +175,14 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
             }
             continue;
         }
-        scene_lights.push((
-            lights::build_scene_light(&child.node)?,
-            child.location.clone(),
-        ));
+        let (light, weight) = lights::build_scene_light(&child.node)?;
+        scene_lights.push((light, weight, child.location.clone()));
     }
     lights::check_single_environment(&scene_lights)?;
-    lights.extend(scene_lights.into_iter().map(|(light, _)| light));
+    for (light, weight, _) in scene_lights {
+        lights.push(light);
+        sampling_weights.push(weight);
+    }
 
     // BSDFs declared at the top level (to be referenced by id) are built even when unused, so
     // that their errors are reported as Mitsuba would.
@@ -201,7 +205,8 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
     }
     params.finish()?;
 
-    let world = World::new(Geometry::new(shapes), shape_info, materials, lights);
+    let world = World::new(Geometry::new(shapes), shape_info, materials, lights)
+        .with_sampling_weights(sampling_weights);
     let mut scene = Scene::new(
         world,
         sensor.camera,
