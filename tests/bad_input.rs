@@ -292,10 +292,20 @@ fn cases() -> Vec<Case> {
             "above 1",
         ),
         render_scene(
-            "area emitter at the top",
-            scene!("    <emitter type=\"area\"/>"),
-            "scene.xml:3:5",
-            "nested in a shape",
+            "area emitter on two shapes",
+            scene!(
+                "    <emitter type=\"area\" id=\"light\"/><shape type=\"sphere\"><ref id=\"light\"/></shape><shape type=\"disk\"><ref id=\"light\"/></shape>"
+            ),
+            "scene.xml:3:",
+            "already attached",
+        ),
+        render_scene(
+            "unreferenced area emitter with negative radiance",
+            scene!(
+                "    <emitter type=\"area\" id=\"light\"><rgb name=\"radiance\" value=\"-1\"/></emitter>"
+            ),
+            "scene.xml:3:",
+            "negative",
         ),
         render_scene(
             "twosided in twosided",

@@ -9,13 +9,13 @@ use common::chi2::{assert_passes, chi2_discrete, chi2_interval, chi2_rectangle, 
 use glam::{Mat3, Vec2, Vec3};
 use prism_core::geometry::Sphere;
 use prism_core::geometry::TriangleMesh;
-use prism_core::light::LightSampler;
+use prism_core::light::{LightSampler, LightSelection};
 use prism_core::sampling::rng::Pcg32;
 use prism_core::sampling::warp;
 use prism_core::spectrum::WavelengthSampling;
 
 /// Number of chi-square tests in this file, for Šidák's correction.
-const TESTS: usize = 9;
+const TESTS: usize = 11;
 const SAMPLES: usize = 1_000_000;
 
 fn u2(rng: &mut Pcg32) -> Vec2 {
@@ -134,6 +134,40 @@ fn light_selection_is_proportional_to_power() {
     })
     .unwrap();
     assert_passes("light selection", &outcome, TESTS);
+}
+
+/// Mitsuba's `sampling_weight`s: uniform selection picks light i with P(i) = wᵢ/Σw, selection by
+/// power with P(i) = Φᵢwᵢ/ΣΦw; a light of weight 0 is never picked.
+#[test]
+fn light_selection_follows_the_sampling_weights() {
+    let powers = [1.0f32, 5.0, 0.5, 3.0, 2.0, 12.0];
+    let weights = [2.0f32, 0.25, 1.0, 0.0, 3.0, 1.0];
+    for selection in [LightSelection::Uniform, LightSelection::Power] {
+        let sampler = LightSampler::with_selection(&powers, &weights, selection);
+        let shares: Vec<f64> = powers
+            .iter()
+            .zip(&weights)
+            .map(|(&p, &w)| match selection {
+                LightSelection::Uniform => f64::from(w),
+                LightSelection::Power => f64::from(p * w),
+            })
+            .collect();
+        let total: f64 = shares.iter().sum();
+        let probabilities: Vec<f64> = shares.iter().map(|s| s / total).collect();
+        let outcome = chi2_discrete(SAMPLES, &probabilities, 8, |rng| {
+            let (index, pmf) = sampler.sample(rng.next_f32()).unwrap();
+            assert_ne!(index, 3, "a light of weight 0 is never chosen");
+            assert_eq!(pmf, sampler.pmf(index));
+            assert!((f64::from(pmf) - probabilities[index]).abs() < 1e-6);
+            index
+        })
+        .unwrap();
+        assert_passes(
+            &format!("light selection {selection:?} with weights"),
+            &outcome,
+            TESTS,
+        );
+    }
 }
 
 /// A unit square split into four triangles of unequal area around an off-centre point.

@@ -95,6 +95,43 @@ fn emitting_shapes_without_a_bsdf_are_black() {
     assert_eq!(reflectance(1), 0.5);
 }
 
+/// An `area` emitter declared at the top level with an id (before or after its shape) is the
+/// emitter of the shape that references it, registered once; one that
+/// no shape references emits nothing, as in Mitsuba 3.
+#[test]
+fn area_emitters_referenced_by_id() {
+    let nested = load(
+        Path::new("."),
+        r#"<shape type="sphere"><emitter type="area"><rgb name="radiance" value="2, 1, 0.5"/></emitter></shape>
+    <emitter type="point"/>"#,
+    );
+    for body in [
+        r#"<emitter type="area" id="light"><rgb name="radiance" value="2, 1, 0.5"/></emitter>
+    <shape type="sphere"><ref id="light"/></shape>
+    <emitter type="point"/>"#,
+        r#"<shape type="sphere"><ref name="emitter" id="light"/></shape>
+    <emitter type="point"/>
+    <emitter type="area" id="light"><rgb name="radiance" value="2, 1, 0.5"/></emitter>"#,
+        r#"<shape type="sphere"><ref id="light"/></shape>
+    <emitter type="point"/>
+    <emitter type="area" id="unused"><rgb name="radiance" value="7"/></emitter>
+    <emitter type="area" id="light"><rgb name="radiance" value="2, 1, 0.5"/></emitter>"#,
+    ] {
+        let referenced = load(Path::new("."), body);
+        assert_eq!(referenced.world.lights.len(), 2, "{body}");
+        assert_eq!(referenced.world.shape_info[0].light, Some(0), "{body}");
+        assert!(
+            matches!(referenced.world.lights[1], Light::Point(_)),
+            "{body}"
+        );
+        for lambda in [450.0, 600.0] {
+            let a = emission_at(&nested, 0, Vec3::new(0.0, 0.0, 3.0), lambda);
+            let b = emission_at(&referenced, 0, Vec3::new(0.0, 0.0, 3.0), lambda);
+            assert_eq!(a, b, "{body} at {lambda} nm");
+        }
+    }
+}
+
 /// The spot's defaults are a 20° cutoff and a beam of ¾ of it; its power is
 /// 2πI(1 − (sin c − sin β)/(c − β)) with I of luminance 1.
 #[test]

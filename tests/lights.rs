@@ -343,8 +343,9 @@ fn diffuse_plane_under_an_environment_map() {
 }
 
 /// Light selection must not change the answer (DESIGN.md §7): a point light and a sphere light
-/// over a plane, rendered with selection by power and uniformly, against the sum of their
-/// closed forms.
+/// over a plane, rendered with selection by power and uniformly, with equal and unequal
+/// `sampling_weight`s, against the sum of their closed forms; a point light of weight 0 is never
+/// sampled and so adds nothing (as in Mitsuba).
 #[test]
 fn light_selection_does_not_change_the_answer() {
     let (rho, intensity, radiance, radius) = (0.5f64, 3.0f64, 20.0f64, 0.2f64);
@@ -352,11 +353,14 @@ fn light_selection_does_not_change_the_answer() {
     let center = DVec3::new(0.5, 0.0, 1.5);
     let size = UVec2::new(10, 8);
     let camera = camera(DVec3::new(0.0, 0.0, 0.9), DVec3::ZERO, DVec3::Y, 80.0, size);
-    for (selection, seed) in [
-        (LightSelection::Power, 36u64),
-        (LightSelection::Uniform, 37),
+    for (selection, weights, spp, seed) in [
+        (LightSelection::Power, [1.0, 1.0], 2048, 36u64),
+        (LightSelection::Uniform, [1.0, 1.0], 2048, 37),
+        (LightSelection::Power, [0.5, 2.0], 8192, 38),
+        (LightSelection::Uniform, [0.5, 2.0], 8192, 39),
+        (LightSelection::Uniform, [1.0, 0.0], 2048, 40),
     ] {
-        let scene = build(
+        let mut scene = build(
             vec![
                 floor(rho as f32),
                 Object {
@@ -376,15 +380,21 @@ fn light_selection_does_not_change_the_answer() {
                 ..PathIntegrator::default()
             },
         );
-        let film = render_film(&scene, 2048, seed, None);
+        assert!(matches!(scene.world.lights[0], Light::Area(_)));
+        scene.world.light_sampling_weights = weights.to_vec();
+        let film = render_film(&scene, spp, seed, None);
         assert_pixels(
-            &format!("two lights, {selection:?}"),
+            &format!("two lights, {selection:?}, sampling weights {weights:?}"),
             &film,
             &camera,
             |ray| {
                 let x = on_floor(ray);
                 let (dp, dc) = ((point - x).length(), (center - x).length());
-                let e_point = intensity * point.z / dp.powi(3);
+                let e_point = if weights[1] > 0.0 {
+                    intensity * point.z / dp.powi(3)
+                } else {
+                    0.0
+                };
                 let e_sphere = PI * radiance * (radius / dc).powi(2) * (center.z / dc);
                 rho * (e_point + e_sphere) / PI
             },

@@ -78,6 +78,7 @@ impl Integrator {
             world,
             light_sampler: LightSampler::with_selection(
                 &world.light_powers,
+                &world.light_sampling_weights,
                 self.light_selection(),
             ),
         }

@@ -78,8 +78,8 @@ const EMITTER_SAMPLING: ParamSpec = ParamSpec::new(
     "emitter_sampling",
     ParamKind::Choice(&["power", "uniform"]),
     Default::Str("power"),
-    "Prism only (Mitsuba rejects it): one light per shading point chosen ∝ its power, or \
-     uniformly (as Mitsuba's default equal `sampling_weight`s)",
+    "Prism only (Mitsuba rejects it): one light per shading point chosen ∝ its power × \
+     `sampling_weight`, or ∝ `sampling_weight` alone (Mitsuba's rule; uniform by default)",
 );
 const BOUNCE_SAMPLES: ParamSpec = ParamSpec::new(
     "bounce_samples",

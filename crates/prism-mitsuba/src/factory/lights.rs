@@ -1,4 +1,5 @@
-//! Emitter plugins: `area` (nested in a shape), and at the top level of the scene `point`,
+//! Emitter plugins: `area` (nested in a shape, or declared with an id and referenced from one),
+//! and at the top level of the scene `point`,
 //! `spot`, `directional`, `constant` and `envmap` (see each light's module in [`prism_core::light`]
 //! for its parameters). Emission may be given as `<rgb>` (an illuminant: the upsampled colour
 //! times D65), `<float>` (D65 scaled), `<spectrum>` (as written) or a nested
@@ -29,8 +30,8 @@ pub static EMITTERS: Registry<Build> = Registry {
         Plugin {
             name: "area",
             origin: Origin::Mitsuba3,
-            summary: "Nested in a shape: emits `radiance` from the side the normal points to.                       Spheres are sampled by the cone they subtend, other shapes by area.",
-            params: &[RADIANCE],
+            summary: "Nested in a shape, or declared with an `id` and referenced from one shape: emits                       `radiance` from the side the normal points to.                       Spheres are sampled by the cone they subtend, other shapes by area.",
+            params: &[RADIANCE, SAMPLING_WEIGHT],
             build: |params, shape| {
                 Ok(Light::Area(AreaLight {
                     shape: shape.unwrap_or(0),
@@ -42,28 +43,34 @@ pub static EMITTERS: Registry<Build> = Registry {
             name: "point",
             origin: Origin::Mitsuba3,
             summary: "A point light.",
-            params: &[INTENSITY, POSITION, TO_WORLD],
+            params: &[INTENSITY, POSITION, TO_WORLD, SAMPLING_WEIGHT],
             build: |params, _| build_point(params),
         },
         Plugin {
             name: "spot",
             origin: Origin::Mitsuba3,
             summary: "A spot light shining along its +z: full intensity within the beam, linear in                       angle to zero at the cutoff. No projected texture.",
-            params: &[INTENSITY, CUTOFF_ANGLE, BEAM_WIDTH, TO_WORLD],
+            params: &[
+                INTENSITY,
+                CUTOFF_ANGLE,
+                BEAM_WIDTH,
+                TO_WORLD,
+                SAMPLING_WEIGHT,
+            ],
             build: |params, _| build_spot(params),
         },
         Plugin {
             name: "directional",
             origin: Origin::Mitsuba3,
             summary: "Light from one direction, at infinity.",
-            params: &[IRRADIANCE, DIRECTION, TO_WORLD],
+            params: &[IRRADIANCE, DIRECTION, TO_WORLD, SAMPLING_WEIGHT],
             build: |params, _| build_directional(params),
         },
         Plugin {
             name: "constant",
             origin: Origin::Mitsuba3,
             summary: "Uniform light from every direction, at infinity.",
-            params: &[RADIANCE],
+            params: &[RADIANCE, SAMPLING_WEIGHT],
             build: |params, _| {
                 Ok(Light::Constant(ConstantLight::new(emission_param(
                     params, &RADIANCE,
@@ -74,12 +81,19 @@ pub static EMITTERS: Registry<Build> = Registry {
             name: "envmap",
             origin: Origin::Mitsuba3,
             summary: "An environment map: a latitude–longitude image with Mitsuba's orientation                       (+y up, u = 0 looks along −z), pixel-node bilinear lookup and spectral                       upsampling; importance sampled ∝ luminance · sin θ.",
-            params: &[ENVMAP_FILENAME, ENVMAP_SCALE, TO_WORLD],
+            params: &[ENVMAP_FILENAME, ENVMAP_SCALE, TO_WORLD, SAMPLING_WEIGHT],
             build: |params, _| build_envmap(params),
         },
     ],
 };
 
+const SAMPLING_WEIGHT: ParamSpec = ParamSpec::new(
+    "sampling_weight",
+    ParamKind::Float,
+    Default::Float(1.0),
+    "relative weight of choosing this emitter for direct light: P ∝ weight (uniform \
+     `emitter_sampling`, Mitsuba's rule) or ∝ power × weight (by power); 0 never chooses it",
+);
 const D65: Default = Default::Text("D65 of luminance 1");
 const RADIANCE: ParamSpec = ParamSpec::new(
     "radiance",
@@ -151,8 +165,8 @@ const ENVMAP_SCALE: ParamSpec = ParamSpec::new(
     "factor on the image's values",
 );
 
-/// Builds the area light nested in the shape with index `shape`.
-pub fn build_area_light(node: &PluginNode, shape: u32) -> Result<Light> {
+/// Builds the area light nested in the shape with index `shape`, with its sampling weight.
+pub fn build_area_light(node: &PluginNode, shape: u32) -> Result<(Light, f32)> {
     let plugin = EMITTERS.find(node)?;
     if plugin.name != "area" {
         return Err(Error::input(
@@ -168,8 +182,9 @@ pub fn build_area_light(node: &PluginNode, shape: u32) -> Result<Light> {
     }
     let params = Params::new(node, plugin.params);
     let light = (plugin.build)(&params, Some(shape))?;
+    let weight = sampling_weight(&params)?;
     params.finish()?;
-    Ok(light)
+    Ok((light, weight))
 }
 
 /// The material of an emitting shape that names no BSDF: Mitsuba 3 gives such shapes a black
@@ -180,20 +195,26 @@ pub fn default_emitter_material() -> Material {
     })
 }
 
-/// Builds an emitter declared at the top level of the scene.
-pub fn build_scene_light(node: &PluginNode) -> Result<Light> {
+/// Whether `node` is an `area` emitter, which emits from the shape it is attached to.
+pub fn is_area(node: &PluginNode) -> bool {
+    node.class == PluginClass::Emitter && node.plugin_type == "area"
+}
+
+/// Builds an emitter declared at the top level of the scene, other than `area`, with its
+/// sampling weight.
+pub fn build_scene_light(node: &PluginNode) -> Result<(Light, f32)> {
     let plugin = EMITTERS.find(node)?;
-    if plugin.name == "area" {
-        return Err(Error::input(
-            &node.location,
-            "an \"area\" emitter must be nested in a shape",
-        )
-        .with_help("move it inside the <shape> that should emit light"));
-    }
     let params = Params::new(node, plugin.params);
     let light = (plugin.build)(&params, None)?;
+    let weight = sampling_weight(&params)?;
     params.finish()?;
-    Ok(light)
+    Ok((light, weight))
+}
+
+/// The emitter's `sampling_weight`: finite and at least 0.
+fn sampling_weight(params: &Params) -> Result<f32> {
+    let weight = params.float_in(&SAMPLING_WEIGHT, 1.0, 0.0, f64::from(f32::MAX))?;
+    Ok(weight as f32)
 }
 
 fn build_point(params: &Params) -> Result<Light> {
@@ -262,9 +283,9 @@ fn build_directional(params: &Params) -> Result<Light> {
 
 /// Checks that a scene has at most one environment emitter (`constant` or `envmap`), as
 /// Mitsuba requires; `lights` are the top-level emitters with their elements' locations.
-pub fn check_single_environment(lights: &[(Light, SourceLocation)]) -> Result<()> {
-    let mut environments = lights.iter().filter(|(light, _)| light.is_environment());
-    if let (Some(_), Some((_, second))) = (environments.next(), environments.next()) {
+pub fn check_single_environment(lights: &[(Light, f32, SourceLocation)]) -> Result<()> {
+    let mut environments = lights.iter().filter(|(light, _, _)| light.is_environment());
+    if let (Some(_), Some((_, _, second))) = (environments.next(), environments.next()) {
         return Err(
             Error::input(second, "the scene has more than one environment emitter")
                 .with_help("keep one \"constant\" or \"envmap\" emitter; Mitsuba allows only one"),

@@ -22,7 +22,7 @@ use crate::description::{PluginClass, PluginNode};
 use crate::params::{Params, Warning};
 use crate::registry::{Default, ParamSpec};
 use prism_core::bsdf::Material;
-use prism_core::error::{Error, Result};
+use prism_core::error::{Error, Result, SourceLocation};
 use prism_core::geometry::{Geometry, Primitive};
 use prism_core::integrator::{Integrator, PathIntegrator};
 use prism_core::scene::Scene;
@@ -48,7 +48,7 @@ const SHAPES: ParamSpec = ParamSpec::nested(PluginClass::Shape, Default::None, "
 const EMITTERS: ParamSpec = ParamSpec::nested(
     PluginClass::Emitter,
     Default::None,
-    "lights other than area lights",
+    "lights; an `area` emitter here is attached to the shape that references its id",
 );
 const BSDFS: ParamSpec = ParamSpec::nested(
     PluginClass::Bsdf,
@@ -114,9 +114,13 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
     let mut shapes = Vec::new();
     let mut shape_info = Vec::new();
     let mut lights = Vec::new();
+    let mut sampling_weights = Vec::new();
     let mut textures = textures::TextureCache::default();
     let mut media = MediaCache::default();
     let mut medium_interfaces = Vec::new();
+    // The area emitters attached to shapes, with where each was attached (an emitter declared
+    // at the top level with an id reaches its shape by a `<ref>`).
+    let mut attached_emitters: HashMap<*const PluginNode, &SourceLocation> = HashMap::new();
 
     let integrator = match params.single_child(&INTEGRATOR)? {
         Some(child) => integrators::build_integrator(&child.node)?,
@@ -182,7 +186,24 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
                         "animate the emitter with rotations, translations and uniform scales only",
                     ));
                 }
-                lights.push(lights::build_area_light(&emitter.node, shape_index)?);
+                if let Some(first) =
+                    attached_emitters.insert(Arc::as_ptr(&emitter.node), &emitter.location)
+                {
+                    return Err(Error::input(
+                        &emitter.location,
+                        format!(
+                            "{} is already attached to the shape at {first}",
+                            emitter.node.describe()
+                        ),
+                    )
+                    .with_help(
+                        "an area emitter can be attached to a single shape (as in Mitsuba): \
+                         give each shape its own <emitter type=\"area\">",
+                    ));
+                }
+                let (light, weight) = lights::build_area_light(&emitter.node, shape_index)?;
+                lights.push(light);
+                sampling_weights.push(weight);
                 Some((lights.len() - 1) as u32)
             }
             None => None,
@@ -202,13 +223,23 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
 
     let mut scene_lights = Vec::new();
     for child in params.children(&EMITTERS) {
-        scene_lights.push((
-            lights::build_scene_light(&child.node)?,
-            child.location.clone(),
-        ));
+        if lights::is_area(&child.node) {
+            // An area emitter declared at the top level belongs to the shape that references
+            // it; one that no shape references emits nothing (Mitsuba ignores it), but its
+            // parameters are still checked.
+            if !attached_emitters.contains_key(&Arc::as_ptr(&child.node)) {
+                lights::build_area_light(&child.node, 0)?;
+            }
+            continue;
+        }
+        let (light, weight) = lights::build_scene_light(&child.node)?;
+        scene_lights.push((light, weight, child.location.clone()));
     }
     lights::check_single_environment(&scene_lights)?;
-    lights.extend(scene_lights.into_iter().map(|(light, _)| light));
+    for (light, weight, _) in scene_lights {
+        lights.push(light);
+        sampling_weights.push(weight);
+    }
 
     // BSDFs declared at the top level (to be referenced by id) are built even when unused, so
     // that their errors are reported as Mitsuba would.
@@ -256,7 +287,8 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
         .with_help("render scenes with media with <integrator type=\"volpath\">"));
     }
 
-    let mut world = World::new(Geometry::new(shapes), shape_info, materials, lights);
+    let mut world = World::new(Geometry::new(shapes), shape_info, materials, lights)
+        .with_sampling_weights(sampling_weights);
     if medium_interfaces.iter().any(|m| m.is_transition()) {
         world.medium_interfaces = medium_interfaces;
     }

@@ -402,6 +402,62 @@ fn reference_errors() {
     assert_error(&err, &["missing the attribute \"id\""]);
 }
 
+/// Ids as Mitsuba 3.9.1 reads them (each case checked with Mitsuba): in a version 0.x file as in
+/// a 3.x one, declared in an included file, before or after the reference, nested anywhere;
+/// matched exactly (no renaming in old files, no trimming, letter case counts); a `name` is not
+/// an id, and properties take none.
+#[test]
+fn ids_resolve_as_in_mitsuba() {
+    let include = TempDir::new("ids-include");
+    include.write(
+        "materials.xml",
+        r#"<scene version="0.5.0"><bsdf type="diffuse" id="fromInclude"/></scene>"#,
+    );
+    let main = include.write(
+        "main.xml",
+        r#"<scene version="0.5.0">
+            <shape type="sphere"><ref id="laterMat"/></shape>
+            <shape type="sphere"><ref name="bsdf" id="fromInclude"/></shape>
+            <include filename="materials.xml"/>
+            <shape type="cube"><bsdf type="twosided" id="outerMat"><bsdf type="diffuse" id="laterMat"/></bsdf></shape>
+        </scene>"#,
+    );
+    let root = read_scene_file(&main, &[]).unwrap();
+    let shape = |i: usize| &root.children[i].node.children[0].node;
+    assert_eq!(shape(0).id.as_deref(), Some("laterMat"));
+    assert_eq!(shape(1).id.as_deref(), Some("fromInclude"));
+    assert!(Arc::ptr_eq(shape(0), &shape(3).children[0].node));
+
+    for (body, missing) in [
+        (
+            r#"<bsdf type="diffuse" id="myMat"/><shape type="cube"><ref id="my_mat"/></shape>"#,
+            "my_mat",
+        ),
+        (
+            r#"<bsdf type="diffuse" id="m "/><shape type="cube"><ref id="m"/></shape>"#,
+            "m",
+        ),
+        (
+            r#"<bsdf type="diffuse" id="m"/><shape type="cube"><ref id="M"/></shape>"#,
+            "M",
+        ),
+        (
+            r#"<bsdf type="diffuse" name="m"/><shape type="cube"><ref id="m"/></shape>"#,
+            "m",
+        ),
+    ] {
+        let xml = format!("<scene version=\"0.5.0\">{body}</scene>");
+        assert_error(
+            &error(&xml),
+            &[&format!("no object has the id \"{missing}\"")],
+        );
+    }
+    assert_error(
+        &error(&scene(r#"<rgb name="x" value="0.5" id="c"/>"#)),
+        &["unexpected attribute \"id\""],
+    );
+}
+
 #[test]
 fn aliases_name_earlier_objects() {
     let root = read(&scene(
