@@ -533,6 +533,38 @@ fn cases() -> Vec<Case> {
             location: "",
             says: "missing.state",
         },
+        render_scene(
+            "rawconstant of three values read as a colour",
+            scene!(
+                "    <shape type=\"sphere\"><bsdf type=\"diffuse\"><texture type=\"rawconstant\" name=\"reflectance\">\n        <vector name=\"value\" x=\"1\" y=\"0\" z=\"0\"/></texture></bsdf></shape>"
+            ),
+            "scene.xml:4:9",
+            "three values",
+        ),
+        render_scene(
+            "rawconstant without a value",
+            scene!(
+                "    <shape type=\"sphere\"><bsdf type=\"diffuse\"><texture type=\"rawconstant\" name=\"reflectance\"/></bsdf></shape>"
+            ),
+            "scene.xml:3:",
+            "needs a \"value\"",
+        ),
+        render_scene(
+            "conductor exterior index not a constant",
+            scene!(
+                "    <shape type=\"sphere\"><bsdf type=\"conductor\">\n        <spectrum name=\"ext_eta\" value=\"400:1.3, 700:1.4\"/></bsdf></shape>"
+            ),
+            "scene.xml:4:9",
+            "must be a constant",
+        ),
+        render_scene(
+            "colour opacity outside [0, 1]",
+            scene!(
+                "    <shape type=\"sphere\"><bsdf type=\"mask\">\n        <rgb name=\"opacity\" value=\"3, 2, 4\"/><bsdf type=\"diffuse\"/></bsdf></shape>"
+            ),
+            "scene.xml:4:9",
+            "whose mean",
+        ),
     ];
     // Command-line parameters.
     cases.extend(media_cases());

@@ -61,6 +61,8 @@ pub enum ParamKind {
     AnimatedTransform,
     Point,
     Vector,
+    /// A `<float>` or a `<vector>` (three raw values).
+    FloatOrVector,
     /// A colour or spectrum (`<rgb>`, `<spectrum>`, `<float>`), or with `textured` a nested
     /// `<texture>` read as colours.
     Spectrum {
@@ -89,6 +91,7 @@ impl ParamKind {
             ParamKind::AnimatedTransform => "transform or animation".into(),
             ParamKind::Point => "point".into(),
             ParamKind::Vector => "vector".into(),
+            ParamKind::FloatOrVector => "float or vector".into(),
             ParamKind::Spectrum { range, textured } => {
                 let what = match range {
                     Range::Albedo => "reflectance",

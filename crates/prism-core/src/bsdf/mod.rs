@@ -49,6 +49,7 @@
 //! | `mask` | [`mask`] | the nested BSDF's, and null transmission |
 //! | `null` | [`null`] | null transmission only (a medium's boundary) |
 //! | `blendbsdf` | [`blend`] | both nested BSDFs' |
+//! | `null` | [`null`] | null transmission |
 //! | `bumpmap`, `normalmap` | [`bumpmap`], [`normalmap`] | the nested BSDF's, in a perturbed frame |
 
 pub mod blend;
@@ -106,8 +107,9 @@ impl BsdfFlags {
     pub const GLOSSY: BsdfFlags = BsdfFlags(2);
     /// A Dirac delta lobe (mirror or clear glass): cannot be evaluated, only sampled.
     pub const SPECULAR: BsdfFlags = BsdfFlags(4);
-    /// Light passing straight through, unchanged in direction (Mitsuba's `Null`: the transparent
-    /// part of `mask`, the transmission of `thindielectric`); a delta lobe too.
+    /// Light passing straight through, unchanged in direction (Mitsuba's `Null`: the `null`
+    /// BSDF, the transparent part of `mask`, the transmission of `thindielectric`); a delta lobe
+    /// too.
     pub const NULL: BsdfFlags = BsdfFlags(32);
     pub const REFLECTION: BsdfFlags = BsdfFlags(8);
     pub const TRANSMISSION: BsdfFlags = BsdfFlags(16);

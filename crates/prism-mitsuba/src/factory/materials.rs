@@ -58,13 +58,14 @@ pub static BSDFS: Registry<Build> = Registry {
             name: "conductor",
             origin: Origin::Mitsuba3,
             summary: "A smooth metal: a mirror with the Fresnel reflectance of η + ik. One-sided.",
-            params: &[MATERIAL, ETA, K, CONDUCTOR_SPECULAR],
+            params: &[MATERIAL, ETA, K, CONDUCTOR_SPECULAR, EXT_ETA],
             build: |params, t| {
                 let (eta, k) = conductor_ior(params, t)?;
                 Ok(Bsdf::Conductor(Conductor {
                     eta,
                     k,
                     specular_reflectance: spectrum_texture(params, &CONDUCTOR_SPECULAR, t)?,
+                    ext_eta: exterior_eta(params)?,
                 }))
             },
         },
@@ -78,6 +79,7 @@ pub static BSDFS: Registry<Build> = Registry {
                 ETA,
                 K,
                 CONDUCTOR_SPECULAR,
+                EXT_ETA,
                 DISTRIBUTION,
                 ALPHA,
                 ALPHA_U,
@@ -95,6 +97,7 @@ pub static BSDFS: Registry<Build> = Registry {
                     eta,
                     k,
                     specular_reflectance: spectrum_texture(params, &CONDUCTOR_SPECULAR, t)?,
+                    ext_eta: exterior_eta(params)?,
                 }))
             },
         },
@@ -279,8 +282,10 @@ pub static BSDFS: Registry<Build> = Registry {
         Plugin {
             name: "null",
             origin: Origin::Mitsuba3,
-            summary: "Light passes through unchanged: the boundary of a medium that does not \
-                      scatter (an index-matched interface).",
+            summary: "Light passes straight through, unchanged (an index-matched boundary, the \
+                      outline of a medium, an invisible shape); in `path` it counts as a bounce \
+                      and shadow rays see it as opaque, in `volpath` it is no bounce and shadow \
+                      rays pass, as in Mitsuba 3.",
             params: &[],
             build: |_, _| Ok(Bsdf::Null(Null)),
         },
@@ -370,6 +375,13 @@ const CONDUCTOR_SPECULAR: ParamSpec = colour(
     Range::Albedo,
     1.0,
     "a factor on the reflectance",
+);
+const EXT_ETA: ParamSpec = ParamSpec::new(
+    "ext_eta",
+    ParamKind::Ior,
+    Default::Text("1"),
+    "(Mitsuba 0.6's `extEta`) index of the medium outside, a number or a name: η and k are \
+     divided by it. Mitsuba 3 reads no exterior index",
 );
 const DISTRIBUTION: ParamSpec = ParamSpec::new(
     "distribution",
@@ -830,6 +842,25 @@ fn conductor_ior(params: &Params, textures: &mut TextureCache) -> Result<(Textur
             .unwrap_or_else(|| Texture::constant(0.0))
     };
     Ok((table(1), table(2)))
+}
+
+/// A conductor's `ext_eta` (Mitsuba 0.6's `extEta`): a constant index, 1 when absent (Mitsuba 3
+/// has no exterior index; Mitsuba 0.6's default, air, differs from 1 by 3·10⁻⁴).
+fn exterior_eta(params: &Params) -> Result<f32> {
+    if !params.has(&EXT_ETA) {
+        return Ok(1.0);
+    }
+    match ior(params, &EXT_ETA)? {
+        Ior::Constant(eta) => Ok(eta),
+        _ => Err(Error::input(
+            params.location_of(&EXT_ETA),
+            format!(
+                "the exterior index \"ext_eta\" of {} must be a constant",
+                params.node().describe()
+            ),
+        )
+        .with_help("give a number or a name such as \"water\", as Mitsuba 0.6 reads it")),
+    }
 }
 
 /// `int_ior` (as `interior` declares it) and `ext_ior`. With `must_differ`, equal constant
