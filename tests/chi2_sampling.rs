@@ -15,7 +15,7 @@ use prism_core::sampling::warp;
 use prism_core::spectrum::WavelengthSampling;
 
 /// Number of chi-square tests in this file, for Šidák's correction.
-const TESTS: usize = 11;
+const TESTS: usize = 13;
 const SAMPLES: usize = 1_000_000;
 
 fn u2(rng: &mut Pcg32) -> Vec2 {
@@ -99,6 +99,68 @@ fn wavelength_sampling_follows_the_sum_of_the_colour_matching_functions() {
         let expected = 0.5 * (sum(l - 0.5) + sum(l + 0.5)) * normalisation;
         assert!((sampling.pdf(l) - expected).abs() <= 1e-5 * expected, "{l}");
     }
+}
+
+#[test]
+fn balanced_wavelength_sampling_follows_its_density() {
+    let sampling = WavelengthSampling::Balanced;
+    let outcome = chi2_interval(
+        SAMPLES,
+        360.0,
+        830.0,
+        235,
+        6,
+        |rng| Some(f64::from(sampling.sample(rng.next_f32()))),
+        |l| f64::from(sampling.pdf(l as f32)),
+    )
+    .unwrap();
+    assert_passes("wavelengths balanced", &outcome, TESTS);
+    // The tabulated density is D65 · sqrt(3 ȳ²/I_Y² + Σ_c c̄²/I_c²) normalised, the c̄ linear
+    // sRGB: compare ratios between cells with the formula (the I_c cancel only in part, so
+    // compute them here too).
+    use prism_core::spectrum::cie::{XYZ_TO_LINEAR_SRGB, cie_xyz, d65_normalized, mul3};
+    let responses = |l: f32| {
+        let xyz = cie_xyz(l);
+        let rgb = mul3(&XYZ_TO_LINEAR_SRGB, xyz);
+        [xyz[1], rgb[0], rgb[1], rgb[2]].map(f64::from)
+    };
+    let mut means = [0.0f64; 4];
+    for i in 0..=4700 {
+        let l = 360.0 + i as f32 * 0.1;
+        let w = if i == 0 || i == 4700 { 0.05 } else { 0.1 };
+        for (m, r) in means.iter_mut().zip(responses(l)) {
+            *m += w * f64::from(d65_normalized(l)) * r;
+        }
+    }
+    let shape = |l: f32| {
+        let r = responses(l);
+        let sum = 3.0 * (r[0] / means[0]).powi(2)
+            + (1..4).map(|c| (r[c] / means[c]).powi(2)).sum::<f64>();
+        f64::from(d65_normalized(l)) * sum.sqrt()
+    };
+    let cell = |l: f32| 0.5 * (shape(l - 0.5) + shape(l + 0.5));
+    let normalisation = f64::from(sampling.pdf(555.5)) / cell(555.5);
+    for l in [400.5f32, 450.5, 600.5, 700.5] {
+        let expected = cell(l) * normalisation;
+        let got = f64::from(sampling.pdf(l));
+        assert!((got - expected).abs() <= 1e-3 * expected, "{l}: {got} vs {expected}");
+    }
+}
+
+#[test]
+fn uniform_wavelength_sampling_follows_its_density() {
+    let sampling = WavelengthSampling::Uniform;
+    let outcome = chi2_interval(
+        SAMPLES,
+        360.0,
+        830.0,
+        235,
+        7,
+        |rng| Some(f64::from(sampling.sample(rng.next_f32()))),
+        |l| f64::from(sampling.pdf(l as f32)),
+    )
+    .unwrap();
+    assert_passes("wavelengths uniform", &outcome, TESTS);
 }
 
 #[test]

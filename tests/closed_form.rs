@@ -15,7 +15,7 @@ use prism_core::geometry::Sphere;
 use prism_core::integrator::{DistributionIntegrator, Integrator, PathIntegrator};
 use prism_core::light::{Light, PointLight};
 use prism_core::math::Transform;
-use prism_core::spectrum::Spectrum;
+use prism_core::spectrum::{Spectrum, WavelengthSampling};
 use prism_mitsuba::factory::shapes::{cube, rectangle, transform_mesh};
 
 /// The inside of a unit sphere: normals point inwards, so the inner face is the front.
@@ -89,6 +89,17 @@ fn closed_sphere_furnace_gives_le_over_one_minus_rho() {
         let name = format!("sphere furnace, rho 0.5, {integrator:?}");
         let film = furnace(inner_sphere(), 0.5, 1.0, integrator, spp, 1);
         assert_mean_luminance(&name, &film, 2.0);
+    }
+}
+
+/// The furnace's answer holds for every wavelength density a film may choose.
+#[test]
+fn closed_sphere_furnace_with_every_wavelength_density() {
+    for (density, seed) in WavelengthSampling::ALL.into_iter().zip(20..) {
+        let mut scene = furnace_scene(inner_sphere(), 0.5, 1.0, PathIntegrator::default());
+        scene.film.wavelength_sampling = density;
+        let film = render_film(&scene, 1024, seed, None);
+        assert_mean_luminance(&format!("sphere furnace, {density:?}"), &film, 2.0);
     }
 }
 

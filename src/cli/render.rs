@@ -30,6 +30,8 @@ use prism_core::render::{
 };
 use prism_core::sampling::sampler::{Sampler, SamplerKind};
 use prism_core::scene::Scene;
+use prism_core::spectrum::WavelengthSampling;
+use prism_mitsuba::fingerprint::Fnv64;
 use prism_mitsuba::load_scene;
 
 #[derive(Args, Debug)]
@@ -82,6 +84,10 @@ pub struct RenderArgs {
     /// with `--features embree`)
     #[arg(long, value_name = "ACCEL", default_value = "bvh")]
     pub accel: Accel,
+    /// Draw wavelengths from this density instead of the film's `wavelength_sampling`:
+    /// balanced, cie_sum, visible or uniform
+    #[arg(long, value_name = "DENSITY", value_parser = parse_wavelengths)]
+    pub wavelengths: Option<WavelengthSampling>,
 }
 
 pub(crate) fn parse_define(text: &str) -> Result<(String, String), String> {
@@ -106,6 +112,15 @@ fn parse_numbers(
         return Err(format!("expected {what}, got \"{text}\""));
     }
     Ok(numbers)
+}
+
+pub(crate) fn parse_wavelengths(text: &str) -> Result<WavelengthSampling, String> {
+    WavelengthSampling::from_name(text).ok_or_else(|| {
+        format!(
+            "expected one of {}, got \"{text}\"",
+            WavelengthSampling::NAMES.join(", ")
+        )
+    })
 }
 
 fn parse_crop(text: &str) -> Result<[u32; 4], String> {
@@ -235,6 +250,17 @@ fn install_signal_handlers(interrupt: Arc<AtomicBool>, signal: Arc<AtomicI32>) -
     Ok(())
 }
 
+/// Draws the scene's wavelengths from `density`. The density joins the scene's fingerprint, so a
+/// render state records it: resuming or merging with another density is refused.
+pub(crate) fn override_wavelengths(scene: &mut Scene, density: WavelengthSampling) {
+    scene.film.wavelength_sampling = density;
+    let mut hash = Fnv64::default();
+    hash.write(&scene.fingerprint.to_le_bytes());
+    hash.write_str("wavelength_sampling");
+    hash.write_str(density.name());
+    scene.fingerprint = hash.finish();
+}
+
 pub fn run(args: &RenderArgs) -> Result<()> {
     if args.spp == Some(0) {
         return Err(Error::usage("--spp must be at least 1"));
@@ -273,6 +299,9 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             size: UVec2::new(x1 - x0, y1 - y0),
         };
     }
+    if let Some(density) = args.wavelengths {
+        override_wavelengths(&mut scene, density);
+    }
     let seed = args.seed.unwrap_or(loaded.seed);
     let strata = scene
         .sampler
@@ -298,7 +327,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         let state = RenderState::read(path)?;
         if let Some(reason) = identity.mismatch(&state.identity) {
             return Err(Error::usage(format!("cannot resume from \"{}\": {reason}", path.display()))
-                .with_help("resume with the same scene, -D values, --spp, --seed and --crop as the interrupted render"));
+                .with_help("resume with the same scene, -D values, --spp, --seed, --crop and --wavelengths as the interrupted render"));
         }
         let [range] = state.ranges.as_slice() else {
             return Err(Error::usage(format!(

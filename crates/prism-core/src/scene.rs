@@ -16,6 +16,8 @@ pub struct FilmSettings {
     pub size: UVec2,
     pub crop: CropWindow,
     pub filter: Filter,
+    /// The density the wavelengths of each camera sample are drawn from.
+    pub wavelength_sampling: WavelengthSampling,
 }
 
 /// Which per-pixel sampler to use and how many samples per pixel.
@@ -34,7 +36,6 @@ pub struct Scene {
     /// The estimator and its parameters; it builds its light sampler from the world when a
     /// render starts.
     pub integrator: Integrator,
-    pub wavelength_sampling: WavelengthSampling,
     /// When camera rays are taken (the sensor's shutter interval and temporal filter).
     pub shutter: Shutter,
     /// How the 8-bit image beside the EXR is tonemapped and written.
@@ -60,7 +61,6 @@ impl Scene {
             film,
             sampler,
             integrator,
-            wavelength_sampling: WavelengthSampling::default(),
             shutter: Shutter::instant(),
             ldr_output: LdrOutput::default(),
             fingerprint: 0,

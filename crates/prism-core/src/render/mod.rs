@@ -222,7 +222,7 @@ impl<'a> SampleEstimator<'a> {
         let scene = self.scene;
         sampler.start_pixel_sample(pixel, index);
         let primary = sampler.camera_sample();
-        let lambda = SampledWavelengths::sample(primary.wavelength, scene.wavelength_sampling);
+        let lambda = SampledWavelengths::sample(primary.wavelength, scene.film.wavelength_sampling);
         let (offset, filter_weight) = self.filter.sample(primary.film);
         let (time, time_weight) = scene.shutter.sample(primary.time);
         let film_position = pixel.as_vec2() + Vec2::splat(0.5) + offset;

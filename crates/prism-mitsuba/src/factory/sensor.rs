@@ -16,6 +16,7 @@ use prism_core::film::{CropWindow, Filter, LdrFormat, LdrOutput, Tonemap, Transf
 use prism_core::image::Channels;
 use prism_core::sampling::sampler::MAX_ORTHOGONAL_STRENGTH;
 use prism_core::scene::{FilmSettings, SamplerKind, SamplerSettings};
+use prism_core::spectrum::WavelengthSampling;
 
 /// Builds a sensor; `thinlens` says whether it has a lens.
 type SensorBuild = fn(&Params, bool) -> Result<SensorSettings>;
@@ -207,7 +208,8 @@ pub static FILMS: Registry<FilmBuild> = Registry {
         Plugin {
             name: "hdrfilm",
             origin: Origin::Mitsuba3,
-            summary: "A high dynamic range film; Prism writes it as 32-bit OpenEXR (RGB, XYZ, per-pixel                   variance and relative error) and an sRGB PNG.",
+            summary: "A high dynamic range film; Prism writes it as 32-bit OpenEXR (RGB, XYZ, per-pixel \
+                      variance and relative error) and an sRGB PNG.",
             params: &[
                 WIDTH,
                 HEIGHT,
@@ -219,6 +221,7 @@ pub static FILMS: Registry<FilmBuild> = Registry {
                 PIXEL_FORMAT,
                 COMPONENT_FORMAT,
                 RFILTER,
+                WAVELENGTH_SAMPLING,
                 BANNER,
                 ATTACH_LOG,
                 HIGH_QUALITY_EDGES,
@@ -229,7 +232,8 @@ pub static FILMS: Registry<FilmBuild> = Registry {
         Plugin {
             name: "ldrfilm",
             origin: Origin::Mitsuba06,
-            summary: "Mitsuba 0.6's low dynamic range film: Prism writes its usual OpenEXR and, in                   place of the sRGB PNG, the 8-bit PNG or JPEG tonemapped as the film asks.",
+            summary: "Mitsuba 0.6's low dynamic range film: Prism writes its usual OpenEXR and, in \
+                      place of the sRGB PNG, the 8-bit PNG or JPEG tonemapped as the film asks.",
             params: &[
                 WIDTH,
                 HEIGHT,
@@ -245,6 +249,7 @@ pub static FILMS: Registry<FilmBuild> = Registry {
                 KEY,
                 BURN,
                 RFILTER,
+                WAVELENGTH_SAMPLING,
                 BANNER,
                 HIGH_QUALITY_EDGES,
             ],
@@ -300,6 +305,14 @@ const PIXEL_FORMAT: ParamSpec = ParamSpec::new(
     ParamKind::Choice(&["rgb", "rgba", "xyz", "xyza", "luminance", "luminance_alpha"]),
     Default::Str("rgb"),
     "accepted; the output always holds RGB and XYZ",
+);
+const WAVELENGTH_SAMPLING: ParamSpec = ParamSpec::new(
+    "wavelength_sampling",
+    ParamKind::Choice(&WavelengthSampling::NAMES),
+    Default::Str("balanced"),
+    "Prism only (Mitsuba rejects it): the density wavelengths are drawn from: `balanced` \
+     (least error of luminance and linear sRGB under white light), `cie_sum` (∝ x̄+ȳ+z̄, the \
+     lecture's), `visible` (Mitsuba's and pbrt's), `uniform`; see docs/wavelengths.md",
 );
 const COMPONENT_FORMAT: ParamSpec = ParamSpec::new(
     "component_format",
@@ -879,6 +892,7 @@ fn default_film() -> FilmSettings {
             size,
         },
         filter: Filter::Gaussian { stddev: 0.5 },
+        wavelength_sampling: WavelengthSampling::default(),
     }
 }
 
@@ -970,7 +984,7 @@ fn build_ldrfilm(params: &Params) -> Result<(FilmSettings, LdrOutput)> {
     ))
 }
 
-/// The size, crop window and filter that `hdrfilm` and `ldrfilm` share.
+/// The size, crop window, filter and wavelength density that `hdrfilm` and `ldrfilm` share.
 fn film_settings(params: &Params) -> Result<FilmSettings> {
     let width = params.integer(&WIDTH)?;
     let height = params.integer(&HEIGHT)?;
@@ -1008,6 +1022,8 @@ fn film_settings(params: &Params) -> Result<FilmSettings> {
         Some(child) => build_filter(&child.node)?,
         None => Filter::Gaussian { stddev: 0.5 },
     };
+    let wavelength_sampling = WavelengthSampling::from_name(params.choice(&WAVELENGTH_SAMPLING)?)
+        .expect("the choice is one of the names");
     let size = UVec2::new(width as u32, height as u32);
     Ok(FilmSettings {
         size,
@@ -1016,6 +1032,7 @@ fn film_settings(params: &Params) -> Result<FilmSettings> {
             size: UVec2::new(crop_width as u32, crop_height as u32),
         },
         filter,
+        wavelength_sampling,
     })
 }
 
