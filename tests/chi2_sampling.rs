@@ -143,7 +143,10 @@ fn balanced_wavelength_sampling_follows_its_density() {
     for l in [400.5f32, 450.5, 600.5, 700.5] {
         let expected = cell(l) * normalisation;
         let got = f64::from(sampling.pdf(l));
-        assert!((got - expected).abs() <= 1e-3 * expected, "{l}: {got} vs {expected}");
+        assert!(
+            (got - expected).abs() <= 1e-3 * expected,
+            "{l}: {got} vs {expected}"
+        );
     }
 }
 

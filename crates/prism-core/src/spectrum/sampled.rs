@@ -7,9 +7,7 @@ use std::sync::OnceLock;
 
 use wide::f32x4;
 
-use super::cie::{
-    CIE_Y_INTEGRAL_F32, XYZ_TO_LINEAR_SRGB, cie_xyz, cie_xyz4, d65_normalized, mul3,
-};
+use super::cie::{CIE_Y_INTEGRAL_F32, XYZ_TO_LINEAR_SRGB, cie_xyz, cie_xyz4, d65_normalized, mul3};
 use super::{LAMBDA_MAX, LAMBDA_MIN};
 use crate::sampling::distribution::PiecewiseConstant1D;
 
@@ -479,12 +477,19 @@ mod tests {
     /// exact up to the quadrature, so the comparisons have no noise to allow for.
     #[test]
     fn balanced_density_is_quieter_than_visible_under_white_light() {
-        let (balanced_y, balanced_rgb) = white_light_relative_variances(WavelengthSampling::Balanced);
+        let (balanced_y, balanced_rgb) =
+            white_light_relative_variances(WavelengthSampling::Balanced);
         let (visible_y, visible_rgb) = white_light_relative_variances(WavelengthSampling::Visible);
         let (cie_y, cie_rgb) = white_light_relative_variances(WavelengthSampling::CieSum);
         assert!(balanced_y < visible_y, "Y: {balanced_y} vs {visible_y}");
-        assert!(balanced_rgb < 0.6 * visible_rgb, "RGB: {balanced_rgb} vs {visible_rgb}");
-        assert!(balanced_rgb < 1.1 * cie_rgb, "RGB: {balanced_rgb} vs {cie_rgb}");
+        assert!(
+            balanced_rgb < 0.6 * visible_rgb,
+            "RGB: {balanced_rgb} vs {visible_rgb}"
+        );
+        assert!(
+            balanced_rgb < 1.1 * cie_rgb,
+            "RGB: {balanced_rgb} vs {cie_rgb}"
+        );
         assert!(cie_y > 15.0 * visible_y, "Y: {cie_y} vs {visible_y}");
     }
 }
