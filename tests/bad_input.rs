@@ -568,6 +568,7 @@ fn cases() -> Vec<Case> {
     ];
     // Command-line parameters.
     cases.extend(media_cases());
+    cases.extend(instancing_cases());
     for (name, extra, says) in [
         ("zero samples", &["--spp", "0"][..], "--spp"),
         (
@@ -801,4 +802,57 @@ fn every_malformed_input_gets_one_clear_error() {
         cases.len(),
         failures.join("\n")
     );
+}
+
+/// Bad instancing: emitters, moving shapes and nested groups or instances inside a shapegroup,
+/// an instance of something that is not a group, and an instance naming no group.
+fn instancing_cases() -> Vec<Case> {
+    vec![
+        render_scene(
+            "emitter in a shapegroup",
+            scene!(
+                "    <shape type=\"shapegroup\" id=\"g\">\n        <shape type=\"sphere\"><emitter type=\"area\"/></shape>\n    </shape>"
+            ),
+            "scene.xml:4:30",
+            "cannot emit light",
+        ),
+        render_scene(
+            "shapegroup in a shapegroup",
+            scene!(
+                "    <shape type=\"shapegroup\" id=\"g\">\n        <shape type=\"shapegroup\"><shape type=\"sphere\"/></shape>\n    </shape>"
+            ),
+            "scene.xml:4:9",
+            "instancing does not nest",
+        ),
+        render_scene(
+            "instance in a shapegroup",
+            scene!(
+                "    <shape type=\"shapegroup\" id=\"g\"><shape type=\"sphere\"/></shape>\n    <shape type=\"shapegroup\" id=\"h\">\n        <shape type=\"instance\"><ref id=\"g\"/></shape>\n    </shape>"
+            ),
+            "scene.xml:5:9",
+            "instancing does not nest",
+        ),
+        render_scene(
+            "moving shape in a shapegroup",
+            scene!(
+                "    <shape type=\"shapegroup\" id=\"g\">\n        <shape type=\"sphere\"><animation name=\"to_world\"><transform time=\"0\"/><transform time=\"1\"><translate x=\"1\"/></transform></animation></shape>\n    </shape>"
+            ),
+            "scene.xml:4:9",
+            "cannot move",
+        ),
+        render_scene(
+            "instance of a sphere",
+            scene!(
+                "    <shape type=\"sphere\" id=\"ball\"/>\n    <shape type=\"instance\"><ref id=\"ball\"/></shape>"
+            ),
+            "scene.xml:4:28",
+            "places a shapegroup",
+        ),
+        render_scene(
+            "instance of nothing",
+            scene!("    <shape type=\"instance\"/>"),
+            "scene.xml:3:5",
+            "shapegroup",
+        ),
+    ]
 }

@@ -5,6 +5,7 @@
 //! parameters are reported with their location. Objects declared once and referenced many
 //! times (a BSDF with an `id`) are built once.
 
+mod instancing;
 pub mod integrators;
 pub mod lights;
 pub mod materials;
@@ -106,6 +107,66 @@ impl MediaCache {
     }
 }
 
+/// The index of a shape's material: its BSDF, built once however often it is referenced, or
+/// the default (black for an emitter, as Mitsuba's, else diffuse 0.5).
+fn shape_material(
+    bsdf: Option<&crate::description::NestedPlugin>,
+    emits: bool,
+    materials: &mut Vec<Material>,
+    material_ids: &mut HashMap<*const PluginNode, u32>,
+    textures: &mut textures::TextureCache,
+) -> Result<u32> {
+    if let Some(bsdf) = bsdf {
+        let key = Arc::as_ptr(&bsdf.node);
+        if let Some(&index) = material_ids.get(&key) {
+            return Ok(index);
+        }
+        materials.push(materials::build_material(&bsdf.node, textures)?);
+        let index = (materials.len() - 1) as u32;
+        material_ids.insert(key, index);
+        return Ok(index);
+    }
+    materials.push(if emits {
+        lights::default_emitter_material()
+    } else {
+        materials::default_material()
+    });
+    Ok((materials.len() - 1) as u32)
+}
+
+/// The media on the two sides of a shape (its `interior` and `exterior`).
+fn shape_media(
+    shape_params: &Params,
+    media: &mut MediaCache,
+) -> Result<prism_core::medium::MediumInterface> {
+    let mut interface = prism_core::medium::MediumInterface::default();
+    if let Some(child) = shape_params.named_child(&shapes::INTERIOR) {
+        interface.interior = Some(media.index(child)?);
+    }
+    if let Some(child) = shape_params.named_child(&shapes::EXTERIOR) {
+        interface.exterior = Some(media.index(child)?);
+    }
+    Ok(interface)
+}
+
+/// The material and media of a shape in a `shapegroup`.
+fn group_member(
+    member: &Params,
+    materials: &mut Vec<Material>,
+    material_ids: &mut HashMap<*const PluginNode, u32>,
+    textures: &mut textures::TextureCache,
+    media: &mut MediaCache,
+) -> Result<(u32, prism_core::medium::MediumInterface)> {
+    let material = shape_material(
+        member.single_child(&shapes::BSDF)?,
+        false,
+        materials,
+        material_ids,
+        textures,
+    )?;
+    Ok((material, shape_media(member, media)?))
+}
+
 /// Builds the scene described by the root `<scene>` node.
 pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
     let params = Params::new(root, SCENE);
@@ -118,6 +179,7 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
     let mut textures = textures::TextureCache::default();
     let mut media = MediaCache::default();
     let mut medium_interfaces = Vec::new();
+    let mut groups = instancing::ShapeGroups::default();
     // The area emitters attached to shapes, with where each was attached (an emitter declared
     // at the top level with an id reaches its shape by a `<ref>`).
     let mut attached_emitters: HashMap<*const PluginNode, &SourceLocation> = HashMap::new();
@@ -140,6 +202,39 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
     let sensor = sensor::build_sensor(&sensor.node)?;
 
     for child in params.children(&SHAPES) {
+        match child.node.plugin_type.as_str() {
+            "shapegroup" => {
+                groups.group(&child.node, &mut |member| {
+                    group_member(
+                        member,
+                        &mut materials,
+                        &mut material_ids,
+                        &mut textures,
+                        &mut media,
+                    )
+                })?;
+                continue;
+            }
+            "instance" => {
+                if let Some(instance) =
+                    groups.instance(&child.node, shapes.len(), &mut |member| {
+                        group_member(
+                            member,
+                            &mut materials,
+                            &mut material_ids,
+                            &mut textures,
+                            &mut media,
+                        )
+                    })?
+                {
+                    shapes.push(instance.primitive);
+                    shape_info.push(instance.info);
+                    medium_interfaces.push(prism_core::medium::MediumInterface::default());
+                }
+                continue;
+            }
+            _ => {}
+        }
         let (plugin, shape_params) = shapes::shape_params(&child.node)?;
         let shape = shapes::build_shape(plugin, &shape_params)?;
         if shape.area() == 0.0 || !shape.area().is_finite() {
@@ -151,28 +246,13 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
         }
         let shape_index = shapes.len() as u32;
         let emitter = shape_params.single_child(&shapes::EMITTER)?;
-        let material = match shape_params.single_child(&shapes::BSDF)? {
-            Some(bsdf) => {
-                let key = Arc::as_ptr(&bsdf.node);
-                match material_ids.get(&key) {
-                    Some(&index) => index,
-                    None => {
-                        materials.push(materials::build_material(&bsdf.node, &mut textures)?);
-                        let index = (materials.len() - 1) as u32;
-                        material_ids.insert(key, index);
-                        index
-                    }
-                }
-            }
-            None if emitter.is_some() => {
-                materials.push(lights::default_emitter_material());
-                (materials.len() - 1) as u32
-            }
-            None => {
-                materials.push(materials::default_material());
-                (materials.len() - 1) as u32
-            }
-        };
+        let material = shape_material(
+            shape_params.single_child(&shapes::BSDF)?,
+            emitter.is_some(),
+            &mut materials,
+            &mut material_ids,
+            &mut textures,
+        )?;
         let light = match emitter {
             Some(emitter) => {
                 if let Primitive::Instance(instance) = &shape
@@ -208,18 +288,12 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
             }
             None => None,
         };
-        let mut interface = prism_core::medium::MediumInterface::default();
-        if let Some(child) = shape_params.named_child(&shapes::INTERIOR) {
-            interface.interior = Some(media.index(child)?);
-        }
-        if let Some(child) = shape_params.named_child(&shapes::EXTERIOR) {
-            interface.exterior = Some(media.index(child)?);
-        }
-        medium_interfaces.push(interface);
+        medium_interfaces.push(shape_media(&shape_params, &mut media)?);
         shape_params.finish()?;
         shapes.push(shape);
         shape_info.push(ShapeInfo { material, light });
     }
+    groups.assign_shape_ids(&mut shapes, &mut shape_info, &mut medium_interfaces);
 
     let mut scene_lights = Vec::new();
     for child in params.children(&EMITTERS) {
