@@ -186,6 +186,18 @@ impl Medium {
         }
     }
 
+    /// Each wavelength's own majorant m(λᵢ) ≥ σ_t(x, λᵢ) for every point: σ_t(λᵢ) itself for a
+    /// homogeneous medium (which then has no null collisions), the grid's maximum for all four
+    /// in a heterogeneous one.
+    #[inline]
+    pub fn majorants(&self, lambda: &SampledWavelengths) -> SampledSpectrum {
+        if self.is_homogeneous() {
+            self.coefficients(Vec3::ZERO, lambda).sigma_t
+        } else {
+            SampledSpectrum::splat(self.majorant(lambda))
+        }
+    }
+
     /// The parameter interval of `ray` (unit direction) in which the medium may be non-empty,
     /// within [0, t_max].
     #[inline]
