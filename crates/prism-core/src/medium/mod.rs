@@ -29,7 +29,9 @@
 //! hero, so chromatic media get fireflies. Here every weight is bounded (by N = 4 times the
 //! ratio of coefficients) and the majorant is one number per path segment, which a
 //! lane-parallel integrator can share across lanes. The price is extra null collisions where
-//! the four extinctions differ.
+//! the four extinctions differ. (`volpathmis` takes the other route and bounds the hero's
+//! weights by multiple importance sampling over the four wavelengths' densities, with each
+//! wavelength's own majorant, [`Medium::majorants`]; see `integrator::volpathmis`.)
 //!
 //! # Transmittance of shadow rays
 //! A homogeneous medium's transmittance is the closed form exp(−σ_t d); a heterogeneous one's
