@@ -17,7 +17,7 @@ use prism_core::error::{Error, Result};
 use prism_core::image::compare::rel_mse_rgb;
 use prism_core::image::read_exr;
 use prism_core::integrator::{
-    DistributionIntegrator, Integrator, PathIntegrator, VolPathIntegrator,
+    DistributionIntegrator, Integrator, PathIntegrator, Tracking, VolPathIntegrator,
 };
 use prism_core::render::{RenderOptions, render};
 use prism_core::sampling::sampler::SamplerKind;
@@ -102,15 +102,28 @@ fn integrator_named(name: &str, scene: &Scene) -> Result<Integrator> {
             .into(),
         }),
         "volpath" => Ok(match &scene.integrator {
-            Integrator::VolPath(v) => Integrator::VolPath(v.clone()),
+            Integrator::VolPath(v) if v.tracking == Tracking::Spectral => {
+                Integrator::VolPath(v.clone())
+            }
             _ => VolPathIntegrator {
                 max_depth,
                 ..VolPathIntegrator::default()
             }
             .into(),
         }),
+        "volpathmis" => Ok(match &scene.integrator {
+            Integrator::VolPath(v) if v.tracking != Tracking::Spectral => {
+                Integrator::VolPath(v.clone())
+            }
+            _ => VolPathIntegrator {
+                max_depth,
+                tracking: Tracking::HeroMis { spectral_mis: true },
+                ..VolPathIntegrator::default()
+            }
+            .into(),
+        }),
         other => Err(Error::usage(format!("unknown integrator \"{other}\""))
-            .with_help("use path, distrib or volpath")),
+            .with_help("use path, distrib, volpath or volpathmis")),
     }
 }
 
@@ -137,7 +150,8 @@ fn integrator_label(integrator: &Integrator) -> &'static str {
     match integrator {
         Integrator::Path(_) => "path",
         Integrator::Distribution(_) => "distrib",
-        Integrator::VolPath(_) => "volpath",
+        Integrator::VolPath(v) if v.tracking == Tracking::Spectral => "volpath",
+        Integrator::VolPath(_) => "volpathmis",
     }
 }
 

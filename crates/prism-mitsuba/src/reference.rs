@@ -90,9 +90,9 @@ pub fn reference() -> Vec<ClassReference> {
         ),
         (
             PluginClass::Medium,
-            "Participating media, for the `volpath` integrator: a shape nests them as \
-             `<medium name=\"interior\">` or `name=\"exterior\"` (inline or `<ref>`), the sensor \
-             as the medium it sits in. Give a medium's boundary a `null` BSDF to let light \
+            "Participating media, for the `volpath` and `volpathmis` integrators: a shape nests \
+             them as `<medium name=\"interior\">` or `name=\"exterior\"` (inline or `<ref>`), the \
+             sensor as the medium it sits in. Give a medium's boundary a `null` BSDF to let light \
              through unchanged. `distrib` refuses media; `path` ignores them, as Mitsuba's does.",
             entries(&crate::factory::media::MEDIA),
         ),

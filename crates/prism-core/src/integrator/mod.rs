@@ -1,5 +1,5 @@
 //! Integrators: estimators of the radiance arriving along a camera ray: the path tracer and the
-//! lecture's distribution ray tracer with splitting, and the volumetric path tracer.
+//! lecture's distribution ray tracer with splitting, and the volumetric path tracers.
 //!
 //! An [`Integrator`] is what a scene asks for: an estimator and its parameters. Before a render
 //! it is prepared for the world ([`Integrator::prepare`]), which builds the light sampler it
@@ -8,10 +8,14 @@
 pub mod distribution;
 pub mod path;
 pub mod volpath;
+pub mod volpathmis;
 
 pub use distribution::DistributionIntegrator;
 pub use path::PathIntegrator;
-pub use volpath::VolPathIntegrator;
+pub use volpath::{Tracking, VolPathIntegrator};
+
+use volpath::SpectralTracking;
+use volpathmis::SpectralMis;
 
 use crate::bsdf::{BsdfEval, Scattering};
 use crate::geometry::SurfaceInteraction;
@@ -105,9 +109,19 @@ impl PreparedIntegrator<'_> {
             Integrator::Distribution(integrator) => {
                 integrator.radiance(self, ray, lambda, sampler, count)
             }
-            Integrator::VolPath(integrator) => {
-                integrator.radiance(self, ray, lambda, sampler, count)
-            }
+            Integrator::VolPath(integrator) => match integrator.tracking {
+                Tracking::Spectral => {
+                    integrator.trace(SpectralTracking::new(), self, ray, lambda, sampler, count)
+                }
+                Tracking::HeroMis { spectral_mis } => integrator.trace(
+                    SpectralMis::new(spectral_mis),
+                    self,
+                    ray,
+                    lambda,
+                    sampler,
+                    count,
+                ),
+            },
         }
     }
 }

@@ -30,6 +30,10 @@
 //!   starts after `rr_depth` bounces (depth > rr_depth, as Mitsuba's volpath).
 //! * Chromatic media keep all four wavelengths unbiased (see [`crate::medium`] for why one
 //!   majorant over the four rather than hero-wavelength tracking).
+//!
+//! The path loop below is shared with `volpathmis` ([`super::volpathmis`]): what differs is how
+//! free flights are drawn and how the path's weights and its estimate are kept, the
+//! [`PathWeights`] of each ([`SpectralTracking`] here).
 
 use glam::Vec3;
 
@@ -56,6 +60,8 @@ pub struct VolPathIntegrator {
     pub hide_emitters: bool,
     /// How one light is chosen for each light sample.
     pub light_selection: LightSelection,
+    /// How free flights are drawn and weighted: `volpath` or `volpathmis`.
+    pub tracking: Tracking,
 }
 
 impl Default for VolPathIntegrator {
@@ -65,25 +71,176 @@ impl Default for VolPathIntegrator {
             rr_depth: 5,
             hide_emitters: false,
             light_selection: LightSelection::Power,
+            tracking: Tracking::Spectral,
         }
     }
 }
 
-/// The last scattering vertex (on a surface or in a medium), which emitters found by its
-/// directional sample are MIS-weighted against.
-#[derive(Clone, Copy)]
-struct Previous {
-    p: Vec3,
-    /// Solid-angle density of the sampled direction.
+/// The two volumetric path tracers.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Tracking {
+    /// `volpath`: spectral tracking with one majorant for the four wavelengths, light and
+    /// directional samples combined by the power heuristic.
+    Spectral,
+    /// `volpathmis`: the hero wavelength's free flights, and the balance heuristic over the
+    /// light and directional samples and (with `spectral_mis`, Mitsuba's default) over the
+    /// four wavelengths' densities ([`super::volpathmis`]).
+    HeroMis { spectral_mis: bool },
+}
+
+/// What a volumetric path keeps besides its geometry: its weights, the state its MIS weights
+/// need, and the estimate it sums. The loop in [`VolPathIntegrator`] calls these at each event.
+pub(super) trait PathWeights {
+    /// The factor by which the path's further contributions are weighted (before MIS against
+    /// light samples): Russian roulette and termination look at it.
+    fn throughput(&self) -> SampledSpectrum;
+
+    /// Multiplies the path's weight by `factor` (Russian roulette's 1/survival).
+    fn scale(&mut self, factor: f32);
+
+    /// Tracks the path along `ray` (unit direction) through `medium` up to the surface at
+    /// `t_surface`: the distance of a real collision, or `None` when the path reaches the
+    /// surface (or leaves the medium's extent) first.
+    fn free_flight(
+        &mut self,
+        medium: &Medium,
+        ray: &Ray,
+        t_surface: f32,
+        lambda: &SampledWavelengths,
+        sampler: &mut Sampler,
+    ) -> Option<f32>;
+
+    /// A directional sample at a scattering vertex: value over density `weight`, solid-angle
+    /// density `pdf`; `unweighted` when no light sample could have found what it finds (a
+    /// delta lobe, or a medium without `sample_emitters`), whose emission then counts in full.
+    fn scatter(&mut self, weight: SampledSpectrum, pdf: f32, unweighted: bool);
+
+    /// Whether emission found next is weighted against light sampling (so its light density
+    /// is needed).
+    fn weights_emission(&self) -> bool;
+
+    /// Adds emitted radiance `emitted` found by the path, which light sampling from the last
+    /// vertex finds with solid-angle density `light_pdf` (ignored when unweighted).
+    fn add_emission(&mut self, emitted: SampledSpectrum, light_pdf: f32);
+
+    /// Adds a light sample taken at the path's current vertex.
+    fn add_light_sample(&mut self, sample: &LightSampleTerms);
+
+    /// The path's estimate for the caller's wavelengths; `lambda_was_whole` when the path
+    /// started with all four.
+    fn estimate(&self, lambda: &SampledWavelengths, lambda_was_whole: bool) -> SampledSpectrum;
+}
+
+/// The factors of one light sample at a vertex: the BSDF's or phase function's value towards
+/// the light, the solid-angle densities of sampling that direction by the vertex and by the
+/// light (the light's choice included), the transmittance of the shadow ray and the radiance.
+pub(super) struct LightSampleTerms {
+    pub value: SampledSpectrum,
+    pub direction_pdf: f32,
+    pub light_pdf: f32,
+    pub is_delta: bool,
+    pub transmittance: SampledSpectrum,
+    pub radiance: SampledSpectrum,
+}
+
+/// `volpath`'s weights: the throughput of spectral tracking and the density of the last
+/// directional sample, for the power heuristic against light samples.
+pub(super) struct SpectralTracking {
+    throughput: SampledSpectrum,
+    /// Solid-angle density of the last directional sample.
     pdf: f32,
-    /// Whether no light sample could have found what the direction finds (a delta lobe, or a
-    /// medium without `sample_emitters`): its emission then counts in full.
     unweighted: bool,
+    result: SampledSpectrum,
+}
+
+impl SpectralTracking {
+    pub(super) fn new() -> Self {
+        SpectralTracking {
+            throughput: SampledSpectrum::ONE,
+            pdf: 0.0,
+            unweighted: true,
+            result: SampledSpectrum::ZERO,
+        }
+    }
+}
+
+impl PathWeights for SpectralTracking {
+    #[inline]
+    fn throughput(&self) -> SampledSpectrum {
+        self.throughput
+    }
+
+    #[inline]
+    fn scale(&mut self, factor: f32) {
+        self.throughput *= factor;
+    }
+
+    #[inline]
+    fn free_flight(
+        &mut self,
+        medium: &Medium,
+        ray: &Ray,
+        t_surface: f32,
+        lambda: &SampledWavelengths,
+        sampler: &mut Sampler,
+    ) -> Option<f32> {
+        spectral_tracking(
+            medium,
+            ray,
+            t_surface,
+            lambda,
+            &mut self.throughput,
+            sampler,
+        )
+    }
+
+    #[inline]
+    fn scatter(&mut self, weight: SampledSpectrum, pdf: f32, unweighted: bool) {
+        self.throughput *= weight;
+        self.pdf = pdf;
+        self.unweighted = unweighted;
+    }
+
+    #[inline]
+    fn weights_emission(&self) -> bool {
+        !self.unweighted
+    }
+
+    #[inline]
+    fn add_emission(&mut self, emitted: SampledSpectrum, light_pdf: f32) {
+        let weight = if self.unweighted {
+            1.0
+        } else {
+            power_heuristic(self.pdf, light_pdf)
+        };
+        self.result += self.throughput * emitted * weight;
+    }
+
+    /// f·Tr·L·w / p_light, w the power heuristic against the directional density.
+    #[inline]
+    fn add_light_sample(&mut self, s: &LightSampleTerms) {
+        let weight = if s.is_delta {
+            1.0
+        } else {
+            power_heuristic(s.light_pdf, s.direction_pdf)
+        };
+        self.result +=
+            self.throughput * s.value * s.transmittance * s.radiance * (weight / s.light_pdf);
+    }
+
+    #[inline]
+    fn estimate(&self, lambda: &SampledWavelengths, lambda_was_whole: bool) -> SampledSpectrum {
+        if lambda_was_whole && lambda.secondary_terminated() {
+            hero_only(self.result)
+        } else {
+            self.result
+        }
+    }
 }
 
 /// The medium a ray leaving `si` in direction `d` travels in, when it was in `current`.
 #[inline]
-fn medium_after(
+pub(super) fn medium_after(
     world: &World,
     si: &SurfaceInteraction,
     d: Vec3,
@@ -114,7 +271,7 @@ fn counted(throughput: SampledSpectrum, lambda: &SampledWavelengths) -> SampledS
 /// the distance of a real collision, or `None` when the path reaches the surface (or leaves
 /// the medium's extent) first. The throughput is multiplied by each event's weight.
 #[inline]
-fn free_flight(
+fn spectral_tracking(
     medium: &Medium,
     ray: &Ray,
     t_surface: f32,
@@ -215,8 +372,10 @@ impl VolPathIntegrator {
         self.max_depth < 0 || depth + 1 < self.max_depth
     }
 
-    pub(super) fn radiance(
+    /// The path loop of both volumetric path tracers, keeping the path's weights in `weights`.
+    pub(super) fn trace<W: PathWeights>(
         &self,
+        mut weights: W,
         prepared: &PreparedIntegrator,
         camera_ray: Ray,
         wavelengths: &SampledWavelengths,
@@ -226,10 +385,9 @@ impl VolPathIntegrator {
         let world = prepared.world;
         let mut lambda = *wavelengths;
         let lambda_was_whole = !wavelengths.secondary_terminated();
-        let mut result = SampledSpectrum::ZERO;
-        let mut throughput = SampledSpectrum::ONE;
         let mut eta_scale = 1.0f32;
-        let mut previous: Option<Previous> = None;
+        // The last scattering vertex, which light sampling would have started from.
+        let mut previous = Vec3::ZERO;
         let mut depth = 0i32;
         let mut medium = world.camera_medium;
         let mut ray = Ray {
@@ -238,7 +396,7 @@ impl VolPathIntegrator {
         };
         let mut lobes = BxdfTree::empty();
         if self.max_depth == 0 {
-            return result;
+            return SampledSpectrum::ZERO;
         }
         loop {
             count.rays += 1;
@@ -248,9 +406,8 @@ impl VolPathIntegrator {
             if let Some(m) = medium {
                 let med = &world.media[m as usize];
                 let t_surface = hit.map_or(f32::INFINITY, |si| si.t);
-                let collision =
-                    free_flight(med, &ray, t_surface, &lambda, &mut throughput, sampler);
-                if throughput.is_black() {
+                let collision = weights.free_flight(med, &ray, t_surface, &lambda, sampler);
+                if weights.throughput().is_black() {
                     break;
                 }
                 if let Some(t) = collision {
@@ -259,25 +416,22 @@ impl VolPathIntegrator {
                     }
                     let p = ray.at(t);
                     let wo = -ray.d;
-                    if med.sample_emitters {
-                        result += throughput
-                            * Self::sample_direct_medium(
-                                prepared, p, wo, ray.time, &med.phase, medium, &lambda, sampler,
-                                count,
-                            );
+                    if med.sample_emitters
+                        && let Some(terms) = Self::sample_direct_medium(
+                            prepared, p, wo, ray.time, &med.phase, medium, &lambda, sampler, count,
+                        )
+                    {
+                        weights.add_light_sample(&terms);
                     }
                     let ps = med.phase.sample(wo, sampler.next_2d());
                     if !(ps.pdf > 0.0) {
                         break;
                     }
                     ray = Ray::new(p, ps.wi, f32::INFINITY, ray.time);
-                    previous = Some(Previous {
-                        p,
-                        pdf: ps.pdf,
-                        unweighted: !med.sample_emitters,
-                    });
+                    weights.scatter(SampledSpectrum::ONE, ps.pdf, !med.sample_emitters);
+                    previous = p;
                     depth += 1;
-                    if !self.survives_roulette(depth, &mut throughput, eta_scale, sampler) {
+                    if !self.survives_roulette(depth, &mut weights, eta_scale, sampler) {
                         break;
                     }
                     continue;
@@ -290,15 +444,14 @@ impl VolPathIntegrator {
                 {
                     let light = &world.lights[env as usize];
                     let emitted = light.environment_radiance(ray.d, &lambda);
-                    let weight = match &previous {
-                        Some(prev) if !prev.unweighted && !emitted.is_black() => {
-                            let light_pdf = prepared.light_sampler.pmf(env as usize)
-                                * light.environment_pdf(ray.d);
-                            power_heuristic(prev.pdf, light_pdf)
-                        }
-                        _ => 1.0,
-                    };
-                    result += throughput * emitted * weight;
+                    if !emitted.is_black() {
+                        let light_pdf = if weights.weights_emission() {
+                            prepared.light_sampler.pmf(env as usize) * light.environment_pdf(ray.d)
+                        } else {
+                            0.0
+                        };
+                        weights.add_emission(emitted, light_pdf);
+                    }
                 }
                 break;
             };
@@ -314,16 +467,14 @@ impl VolPathIntegrator {
                 };
                 let emitted = light.emitted(si.shading.n, wo, &lambda);
                 if !emitted.is_black() {
-                    let weight = match &previous {
-                        Some(prev) if !prev.unweighted => {
-                            let shape = &world.geometry.primitives[si.shape as usize];
-                            let light_pdf = prepared.light_sampler.pmf(light_index as usize)
-                                * shape.pdf_from(prev.p, si.time, si.p, si.n);
-                            power_heuristic(prev.pdf, light_pdf)
-                        }
-                        _ => 1.0,
+                    let light_pdf = if weights.weights_emission() {
+                        let shape = &world.geometry.primitives[si.shape as usize];
+                        prepared.light_sampler.pmf(light_index as usize)
+                            * shape.pdf_from(previous, si.time, si.p, si.n)
+                    } else {
+                        0.0
                     };
-                    result += throughput * emitted * weight;
+                    weights.add_emission(emitted, light_pdf);
                 }
             }
 
@@ -343,17 +494,18 @@ impl VolPathIntegrator {
             if smooth && scattering.is_dispersive() {
                 lambda.terminate_secondary();
             }
-            if smooth {
-                result += throughput
-                    * Self::sample_direct_surface(
-                        prepared,
-                        &si,
-                        &scattering,
-                        medium,
-                        &lambda,
-                        sampler,
-                        count,
-                    );
+            if smooth
+                && let Some(terms) = Self::sample_direct_surface(
+                    prepared,
+                    &si,
+                    &scattering,
+                    medium,
+                    &lambda,
+                    sampler,
+                    count,
+                )
+            {
+                weights.add_light_sample(&terms);
             }
 
             let u_lobe = sampler.next_1d();
@@ -364,48 +516,41 @@ impl VolPathIntegrator {
             if bs.terminates_secondary {
                 lambda.terminate_secondary();
             }
-            throughput *= bs.weight;
+            weights.scatter(bs.weight, bs.pdf, bs.flags.is_delta());
             eta_scale *= bs.eta;
-            if throughput.is_black() {
+            if weights.throughput().is_black() {
                 break;
             }
             let wi = bs.wi.normalize();
             medium = medium_after(world, &si, wi, medium);
             ray = si.spawn_ray(wi);
-            previous = Some(Previous {
-                p: si.p,
-                pdf: bs.pdf,
-                unweighted: bs.flags.is_delta(),
-            });
+            previous = si.p;
             depth += 1;
-            if !self.survives_roulette(depth, &mut throughput, eta_scale, sampler) {
+            if !self.survives_roulette(depth, &mut weights, eta_scale, sampler) {
                 break;
             }
         }
-        if lambda_was_whole && lambda.secondary_terminated() {
-            return hero_only(result);
-        }
-        result
+        weights.estimate(&lambda, lambda_was_whole)
     }
 
     /// Russian roulette after `rr_depth` bounces: survival s = min(max throughput · η², 0.95),
-    /// the survivor's throughput divided by s.
+    /// the survivor's weight divided by s.
     #[inline]
     fn survives_roulette(
         &self,
         depth: i32,
-        throughput: &mut SampledSpectrum,
+        weights: &mut impl PathWeights,
         eta_scale: f32,
         sampler: &mut Sampler,
     ) -> bool {
         if depth <= self.rr_depth {
             return true;
         }
-        let survival = (throughput.max_value() * eta_scale * eta_scale).min(0.95);
+        let survival = (weights.throughput().max_value() * eta_scale * eta_scale).min(0.95);
         if !(sampler.next_1d() < survival) {
             return false;
         }
-        *throughput *= 1.0 / survival;
+        weights.scale(1.0 / survival);
         true
     }
 
@@ -435,8 +580,8 @@ impl VolPathIntegrator {
         Some((ls, choice_pmf))
     }
 
-    /// One light sample at the surface point `si`: f·Tr·L·w / (p_light · p_choice), with the
-    /// transmittance Tr of the media the shadow ray crosses.
+    /// One light sample at the surface point `si`, with the transmittance Tr of the media the
+    /// shadow ray crosses; `None` when it contributes nothing.
     fn sample_direct_surface(
         prepared: &PreparedIntegrator,
         si: &SurfaceInteraction,
@@ -445,15 +590,12 @@ impl VolPathIntegrator {
         lambda: &SampledWavelengths,
         sampler: &mut Sampler,
         count: &mut RayCount,
-    ) -> SampledSpectrum {
+    ) -> Option<LightSampleTerms> {
         let world = prepared.world;
-        let Some((ls, choice_pmf)) = Self::sample_light(prepared, si.p, si.time, lambda, sampler)
-        else {
-            return SampledSpectrum::ZERO;
-        };
+        let (ls, choice_pmf) = Self::sample_light(prepared, si.p, si.time, lambda, sampler)?;
         let f = scattering.eval(ls.wi);
         if f.value.is_black() {
-            return SampledSpectrum::ZERO;
+            return None;
         }
         let shadow = si.spawn_ray_to(ls.p, ls.n);
         let end = shadow.o + shadow.d * shadow.t_max;
@@ -468,20 +610,21 @@ impl VolPathIntegrator {
             count,
         );
         if transmittance.is_black() {
-            return SampledSpectrum::ZERO;
+            return None;
         }
-        let light_pdf = choice_pmf * ls.pdf;
-        let weight = if ls.is_delta {
-            1.0
-        } else {
-            power_heuristic(light_pdf, f.pdf)
-        };
-        f.value * transmittance * ls.radiance * (weight / light_pdf)
+        Some(LightSampleTerms {
+            value: f.value,
+            direction_pdf: f.pdf,
+            light_pdf: choice_pmf * ls.pdf,
+            is_delta: ls.is_delta,
+            transmittance,
+            radiance: ls.radiance,
+        })
     }
 
-    /// One light sample at the point `p` of `medium`, scattered towards `wo` by `phase`:
-    /// σ_s-weighted phase value times Tr·L·w / (p_light · p_choice). (The path throughput
-    /// already carries σ_s/σ_t of the real collision.)
+    /// One light sample at the point `p` of `medium`, scattered towards `wo` by `phase` (the
+    /// path's weight already carries σ_s of the real collision); `None` when it contributes
+    /// nothing.
     #[allow(clippy::too_many_arguments)] // the vertex, its medium and the path's state
     fn sample_direct_medium(
         prepared: &PreparedIntegrator,
@@ -493,14 +636,12 @@ impl VolPathIntegrator {
         lambda: &SampledWavelengths,
         sampler: &mut Sampler,
         count: &mut RayCount,
-    ) -> SampledSpectrum {
+    ) -> Option<LightSampleTerms> {
         let world = prepared.world;
-        let Some((ls, choice_pmf)) = Self::sample_light(prepared, p, time, lambda, sampler) else {
-            return SampledSpectrum::ZERO;
-        };
+        let (ls, choice_pmf) = Self::sample_light(prepared, p, time, lambda, sampler)?;
         let phase_value = phase.eval(wo, ls.wi);
         if !(phase_value > 0.0) {
-            return SampledSpectrum::ZERO;
+            return None;
         }
         let transmittance = shadow_transmittance(
             world,
@@ -513,14 +654,15 @@ impl VolPathIntegrator {
             count,
         );
         if transmittance.is_black() {
-            return SampledSpectrum::ZERO;
+            return None;
         }
-        let light_pdf = choice_pmf * ls.pdf;
-        let weight = if ls.is_delta {
-            1.0
-        } else {
-            power_heuristic(light_pdf, phase_value)
-        };
-        transmittance * ls.radiance * (phase_value * weight / light_pdf)
+        Some(LightSampleTerms {
+            value: SampledSpectrum::splat(phase_value),
+            direction_pdf: phase_value,
+            light_pdf: choice_pmf * ls.pdf,
+            is_delta: ls.is_delta,
+            transmittance,
+            radiance: ls.radiance,
+        })
     }
 }

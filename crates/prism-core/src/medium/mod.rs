@@ -29,7 +29,9 @@
 //! hero, so chromatic media get fireflies. Here every weight is bounded (by N = 4 times the
 //! ratio of coefficients) and the majorant is one number per path segment, which a
 //! lane-parallel integrator can share across lanes. The price is extra null collisions where
-//! the four extinctions differ.
+//! the four extinctions differ. (`volpathmis` takes the other route and bounds the hero's
+//! weights by multiple importance sampling over the four wavelengths' densities, with each
+//! wavelength's own majorant, [`Medium::majorants`]; see `integrator::volpathmis`.)
 //!
 //! # Transmittance of shadow rays
 //! A homogeneous medium's transmittance is the closed form exp(−σ_t d); a heterogeneous one's
@@ -183,6 +185,18 @@ impl Medium {
                 self.coefficients(Vec3::ZERO, lambda).sigma_t.max_value()
             }
             MediumKind::Heterogeneous { sigma_t, scale, .. } => sigma_t.max_value() * scale,
+        }
+    }
+
+    /// Each wavelength's own majorant m(λᵢ) ≥ σ_t(x, λᵢ) for every point: σ_t(λᵢ) itself for a
+    /// homogeneous medium (which then has no null collisions), the grid's maximum for all four
+    /// in a heterogeneous one.
+    #[inline]
+    pub fn majorants(&self, lambda: &SampledWavelengths) -> SampledSpectrum {
+        if self.is_homogeneous() {
+            self.coefficients(Vec3::ZERO, lambda).sigma_t
+        } else {
+            SampledSpectrum::splat(self.majorant(lambda))
         }
     }
 

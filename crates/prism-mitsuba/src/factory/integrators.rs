@@ -1,5 +1,6 @@
 //! Integrator plugins: `path` (with Prism's `emitter_sampling`, see
-//! [`prism_core::light::sampler`]), the lecture's `distrib`, and `volpath` for media.
+//! [`prism_core::light::sampler`]), the lecture's `distrib`, and `volpath` and `volpathmis`
+//! for media.
 
 use crate::description::{PluginClass, PluginNode};
 use crate::params::Params;
@@ -7,7 +8,7 @@ use crate::registry::{Default, Origin, ParamKind, ParamSpec, Plugin, Registry};
 use prism_core::error::{Error, Result};
 use prism_core::integrator::distribution::DirectLights;
 use prism_core::integrator::{
-    DistributionIntegrator, Integrator, PathIntegrator, VolPathIntegrator,
+    DistributionIntegrator, Integrator, PathIntegrator, Tracking, VolPathIntegrator,
 };
 use prism_core::light::LightSelection;
 
@@ -53,6 +54,22 @@ pub static INTEGRATORS: Registry<Build> = Registry {
             params: &[MAX_DEPTH, RR_DEPTH, HIDE_EMITTERS, EMITTER_SAMPLING],
             build: build_volpath,
         },
+        Plugin {
+            name: "volpathmis",
+            origin: Origin::Mitsuba3,
+            summary: "Volumetric path tracing with spectral MIS (Miller, Georgiev & Jarosz \
+                      2019): `volpath`'s path loop with the hero wavelength's free flights, \
+                      combined over the path's four wavelengths and with light samples by the \
+                      balance heuristic, so chromatic media stay free of fireflies.",
+            params: &[
+                MAX_DEPTH,
+                RR_DEPTH,
+                HIDE_EMITTERS,
+                EMITTER_SAMPLING,
+                USE_SPECTRAL_MIS,
+            ],
+            build: build_volpathmis,
+        },
     ],
 };
 
@@ -80,6 +97,13 @@ const EMITTER_SAMPLING: ParamSpec = ParamSpec::new(
     Default::Str("power"),
     "Prism only (Mitsuba rejects it): one light per shading point chosen ∝ its power × \
      `sampling_weight`, or ∝ `sampling_weight` alone (Mitsuba's rule; uniform by default)",
+);
+const USE_SPECTRAL_MIS: ParamSpec = ParamSpec::new(
+    "use_spectral_mis",
+    ParamKind::Boolean,
+    Default::Boolean(true),
+    "combine the four wavelengths' free-flight densities by MIS; false weights every \
+     wavelength by the hero's densities alone",
 );
 const BOUNCE_SAMPLES: ParamSpec = ParamSpec::new(
     "bounce_samples",
@@ -169,6 +193,19 @@ fn build_volpath(params: &Params) -> Result<Integrator> {
         rr_depth: path.rr_depth,
         hide_emitters: path.hide_emitters,
         light_selection: path.light_selection,
+        tracking: Tracking::Spectral,
+    }))
+}
+
+fn build_volpathmis(params: &Params) -> Result<Integrator> {
+    let Integrator::VolPath(volpath) = build_volpath(params)? else {
+        unreachable!("build_volpath builds a volumetric path integrator");
+    };
+    Ok(Integrator::VolPath(VolPathIntegrator {
+        tracking: Tracking::HeroMis {
+            spectral_mis: params.boolean(&USE_SPECTRAL_MIS)?,
+        },
+        ..volpath
     }))
 }
 

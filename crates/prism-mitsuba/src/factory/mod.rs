@@ -358,7 +358,9 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
             location,
             "the distrib integrator does not render participating media",
         )
-        .with_help("render scenes with media with <integrator type=\"volpath\">"));
+        .with_help(
+            "render scenes with media with <integrator type=\"volpath\"> or \"volpathmis\"",
+        ));
     }
 
     let mut world = World::new(Geometry::new(shapes), shape_info, materials, lights)
