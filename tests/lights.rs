@@ -496,10 +496,7 @@ fn flux_of_point_spot_and_area_lights() {
     let spot_flux = 2.0 * PI * 3.0 * (1.0 - (cutoff.sin() - beam.sin()) / (cutoff - beam));
     assert_flux("spot", &spot, &[], around, true, spot_flux, 42);
 
-    let area = Light::Area(AreaLight {
-        shape: 0,
-        radiance: Spectrum::Constant(1.5),
-    });
+    let area = Light::Area(AreaLight::uniform(0, Spectrum::Constant(1.5)));
     let ball = [sphere(Vec3::new(0.0, 0.3, 0.2), 0.7)];
     assert_flux(
         "sphere light",
