@@ -22,8 +22,8 @@
 //! texture's luminance, mapped onto the shape by the inverse of its uv parametrisation
 //! ([`crate::geometry::Shape::at_uv`]). A density p_uv over uv becomes one over area by the
 //! Jacobian of the map, p_A = p_uv / |∂p/∂u × ∂p/∂v|, which corrects for meshes whose uv layout
-//! does not preserve area, and one over solid angle by p_ω = p_A · d² / |cos θ| (Veach 1997,
-//! §8.2.2). Unlike Mitsuba, this strategy is mixed with the shape's own one, taken with
+//! does not preserve area, and one over solid angle by p_ω = p_A · d² / |cos θ| (pbrt-v4
+//! §4.2.3). Unlike Mitsuba, this strategy is mixed with the shape's own one, taken with
 //! probability [`SHAPE_STRATEGY_FRACTION`] (defensive importance sampling, Hesterberg 1995):
 //! p = f · p_shape + (1 − f) · p_texture. The mixture is positive wherever the surface is, so
 //! the estimate stays unbiased where the texture strategy cannot reach: surface whose texture
