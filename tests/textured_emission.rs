@@ -1,5 +1,5 @@
 //! Area emitters whose radiance is a texture: the sampled density (chi-square, DESIGN.md §6) on a
-//! mesh whose uv layout does not preserve area, the density claimed for light samples and for
+//! mesh whose uv layout does not preserve area and on a sphere lit from inside, the density claimed for light samples and for
 //! points found by rays (the multiple importance sampling weight), the emitted flux against its
 //! closed form (also where the texture strategy cannot reach part of the surface), and the
 //! inverse uv maps of spheres and disks.
@@ -30,7 +30,7 @@ use prism_core::spectrum::SampledWavelengths;
 use prism_core::texture::{BitmapTexture, FilterType, Texture, TextureUse, UvTransform, WrapMode};
 
 /// Number of chi-square tests in this file, for Šidák's correction.
-const TESTS: usize = 1;
+const TESTS: usize = 2;
 const SAMPLES: usize = 1_000_000;
 
 /// The texels (row-major, row 0 at v < ½): one black, one brighter than 1.
@@ -186,6 +186,79 @@ fn textured_area_light_samples_follow_the_texture_through_the_uv_map() {
     })
     .unwrap();
     assert_passes("textured area light over uv", &outcome, TESTS);
+}
+
+/// A sphere of radius R lighting its inside (flipped normals), textured with the same image,
+/// seen from a point inside: the shape strategy is then uniform in area, whose density over uv
+/// is J / (4πR²) = (π/2) sin πv (J = 2π²R² sin πv), so a cell [u₀, u₁] × [v₀, v₁] gets
+/// (u₁ − u₀)(cos πv₀ − cos πv₁)/2 of it; the texture strategy is constant on each cell.
+#[test]
+fn textured_sphere_light_samples_follow_the_texture() {
+    let radius = 0.8f32;
+    let center = Vec3::new(0.1, -0.2, 0.3);
+    let shapes: Vec<Primitive> = vec![
+        Shape::Sphere(Sphere {
+            center,
+            radius,
+            rotation: glam::Mat3::IDENTITY,
+            flip_normals: true,
+        })
+        .into(),
+    ];
+    let light = Light::Area(AreaLight::new(0, texture(WrapMode::Repeat)));
+    let lambda = SampledWavelengths::single(550.0);
+    let reference = center + Vec3::new(0.2, 0.1, -0.3);
+    let f = f64::from(SHAPE_STRATEGY_FRACTION);
+    let area = 4.0 * std::f64::consts::PI * f64::from(radius).powi(2);
+    const N: usize = 8;
+    let mut probabilities: Vec<f64> = (0..N * N)
+        .map(|cell| {
+            let (i, j) = (cell % N, cell / N);
+            let uv = Vec2::new((i as f32 + 0.5) / N as f32, (j as f32 + 0.5) / N as f32);
+            if texel(uv) == 0.0 {
+                return 0.0;
+            }
+            let (v0, v1) = (j as f64 / N as f64, (j + 1) as f64 / N as f64);
+            let shape = ((std::f64::consts::PI * v0).cos() - (std::f64::consts::PI * v1).cos())
+                / (2.0 * N as f64);
+            f * shape + (1.0 - f) * texture_uv_density(uv) / (N * N) as f64
+        })
+        .collect();
+    probabilities.push(1.0 - probabilities.iter().sum::<f64>());
+    let outcome = chi2_discrete(SAMPLES, &probabilities, 9, |rng| {
+        let Some(ls) =
+            light.sample_incident(&shapes, reference, 0.0, rng.next_f32(), u2(rng), &lambda)
+        else {
+            return N * N;
+        };
+        // θ from atan2(√(x² + y²), z), which keeps its precision at the poles (acos z loses it).
+        let outward = (ls.p - center).normalize();
+        let local = outward.as_dvec3();
+        let mut phi = local.y.atan2(local.x);
+        if phi < 0.0 {
+            phi += 2.0 * std::f64::consts::PI;
+        }
+        let theta = local.x.hypot(local.y).atan2(local.z);
+        let uv = Vec2::new(
+            (phi / (2.0 * std::f64::consts::PI)) as f32,
+            (theta / std::f64::consts::PI) as f32,
+        );
+        let d = ls.p - reference;
+        let area_pdf = f64::from(ls.pdf) * f64::from(d.normalize().dot(outward).abs())
+            / f64::from(d.length_squared());
+        let jacobian = 2.0 * std::f64::consts::PI.powi(2) * f64::from(radius).powi(2) * theta.sin();
+        let expected = f / area + (1.0 - f) * texture_uv_density(uv) / jacobian;
+        // The point, from which uv is recomputed here, is stored in single precision.
+        assert!(
+            (area_pdf / expected - 1.0).abs() < 2e-3,
+            "at uv {uv}: pdf {area_pdf} per area instead of {expected}"
+        );
+        let i = ((uv.x * N as f32) as usize).min(N - 1);
+        let j = ((uv.y * N as f32) as usize).min(N - 1);
+        j * N + i
+    })
+    .unwrap();
+    assert_passes("textured sphere light over uv", &outcome, TESTS);
 }
 
 /// The density a ray hit reports for multiple importance sampling equals the one the light
