@@ -300,6 +300,38 @@ fn cases() -> Vec<Case> {
             "already attached",
         ),
         render_scene(
+            "area emitter radiance texture without its image",
+            scene!(
+                "    <shape type=\"sphere\"><emitter type=\"area\"><texture type=\"bitmap\" name=\"radiance\"><string name=\"filename\" value=\"missing.png\"/></texture></emitter></shape>"
+            ),
+            "scene.xml:3:",
+            "not found",
+        ),
+        render_scene(
+            "area emitter radiance given as a bsdf",
+            scene!(
+                "    <shape type=\"sphere\"><emitter type=\"area\"><bsdf type=\"diffuse\" name=\"radiance\"/></emitter></shape>"
+            ),
+            "scene.xml:3:",
+            "is not supported",
+        ),
+        render_scene(
+            "spot light texture with a cutoff beyond 90 degrees",
+            scene!(
+                "    <emitter type=\"spot\"><float name=\"cutoff_angle\" value=\"120\"/><texture type=\"checkerboard\" name=\"texture\"/></emitter>"
+            ),
+            "scene.xml:3:",
+            "below 90 degrees",
+        ),
+        render_scene(
+            "projector irradiance given as a bsdf",
+            scene!(
+                "    <emitter type=\"projector\"><bsdf type=\"diffuse\" name=\"irradiance\"/></emitter>"
+            ),
+            "scene.xml:3:",
+            "is not supported",
+        ),
+        render_scene(
             "unreferenced area emitter with negative radiance",
             scene!(
                 "    <emitter type=\"area\" id=\"light\"><rgb name=\"radiance\" value=\"-1\"/></emitter>"

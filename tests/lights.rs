@@ -7,6 +7,7 @@
 mod common;
 
 use std::f64::consts::PI;
+use std::sync::Arc;
 
 use common::chi2::regularized_gamma_q;
 use common::scenes::{
@@ -27,6 +28,7 @@ use prism_core::math::{Ray, Transform};
 use prism_core::sampling::rng::Pcg32;
 use prism_core::sampling::warp::sample_uniform_sphere;
 use prism_core::spectrum::{SampledWavelengths, Spectrum};
+use prism_core::texture::{BitmapTexture, FilterType, Texture, TextureUse, UvTransform, WrapMode};
 use prism_mitsuba::factory::shapes::{rectangle, transform_mesh};
 
 /// The plane z = 0, 100 × 100, diffuse `rho`, facing +z.
@@ -213,6 +215,80 @@ fn rectangle_light_by_lamberts_formula() {
     let film = render_film(&scene, 512, 33, None);
     assert_pixels("rectangle light", &film, &camera, |ray| {
         rho / PI * lambert_polygon(on_floor(ray), DVec3::Z, &vertices, radiance)
+    });
+}
+
+/// The rectangle light of [`rectangle_light_by_lamberts_formula`] with a 2 × 2 texture of
+/// nearest texels as its radiance: each texel covers a quarter of the rectangle, a polygon of
+/// constant radiance, so the irradiance is the sum of Lambert's formula over the quarters. The
+/// light is sampled by its texture through the uv map and found by BSDF samples, both weighted
+/// by the mixture's density (MIS).
+#[test]
+fn textured_rectangle_light_by_lamberts_formula() {
+    let rho = 0.5f64;
+    // Row-major, row 0 at v < ½; one black texel.
+    let texels = [6.0f32, 1.0, 0.0, 3.0];
+    let to_world = DMat4::from_translation(DVec3::new(0.3, 0.0, 1.0))
+        * DMat4::from_rotation_x(PI)
+        * DMat4::from_scale(DVec3::new(0.5, 0.3, 1.0));
+    let light = transform_mesh(rectangle(), &Transform::new(to_world).unwrap(), false, true);
+    // Texel (i, j) covers u ∈ [i/2, (i+1)/2], v ∈ [j/2, (j+1)/2]: local x ∈ [i − 1, i], y alike.
+    let quarters: Vec<(f64, Vec<DVec3>)> = (0..4)
+        .map(|t| {
+            let (i, j) = ((t % 2) as f64, (t / 2) as f64);
+            let corners = [(i - 1.0, j - 1.0), (i, j - 1.0), (i, j), (i - 1.0, j)];
+            let vertices = corners
+                .iter()
+                .map(|&(x, y)| to_world.transform_point3(DVec3::new(x, y, 0.0)))
+                .collect();
+            (f64::from(texels[t]), vertices)
+        })
+        .collect();
+    let size = UVec2::new(12, 10);
+    let camera = camera(
+        DVec3::new(0.0, -0.3, 0.8),
+        DVec3::ZERO,
+        DVec3::Y,
+        80.0,
+        size,
+    );
+    let mut scene = build(
+        vec![
+            floor(rho as f32),
+            Object {
+                shape: Shape::Mesh(light).into(),
+                reflectance: 0.0,
+                emission: Some(1.0),
+            },
+        ],
+        vec![],
+        camera.clone(),
+        size,
+        PathIntegrator::default(),
+    );
+    let bitmap = Bitmap {
+        width: 2,
+        height: 2,
+        channels: 1,
+        data: texels.to_vec(),
+        encoding: Encoding::Linear,
+    };
+    let texture = Texture::Bitmap(Arc::new(BitmapTexture::new(
+        &bitmap,
+        TextureUse::Emission,
+        FilterType::Nearest,
+        WrapMode::Clamp,
+        UvTransform::IDENTITY,
+    )));
+    scene.world.lights[0] = Light::Area(AreaLight::new(1, texture));
+    let film = render_film(&scene, 512, 34, None);
+    assert_pixels("textured rectangle light", &film, &camera, |ray| {
+        let x = on_floor(ray);
+        rho / PI
+            * quarters
+                .iter()
+                .map(|(radiance, vertices)| lambert_polygon(x, DVec3::Z, vertices, *radiance))
+                .sum::<f64>()
     });
 }
 
@@ -496,10 +572,7 @@ fn flux_of_point_spot_and_area_lights() {
     let spot_flux = 2.0 * PI * 3.0 * (1.0 - (cutoff.sin() - beam.sin()) / (cutoff - beam));
     assert_flux("spot", &spot, &[], around, true, spot_flux, 42);
 
-    let area = Light::Area(AreaLight {
-        shape: 0,
-        radiance: Spectrum::Constant(1.5),
-    });
+    let area = Light::Area(AreaLight::uniform(0, Spectrum::Constant(1.5)));
     let ball = [sphere(Vec3::new(0.0, 0.3, 0.2), 0.7)];
     assert_flux(
         "sphere light",

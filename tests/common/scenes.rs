@@ -57,10 +57,10 @@ pub fn build(
             back: None,
         });
         let light = object.emission.map(|radiance| {
-            lights.push(Light::Area(AreaLight {
-                shape: i as u32,
-                radiance: Spectrum::Constant(radiance),
-            }));
+            lights.push(Light::Area(AreaLight::uniform(
+                i as u32,
+                Spectrum::Constant(radiance),
+            )));
             (lights.len() - 1) as u32
         });
         info.push(ShapeInfo {

@@ -129,6 +129,8 @@ impl Instance {
             p: transform.point(s.p),
             n: transform.normal(s.n).normalize(),
             shading_n: transform.normal(s.shading_n).normalize(),
+            uv: s.uv,
+            primitive: s.primitive,
             pdf: s.pdf,
         })
     }

@@ -6,6 +6,7 @@
 //! times (a BSDF with an `id`) are built once.
 
 mod instancing;
+pub mod fov;
 pub mod integrators;
 pub mod lights;
 pub mod materials;
@@ -281,7 +282,8 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
                          give each shape its own <emitter type=\"area\">",
                     ));
                 }
-                let (light, weight) = lights::build_area_light(&emitter.node, shape_index)?;
+                let (light, weight) =
+                    lights::build_area_light(&emitter.node, shape_index, &mut textures)?;
                 lights.push(light);
                 sampling_weights.push(weight);
                 Some((lights.len() - 1) as u32)
@@ -302,11 +304,11 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
             // it; one that no shape references emits nothing (Mitsuba ignores it), but its
             // parameters are still checked.
             if !attached_emitters.contains_key(&Arc::as_ptr(&child.node)) {
-                lights::build_area_light(&child.node, 0)?;
+                lights::build_area_light(&child.node, 0, &mut textures)?;
             }
             continue;
         }
-        let (light, weight) = lights::build_scene_light(&child.node)?;
+        let (light, weight) = lights::build_scene_light(&child.node, &mut textures)?;
         scene_lights.push((light, weight, child.location.clone()));
     }
     lights::check_single_environment(&scene_lights)?;

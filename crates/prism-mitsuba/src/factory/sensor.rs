@@ -6,10 +6,10 @@ use std::sync::Arc;
 
 use glam::{UVec2, Vec2};
 
+use super::fov::{FOCAL_LENGTH, FOV, FOV_AXIS, horizontal_fov_param};
 use crate::description::{PluginClass, PluginNode};
 use crate::params::{Params, Warning};
 use crate::registry::{Default, Origin, ParamKind, ParamSpec, Plugin, Registry};
-use prism_core::camera::perspective::{FovAxis, focal_length_to_diagonal_fov, horizontal_fov};
 use prism_core::camera::{Camera, OrthographicCamera, PerspectiveCamera, Shutter};
 use prism_core::error::{Error, Result};
 use prism_core::film::{CropWindow, Filter, LdrFormat, LdrOutput, Tonemap, TransferCurve};
@@ -48,24 +48,6 @@ pub static SENSORS: Registry<SensorBuild> = Registry {
     ],
 };
 
-const FOV: ParamSpec = ParamSpec::new(
-    "fov",
-    ParamKind::Float,
-    Default::Text("from `focal_length`"),
-    "field of view in degrees, along `fov_axis`",
-);
-const FOV_AXIS: ParamSpec = ParamSpec::new(
-    "fov_axis",
-    ParamKind::Choice(&["x", "y", "diagonal", "smaller", "larger"]),
-    Default::Str("x"),
-    "the film axis `fov` is measured along",
-);
-const FOCAL_LENGTH: ParamSpec = ParamSpec::new(
-    "focal_length",
-    ParamKind::String,
-    Default::Str("50mm"),
-    "the field of view as the focal length of a lens on 35 mm film (diagonal); instead of `fov`",
-);
 const NEAR_CLIP: ParamSpec = ParamSpec::new(
     "near_clip",
     ParamKind::Float,
@@ -718,54 +700,7 @@ fn build_sensor_of(params: &Params, thinlens: bool) -> Result<SensorSettings> {
     } = sensor_parts(params)?;
 
     let aspect = f64::from(film.size.x) / f64::from(film.size.y);
-    let fov_x = match (params.float_opt(&FOV)?, params.string_opt(&FOCAL_LENGTH)?) {
-        (Some(_), Some(_)) => {
-            return Err(Error::input(
-                params.location_of(&FOCAL_LENGTH),
-                "give either \"fov\" or \"focal_length\", not both",
-            ));
-        }
-        (Some(fov), None) => {
-            let axis = match params.choice(&FOV_AXIS)? {
-                "y" => FovAxis::Y,
-                "diagonal" => FovAxis::Diagonal,
-                "smaller" => FovAxis::Smaller,
-                "larger" => FovAxis::Larger,
-                _ => FovAxis::X,
-            };
-            horizontal_fov(fov, axis, aspect)
-        }
-        (None, focal_length) => {
-            let text = focal_length.unwrap_or("50mm");
-            let mm: f64 = text
-                .trim()
-                .trim_end_matches("mm")
-                .trim()
-                .parse()
-                .map_err(|_| {
-                    Error::input(
-                        params.location_of(&FOCAL_LENGTH),
-                        format!("could not read the focal length \"{text}\""),
-                    )
-                    .with_help("write it as a number of millimetres, e.g. \"35mm\"")
-                })?;
-            if !(mm > 0.0) {
-                return Err(Error::input(
-                    params.location_of(&FOCAL_LENGTH),
-                    "the focal length must be positive",
-                ));
-            }
-            horizontal_fov(focal_length_to_diagonal_fov(mm), FovAxis::Diagonal, aspect)
-        }
-    };
-    if !(fov_x > 0.0 && fov_x < 180.0) {
-        return Err(Error::input(
-            params.location_of(&FOV),
-            format!(
-                "the horizontal field of view is {fov_x} degrees; it must lie strictly between 0 and 180"
-            ),
-        ));
-    }
+    let fov_x = horizontal_fov_param(params, aspect)?;
     let (near_clip, far_clip) = clip_distances(params)?;
     let to_world = params.animated_transform(&SENSOR_TO_WORLD)?;
     let (lens_radius, focus_distance) = if thinlens {
