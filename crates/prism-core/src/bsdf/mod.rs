@@ -45,6 +45,8 @@
 //! | `plastic` | [`plastic`] | specular and diffuse reflection |
 //! | `roughplastic` | [`roughplastic`] | glossy and diffuse reflection |
 //! | `phong` | [`phong`] | glossy and diffuse reflection |
+//! | `pplastic` | [`pplastic`] | glossy and diffuse reflection |
+//! | `ward` | [`ward`] | glossy and diffuse reflection |
 //! | `twosided` | [`twosided`] | those of the nested BSDFs, on both sides |
 //! | `mask` | [`mask`] | the nested BSDF's, and null transmission |
 //! | `null` | [`null`] | null transmission only (a medium's boundary) |
@@ -66,12 +68,14 @@ pub mod null;
 pub mod perturbed;
 pub mod phong;
 pub mod plastic;
+pub mod pplastic;
 pub mod roughconductor;
 pub mod roughdielectric;
 pub mod roughdiffuse;
 pub mod roughplastic;
 pub mod thindielectric;
 pub mod twosided;
+pub mod ward;
 
 use arrayvec::ArrayVec;
 use glam::{Vec2, Vec3};
@@ -87,12 +91,14 @@ pub use normalmap::NormalMap;
 pub use null::Null;
 pub use phong::Phong;
 pub use plastic::Plastic;
+pub use pplastic::PolarizedPlastic;
 pub use roughconductor::RoughConductor;
 pub use roughdielectric::RoughDielectric;
 pub use roughdiffuse::RoughDiffuse;
 pub use roughplastic::RoughPlastic;
 pub use thindielectric::ThinDielectric;
 pub use twosided::TwoSided;
+pub use ward::{Ward, WardVariant};
 
 use crate::math::Frame;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
@@ -415,6 +421,8 @@ bsdfs! {
         Plastic(Plastic),
         RoughPlastic(RoughPlastic),
         Phong(Phong),
+        PolarizedPlastic(PolarizedPlastic),
+        Ward(Ward),
         TwoSided(TwoSided),
         Mask(Mask),
         Blend(Blend),
@@ -433,6 +441,8 @@ bsdfs! {
         Plastic(plastic::PlasticLobes<'a>),
         RoughPlastic(roughplastic::RoughPlasticLobes<'a>),
         Phong(phong::PhongLobes),
+        PolarizedPlastic(pplastic::PolarizedPlasticLobes),
+        Ward(ward::WardLobes),
         BackSide(twosided::BackSideLobes),
         Mask(mask::MaskLobes),
         Blend(blend::BlendLobes),
