@@ -8,4 +8,4 @@ pub mod stats;
 
 pub use accumulation::{CropWindow, Film, PixelSums};
 pub use filter::{Filter, FilterSampler};
-pub use output::write_images;
+pub use output::{FilmImages, write_images};

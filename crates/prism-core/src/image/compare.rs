@@ -9,6 +9,8 @@
 //! zᵢ = (aᵢ − bᵢ)/√(σ²_a + σ²_b), Σ zᵢ² is χ²-distributed over the pixels if the images differ
 //! only by noise, and the largest |zᵢ| is judged with a Bonferroni correction.
 
+use std::fmt;
+
 use super::ChannelImage;
 use crate::error::{Error, Result};
 use crate::math::special::regularized_gamma_q;
@@ -33,6 +35,45 @@ impl Comparison {
     /// The relative MSE averaged over the compared channels.
     pub fn rel_mse(&self) -> f64 {
         self.channels.iter().map(|d| d.rel_mse).sum::<f64>() / self.channels.len().max(1) as f64
+    }
+}
+
+/// The table `prism compare` prints: per channel the means, their ratio, the MSE, the relative
+/// MSE and the largest difference, the averages over channels, and the z-test's verdict.
+impl fmt::Display for Comparison {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        writeln!(
+            f,
+            "{:>8} {:>12} {:>12} {:>9} {:>12} {:>12} {:>12}",
+            "channel", "mean test", "mean ref", "ratio", "MSE", "relMSE", "max |diff|"
+        )?;
+        for d in &self.channels {
+            writeln!(
+                f,
+                "{:>8} {:>12.6} {:>12.6} {:>9.5} {:>12.4e} {:>12.4e} {:>12.4e}",
+                d.name,
+                d.mean_test,
+                d.mean_reference,
+                d.mean_test / d.mean_reference,
+                d.mse,
+                d.rel_mse,
+                d.max_abs
+            )?;
+        }
+        write!(
+            f,
+            "{:>8} {:>12} {:>12} {:>9} {:>12.4e} {:>12.4e}",
+            "all",
+            "",
+            "",
+            "",
+            self.mse(),
+            self.rel_mse()
+        )?;
+        if let Some(z) = &self.z_test {
+            write!(f, "\n{z}")?;
+        }
+        Ok(())
     }
 }
 
@@ -138,6 +179,26 @@ impl ZTest {
     /// 0.01.
     pub fn consistent_with_noise(&self) -> bool {
         self.p_value > 0.01 && self.max_z_p_value > 0.01
+    }
+}
+
+impl fmt::Display for ZTest {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let verdict = if self.consistent_with_noise() {
+            "consistent with noise"
+        } else {
+            "NOT consistent with noise"
+        };
+        write!(
+            f,
+            "z-test of Y over {} pixels: chi² {:.1} (p = {:.3}), max |z| {:.2} (Bonferroni p = {:.3}), {:.2} % beyond |z| = 3 (0.27 % expected): {verdict}",
+            self.pixels,
+            self.chi2,
+            self.p_value,
+            self.max_z,
+            self.max_z_p_value,
+            100.0 * self.beyond_three
+        )
     }
 }
 

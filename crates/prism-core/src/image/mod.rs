@@ -19,7 +19,7 @@ use std::path::{Path, PathBuf};
 
 pub use bitmap::{Bitmap, Encoding, read_bitmap};
 pub use exr::{ChannelImage, read_exr, write_exr};
-pub use png::write_png_srgb;
+pub use png::{png_srgb_bytes, write_png_srgb};
 
 use crate::error::{Error, Result};
 
