@@ -443,6 +443,34 @@ fn number_text(value: &DictValue) -> Option<String> {
     }
 }
 
+/// The transforms of a dictionary's `to_world`, built by the operations of the XML reader's
+/// `<transform>` (Mitsuba's `ScalarTransform4f`); matrices act on column vectors.
+pub mod transform {
+    use glam::{DMat4, DVec3};
+
+    /// `<translate>`: the translation by `offset`.
+    pub fn translate(offset: DVec3) -> DMat4 {
+        crate::transform_ops::translation(offset)
+    }
+
+    /// `<scale>`: the scaling by `factors` along x, y and z.
+    pub fn scale(factors: DVec3) -> DMat4 {
+        crate::transform_ops::scaling(factors)
+    }
+
+    /// `<rotate>`: the right-handed rotation by `angle` degrees about `axis`; the error names
+    /// the problem with the axis.
+    pub fn rotate(axis: DVec3, angle: f64) -> Result<DMat4, &'static str> {
+        crate::transform_ops::rotation(axis, angle)
+    }
+
+    /// `<lookat>`: the camera-to-world matrix looking from `origin` to `target` with `up`
+    /// (zero: any direction perpendicular to the view); the error names the problem.
+    pub fn look_at(origin: DVec3, target: DVec3, up: DVec3) -> Result<DMat4, &'static str> {
+        crate::transform_ops::look_at(origin, target, up)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

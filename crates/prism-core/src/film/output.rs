@@ -73,6 +73,24 @@ impl FilmImages {
         }
     }
 
+    /// The images of channels named as [`FilmImages::channels`] names them (an EXR that Prism
+    /// wrote); the error is the name of the first channel missing.
+    pub fn from_channels(image: &ChannelImage) -> std::result::Result<FilmImages, &'static str> {
+        let channel = |name: &'static str| image.channel(name).ok_or(name);
+        let interleave = |names: [&'static str; 3]| -> std::result::Result<Vec<f32>, &'static str> {
+            let [a, b, c] = [channel(names[0])?, channel(names[1])?, channel(names[2])?];
+            Ok((0..a.len()).flat_map(|i| [a[i], b[i], c[i]]).collect())
+        };
+        Ok(FilmImages {
+            width: image.width,
+            height: image.height,
+            rgb: interleave(["R", "G", "B"])?,
+            xyz: interleave(["X", "Y", "Z"])?,
+            variance: interleave(["variance.X", "variance.Y", "variance.Z"])?,
+            relative_error: channel("relative_error.Y")?.to_vec(),
+        })
+    }
+
     /// Writes the OpenEXR image of [`FilmImages::channels`].
     pub fn write_exr(&self, path: &Path) -> Result<()> {
         write_exr(path, &self.channels())
@@ -94,4 +112,43 @@ pub fn write_images(film: &Film, exr_path: &Path, png_path: &Path) -> Result<()>
     let images = FilmImages::of(film);
     images.write_exr(exr_path)?;
     images.write_png(png_path)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::film::CropWindow;
+    use glam::UVec2;
+
+    #[test]
+    fn channels_read_back_as_the_same_images() {
+        let size = UVec2::new(3, 2);
+        let mut film = Film::new(
+            size,
+            CropWindow {
+                offset: UVec2::ZERO,
+                size,
+            },
+        );
+        for (i, pixel) in film.pixels.iter_mut().enumerate() {
+            let v = i as f32;
+            pixel.add([v, 2.0 * v, 0.5]);
+            pixel.add([v + 1.0, v, 0.25]);
+        }
+        let images = FilmImages::of(&film);
+        assert_eq!(images.rgb.len(), 18);
+        assert_eq!(images.relative_error.len(), 6);
+        assert_eq!(
+            FilmImages::from_channels(&images.channels()),
+            Ok(images.clone())
+        );
+        let mut without_variance = images.channels();
+        without_variance
+            .channels
+            .retain(|(name, _)| name != "variance.Y");
+        assert_eq!(
+            FilmImages::from_channels(&without_variance),
+            Err("variance.Y")
+        );
+    }
 }
