@@ -17,7 +17,7 @@ import math
 import os
 import sys
 import time
-from typing import Callable, Optional, Sequence, Union
+from typing import Any, Callable, Optional, Sequence, Union
 
 from ._native import (
     ChannelDifference,
@@ -138,12 +138,14 @@ class _ProgressBar:
     standard error rewritten twice a second."""
 
     def __init__(self) -> None:
+        self._tqdm: Any = None
         try:
             from tqdm.auto import tqdm
+
+            self._tqdm = tqdm
         except ImportError:
-            tqdm = None
-        self._tqdm = tqdm
-        self._bar = None
+            pass
+        self._bar: Any = None
         self._samples = 0
         self._last_line = -math.inf
         self._line_shown = False
