@@ -140,3 +140,14 @@ def test_a_dictionary_key_must_be_a_string():
 def test_the_root_must_be_a_scene():
     with pytest.raises(pr.PrismError, match='not "scene"'):
         pr.load_dict({"type": "sphere"})
+
+
+def test_path_objects_and_numpy_values_are_read_as_their_values(cornell_dict, cornell):
+    from pathlib import Path
+
+    d = dict(cornell_dict)
+    d["floor"] = dict(cornell_dict["floor"], filename=Path(cornell_dict["floor"]["filename"]))
+    d["sensor"] = dict(cornell_dict["sensor"], fov=np.float64(39.3077))
+    d["sensor"]["film"] = dict(cornell_dict["sensor"]["film"], width=np.int32(24))
+    a = pr.render(pr.load_dict(d), seed=5, progress=False)
+    assert_same_image(a, pr.render(cornell, seed=5, progress=False))
