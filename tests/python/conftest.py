@@ -30,7 +30,7 @@ def prism_cli() -> Path:
     return path
 
 
-def _spectrum_pairs(text: str):
+def _spectrum_pairs(text: str) -> list:
     """'400:0.343, 404:0.445' as [(400.0, 0.343), (404.0, 0.445)]."""
     pairs = []
     for entry in text.split(","):
@@ -43,11 +43,11 @@ def _spectrum_pairs(text: str):
 def cornell_dict(cornell_path: Path) -> dict:
     """The Cornell box of scene.xml at SIZE, written as a dictionary by hand; only the measured
     reflectance spectra are taken from the file, as lists of (wavelength, value) pairs."""
-    spectra = {
-        bsdf.get("id"): bsdf.find("spectrum").get("value")
-        for bsdf in ElementTree.parse(cornell_path).getroot().iter("bsdf")
-        if bsdf.find("spectrum") is not None
-    }
+    spectra = {}
+    for bsdf in ElementTree.parse(cornell_path).getroot().iter("bsdf"):
+        spectrum = bsdf.find("spectrum")
+        if spectrum is not None:
+            spectra[bsdf.get("id")] = spectrum.get("value", "")
     meshes = cornell_path.parent / "meshes"
 
     def diffuse(name: str) -> dict:
