@@ -81,14 +81,17 @@ pub fn render(
     };
 
     let caller = std::thread::current();
+    let done = AtomicBool::new(false);
     let (outcome, raised) = std::thread::scope(|scope| {
         let worker = scope.spawn(|| {
             let output = render_scene(&loaded.scene, &options);
+            done.store(true, Ordering::Release);
             caller.unpark();
             output
         });
         let mut raised: Option<PyErr> = None;
-        while !worker.is_finished() {
+        // `is_finished` too, in case the render panics before saying it is done.
+        while !done.load(Ordering::Acquire) && !worker.is_finished() {
             py.detach(|| std::thread::park_timeout(POLL));
             if raised.is_none()
                 && let Err(error) = py.check_signals().and_then(|()| report())
@@ -97,7 +100,7 @@ pub fn render(
                 raised = Some(error);
             }
         }
-        (worker.join(), raised)
+        (py.detach(|| worker.join()), raised)
     });
     if let Some(error) = raised {
         return Err(error);
