@@ -151,3 +151,14 @@ def test_path_objects_and_numpy_values_are_read_as_their_values(cornell_dict, co
     d["sensor"]["film"] = dict(cornell_dict["sensor"]["film"], width=np.int32(24))
     a = pr.render(pr.load_dict(d), seed=5, progress=False)
     assert_same_image(a, pr.render(cornell, seed=5, progress=False))
+
+
+def test_a_dictionary_or_list_containing_itself_is_an_error():
+    ball: dict = {"type": "sphere"}
+    ball["bsdf"] = ball
+    with pytest.raises(pr.PrismError, match="nested more than"):
+        pr.load_dict(scene_with(ball=ball))
+    center: list = [1.0, 2.0]
+    center.append(center)
+    with pytest.raises(pr.PrismError, match="nested more than"):
+        pr.load_dict(scene_with(ball={"type": "sphere", "center": center}))
