@@ -9,8 +9,8 @@ use std::path::{Path, PathBuf};
 use clap::Args;
 
 use prism_core::error::{Error, ErrorKind, Result};
-use prism_core::image::compare::{compare, difference_image};
-use prism_core::image::{ChannelImage, read_exr, write_png_srgb};
+use prism_core::image::compare::{compare, write_difference_png};
+use prism_core::image::{ChannelImage, read_exr};
 
 #[derive(Args, Debug)]
 pub struct CompareArgs {
@@ -56,9 +56,7 @@ pub fn run(args: &CompareArgs) -> Result<()> {
     );
     println!("{comparison}");
     if let Some(path) = &args.diff {
-        let names: Vec<String> = comparison.channels.iter().map(|d| d.name.clone()).collect();
-        let rgb = difference_image(&test, &reference, &names);
-        write_png_srgb(path, test.width, test.height, &rgb)?;
+        write_difference_png(&test, &reference, &comparison, path)?;
         println!("difference image: {}", path.display());
     }
     Ok(())

@@ -62,10 +62,14 @@ def test_compare_gives_the_command_lines_statistics(cornell, prism_cli, tmp_path
     a = _written(pr.render(cornell, seed=1, progress=False), tmp_path / "a.exr")
     b = _written(pr.render(cornell, seed=2, progress=False), tmp_path / "b.exr")
     printed = subprocess.run(
-        [str(prism_cli), "compare", str(a), str(b)], check=True, capture_output=True, text=True
+        [str(prism_cli), "compare", str(a), str(b), "--diff", str(tmp_path / "cli-diff.png")],
+        check=True,
+        capture_output=True,
+        text=True,
     ).stdout
-    comparison = pr.compare(a, pr.Image.read(b))
+    comparison = pr.compare(a, pr.Image.read(b), diff=tmp_path / "diff.png")
     assert str(comparison) in printed
+    assert (tmp_path / "diff.png").read_bytes() == (tmp_path / "cli-diff.png").read_bytes()
     assert comparison.rel_mse > 0
     z = comparison.z_test
     assert z.pixels > 0 and 0 <= z.p_value <= 1

@@ -183,18 +183,24 @@ impl Operand<'_> {
 
 /// Compares a test image with a reference, each an `Image` or the path of an EXR file, on
 /// `channels` (default: R, G, B if both have them, else X, Y, Z): `prism compare`'s
-/// statistics, with the z-test where the test image has variances.
+/// statistics, with the z-test where the test image has variances; with `diff`, writes the
+/// false-colour difference PNG there, as `prism compare --diff`.
 #[pyfunction]
-#[pyo3(signature = (test, reference, channels = None))]
+#[pyo3(signature = (test, reference, channels = None, diff = None))]
 pub fn compare(
     py: Python<'_>,
     test: Operand<'_>,
     reference: Operand<'_>,
     channels: Option<Vec<String>>,
+    diff: Option<PathBuf>,
 ) -> PyResult<Comparison> {
     let test = test.channels(py)?;
     let reference = reference.channels(py)?;
     let comparison = stats::compare(&test, &reference, channels.as_deref()).into_py_result(py)?;
+    if let Some(path) = diff {
+        py.detach(|| stats::write_difference_png(&test, &reference, &comparison, &path))
+            .into_py_result(py)?;
+    }
     Ok(Comparison { comparison })
 }
 

@@ -275,6 +275,18 @@ pub fn chosen_channels(
     )
 }
 
+/// Writes [`difference_image`] of the channels `comparison` compared as an sRGB PNG.
+pub fn write_difference_png(
+    test: &ChannelImage,
+    reference: &ChannelImage,
+    comparison: &Comparison,
+    path: &std::path::Path,
+) -> Result<()> {
+    let names: Vec<String> = comparison.channels.iter().map(|d| d.name.clone()).collect();
+    let rgb = difference_image(test, reference, &names);
+    super::write_png_srgb(path, test.width, test.height, &rgb)
+}
+
 /// The signed difference of the channels' mean in false colour, as linear RGB triples: red where
 /// the test image is brighter, blue where darker, scaled so that the 99th percentile of |a − b|
 /// is full intensity.

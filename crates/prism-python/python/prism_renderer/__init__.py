@@ -120,16 +120,23 @@ def compare(
     test: Union[Image, str, os.PathLike],
     reference: Union[Image, str, os.PathLike],
     channels: Optional[Sequence[str]] = None,
+    diff: Optional[Union[str, os.PathLike]] = None,
 ) -> Comparison:
     """Compares ``test`` with ``reference`` (each an :class:`Image` or an EXR file's path) as
     ``prism compare`` does: per channel the means, MSE, relative MSE and largest difference,
     and the per-pixel z-test of luminance when the test image has variances. ``str()`` of the
-    result is ``prism compare``'s table."""
+    result is ``prism compare``'s table. ``diff``: a PNG file to write the signed difference
+    to in false colour (red where the test is brighter, blue where darker), as
+    ``prism compare --diff``."""
+
     def operand(value: Union[Image, str, os.PathLike]) -> Union[Image, str]:
         return value if isinstance(value, Image) else os.fspath(value)
 
     return _native.compare(
-        operand(test), operand(reference), None if channels is None else list(channels)
+        operand(test),
+        operand(reference),
+        None if channels is None else list(channels),
+        None if diff is None else os.fspath(diff),
     )
 
 

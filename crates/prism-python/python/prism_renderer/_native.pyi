@@ -192,5 +192,7 @@ def compare(
     test: Union[Image, str, os.PathLike],
     reference: Union[Image, str, os.PathLike],
     channels: Optional[List[str]] = None,
+    diff: Optional[Union[str, os.PathLike]] = None,
 ) -> Comparison:
-    """``prism compare``'s statistics of ``test`` against ``reference``."""
+    """``prism compare``'s statistics of ``test`` against ``reference``; with ``diff``, the
+    false-colour difference PNG written there."""
