@@ -25,8 +25,8 @@ use prism_core::film::{CropWindow, PixelSums};
 use prism_core::integrator::RayCount;
 use prism_core::render::state::{RenderIdentity, RenderState};
 use prism_core::render::{
-    Checkpoints, RenderOptions, SampleEstimator, Snapshot, StopReason, StopRule,
-    render_with_checkpoints,
+    Checkpoints, Progress, RenderOptions, SampleEstimator, Snapshot, StopReason, StopRule,
+    StopRuleNames, render_with_checkpoints,
 };
 use prism_core::sampling::sampler::{Sampler, SamplerKind};
 use prism_core::scene::Scene;
@@ -185,36 +185,25 @@ fn default_name(scene: &Path) -> String {
     stem.to_string()
 }
 
-/// The stopping rule the arguments ask for, for samples from `first` on. Without --time-limit
-/// or --target-error the render takes exactly the requested samples; with either, --spp (if
-/// given) only caps them.
+/// The stopping rule the arguments ask for (see [`StopRule::requested`]); a --sample-range
+/// ends where the range does.
 fn stop_rule(args: &RenderArgs, scene_spp: u32) -> Result<StopRule> {
-    let time_limit = match args.time_limit {
-        Some(t) if !(t > 0.0 && t.is_finite()) => {
-            return Err(Error::usage(format!(
-                "--time-limit must be a positive number of seconds, not {t}"
-            )));
-        }
-        t => t.map(Duration::from_secs_f64),
+    let names = StopRuleNames {
+        spp: "--spp",
+        time_limit: "--time-limit",
+        target_error: "--target-error",
     };
-    if let Some(e) = args.target_error
-        && !(e > 0.0 && e.is_finite())
-    {
-        return Err(Error::usage(format!(
-            "--target-error must be positive, not {e}"
-        )));
+    let mut rule = StopRule::requested(
+        args.spp,
+        scene_spp,
+        args.time_limit,
+        args.target_error,
+        &names,
+    )?;
+    if let Some(range) = &args.sample_range {
+        rule.sample_end = Some(range.end);
     }
-    let open_ended = time_limit.is_some() || args.target_error.is_some();
-    let sample_end = match &args.sample_range {
-        Some(range) => Some(range.end),
-        None if open_ended => args.spp,
-        None => Some(args.spp.unwrap_or(scene_spp)),
-    };
-    Ok(StopRule {
-        sample_end,
-        time_limit,
-        target_error: args.target_error,
-    })
+    Ok(rule)
 }
 
 /// The sampler's name in render states and messages.
@@ -368,7 +357,11 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         interrupt: Some(interrupt),
         threads: args.threads,
         seed,
-        progress: std::io::stderr().is_terminal(),
+        progress: if std::io::stderr().is_terminal() {
+            Progress::Terminal
+        } else {
+            Progress::Hidden
+        },
     };
     let (exr_path, png_path) = output_paths(args);
     let png_path = png_path.with_extension(scene.ldr_output.format.extension());

@@ -11,4 +11,4 @@ pub mod stats;
 pub use accumulation::{CropWindow, Film, PixelSums};
 pub use filter::{Filter, FilterSampler};
 pub use ldr::{LdrFormat, LdrOutput, Tonemap, TransferCurve};
-pub use output::{write_images, write_images_with};
+pub use output::{FilmImages, write_images, write_images_with};

@@ -5,8 +5,8 @@
 //! parameters are reported with their location. Objects declared once and referenced many
 //! times (a BSDF with an `id`) are built once.
 
-mod instancing;
 pub mod fov;
+mod instancing;
 pub mod integrators;
 pub mod lights;
 pub mod materials;
