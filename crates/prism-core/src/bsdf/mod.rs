@@ -51,6 +51,7 @@
 //! | `principledthin` | [`principledthin`] | diffuse and glossy reflection and transmission |
 //! | `twosided` | [`twosided`] | those of the nested BSDFs, on both sides |
 //! | `mask` | [`mask`] | the nested BSDF's, and null transmission |
+//! | `null` | [`null`] | null transmission only (a medium's boundary) |
 //! | `blendbsdf` | [`blend`] | both nested BSDFs' |
 //! | `null` | [`null`] | null transmission |
 //! | `bumpmap`, `normalmap` | [`bumpmap`], [`normalmap`] | the nested BSDF's, in a perturbed frame |

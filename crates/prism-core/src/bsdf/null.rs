@@ -7,7 +7,9 @@
 //! A single null lobe δ(wi + wo) on both sides, with weight 1: `sample` returns −wo with
 //! probability 1, nothing can be evaluated. As in Mitsuba 3's `path` integrator, passing through
 //! counts as a bounce towards `max_depth`, and shadow rays see the surface as opaque (light
-//! beyond it is found by BSDF sampling alone), as for `mask`.
+//! beyond it is found by BSDF sampling alone), as for `mask`. As in Mitsuba 3's `volpath`, the
+//! volumetric path tracer crosses it without a bounce and lets shadow rays through
+//! ([`crate::integrator::volpath`]).
 
 use glam::{Vec2, Vec3};
 

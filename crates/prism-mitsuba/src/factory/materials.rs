@@ -384,9 +384,10 @@ pub static BSDFS: Registry<Build> = Registry {
         Plugin {
             name: "null",
             origin: Origin::Mitsuba3,
-            summary: "Light passes straight through, unchanged (an index-matched boundary, an \
-                      invisible shape); counts as a bounce, and shadow rays see it as opaque, as \
-                      in Mitsuba 3's `path`.",
+            summary: "Light passes straight through, unchanged (an index-matched boundary, the \
+                      outline of a medium, an invisible shape); in `path` it counts as a bounce \
+                      and shadow rays see it as opaque, in `volpath` it is no bounce and shadow \
+                      rays pass, as in Mitsuba 3.",
             params: &[],
             build: |_, _| Ok(Bsdf::Null(Null)),
         },

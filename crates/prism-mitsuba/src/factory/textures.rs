@@ -297,6 +297,20 @@ pub fn build_texture(
     Ok(texture)
 }
 
+/// A colour `spec` of a texture that an emitter reads: a value as a reflectance (Mitsuba 3
+/// reads an emitter's checkerboard so, without a D65 factor, and refuses values above 1), a
+/// nested texture read as emission.
+fn emission_texture(
+    params: &Params,
+    spec: &ParamSpec,
+    cache: &mut TextureCache,
+) -> Result<Texture> {
+    if let Some(child) = params.named_child(spec) {
+        return nested_texture(params, spec.name, &child.node, TextureUse::Emission, cache);
+    }
+    Ok(Texture::Constant(spectrum_param(params, spec)?))
+}
+
 /// Read as a number, a checkerboard's colours are numbers too.
 const SCALAR_COLOR0: ParamSpec = ParamSpec::new(
     "color0",
@@ -324,6 +338,10 @@ fn build_checkerboard(
         TextureUse::Spectral | TextureUse::Rgb => (
             spectrum_texture(params, &COLOR0, cache)?,
             spectrum_texture(params, &COLOR1, cache)?,
+        ),
+        TextureUse::Emission => (
+            emission_texture(params, &COLOR0, cache)?,
+            emission_texture(params, &COLOR1, cache)?,
         ),
     };
     Ok(Texture::Checkerboard(Box::new(Checkerboard {
