@@ -89,15 +89,31 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
     for child in params.children(&SHAPES) {
         let (plugin, shape_params) = shapes::shape_params(&child.node)?;
         let shape = shapes::build_shape(plugin, &shape_params)?;
-        if shape.area() == 0.0 || !shape.area().is_finite() {
+        let area = shape.area();
+        if !area.is_finite() {
             return Err(Error::input(
                 &child.location,
-                format!("{} has no area", child.node.describe()),
+                format!(
+                    "the area of {} is not a finite number",
+                    child.node.describe()
+                ),
             )
-            .with_help("remove degenerate shapes or fix their transform"));
+            .with_help("fix the shape's transform or its vertices"));
         }
         let shape_index = shapes.len() as u32;
         let emitter = shape_params.single_child(&shapes::EMITTER)?;
+        // A shape of zero area is never hit, so it contributes nothing; like Mitsuba, Prism
+        // reads it (its BSDF included) and renders without it, but an emitter needs an area
+        // to send its power from (Mitsuba refuses it too).
+        if area == 0.0
+            && let Some(emitter) = &emitter
+        {
+            return Err(Error::input(
+                &emitter.location,
+                format!("{} has no area, so it cannot emit", child.node.describe()),
+            )
+            .with_help("remove the emitter, or fix the shape's transform or its vertices"));
+        }
         let material = match shape_params.single_child(&shapes::BSDF)? {
             Some(bsdf) => {
                 let key = Arc::as_ptr(&bsdf.node);
@@ -139,6 +155,9 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
             None => None,
         };
         shape_params.finish()?;
+        if area == 0.0 {
+            continue;
+        }
         shapes.push(shape);
         shape_info.push(ShapeInfo { material, light });
     }
