@@ -2,6 +2,8 @@
 //! parameters — each run through the `prism` binary, asserting the exit status (2 for bad input)
 //! and the exact place (file:line:column) the error names, and that nothing panics.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -887,4 +889,170 @@ fn instancing_cases() -> Vec<Case> {
             "shapegroup",
         ),
     ]
+}
+/// A malformed Mitsuba serialized mesh: the scene loads `mesh.serialized` with `properties`
+/// inside its `<shape>`, and the error must name the shape (scene.xml line 3) and say `says`.
+struct SerializedCase {
+    name: &'static str,
+    mesh: Vec<u8>,
+    properties: &'static str,
+    says: &'static str,
+}
+
+fn serialized_cases() -> Vec<SerializedCase> {
+    use common::serialized::{SerializedShape, serialized_file, shape_header, triangle_shape};
+    use miniz_oxide::deflate::compress_to_vec_zlib;
+
+    let good = serialized_file(&[triangle_shape()], 4);
+    let with_stream = |stream: &[u8]| {
+        let mut file = shape_header(4);
+        file.extend_from_slice(&compress_to_vec_zlib(stream, 6));
+        file.extend_from_slice(&0u64.to_le_bytes());
+        file.extend_from_slice(&1u32.to_le_bytes());
+        file
+    };
+    let mut huge = 0x1000u32.to_le_bytes().to_vec();
+    huge.push(0);
+    huge.extend_from_slice(&1_000_000_000_000u64.to_le_bytes());
+    huge.extend_from_slice(&1u64.to_le_bytes());
+    let mut bad_version = good.clone();
+    bad_version[2] = 5;
+    let mut bad_offset = serialized_file(&[triangle_shape(), triangle_shape()], 4);
+    let entry = bad_offset.len() - 12;
+    bad_offset[entry..entry + 8].copy_from_slice(&1_000_000u64.to_le_bytes());
+    let shape = |positions: Vec<[f32; 3]>, triangles: Vec<[u32; 3]>| {
+        serialized_file(
+            &[SerializedShape {
+                positions,
+                triangles,
+                ..SerializedShape::default()
+            }],
+            3,
+        )
+    };
+    let corner = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+    let mut corrupt = shape_header(4);
+    corrupt.extend_from_slice(&[0x78, 0x9c, 0xff, 0xff, 0xff, 0xff, 0, 0, 0, 0, 1, 0, 0, 0]);
+    vec![
+        SerializedCase {
+            name: "serialized: not one",
+            mesh: b"PK\x03\x04 a zip file".to_vec(),
+            properties: "",
+            says: "not a Mitsuba serialized mesh",
+        },
+        SerializedCase {
+            name: "serialized: shorter than a header",
+            mesh: vec![0x1c],
+            properties: "",
+            says: "ends inside the shape header",
+        },
+        SerializedCase {
+            name: "serialized: unknown version",
+            mesh: bad_version,
+            properties: "",
+            says: "has version 5",
+        },
+        SerializedCase {
+            name: "serialized: cut short",
+            mesh: good[..good.len() / 2].to_vec(),
+            properties: "",
+            says: "ends before the data its header declares",
+        },
+        SerializedCase {
+            name: "serialized: corrupt zlib stream",
+            mesh: corrupt,
+            properties: "",
+            says: "is corrupt",
+        },
+        SerializedCase {
+            name: "serialized: shape index out of range",
+            mesh: good.clone(),
+            properties: "<integer name=\"shape_index\" value=\"1\"/>",
+            says: "shape_index 1 is out of range: the file holds 1 shapes (0..0)",
+        },
+        SerializedCase {
+            name: "serialized: negative shape index",
+            mesh: good.clone(),
+            properties: "<integer name=\"shape_index\" value=\"-1\"/>",
+            says: "must be 0 or more",
+        },
+        SerializedCase {
+            name: "serialized: table pointing outside the file",
+            mesh: bad_offset,
+            properties: "<integer name=\"shape_index\" value=\"1\"/>",
+            says: "outside the shapes",
+        },
+        SerializedCase {
+            name: "serialized: counts the file cannot hold",
+            mesh: with_stream(&huge),
+            properties: "",
+            says: "more than the rest of the file can hold",
+        },
+        SerializedCase {
+            name: "serialized: index out of range",
+            mesh: shape(corner.clone(), vec![[0, 1, 3]]),
+            properties: "",
+            says: "refers to vertex 3",
+        },
+        SerializedCase {
+            name: "serialized: position not a number",
+            mesh: shape(
+                vec![[0.0, 0.0, 0.0], [f32::NAN, 0.0, 0.0], [0.0, 1.0, 0.0]],
+                vec![[0, 1, 2]],
+            ),
+            properties: "",
+            says: "vertex 1 is not a finite number",
+        },
+        SerializedCase {
+            name: "serialized: no triangles",
+            mesh: shape(corner, Vec::new()),
+            properties: "",
+            says: "has no triangles",
+        },
+    ]
+}
+
+#[test]
+fn every_malformed_serialized_mesh_gets_one_clear_error() {
+    let root: PathBuf =
+        std::env::temp_dir().join(format!("prism-bad-serialized-{}", std::process::id()));
+    let mut failures = Vec::new();
+    let cases = serialized_cases();
+    for (i, case) in cases.iter().enumerate() {
+        let dir = root.join(i.to_string());
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::write(dir.join("mesh.serialized"), &case.mesh).unwrap();
+        let xml = scene!(
+            "    <shape type=\"serialized\"><string name=\"filename\" value=\"mesh.serialized\"/>PROPERTIES</shape>"
+        )
+        .replace("PROPERTIES", case.properties);
+        let scene = Case {
+            name: case.name,
+            files: Box::leak(Box::new([("scene.xml", &*xml.leak())])),
+            arguments: RENDER,
+            location: "scene.xml:3:",
+            says: case.says,
+        };
+        let (status, text) = run_case(&scene, &dir);
+        let location = format!("{}/scene.xml:3:", dir.display());
+        if !(status == 2
+            && text.starts_with("error: ")
+            && text.contains(&location)
+            && text.contains(case.says)
+            && !text.contains("panicked"))
+        {
+            failures.push(format!(
+                "{}: status {status}, expected {location:?} and {:?}:\n{text}",
+                case.name, case.says
+            ));
+        }
+    }
+    let _ = std::fs::remove_dir_all(&root);
+    assert!(
+        failures.is_empty(),
+        "{} of {} cases failed:\n{}",
+        failures.len(),
+        cases.len(),
+        failures.join("\n")
+    );
 }

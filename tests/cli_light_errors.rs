@@ -235,7 +235,7 @@ fn area_light_on_a_shape_without_area() {
         "    <shape type=\"obj\">\n        <string name=\"filename\" value=\"flat.obj\"/>\n        <emitter type=\"area\"/>\n    </shape>",
     );
     std::fs::write(dir.join("flat.obj"), "v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n").unwrap();
-    assert_error(&dir, "scene.xml:8:5", &["has no area"]);
+    assert_error(&dir, "scene.xml:10:9", &["has no area, so it cannot emit"]);
 }
 
 #[test]

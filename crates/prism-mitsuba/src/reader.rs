@@ -24,6 +24,7 @@
 //!   (a second id for an object declared earlier), `<include filename="..."/>` and
 //!   `<path value="..."/>` (only directly inside the root `<scene>`).
 //! - Text other than whitespace, unknown elements and unknown attributes are errors.
+//! - Comments may contain `--` and end in `-`, as in Mitsuba (`comments.rs`).
 //!
 //! Files older than 2.0.0 are upgraded as Mitsuba 3 does: parameter names go from camelCase to
 //! snake_case (`camel_to_snake`), `<lookAt>` becomes `<lookat>`, a diffuse BSDF's
@@ -46,6 +47,8 @@
 //! uses an explicit stack, and positions are computed from a line index (a scene of a million
 //! elements costs a million binary searches, not a million scans).
 
+mod comments;
+
 use std::cell::Cell;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -62,6 +65,7 @@ use super::property_values;
 use super::substitution::{Parameters, camel_to_snake};
 use super::transform_ops;
 use crate::suggest::closest_match;
+use comments::tolerate_hyphens_in_comments;
 use prism_core::error::{Error, Result, SourceLocation};
 
 /// Deepest nesting of elements accepted; deeper documents are certainly not scenes.
@@ -282,7 +286,8 @@ fn parse_version(attribute: &Attribute) -> Result<(u32, u32, u32)> {
 impl Reader {
     /// Reads the main scene file into the root draft and everything below it.
     fn read_main(&mut self, text: &str, path: &Path) -> Result<()> {
-        let mut source = Source::new(path, text, 0);
+        let text = tolerate_hyphens_in_comments(text);
+        let mut source = Source::new(path, &text, 0);
         let document = parse_xml(&source)?;
         let root = document.root_element();
         let location = source.location(root.range().start);
@@ -840,6 +845,7 @@ impl Reader {
         let text = std::fs::read_to_string(&path).map_err(|err| {
             Error::io(&path, &err, "read the included file").at(&element.location)
         })?;
+        let text = tolerate_hyphens_in_comments(&text);
         let mut included = Source::new(&path, &text, source.include_depth + 1);
         let document = parse_xml(&included).map_err(|err| {
             let position = err.location.map(|l| l.to_string()).unwrap_or_default();

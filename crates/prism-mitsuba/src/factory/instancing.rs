@@ -70,12 +70,15 @@ impl ShapeGroups {
                     .with_help("animate the instances' to_world instead"));
                 }
             };
-            if shape.area() == 0.0 || !shape.area().is_finite() {
+            if !shape.area().is_finite() {
                 return Err(Error::input(
                     &child.location,
-                    format!("{} has no area", child.node.describe()),
+                    format!(
+                        "the area of {} is not a finite number",
+                        child.node.describe()
+                    ),
                 )
-                .with_help("remove degenerate shapes or fix their transform"));
+                .with_help("fix the shape's transform or its vertices"));
             }
             if let Some(emitter) = shape_params.single_child(&shapes::EMITTER)? {
                 return Err(Error::input(
@@ -88,6 +91,10 @@ impl ShapeGroups {
             }
             let (material, interface) = member(&shape_params)?;
             shape_params.finish()?;
+            // A shape of zero area is never hit: read, as at the top level, and left out.
+            if shape.area() == 0.0 {
+                continue;
+            }
             object.push(shape);
             members.push((
                 ShapeInfo {

@@ -238,15 +238,31 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
         }
         let (plugin, shape_params) = shapes::shape_params(&child.node)?;
         let shape = shapes::build_shape(plugin, &shape_params)?;
-        if shape.area() == 0.0 || !shape.area().is_finite() {
+        let area = shape.area();
+        if !area.is_finite() {
             return Err(Error::input(
                 &child.location,
-                format!("{} has no area", child.node.describe()),
+                format!(
+                    "the area of {} is not a finite number",
+                    child.node.describe()
+                ),
             )
-            .with_help("remove degenerate shapes or fix their transform"));
+            .with_help("fix the shape's transform or its vertices"));
         }
         let shape_index = shapes.len() as u32;
         let emitter = shape_params.single_child(&shapes::EMITTER)?;
+        // A shape of zero area is never hit, so it contributes nothing; like Mitsuba, Prism
+        // reads it (its BSDF included) and renders without it, but an emitter needs an area
+        // to send its power from (Mitsuba refuses it too).
+        if area == 0.0
+            && let Some(emitter) = &emitter
+        {
+            return Err(Error::input(
+                &emitter.location,
+                format!("{} has no area, so it cannot emit", child.node.describe()),
+            )
+            .with_help("remove the emitter, or fix the shape's transform or its vertices"));
+        }
         let material = shape_material(
             shape_params.single_child(&shapes::BSDF)?,
             emitter.is_some(),
@@ -290,10 +306,14 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
             }
             None => None,
         };
-        medium_interfaces.push(shape_media(&shape_params, &mut media)?);
+        let interface = shape_media(&shape_params, &mut media)?;
         shape_params.finish()?;
+        if area == 0.0 {
+            continue;
+        }
         shapes.push(shape);
         shape_info.push(ShapeInfo { material, light });
+        medium_interfaces.push(interface);
     }
     groups.assign_shape_ids(&mut shapes, &mut shape_info, &mut medium_interfaces);
 

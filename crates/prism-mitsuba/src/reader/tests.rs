@@ -697,6 +697,17 @@ fn structure_errors() {
 }
 
 #[test]
+fn comments_may_hold_double_hyphens_as_in_mitsuba() {
+    read(&scene("<!-- a -- b --->\n<!---- rule ---->")).unwrap();
+    // Blanking the hyphens keeps positions: the error after the comments is where it was.
+    let err = error(&scene(
+        "<!-- é -- ü\n -- --->\n    <shape type=\"sphere\"><float name=\"radius\" value=\"x\"/></shape>",
+    ));
+    let location = err.location.clone().unwrap();
+    assert_eq!((location.line, location.column), (3, 47), "{err}");
+}
+
+#[test]
 fn nested_plugins_keep_order_names_and_classes() {
     let root = read(&scene(
         r#"<shape type="sphere">
