@@ -201,6 +201,22 @@ fn cases() -> Vec<Case> {
             "max_depth",
         ),
         render_scene(
+            "direct with shading_samples and emitter_samples",
+            scene!(
+                "    <integrator type=\"direct\"><integer name=\"shading_samples\" value=\"2\"/><integer name=\"emitter_samples\" value=\"1\"/></integrator>"
+            ),
+            "scene.xml:3:",
+            "cannot be given with \"shading_samples\"",
+        ),
+        render_scene(
+            "direct without samples",
+            scene!(
+                "    <integrator type=\"direct\"><integer name=\"shading_samples\" value=\"0\"/></integrator>"
+            ),
+            "scene.xml:3:",
+            "at least one emitter or BSDF sample",
+        ),
+        render_scene(
             "NaN float",
             scene!("    <shape type=\"sphere\"><float name=\"radius\" value=\"nan\"/></shape>"),
             "scene.xml:3:",

@@ -16,7 +16,9 @@ use plotters::prelude::*;
 use prism_core::error::{Error, Result};
 use prism_core::image::compare::rel_mse_rgb;
 use prism_core::image::read_exr;
-use prism_core::integrator::{DistributionIntegrator, Integrator, PathIntegrator};
+use prism_core::integrator::{
+    DirectIntegrator, DistributionIntegrator, Integrator, PathIntegrator,
+};
 use prism_core::render::{RenderOptions, render};
 use prism_core::sampling::sampler::SamplerKind;
 use prism_core::scene::Scene;
@@ -79,6 +81,8 @@ impl Series {
 fn integrator_named(name: &str, scene: &Scene) -> Result<Integrator> {
     let max_depth = match &scene.integrator {
         Integrator::Path(p) => p.max_depth,
+        // Direct illumination is the path tracer's estimate of paths of two vertices.
+        Integrator::Direct(_) => 2,
         Integrator::Distribution(d) => d.max_depth,
     };
     match name {
@@ -90,6 +94,10 @@ fn integrator_named(name: &str, scene: &Scene) -> Result<Integrator> {
             }
             .into(),
         }),
+        "direct" => Ok(match &scene.integrator {
+            Integrator::Direct(d) => Integrator::Direct(d.clone()),
+            _ => DirectIntegrator::default().into(),
+        }),
         "distrib" => Ok(match &scene.integrator {
             Integrator::Distribution(d) => Integrator::Distribution(d.clone()),
             _ => DistributionIntegrator {
@@ -99,7 +107,7 @@ fn integrator_named(name: &str, scene: &Scene) -> Result<Integrator> {
             .into(),
         }),
         other => Err(Error::usage(format!("unknown integrator \"{other}\""))
-            .with_help("use path or distrib")),
+            .with_help("use path, direct or distrib")),
     }
 }
 
@@ -117,6 +125,7 @@ fn sampler_named(name: &str) -> Result<SamplerKind> {
 fn integrator_label(integrator: &Integrator) -> &'static str {
     match integrator {
         Integrator::Path(_) => "path",
+        Integrator::Direct(_) => "direct",
         Integrator::Distribution(_) => "distrib",
     }
 }

@@ -1,13 +1,16 @@
-//! Integrators: estimators of the radiance arriving along a camera ray: the path tracer and the
-//! lecture's distribution ray tracer with splitting.
+//! Integrators: estimators of the radiance arriving along a camera ray: the path tracer, direct
+//! illumination and the lecture's distribution ray tracer with splitting.
 //!
 //! An [`Integrator`] is what a scene asks for: an estimator and its parameters. Before a render
 //! it is prepared for the world ([`Integrator::prepare`]), which builds the light sampler it
 //! chooses lights with, so the sampler always follows the integrator's own settings.
 
+pub mod direct;
 pub mod distribution;
+pub mod mis;
 pub mod path;
 
+pub use direct::DirectIntegrator;
 pub use distribution::DistributionIntegrator;
 pub use path::PathIntegrator;
 
@@ -23,7 +26,14 @@ use crate::world::World;
 #[derive(Clone, Debug)]
 pub enum Integrator {
     Path(PathIntegrator),
+    Direct(DirectIntegrator),
     Distribution(DistributionIntegrator),
+}
+
+impl From<DirectIntegrator> for Integrator {
+    fn from(integrator: DirectIntegrator) -> Integrator {
+        Integrator::Direct(integrator)
+    }
 }
 
 impl From<PathIntegrator> for Integrator {
@@ -57,6 +67,7 @@ impl Integrator {
     fn light_selection(&self) -> LightSelection {
         match self {
             Integrator::Path(path) => path.light_selection,
+            Integrator::Direct(_) => LightSelection::Power,
             Integrator::Distribution(distrib) => distrib.light_selection(),
         }
     }
@@ -91,6 +102,9 @@ impl PreparedIntegrator<'_> {
     ) -> SampledSpectrum {
         match self.integrator {
             Integrator::Path(integrator) => integrator.radiance(self, ray, lambda, sampler, count),
+            Integrator::Direct(integrator) => {
+                integrator.radiance(self, ray, lambda, sampler, count)
+            }
             Integrator::Distribution(integrator) => {
                 integrator.radiance(self, ray, lambda, sampler, count)
             }

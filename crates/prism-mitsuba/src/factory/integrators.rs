@@ -1,12 +1,14 @@
 //! Integrator plugins: `path` (with Prism's `emitter_sampling`, see
-//! [`prism_core::light::sampler`]) and the lecture's `distrib`.
+//! [`prism_core::light::sampler`]), `direct` and the lecture's `distrib`.
 
 use crate::description::{PluginClass, PluginNode};
 use crate::params::Params;
 use crate::registry::{Default, Origin, ParamKind, ParamSpec, Plugin, Registry};
 use prism_core::error::{Error, Result};
 use prism_core::integrator::distribution::DirectLights;
-use prism_core::integrator::{DistributionIntegrator, Integrator, PathIntegrator};
+use prism_core::integrator::{
+    DirectIntegrator, DistributionIntegrator, Integrator, PathIntegrator,
+};
 use prism_core::light::LightSelection;
 
 type Build = fn(&Params) -> Result<Integrator>;
@@ -21,6 +23,20 @@ pub static INTEGRATORS: Registry<Build> = Registry {
                       (power heuristic) and Russian roulette on the path's potential.",
             params: &[MAX_DEPTH, RR_DEPTH, HIDE_EMITTERS, EMITTER_SAMPLING],
             build: build_path,
+        },
+        Plugin {
+            name: "direct",
+            origin: Origin::Mitsuba3,
+            summary: "Direct illumination: light samples and BSDF samples at the first hit, \
+                      combined by multiple importance sampling (power heuristic with the sample \
+                      counts).",
+            params: &[
+                SHADING_SAMPLES,
+                EMITTER_SAMPLES,
+                BSDF_SAMPLES,
+                HIDE_EMITTERS,
+            ],
+            build: build_direct,
         },
         Plugin {
             name: "distrib",
@@ -67,6 +83,24 @@ const EMITTER_SAMPLING: ParamSpec = ParamSpec::new(
     Default::Str("power"),
     "Prism only (Mitsuba rejects it): one light per shading point chosen ∝ its power, or \
      uniformly (as Mitsuba's default equal `sampling_weight`s)",
+);
+const SHADING_SAMPLES: ParamSpec = ParamSpec::new(
+    "shading_samples",
+    ParamKind::Integer,
+    Default::Integer(1),
+    "sets both emitter_samples and bsdf_samples (not with either of them)",
+);
+const EMITTER_SAMPLES: ParamSpec = ParamSpec::new(
+    "emitter_samples",
+    ParamKind::Integer,
+    Default::Text("shading_samples"),
+    "light samples per camera ray",
+);
+const BSDF_SAMPLES: ParamSpec = ParamSpec::new(
+    "bsdf_samples",
+    ParamKind::Integer,
+    Default::Text("shading_samples"),
+    "BSDF samples per camera ray",
 );
 const BOUNCE_SAMPLES: ParamSpec = ParamSpec::new(
     "bounce_samples",
@@ -144,6 +178,46 @@ fn build_path(params: &Params) -> Result<Integrator> {
         rr_depth: rr_depth as i32,
         hide_emitters: params.boolean(&HIDE_EMITTERS)?,
         light_selection,
+    }))
+}
+
+/// A sample count of `direct`: 0 to 1024.
+fn shading_count(params: &Params, spec: &ParamSpec, default: i64) -> Result<u32> {
+    let value = params.integer_opt(spec)?.unwrap_or(default);
+    if !(0..=1024).contains(&value) {
+        return Err(Error::input(
+            params.location_of(spec),
+            format!("\"{}\" must be between 0 and 1024, not {value}", spec.name),
+        ));
+    }
+    Ok(value as u32)
+}
+
+fn build_direct(params: &Params) -> Result<Integrator> {
+    if params.has(&SHADING_SAMPLES) {
+        for spec in [&EMITTER_SAMPLES, &BSDF_SAMPLES] {
+            if params.has(spec) {
+                return Err(Error::input(
+                    params.location_of(spec),
+                    format!("\"{}\" cannot be given with \"shading_samples\"", spec.name),
+                )
+                .with_help("give either shading_samples, or emitter_samples and bsdf_samples"));
+            }
+        }
+    }
+    let shading_samples = shading_count(params, &SHADING_SAMPLES, 1)?;
+    let emitter_samples = shading_count(params, &EMITTER_SAMPLES, i64::from(shading_samples))?;
+    let bsdf_samples = shading_count(params, &BSDF_SAMPLES, i64::from(shading_samples))?;
+    if emitter_samples + bsdf_samples == 0 {
+        return Err(Error::input(
+            params.location(),
+            "the direct integrator needs at least one emitter or BSDF sample",
+        ));
+    }
+    Ok(Integrator::Direct(DirectIntegrator {
+        emitter_samples,
+        bsdf_samples,
+        hide_emitters: params.boolean(&HIDE_EMITTERS)?,
     }))
 }
 
