@@ -6,6 +6,6 @@ pub mod filter;
 pub mod output;
 pub mod stats;
 
-pub use accumulation::{CropWindow, Film, PixelSums};
+pub use accumulation::{CropWindow, Film, PixelSums, ValueSum};
 pub use filter::{Filter, FilterSampler};
 pub use output::write_images;

@@ -11,7 +11,8 @@ use crate::image::{ChannelImage, write_exr, write_png_srgb};
 /// Writes the film as an EXR and as an sRGB PNG. The EXR's channels are `R`, `G`, `B` (linear
 /// sRGB), `X`, `Y`, `Z` (CIE 1931), `variance.X`, `variance.Y`, `variance.Z` (the estimated
 /// variance of each pixel's mean, see [`super::stats`]) and `relative_error.Y` (the
-/// pixel's relative standard error of luminance).
+/// pixel's relative standard error of luminance), then the integrator's extra channels under
+/// their own names.
 pub fn write_images(film: &Film, exr_path: &Path, png_path: &Path) -> Result<()> {
     let xyz = film.xyz();
     let rgb = film.linear_srgb();
@@ -22,7 +23,7 @@ pub fn write_images(film: &Film, exr_path: &Path, png_path: &Path) -> Result<()>
             .map(|p| variance_of_mean(p, c) as f32)
             .collect::<Vec<f32>>()
     };
-    let image = ChannelImage {
+    let mut image = ChannelImage {
         width: film.crop.size.x as usize,
         height: film.crop.size.y as usize,
         channels: vec![
@@ -44,6 +45,9 @@ pub fn write_images(film: &Film, exr_path: &Path, png_path: &Path) -> Result<()>
             ),
         ],
     };
+    for (c, name) in film.aov_names.iter().enumerate() {
+        image.channels.push((name.clone(), film.aov(c)));
+    }
     write_exr(exr_path, &image)?;
     let interleaved: Vec<f32> = rgb.iter().flatten().copied().collect();
     write_png_srgb(png_path, image.width, image.height, &interleaved)

@@ -60,6 +60,8 @@ pub struct PreparedIntegrator<'a> {
     integrator: &'a Integrator,
     world: &'a World,
     light_sampler: LightSampler,
+    /// How many extra channels a sample writes.
+    aov_count: usize,
 }
 
 impl Integrator {
@@ -72,6 +74,16 @@ impl Integrator {
         }
     }
 
+    /// Names of the extra film channels (AOVs) the integrator writes beside the image, as
+    /// Mitsuba names them in its EXR files; none for the plain estimators.
+    pub fn aov_names(&self) -> Vec<String> {
+        match self {
+            Integrator::Path(_) | Integrator::Direct(_) | Integrator::Distribution(_) => {
+                Vec::new()
+            }
+        }
+    }
+
     /// The integrator with its light sampler for `world`.
     pub fn prepare<'a>(&'a self, world: &'a World) -> PreparedIntegrator<'a> {
         PreparedIntegrator {
@@ -81,25 +93,34 @@ impl Integrator {
                 &world.light_powers,
                 self.light_selection(),
             ),
+            aov_count: self.aov_names().len(),
         }
     }
 }
 
 impl PreparedIntegrator<'_> {
+    /// How many extra channels each sample writes.
+    pub fn aov_count(&self) -> usize {
+        self.aov_count
+    }
+
     /// The light sampler the integrator chooses lights with.
     pub fn light_sampler(&self) -> &LightSampler {
         &self.light_sampler
     }
 
     /// An estimate of the radiance arriving at the camera along `ray` at the wavelengths
-    /// `lambda`, drawing random numbers from `sampler`.
+    /// `lambda`, drawing random numbers from `sampler`; the sample's extra channels are written
+    /// to `aovs` (as many as [`Integrator::aov_names`] names).
     pub fn radiance(
         &self,
         ray: Ray,
         lambda: &SampledWavelengths,
         sampler: &mut Sampler,
         count: &mut RayCount,
+        aovs: &mut [f32],
     ) -> SampledSpectrum {
+        debug_assert_eq!(aovs.len(), self.aov_count);
         match self.integrator {
             Integrator::Path(integrator) => integrator.radiance(self, ray, lambda, sampler, count),
             Integrator::Direct(integrator) => {
