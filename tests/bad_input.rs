@@ -217,6 +217,20 @@ fn cases() -> Vec<Case> {
             "at least one emitter or BSDF sample",
         ),
         render_scene(
+            "moment without nested integrators",
+            scene!("    <integrator type=\"moment\"/>"),
+            "scene.xml:3:",
+            "at least one nested integrator",
+        ),
+        render_scene(
+            "moment with a nested integrator named as an unnamed one is",
+            scene!(
+                "    <integrator type=\"moment\"><integrator type=\"path\" name=\"_arg_0\"/>\n<integrator type=\"direct\"/></integrator>"
+            ),
+            "scene.xml:4:",
+            "named \"_arg_0\"",
+        ),
+        render_scene(
             "NaN float",
             scene!("    <shape type=\"sphere\"><float name=\"radius\" value=\"nan\"/></shape>"),
             "scene.xml:3:",

@@ -79,14 +79,16 @@ impl Series {
 }
 
 fn integrator_named(name: &str, scene: &Scene) -> Result<Integrator> {
-    let max_depth = match &scene.integrator {
+    let image = scene.integrator.image_integrator();
+    let max_depth = match image {
         Integrator::Path(p) => p.max_depth,
         // Direct illumination is the path tracer's estimate of paths of two vertices.
         Integrator::Direct(_) => 2,
         Integrator::Distribution(d) => d.max_depth,
+        Integrator::Moment(_) => -1,
     };
     match name {
-        "path" => Ok(match &scene.integrator {
+        "path" => Ok(match image {
             Integrator::Path(p) => Integrator::Path(p.clone()),
             _ => PathIntegrator {
                 max_depth,
@@ -94,11 +96,11 @@ fn integrator_named(name: &str, scene: &Scene) -> Result<Integrator> {
             }
             .into(),
         }),
-        "direct" => Ok(match &scene.integrator {
+        "direct" => Ok(match image {
             Integrator::Direct(d) => Integrator::Direct(d.clone()),
             _ => DirectIntegrator::default().into(),
         }),
-        "distrib" => Ok(match &scene.integrator {
+        "distrib" => Ok(match image {
             Integrator::Distribution(d) => Integrator::Distribution(d.clone()),
             _ => DistributionIntegrator {
                 max_depth,
@@ -127,6 +129,7 @@ fn integrator_label(integrator: &Integrator) -> &'static str {
         Integrator::Path(_) => "path",
         Integrator::Direct(_) => "direct",
         Integrator::Distribution(_) => "distrib",
+        Integrator::Moment(_) => "moment",
     }
 }
 

@@ -1,5 +1,6 @@
 //! Integrators: estimators of the radiance arriving along a camera ray: the path tracer, direct
-//! illumination and the lecture's distribution ray tracer with splitting.
+//! illumination and the lecture's distribution ray tracer with splitting; `moment` runs nested
+//! integrators and writes their estimates and second moments as extra film channels.
 //!
 //! An [`Integrator`] is what a scene asks for: an estimator and its parameters. Before a render
 //! it is prepared for the world ([`Integrator::prepare`]), which builds the light sampler it
@@ -8,10 +9,12 @@
 pub mod direct;
 pub mod distribution;
 pub mod mis;
+pub mod moment;
 pub mod path;
 
 pub use direct::DirectIntegrator;
 pub use distribution::DistributionIntegrator;
+pub use moment::MomentIntegrator;
 pub use path::PathIntegrator;
 
 use crate::bsdf::{BsdfEval, Scattering};
@@ -28,11 +31,18 @@ pub enum Integrator {
     Path(PathIntegrator),
     Direct(DirectIntegrator),
     Distribution(DistributionIntegrator),
+    Moment(MomentIntegrator),
 }
 
 impl From<DirectIntegrator> for Integrator {
     fn from(integrator: DirectIntegrator) -> Integrator {
         Integrator::Direct(integrator)
+    }
+}
+
+impl From<MomentIntegrator> for Integrator {
+    fn from(integrator: MomentIntegrator) -> Integrator {
+        Integrator::Moment(integrator)
     }
 }
 
@@ -62,6 +72,8 @@ pub struct PreparedIntegrator<'a> {
     light_sampler: LightSampler,
     /// How many extra channels a sample writes.
     aov_count: usize,
+    /// The nested integrators (of `moment`), prepared in turn.
+    nested: Vec<PreparedIntegrator<'a>>,
 }
 
 impl Integrator {
@@ -71,6 +83,24 @@ impl Integrator {
             Integrator::Path(path) => path.light_selection,
             Integrator::Direct(_) => LightSelection::Power,
             Integrator::Distribution(distrib) => distrib.light_selection(),
+            Integrator::Moment(_) => LightSelection::Power,
+        }
+    }
+
+    /// The integrators nested in this one.
+    fn nested(&self) -> impl Iterator<Item = &Integrator> {
+        let nested: &[(String, Integrator)] = match self {
+            Integrator::Moment(moment) => &moment.integrators,
+            Integrator::Path(_) | Integrator::Direct(_) | Integrator::Distribution(_) => &[],
+        };
+        nested.iter().map(|(_, integrator)| integrator)
+    }
+
+    /// The integrator whose estimate is the image: this one, or the first nested one's.
+    pub fn image_integrator(&self) -> &Integrator {
+        match self.nested().next() {
+            Some(first) => first.image_integrator(),
+            None => self,
         }
     }
 
@@ -78,9 +108,8 @@ impl Integrator {
     /// Mitsuba names them in its EXR files; none for the plain estimators.
     pub fn aov_names(&self) -> Vec<String> {
         match self {
-            Integrator::Path(_) | Integrator::Direct(_) | Integrator::Distribution(_) => {
-                Vec::new()
-            }
+            Integrator::Path(_) | Integrator::Direct(_) | Integrator::Distribution(_) => Vec::new(),
+            Integrator::Moment(moment) => moment.aov_names(),
         }
     }
 
@@ -94,6 +123,7 @@ impl Integrator {
                 self.light_selection(),
             ),
             aov_count: self.aov_names().len(),
+            nested: self.nested().map(|i| i.prepare(world)).collect(),
         }
     }
 }
@@ -128,6 +158,9 @@ impl PreparedIntegrator<'_> {
             }
             Integrator::Distribution(integrator) => {
                 integrator.radiance(self, ray, lambda, sampler, count)
+            }
+            Integrator::Moment(_) => {
+                MomentIntegrator::radiance(self, ray, lambda, sampler, count, aovs)
             }
         }
     }

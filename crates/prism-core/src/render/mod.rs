@@ -27,8 +27,8 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
 
 use crate::error::{Error, Result};
-pub use crate::film::stats::relative_error;
 use crate::film::accumulation::add_aov_sample;
+pub use crate::film::stats::relative_error;
 use crate::film::{Film, FilterSampler, PixelSums, ValueSum};
 use crate::integrator::{PreparedIntegrator, RayCount};
 use crate::sampling::sampler::Sampler;
@@ -503,7 +503,8 @@ fn tile_major(
                     match initial {
                         Some((pixels, aovs)) => {
                             sums.pixels.push(pixels[index]);
-                            sums.aovs.extend_from_slice(&aovs[index * k..(index + 1) * k]);
+                            sums.aovs
+                                .extend_from_slice(&aovs[index * k..(index + 1) * k]);
                         }
                         None => {
                             sums.pixels.push(PixelSums::default());

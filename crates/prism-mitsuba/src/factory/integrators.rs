@@ -1,5 +1,5 @@
 //! Integrator plugins: `path` (with Prism's `emitter_sampling`, see
-//! [`prism_core::light::sampler`]), `direct` and the lecture's `distrib`.
+//! [`prism_core::light::sampler`]), `direct`, `moment` and the lecture's `distrib`.
 
 use crate::description::{PluginClass, PluginNode};
 use crate::params::Params;
@@ -7,7 +7,7 @@ use crate::registry::{Default, Origin, ParamKind, ParamSpec, Plugin, Registry};
 use prism_core::error::{Error, Result};
 use prism_core::integrator::distribution::DirectLights;
 use prism_core::integrator::{
-    DirectIntegrator, DistributionIntegrator, Integrator, PathIntegrator,
+    DirectIntegrator, DistributionIntegrator, Integrator, MomentIntegrator, PathIntegrator,
 };
 use prism_core::light::LightSelection;
 
@@ -37,6 +37,16 @@ pub static INTEGRATORS: Registry<Build> = Registry {
                 HIDE_EMITTERS,
             ],
             build: build_direct,
+        },
+        Plugin {
+            name: "moment",
+            origin: Origin::Mitsuba3,
+            summary: "Runs its nested integrators on each camera ray and writes, for each one \
+                      named n (unnamed ones are _arg_0, _arg_1, ...), its XYZ estimate as the \
+                      EXR channels n.X, n.Y, n.Z and their second moments as m2_n.X, m2_n.Y, \
+                      m2_n.Z; the image is the first one's.",
+            params: &[NESTED_INTEGRATORS],
+            build: build_moment,
         },
         Plugin {
             name: "distrib",
@@ -101,6 +111,11 @@ const BSDF_SAMPLES: ParamSpec = ParamSpec::new(
     ParamKind::Integer,
     Default::Text("shading_samples"),
     "BSDF samples per camera ray",
+);
+const NESTED_INTEGRATORS: ParamSpec = ParamSpec::nested(
+    PluginClass::Integrator,
+    Default::Required,
+    "the integrators whose moments are recorded (at least one), in order",
 );
 const BOUNCE_SAMPLES: ParamSpec = ParamSpec::new(
     "bounce_samples",
@@ -219,6 +234,44 @@ fn build_direct(params: &Params) -> Result<Integrator> {
         bsdf_samples,
         hide_emitters: params.boolean(&HIDE_EMITTERS)?,
     }))
+}
+
+/// The nested integrators of `moment`, each with the name its channels carry: its `name`
+/// attribute, or `_arg_i` for the i-th unnamed one (as Mitsuba names unnamed nested objects).
+fn build_moment(params: &Params) -> Result<Integrator> {
+    let children = params.children(&NESTED_INTEGRATORS);
+    if children.is_empty() {
+        return Err(Error::input(
+            params.location(),
+            "the moment integrator needs at least one nested integrator",
+        )
+        .with_help(
+            "nest the integrator whose moments you want, e.g. <integrator type=\"path\"/>",
+        ));
+    }
+    let mut integrators: Vec<(String, Integrator)> = Vec::with_capacity(children.len());
+    let mut unnamed = 0;
+    for child in children {
+        let name = match &child.name {
+            Some(name) => name.clone(),
+            None => {
+                unnamed += 1;
+                format!("_arg_{}", unnamed - 1)
+            }
+        };
+        if integrators.iter().any(|(n, _)| *n == name) {
+            return Err(Error::input(
+                &child.location,
+                format!("two nested integrators of moment are named \"{name}\""),
+            )
+            .with_help(
+                "give each nested integrator its own name (unnamed ones are called _arg_0, \
+                 _arg_1, ... in order)",
+            ));
+        }
+        integrators.push((name, build_integrator(&child.node)?));
+    }
+    Ok(MomentIntegrator { integrators }.into())
 }
 
 fn build_distrib(params: &Params) -> Result<Integrator> {
