@@ -231,6 +231,38 @@ fn cases() -> Vec<Case> {
             "named \"_arg_0\"",
         ),
         render_scene(
+            "aov of an unknown type",
+            scene!(
+                "    <integrator type=\"aov\"><string name=\"aovs\" value=\"nn:sh_normals\"/></integrator>"
+            ),
+            "scene.xml:3:",
+            "did you mean \"sh_normal\"",
+        ),
+        render_scene(
+            "aov without a type",
+            scene!(
+                "    <integrator type=\"aov\"><string name=\"aovs\" value=\"nn\"/></integrator>"
+            ),
+            "scene.xml:3:",
+            "not a name:type pair",
+        ),
+        render_scene(
+            "aov of a type Prism cannot produce",
+            scene!(
+                "    <integrator type=\"aov\"><string name=\"aovs\" value=\"d:duv_dx\"/></integrator>"
+            ),
+            "scene.xml:3:",
+            "ray differentials",
+        ),
+        render_scene(
+            "aov named as an image channel",
+            scene!(
+                "    <integrator type=\"aov\"><string name=\"aovs\" value=\"variance:position\"/></integrator>"
+            ),
+            "scene.xml:3:",
+            "would replace the image's own",
+        ),
+        render_scene(
             "NaN float",
             scene!("    <shape type=\"sphere\"><float name=\"radius\" value=\"nan\"/></shape>"),
             "scene.xml:3:",

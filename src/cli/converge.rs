@@ -85,7 +85,7 @@ fn integrator_named(name: &str, scene: &Scene) -> Result<Integrator> {
         // Direct illumination is the path tracer's estimate of paths of two vertices.
         Integrator::Direct(_) => 2,
         Integrator::Distribution(d) => d.max_depth,
-        Integrator::Moment(_) => -1,
+        Integrator::Moment(_) | Integrator::Aov(_) => -1,
     };
     match name {
         "path" => Ok(match image {
@@ -130,6 +130,7 @@ fn integrator_label(integrator: &Integrator) -> &'static str {
         Integrator::Direct(_) => "direct",
         Integrator::Distribution(_) => "distrib",
         Integrator::Moment(_) => "moment",
+        Integrator::Aov(_) => "aov",
     }
 }
 

@@ -8,6 +8,20 @@ use super::stats::{pixel_relative_error, variance_of_mean};
 use crate::error::Result;
 use crate::image::{ChannelImage, write_exr, write_png_srgb};
 
+/// The EXR channels of the image, which the integrator's extra channels may not reuse.
+pub const IMAGE_CHANNELS: [&str; 10] = [
+    "R",
+    "G",
+    "B",
+    "X",
+    "Y",
+    "Z",
+    "variance.X",
+    "variance.Y",
+    "variance.Z",
+    "relative_error.Y",
+];
+
 /// Writes the film as an EXR and as an sRGB PNG. The EXR's channels are `R`, `G`, `B` (linear
 /// sRGB), `X`, `Y`, `Z` (CIE 1931), `variance.X`, `variance.Y`, `variance.Z` (the estimated
 /// variance of each pixel's mean, see [`super::stats`]) and `relative_error.Y` (the
@@ -23,27 +37,29 @@ pub fn write_images(film: &Film, exr_path: &Path, png_path: &Path) -> Result<()>
             .map(|p| variance_of_mean(p, c) as f32)
             .collect::<Vec<f32>>()
     };
+    let values = [
+        channel(&rgb, 0),
+        channel(&rgb, 1),
+        channel(&rgb, 2),
+        channel(&xyz, 0),
+        channel(&xyz, 1),
+        channel(&xyz, 2),
+        variance(0),
+        variance(1),
+        variance(2),
+        film.pixels
+            .iter()
+            .map(|p| pixel_relative_error(p) as f32)
+            .collect(),
+    ];
     let mut image = ChannelImage {
         width: film.crop.size.x as usize,
         height: film.crop.size.y as usize,
-        channels: vec![
-            ("R".to_string(), channel(&rgb, 0)),
-            ("G".to_string(), channel(&rgb, 1)),
-            ("B".to_string(), channel(&rgb, 2)),
-            ("X".to_string(), channel(&xyz, 0)),
-            ("Y".to_string(), channel(&xyz, 1)),
-            ("Z".to_string(), channel(&xyz, 2)),
-            ("variance.X".to_string(), variance(0)),
-            ("variance.Y".to_string(), variance(1)),
-            ("variance.Z".to_string(), variance(2)),
-            (
-                "relative_error.Y".to_string(),
-                film.pixels
-                    .iter()
-                    .map(|p| pixel_relative_error(p) as f32)
-                    .collect(),
-            ),
-        ],
+        channels: IMAGE_CHANNELS
+            .iter()
+            .map(|name| name.to_string())
+            .zip(values)
+            .collect(),
     };
     for (c, name) in film.aov_names.iter().enumerate() {
         image.channels.push((name.clone(), film.aov(c)));

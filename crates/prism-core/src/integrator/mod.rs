@@ -1,17 +1,21 @@
 //! Integrators: estimators of the radiance arriving along a camera ray: the path tracer, direct
 //! illumination and the lecture's distribution ray tracer with splitting; `moment` runs nested
-//! integrators and writes their estimates and second moments as extra film channels.
+//! integrators and writes their estimates and second moments as extra film channels, `aov` the
+//! albedo, normals, depth and other variables of the first hit beside nested integrators'
+//! images.
 //!
 //! An [`Integrator`] is what a scene asks for: an estimator and its parameters. Before a render
 //! it is prepared for the world ([`Integrator::prepare`]), which builds the light sampler it
 //! chooses lights with, so the sampler always follows the integrator's own settings.
 
+pub mod aov;
 pub mod direct;
 pub mod distribution;
 pub mod mis;
 pub mod moment;
 pub mod path;
 
+pub use aov::AovIntegrator;
 pub use direct::DirectIntegrator;
 pub use distribution::DistributionIntegrator;
 pub use moment::MomentIntegrator;
@@ -32,6 +36,13 @@ pub enum Integrator {
     Direct(DirectIntegrator),
     Distribution(DistributionIntegrator),
     Moment(MomentIntegrator),
+    Aov(AovIntegrator),
+}
+
+impl From<AovIntegrator> for Integrator {
+    fn from(integrator: AovIntegrator) -> Integrator {
+        Integrator::Aov(integrator)
+    }
 }
 
 impl From<DirectIntegrator> for Integrator {
@@ -83,7 +94,7 @@ impl Integrator {
             Integrator::Path(path) => path.light_selection,
             Integrator::Direct(_) => LightSelection::Power,
             Integrator::Distribution(distrib) => distrib.light_selection(),
-            Integrator::Moment(_) => LightSelection::Power,
+            Integrator::Moment(_) | Integrator::Aov(_) => LightSelection::Power,
         }
     }
 
@@ -91,9 +102,23 @@ impl Integrator {
     fn nested(&self) -> impl Iterator<Item = &Integrator> {
         let nested: &[(String, Integrator)] = match self {
             Integrator::Moment(moment) => &moment.integrators,
+            Integrator::Aov(aov) => &aov.integrators,
             Integrator::Path(_) | Integrator::Direct(_) | Integrator::Distribution(_) => &[],
         };
         nested.iter().map(|(_, integrator)| integrator)
+    }
+
+    /// Whether the emitters the camera sees directly are left out of the image.
+    pub fn hides_emitters(&self) -> bool {
+        match self {
+            Integrator::Path(path) => path.hide_emitters,
+            Integrator::Direct(direct) => direct.hide_emitters,
+            Integrator::Distribution(distrib) => distrib.hide_emitters,
+            Integrator::Moment(_) | Integrator::Aov(_) => match self.nested().next() {
+                Some(first) => first.hides_emitters(),
+                None => true,
+            },
+        }
     }
 
     /// The integrator whose estimate is the image: this one, or the first nested one's.
@@ -110,6 +135,7 @@ impl Integrator {
         match self {
             Integrator::Path(_) | Integrator::Direct(_) | Integrator::Distribution(_) => Vec::new(),
             Integrator::Moment(moment) => moment.aov_names(),
+            Integrator::Aov(aov) => aov.aov_names(),
         }
     }
 
@@ -161,6 +187,9 @@ impl PreparedIntegrator<'_> {
             }
             Integrator::Moment(_) => {
                 MomentIntegrator::radiance(self, ray, lambda, sampler, count, aovs)
+            }
+            Integrator::Aov(integrator) => {
+                integrator.radiance(self, ray, lambda, sampler, count, aovs)
             }
         }
     }

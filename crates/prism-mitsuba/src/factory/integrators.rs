@@ -1,13 +1,17 @@
 //! Integrator plugins: `path` (with Prism's `emitter_sampling`, see
-//! [`prism_core::light::sampler`]), `direct`, `moment` and the lecture's `distrib`.
+//! [`prism_core::light::sampler`]), `direct`, `moment`, `aov` and the lecture's `distrib`.
 
 use crate::description::{PluginClass, PluginNode};
 use crate::params::Params;
 use crate::registry::{Default, Origin, ParamKind, ParamSpec, Plugin, Registry};
-use prism_core::error::{Error, Result};
+use crate::suggest::closest_match;
+use prism_core::error::{Error, Result, SourceLocation};
+use prism_core::film::output::IMAGE_CHANNELS;
+use prism_core::integrator::aov::{Aov, AovKind};
 use prism_core::integrator::distribution::DirectLights;
 use prism_core::integrator::{
-    DirectIntegrator, DistributionIntegrator, Integrator, MomentIntegrator, PathIntegrator,
+    AovIntegrator, DirectIntegrator, DistributionIntegrator, Integrator, MomentIntegrator,
+    PathIntegrator,
 };
 use prism_core::light::LightSelection;
 
@@ -47,6 +51,16 @@ pub static INTEGRATORS: Registry<Build> = Registry {
                       m2_n.Z; the image is the first one's.",
             params: &[NESTED_INTEGRATORS],
             build: build_moment,
+        },
+        Plugin {
+            name: "aov",
+            origin: Origin::Mitsuba3,
+            summary: "Arbitrary output variables of the first hit (albedo, depth, position, uv, \
+                      geo_normal, sh_normal, dp_du, dp_dv, prim_index, shape_index) as EXR \
+                      channels, beside each nested integrator's image as n.R, n.G, n.B, n.A; \
+                      the image is the first nested integrator's.",
+            params: &[AOVS, NESTED_IMAGE_INTEGRATORS],
+            build: build_aov,
         },
         Plugin {
             name: "distrib",
@@ -117,6 +131,17 @@ const NESTED_INTEGRATORS: ParamSpec = ParamSpec::nested(
     Default::Required,
     "the integrators whose moments are recorded (at least one), in order",
 );
+const NESTED_IMAGE_INTEGRATORS: ParamSpec = ParamSpec::nested(
+    PluginClass::Integrator,
+    Default::Text("none (a black image)"),
+    "the integrators whose images are written beside the variables, in order",
+);
+const AOVS: ParamSpec = ParamSpec::new(
+    "aovs",
+    ParamKind::String,
+    Default::Required,
+    "comma-separated name:type pairs, e.g. \"dd.y:depth,nn:sh_normal,alb:albedo\"",
+);
 const BOUNCE_SAMPLES: ParamSpec = ParamSpec::new(
     "bounce_samples",
     ParamKind::Integer,
@@ -149,6 +174,25 @@ pub fn build_integrator(node: &PluginNode) -> Result<Integrator> {
     let integrator = (plugin.build)(&params)?;
     params.finish()?;
     Ok(integrator)
+}
+
+/// Refuses a scene integrator whose extra channels would take the name of an image channel.
+pub fn check_channel_names(integrator: &Integrator, location: &SourceLocation) -> Result<()> {
+    match integrator
+        .aov_names()
+        .into_iter()
+        .find(|name| IMAGE_CHANNELS.contains(&name.as_str()))
+    {
+        Some(name) => Err(Error::input(
+            location,
+            format!("the integrator's channel \"{name}\" would replace the image's own"),
+        )
+        .with_help(format!(
+            "rename the variable or nested integrator; the image's channels are {}",
+            IMAGE_CHANNELS.join(", ")
+        ))),
+        None => Ok(()),
+    }
 }
 
 /// `max_depth`: −1 (unbounded) or at least 0.
@@ -236,19 +280,10 @@ fn build_direct(params: &Params) -> Result<Integrator> {
     }))
 }
 
-/// The nested integrators of `moment`, each with the name its channels carry: its `name`
+/// The nested integrators of `spec`, each with the name its channels carry: its `name`
 /// attribute, or `_arg_i` for the i-th unnamed one (as Mitsuba names unnamed nested objects).
-fn build_moment(params: &Params) -> Result<Integrator> {
-    let children = params.children(&NESTED_INTEGRATORS);
-    if children.is_empty() {
-        return Err(Error::input(
-            params.location(),
-            "the moment integrator needs at least one nested integrator",
-        )
-        .with_help(
-            "nest the integrator whose moments you want, e.g. <integrator type=\"path\"/>",
-        ));
-    }
+fn named_integrators(params: &Params, spec: &ParamSpec) -> Result<Vec<(String, Integrator)>> {
+    let children = params.children(spec);
     let mut integrators: Vec<(String, Integrator)> = Vec::with_capacity(children.len());
     let mut unnamed = 0;
     for child in children {
@@ -262,7 +297,10 @@ fn build_moment(params: &Params) -> Result<Integrator> {
         if integrators.iter().any(|(n, _)| *n == name) {
             return Err(Error::input(
                 &child.location,
-                format!("two nested integrators of moment are named \"{name}\""),
+                format!(
+                    "two nested integrators of {} are named \"{name}\"",
+                    params.node().describe()
+                ),
             )
             .with_help(
                 "give each nested integrator its own name (unnamed ones are called _arg_0, \
@@ -271,7 +309,101 @@ fn build_moment(params: &Params) -> Result<Integrator> {
         }
         integrators.push((name, build_integrator(&child.node)?));
     }
+    Ok(integrators)
+}
+
+fn build_moment(params: &Params) -> Result<Integrator> {
+    let integrators = named_integrators(params, &NESTED_INTEGRATORS)?;
+    if integrators.is_empty() {
+        return Err(Error::input(
+            params.location(),
+            "the moment integrator needs at least one nested integrator",
+        )
+        .with_help(
+            "nest the integrator whose moments you want, e.g. <integrator type=\"path\"/>",
+        ));
+    }
     Ok(MomentIntegrator { integrators }.into())
+}
+
+/// Mitsuba's AOV types that Prism cannot produce, and why.
+const UNSUPPORTED_AOVS: [(&str, &str); 3] = [
+    ("duv_dx", "Prism's cameras trace no ray differentials"),
+    ("duv_dy", "Prism's cameras trace no ray differentials"),
+    (
+        "boundary_test",
+        "it serves differentiable rendering, which Prism does not do",
+    ),
+];
+
+/// `aovs`: `name:type` pairs separated by commas (or spaces, as Mitsuba's tokenizer allows).
+fn parse_aovs(params: &Params) -> Result<Vec<Aov>> {
+    let location = params.location_of(&AOVS);
+    let Some(list) = params.string_opt(&AOVS)? else {
+        return Err(Error::input(
+            params.location(),
+            "the aov integrator needs \"aovs\", the variables to write",
+        )
+        .with_help("add e.g. <string name=\"aovs\" value=\"nn:sh_normal,alb:albedo\"/>"));
+    };
+    let names: Vec<&str> = AovKind::ALL.iter().map(|(name, _)| *name).collect();
+    let mut aovs = Vec::new();
+    for item in list.split([',', ' ']).filter(|item| !item.is_empty()) {
+        let (name, kind) = match item.split(':').collect::<Vec<&str>>()[..] {
+            [name, kind] if !name.is_empty() && !kind.is_empty() => (name, kind),
+            _ => {
+                return Err(Error::input(
+                    location,
+                    format!("\"{item}\" in \"aovs\" is not a name:type pair"),
+                )
+                .with_help("write each variable as name:type, e.g. nn:sh_normal"));
+            }
+        };
+        if let Some((_, why)) = UNSUPPORTED_AOVS.iter().find(|(n, _)| *n == kind) {
+            return Err(Error::input(
+                location,
+                format!("the AOV type \"{kind}\" is not supported: {why}"),
+            )
+            .with_help(format!("remove \"{item}\" from \"aovs\"")));
+        }
+        let Some((_, kind)) = AovKind::ALL.iter().find(|(n, _)| *n == kind) else {
+            let mut error =
+                Error::input(location, format!("unknown AOV type \"{kind}\" in \"aovs\""));
+            error = match closest_match(kind, &names) {
+                Some(close) => error.with_help(format!("did you mean \"{close}\"?")),
+                None => error.with_help(format!("the types are {}", names.join(", "))),
+            };
+            return Err(error);
+        };
+        aovs.push(Aov {
+            name: name.to_string(),
+            kind: *kind,
+        });
+    }
+    Ok(aovs)
+}
+
+fn build_aov(params: &Params) -> Result<Integrator> {
+    let aovs = parse_aovs(params)?;
+    let integrators = named_integrators(params, &NESTED_IMAGE_INTEGRATORS)?;
+    let integrator = AovIntegrator { aovs, integrators };
+    let names = integrator.aov_names();
+    if names.is_empty() {
+        return Err(Error::input(
+            params.location_of(&AOVS),
+            "the aov integrator has nothing to write: \"aovs\" is empty and no integrator is nested",
+        ));
+    }
+    for (i, name) in names.iter().enumerate() {
+        if names[..i].contains(name) {
+            return Err(Error::input(
+                params.location_of(&AOVS),
+                format!("two of the aov integrator's channels are named \"{name}\""),
+            )
+            .with_help("give each variable and nested integrator its own name"));
+        }
+    }
+    Ok(integrator.into())
 }
 
 fn build_distrib(params: &Params) -> Result<Integrator> {
