@@ -101,6 +101,7 @@ impl DirectIntegrator {
                     sampler,
                     count,
                     strategies,
+                    false,
                 );
             }
             result += light * (1.0 / self.emitter_samples as f32);

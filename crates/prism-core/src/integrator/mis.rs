@@ -19,7 +19,7 @@ use glam::Vec3;
 
 use crate::bsdf::Scattering;
 use crate::geometry::SurfaceInteraction;
-use crate::integrator::{PreparedIntegrator, RayCount, unoccluded};
+use crate::integrator::{PreparedIntegrator, RayCount, normals_agree, unoccluded};
 use crate::light::Light;
 use crate::math::Ray;
 use crate::sampling::sampler::Sampler;
@@ -124,7 +124,10 @@ enum LightPdf<'a> {
 }
 
 /// One light sample at `si`: a light chosen by the light sampler, a point on it, the shadow
-/// ray, and the MIS-weighted contribution f·L·w / (p_light · p_choice).
+/// ray, and the MIS-weighted contribution f·L·w / (p_light · p_choice). With `strict_normals`
+/// a light whose direction the geometric and shading normals put on different sides
+/// contributes nothing (Mitsuba 0.6's `strictNormals`).
+#[allow(clippy::too_many_arguments)]
 #[inline]
 pub fn sample_light(
     prepared: &PreparedIntegrator,
@@ -134,6 +137,7 @@ pub fn sample_light(
     sampler: &mut Sampler,
     count: &mut RayCount,
     strategies: Strategies,
+    strict_normals: bool,
 ) -> SampledSpectrum {
     let world = prepared.world;
     let u_light = sampler.next_1d();
@@ -153,6 +157,9 @@ pub fn sample_light(
     ) else {
         return SampledSpectrum::ZERO;
     };
+    if strict_normals && !normals_agree(si, ls.wi) {
+        return SampledSpectrum::ZERO;
+    }
     let Some(f) = unoccluded(world, si, scattering, &ls, count) else {
         return SampledSpectrum::ZERO;
     };

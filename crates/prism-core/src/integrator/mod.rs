@@ -216,6 +216,14 @@ fn unoccluded(
     Some(f)
 }
 
+/// Whether the geometric and the shading normal at `si` put direction `d` on the same side of
+/// the surface (Mitsuba 0.6's `strictNormals` test, which stops light leaking through surfaces
+/// whose shading normals bend far from the geometry).
+#[inline]
+fn normals_agree(si: &SurfaceInteraction, d: glam::Vec3) -> bool {
+    si.n.dot(d) * si.shading.n.dot(d) > 0.0
+}
+
 /// A path's estimate for the caller's wavelengths once the path has kept only its hero
 /// wavelength: the hero carries the whole estimate with a quarter of its density
 /// (`terminate_secondary`); expressed for wavelengths whose `to_xyz` divides by the full

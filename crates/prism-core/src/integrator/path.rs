@@ -8,6 +8,7 @@
 //!     <integer name="rr_depth" value="5"/>       <!-- depth at which Russian roulette starts -->
 //!     <boolean name="hide_emitters" value="false"/>
 //!     <string name="emitter_sampling" value="power"/>   <!-- or "uniform" (Prism only) -->
+//!     <boolean name="strict_normals" value="false"/>    <!-- Mitsuba 0.6's strictNormals -->
 //! </integrator>
 //! ```
 //!
@@ -27,10 +28,15 @@
 //! * Dispersion: where a BSDF refracts each wavelength its own way, the path keeps only its hero
 //!   wavelength from there on (`SampledWavelengths::terminate_secondary`).
 //! * Depth follows Mitsuba: the camera ray's hit is depth 0; a path of depth d has d bounces.
+//! * `strict_normals` (Mitsuba 0.6; Mitsuba 3 has no such parameter): where the geometric and
+//!   the shading normal put a direction on different sides of the surface, the path ends on
+//!   arriving from it, a light sample towards it adds nothing, and a BSDF sample into it ends
+//!   the path, as in Mitsuba 0.6's `path`: no light leaks through surfaces whose shading
+//!   normals bend across the geometry, at the price of some energy.
 
 use crate::bsdf::BxdfTree;
 use crate::integrator::mis::{BsdfSampleOrigin, Strategies, emission_found, sample_light};
-use crate::integrator::{PreparedIntegrator, RayCount, hero_only};
+use crate::integrator::{PreparedIntegrator, RayCount, hero_only, normals_agree};
 use crate::light::LightSelection;
 use crate::math::Ray;
 use crate::sampling::sampler::Sampler;
@@ -46,6 +52,8 @@ pub struct PathIntegrator {
     pub hide_emitters: bool,
     /// How one light is chosen for each light sample.
     pub light_selection: LightSelection,
+    /// Whether directions the geometric and shading normals disagree about end the path.
+    pub strict_normals: bool,
 }
 
 impl Default for PathIntegrator {
@@ -55,6 +63,7 @@ impl Default for PathIntegrator {
             rr_depth: 5,
             hide_emitters: false,
             light_selection: LightSelection::Power,
+            strict_normals: false,
         }
     }
 }
@@ -109,7 +118,9 @@ impl PathIntegrator {
             let wo_world = -ray.d.normalize();
             let info = world.shape_info[si.shape as usize];
 
-            if !self.depth_allows_next_vertex(depth) {
+            if !self.depth_allows_next_vertex(depth)
+                || (self.strict_normals && !normals_agree(&si, wo_world))
+            {
                 break;
             }
 
@@ -134,6 +145,7 @@ impl PathIntegrator {
                         sampler,
                         count,
                         Strategies::ONE_EACH,
+                        self.strict_normals,
                     );
             }
 
@@ -143,6 +155,9 @@ impl PathIntegrator {
             let Some(bs) = scattering.sample(u_lobe, u) else {
                 break;
             };
+            if self.strict_normals && !normals_agree(&si, bs.wi) {
+                break;
+            }
             if bs.terminates_secondary {
                 lambda.terminate_secondary();
             }

@@ -25,7 +25,13 @@ pub static INTEGRATORS: Registry<Build> = Registry {
             origin: Origin::Mitsuba3,
             summary: "Path tracing with next-event estimation, multiple importance sampling \
                       (power heuristic) and Russian roulette on the path's potential.",
-            params: &[MAX_DEPTH, RR_DEPTH, HIDE_EMITTERS, EMITTER_SAMPLING],
+            params: &[
+                MAX_DEPTH,
+                RR_DEPTH,
+                HIDE_EMITTERS,
+                EMITTER_SAMPLING,
+                STRICT_NORMALS,
+            ],
             build: build_path,
         },
         Plugin {
@@ -107,6 +113,13 @@ const EMITTER_SAMPLING: ParamSpec = ParamSpec::new(
     Default::Str("power"),
     "Prism only (Mitsuba rejects it): one light per shading point chosen ∝ its power, or \
      uniformly (as Mitsuba's default equal `sampling_weight`s)",
+);
+const STRICT_NORMALS: ParamSpec = ParamSpec::new(
+    "strict_normals",
+    ParamKind::Boolean,
+    Default::Boolean(false),
+    "Mitsuba 0.6 (`strictNormals`; Mitsuba 3 has none): end paths at directions the geometric \
+     and shading normals put on different sides",
 );
 const SHADING_SAMPLES: ParamSpec = ParamSpec::new(
     "shading_samples",
@@ -237,6 +250,7 @@ fn build_path(params: &Params) -> Result<Integrator> {
         rr_depth: rr_depth as i32,
         hide_emitters: params.boolean(&HIDE_EMITTERS)?,
         light_selection,
+        strict_normals: params.boolean(&STRICT_NORMALS)?,
     }))
 }
 
