@@ -145,8 +145,9 @@ fn depth_position_normals_and_albedo_of_a_plane() {
     }
     for name in ["nn", "gn"] {
         let normal = [".X", ".Y", ".Z"].map(|c| channel(&film, &format!("{name}{c}")));
-        for pixel in 0..W * W {
-            let n = Vec3::new(normal[0][pixel], normal[1][pixel], normal[2][pixel]);
+        let [x, y, z] = &normal;
+        for (pixel, ((&x, &y), &z)) in x.iter().zip(y).zip(z).enumerate() {
+            let n = Vec3::new(x, y, z);
             assert!((n - Vec3::Z).length() < 1e-6, "pixel {pixel}: {name} = {n}");
         }
     }
