@@ -156,7 +156,7 @@ fn depth_position_normals_and_albedo_of_a_plane() {
     let (mut mean, mut lo, mut hi) = ([0.0f64; 3], [f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
     for i in 0..steps {
         let u = (i as f32 + 0.5) / steps as f32;
-        let lambda = SampledWavelengths::sample(u, scene.wavelength_sampling);
+        let lambda = SampledWavelengths::sample(u, scene.film.wavelength_sampling);
         let rgb = xyz_to_linear_srgb(lambda.to_xyz(&SampledSpectrum::splat(0.5)));
         for c in 0..3 {
             let v = f64::from(rgb[c]);
@@ -206,6 +206,17 @@ fn albedo_of_every_bsdf() {
                 .into(),
             0.3,
         ),
+        (
+            r#"<bsdf type="pplastic"><spectrum name="diffuse_reflectance" value="0.3"/></bsdf>"#
+                .into(),
+            0.3,
+        ),
+        (
+            r#"<bsdf type="ward"><spectrum name="diffuse_reflectance" value="0.3"/><spectrum name="specular_reflectance" value="0.2"/></bsdf>"#
+                .into(),
+            0.3,
+        ),
+        (r#"<bsdf type="null"/>"#.into(), 0.0),
         (r#"<bsdf type="conductor"/>"#.into(), 0.0),
         (r#"<bsdf type="roughconductor"/>"#.into(), 0.0),
         (r#"<bsdf type="dielectric"/>"#.into(), 0.0),

@@ -155,7 +155,7 @@ fn second_moment_of_a_constant_environment() {
     let (mut m1, mut m2) = (0.0, 0.0);
     for i in 0..steps {
         let u = (i as f32 + 0.5) / steps as f32;
-        let lambda = SampledWavelengths::sample(u, scene.wavelength_sampling);
+        let lambda = SampledWavelengths::sample(u, scene.film.wavelength_sampling);
         let y = f64::from(lambda.to_xyz(&SampledSpectrum::splat(radiance))[1]);
         m1 += y / steps as f64;
         m2 += y * y / steps as f64;

@@ -18,9 +18,9 @@
 use glam::Vec3;
 
 use crate::bsdf::Scattering;
-use crate::geometry::SurfaceInteraction;
+use crate::geometry::{SurfaceInteraction, SurfaceSample};
 use crate::integrator::{PreparedIntegrator, RayCount, normals_agree, unoccluded};
-use crate::light::Light;
+use crate::light::{AreaLight, Light};
 use crate::math::Ray;
 use crate::sampling::sampler::Sampler;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
@@ -92,8 +92,8 @@ pub fn emission_found(
             let Light::Area(light) = &world.lights[light_index as usize] else {
                 unreachable!("only area lights are attached to shapes");
             };
-            let emitted = light.emitted(si.shading.n, -ray.d.normalize(), lambda);
-            (emitted, light_index, LightPdf::Area(si))
+            let emitted = light.emitted(si.uv, si.shading.n, -ray.d.normalize(), lambda);
+            (emitted, light_index, LightPdf::Area(light, si))
         }
     };
     let Some(origin) = origin.filter(|o| !o.specular) else {
@@ -106,9 +106,12 @@ pub fn emission_found(
     let light_pdf = choice
         * match light_pdf {
             LightPdf::Environment(d) => world.lights[light_index as usize].environment_pdf(d),
-            LightPdf::Area(si) => {
-                world.geometry.primitives[si.shape as usize].pdf_from(origin.p, si.time, si.p, si.n)
-            }
+            LightPdf::Area(light, si) => light.pdf_from(
+                &world.geometry.primitives,
+                origin.p,
+                si.time,
+                &SurfaceSample::at(si),
+            ),
         };
     emitted
         * power_heuristic(
@@ -120,7 +123,7 @@ pub fn emission_found(
 /// What the light-sampling density of an emitter found by a BSDF sample depends on.
 enum LightPdf<'a> {
     Environment(Vec3),
-    Area(&'a SurfaceInteraction),
+    Area(&'a AreaLight, &'a SurfaceInteraction),
 }
 
 /// One light sample at `si`: a light chosen by the light sampler, a point on it, the shadow

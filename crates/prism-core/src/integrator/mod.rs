@@ -1,5 +1,6 @@
 //! Integrators: estimators of the radiance arriving along a camera ray: the path tracer, direct
-//! illumination and the lecture's distribution ray tracer with splitting; `moment` runs nested
+//! illumination, the lecture's distribution ray tracer with splitting and the volumetric path
+//! tracers; `moment` runs nested
 //! integrators and writes their estimates and second moments as extra film channels, `aov` the
 //! albedo, normals, depth and other variables of the first hit beside nested integrators'
 //! images.
@@ -14,12 +15,18 @@ pub mod distribution;
 pub mod mis;
 pub mod moment;
 pub mod path;
+pub mod volpath;
+pub mod volpathmis;
 
 pub use aov::AovIntegrator;
 pub use direct::DirectIntegrator;
 pub use distribution::DistributionIntegrator;
 pub use moment::MomentIntegrator;
 pub use path::PathIntegrator;
+pub use volpath::{Tracking, VolPathIntegrator};
+
+use volpath::SpectralTracking;
+use volpathmis::SpectralMis;
 
 use crate::bsdf::{BsdfEval, Scattering};
 use crate::geometry::SurfaceInteraction;
@@ -37,6 +44,7 @@ pub enum Integrator {
     Distribution(DistributionIntegrator),
     Moment(MomentIntegrator),
     Aov(AovIntegrator),
+    VolPath(VolPathIntegrator),
 }
 
 impl From<AovIntegrator> for Integrator {
@@ -54,6 +62,12 @@ impl From<DirectIntegrator> for Integrator {
 impl From<MomentIntegrator> for Integrator {
     fn from(integrator: MomentIntegrator) -> Integrator {
         Integrator::Moment(integrator)
+    }
+}
+
+impl From<VolPathIntegrator> for Integrator {
+    fn from(integrator: VolPathIntegrator) -> Integrator {
+        Integrator::VolPath(integrator)
     }
 }
 
@@ -94,6 +108,7 @@ impl Integrator {
             Integrator::Path(path) => path.light_selection,
             Integrator::Direct(_) => LightSelection::Power,
             Integrator::Distribution(distrib) => distrib.light_selection(),
+            Integrator::VolPath(volpath) => volpath.light_selection,
             Integrator::Moment(_) | Integrator::Aov(_) => LightSelection::Power,
         }
     }
@@ -103,7 +118,10 @@ impl Integrator {
         let nested: &[(String, Integrator)] = match self {
             Integrator::Moment(moment) => &moment.integrators,
             Integrator::Aov(aov) => &aov.integrators,
-            Integrator::Path(_) | Integrator::Direct(_) | Integrator::Distribution(_) => &[],
+            Integrator::Path(_)
+            | Integrator::Direct(_)
+            | Integrator::Distribution(_)
+            | Integrator::VolPath(_) => &[],
         };
         nested.iter().map(|(_, integrator)| integrator)
     }
@@ -114,6 +132,7 @@ impl Integrator {
             Integrator::Path(path) => path.hide_emitters,
             Integrator::Direct(direct) => direct.hide_emitters,
             Integrator::Distribution(distrib) => distrib.hide_emitters,
+            Integrator::VolPath(volpath) => volpath.hide_emitters,
             Integrator::Moment(_) | Integrator::Aov(_) => match self.nested().next() {
                 Some(first) => first.hides_emitters(),
                 None => true,
@@ -133,7 +152,10 @@ impl Integrator {
     /// Mitsuba names them in its EXR files; none for the plain estimators.
     pub fn aov_names(&self) -> Vec<String> {
         match self {
-            Integrator::Path(_) | Integrator::Direct(_) | Integrator::Distribution(_) => Vec::new(),
+            Integrator::Path(_)
+            | Integrator::Direct(_)
+            | Integrator::Distribution(_)
+            | Integrator::VolPath(_) => Vec::new(),
             Integrator::Moment(moment) => moment.aov_names(),
             Integrator::Aov(aov) => aov.aov_names(),
         }
@@ -146,6 +168,7 @@ impl Integrator {
             world,
             light_sampler: LightSampler::with_selection(
                 &world.light_powers,
+                &world.light_sampling_weights,
                 self.light_selection(),
             ),
             aov_count: self.aov_names().len(),
@@ -191,6 +214,19 @@ impl PreparedIntegrator<'_> {
             Integrator::Aov(integrator) => {
                 integrator.radiance(self, ray, lambda, sampler, count, aovs)
             }
+            Integrator::VolPath(integrator) => match integrator.tracking {
+                Tracking::Spectral => {
+                    integrator.trace(SpectralTracking::new(), self, ray, lambda, sampler, count)
+                }
+                Tracking::HeroMis { spectral_mis } => integrator.trace(
+                    SpectralMis::new(spectral_mis),
+                    self,
+                    ray,
+                    lambda,
+                    sampler,
+                    count,
+                ),
+            },
         }
     }
 }

@@ -1,5 +1,6 @@
 //! Integrator plugins: `path` (with Prism's `emitter_sampling`, see
-//! [`prism_core::light::sampler`]), `direct`, `moment`, `aov` and the lecture's `distrib`.
+//! [`prism_core::light::sampler`]), `direct`, `moment`, `aov`, the lecture's `distrib`, and
+//! `volpath` and `volpathmis` for media.
 
 use crate::description::{PluginClass, PluginNode};
 use crate::params::Params;
@@ -11,7 +12,7 @@ use prism_core::integrator::aov::{Aov, AovKind};
 use prism_core::integrator::distribution::DirectLights;
 use prism_core::integrator::{
     AovIntegrator, DirectIntegrator, DistributionIntegrator, Integrator, MomentIntegrator,
-    PathIntegrator,
+    PathIntegrator, Tracking, VolPathIntegrator,
 };
 use prism_core::light::LightSelection;
 
@@ -86,6 +87,33 @@ pub static INTEGRATORS: Registry<Build> = Registry {
             ],
             build: build_distrib,
         },
+        Plugin {
+            name: "volpath",
+            origin: Origin::Mitsuba3,
+            summary: "Volumetric path tracing: `path` with participating media between the \
+                      surfaces, free flights by spectral tracking with one majorant for the \
+                      path's four wavelengths, shadow rays through media (closed-form or \
+                      ratio-tracking transmittance) and `null` boundaries, light and phase \
+                      samples in media combined by MIS.",
+            params: &[MAX_DEPTH, RR_DEPTH, HIDE_EMITTERS, EMITTER_SAMPLING],
+            build: build_volpath,
+        },
+        Plugin {
+            name: "volpathmis",
+            origin: Origin::Mitsuba3,
+            summary: "Volumetric path tracing with spectral MIS (Miller, Georgiev & Jarosz \
+                      2019): `volpath`'s path loop with the hero wavelength's free flights, \
+                      combined over the path's four wavelengths and with light samples by the \
+                      balance heuristic, so chromatic media stay free of fireflies.",
+            params: &[
+                MAX_DEPTH,
+                RR_DEPTH,
+                HIDE_EMITTERS,
+                EMITTER_SAMPLING,
+                USE_SPECTRAL_MIS,
+            ],
+            build: build_volpathmis,
+        },
     ],
 };
 
@@ -111,8 +139,15 @@ const EMITTER_SAMPLING: ParamSpec = ParamSpec::new(
     "emitter_sampling",
     ParamKind::Choice(&["power", "uniform"]),
     Default::Str("power"),
-    "Prism only (Mitsuba rejects it): one light per shading point chosen ∝ its power, or \
-     uniformly (as Mitsuba's default equal `sampling_weight`s)",
+    "Prism only (Mitsuba rejects it): one light per shading point chosen ∝ its power × \
+     `sampling_weight`, or ∝ `sampling_weight` alone (Mitsuba's rule; uniform by default)",
+);
+const USE_SPECTRAL_MIS: ParamSpec = ParamSpec::new(
+    "use_spectral_mis",
+    ParamKind::Boolean,
+    Default::Boolean(true),
+    "combine the four wavelengths' free-flight densities by MIS; false weights every \
+     wavelength by the hero's densities alone",
 );
 const STRICT_NORMALS: ParamSpec = ParamSpec::new(
     "strict_normals",
@@ -233,6 +268,14 @@ fn count(params: &Params, spec: &ParamSpec) -> Result<u32> {
 }
 
 fn build_path(params: &Params) -> Result<Integrator> {
+    Ok(Integrator::Path(PathIntegrator {
+        strict_normals: params.boolean(&STRICT_NORMALS)?,
+        ..path_settings(params)?
+    }))
+}
+
+/// The settings `path` shares with `volpath` and `volpathmis`.
+fn path_settings(params: &Params) -> Result<PathIntegrator> {
     let max_depth = max_depth(params)?;
     let rr_depth = params.integer(&RR_DEPTH)?;
     if rr_depth < 1 || rr_depth > i64::from(i32::MAX) {
@@ -245,13 +288,13 @@ fn build_path(params: &Params) -> Result<Integrator> {
         "uniform" => LightSelection::Uniform,
         _ => LightSelection::Power,
     };
-    Ok(Integrator::Path(PathIntegrator {
+    Ok(PathIntegrator {
         max_depth,
         rr_depth: rr_depth as i32,
         hide_emitters: params.boolean(&HIDE_EMITTERS)?,
         light_selection,
-        strict_normals: params.boolean(&STRICT_NORMALS)?,
-    }))
+        strict_normals: false,
+    })
 }
 
 /// A sample count of `direct`: 0 to 1024.
@@ -418,6 +461,29 @@ fn build_aov(params: &Params) -> Result<Integrator> {
         }
     }
     Ok(integrator.into())
+}
+
+fn build_volpath(params: &Params) -> Result<Integrator> {
+    let path = path_settings(params)?;
+    Ok(Integrator::VolPath(VolPathIntegrator {
+        max_depth: path.max_depth,
+        rr_depth: path.rr_depth,
+        hide_emitters: path.hide_emitters,
+        light_selection: path.light_selection,
+        tracking: Tracking::Spectral,
+    }))
+}
+
+fn build_volpathmis(params: &Params) -> Result<Integrator> {
+    let Integrator::VolPath(volpath) = build_volpath(params)? else {
+        unreachable!("build_volpath builds a volumetric path integrator");
+    };
+    Ok(Integrator::VolPath(VolPathIntegrator {
+        tracking: Tracking::HeroMis {
+            spectral_mis: params.boolean(&USE_SPECTRAL_MIS)?,
+        },
+        ..volpath
+    }))
 }
 
 fn build_distrib(params: &Params) -> Result<Integrator> {
