@@ -109,6 +109,16 @@ impl BsdfModel for Principled {
         1
     }
 
+    /// The base colour, as Mitsuba's `eval_diffuse_reflectance`.
+    fn diffuse_reflectance(
+        &self,
+        point: &ShadingPoint,
+        _wo: Vec3,
+        lambda: &SampledWavelengths,
+    ) -> SampledSpectrum {
+        self.base_color.eval(point.uv, lambda)
+    }
+
     #[inline]
     fn resolve<'a>(
         &'a self,
