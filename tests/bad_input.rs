@@ -2,6 +2,8 @@
 //! parameters — each run through the `prism` binary, asserting the exit status (2 for bad input)
 //! and the exact place (file:line:column) the error names, and that nothing panics.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -201,6 +203,68 @@ fn cases() -> Vec<Case> {
             "max_depth",
         ),
         render_scene(
+            "direct with shading_samples and emitter_samples",
+            scene!(
+                "    <integrator type=\"direct\"><integer name=\"shading_samples\" value=\"2\"/><integer name=\"emitter_samples\" value=\"1\"/></integrator>"
+            ),
+            "scene.xml:3:",
+            "cannot be given with \"shading_samples\"",
+        ),
+        render_scene(
+            "direct without samples",
+            scene!(
+                "    <integrator type=\"direct\"><integer name=\"shading_samples\" value=\"0\"/></integrator>"
+            ),
+            "scene.xml:3:",
+            "at least one emitter or BSDF sample",
+        ),
+        render_scene(
+            "moment without nested integrators",
+            scene!("    <integrator type=\"moment\"/>"),
+            "scene.xml:3:",
+            "at least one nested integrator",
+        ),
+        render_scene(
+            "moment with a nested integrator named as an unnamed one is",
+            scene!(
+                "    <integrator type=\"moment\"><integrator type=\"path\" name=\"_arg_0\"/>\n<integrator type=\"direct\"/></integrator>"
+            ),
+            "scene.xml:4:",
+            "named \"_arg_0\"",
+        ),
+        render_scene(
+            "aov of an unknown type",
+            scene!(
+                "    <integrator type=\"aov\"><string name=\"aovs\" value=\"nn:sh_normals\"/></integrator>"
+            ),
+            "scene.xml:3:",
+            "did you mean \"sh_normal\"",
+        ),
+        render_scene(
+            "aov without a type",
+            scene!(
+                "    <integrator type=\"aov\"><string name=\"aovs\" value=\"nn\"/></integrator>"
+            ),
+            "scene.xml:3:",
+            "not a name:type pair",
+        ),
+        render_scene(
+            "aov of a type Prism cannot produce",
+            scene!(
+                "    <integrator type=\"aov\"><string name=\"aovs\" value=\"d:duv_dx\"/></integrator>"
+            ),
+            "scene.xml:3:",
+            "ray differentials",
+        ),
+        render_scene(
+            "aov named as an image channel",
+            scene!(
+                "    <integrator type=\"aov\"><string name=\"aovs\" value=\"variance:position\"/></integrator>"
+            ),
+            "scene.xml:3:",
+            "would replace the image's own",
+        ),
+        render_scene(
             "NaN float",
             scene!("    <shape type=\"sphere\"><float name=\"radius\" value=\"nan\"/></shape>"),
             "scene.xml:3:",
@@ -292,10 +356,52 @@ fn cases() -> Vec<Case> {
             "above 1",
         ),
         render_scene(
-            "area emitter at the top",
-            scene!("    <emitter type=\"area\"/>"),
-            "scene.xml:3:5",
-            "nested in a shape",
+            "area emitter on two shapes",
+            scene!(
+                "    <emitter type=\"area\" id=\"light\"/><shape type=\"sphere\"><ref id=\"light\"/></shape><shape type=\"disk\"><ref id=\"light\"/></shape>"
+            ),
+            "scene.xml:3:",
+            "already attached",
+        ),
+        render_scene(
+            "area emitter radiance texture without its image",
+            scene!(
+                "    <shape type=\"sphere\"><emitter type=\"area\"><texture type=\"bitmap\" name=\"radiance\"><string name=\"filename\" value=\"missing.png\"/></texture></emitter></shape>"
+            ),
+            "scene.xml:3:",
+            "not found",
+        ),
+        render_scene(
+            "area emitter radiance given as a bsdf",
+            scene!(
+                "    <shape type=\"sphere\"><emitter type=\"area\"><bsdf type=\"diffuse\" name=\"radiance\"/></emitter></shape>"
+            ),
+            "scene.xml:3:",
+            "is not supported",
+        ),
+        render_scene(
+            "spot light texture with a cutoff beyond 90 degrees",
+            scene!(
+                "    <emitter type=\"spot\"><float name=\"cutoff_angle\" value=\"120\"/><texture type=\"checkerboard\" name=\"texture\"/></emitter>"
+            ),
+            "scene.xml:3:",
+            "below 90 degrees",
+        ),
+        render_scene(
+            "projector irradiance given as a bsdf",
+            scene!(
+                "    <emitter type=\"projector\"><bsdf type=\"diffuse\" name=\"irradiance\"/></emitter>"
+            ),
+            "scene.xml:3:",
+            "is not supported",
+        ),
+        render_scene(
+            "unreferenced area emitter with negative radiance",
+            scene!(
+                "    <emitter type=\"area\" id=\"light\"><rgb name=\"radiance\" value=\"-1\"/></emitter>"
+            ),
+            "scene.xml:3:",
+            "negative",
         ),
         render_scene(
             "twosided in twosided",
@@ -322,6 +428,24 @@ fn cases() -> Vec<Case> {
             "<scene version=\"3.0.0\">\n    <sensor type=\"perspective\"><film type=\"hdrfilm\"><integer name=\"width\" value=\"4\"/><integer name=\"height\" value=\"4\"/><integer name=\"crop_width\" value=\"9\"/></film></sensor>\n</scene>\n",
             "scene.xml:2:",
             "does not fit",
+        ),
+        render_scene(
+            "a misspelt Mitsuba 0.6 film parameter",
+            "<scene version=\"0.6.0\">\n    <sensor type=\"perspective\"><film type=\"hdrfilm\"><integer name=\"width\" value=\"4\"/><integer name=\"height\" value=\"4\"/>\n        <boolean name=\"banerr\" value=\"false\"/></film></sensor>\n</scene>\n",
+            "scene.xml:3:9",
+            "did you mean \"banner\"",
+        ),
+        render_scene(
+            "ldrfilm gamma of zero",
+            "<scene version=\"3.0.0\">\n    <sensor type=\"perspective\"><film type=\"ldrfilm\"><integer name=\"width\" value=\"4\"/><integer name=\"height\" value=\"4\"/>\n        <float name=\"gamma\" value=\"0\"/></film></sensor>\n</scene>\n",
+            "scene.xml:3:9",
+            "or −1 for the sRGB curve",
+        ),
+        render_scene(
+            "ldrfilm unknown tonemapper",
+            "<scene version=\"3.0.0\">\n    <sensor type=\"perspective\"><film type=\"ldrfilm\"><integer name=\"width\" value=\"4\"/><integer name=\"height\" value=\"4\"/>\n        <string name=\"tonemap_method\" value=\"filmic\"/></film></sensor>\n</scene>\n",
+            "scene.xml:3:9",
+            "gamma, reinhard",
         ),
         render_scene(
             "film of 10^6 × 10^6 pixels",
@@ -505,9 +629,42 @@ fn cases() -> Vec<Case> {
             location: "",
             says: "missing.state",
         },
+        render_scene(
+            "rawconstant of three values read as a colour",
+            scene!(
+                "    <shape type=\"sphere\"><bsdf type=\"diffuse\"><texture type=\"rawconstant\" name=\"reflectance\">\n        <vector name=\"value\" x=\"1\" y=\"0\" z=\"0\"/></texture></bsdf></shape>"
+            ),
+            "scene.xml:4:9",
+            "three values",
+        ),
+        render_scene(
+            "rawconstant without a value",
+            scene!(
+                "    <shape type=\"sphere\"><bsdf type=\"diffuse\"><texture type=\"rawconstant\" name=\"reflectance\"/></bsdf></shape>"
+            ),
+            "scene.xml:3:",
+            "needs a \"value\"",
+        ),
+        render_scene(
+            "conductor exterior index not a constant",
+            scene!(
+                "    <shape type=\"sphere\"><bsdf type=\"conductor\">\n        <spectrum name=\"ext_eta\" value=\"400:1.3, 700:1.4\"/></bsdf></shape>"
+            ),
+            "scene.xml:4:9",
+            "must be a constant",
+        ),
+        render_scene(
+            "colour opacity outside [0, 1]",
+            scene!(
+                "    <shape type=\"sphere\"><bsdf type=\"mask\">\n        <rgb name=\"opacity\" value=\"3, 2, 4\"/><bsdf type=\"diffuse\"/></bsdf></shape>"
+            ),
+            "scene.xml:4:9",
+            "whose mean",
+        ),
     ];
     // Command-line parameters.
     cases.extend(media_cases());
+    cases.extend(instancing_cases());
     for (name, extra, says) in [
         ("zero samples", &["--spp", "0"][..], "--spp"),
         (
@@ -729,6 +886,225 @@ fn every_malformed_input_gets_one_clear_error() {
         if !ok {
             failures.push(format!(
                 "{}: status {status}, expected location {location:?} and {:?}:\n{text}",
+                case.name, case.says
+            ));
+        }
+    }
+    let _ = std::fs::remove_dir_all(&root);
+    assert!(
+        failures.is_empty(),
+        "{} of {} cases failed:\n{}",
+        failures.len(),
+        cases.len(),
+        failures.join("\n")
+    );
+}
+
+/// Bad instancing: emitters, moving shapes and nested groups or instances inside a shapegroup,
+/// an instance of something that is not a group, and an instance naming no group.
+fn instancing_cases() -> Vec<Case> {
+    vec![
+        render_scene(
+            "emitter in a shapegroup",
+            scene!(
+                "    <shape type=\"shapegroup\" id=\"g\">\n        <shape type=\"sphere\"><emitter type=\"area\"/></shape>\n    </shape>"
+            ),
+            "scene.xml:4:30",
+            "cannot emit light",
+        ),
+        render_scene(
+            "shapegroup in a shapegroup",
+            scene!(
+                "    <shape type=\"shapegroup\" id=\"g\">\n        <shape type=\"shapegroup\"><shape type=\"sphere\"/></shape>\n    </shape>"
+            ),
+            "scene.xml:4:9",
+            "instancing does not nest",
+        ),
+        render_scene(
+            "instance in a shapegroup",
+            scene!(
+                "    <shape type=\"shapegroup\" id=\"g\"><shape type=\"sphere\"/></shape>\n    <shape type=\"shapegroup\" id=\"h\">\n        <shape type=\"instance\"><ref id=\"g\"/></shape>\n    </shape>"
+            ),
+            "scene.xml:5:9",
+            "instancing does not nest",
+        ),
+        render_scene(
+            "moving shape in a shapegroup",
+            scene!(
+                "    <shape type=\"shapegroup\" id=\"g\">\n        <shape type=\"sphere\"><animation name=\"to_world\"><transform time=\"0\"/><transform time=\"1\"><translate x=\"1\"/></transform></animation></shape>\n    </shape>"
+            ),
+            "scene.xml:4:9",
+            "cannot move",
+        ),
+        render_scene(
+            "instance of a sphere",
+            scene!(
+                "    <shape type=\"sphere\" id=\"ball\"/>\n    <shape type=\"instance\"><ref id=\"ball\"/></shape>"
+            ),
+            "scene.xml:4:28",
+            "places a shapegroup",
+        ),
+        render_scene(
+            "instance of nothing",
+            scene!("    <shape type=\"instance\"/>"),
+            "scene.xml:3:5",
+            "shapegroup",
+        ),
+    ]
+}
+/// A malformed Mitsuba serialized mesh: the scene loads `mesh.serialized` with `properties`
+/// inside its `<shape>`, and the error must name the shape (scene.xml line 3) and say `says`.
+struct SerializedCase {
+    name: &'static str,
+    mesh: Vec<u8>,
+    properties: &'static str,
+    says: &'static str,
+}
+
+fn serialized_cases() -> Vec<SerializedCase> {
+    use common::serialized::{SerializedShape, serialized_file, shape_header, triangle_shape};
+    use miniz_oxide::deflate::compress_to_vec_zlib;
+
+    let good = serialized_file(&[triangle_shape()], 4);
+    let with_stream = |stream: &[u8]| {
+        let mut file = shape_header(4);
+        file.extend_from_slice(&compress_to_vec_zlib(stream, 6));
+        file.extend_from_slice(&0u64.to_le_bytes());
+        file.extend_from_slice(&1u32.to_le_bytes());
+        file
+    };
+    let mut huge = 0x1000u32.to_le_bytes().to_vec();
+    huge.push(0);
+    huge.extend_from_slice(&1_000_000_000_000u64.to_le_bytes());
+    huge.extend_from_slice(&1u64.to_le_bytes());
+    let mut bad_version = good.clone();
+    bad_version[2] = 5;
+    let mut bad_offset = serialized_file(&[triangle_shape(), triangle_shape()], 4);
+    let entry = bad_offset.len() - 12;
+    bad_offset[entry..entry + 8].copy_from_slice(&1_000_000u64.to_le_bytes());
+    let shape = |positions: Vec<[f32; 3]>, triangles: Vec<[u32; 3]>| {
+        serialized_file(
+            &[SerializedShape {
+                positions,
+                triangles,
+                ..SerializedShape::default()
+            }],
+            3,
+        )
+    };
+    let corner = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+    let mut corrupt = shape_header(4);
+    corrupt.extend_from_slice(&[0x78, 0x9c, 0xff, 0xff, 0xff, 0xff, 0, 0, 0, 0, 1, 0, 0, 0]);
+    vec![
+        SerializedCase {
+            name: "serialized: not one",
+            mesh: b"PK\x03\x04 a zip file".to_vec(),
+            properties: "",
+            says: "not a Mitsuba serialized mesh",
+        },
+        SerializedCase {
+            name: "serialized: shorter than a header",
+            mesh: vec![0x1c],
+            properties: "",
+            says: "ends inside the shape header",
+        },
+        SerializedCase {
+            name: "serialized: unknown version",
+            mesh: bad_version,
+            properties: "",
+            says: "has version 5",
+        },
+        SerializedCase {
+            name: "serialized: cut short",
+            mesh: good[..good.len() / 2].to_vec(),
+            properties: "",
+            says: "ends before the data its header declares",
+        },
+        SerializedCase {
+            name: "serialized: corrupt zlib stream",
+            mesh: corrupt,
+            properties: "",
+            says: "is corrupt",
+        },
+        SerializedCase {
+            name: "serialized: shape index out of range",
+            mesh: good.clone(),
+            properties: "<integer name=\"shape_index\" value=\"1\"/>",
+            says: "shape_index 1 is out of range: the file holds 1 shapes (0..0)",
+        },
+        SerializedCase {
+            name: "serialized: negative shape index",
+            mesh: good.clone(),
+            properties: "<integer name=\"shape_index\" value=\"-1\"/>",
+            says: "must be 0 or more",
+        },
+        SerializedCase {
+            name: "serialized: table pointing outside the file",
+            mesh: bad_offset,
+            properties: "<integer name=\"shape_index\" value=\"1\"/>",
+            says: "outside the shapes",
+        },
+        SerializedCase {
+            name: "serialized: counts the file cannot hold",
+            mesh: with_stream(&huge),
+            properties: "",
+            says: "more than the rest of the file can hold",
+        },
+        SerializedCase {
+            name: "serialized: index out of range",
+            mesh: shape(corner.clone(), vec![[0, 1, 3]]),
+            properties: "",
+            says: "refers to vertex 3",
+        },
+        SerializedCase {
+            name: "serialized: position not a number",
+            mesh: shape(
+                vec![[0.0, 0.0, 0.0], [f32::NAN, 0.0, 0.0], [0.0, 1.0, 0.0]],
+                vec![[0, 1, 2]],
+            ),
+            properties: "",
+            says: "vertex 1 is not a finite number",
+        },
+        SerializedCase {
+            name: "serialized: no triangles",
+            mesh: shape(corner, Vec::new()),
+            properties: "",
+            says: "has no triangles",
+        },
+    ]
+}
+
+#[test]
+fn every_malformed_serialized_mesh_gets_one_clear_error() {
+    let root: PathBuf =
+        std::env::temp_dir().join(format!("prism-bad-serialized-{}", std::process::id()));
+    let mut failures = Vec::new();
+    let cases = serialized_cases();
+    for (i, case) in cases.iter().enumerate() {
+        let dir = root.join(i.to_string());
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::write(dir.join("mesh.serialized"), &case.mesh).unwrap();
+        let xml = scene!(
+            "    <shape type=\"serialized\"><string name=\"filename\" value=\"mesh.serialized\"/>PROPERTIES</shape>"
+        )
+        .replace("PROPERTIES", case.properties);
+        let scene = Case {
+            name: case.name,
+            files: Box::leak(Box::new([("scene.xml", &*xml.leak())])),
+            arguments: RENDER,
+            location: "scene.xml:3:",
+            says: case.says,
+        };
+        let (status, text) = run_case(&scene, &dir);
+        let location = format!("{}/scene.xml:3:", dir.display());
+        if !(status == 2
+            && text.starts_with("error: ")
+            && text.contains(&location)
+            && text.contains(case.says)
+            && !text.contains("panicked"))
+        {
+            failures.push(format!(
+                "{}: status {status}, expected {location:?} and {:?}:\n{text}",
                 case.name, case.says
             ));
         }

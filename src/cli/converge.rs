@@ -17,7 +17,8 @@ use prism_core::error::{Error, Result};
 use prism_core::image::compare::rel_mse_rgb;
 use prism_core::image::read_exr;
 use prism_core::integrator::{
-    DistributionIntegrator, Integrator, PathIntegrator, Tracking, VolPathIntegrator,
+    DirectIntegrator, DistributionIntegrator, Integrator, PathIntegrator, Tracking,
+    VolPathIntegrator,
 };
 use prism_core::render::{RenderOptions, render};
 use prism_core::sampling::sampler::SamplerKind;
@@ -79,13 +80,17 @@ impl Series {
 }
 
 fn integrator_named(name: &str, scene: &Scene) -> Result<Integrator> {
-    let max_depth = match &scene.integrator {
+    let image = scene.integrator.image_integrator();
+    let max_depth = match image {
         Integrator::Path(p) => p.max_depth,
+        // Direct illumination is the path tracer's estimate of paths of two vertices.
+        Integrator::Direct(_) => 2,
         Integrator::Distribution(d) => d.max_depth,
         Integrator::VolPath(v) => v.max_depth,
+        Integrator::Moment(_) | Integrator::Aov(_) => -1,
     };
     match name {
-        "path" => Ok(match &scene.integrator {
+        "path" => Ok(match image {
             Integrator::Path(p) => Integrator::Path(p.clone()),
             _ => PathIntegrator {
                 max_depth,
@@ -93,7 +98,11 @@ fn integrator_named(name: &str, scene: &Scene) -> Result<Integrator> {
             }
             .into(),
         }),
-        "distrib" => Ok(match &scene.integrator {
+        "direct" => Ok(match image {
+            Integrator::Direct(d) => Integrator::Direct(d.clone()),
+            _ => DirectIntegrator::default().into(),
+        }),
+        "distrib" => Ok(match image {
             Integrator::Distribution(d) => Integrator::Distribution(d.clone()),
             _ => DistributionIntegrator {
                 max_depth,
@@ -101,7 +110,7 @@ fn integrator_named(name: &str, scene: &Scene) -> Result<Integrator> {
             }
             .into(),
         }),
-        "volpath" => Ok(match &scene.integrator {
+        "volpath" => Ok(match image {
             Integrator::VolPath(v) if v.tracking == Tracking::Spectral => {
                 Integrator::VolPath(v.clone())
             }
@@ -111,7 +120,7 @@ fn integrator_named(name: &str, scene: &Scene) -> Result<Integrator> {
             }
             .into(),
         }),
-        "volpathmis" => Ok(match &scene.integrator {
+        "volpathmis" => Ok(match image {
             Integrator::VolPath(v) if v.tracking != Tracking::Spectral => {
                 Integrator::VolPath(v.clone())
             }
@@ -123,7 +132,7 @@ fn integrator_named(name: &str, scene: &Scene) -> Result<Integrator> {
             .into(),
         }),
         other => Err(Error::usage(format!("unknown integrator \"{other}\""))
-            .with_help("use path, distrib, volpath or volpathmis")),
+            .with_help("use path, direct, distrib, volpath or volpathmis")),
     }
 }
 
@@ -133,17 +142,28 @@ fn sampler_named(name: &str) -> Result<SamplerKind> {
         "stratified" => Ok(SamplerKind::Stratified { jitter: true }),
         "multijitter" => Ok(SamplerKind::MultiJitter { jitter: true }),
         "nrooks" => Ok(SamplerKind::NRooks),
-        other => Err(Error::usage(format!("unknown sampler \"{other}\""))
-            .with_help("use independent, stratified, multijitter or nrooks")),
+        "ldsampler" => Ok(SamplerKind::LowDiscrepancy),
+        "orthogonal" => Ok(SamplerKind::Orthogonal {
+            strength: 2,
+            jitter: true,
+        }),
+        other => Err(
+            Error::usage(format!("unknown sampler \"{other}\"")).with_help(
+                "use independent, stratified, multijitter, nrooks, ldsampler or orthogonal",
+            ),
+        ),
     }
 }
 
 fn integrator_label(integrator: &Integrator) -> &'static str {
     match integrator {
         Integrator::Path(_) => "path",
+        Integrator::Direct(_) => "direct",
         Integrator::Distribution(_) => "distrib",
         Integrator::VolPath(v) if v.tracking == Tracking::Spectral => "volpath",
         Integrator::VolPath(_) => "volpathmis",
+        Integrator::Moment(_) => "moment",
+        Integrator::Aov(_) => "aov",
     }
 }
 
@@ -153,6 +173,8 @@ fn sampler_label(kind: SamplerKind) -> &'static str {
         SamplerKind::Stratified { .. } => "stratified",
         SamplerKind::MultiJitter { .. } => "multijitter",
         SamplerKind::NRooks => "nrooks",
+        SamplerKind::LowDiscrepancy => "ldsampler",
+        SamplerKind::Orthogonal { .. } => "orthogonal",
     }
 }
 
@@ -167,7 +189,11 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
         e.kind = prism_core::error::ErrorKind::Input;
         e
     })?;
-    let mut scene = load_scene(&args.scene, &args.defines)?.scene;
+    let loaded = load_scene(&args.scene, &args.defines)?;
+    for warning in &loaded.warnings {
+        eprintln!("{warning}");
+    }
+    let mut scene = loaded.scene;
     let size = scene.film.crop.size;
     if (reference.width, reference.height) != (size.x as usize, size.y as usize) {
         return Err(Error::usage(format!(

@@ -6,3 +6,4 @@
 
 pub mod chi2;
 pub mod scenes;
+pub mod serialized;

@@ -25,6 +25,9 @@ pub struct World {
     /// Each light's power (see [`Light::power`]), from which integrators build their light
     /// samplers.
     pub light_powers: Vec<f32>,
+    /// Each light's `sampling_weight` (1 unless the scene says otherwise), which scales its
+    /// probability of being chosen (see [`crate::light::sampler`]).
+    pub light_sampling_weights: Vec<f32>,
     /// Index into `lights` of the environment (`constant` or `envmap`), which rays that leave
     /// the scene see; a scene has at most one.
     pub environment: Option<u32>,
@@ -54,6 +57,7 @@ impl World {
             .iter()
             .map(|l| l.power(&geometry.primitives))
             .collect();
+        let light_sampling_weights = vec![1.0; lights.len()];
         World {
             environment: lights
                 .iter()
@@ -67,6 +71,7 @@ impl World {
             media: Vec::new(),
             medium_interfaces: Vec::new(),
             camera_medium: None,
+            light_sampling_weights,
         }
     }
 
@@ -82,5 +87,21 @@ impl World {
     /// Whether the scene has participating media.
     pub fn has_media(&self) -> bool {
         !self.media.is_empty()
+    }
+
+    /// The world with the lights' sampling weights (one per light, each finite and at
+    /// least 0) in place of the default 1.
+    pub fn with_sampling_weights(mut self, weights: Vec<f32>) -> World {
+        assert_eq!(
+            weights.len(),
+            self.lights.len(),
+            "one sampling weight per light"
+        );
+        assert!(
+            weights.iter().all(|w| w.is_finite() && *w >= 0.0),
+            "sampling weights are finite and at least 0"
+        );
+        self.light_sampling_weights = weights;
+        self
     }
 }

@@ -16,13 +16,15 @@
 //! - The root is `<scene version="major.minor.patch">` (an optional `id` is allowed).
 //! - Plugins: `<bsdf type="..." id="..." name="...">` and the other tags of [`PluginClass`];
 //!   `<spectrum>` is a plugin only with a `type` attribute, otherwise a property.
-//! - Properties: `<float>`, `<integer>`, `<boolean>`, `<string>`, `<rgb>`, `<spectrum>`,
+//! - Properties: `<float>`, `<integer>`, `<boolean>`, `<string>`, `<rgb>`, `<srgb>` (Mitsuba
+//!   0.6), `<spectrum>`,
 //!   `<point>`, `<vector>` and `<transform>` (see `transform_ops.rs`), each with a `name`
 //!   unique within its plugin (nested plugins' names included).
 //! - `<ref id="..." name="..."/>`, `<default name="..." value="..."/>`, `<alias id="..." as="..."/>`
 //!   (a second id for an object declared earlier), `<include filename="..."/>` and
 //!   `<path value="..."/>` (only directly inside the root `<scene>`).
 //! - Text other than whitespace, unknown elements and unknown attributes are errors.
+//! - Comments may contain `--` and end in `-`, as in Mitsuba (`comments.rs`).
 //!
 //! Files older than 2.0.0 are upgraded as Mitsuba 3 does: parameter names go from camelCase to
 //! snake_case (`camel_to_snake`), `<lookAt>` becomes `<lookat>`, a diffuse BSDF's
@@ -45,6 +47,8 @@
 //! uses an explicit stack, and positions are computed from a line index (a scene of a million
 //! elements costs a million binary searches, not a million scans).
 
+mod comments;
+
 use std::cell::Cell;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -61,6 +65,7 @@ use super::property_values;
 use super::substitution::{Parameters, camel_to_snake};
 use super::transform_ops;
 use crate::suggest::closest_match;
+use comments::tolerate_hyphens_in_comments;
 use prism_core::error::{Error, Result, SourceLocation};
 
 /// Deepest nesting of elements accepted; deeper documents are certainly not scenes.
@@ -281,7 +286,8 @@ fn parse_version(attribute: &Attribute) -> Result<(u32, u32, u32)> {
 impl Reader {
     /// Reads the main scene file into the root draft and everything below it.
     fn read_main(&mut self, text: &str, path: &Path) -> Result<()> {
-        let mut source = Source::new(path, text, 0);
+        let text = tolerate_hyphens_in_comments(text);
+        let mut source = Source::new(path, &text, 0);
         let document = parse_xml(&source)?;
         let root = document.root_element();
         let location = source.location(root.range().start);
@@ -451,7 +457,7 @@ impl Reader {
     ) -> Result<()> {
         let tag = element.tag.as_str();
         match tag {
-            "float" | "integer" | "boolean" | "string" | "rgb" | "spectrum" | "point"
+            "float" | "integer" | "boolean" | "string" | "rgb" | "srgb" | "spectrum" | "point"
             | "vector" | "transform" => self.read_property(source, node, element, parent),
             "animation" => self.read_animation(source, node, element, parent),
             "ref" => {
@@ -625,7 +631,7 @@ impl Reader {
         Ok(())
     }
 
-    /// `<float>`, `<integer>`, `<boolean>`, `<string>`, `<rgb>`, `<spectrum>` (without a type),
+    /// `<float>`, `<integer>`, `<boolean>`, `<string>`, `<rgb>`, `<srgb>`, `<spectrum>` (without a type),
     /// `<point>`, `<vector>` and `<transform>`.
     fn read_property(
         &mut self,
@@ -675,9 +681,10 @@ impl Reader {
             "integer" => PropertyValue::Integer(element.integer(element.require("value")?)?),
             "boolean" => PropertyValue::Boolean(element.boolean(element.require("value")?)?),
             "rgb" => PropertyValue::Rgb(property_values::rgb(element)?),
+            "srgb" => PropertyValue::Rgb(property_values::srgb_color(element)?),
             "spectrum" => {
                 let search_paths = self.search_paths(source);
-                PropertyValue::Spectrum(property_values::spectrum(element, &search_paths)?)
+                property_values::spectrum(element, &search_paths)?
             }
             "point" => PropertyValue::Point(element.xyz(0.0)?),
             "vector" => PropertyValue::Vector(element.xyz(0.0)?),
@@ -838,6 +845,7 @@ impl Reader {
         let text = std::fs::read_to_string(&path).map_err(|err| {
             Error::io(&path, &err, "read the included file").at(&element.location)
         })?;
+        let text = tolerate_hyphens_in_comments(&text);
         let mut included = Source::new(&path, &text, source.include_depth + 1);
         let document = parse_xml(&included).map_err(|err| {
             let position = err.location.map(|l| l.to_string()).unwrap_or_default();
@@ -986,7 +994,7 @@ fn expect_no_content(source: &Source, node: Node, element: &Element) -> Result<(
 }
 
 /// Every tag a scene may contain, for messages.
-const KNOWN_TAGS: [&str; 32] = [
+const KNOWN_TAGS: [&str; 33] = [
     "alias",
     "animation",
     "boolean",
@@ -1013,6 +1021,7 @@ const KNOWN_TAGS: [&str; 32] = [
     "sensor",
     "shape",
     "spectrum",
+    "srgb",
     "string",
     "texture",
     "transform",

@@ -61,6 +61,8 @@ pub enum ParamKind {
     AnimatedTransform,
     Point,
     Vector,
+    /// A `<float>` or a `<vector>` (three raw values).
+    FloatOrVector,
     /// A colour or spectrum (`<rgb>`, `<spectrum>`, `<float>`), or with `textured` a nested
     /// `<texture>` read as colours.
     Spectrum {
@@ -89,6 +91,7 @@ impl ParamKind {
             ParamKind::AnimatedTransform => "transform or animation".into(),
             ParamKind::Point => "point".into(),
             ParamKind::Vector => "vector".into(),
+            ParamKind::FloatOrVector => "float or vector".into(),
             ParamKind::Spectrum { range, textured } => {
                 let what = match range {
                     Range::Albedo => "reflectance",
@@ -175,6 +178,9 @@ pub enum Default {
     Required,
     /// Absent means absent (an optional factor, an optional nested plugin).
     None,
+    /// A Mitsuba 0.6 parameter whose meaning is clear but which Prism does not implement: it is
+    /// read and ignored, with a warning ([`crate::params::Warning`]).
+    Ignored,
 }
 
 impl Default {
@@ -187,6 +193,7 @@ impl Default {
             Default::Text(t) => (*t).to_string(),
             Default::Required => "required".into(),
             Default::None => "—".into(),
+            Default::Ignored => "ignored, with a warning".into(),
         }
     }
 }

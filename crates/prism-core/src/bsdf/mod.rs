@@ -45,10 +45,13 @@
 //! | `plastic` | [`plastic`] | specular and diffuse reflection |
 //! | `roughplastic` | [`roughplastic`] | glossy and diffuse reflection |
 //! | `phong` | [`phong`] | glossy and diffuse reflection |
+//! | `pplastic` | [`pplastic`] | glossy and diffuse reflection |
+//! | `ward` | [`ward`] | glossy and diffuse reflection |
 //! | `twosided` | [`twosided`] | those of the nested BSDFs, on both sides |
 //! | `mask` | [`mask`] | the nested BSDF's, and null transmission |
 //! | `null` | [`null`] | null transmission only (a medium's boundary) |
 //! | `blendbsdf` | [`blend`] | both nested BSDFs' |
+//! | `null` | [`null`] | null transmission |
 //! | `bumpmap`, `normalmap` | [`bumpmap`], [`normalmap`] | the nested BSDF's, in a perturbed frame |
 
 pub mod blend;
@@ -65,12 +68,14 @@ pub mod null;
 pub mod perturbed;
 pub mod phong;
 pub mod plastic;
+pub mod pplastic;
 pub mod roughconductor;
 pub mod roughdielectric;
 pub mod roughdiffuse;
 pub mod roughplastic;
 pub mod thindielectric;
 pub mod twosided;
+pub mod ward;
 
 use arrayvec::ArrayVec;
 use glam::{Vec2, Vec3};
@@ -86,12 +91,14 @@ pub use normalmap::NormalMap;
 pub use null::Null;
 pub use phong::Phong;
 pub use plastic::Plastic;
+pub use pplastic::PolarizedPlastic;
 pub use roughconductor::RoughConductor;
 pub use roughdielectric::RoughDielectric;
 pub use roughdiffuse::RoughDiffuse;
 pub use roughplastic::RoughPlastic;
 pub use thindielectric::ThinDielectric;
 pub use twosided::TwoSided;
+pub use ward::{Ward, WardVariant};
 
 use crate::math::Frame;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
@@ -106,8 +113,9 @@ impl BsdfFlags {
     pub const GLOSSY: BsdfFlags = BsdfFlags(2);
     /// A Dirac delta lobe (mirror or clear glass): cannot be evaluated, only sampled.
     pub const SPECULAR: BsdfFlags = BsdfFlags(4);
-    /// Light passing straight through, unchanged in direction (Mitsuba's `Null`: the transparent
-    /// part of `mask`, the transmission of `thindielectric`); a delta lobe too.
+    /// Light passing straight through, unchanged in direction (Mitsuba's `Null`: the `null`
+    /// BSDF, the transparent part of `mask`, the transmission of `thindielectric`); a delta lobe
+    /// too.
     pub const NULL: BsdfFlags = BsdfFlags(32);
     pub const REFLECTION: BsdfFlags = BsdfFlags(8);
     pub const TRANSMISSION: BsdfFlags = BsdfFlags(16);
@@ -240,6 +248,15 @@ pub trait BsdfModel {
     fn is_dispersive(&self) -> bool;
     /// The nodes its lobes take in a [`BxdfTree`] (1 for a BSDF that nests none).
     fn node_count(&self) -> usize;
+    /// The albedo a denoiser wants (Mitsuba's `eval_diffuse_reflectance`): the reflectance of
+    /// the diffuse part at `point` for the wavelengths `lambda`, seen from `wo` (local), which
+    /// `twosided` needs to choose a side; zero for BSDFs without a diffuse part.
+    fn diffuse_reflectance(
+        &self,
+        point: &ShadingPoint,
+        wo: Vec3,
+        lambda: &SampledWavelengths,
+    ) -> SampledSpectrum;
     /// Evaluates the textures at `point` for the wavelengths `lambda` and adds the lobes there
     /// to `tree`, for the outgoing direction `wo` (local to `point.frame`), which adapters need
     /// to choose a side or tilt a frame. Returns the index of the node added last, its root.
@@ -351,6 +368,17 @@ macro_rules! bsdfs {
                 }
             }
 
+            fn diffuse_reflectance(
+                &self,
+                point: &ShadingPoint,
+                wo: Vec3,
+                lambda: &SampledWavelengths,
+            ) -> SampledSpectrum {
+                match self {
+                    $(Bsdf::$variant(b) => b.diffuse_reflectance(point, wo, lambda),)+
+                }
+            }
+
             #[inline]
             fn resolve<'a>(
                 &'a self,
@@ -413,6 +441,8 @@ bsdfs! {
         Plastic(Plastic),
         RoughPlastic(RoughPlastic),
         Phong(Phong),
+        PolarizedPlastic(PolarizedPlastic),
+        Ward(Ward),
         TwoSided(TwoSided),
         Mask(Mask),
         Blend(Blend),
@@ -431,6 +461,8 @@ bsdfs! {
         Plastic(plastic::PlasticLobes<'a>),
         RoughPlastic(roughplastic::RoughPlasticLobes<'a>),
         Phong(phong::PhongLobes),
+        PolarizedPlastic(pplastic::PolarizedPlasticLobes),
+        Ward(ward::WardLobes),
         BackSide(twosided::BackSideLobes),
         Mask(mask::MaskLobes),
         Blend(blend::BlendLobes),

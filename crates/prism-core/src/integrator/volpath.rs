@@ -38,10 +38,10 @@
 use glam::Vec3;
 
 use crate::bsdf::{BxdfTree, Scattering};
-use crate::geometry::SurfaceInteraction;
 use crate::geometry::interaction::SHADOW_EPSILON;
 use crate::geometry::offset::offset_ray_origin;
-use crate::integrator::path::power_heuristic;
+use crate::geometry::{SurfaceInteraction, SurfaceSample};
+use crate::integrator::mis::power_heuristic;
 use crate::integrator::{PreparedIntegrator, RayCount, hero_only};
 use crate::light::{Light, LightSample, LightSelection};
 use crate::math::Ray;
@@ -465,12 +465,16 @@ impl VolPathIntegrator {
                 let Light::Area(light) = &world.lights[light_index as usize] else {
                     unreachable!("only area lights are attached to shapes");
                 };
-                let emitted = light.emitted(si.shading.n, wo, &lambda);
+                let emitted = light.emitted(si.uv, si.shading.n, wo, &lambda);
                 if !emitted.is_black() {
                     let light_pdf = if weights.weights_emission() {
-                        let shape = &world.geometry.primitives[si.shape as usize];
                         prepared.light_sampler.pmf(light_index as usize)
-                            * shape.pdf_from(previous, si.time, si.p, si.n)
+                            * light.pdf_from(
+                                &world.geometry.primitives,
+                                previous,
+                                si.time,
+                                &SurfaceSample::at(&si),
+                            )
                     } else {
                         0.0
                     };

@@ -5,6 +5,8 @@
 //! parameters are reported with their location. Objects declared once and referenced many
 //! times (a BSDF with an `id`) are built once.
 
+pub mod fov;
+mod instancing;
 pub mod integrators;
 pub mod lights;
 pub mod materials;
@@ -19,10 +21,10 @@ use std::collections::hash_map::Entry;
 use std::sync::Arc;
 
 use crate::description::{PluginClass, PluginNode};
-use crate::params::Params;
+use crate::params::{Params, Warning};
 use crate::registry::{Default, ParamSpec};
 use prism_core::bsdf::Material;
-use prism_core::error::{Error, Result};
+use prism_core::error::{Error, Result, SourceLocation};
 use prism_core::geometry::{Geometry, Primitive};
 use prism_core::integrator::{Integrator, PathIntegrator};
 use prism_core::scene::Scene;
@@ -33,6 +35,9 @@ pub struct LoadedScene {
     pub scene: Scene,
     /// The sampler's `seed` parameter.
     pub seed: u64,
+    /// Parameters of the file that Prism reads but ignores (Mitsuba 0.6 forms), one warning
+    /// each, in the order they were read.
+    pub warnings: Vec<Warning>,
 }
 
 const INTEGRATOR: ParamSpec = ParamSpec::nested(
@@ -45,7 +50,7 @@ const SHAPES: ParamSpec = ParamSpec::nested(PluginClass::Shape, Default::None, "
 const EMITTERS: ParamSpec = ParamSpec::nested(
     PluginClass::Emitter,
     Default::None,
-    "lights other than area lights",
+    "lights; an `area` emitter here is attached to the shape that references its id",
 );
 const BSDFS: ParamSpec = ParamSpec::nested(
     PluginClass::Bsdf,
@@ -57,13 +62,20 @@ const TEXTURES: ParamSpec = ParamSpec::nested(
     Default::None,
     "textures declared to be referenced by id",
 );
+const SAMPLERS: ParamSpec = ParamSpec::nested(
+    PluginClass::Sampler,
+    Default::None,
+    "samplers declared to be referenced by id from the sensor",
+);
 const MEDIA: ParamSpec = ParamSpec::nested(
     PluginClass::Medium,
     Default::None,
     "media declared to be referenced by id",
 );
 /// What the `<scene>` element holds.
-const SCENE: &[ParamSpec] = &[INTEGRATOR, SENSOR, SHAPES, EMITTERS, BSDFS, TEXTURES, MEDIA];
+const SCENE: &[ParamSpec] = &[
+    INTEGRATOR, SENSOR, SHAPES, EMITTERS, BSDFS, TEXTURES, SAMPLERS, MEDIA,
+];
 
 /// The scene's media, each built once however often it is referenced.
 #[derive(Default)]
@@ -96,6 +108,66 @@ impl MediaCache {
     }
 }
 
+/// The index of a shape's material: its BSDF, built once however often it is referenced, or
+/// the default (black for an emitter, as Mitsuba's, else diffuse 0.5).
+fn shape_material(
+    bsdf: Option<&crate::description::NestedPlugin>,
+    emits: bool,
+    materials: &mut Vec<Material>,
+    material_ids: &mut HashMap<*const PluginNode, u32>,
+    textures: &mut textures::TextureCache,
+) -> Result<u32> {
+    if let Some(bsdf) = bsdf {
+        let key = Arc::as_ptr(&bsdf.node);
+        if let Some(&index) = material_ids.get(&key) {
+            return Ok(index);
+        }
+        materials.push(materials::build_material(&bsdf.node, textures)?);
+        let index = (materials.len() - 1) as u32;
+        material_ids.insert(key, index);
+        return Ok(index);
+    }
+    materials.push(if emits {
+        lights::default_emitter_material()
+    } else {
+        materials::default_material()
+    });
+    Ok((materials.len() - 1) as u32)
+}
+
+/// The media on the two sides of a shape (its `interior` and `exterior`).
+fn shape_media(
+    shape_params: &Params,
+    media: &mut MediaCache,
+) -> Result<prism_core::medium::MediumInterface> {
+    let mut interface = prism_core::medium::MediumInterface::default();
+    if let Some(child) = shape_params.named_child(&shapes::INTERIOR) {
+        interface.interior = Some(media.index(child)?);
+    }
+    if let Some(child) = shape_params.named_child(&shapes::EXTERIOR) {
+        interface.exterior = Some(media.index(child)?);
+    }
+    Ok(interface)
+}
+
+/// The material and media of a shape in a `shapegroup`.
+fn group_member(
+    member: &Params,
+    materials: &mut Vec<Material>,
+    material_ids: &mut HashMap<*const PluginNode, u32>,
+    textures: &mut textures::TextureCache,
+    media: &mut MediaCache,
+) -> Result<(u32, prism_core::medium::MediumInterface)> {
+    let material = shape_material(
+        member.single_child(&shapes::BSDF)?,
+        false,
+        materials,
+        material_ids,
+        textures,
+    )?;
+    Ok((material, shape_media(member, media)?))
+}
+
 /// Builds the scene described by the root `<scene>` node.
 pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
     let params = Params::new(root, SCENE);
@@ -104,12 +176,21 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
     let mut shapes = Vec::new();
     let mut shape_info = Vec::new();
     let mut lights = Vec::new();
+    let mut sampling_weights = Vec::new();
     let mut textures = textures::TextureCache::default();
     let mut media = MediaCache::default();
     let mut medium_interfaces = Vec::new();
+    let mut groups = instancing::ShapeGroups::default();
+    // The area emitters attached to shapes, with where each was attached (an emitter declared
+    // at the top level with an id reaches its shape by a `<ref>`).
+    let mut attached_emitters: HashMap<*const PluginNode, &SourceLocation> = HashMap::new();
 
     let integrator = match params.single_child(&INTEGRATOR)? {
-        Some(child) => integrators::build_integrator(&child.node)?,
+        Some(child) => {
+            let integrator = integrators::build_integrator(&child.node)?;
+            integrators::check_channel_names(&integrator, &child.location)?;
+            integrator
+        }
         None => Integrator::Path(PathIntegrator::default()),
     };
     let sensors = params.children(&SENSOR);
@@ -126,39 +207,73 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
     let sensor = sensor::build_sensor(&sensor.node)?;
 
     for child in params.children(&SHAPES) {
+        match child.node.plugin_type.as_str() {
+            "shapegroup" => {
+                groups.group(&child.node, &mut |member| {
+                    group_member(
+                        member,
+                        &mut materials,
+                        &mut material_ids,
+                        &mut textures,
+                        &mut media,
+                    )
+                })?;
+                continue;
+            }
+            "instance" => {
+                if let Some(instance) =
+                    groups.instance(&child.node, shapes.len(), &mut |member| {
+                        group_member(
+                            member,
+                            &mut materials,
+                            &mut material_ids,
+                            &mut textures,
+                            &mut media,
+                        )
+                    })?
+                {
+                    shapes.push(instance.primitive);
+                    shape_info.push(instance.info);
+                    medium_interfaces.push(prism_core::medium::MediumInterface::default());
+                }
+                continue;
+            }
+            _ => {}
+        }
         let (plugin, shape_params) = shapes::shape_params(&child.node)?;
         let shape = shapes::build_shape(plugin, &shape_params)?;
-        if shape.area() == 0.0 || !shape.area().is_finite() {
+        let area = shape.area();
+        if !area.is_finite() {
             return Err(Error::input(
                 &child.location,
-                format!("{} has no area", child.node.describe()),
+                format!(
+                    "the area of {} is not a finite number",
+                    child.node.describe()
+                ),
             )
-            .with_help("remove degenerate shapes or fix their transform"));
+            .with_help("fix the shape's transform or its vertices"));
         }
         let shape_index = shapes.len() as u32;
         let emitter = shape_params.single_child(&shapes::EMITTER)?;
-        let material = match shape_params.single_child(&shapes::BSDF)? {
-            Some(bsdf) => {
-                let key = Arc::as_ptr(&bsdf.node);
-                match material_ids.get(&key) {
-                    Some(&index) => index,
-                    None => {
-                        materials.push(materials::build_material(&bsdf.node, &mut textures)?);
-                        let index = (materials.len() - 1) as u32;
-                        material_ids.insert(key, index);
-                        index
-                    }
-                }
-            }
-            None if emitter.is_some() => {
-                materials.push(lights::default_emitter_material());
-                (materials.len() - 1) as u32
-            }
-            None => {
-                materials.push(materials::default_material());
-                (materials.len() - 1) as u32
-            }
-        };
+        // A shape of zero area is never hit, so it contributes nothing; like Mitsuba, Prism
+        // reads it (its BSDF included) and renders without it, but an emitter needs an area
+        // to send its power from (Mitsuba refuses it too).
+        if area == 0.0
+            && let Some(emitter) = &emitter
+        {
+            return Err(Error::input(
+                &emitter.location,
+                format!("{} has no area, so it cannot emit", child.node.describe()),
+            )
+            .with_help("remove the emitter, or fix the shape's transform or its vertices"));
+        }
+        let material = shape_material(
+            shape_params.single_child(&shapes::BSDF)?,
+            emitter.is_some(),
+            &mut materials,
+            &mut material_ids,
+            &mut textures,
+        )?;
         let light = match emitter {
             Some(emitter) => {
                 if let Primitive::Instance(instance) = &shape
@@ -172,33 +287,59 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
                         "animate the emitter with rotations, translations and uniform scales only",
                     ));
                 }
-                lights.push(lights::build_area_light(&emitter.node, shape_index)?);
+                if let Some(first) =
+                    attached_emitters.insert(Arc::as_ptr(&emitter.node), &emitter.location)
+                {
+                    return Err(Error::input(
+                        &emitter.location,
+                        format!(
+                            "{} is already attached to the shape at {first}",
+                            emitter.node.describe()
+                        ),
+                    )
+                    .with_help(
+                        "an area emitter can be attached to a single shape (as in Mitsuba): \
+                         give each shape its own <emitter type=\"area\">",
+                    ));
+                }
+                let (light, weight) =
+                    lights::build_area_light(&emitter.node, shape_index, &mut textures)?;
+                lights.push(light);
+                sampling_weights.push(weight);
                 Some((lights.len() - 1) as u32)
             }
             None => None,
         };
-        let mut interface = prism_core::medium::MediumInterface::default();
-        if let Some(child) = shape_params.named_child(&shapes::INTERIOR) {
-            interface.interior = Some(media.index(child)?);
-        }
-        if let Some(child) = shape_params.named_child(&shapes::EXTERIOR) {
-            interface.exterior = Some(media.index(child)?);
-        }
-        medium_interfaces.push(interface);
+        let interface = shape_media(&shape_params, &mut media)?;
         shape_params.finish()?;
+        if area == 0.0 {
+            continue;
+        }
         shapes.push(shape);
         shape_info.push(ShapeInfo { material, light });
+        medium_interfaces.push(interface);
     }
+    groups.assign_shape_ids(&mut shapes, &mut shape_info, &mut medium_interfaces);
 
     let mut scene_lights = Vec::new();
     for child in params.children(&EMITTERS) {
-        scene_lights.push((
-            lights::build_scene_light(&child.node)?,
-            child.location.clone(),
-        ));
+        if lights::is_area(&child.node) {
+            // An area emitter declared at the top level belongs to the shape that references
+            // it; one that no shape references emits nothing (Mitsuba ignores it), but its
+            // parameters are still checked.
+            if !attached_emitters.contains_key(&Arc::as_ptr(&child.node)) {
+                lights::build_area_light(&child.node, 0, &mut textures)?;
+            }
+            continue;
+        }
+        let (light, weight) = lights::build_scene_light(&child.node, &mut textures)?;
+        scene_lights.push((light, weight, child.location.clone()));
     }
     lights::check_single_environment(&scene_lights)?;
-    lights.extend(scene_lights.into_iter().map(|(light, _)| light));
+    for (light, weight, _) in scene_lights {
+        lights.push(light);
+        sampling_weights.push(weight);
+    }
 
     // BSDFs declared at the top level (to be referenced by id) are built even when unused, so
     // that their errors are reported as Mitsuba would.
@@ -218,6 +359,11 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
                 &mut textures,
             )?;
         }
+    }
+    // Samplers declared at the top level (to be referenced by id from the sensor) are checked
+    // even when no sensor uses them.
+    for child in params.children(&SAMPLERS) {
+        sensor::build_sampler(&child.node)?;
     }
     let camera_medium = match &sensor.medium {
         Some(node) => Some(media.index(&crate::description::NestedPlugin {
@@ -243,7 +389,8 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
         ));
     }
 
-    let mut world = World::new(Geometry::new(shapes), shape_info, materials, lights);
+    let mut world = World::new(Geometry::new(shapes), shape_info, materials, lights)
+        .with_sampling_weights(sampling_weights);
     if medium_interfaces.iter().any(|m| m.is_transition()) {
         world.medium_interfaces = medium_interfaces;
     }
@@ -257,9 +404,11 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
         integrator,
     );
     scene.shutter = sensor.shutter;
+    scene.ldr_output = sensor.ldr_output;
     scene.fingerprint = crate::fingerprint::scene_fingerprint(root);
     Ok(LoadedScene {
         scene,
         seed: sensor.seed,
+        warnings: sensor.warnings,
     })
 }

@@ -1,11 +1,12 @@
-//! Shape plugins: `obj`, `ply`, `rectangle`, `cube`, `sphere` and `disk`. Any shape whose
+//! Shape plugins: `obj`, `ply`, `serialized`, `rectangle`, `cube`, `sphere` and `disk`, and the
+//! instancing plugins `shapegroup` and `instance` (built by the scene, [`super::instancing`]). Any shape whose
 //! `to_world` is an `<animation>` moves while the shutter is open: it is built in object space
 //! and placed by an [`Instance`].
 
 use glam::{DVec3, Mat3, Vec2, Vec3};
 
 use crate::description::{PluginClass, PluginNode};
-use crate::mesh::{MeshData, load_obj, load_ply};
+use crate::mesh::{MeshData, load_obj, load_ply, load_serialized};
 use crate::params::Params;
 use crate::registry::{Default, Origin, ParamKind, ParamSpec, Plugin, Registry};
 use prism_core::error::{Error, Result};
@@ -34,7 +35,7 @@ pub static SHAPES: Registry<Build> = Registry {
                 INTERIOR,
                 EXTERIOR,
             ],
-            build: |params, to_world| build_mesh_file(params, to_world, true),
+            build: |params, to_world| build_mesh_file(params, to_world, MeshFormat::Obj),
         },
         Plugin {
             name: "ply",
@@ -50,7 +51,26 @@ pub static SHAPES: Registry<Build> = Registry {
                 INTERIOR,
                 EXTERIOR,
             ],
-            build: |params, to_world| build_mesh_file(params, to_world, false),
+            build: |params, to_world| build_mesh_file(params, to_world, MeshFormat::Ply),
+        },
+        Plugin {
+            name: "serialized",
+            origin: Origin::Mitsuba3,
+            summary: "A mesh of Mitsuba's compressed serialized format (versions 3 and 4; one \
+                      file may hold several shapes); smooth vertex normals computed when the \
+                      shape has none.",
+            params: &[
+                FILENAME,
+                SHAPE_INDEX,
+                FACE_NORMALS,
+                FLIP_NORMALS,
+                TO_WORLD,
+                BSDF,
+                EMITTER,
+                INTERIOR,
+                EXTERIOR,
+            ],
+            build: |params, to_world| build_mesh_file(params, to_world, MeshFormat::Serialized),
         },
         Plugin {
             name: "rectangle",
@@ -109,14 +129,70 @@ pub static SHAPES: Registry<Build> = Registry {
                 )))
             },
         },
+        Plugin {
+            name: "shapegroup",
+            origin: Origin::Mitsuba3,
+            summary: "Shapes to be placed by `instance`s, which share their geometry and \
+                      hierarchy; renders nothing itself. No emitters, no nested groups or \
+                      instances (as in Mitsuba 3).",
+            params: &[GROUP_SHAPES],
+            build: |params, _| Err(nested_instancing(params, "a shapegroup")),
+        },
+        Plugin {
+            name: "instance",
+            origin: Origin::Mitsuba3,
+            summary: "A `shapegroup` (by `<ref id=\"...\"/>`) placed by `to_world`; the scene's \
+                      hierarchy holds it as one primitive over the group's own.",
+            params: &[INSTANCE_GROUP, INSTANCE_TO_WORLD],
+            build: |params, _| Err(nested_instancing(params, "an instance")),
+        },
     ],
 };
+
+/// The shapes of a `shapegroup`.
+pub const GROUP_SHAPES: ParamSpec = ParamSpec::nested(
+    PluginClass::Shape,
+    Default::None,
+    "the group's shapes, each with its BSDF and media",
+);
+/// The group an `instance` places.
+pub const INSTANCE_GROUP: ParamSpec = ParamSpec::nested(
+    PluginClass::Shape,
+    Default::Required,
+    "the `shapegroup` placed, usually `<ref id=\"...\"/>`",
+);
+/// The transform of an `instance`.
+pub const INSTANCE_TO_WORLD: ParamSpec = ParamSpec::new(
+    "to_world",
+    ParamKind::AnimatedTransform,
+    Default::Text("identity"),
+    "group to world; an `<animation>` moves the instance during the exposure (Prism; Mitsuba 3 \
+     takes a fixed transform)",
+);
+
+/// The error for a `shapegroup` or `instance` inside a `shapegroup` (a shape built as a
+/// group's member; the scene builds top-level groups and instances itself).
+fn nested_instancing(params: &Params, what: &str) -> Error {
+    Error::input(
+        params.location(),
+        format!("{what} cannot be part of a shapegroup: instancing does not nest"),
+    )
+    .with_help(
+        "declare shapegroups and instances at the top level of the scene (as Mitsuba 3 requires)",
+    )
+}
 
 const FILENAME: ParamSpec = ParamSpec::new(
     "filename",
     ParamKind::String,
     Default::Required,
     "the mesh file",
+);
+const SHAPE_INDEX: ParamSpec = ParamSpec::new(
+    "shape_index",
+    ParamKind::Integer,
+    Default::Integer(0),
+    "which of the file's shapes to load, counted from 0",
 );
 const FACE_NORMALS: ParamSpec = ParamSpec::new(
     "face_normals",
@@ -190,6 +266,11 @@ pub fn shape_params(node: &PluginNode) -> Result<(&'static Plugin<Build>, Params
 /// whose `to_world` is an `<animation>` is built in object space and placed by an [`Instance`];
 /// a fixed `to_world` is applied to the shape once.
 pub fn build_shape(plugin: &Plugin<Build>, params: &Params) -> Result<Primitive> {
+    // A `shapegroup` has no transform: the scene builds it, so it only gets here nested, where
+    // its builder refuses it.
+    if plugin.params.iter().all(|p| p.name != TO_WORLD.name) {
+        return (plugin.build)(params, &Transform::IDENTITY).map(Primitive::Shape);
+    }
     let to_world = params.animated_transform(&TO_WORLD)?;
     if to_world.is_animated() {
         let shape = (plugin.build)(params, &Transform::IDENTITY)?;
@@ -198,8 +279,16 @@ pub fn build_shape(plugin: &Plugin<Build>, params: &Params) -> Result<Primitive>
     (plugin.build)(params, to_world.first()).map(Primitive::Shape)
 }
 
-/// An OBJ or PLY mesh placed by `to_world`.
-fn build_mesh_file(params: &Params, to_world: &Transform, obj: bool) -> Result<Shape> {
+/// The mesh file formats.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum MeshFormat {
+    Obj,
+    Ply,
+    Serialized,
+}
+
+/// A mesh read from a file, placed by `to_world`.
+fn build_mesh_file(params: &Params, to_world: &Transform, format: MeshFormat) -> Result<Shape> {
     let node = params.node();
     let flip_normals = params.boolean(&FLIP_NORMALS)?;
     let filename = params.string_opt(&FILENAME)?.ok_or_else(|| {
@@ -212,20 +301,26 @@ fn build_mesh_file(params: &Params, to_world: &Transform, obj: bool) -> Result<S
     let location = params.location_of(&FILENAME);
     let path = node.resolve_file(filename, location)?;
     let face_normals = params.boolean(&FACE_NORMALS)?;
-    let flip_tex_coords = if obj {
-        params.boolean(&FLIP_TEX_COORDS)?
-    } else {
-        false
-    };
-    let loaded = if obj {
-        load_obj(&path)
-    } else {
-        load_ply(&path)
+    // The OBJ reader flips v as Mitsuba's does; `flip_tex_coords="false"` undoes it. PLY and
+    // serialized coordinates are used as stored.
+    let unflip_tex_coords = format == MeshFormat::Obj && !params.boolean(&FLIP_TEX_COORDS)?;
+    let loaded = match format {
+        MeshFormat::Obj => load_obj(&path),
+        MeshFormat::Ply => load_ply(&path),
+        MeshFormat::Serialized => {
+            let shape_index = params.integer(&SHAPE_INDEX)?;
+            let shape_index = u32::try_from(shape_index).map_err(|_| {
+                Error::input(
+                    params.location_of(&SHAPE_INDEX),
+                    format!("\"shape_index\" must be 0 or more, not {shape_index}"),
+                )
+            })?;
+            load_serialized(&path, shape_index)
+        }
     };
     let mut data = loaded.map_err(|e| mesh_error(e, node))?;
     data.validate(&path).map_err(|e| mesh_error(e, node))?;
-    if !flip_tex_coords && let Some(uvs) = &mut data.uvs {
-        // The OBJ reader flips v; undo it when the scene asks for raw coordinates.
+    if unflip_tex_coords && let Some(uvs) = &mut data.uvs {
         for uv in uvs.iter_mut() {
             uv.y = 1.0 - uv.y;
         }
@@ -349,6 +444,7 @@ pub fn rectangle() -> MeshData {
             Vec2::new(1.0, 1.0),
             Vec2::new(0.0, 1.0),
         ]),
+        colors: None,
         triangles: vec![[0, 1, 2], [2, 3, 0]],
     }
 }
@@ -360,6 +456,7 @@ pub fn cube() -> MeshData {
         positions: Vec::new(),
         normals: Some(Vec::new()),
         uvs: Some(Vec::new()),
+        colors: None,
         triangles: Vec::new(),
     };
     let axes = [Vec3::X, Vec3::Y, Vec3::Z];

@@ -1,7 +1,8 @@
-//! Triangle meshes read from files: Wavefront OBJ ([`obj`]) and Stanford PLY ([`ply`]).
+//! Triangle meshes read from files: Wavefront OBJ ([`obj`]), Stanford PLY ([`ply`]) and
+//! Mitsuba's compressed format ([`serialized`]).
 //!
 //! A reader turns a file into a [`MeshData`] in object space: positions, optional per-vertex
-//! normals and texture coordinates, and triangles indexing them. Polygons are triangulated as a
+//! normals, texture coordinates and colours, and triangles indexing them. Polygons are triangulated as a
 //! fan around their first vertex, as Mitsuba 3 does. Readers never trust their input: every
 //! index is checked against the vertex count and every number must be finite, and the errors
 //! name the file and, where the format has lines, the line (binary PLY: the byte offset).
@@ -13,6 +14,7 @@
 
 pub mod obj;
 pub mod ply;
+pub mod serialized;
 
 use std::f32::consts::PI;
 use std::fmt::Display;
@@ -24,6 +26,7 @@ use prism_core::error::{Error, Result};
 
 pub use obj::parse_obj;
 pub use ply::parse_ply;
+pub use serialized::parse_serialized;
 
 /// A triangle mesh as read from a file, before any transform.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -34,6 +37,8 @@ pub struct MeshData {
     /// One per vertex when present, in Mitsuba's convention (OBJ's `vt` are flipped on reading,
     /// v -> 1 - v).
     pub uvs: Option<Vec<Vec2>>,
+    /// One linear RGB colour per vertex when present (Mitsuba's `vertex_color` attribute).
+    pub colors: Option<Vec<Vec3>>,
     /// Counter-clockwise seen from the side the face normal points to.
     pub triangles: Vec<[u32; 3]>,
 }
@@ -48,6 +53,12 @@ pub fn load_obj(path: &Path) -> Result<MeshData> {
 pub fn load_ply(path: &Path) -> Result<MeshData> {
     let bytes = std::fs::read(path).map_err(|e| Error::io(path, &e, "read the mesh"))?;
     parse_ply(&bytes, path)
+}
+
+/// Reads shape `shape_index` of a Mitsuba serialized file (see [`serialized`]).
+pub fn load_serialized(path: &Path, shape_index: u32) -> Result<MeshData> {
+    let bytes = std::fs::read(path).map_err(|e| Error::io(path, &e, "read the mesh"))?;
+    parse_serialized(&bytes, shape_index, path)
 }
 
 /// An input error about a mesh file where no line and column apply (a binary file, or the
@@ -111,6 +122,20 @@ impl MeshData {
                 return Err(file_error(
                     path,
                     format!("the texture coordinate of vertex {i} is not a finite number"),
+                ));
+            }
+        }
+        if let Some(colors) = &self.colors {
+            if colors.len() != vertex_count {
+                return Err(file_error(
+                    path,
+                    format!("{} colours for {vertex_count} vertices", colors.len()),
+                ));
+            }
+            if let Some(i) = colors.iter().position(|c| !c.is_finite()) {
+                return Err(file_error(
+                    path,
+                    format!("the colour of vertex {i} is not a finite number"),
                 ));
             }
         }

@@ -15,6 +15,10 @@
 //!   not know (`s`, `p`, `vp`, ...) are ignored.
 //! - A mesh vertex is a distinct (v, vt, vn) triple. Normals are kept only when every face vertex
 //!   names one, texture coordinates likewise (Mitsuba would leave the missing ones undefined).
+//! - The text need not be UTF-8: Mitsuba reads the file as bytes, so a Latin-1 comment or
+//!   material name is no error. Bytes that are not UTF-8 are read as U+FFFD (which keeps lines
+//!   and, one character per byte of a single-byte encoding, columns); where a number is
+//!   expected, that is an error on its line.
 //! - Texture coordinates are flipped vertically, v -> 1 - v: Mitsuba's default
 //!   (`flip_tex_coords`), since OBJ files put v = 0 at the bottom of the image.
 //!
@@ -32,13 +36,8 @@ use prism_core::error::{Error, Result, SourceLocation};
 
 /// Parses the OBJ text in `bytes`; `path` only names the file in messages.
 pub fn parse_obj(bytes: &[u8], path: &Path) -> Result<MeshData> {
-    let text = std::str::from_utf8(bytes).map_err(|e| {
-        let line = bytes[..e.valid_up_to()]
-            .iter()
-            .filter(|&&b| b == b'\n')
-            .count();
-        Error::input(&location(path, line, 1), "the line is not valid UTF-8 text")
-    })?;
+    let text = String::from_utf8_lossy(bytes);
+    let text = text.as_ref();
     check_face_lines(text, path)?;
     let text = text_for_tobj(text);
 
@@ -543,14 +542,17 @@ mod tests {
     }
 
     #[test]
+    fn latin1_comments_and_names_are_read_as_mitsuba_reads_them() {
+        let text = b"# caf\xe9 cr\xe8me\no pi\xe8ce\nusemtl m\xe9tal\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+        let mesh = parse_obj(text, Path::new("mesh.obj")).unwrap();
+        assert_eq!(mesh.triangles, vec![[0, 1, 2]]);
+        assert_eq!(mesh.positions[1], Vec3::X);
+    }
+
+    #[test]
     fn invalid_text_and_empty_meshes_are_errors() {
         let message = parse_obj(b"v 0 0 0\nv \xff 0 0\n", Path::new("mesh.obj")).unwrap_err();
-        assert!(
-            message
-                .to_string()
-                .starts_with("mesh.obj:2:1: the line is not valid UTF-8"),
-            "{message}"
-        );
+        assert!(message.to_string().starts_with("mesh.obj:2:"), "{message}");
         let message = error(SQUARE);
         assert_eq!(message, "mesh.obj: the file has no faces");
         assert_eq!(error(""), "mesh.obj: the file has no faces");

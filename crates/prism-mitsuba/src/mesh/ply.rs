@@ -581,6 +581,7 @@ fn read_body(reader: &mut impl BodyReader, header: &Header, layout: &Layout) -> 
             .has_normals
             .then(|| Vec::with_capacity(vertex_capacity)),
         uvs: layout.has_uvs.then(|| Vec::with_capacity(vertex_capacity)),
+        colors: None,
         triangles: Vec::new(),
     };
     let mut polygon = Vec::new();
@@ -980,6 +981,7 @@ mod tests {
             positions: corners.iter().map(|&[x, y]| Vec3::new(x, y, 0.0)).collect(),
             normals: Some(vec![Vec3::Z; 4]),
             uvs: Some(corners.iter().map(|&c| Vec2::from(c)).collect()),
+            colors: None,
             triangles: vec![[0, 1, 2], [0, 2, 3], [3, 1, 2]],
         }
     }
