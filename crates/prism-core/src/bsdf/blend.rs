@@ -49,7 +49,7 @@ impl BsdfModel for Blend {
         let first = self.nested[0].resolve(point, wo, lambda, tree);
         let second = self.nested[1].resolve(point, wo, lambda, tree);
         tree.push(BlendLobes {
-            weight: self.weight.eval_1(point.uv).clamp(0.0, 1.0),
+            weight: self.weight.eval_1(point.at()).clamp(0.0, 1.0),
             nested: [first, second],
         })
     }

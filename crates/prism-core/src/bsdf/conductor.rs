@@ -17,7 +17,7 @@ use wide::f32x4;
 use super::fresnel::{fresnel_conductor4, reflect_z};
 use super::{BsdfFlags, BsdfModel, BsdfSample, Bxdf, BxdfTree, NodeId, ShadingPoint};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
-use crate::texture::Texture;
+use crate::texture::{Texture, TexturePoint};
 
 #[derive(Clone, Debug)]
 pub struct Conductor {
@@ -35,12 +35,17 @@ pub struct ConductorIor {
 }
 
 impl ConductorIor {
-    /// η and k read from textures at `uv`.
+    /// η and k read from textures at `at`.
     #[inline]
-    pub fn at(eta: &Texture, k: &Texture, uv: Vec2, lambda: &SampledWavelengths) -> ConductorIor {
+    pub fn at(
+        eta: &Texture,
+        k: &Texture,
+        at: TexturePoint,
+        lambda: &SampledWavelengths,
+    ) -> ConductorIor {
         ConductorIor {
-            eta: eta.eval(uv, lambda),
-            k: k.eval(uv, lambda),
+            eta: eta.eval(at, lambda),
+            k: k.eval(at, lambda),
         }
     }
 
@@ -77,8 +82,8 @@ impl BsdfModel for Conductor {
         tree: &mut BxdfTree<'a>,
     ) -> NodeId {
         tree.push(ConductorLobes {
-            ior: ConductorIor::at(&self.eta, &self.k, point.uv, lambda),
-            specular_reflectance: self.specular_reflectance.eval(point.uv, lambda),
+            ior: ConductorIor::at(&self.eta, &self.k, point.at(), lambda),
+            specular_reflectance: self.specular_reflectance.eval(point.at(), lambda),
         })
     }
 }

@@ -46,7 +46,7 @@ impl BsdfModel for Diffuse {
         tree: &mut BxdfTree<'a>,
     ) -> NodeId {
         tree.push(DiffuseLobes {
-            reflectance: self.reflectance.eval(point.uv, lambda),
+            reflectance: self.reflectance.eval(point.at(), lambda),
         })
     }
 }

@@ -57,8 +57,8 @@ impl BsdfModel for RoughDiffuse {
         tree: &mut BxdfTree<'a>,
     ) -> NodeId {
         tree.push(RoughDiffuseLobes {
-            reflectance: self.reflectance.eval(point.uv, lambda),
-            sigma: self.alpha.eval_1(point.uv) * FRAC_1_SQRT_2,
+            reflectance: self.reflectance.eval(point.at(), lambda),
+            sigma: self.alpha.eval_1(point.at()) * FRAC_1_SQRT_2,
             use_fast_approx: self.use_fast_approx,
         })
     }

@@ -13,7 +13,7 @@
 
 use glam::Vec2;
 
-use super::{Texture, UvTransform};
+use super::{Texture, TexturePoint, UvTransform};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 
 #[derive(Clone, Debug)]
@@ -36,12 +36,12 @@ impl Checkerboard {
         }
     }
 
-    pub fn eval(&self, uv: Vec2, lambda: &SampledWavelengths) -> SampledSpectrum {
-        self.select(uv).eval(uv, lambda)
+    pub fn eval(&self, at: &TexturePoint, lambda: &SampledWavelengths) -> SampledSpectrum {
+        self.select(at.uv).eval(*at, lambda)
     }
 
-    pub fn eval_1(&self, uv: Vec2) -> f32 {
-        self.select(uv).eval_1(uv)
+    pub fn eval_1(&self, at: &TexturePoint) -> f32 {
+        self.select(at.uv).eval_1(*at)
     }
 
     pub fn max_value(&self) -> f32 {
@@ -64,9 +64,10 @@ mod tests {
             color1: Texture::constant(0.2),
             to_uv: UvTransform::IDENTITY,
         };
-        assert_eq!(c.eval_1(Vec2::new(0.25, 0.25)), 0.4);
-        assert_eq!(c.eval_1(Vec2::new(0.75, 0.75)), 0.4);
-        assert_eq!(c.eval_1(Vec2::new(0.75, 0.25)), 0.2);
-        assert_eq!(c.eval_1(Vec2::new(1.25, -0.25)), 0.2);
+        let at = |u, v| TexturePoint::from(Vec2::new(u, v));
+        assert_eq!(c.eval_1(&at(0.25, 0.25)), 0.4);
+        assert_eq!(c.eval_1(&at(0.75, 0.75)), 0.4);
+        assert_eq!(c.eval_1(&at(0.75, 0.25)), 0.2);
+        assert_eq!(c.eval_1(&at(1.25, -0.25)), 0.2);
     }
 }

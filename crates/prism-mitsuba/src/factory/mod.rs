@@ -22,7 +22,7 @@ use crate::params::Params;
 use crate::registry::{Default, ParamSpec};
 use prism_core::bsdf::Material;
 use prism_core::error::{Error, Result};
-use prism_core::geometry::{Geometry, Primitive};
+use prism_core::geometry::{Geometry, Primitive, Shape};
 use prism_core::integrator::{Integrator, PathIntegrator};
 use prism_core::scene::Scene;
 use prism_core::world::{ShapeInfo, World};
@@ -59,11 +59,64 @@ const TEXTURES: ParamSpec = ParamSpec::nested(
 /// What the `<scene>` element holds.
 const SCENE: &[ParamSpec] = &[INTEGRATOR, SENSOR, SHAPES, EMITTERS, BSDFS, TEXTURES];
 
+/// Makes the shape's mesh fill the attribute slots its BSDF's `mesh_attribute` textures read;
+/// a shape without one of those attributes is an error (Mitsuba's "invalid attribute
+/// requested", which it reports while rendering).
+fn bind_mesh_attributes(
+    shape: &mut Primitive,
+    attributes: &[(u8, String)],
+    node: &PluginNode,
+) -> Result<()> {
+    let Some((_, first)) = attributes.first() else {
+        return Ok(());
+    };
+    let Primitive::Shape(Shape::Mesh(mesh)) = shape else {
+        let what = if matches!(shape, Primitive::Instance(_)) {
+            "a moving shape"
+        } else {
+            "a shape that is not a mesh"
+        };
+        return Err(Error::input(
+            &node.location,
+            format!(
+                "{} has no attribute \"{first}\" (Mitsuba: invalid attribute requested): its \
+                 BSDF reads mesh attributes, which {what} does not carry",
+                node.describe()
+            ),
+        )
+        .with_help("give the attribute to a ply or serialized mesh that has it"));
+    };
+    for (slot, name) in attributes {
+        if !mesh.bind_attribute(name, *slot) {
+            let names: Vec<&str> = mesh.attribute_names().collect();
+            let has = if names.is_empty() {
+                "it has none".to_string()
+            } else {
+                format!("it has {}", names.join(", "))
+            };
+            return Err(Error::input(
+                &node.location,
+                format!(
+                    "{} has no attribute \"{name}\" (Mitsuba: invalid attribute requested); \
+                     {has}",
+                    node.describe()
+                ),
+            )
+            .with_help(
+                "use a mesh with per-vertex colours (PLY red green blue, or serialized colours)",
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// Builds the scene described by the root `<scene>` node.
 pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
     let params = Params::new(root, SCENE);
     let mut materials: Vec<Material> = Vec::new();
     let mut material_ids: HashMap<*const PluginNode, u32> = HashMap::new();
+    // The mesh attributes each material's textures read: (slot, name).
+    let mut material_attributes: HashMap<u32, Vec<(u8, String)>> = HashMap::new();
     let mut shapes = Vec::new();
     let mut shape_info = Vec::new();
     let mut lights = Vec::new();
@@ -88,7 +141,7 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
 
     for child in params.children(&SHAPES) {
         let (plugin, shape_params) = shapes::shape_params(&child.node)?;
-        let shape = shapes::build_shape(plugin, &shape_params)?;
+        let mut shape = shapes::build_shape(plugin, &shape_params)?;
         let area = shape.area();
         if !area.is_finite() {
             return Err(Error::input(
@@ -120,9 +173,11 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
                 match material_ids.get(&key) {
                     Some(&index) => index,
                     None => {
+                        textures.take_used_slots();
                         materials.push(materials::build_material(&bsdf.node, &mut textures)?);
                         let index = (materials.len() - 1) as u32;
                         material_ids.insert(key, index);
+                        material_attributes.insert(index, textures.take_used_slots());
                         index
                     }
                 }
@@ -154,6 +209,9 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
             }
             None => None,
         };
+        if let Some(attributes) = material_attributes.get(&material) {
+            bind_mesh_attributes(&mut shape, attributes, &child.node)?;
+        }
         shape_params.finish()?;
         if area == 0.0 {
             continue;

@@ -9,6 +9,7 @@ use crate::mesh::{MeshData, load_obj, load_ply, load_serialized};
 use crate::params::Params;
 use crate::registry::{Default, Origin, ParamKind, ParamSpec, Plugin, Registry};
 use prism_core::error::{Error, Result};
+use prism_core::geometry::shape::MeshAttribute;
 use prism_core::geometry::{Disk, Instance, Primitive, Shape, Sphere, TriangleMesh};
 use prism_core::math::Transform;
 
@@ -340,7 +341,20 @@ pub fn transform_mesh(
             t.swap(1, 2);
         }
     }
-    TriangleMesh::new(positions, normals, data.uvs, triangles, flip_normals)
+    let mut mesh = TriangleMesh::new(positions, normals, data.uvs, triangles, flip_normals);
+    if let Some(colors) = data.colors {
+        mesh.set_attributes(vec![vertex_color_attribute(colors)]);
+    }
+    mesh
+}
+
+/// Mitsuba's `vertex_color` attribute: the vertices' linear RGB colours.
+fn vertex_color_attribute(colors: Vec<Vec3>) -> MeshAttribute {
+    MeshAttribute {
+        name: "vertex_color".to_string(),
+        per_face: false,
+        values: colors,
+    }
 }
 
 /// Mitsuba's `rectangle`: [−1, 1]² in the z = 0 plane, normal +z, uv from (0, 0) to (1, 1).

@@ -4,7 +4,7 @@ use std::sync::OnceLock;
 
 use glam::{Vec2, Vec3};
 
-use crate::geometry::interaction::SurfaceInteraction;
+use crate::geometry::interaction::{AttributeValues, SurfaceInteraction};
 use crate::geometry::triangle::TriangleHit;
 use crate::math::Frame;
 use crate::sampling::distribution::AliasTable;
@@ -29,6 +29,20 @@ pub struct TriangleMesh {
     /// first area sample, so that only meshes that are lights pay its 12 bytes per triangle.
     area_table: OnceLock<Option<AliasTable>>,
     area: f32,
+    /// The attributes the mesh carries (Mitsuba's `vertex_color`, `face_color`, ...).
+    attributes: Vec<MeshAttribute>,
+    /// The attributes the scene's textures read: (slot, index into `attributes`).
+    bound: Vec<(u8, u8)>,
+}
+
+/// Values a mesh carries per vertex or per triangle, under a Mitsuba attribute name
+/// (`vertex_...` or `face_...`); a colour is linear RGB.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MeshAttribute {
+    pub name: String,
+    /// One value per triangle (else one per vertex).
+    pub per_face: bool,
+    pub values: Vec<Vec3>,
 }
 
 /// A point drawn on a surface.
@@ -61,6 +75,8 @@ impl TriangleMesh {
             flip_normals,
             area_table: OnceLock::new(),
             area: 0.0,
+            attributes: Vec::new(),
+            bound: Vec::new(),
         };
         mesh.area = mesh.triangle_areas().iter().sum::<f64>() as f32;
         mesh.positions.shrink_to_fit();
@@ -69,6 +85,55 @@ impl TriangleMesh {
             .map(|i| mesh.computed_face_normal(i))
             .collect();
         mesh
+    }
+
+    /// Gives the mesh its attributes; each has one value per vertex, or per triangle when
+    /// `per_face` (the mesh readers validate the counts).
+    pub fn set_attributes(&mut self, attributes: Vec<MeshAttribute>) {
+        debug_assert!(attributes.iter().all(|a| {
+            a.values.len()
+                == if a.per_face {
+                    self.triangles.len()
+                } else {
+                    self.positions.len()
+                }
+        }));
+        self.attributes = attributes;
+        self.bound.clear();
+    }
+
+    /// The names of the mesh's attributes.
+    pub fn attribute_names(&self) -> impl Iterator<Item = &str> {
+        self.attributes.iter().map(|a| a.name.as_str())
+    }
+
+    /// Makes every hit fill `slot` with the attribute `name`; false when the mesh has none of
+    /// that name.
+    pub fn bind_attribute(&mut self, name: &str, slot: u8) -> bool {
+        let Some(index) = self.attributes.iter().position(|a| a.name == name) else {
+            return false;
+        };
+        if !self.bound.iter().any(|&(s, _)| s == slot) {
+            self.bound.push((slot, index as u8));
+        }
+        true
+    }
+
+    /// The bound attributes at barycentrics `b` of `triangle`: a vertex attribute interpolated,
+    /// a face attribute as it is.
+    #[inline]
+    fn attributes_at(&self, triangle: usize, b: [f32; 3]) -> AttributeValues {
+        let mut values = AttributeValues::default();
+        for &(slot, index) in &self.bound {
+            let attribute = &self.attributes[usize::from(index)];
+            values.0[usize::from(slot)] = if attribute.per_face {
+                attribute.values[triangle]
+            } else {
+                let [i, j, k] = self.triangles[triangle].map(|v| v as usize);
+                attribute.values[i] * b[0] + attribute.values[j] * b[1] + attribute.values[k] * b[2]
+            };
+        }
+        values
     }
 
     pub fn positions(&self) -> &[Vec3] {
@@ -119,6 +184,11 @@ impl TriangleMesh {
                 .map_or(0, |uv| uv.capacity() * size_of::<Vec2>())
             + self.triangles.capacity() * size_of::<[u32; 3]>()
             + self.face_normals.capacity() * size_of::<Vec3>()
+            + self
+                .attributes
+                .iter()
+                .map(|a| a.values.capacity() * size_of::<Vec3>())
+                .sum::<usize>()
             + self
                 .area_table
                 .get()
@@ -202,6 +272,7 @@ impl TriangleMesh {
             shape,
             primitive: triangle as u32,
             time: 0.0,
+            attributes: self.attributes_at(triangle, b),
         }
     }
 

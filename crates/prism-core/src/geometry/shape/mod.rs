@@ -10,7 +10,7 @@ pub mod sphere;
 use glam::{Vec2, Vec3};
 
 pub use disk::Disk;
-pub use mesh::{SurfaceSample, TriangleMesh};
+pub use mesh::{MeshAttribute, SurfaceSample, TriangleMesh};
 pub use sphere::{Sphere, area_to_solid_angle};
 
 use crate::geometry::interaction::SurfaceInteraction;
