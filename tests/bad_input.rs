@@ -507,6 +507,29 @@ fn cases() -> Vec<Case> {
             location: "",
             says: "missing.state",
         },
+        // Cylinders.
+        render_scene(
+            "cylinder: p0 and p1 the same point",
+            scene!(
+                "    <shape type=\"cylinder\"><point name=\"p1\" x=\"0\" y=\"0\" z=\"0\"/></shape>"
+            ),
+            "scene.xml:3:5",
+            "are the same point",
+        ),
+        render_scene(
+            "cylinder: negative radius",
+            scene!("    <shape type=\"cylinder\"><float name=\"radius\" value=\"-1\"/></shape>"),
+            "scene.xml:3:",
+            "radius must be positive",
+        ),
+        render_scene(
+            "cylinder: an elliptic to_world",
+            scene!(
+                "    <shape type=\"cylinder\"><transform name=\"to_world\"><scale x=\"2\"/></transform></shape>"
+            ),
+            "scene.xml:3:",
+            "may not make it elliptic",
+        ),
         // mesh_attribute textures.
         Case {
             name: "mesh_attribute: the mesh has no such attribute",
