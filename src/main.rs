@@ -27,6 +27,7 @@ enum Command {
 }
 
 fn main() {
+    restore_default_sigpipe();
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Render(args) => prism::cli::render::run(&args),
@@ -39,5 +40,15 @@ fn main() {
     if let Err(error) = result {
         eprintln!("error: {error}");
         std::process::exit(error.kind.exit_code());
+    }
+}
+
+/// Lets a closed pipe end the program quietly, as it ends other Unix tools: Rust ignores
+/// SIGPIPE, so `prism compare a.exr b.exr | head -1` would otherwise panic on its next write.
+fn restore_default_sigpipe() {
+    #[cfg(unix)]
+    // SAFETY: called first in `main`, before any other thread exists; SIG_DFL is a valid handler.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
     }
 }

@@ -294,10 +294,52 @@ fn cases() -> Vec<Case> {
             "above 1",
         ),
         render_scene(
-            "area emitter at the top",
-            scene!("    <emitter type=\"area\"/>"),
-            "scene.xml:3:5",
-            "nested in a shape",
+            "area emitter on two shapes",
+            scene!(
+                "    <emitter type=\"area\" id=\"light\"/><shape type=\"sphere\"><ref id=\"light\"/></shape><shape type=\"disk\"><ref id=\"light\"/></shape>"
+            ),
+            "scene.xml:3:",
+            "already attached",
+        ),
+        render_scene(
+            "area emitter radiance texture without its image",
+            scene!(
+                "    <shape type=\"sphere\"><emitter type=\"area\"><texture type=\"bitmap\" name=\"radiance\"><string name=\"filename\" value=\"missing.png\"/></texture></emitter></shape>"
+            ),
+            "scene.xml:3:",
+            "not found",
+        ),
+        render_scene(
+            "area emitter radiance given as a bsdf",
+            scene!(
+                "    <shape type=\"sphere\"><emitter type=\"area\"><bsdf type=\"diffuse\" name=\"radiance\"/></emitter></shape>"
+            ),
+            "scene.xml:3:",
+            "is not supported",
+        ),
+        render_scene(
+            "spot light texture with a cutoff beyond 90 degrees",
+            scene!(
+                "    <emitter type=\"spot\"><float name=\"cutoff_angle\" value=\"120\"/><texture type=\"checkerboard\" name=\"texture\"/></emitter>"
+            ),
+            "scene.xml:3:",
+            "below 90 degrees",
+        ),
+        render_scene(
+            "projector irradiance given as a bsdf",
+            scene!(
+                "    <emitter type=\"projector\"><bsdf type=\"diffuse\" name=\"irradiance\"/></emitter>"
+            ),
+            "scene.xml:3:",
+            "is not supported",
+        ),
+        render_scene(
+            "unreferenced area emitter with negative radiance",
+            scene!(
+                "    <emitter type=\"area\" id=\"light\"><rgb name=\"radiance\" value=\"-1\"/></emitter>"
+            ),
+            "scene.xml:3:",
+            "negative",
         ),
         render_scene(
             "twosided in twosided",
@@ -324,6 +366,24 @@ fn cases() -> Vec<Case> {
             "<scene version=\"3.0.0\">\n    <sensor type=\"perspective\"><film type=\"hdrfilm\"><integer name=\"width\" value=\"4\"/><integer name=\"height\" value=\"4\"/><integer name=\"crop_width\" value=\"9\"/></film></sensor>\n</scene>\n",
             "scene.xml:2:",
             "does not fit",
+        ),
+        render_scene(
+            "a misspelt Mitsuba 0.6 film parameter",
+            "<scene version=\"0.6.0\">\n    <sensor type=\"perspective\"><film type=\"hdrfilm\"><integer name=\"width\" value=\"4\"/><integer name=\"height\" value=\"4\"/>\n        <boolean name=\"banerr\" value=\"false\"/></film></sensor>\n</scene>\n",
+            "scene.xml:3:9",
+            "did you mean \"banner\"",
+        ),
+        render_scene(
+            "ldrfilm gamma of zero",
+            "<scene version=\"3.0.0\">\n    <sensor type=\"perspective\"><film type=\"ldrfilm\"><integer name=\"width\" value=\"4\"/><integer name=\"height\" value=\"4\"/>\n        <float name=\"gamma\" value=\"0\"/></film></sensor>\n</scene>\n",
+            "scene.xml:3:9",
+            "or −1 for the sRGB curve",
+        ),
+        render_scene(
+            "ldrfilm unknown tonemapper",
+            "<scene version=\"3.0.0\">\n    <sensor type=\"perspective\"><film type=\"ldrfilm\"><integer name=\"width\" value=\"4\"/><integer name=\"height\" value=\"4\"/>\n        <string name=\"tonemap_method\" value=\"filmic\"/></film></sensor>\n</scene>\n",
+            "scene.xml:3:9",
+            "gamma, reinhard",
         ),
         render_scene(
             "film of 10^6 × 10^6 pixels",
@@ -578,8 +638,42 @@ fn cases() -> Vec<Case> {
             "scene.xml:3:",
             "needs the \"name\"",
         ),
+        render_scene(
+            "rawconstant of three values read as a colour",
+            scene!(
+                "    <shape type=\"sphere\"><bsdf type=\"diffuse\"><texture type=\"rawconstant\" name=\"reflectance\">\n        <vector name=\"value\" x=\"1\" y=\"0\" z=\"0\"/></texture></bsdf></shape>"
+            ),
+            "scene.xml:4:9",
+            "three values",
+        ),
+        render_scene(
+            "rawconstant without a value",
+            scene!(
+                "    <shape type=\"sphere\"><bsdf type=\"diffuse\"><texture type=\"rawconstant\" name=\"reflectance\"/></bsdf></shape>"
+            ),
+            "scene.xml:3:",
+            "needs a \"value\"",
+        ),
+        render_scene(
+            "conductor exterior index not a constant",
+            scene!(
+                "    <shape type=\"sphere\"><bsdf type=\"conductor\">\n        <spectrum name=\"ext_eta\" value=\"400:1.3, 700:1.4\"/></bsdf></shape>"
+            ),
+            "scene.xml:4:9",
+            "must be a constant",
+        ),
+        render_scene(
+            "colour opacity outside [0, 1]",
+            scene!(
+                "    <shape type=\"sphere\"><bsdf type=\"mask\">\n        <rgb name=\"opacity\" value=\"3, 2, 4\"/><bsdf type=\"diffuse\"/></bsdf></shape>"
+            ),
+            "scene.xml:4:9",
+            "whose mean",
+        ),
     ];
     // Command-line parameters.
+    cases.extend(media_cases());
+    cases.extend(instancing_cases());
     for (name, extra, says) in [
         ("zero samples", &["--spp", "0"][..], "--spp"),
         (
@@ -616,6 +710,143 @@ fn cases() -> Vec<Case> {
         });
     }
     cases
+}
+
+/// A `.vol` header (version 3, 32-bit floats, a zero bounding box) for `resolution` voxels of
+/// `channels`, as the 48 bytes the reader checks first; ASCII-safe for these small sizes.
+macro_rules! vol_header {
+    ($x:literal, $y:literal, $z:literal, $c:literal) => {
+        concat!(
+            "VOL\x03\x01\x00\x00\x00",
+            $x,
+            "\x00\x00\x00",
+            $y,
+            "\x00\x00\x00",
+            $z,
+            "\x00\x00\x00",
+            $c,
+            "\x00\x00\x00",
+            "\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00",
+            "\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00"
+        )
+    };
+}
+
+/// A scene whose shape bounds a heterogeneous medium with the grid `density.vol`.
+const GRID_SCENE: &str = scene!(
+    "    <shape type=\"sphere\"><bsdf type=\"null\"/><medium type=\"heterogeneous\" name=\"interior\"><volume type=\"gridvolume\" name=\"sigma_t\"><string name=\"filename\" value=\"density.vol\"/></volume></medium></shape>"
+);
+
+/// Bad media: negative coefficients, albedos above 1, missing, truncated and foreign grids,
+/// phase functions out of range, misspelt parameters, and media where distrib renders.
+fn media_cases() -> Vec<Case> {
+    let with_grid = |name: &'static str, bytes: &'static str, says: &'static str| Case {
+        name,
+        files: Box::leak(Box::new([
+            ("scene.xml", GRID_SCENE),
+            ("density.vol", bytes),
+        ])),
+        arguments: RENDER,
+        location: "scene.xml:3:",
+        says,
+    };
+    vec![
+        render_scene(
+            "negative extinction",
+            scene!(
+                "    <shape type=\"sphere\"><bsdf type=\"null\"/><medium type=\"homogeneous\" name=\"interior\"><float name=\"sigma_t\" value=\"-1\"/></medium></shape>"
+            ),
+            "scene.xml:3:",
+            "negative",
+        ),
+        render_scene(
+            "albedo above 1",
+            scene!(
+                "    <shape type=\"sphere\"><medium type=\"homogeneous\" name=\"interior\"><float name=\"albedo\" value=\"1.5\"/></medium></shape>"
+            ),
+            "scene.xml:3:",
+            "above 1",
+        ),
+        render_scene(
+            "RGB albedo above 1",
+            scene!(
+                "    <medium type=\"homogeneous\" id=\"fog\"><rgb name=\"albedo\" value=\"0.5, 1.2, 0.3\"/></medium>"
+            ),
+            "scene.xml:3:",
+            "above 1",
+        ),
+        render_scene(
+            "hg asymmetry of 1",
+            scene!(
+                "    <medium type=\"homogeneous\" id=\"fog\"><phase type=\"hg\"><float name=\"g\" value=\"1\"/></phase></medium>"
+            ),
+            "scene.xml:3:",
+            "(-1, 1)",
+        ),
+        render_scene(
+            "misspelt medium parameter",
+            scene!(
+                "    <medium type=\"homogeneous\" id=\"fog\"><float name=\"sigmat\" value=\"1\"/></medium>"
+            ),
+            "scene.xml:3:",
+            "did you mean \"sigma_t\"",
+        ),
+        render_scene(
+            "sigma_a without sigma_s",
+            scene!(
+                "    <medium type=\"homogeneous\" id=\"fog\"><float name=\"sigma_a\" value=\"1\"/></medium>"
+            ),
+            "scene.xml:3:",
+            "without \"sigma_s\"",
+        ),
+        render_scene(
+            "distrib with a medium",
+            scene!(
+                "    <integrator type=\"distrib\"/>\n    <medium type=\"homogeneous\" id=\"fog\"/>"
+            ),
+            "scene.xml:4:",
+            "volpath",
+        ),
+        render_scene("missing grid", GRID_SCENE, "scene.xml:3:", "not found"),
+        with_grid(
+            "truncated grid",
+            concat!(
+                vol_header!("\x02", "\x02", "\x02", "\x01"),
+                "\x00\x00\x00\x3f"
+            ),
+            "truncated",
+        ),
+        with_grid(
+            "grid longer than its header says",
+            concat!(
+                vol_header!("\x01", "\x01", "\x01", "\x01"),
+                "\x00\x00\x00\x00\x00\x00\x00\x00"
+            ),
+            "bytes more",
+        ),
+        with_grid("not a grid", "this is not a volume", "VOL"),
+        with_grid(
+            "grid header cut short",
+            "VOL\x03\x01\x00\x00\x00\x02\x00",
+            "header",
+        ),
+        with_grid(
+            "three-channel grid",
+            concat!(
+                vol_header!("\x01", "\x01", "\x01", "\x03"),
+                "\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00"
+            ),
+            "single-channel",
+        ),
+        with_grid(
+            "negative value in a grid",
+            concat!(
+                vol_header!("\x01", "\x01", "\x01", "\x01"),
+                "\x00\x00\u{bf}"
+            ),
+            "at least 0",
+        ),
+    ]
 }
 
 fn run_case(case: &Case, dir: &Path) -> (i32, String) {
@@ -678,6 +909,58 @@ fn every_malformed_input_gets_one_clear_error() {
     );
 }
 
+/// Bad instancing: emitters, moving shapes and nested groups or instances inside a shapegroup,
+/// an instance of something that is not a group, and an instance naming no group.
+fn instancing_cases() -> Vec<Case> {
+    vec![
+        render_scene(
+            "emitter in a shapegroup",
+            scene!(
+                "    <shape type=\"shapegroup\" id=\"g\">\n        <shape type=\"sphere\"><emitter type=\"area\"/></shape>\n    </shape>"
+            ),
+            "scene.xml:4:30",
+            "cannot emit light",
+        ),
+        render_scene(
+            "shapegroup in a shapegroup",
+            scene!(
+                "    <shape type=\"shapegroup\" id=\"g\">\n        <shape type=\"shapegroup\"><shape type=\"sphere\"/></shape>\n    </shape>"
+            ),
+            "scene.xml:4:9",
+            "instancing does not nest",
+        ),
+        render_scene(
+            "instance in a shapegroup",
+            scene!(
+                "    <shape type=\"shapegroup\" id=\"g\"><shape type=\"sphere\"/></shape>\n    <shape type=\"shapegroup\" id=\"h\">\n        <shape type=\"instance\"><ref id=\"g\"/></shape>\n    </shape>"
+            ),
+            "scene.xml:5:9",
+            "instancing does not nest",
+        ),
+        render_scene(
+            "moving shape in a shapegroup",
+            scene!(
+                "    <shape type=\"shapegroup\" id=\"g\">\n        <shape type=\"sphere\"><animation name=\"to_world\"><transform time=\"0\"/><transform time=\"1\"><translate x=\"1\"/></transform></animation></shape>\n    </shape>"
+            ),
+            "scene.xml:4:9",
+            "cannot move",
+        ),
+        render_scene(
+            "instance of a sphere",
+            scene!(
+                "    <shape type=\"sphere\" id=\"ball\"/>\n    <shape type=\"instance\"><ref id=\"ball\"/></shape>"
+            ),
+            "scene.xml:4:28",
+            "places a shapegroup",
+        ),
+        render_scene(
+            "instance of nothing",
+            scene!("    <shape type=\"instance\"/>"),
+            "scene.xml:3:5",
+            "shapegroup",
+        ),
+    ]
+}
 /// A malformed Mitsuba serialized mesh: the scene loads `mesh.serialized` with `properties`
 /// inside its `<shape>`, and the error must name the shape (scene.xml line 3) and say `says`.
 struct SerializedCase {

@@ -23,10 +23,10 @@ fn field(json: &str, key: &str) -> f64 {
     json[start..end].parse().unwrap()
 }
 
-/// The suite needs nothing outside the repository: all four scenes are listed, with files that
+/// The suite needs nothing outside the repository: all five scenes are listed, with files that
 /// exist.
 #[test]
-fn bench_lists_its_four_scenes_from_the_repository() {
+fn bench_lists_its_five_scenes_from_the_repository() {
     let cache = std::env::temp_dir().join(format!("prism-bench-list-{}", std::process::id()));
     let output = Command::new(env!("CARGO_BIN_EXE_prism"))
         .args(["bench", "--list", "--cache"])
@@ -46,6 +46,7 @@ fn bench_lists_its_four_scenes_from_the_repository() {
             "cornell-box",
             "veach-mis",
             "veach-bidir",
+            "smoke-box",
             "million-triangles"
         ],
         "{stdout}"

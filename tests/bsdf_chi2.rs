@@ -16,7 +16,7 @@ use common::chi2::assert_passes;
 use glam::Vec3;
 
 /// Chi-square tests in this file (for Šidák's correction): one per (BSDF, direction).
-const TESTS: usize = 43;
+const TESTS: usize = 56;
 
 /// Incident directions above the surface: normal, moderate, oblique and grazing.
 fn upper_directions() -> [Vec3; 4] {
@@ -147,6 +147,42 @@ fn phong() {
         <rgb name="specular_reflectance" value="0.4"/><rgb name="diffuse_reflectance" value="0.5"/></bsdf>"#;
     check("phong", xml, &upper_directions()[1..4], 13);
     assert_reciprocal("phong", &bsdf_from_xml(xml), 13);
+}
+
+#[test]
+fn pplastic() {
+    let ggx = r#"<bsdf type="pplastic"><string name="distribution" value="ggx"/>
+        <float name="alpha" value="0.3"/><rgb name="diffuse_reflectance" value="0.7, 0.3, 0.1"/></bsdf>"#;
+    check("pplastic ggx", ggx, &upper_directions(), 19);
+    assert_reciprocal("pplastic ggx", &bsdf_from_xml(ggx), 19);
+    let anisotropic = r#"<bsdf type="pplastic"><float name="alpha_u" value="0.1"/>
+        <float name="alpha_v" value="0.4"/><rgb name="diffuse_reflectance" value="1"/>
+        <rgb name="specular_reflectance" value="0.8"/></bsdf>"#;
+    check(
+        "pplastic beckmann anisotropic",
+        anisotropic,
+        &upper_directions()[1..3],
+        20,
+    );
+    assert_reciprocal("pplastic anisotropic", &bsdf_from_xml(anisotropic), 20);
+}
+
+#[test]
+fn ward() {
+    let balanced = r#"<bsdf type="ward"><float name="alpha_u" value="0.1"/>
+        <float name="alpha_v" value="0.3"/><rgb name="specular_reflectance" value="0.6"/>
+        <rgb name="diffuse_reflectance" value="0.3"/></bsdf>"#;
+    check("ward balanced", balanced, &upper_directions()[1..4], 21);
+    assert_reciprocal("ward balanced", &bsdf_from_xml(balanced), 21);
+    for (i, variant) in ["ward", "ward-duer"].into_iter().enumerate() {
+        let xml = format!(
+            r#"<bsdf type="ward"><string name="variant" value="{variant}"/>
+            <float name="alpha" value="0.25"/><rgb name="specular_reflectance" value="0.5"/></bsdf>"#
+        );
+        let seed = 22 + i as u64;
+        check(variant, &xml, &upper_directions()[..2], seed);
+        assert_reciprocal(variant, &bsdf_from_xml(&xml), seed);
+    }
 }
 
 #[test]

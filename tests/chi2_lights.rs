@@ -100,10 +100,7 @@ fn mesh_light_sampling_is_uniform_in_area() {
     )
     .unwrap();
     let shapes = vec![Shape::Mesh(transform_mesh(rectangle(), &to_world, true, true)).into()];
-    let light = Light::Area(AreaLight {
-        shape: 0,
-        radiance: Spectrum::Constant(1.0),
-    });
+    let light = Light::Area(AreaLight::uniform(0, Spectrum::Constant(1.0)));
     let reference = Vec3::new(-0.7, 0.4, 0.5);
     let lambda = SampledWavelengths::single(550.0);
     let outcome = chi2_rectangle(

@@ -9,13 +9,13 @@ use common::chi2::{assert_passes, chi2_discrete, chi2_interval, chi2_rectangle, 
 use glam::{Mat3, Vec2, Vec3};
 use prism_core::geometry::Sphere;
 use prism_core::geometry::TriangleMesh;
-use prism_core::light::LightSampler;
+use prism_core::light::{LightSampler, LightSelection};
 use prism_core::sampling::rng::Pcg32;
 use prism_core::sampling::warp;
 use prism_core::spectrum::WavelengthSampling;
 
 /// Number of chi-square tests in this file, for Šidák's correction.
-const TESTS: usize = 9;
+const TESTS: usize = 13;
 const SAMPLES: usize = 1_000_000;
 
 fn u2(rng: &mut Pcg32) -> Vec2 {
@@ -102,6 +102,71 @@ fn wavelength_sampling_follows_the_sum_of_the_colour_matching_functions() {
 }
 
 #[test]
+fn balanced_wavelength_sampling_follows_its_density() {
+    let sampling = WavelengthSampling::Balanced;
+    let outcome = chi2_interval(
+        SAMPLES,
+        360.0,
+        830.0,
+        235,
+        6,
+        |rng| Some(f64::from(sampling.sample(rng.next_f32()))),
+        |l| f64::from(sampling.pdf(l as f32)),
+    )
+    .unwrap();
+    assert_passes("wavelengths balanced", &outcome, TESTS);
+    // The tabulated density is D65 · sqrt(3 ȳ²/I_Y² + Σ_c c̄²/I_c²) normalised, the c̄ linear
+    // sRGB: compare ratios between cells with the formula (the I_c cancel only in part, so
+    // compute them here too).
+    use prism_core::spectrum::cie::{XYZ_TO_LINEAR_SRGB, cie_xyz, d65_normalized, mul3};
+    let responses = |l: f32| {
+        let xyz = cie_xyz(l);
+        let rgb = mul3(&XYZ_TO_LINEAR_SRGB, xyz);
+        [xyz[1], rgb[0], rgb[1], rgb[2]].map(f64::from)
+    };
+    let mut means = [0.0f64; 4];
+    for i in 0..=4700 {
+        let l = 360.0 + i as f32 * 0.1;
+        let w = if i == 0 || i == 4700 { 0.05 } else { 0.1 };
+        for (m, r) in means.iter_mut().zip(responses(l)) {
+            *m += w * f64::from(d65_normalized(l)) * r;
+        }
+    }
+    let shape = |l: f32| {
+        let r = responses(l);
+        let sum = 3.0 * (r[0] / means[0]).powi(2)
+            + (1..4).map(|c| (r[c] / means[c]).powi(2)).sum::<f64>();
+        f64::from(d65_normalized(l)) * sum.sqrt()
+    };
+    let cell = |l: f32| 0.5 * (shape(l - 0.5) + shape(l + 0.5));
+    let normalisation = f64::from(sampling.pdf(555.5)) / cell(555.5);
+    for l in [400.5f32, 450.5, 600.5, 700.5] {
+        let expected = cell(l) * normalisation;
+        let got = f64::from(sampling.pdf(l));
+        assert!(
+            (got - expected).abs() <= 1e-3 * expected,
+            "{l}: {got} vs {expected}"
+        );
+    }
+}
+
+#[test]
+fn uniform_wavelength_sampling_follows_its_density() {
+    let sampling = WavelengthSampling::Uniform;
+    let outcome = chi2_interval(
+        SAMPLES,
+        360.0,
+        830.0,
+        235,
+        7,
+        |rng| Some(f64::from(sampling.sample(rng.next_f32()))),
+        |l| f64::from(sampling.pdf(l as f32)),
+    )
+    .unwrap();
+    assert_passes("wavelengths uniform", &outcome, TESTS);
+}
+
+#[test]
 fn visible_wavelength_sampling_follows_its_density() {
     let sampling = WavelengthSampling::Visible;
     let outcome = chi2_interval(
@@ -134,6 +199,40 @@ fn light_selection_is_proportional_to_power() {
     })
     .unwrap();
     assert_passes("light selection", &outcome, TESTS);
+}
+
+/// Mitsuba's `sampling_weight`s: uniform selection picks light i with P(i) = wᵢ/Σw, selection by
+/// power with P(i) = Φᵢwᵢ/ΣΦw; a light of weight 0 is never picked.
+#[test]
+fn light_selection_follows_the_sampling_weights() {
+    let powers = [1.0f32, 5.0, 0.5, 3.0, 2.0, 12.0];
+    let weights = [2.0f32, 0.25, 1.0, 0.0, 3.0, 1.0];
+    for selection in [LightSelection::Uniform, LightSelection::Power] {
+        let sampler = LightSampler::with_selection(&powers, &weights, selection);
+        let shares: Vec<f64> = powers
+            .iter()
+            .zip(&weights)
+            .map(|(&p, &w)| match selection {
+                LightSelection::Uniform => f64::from(w),
+                LightSelection::Power => f64::from(p * w),
+            })
+            .collect();
+        let total: f64 = shares.iter().sum();
+        let probabilities: Vec<f64> = shares.iter().map(|s| s / total).collect();
+        let outcome = chi2_discrete(SAMPLES, &probabilities, 8, |rng| {
+            let (index, pmf) = sampler.sample(rng.next_f32()).unwrap();
+            assert_ne!(index, 3, "a light of weight 0 is never chosen");
+            assert_eq!(pmf, sampler.pmf(index));
+            assert!((f64::from(pmf) - probabilities[index]).abs() < 1e-6);
+            index
+        })
+        .unwrap();
+        assert_passes(
+            &format!("light selection {selection:?} with weights"),
+            &outcome,
+            TESTS,
+        );
+    }
 }
 
 /// A unit square split into four triangles of unequal area around an off-centre point.

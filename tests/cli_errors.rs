@@ -517,3 +517,27 @@ fn bench_refuses_impossible_settings() {
         );
     }
 }
+
+/// A reader that stops early (`prism compare a.exr b.exr | head -1`) ends `prism` quietly, as
+/// it ends other Unix tools, instead of a panic on the closed pipe.
+#[cfg(unix)]
+#[test]
+fn closed_output_pipe_is_not_a_panic() {
+    use std::process::Stdio;
+    let dir = folder("closed-pipe");
+    std::fs::write(dir.join("scene.xml"), scene("", "")).unwrap();
+    let (status, stderr) = render(&dir, &[]);
+    assert_eq!(status, 0, "{stderr}");
+    let image = dir.join("out.exr");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_prism"))
+        .arg("compare")
+        .args([&image, &image])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let output = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(!stderr.contains("panicked"), "{stderr}");
+}

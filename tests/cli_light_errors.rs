@@ -1,8 +1,8 @@
 //! Bad light input gives one clear message naming the file, line and column, and exit status 2
 //! — never a panic: missing, unreadable, too small or negative environment maps, negative or
 //! non-finite emission, bad black-body temperatures, impossible spot and directional
-//! parameters, area lights on shapes without area, and emitters nested where Mitsuba does not
-//! allow them.
+//! parameters, area lights on shapes without area or attached to two shapes, and emitters nested
+//! where Mitsuba does not allow them.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -245,8 +245,15 @@ fn emitters_nested_where_mitsuba_does_not_allow_them() {
         "    <shape type=\"sphere\">\n        <emitter type=\"point\"/>\n    </shape>",
     );
     assert_error(&dir, "scene.xml:9:9", &["cannot be attached to a shape"]);
-    let dir = scene("area-at-top", "    <emitter type=\"area\"/>");
-    assert_error(&dir, "scene.xml:8:5", &["must be nested in a shape"]);
+    let dir = scene(
+        "area-on-two-shapes",
+        "    <emitter type=\"area\" id=\"light\"/>\n    <shape type=\"sphere\"><ref id=\"light\"/></shape>\n    <shape type=\"disk\"><ref id=\"light\"/></shape>",
+    );
+    assert_error(
+        &dir,
+        "scene.xml:10:24",
+        &["already attached", "scene.xml:9:26"],
+    );
     let dir = scene(
         "emitter-in-bsdf",
         "    <shape type=\"sphere\">\n        <bsdf type=\"diffuse\">\n            <emitter type=\"area\"/>\n        </bsdf>\n    </shape>",

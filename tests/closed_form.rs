@@ -15,7 +15,7 @@ use prism_core::geometry::Sphere;
 use prism_core::integrator::{DistributionIntegrator, Integrator, PathIntegrator};
 use prism_core::light::{Light, PointLight};
 use prism_core::math::Transform;
-use prism_core::spectrum::Spectrum;
+use prism_core::spectrum::{Spectrum, WavelengthSampling};
 use prism_mitsuba::factory::shapes::{cube, rectangle, transform_mesh};
 
 /// The inside of a unit sphere: normals point inwards, so the inner face is the front.
@@ -44,6 +44,16 @@ fn furnace(
     spp: u32,
     seed: u64,
 ) -> prism_core::film::Film {
+    render_film(&furnace_scene(shape, rho, le, integrator), spp, seed, None)
+}
+
+/// The scene of [`furnace`].
+fn furnace_scene(
+    shape: Shape,
+    rho: f32,
+    le: f32,
+    integrator: impl Into<Integrator>,
+) -> prism_core::scene::Scene {
     let size = UVec2::new(8, 8);
     let camera = camera(
         DVec3::new(0.1, 0.2, -0.3),
@@ -52,7 +62,7 @@ fn furnace(
         70.0,
         size,
     );
-    let scene = build(
+    build(
         vec![Object {
             shape: shape.into(),
             reflectance: rho,
@@ -62,8 +72,7 @@ fn furnace(
         camera,
         size,
         integrator,
-    );
-    render_film(&scene, spp, seed, None)
+    )
 }
 
 /// Both integrators with their defaults, and the samples per pixel each needs.
@@ -81,6 +90,28 @@ fn closed_sphere_furnace_gives_le_over_one_minus_rho() {
         let film = furnace(inner_sphere(), 0.5, 1.0, integrator, spp, 1);
         assert_mean_luminance(&name, &film, 2.0);
     }
+}
+
+/// The furnace's answer holds for every wavelength density a film may choose.
+#[test]
+fn closed_sphere_furnace_with_every_wavelength_density() {
+    for (density, seed) in WavelengthSampling::ALL.into_iter().zip(20..) {
+        let mut scene = furnace_scene(inner_sphere(), 0.5, 1.0, PathIntegrator::default());
+        scene.film.wavelength_sampling = density;
+        let film = render_film(&scene, 1024, seed, None);
+        assert_mean_luminance(&format!("sphere furnace, {density:?}"), &film, 2.0);
+    }
+}
+
+/// An emitter of `sampling_weight` 0 is never chosen for direct light; the path tracer then finds
+/// it by scattering alone, whose multiple importance sampling weight becomes 1, and the
+/// answer stays Lₑ/(1 − ρ).
+#[test]
+fn an_emitter_of_sampling_weight_zero_is_found_by_scattering() {
+    let mut scene = furnace_scene(inner_sphere(), 0.5, 1.0, PathIntegrator::default());
+    scene.world.light_sampling_weights = vec![0.0];
+    let film = render_film(&scene, 2048, 3, None);
+    assert_mean_luminance("sphere furnace, sampling weight 0", &film, 2.0);
 }
 
 /// The path tracer only: in a box lit by its own walls, a point near an edge sees emitting points

@@ -166,7 +166,9 @@ fn facing_disk(radius: f64, depth: f64) -> Shape {
 }
 
 fn thin_lens(size: UVec2, fov: f64, lens_radius: f32, focus_distance: f32) -> Camera {
-    let Camera::Perspective(pinhole) = camera(DVec3::ZERO, DVec3::Z, DVec3::Y, fov, size);
+    let Camera::Perspective(pinhole) = camera(DVec3::ZERO, DVec3::Z, DVec3::Y, fov, size) else {
+        unreachable!("common::scenes::camera is perspective")
+    };
     Camera::Perspective(PerspectiveCamera {
         lens_radius,
         focus_distance,
@@ -213,7 +215,9 @@ fn defocus_blur_has_the_thin_lens_circle_of_confusion() {
         "mean r² {moment} ± {se} px², thin lens predicts {expected} (circle of confusion radius {coc} px)"
     );
     // In focus the same disk is sharp: only its own image remains.
-    let Camera::Perspective(lens) = &mut scene.camera;
+    let Camera::Perspective(lens) = &mut scene.camera else {
+        unreachable!("the scene's camera is a thin lens")
+    };
     lens.focus_distance = depth as f32;
     let film = render_film(&scene, 256, 2, None);
     let (moment, se, _) = second_moment(&film, centre, None);
@@ -388,7 +392,9 @@ fn a_moving_camera_smears_a_still_emitter() {
         )
         .unwrap()
     };
-    let Camera::Perspective(still) = camera(DVec3::ZERO, DVec3::Z, DVec3::Y, fov, size);
+    let Camera::Perspective(still) = camera(DVec3::ZERO, DVec3::Z, DVec3::Y, fov, size) else {
+        unreachable!("common::scenes::camera is perspective")
+    };
     let moving = Camera::Perspective(PerspectiveCamera {
         to_world: AnimatedTransform::new(&[(0.0, key(-travel / 2.0)), (1.0, key(travel / 2.0))])
             .unwrap(),

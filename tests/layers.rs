@@ -417,6 +417,7 @@ fn modules_use_only_the_layers_below_their_own() {
         ("prism-core", root().join("crates/prism-core/src")),
         ("prism-mitsuba", root().join("crates/prism-mitsuba/src")),
         ("prism", root().join("src")),
+        ("prism-python", root().join("crates/prism-python/src")),
     ];
     let mut problems = Vec::new();
     for (name, src) in crates {

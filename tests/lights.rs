@@ -7,6 +7,7 @@
 mod common;
 
 use std::f64::consts::PI;
+use std::sync::Arc;
 
 use common::chi2::regularized_gamma_q;
 use common::scenes::{
@@ -27,6 +28,7 @@ use prism_core::math::{Ray, Transform};
 use prism_core::sampling::rng::Pcg32;
 use prism_core::sampling::warp::sample_uniform_sphere;
 use prism_core::spectrum::{SampledWavelengths, Spectrum};
+use prism_core::texture::{BitmapTexture, FilterType, Texture, TextureUse, UvTransform, WrapMode};
 use prism_mitsuba::factory::shapes::{rectangle, transform_mesh};
 
 /// The plane z = 0, 100 × 100, diffuse `rho`, facing +z.
@@ -216,6 +218,80 @@ fn rectangle_light_by_lamberts_formula() {
     });
 }
 
+/// The rectangle light of [`rectangle_light_by_lamberts_formula`] with a 2 × 2 texture of
+/// nearest texels as its radiance: each texel covers a quarter of the rectangle, a polygon of
+/// constant radiance, so the irradiance is the sum of Lambert's formula over the quarters. The
+/// light is sampled by its texture through the uv map and found by BSDF samples, both weighted
+/// by the mixture's density (MIS).
+#[test]
+fn textured_rectangle_light_by_lamberts_formula() {
+    let rho = 0.5f64;
+    // Row-major, row 0 at v < ½; one black texel.
+    let texels = [6.0f32, 1.0, 0.0, 3.0];
+    let to_world = DMat4::from_translation(DVec3::new(0.3, 0.0, 1.0))
+        * DMat4::from_rotation_x(PI)
+        * DMat4::from_scale(DVec3::new(0.5, 0.3, 1.0));
+    let light = transform_mesh(rectangle(), &Transform::new(to_world).unwrap(), false, true);
+    // Texel (i, j) covers u ∈ [i/2, (i+1)/2], v ∈ [j/2, (j+1)/2]: local x ∈ [i − 1, i], y alike.
+    let quarters: Vec<(f64, Vec<DVec3>)> = (0..4)
+        .map(|t| {
+            let (i, j) = ((t % 2) as f64, (t / 2) as f64);
+            let corners = [(i - 1.0, j - 1.0), (i, j - 1.0), (i, j), (i - 1.0, j)];
+            let vertices = corners
+                .iter()
+                .map(|&(x, y)| to_world.transform_point3(DVec3::new(x, y, 0.0)))
+                .collect();
+            (f64::from(texels[t]), vertices)
+        })
+        .collect();
+    let size = UVec2::new(12, 10);
+    let camera = camera(
+        DVec3::new(0.0, -0.3, 0.8),
+        DVec3::ZERO,
+        DVec3::Y,
+        80.0,
+        size,
+    );
+    let mut scene = build(
+        vec![
+            floor(rho as f32),
+            Object {
+                shape: Shape::Mesh(light).into(),
+                reflectance: 0.0,
+                emission: Some(1.0),
+            },
+        ],
+        vec![],
+        camera.clone(),
+        size,
+        PathIntegrator::default(),
+    );
+    let bitmap = Bitmap {
+        width: 2,
+        height: 2,
+        channels: 1,
+        data: texels.to_vec(),
+        encoding: Encoding::Linear,
+    };
+    let texture = Texture::Bitmap(Arc::new(BitmapTexture::new(
+        &bitmap,
+        TextureUse::Emission,
+        FilterType::Nearest,
+        WrapMode::Clamp,
+        UvTransform::IDENTITY,
+    )));
+    scene.world.lights[0] = Light::Area(AreaLight::new(1, texture));
+    let film = render_film(&scene, 512, 34, None);
+    assert_pixels("textured rectangle light", &film, &camera, |ray| {
+        let x = on_floor(ray);
+        rho / PI
+            * quarters
+                .iter()
+                .map(|(radiance, vertices)| lambert_polygon(x, DVec3::Z, vertices, *radiance))
+                .sum::<f64>()
+    });
+}
+
 /// A diffuse sphere that fills the view, in a constant environment of radiance L: every point
 /// sees the whole environment above its horizon, so its radiance is ρL (a convex object
 /// reflects no light onto itself).
@@ -343,8 +419,9 @@ fn diffuse_plane_under_an_environment_map() {
 }
 
 /// Light selection must not change the answer (DESIGN.md §7): a point light and a sphere light
-/// over a plane, rendered with selection by power and uniformly, against the sum of their
-/// closed forms.
+/// over a plane, rendered with selection by power and uniformly, with equal and unequal
+/// `sampling_weight`s, against the sum of their closed forms; a point light of weight 0 is never
+/// sampled and so adds nothing (as in Mitsuba).
 #[test]
 fn light_selection_does_not_change_the_answer() {
     let (rho, intensity, radiance, radius) = (0.5f64, 3.0f64, 20.0f64, 0.2f64);
@@ -352,11 +429,14 @@ fn light_selection_does_not_change_the_answer() {
     let center = DVec3::new(0.5, 0.0, 1.5);
     let size = UVec2::new(10, 8);
     let camera = camera(DVec3::new(0.0, 0.0, 0.9), DVec3::ZERO, DVec3::Y, 80.0, size);
-    for (selection, seed) in [
-        (LightSelection::Power, 36u64),
-        (LightSelection::Uniform, 37),
+    for (selection, weights, spp, seed) in [
+        (LightSelection::Power, [1.0, 1.0], 2048, 36u64),
+        (LightSelection::Uniform, [1.0, 1.0], 2048, 37),
+        (LightSelection::Power, [0.5, 2.0], 8192, 38),
+        (LightSelection::Uniform, [0.5, 2.0], 8192, 39),
+        (LightSelection::Uniform, [1.0, 0.0], 2048, 40),
     ] {
-        let scene = build(
+        let mut scene = build(
             vec![
                 floor(rho as f32),
                 Object {
@@ -376,15 +456,21 @@ fn light_selection_does_not_change_the_answer() {
                 ..PathIntegrator::default()
             },
         );
-        let film = render_film(&scene, 2048, seed, None);
+        assert!(matches!(scene.world.lights[0], Light::Area(_)));
+        scene.world.light_sampling_weights = weights.to_vec();
+        let film = render_film(&scene, spp, seed, None);
         assert_pixels(
-            &format!("two lights, {selection:?}"),
+            &format!("two lights, {selection:?}, sampling weights {weights:?}"),
             &film,
             &camera,
             |ray| {
                 let x = on_floor(ray);
                 let (dp, dc) = ((point - x).length(), (center - x).length());
-                let e_point = intensity * point.z / dp.powi(3);
+                let e_point = if weights[1] > 0.0 {
+                    intensity * point.z / dp.powi(3)
+                } else {
+                    0.0
+                };
                 let e_sphere = PI * radiance * (radius / dc).powi(2) * (center.z / dc);
                 rho * (e_point + e_sphere) / PI
             },
@@ -486,10 +572,7 @@ fn flux_of_point_spot_and_area_lights() {
     let spot_flux = 2.0 * PI * 3.0 * (1.0 - (cutoff.sin() - beam.sin()) / (cutoff - beam));
     assert_flux("spot", &spot, &[], around, true, spot_flux, 42);
 
-    let area = Light::Area(AreaLight {
-        shape: 0,
-        radiance: Spectrum::Constant(1.5),
-    });
+    let area = Light::Area(AreaLight::uniform(0, Spectrum::Constant(1.5)));
     let ball = [sphere(Vec3::new(0.0, 0.3, 0.2), 0.7)];
     assert_flux(
         "sphere light",

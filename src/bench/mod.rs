@@ -34,7 +34,8 @@ pub struct BenchScene {
 
 /// The fixed suite, of the scenes bundled in the repository's `scenes/`: the Cornell box
 /// (256 × 256), Veach's MIS and bidirectional scenes (at 320 × 180 and 256 × 256, a twentieth
-/// and a sixteenth of their pixels, so that references take minutes), and the generated
+/// and a sixteenth of their pixels, so that references take minutes), a heterogeneous medium
+/// (`scenes/media/smoke-box.xml`, 128 × 128, rendered by `volpath`), and the generated
 /// million-triangle scene (256 × 256), written into `cache` on first use. Only the scenes
 /// `wanted` accepts are set up.
 pub fn suite(
@@ -49,15 +50,16 @@ pub fn suite(
         ]
     };
     let mut scenes = Vec::new();
-    for (name, x, y) in [
-        ("cornell-box", 256, 256),
-        ("veach-mis", 320, 180),
-        ("veach-bidir", 256, 256),
+    for (name, file, x, y) in [
+        ("cornell-box", "cornell-box/scene.xml", 256, 256),
+        ("veach-mis", "veach-mis/scene.xml", 320, 180),
+        ("veach-bidir", "veach-bidir/scene.xml", 256, 256),
+        ("smoke-box", "media/smoke-box.xml", 128, 128),
     ] {
         if wanted(name) {
             scenes.push(BenchScene {
                 name,
-                path: repository.join("scenes").join(name).join("scene.xml"),
+                path: repository.join("scenes").join(file),
                 defines: resolution(x, y),
             });
         }

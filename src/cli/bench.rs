@@ -69,8 +69,11 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         args.only.is_empty() || args.only.iter().any(|o| name.contains(o.as_str()))
     })?;
     if scenes.is_empty() {
-        return Err(Error::usage("--only matches none of the suite's scenes")
-            .with_help("the scenes are cornell-box, veach-mis, veach-bidir, million-triangles"));
+        return Err(
+            Error::usage("--only matches none of the suite's scenes").with_help(
+                "the scenes are cornell-box, veach-mis, veach-bidir, smoke-box, million-triangles",
+            ),
+        );
     }
     if args.list {
         for scene in &scenes {

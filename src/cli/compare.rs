@@ -9,8 +9,8 @@ use std::path::{Path, PathBuf};
 use clap::Args;
 
 use prism_core::error::{Error, ErrorKind, Result};
-use prism_core::image::compare::{compare, difference_image};
-use prism_core::image::{ChannelImage, read_exr, write_png_srgb};
+use prism_core::image::compare::{compare, write_difference_png};
+use prism_core::image::{ChannelImage, read_exr};
 
 #[derive(Args, Debug)]
 pub struct CompareArgs {
@@ -54,51 +54,9 @@ pub fn run(args: &CompareArgs) -> Result<()> {
         args.test.display(),
         args.reference.display()
     );
-    println!(
-        "{:>8} {:>12} {:>12} {:>9} {:>12} {:>12} {:>12}",
-        "channel", "mean test", "mean ref", "ratio", "MSE", "relMSE", "max |diff|"
-    );
-    for d in &comparison.channels {
-        println!(
-            "{:>8} {:>12.6} {:>12.6} {:>9.5} {:>12.4e} {:>12.4e} {:>12.4e}",
-            d.name,
-            d.mean_test,
-            d.mean_reference,
-            d.mean_test / d.mean_reference,
-            d.mse,
-            d.rel_mse,
-            d.max_abs
-        );
-    }
-    println!(
-        "{:>8} {:>12} {:>12} {:>9} {:>12.4e} {:>12.4e}",
-        "all",
-        "",
-        "",
-        "",
-        comparison.mse(),
-        comparison.rel_mse()
-    );
-    if let Some(z) = &comparison.z_test {
-        let verdict = if z.consistent_with_noise() {
-            "consistent with noise"
-        } else {
-            "NOT consistent with noise"
-        };
-        println!(
-            "z-test of Y over {} pixels: chi² {:.1} (p = {:.3}), max |z| {:.2} (Bonferroni p = {:.3}), {:.2} % beyond |z| = 3 (0.27 % expected): {verdict}",
-            z.pixels,
-            z.chi2,
-            z.p_value,
-            z.max_z,
-            z.max_z_p_value,
-            100.0 * z.beyond_three
-        );
-    }
+    println!("{comparison}");
     if let Some(path) = &args.diff {
-        let names: Vec<String> = comparison.channels.iter().map(|d| d.name.clone()).collect();
-        let rgb = difference_image(&test, &reference, &names);
-        write_png_srgb(path, test.width, test.height, &rgb)?;
+        write_difference_png(&test, &reference, &comparison, path)?;
         println!("difference image: {}", path.display());
     }
     Ok(())

@@ -16,7 +16,9 @@ use plotters::prelude::*;
 use prism_core::error::{Error, Result};
 use prism_core::image::compare::rel_mse_rgb;
 use prism_core::image::read_exr;
-use prism_core::integrator::{DistributionIntegrator, Integrator, PathIntegrator};
+use prism_core::integrator::{
+    DistributionIntegrator, Integrator, PathIntegrator, Tracking, VolPathIntegrator,
+};
 use prism_core::render::{RenderOptions, render};
 use prism_core::sampling::sampler::SamplerKind;
 use prism_core::scene::Scene;
@@ -80,6 +82,7 @@ fn integrator_named(name: &str, scene: &Scene) -> Result<Integrator> {
     let max_depth = match &scene.integrator {
         Integrator::Path(p) => p.max_depth,
         Integrator::Distribution(d) => d.max_depth,
+        Integrator::VolPath(v) => v.max_depth,
     };
     match name {
         "path" => Ok(match &scene.integrator {
@@ -98,8 +101,29 @@ fn integrator_named(name: &str, scene: &Scene) -> Result<Integrator> {
             }
             .into(),
         }),
+        "volpath" => Ok(match &scene.integrator {
+            Integrator::VolPath(v) if v.tracking == Tracking::Spectral => {
+                Integrator::VolPath(v.clone())
+            }
+            _ => VolPathIntegrator {
+                max_depth,
+                ..VolPathIntegrator::default()
+            }
+            .into(),
+        }),
+        "volpathmis" => Ok(match &scene.integrator {
+            Integrator::VolPath(v) if v.tracking != Tracking::Spectral => {
+                Integrator::VolPath(v.clone())
+            }
+            _ => VolPathIntegrator {
+                max_depth,
+                tracking: Tracking::HeroMis { spectral_mis: true },
+                ..VolPathIntegrator::default()
+            }
+            .into(),
+        }),
         other => Err(Error::usage(format!("unknown integrator \"{other}\""))
-            .with_help("use path or distrib")),
+            .with_help("use path, distrib, volpath or volpathmis")),
     }
 }
 
@@ -109,8 +133,16 @@ fn sampler_named(name: &str) -> Result<SamplerKind> {
         "stratified" => Ok(SamplerKind::Stratified { jitter: true }),
         "multijitter" => Ok(SamplerKind::MultiJitter { jitter: true }),
         "nrooks" => Ok(SamplerKind::NRooks),
-        other => Err(Error::usage(format!("unknown sampler \"{other}\""))
-            .with_help("use independent, stratified, multijitter or nrooks")),
+        "ldsampler" => Ok(SamplerKind::LowDiscrepancy),
+        "orthogonal" => Ok(SamplerKind::Orthogonal {
+            strength: 2,
+            jitter: true,
+        }),
+        other => Err(
+            Error::usage(format!("unknown sampler \"{other}\"")).with_help(
+                "use independent, stratified, multijitter, nrooks, ldsampler or orthogonal",
+            ),
+        ),
     }
 }
 
@@ -118,6 +150,8 @@ fn integrator_label(integrator: &Integrator) -> &'static str {
     match integrator {
         Integrator::Path(_) => "path",
         Integrator::Distribution(_) => "distrib",
+        Integrator::VolPath(v) if v.tracking == Tracking::Spectral => "volpath",
+        Integrator::VolPath(_) => "volpathmis",
     }
 }
 
@@ -127,6 +161,8 @@ fn sampler_label(kind: SamplerKind) -> &'static str {
         SamplerKind::Stratified { .. } => "stratified",
         SamplerKind::MultiJitter { .. } => "multijitter",
         SamplerKind::NRooks => "nrooks",
+        SamplerKind::LowDiscrepancy => "ldsampler",
+        SamplerKind::Orthogonal { .. } => "orthogonal",
     }
 }
 
@@ -141,7 +177,11 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
         e.kind = prism_core::error::ErrorKind::Input;
         e
     })?;
-    let mut scene = load_scene(&args.scene, &args.defines)?.scene;
+    let loaded = load_scene(&args.scene, &args.defines)?;
+    for warning in &loaded.warnings {
+        eprintln!("{warning}");
+    }
+    let mut scene = loaded.scene;
     let size = scene.film.crop.size;
     if (reference.width, reference.height) != (size.x as usize, size.y as usize) {
         return Err(Error::usage(format!(

@@ -20,16 +20,18 @@ use glam::UVec2;
 use crate::accel::Accel;
 use prism_core::error::{Error, Result};
 use prism_core::film::stats::rejected_report;
-use prism_core::film::write_images;
+use prism_core::film::write_images_with;
 use prism_core::film::{CropWindow, PixelSums};
 use prism_core::integrator::RayCount;
 use prism_core::render::state::{RenderIdentity, RenderState};
 use prism_core::render::{
-    Checkpoints, RenderOptions, SampleEstimator, Snapshot, StopReason, StopRule,
-    render_with_checkpoints,
+    Checkpoints, Progress, RenderOptions, SampleEstimator, Snapshot, StopReason, StopRule,
+    StopRuleNames, render_with_checkpoints,
 };
 use prism_core::sampling::sampler::{Sampler, SamplerKind};
 use prism_core::scene::Scene;
+use prism_core::spectrum::WavelengthSampling;
+use prism_mitsuba::fingerprint::Fnv64;
 use prism_mitsuba::load_scene;
 
 #[derive(Args, Debug)]
@@ -82,6 +84,10 @@ pub struct RenderArgs {
     /// with `--features embree`)
     #[arg(long, value_name = "ACCEL", default_value = "bvh")]
     pub accel: Accel,
+    /// Draw wavelengths from this density instead of the film's `wavelength_sampling`:
+    /// balanced, cie_sum, visible or uniform
+    #[arg(long, value_name = "DENSITY", value_parser = parse_wavelengths)]
+    pub wavelengths: Option<WavelengthSampling>,
 }
 
 pub(crate) fn parse_define(text: &str) -> Result<(String, String), String> {
@@ -106,6 +112,15 @@ fn parse_numbers(
         return Err(format!("expected {what}, got \"{text}\""));
     }
     Ok(numbers)
+}
+
+pub(crate) fn parse_wavelengths(text: &str) -> Result<WavelengthSampling, String> {
+    WavelengthSampling::from_name(text).ok_or_else(|| {
+        format!(
+            "expected one of {}, got \"{text}\"",
+            WavelengthSampling::NAMES.join(", ")
+        )
+    })
 }
 
 fn parse_crop(text: &str) -> Result<[u32; 4], String> {
@@ -170,36 +185,25 @@ fn default_name(scene: &Path) -> String {
     stem.to_string()
 }
 
-/// The stopping rule the arguments ask for, for samples from `first` on. Without --time-limit
-/// or --target-error the render takes exactly the requested samples; with either, --spp (if
-/// given) only caps them.
+/// The stopping rule the arguments ask for (see [`StopRule::requested`]); a --sample-range
+/// ends where the range does.
 fn stop_rule(args: &RenderArgs, scene_spp: u32) -> Result<StopRule> {
-    let time_limit = match args.time_limit {
-        Some(t) if !(t > 0.0 && t.is_finite()) => {
-            return Err(Error::usage(format!(
-                "--time-limit must be a positive number of seconds, not {t}"
-            )));
-        }
-        t => t.map(Duration::from_secs_f64),
+    let names = StopRuleNames {
+        spp: "--spp",
+        time_limit: "--time-limit",
+        target_error: "--target-error",
     };
-    if let Some(e) = args.target_error
-        && !(e > 0.0 && e.is_finite())
-    {
-        return Err(Error::usage(format!(
-            "--target-error must be positive, not {e}"
-        )));
+    let mut rule = StopRule::requested(
+        args.spp,
+        scene_spp,
+        args.time_limit,
+        args.target_error,
+        &names,
+    )?;
+    if let Some(range) = &args.sample_range {
+        rule.sample_end = Some(range.end);
     }
-    let open_ended = time_limit.is_some() || args.target_error.is_some();
-    let sample_end = match &args.sample_range {
-        Some(range) => Some(range.end),
-        None if open_ended => args.spp,
-        None => Some(args.spp.unwrap_or(scene_spp)),
-    };
-    Ok(StopRule {
-        sample_end,
-        time_limit,
-        target_error: args.target_error,
-    })
+    Ok(rule)
 }
 
 /// The sampler's name in render states and messages.
@@ -209,6 +213,8 @@ fn sampler_name(kind: SamplerKind) -> &'static str {
         SamplerKind::Stratified { .. } => "stratified",
         SamplerKind::MultiJitter { .. } => "multijitter",
         SamplerKind::NRooks => "nrooks",
+        SamplerKind::LowDiscrepancy => "ldsampler",
+        SamplerKind::Orthogonal { .. } => "orthogonal",
     }
 }
 
@@ -233,6 +239,17 @@ fn install_signal_handlers(interrupt: Arc<AtomicBool>, signal: Arc<AtomicI32>) -
     Ok(())
 }
 
+/// Draws the scene's wavelengths from `density`. The density joins the scene's fingerprint, so a
+/// render state records it: resuming or merging with another density is refused.
+pub(crate) fn override_wavelengths(scene: &mut Scene, density: WavelengthSampling) {
+    scene.film.wavelength_sampling = density;
+    let mut hash = Fnv64::default();
+    hash.write(&scene.fingerprint.to_le_bytes());
+    hash.write_str("wavelength_sampling");
+    hash.write_str(density.name());
+    scene.fingerprint = hash.finish();
+}
+
 pub fn run(args: &RenderArgs) -> Result<()> {
     if args.spp == Some(0) {
         return Err(Error::usage("--spp must be at least 1"));
@@ -247,6 +264,9 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     }
     args.accel.check_available()?;
     let loaded = load_scene(&args.scene, &args.defines)?;
+    for warning in &loaded.warnings {
+        eprintln!("{warning}");
+    }
     let mut scene = loaded.scene;
     args.accel.apply(&mut scene.world.geometry)?;
     let crop = match (args.crop, args.pixel) {
@@ -267,6 +287,9 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             offset: UVec2::new(x0, y0),
             size: UVec2::new(x1 - x0, y1 - y0),
         };
+    }
+    if let Some(density) = args.wavelengths {
+        override_wavelengths(&mut scene, density);
     }
     let seed = args.seed.unwrap_or(loaded.seed);
     let strata = scene
@@ -293,7 +316,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         let state = RenderState::read(path)?;
         if let Some(reason) = identity.mismatch(&state.identity) {
             return Err(Error::usage(format!("cannot resume from \"{}\": {reason}", path.display()))
-                .with_help("resume with the same scene, -D values, --spp, --seed and --crop as the interrupted render"));
+                .with_help("resume with the same scene, -D values, --spp, --seed, --crop and --wavelengths as the interrupted render"));
         }
         let [range] = state.ranges.as_slice() else {
             return Err(Error::usage(format!(
@@ -334,9 +357,14 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         interrupt: Some(interrupt),
         threads: args.threads,
         seed,
-        progress: std::io::stderr().is_terminal(),
+        progress: if std::io::stderr().is_terminal() {
+            Progress::Terminal
+        } else {
+            Progress::Hidden
+        },
     };
     let (exr_path, png_path) = output_paths(args);
+    let png_path = png_path.with_extension(scene.ldr_output.format.extension());
     let state_path = args
         .checkpoint
         .clone()
@@ -373,7 +401,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             write: &mut write_checkpoint,
         }),
     )?;
-    write_images(&output.film, &exr_path, &png_path)?;
+    write_images_with(&output.film, &exr_path, &png_path, &scene.ldr_output)?;
     if output.stop == StopReason::Interrupted && !checkpoints {
         // An interrupted render always leaves a state to resume from.
         state_of(&Snapshot {

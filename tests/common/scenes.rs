@@ -12,7 +12,7 @@ use prism_core::math::transform::look_at;
 use prism_core::math::{AnimatedTransform, Transform};
 use prism_core::render::{RenderOptions, render};
 use prism_core::scene::{FilmSettings, SamplerKind, SamplerSettings, Scene};
-use prism_core::spectrum::Spectrum;
+use prism_core::spectrum::{Spectrum, WavelengthSampling};
 use prism_core::world::{ShapeInfo, World};
 
 /// A shape with a one-sided diffuse material and, optionally, constant emitted radiance.
@@ -57,10 +57,10 @@ pub fn build(
             back: None,
         });
         let light = object.emission.map(|radiance| {
-            lights.push(Light::Area(AreaLight {
-                shape: i as u32,
-                radiance: Spectrum::Constant(radiance),
-            }));
+            lights.push(Light::Area(AreaLight::uniform(
+                i as u32,
+                Spectrum::Constant(radiance),
+            )));
             (lights.len() - 1) as u32
         });
         info.push(ShapeInfo {
@@ -80,6 +80,7 @@ pub fn build(
                 size,
             },
             filter: Filter::Box { radius: 0.5 },
+            wavelength_sampling: WavelengthSampling::default(),
         },
         SamplerSettings {
             kind: SamplerKind::Independent,

@@ -9,7 +9,9 @@ use std::fmt;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-/// A place in an input file: 1-based line and column.
+/// A place in an input file: 1-based line and column; or, for a scene given as a dictionary,
+/// the key path of the entry (`scene.sphere.bsdf.reflectance`) as the file, with line and
+/// column 0.
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
 pub struct SourceLocation {
     pub file: Arc<Path>,
@@ -25,11 +27,25 @@ impl SourceLocation {
             column,
         }
     }
+
+    /// The entry of a dictionary at `key_path` (keys joined by dots).
+    pub fn key_path(key_path: &str) -> Self {
+        SourceLocation::new(key_path, 0, 0)
+    }
+
+    /// Whether this is a dictionary's key path rather than a place in a file.
+    pub fn is_key_path(&self) -> bool {
+        self.line == 0
+    }
 }
 
 impl fmt::Display for SourceLocation {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}:{}:{}", self.file.display(), self.line, self.column)
+        if self.is_key_path() {
+            write!(f, "{}", self.file.display())
+        } else {
+            write!(f, "{}:{}:{}", self.file.display(), self.line, self.column)
+        }
     }
 }
 

@@ -44,6 +44,7 @@ pub mod image;
 pub mod integrator;
 pub mod light;
 pub mod math;
+pub mod medium;
 pub mod render;
 pub mod sampling;
 pub mod scene;

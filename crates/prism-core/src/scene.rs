@@ -4,7 +4,7 @@
 use glam::UVec2;
 
 use crate::camera::{Camera, Shutter};
-use crate::film::{CropWindow, Filter};
+use crate::film::{CropWindow, Filter, LdrOutput};
 use crate::integrator::Integrator;
 pub use crate::sampling::sampler::SamplerKind;
 use crate::spectrum::WavelengthSampling;
@@ -16,6 +16,8 @@ pub struct FilmSettings {
     pub size: UVec2,
     pub crop: CropWindow,
     pub filter: Filter,
+    /// The density the wavelengths of each camera sample are drawn from.
+    pub wavelength_sampling: WavelengthSampling,
 }
 
 /// Which per-pixel sampler to use and how many samples per pixel.
@@ -34,17 +36,18 @@ pub struct Scene {
     /// The estimator and its parameters; it builds its light sampler from the world when a
     /// render starts.
     pub integrator: Integrator,
-    pub wavelength_sampling: WavelengthSampling,
     /// When camera rays are taken (the sensor's shutter interval and temporal filter).
     pub shutter: Shutter,
+    /// How the 8-bit image beside the EXR is tonemapped and written.
+    pub ldr_output: LdrOutput,
     /// Hash of the scene's description and the files it loads, which render states record so
     /// that a resumed render is of the same scene; 0 for scenes built in code.
     pub fingerprint: u64,
 }
 
 impl Scene {
-    /// A scene from its parts, with an instantaneous shutter and the lecture's wavelength
-    /// density.
+    /// A scene from its parts, with an instantaneous shutter, the lecture's wavelength
+    /// density and the default sRGB PNG.
     pub fn new(
         world: World,
         camera: Camera,
@@ -58,8 +61,8 @@ impl Scene {
             film,
             sampler,
             integrator,
-            wavelength_sampling: WavelengthSampling::default(),
             shutter: Shutter::instant(),
+            ldr_output: LdrOutput::default(),
             fingerprint: 0,
         }
     }

@@ -4,6 +4,7 @@
 use crate::bsdf::Material;
 use crate::geometry::Geometry;
 use crate::light::{BoundingSphere, Light};
+use crate::medium::{Medium, MediumInterface};
 
 /// What a shape is made of and whether it emits.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -24,9 +25,18 @@ pub struct World {
     /// Each light's power (see [`Light::power`]), from which integrators build their light
     /// samplers.
     pub light_powers: Vec<f32>,
+    /// Each light's `sampling_weight` (1 unless the scene says otherwise), which scales its
+    /// probability of being chosen (see [`crate::light::sampler`]).
+    pub light_sampling_weights: Vec<f32>,
     /// Index into `lights` of the environment (`constant` or `envmap`), which rays that leave
     /// the scene see; a scene has at most one.
     pub environment: Option<u32>,
+    /// The participating media; shapes and the camera refer to them by index.
+    pub media: Vec<Medium>,
+    /// One entry per primitive of `geometry` when some shape bounds a medium, else empty.
+    pub medium_interfaces: Vec<MediumInterface>,
+    /// The medium the camera sits in.
+    pub camera_medium: Option<u32>,
 }
 
 impl World {
@@ -47,6 +57,7 @@ impl World {
             .iter()
             .map(|l| l.power(&geometry.primitives))
             .collect();
+        let light_sampling_weights = vec![1.0; lights.len()];
         World {
             environment: lights
                 .iter()
@@ -57,6 +68,40 @@ impl World {
             materials,
             lights,
             light_powers,
+            media: Vec::new(),
+            medium_interfaces: Vec::new(),
+            camera_medium: None,
+            light_sampling_weights,
         }
+    }
+
+    /// The media on the two sides of primitive `shape`.
+    #[inline]
+    pub fn medium_interface(&self, shape: u32) -> MediumInterface {
+        self.medium_interfaces
+            .get(shape as usize)
+            .copied()
+            .unwrap_or_default()
+    }
+
+    /// Whether the scene has participating media.
+    pub fn has_media(&self) -> bool {
+        !self.media.is_empty()
+    }
+
+    /// The world with the lights' sampling weights (one per light, each finite and at
+    /// least 0) in place of the default 1.
+    pub fn with_sampling_weights(mut self, weights: Vec<f32>) -> World {
+        assert_eq!(
+            weights.len(),
+            self.lights.len(),
+            "one sampling weight per light"
+        );
+        assert!(
+            weights.iter().all(|w| w.is_finite() && *w >= 0.0),
+            "sampling weights are finite and at least 0"
+        );
+        self.light_sampling_weights = weights;
+        self
     }
 }

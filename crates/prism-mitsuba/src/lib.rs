@@ -7,6 +7,7 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod description;
+pub mod dict;
 mod element;
 pub mod factory;
 pub mod fingerprint;
@@ -24,6 +25,12 @@ use std::path::Path;
 
 pub use factory::LoadedScene;
 use prism_core::error::Result;
+
+/// Reads a scene in Mitsuba 3's dictionary form (see [`dict`]) and builds it.
+pub fn load_scene_dict(root: &dict::Dict) -> Result<LoadedScene> {
+    let tree = dict::read_scene_dict(root)?;
+    factory::build_scene(&tree)
+}
 
 /// Reads a Mitsuba XML scene file (with `-D name=value` overrides) and builds it.
 pub fn load_scene(path: &Path, defines: &[(String, String)]) -> Result<LoadedScene> {

@@ -4,8 +4,11 @@
 //! which holds the name and the default); [`Params::finish`] then reports any property or
 //! nested plugin nobody asked for, naming the declared ones and the closest match, so that a
 //! misspelled parameter is an error with a location instead of a silent default.
+//! [`Params::finish_with_warnings`] turns the parameters declared [`Default::Ignored`] (Mitsuba
+//! 0.6 forms Prism reads but does not implement) into one [`Warning`] each.
 
 use std::cell::Cell;
+use std::fmt;
 
 use glam::{DMat4, DVec3};
 
@@ -14,6 +17,19 @@ use crate::registry::{Default, ParamKind, ParamSpec};
 use crate::suggest::closest_match;
 use prism_core::error::{Error, Result, SourceLocation};
 use prism_core::math::{AnimatedTransform, Transform};
+
+/// A parameter of the scene that Prism reads but ignores, where it is written and why.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Warning {
+    pub location: SourceLocation,
+    pub message: String,
+}
+
+impl fmt::Display for Warning {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}: warning: {}", self.location, self.message)
+    }
+}
 
 /// Reads the properties of one plugin node through its plugin's declared parameters, and
 /// remembers which were read.
@@ -324,8 +340,40 @@ impl<'a> Params<'a> {
         Some(&self.node.children[index])
     }
 
-    /// Reports the first property or nested plugin that no one asked for.
+    /// Reports the first property or nested plugin that no one asked for. A plugin that
+    /// declares ignored parameters finishes with [`Params::finish_with_warnings`] instead.
     pub fn finish(self) -> Result<()> {
+        assert!(
+            !self.declared.iter().any(|d| d.default == Default::Ignored),
+            "{} declares ignored parameters: finish it with finish_with_warnings",
+            self.node.describe()
+        );
+        self.finish_with_warnings().map(|_| ())
+    }
+
+    /// As [`Params::finish`], and one warning for each parameter declared
+    /// [`Default::Ignored`] that the node gives, in document order; `doc` of its declaration
+    /// says what is ignored.
+    pub fn finish_with_warnings(self) -> Result<Vec<Warning>> {
+        let mut warnings = Vec::new();
+        for (property, used) in self.node.properties.iter().zip(&self.used_properties) {
+            let ignored = self
+                .declared
+                .iter()
+                .find(|d| d.name == property.name && d.default == Default::Ignored);
+            if let Some(spec) = ignored {
+                used.set(true);
+                warnings.push(Warning {
+                    location: property.location.clone(),
+                    message: format!(
+                        "{} ignores \"{}\": {}",
+                        self.node.describe(),
+                        spec.name,
+                        spec.doc
+                    ),
+                });
+            }
+        }
         let declared: Vec<&str> = self
             .declared
             .iter()
@@ -354,7 +402,7 @@ impl<'a> Params<'a> {
                     .with_help("remove it, or check that it is nested in the right element"));
             }
         }
-        Ok(())
+        Ok(warnings)
     }
 }
 

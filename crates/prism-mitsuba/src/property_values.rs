@@ -3,6 +3,9 @@
 //! - `<rgb value="r, g, b"/>`, or one value `v` meaning `v, v, v` (Mitsuba 3). We also accept
 //!   `value="#rrggbb"`, sRGB-encoded bytes decoded to linear values with the sRGB transfer curve,
 //!   as Mitsuba 0.6 did for hexadecimal colours; Mitsuba 3's own parser rejects this form.
+//! - `<srgb value="r, g, b"/>`, `<srgb value="v"/>` or `<srgb value="#rrggbb"/>` (Mitsuba 0.6):
+//!   sRGB-encoded components, decoded to linear values with the sRGB transfer curve, and then
+//!   read as `<rgb>`.
 //! - `<spectrum value="0.5"/>` is the same value at every wavelength;
 //!   `<spectrum value="400:0.1, 500:0.2"/>` lists (wavelength in nm, value) pairs; and
 //!   `<spectrum filename="x.spd"/>` reads such pairs from a text file with one `wavelength value`
@@ -10,12 +13,21 @@
 //!   `filename` must be given. Mitsuba only rejects decreasing wavelengths; we require at least
 //!   two pairs with positive, strictly increasing wavelengths, since the spectrum is interpolated
 //!   between them.
+//! - `<spectrum value="0.1 0.4 0.9"/>`, values without wavelengths, is Mitsuba 0.6's form for
+//!   the components of its `Spectrum` type (its scene reader requires exactly
+//!   `SPECTRUM_SAMPLES` of them, `src/librender/scenehandler.cpp`). Mitsuba 0.6's default build
+//!   is RGB (`SPECTRUM_SAMPLES` = 3), where three values are linear RGB: they are read as `<rgb>`.
+//!   A spectral build's N values (N = 2 or N > 3) are its N bins of equal width between
+//!   `SPECTRUM_MIN_WAVELENGTH` = 360 and `SPECTRUM_MAX_WAVELENGTH` = 830 nm, constant within each
+//!   bin and zero outside: they are read as wavelength:value pairs at each bin's two ends, the
+//!   end of one bin [`BIN_EDGE`] nm before the start of the next, so that the interpolated
+//!   spectrum steps between bins. Mitsuba 3 refuses both forms.
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use super::description::SpectrumValue;
 use super::description::find_file;
+use super::description::{PropertyValue, SpectrumValue};
 use super::element::{Attribute, Element, parse_finite, quote, tokens};
 use prism_core::error::{Error, Result, SourceLocation};
 use prism_core::image::srgb;
@@ -32,6 +44,21 @@ pub(super) fn rgb(element: &Element) -> Result<[f64; 3]> {
         [r, g, b] => Ok([r, g, b]),
         _ => Err(element.count_error(value, numbers.len(), "1 or 3")),
     }
+}
+
+/// The value of an `<srgb>` element: sRGB-encoded components, decoded to linear RGB.
+pub(super) fn srgb_color(element: &Element) -> Result<[f64; 3]> {
+    let value = element.require("value")?;
+    if let Some(hex) = value.value.trim().strip_prefix('#') {
+        return hex_rgb(element, value, hex);
+    }
+    let numbers = element.number_list(value)?;
+    let encoded = match numbers[..] {
+        [v] => [v; 3],
+        [r, g, b] => [r, g, b],
+        _ => return Err(element.count_error(value, numbers.len(), "1 or 3")),
+    };
+    Ok(encoded.map(|v| f64::from(srgb::decode(v as f32))))
 }
 
 /// `#rrggbb`, sRGB-encoded, to linear RGB.
@@ -60,12 +87,21 @@ fn hex_rgb(element: &Element, value: &Attribute, hex: &str) -> Result<[f64; 3]> 
 
 /// The value of a `<spectrum>` element without a `type` attribute; a `filename` is looked up in
 /// `search_paths`.
-pub(super) fn spectrum(element: &Element, search_paths: &[PathBuf]) -> Result<SpectrumValue> {
+pub(super) fn spectrum(element: &Element, search_paths: &[PathBuf]) -> Result<PropertyValue> {
     let value = element.get("value").filter(|a| !a.value.trim().is_empty());
     let filename = element.get("filename").filter(|a| !a.value.is_empty());
     match (value, filename) {
-        (Some(value), None) => inline_spectrum(element, value),
-        (None, Some(filename)) => spectrum_file(filename, search_paths),
+        (Some(value), None) => {
+            let entries: Vec<&str> = tokens(&value.value).collect();
+            if entries.len() > 1 && entries.iter().all(|entry| !entry.contains(':')) {
+                mitsuba_06_spectrum(element, value)
+            } else {
+                inline_spectrum(element, value).map(PropertyValue::Spectrum)
+            }
+        }
+        (None, Some(filename)) => {
+            spectrum_file(filename, search_paths).map(PropertyValue::Spectrum)
+        }
         _ => Err(Error::input(
             &element.location,
             format!(
@@ -75,6 +111,36 @@ pub(super) fn spectrum(element: &Element, search_paths: &[PathBuf]) -> Result<Sp
         )
         .with_help("write value=\"0.5\", value=\"400:0.1, 700:0.5\" or filename=\"data.spd\"")),
     }
+}
+
+/// The wavelength range of Mitsuba 0.6's spectral bins, in nm.
+const MITSUBA_06_BINS: (f64, f64) = (360.0, 830.0);
+/// How far before the next bin's start a bin's last sample lies, in nm: the interpolated
+/// spectrum rises or falls to the next bin's value within this width.
+const BIN_EDGE: f64 = 1e-6;
+
+/// Values without wavelengths (see the module's documentation): three are linear RGB, other
+/// counts Mitsuba 0.6's spectral bins.
+fn mitsuba_06_spectrum(element: &Element, value: &Attribute) -> Result<PropertyValue> {
+    let values = element.number_list(value)?;
+    if let [r, g, b] = values[..] {
+        return Ok(PropertyValue::Rgb([r, g, b]));
+    }
+    if values.len() > 1024 {
+        return Err(element.count_error(value, values.len(), "at most 1024"));
+    }
+    let (min, max) = MITSUBA_06_BINS;
+    let width = (max - min) / values.len() as f64;
+    let mut samples = Vec::with_capacity(2 * values.len());
+    for (i, &v) in values.iter().enumerate() {
+        let start = min + i as f64 * width;
+        samples.push((start, v));
+        samples.push((
+            start + width - if i + 1 < values.len() { BIN_EDGE } else { 0.0 },
+            v,
+        ));
+    }
+    Ok(PropertyValue::Spectrum(SpectrumValue::Samples(samples)))
 }
 
 fn inline_spectrum(element: &Element, value: &Attribute) -> Result<SpectrumValue> {

@@ -16,7 +16,8 @@
 //! - The root is `<scene version="major.minor.patch">` (an optional `id` is allowed).
 //! - Plugins: `<bsdf type="..." id="..." name="...">` and the other tags of [`PluginClass`];
 //!   `<spectrum>` is a plugin only with a `type` attribute, otherwise a property.
-//! - Properties: `<float>`, `<integer>`, `<boolean>`, `<string>`, `<rgb>`, `<spectrum>`,
+//! - Properties: `<float>`, `<integer>`, `<boolean>`, `<string>`, `<rgb>`, `<srgb>` (Mitsuba
+//!   0.6), `<spectrum>`,
 //!   `<point>`, `<vector>` and `<transform>` (see `transform_ops.rs`), each with a `name`
 //!   unique within its plugin (nested plugins' names included).
 //! - `<ref id="..." name="..."/>`, `<default name="..." value="..."/>`, `<alias id="..." as="..."/>`
@@ -456,7 +457,7 @@ impl Reader {
     ) -> Result<()> {
         let tag = element.tag.as_str();
         match tag {
-            "float" | "integer" | "boolean" | "string" | "rgb" | "spectrum" | "point"
+            "float" | "integer" | "boolean" | "string" | "rgb" | "srgb" | "spectrum" | "point"
             | "vector" | "transform" => self.read_property(source, node, element, parent),
             "animation" => self.read_animation(source, node, element, parent),
             "ref" => {
@@ -630,7 +631,7 @@ impl Reader {
         Ok(())
     }
 
-    /// `<float>`, `<integer>`, `<boolean>`, `<string>`, `<rgb>`, `<spectrum>` (without a type),
+    /// `<float>`, `<integer>`, `<boolean>`, `<string>`, `<rgb>`, `<srgb>`, `<spectrum>` (without a type),
     /// `<point>`, `<vector>` and `<transform>`.
     fn read_property(
         &mut self,
@@ -680,9 +681,10 @@ impl Reader {
             "integer" => PropertyValue::Integer(element.integer(element.require("value")?)?),
             "boolean" => PropertyValue::Boolean(element.boolean(element.require("value")?)?),
             "rgb" => PropertyValue::Rgb(property_values::rgb(element)?),
+            "srgb" => PropertyValue::Rgb(property_values::srgb_color(element)?),
             "spectrum" => {
                 let search_paths = self.search_paths(source);
-                PropertyValue::Spectrum(property_values::spectrum(element, &search_paths)?)
+                property_values::spectrum(element, &search_paths)?
             }
             "point" => PropertyValue::Point(element.xyz(0.0)?),
             "vector" => PropertyValue::Vector(element.xyz(0.0)?),
@@ -992,7 +994,7 @@ fn expect_no_content(source: &Source, node: Node, element: &Element) -> Result<(
 }
 
 /// Every tag a scene may contain, for messages.
-const KNOWN_TAGS: [&str; 32] = [
+const KNOWN_TAGS: [&str; 33] = [
     "alias",
     "animation",
     "boolean",
@@ -1019,6 +1021,7 @@ const KNOWN_TAGS: [&str; 32] = [
     "sensor",
     "shape",
     "spectrum",
+    "srgb",
     "string",
     "texture",
     "transform",

@@ -89,6 +89,25 @@ pub fn reference() -> Vec<ClassReference> {
             entries(&crate::factory::lights::EMITTERS),
         ),
         (
+            PluginClass::Medium,
+            "Participating media, for the `volpath` and `volpathmis` integrators: a shape nests \
+             them as `<medium name=\"interior\">` or `name=\"exterior\"` (inline or `<ref>`), the \
+             sensor as the medium it sits in. Give a medium's boundary a `null` BSDF to let light \
+             through unchanged. `distrib` refuses media; `path` ignores them, as Mitsuba's does.",
+            entries(&crate::factory::media::MEDIA),
+        ),
+        (
+            PluginClass::Phase,
+            "Phase functions of media, nested in a `<medium>`.",
+            entries(&crate::factory::media::PHASES),
+        ),
+        (
+            PluginClass::Volume,
+            "Quantities over space for `heterogeneous` media: `<volume name=\"sigma_t\" ...>` or \
+             `name=\"albedo\"`.",
+            entries(&crate::factory::media::VOLUMES),
+        ),
+        (
             PluginClass::Spectrum,
             "Spectra given as nested plugins: `<spectrum type=\"...\" name=\"...\">`.",
             entries(&crate::factory::spectra::SPECTRA),

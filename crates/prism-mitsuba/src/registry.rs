@@ -41,6 +41,9 @@ pub enum Range {
     /// Any non-negative value, such as the real and imaginary parts of an index of refraction;
     /// `<rgb>` is upsampled without bounds ([`RgbIntent::Unbounded`]).
     Unbounded,
+    /// A medium's coefficient: any non-negative value, with `<rgb>` upsampled as a reflectance
+    /// (as Mitsuba 3's spectral variants read it) and components above 1 let through unbounded.
+    Coefficient,
 }
 
 /// What a parameter holds.
@@ -58,12 +61,16 @@ pub enum ParamKind {
     AnimatedTransform,
     Point,
     Vector,
+    /// A `<float>` or a `<vector>` (three raw values).
+    FloatOrVector,
     /// A colour or spectrum (`<rgb>`, `<spectrum>`, `<float>`), or with `textured` a nested
     /// `<texture>` read as colours.
     Spectrum {
         range: Range,
         textured: bool,
     },
+    /// A colour or spectrum, or a nested `<volume>` (a quantity over space).
+    Volume(Range),
     /// A number within `Bounds`, or a nested `<texture>` read as numbers.
     FloatTexture(Bounds),
     /// An index of refraction: a number, a name, a spectrum or a dispersion formula.
@@ -84,11 +91,13 @@ impl ParamKind {
             ParamKind::AnimatedTransform => "transform or animation".into(),
             ParamKind::Point => "point".into(),
             ParamKind::Vector => "vector".into(),
+            ParamKind::FloatOrVector => "float or vector".into(),
             ParamKind::Spectrum { range, textured } => {
                 let what = match range {
                     Range::Albedo => "reflectance",
                     Range::Emission => "emission",
                     Range::Unbounded => "spectrum",
+                    Range::Coefficient => "coefficient",
                 };
                 if *textured {
                     format!("{what} or texture")
@@ -96,6 +105,10 @@ impl ParamKind {
                     what.into()
                 }
             }
+            ParamKind::Volume(range) => match range {
+                Range::Albedo => "reflectance or volume".into(),
+                _ => "coefficient or volume".into(),
+            },
             ParamKind::FloatTexture(bounds) => format!("float or texture, {}", bounds.describe()),
             ParamKind::Ior => "index of refraction".into(),
             ParamKind::Nested(class) => format!("nested {}", class.tag()),
@@ -165,6 +178,9 @@ pub enum Default {
     Required,
     /// Absent means absent (an optional factor, an optional nested plugin).
     None,
+    /// A Mitsuba 0.6 parameter whose meaning is clear but which Prism does not implement: it is
+    /// read and ignored, with a warning ([`crate::params::Warning`]).
+    Ignored,
 }
 
 impl Default {
@@ -177,6 +193,7 @@ impl Default {
             Default::Text(t) => (*t).to_string(),
             Default::Required => "required".into(),
             Default::None => "—".into(),
+            Default::Ignored => "ignored, with a warning".into(),
         }
     }
 }

@@ -28,12 +28,12 @@ pub(super) fn operation_matrix(element: &Element) -> Result<DMat4> {
         "translate" => {
             element.check_attributes(&["x", "y", "z", "value"])?;
             require_some_attribute(element)?;
-            Ok(DMat4::from_translation(element.xyz(0.0)?))
+            Ok(translation(element.xyz(0.0)?))
         }
         "scale" => {
             element.check_attributes(&["x", "y", "z", "value"])?;
             require_some_attribute(element)?;
-            Ok(DMat4::from_diagonal(element.xyz(1.0)?.extend(1.0)))
+            Ok(scaling(element.xyz(1.0)?))
         }
         "rotate" => rotate(element),
         "matrix" => matrix(element),
@@ -53,6 +53,16 @@ pub(super) fn operation_matrix(element: &Element) -> Result<DMat4> {
             .with_help(help))
         }
     }
+}
+
+/// The translation by `offset`.
+pub(crate) fn translation(offset: DVec3) -> DMat4 {
+    DMat4::from_translation(offset)
+}
+
+/// The scaling by `factors` along x, y and z.
+pub(crate) fn scaling(factors: DVec3) -> DMat4 {
+    DMat4::from_diagonal(factors.extend(1.0))
 }
 
 /// `<translate/>` and `<scale/>` without attributes are errors in Mitsuba (a likely slip).
@@ -76,18 +86,21 @@ fn rotate(element: &Element) -> Result<DMat4> {
     element.check_attributes(&["angle", "x", "y", "z", "value"])?;
     let angle = element.number(element.require("angle")?)?;
     let axis = element.xyz(0.0)?;
+    rotation(axis, angle).map_err(|problem| {
+        Error::input(&element.location, format!("<rotate> has {problem}"))
+            .with_help("give the axis with x, y, z (for example z=\"1\") or value=\"0, 0, 1\"")
+    })
+}
+
+/// The right-handed rotation by `angle` degrees about the normalized `axis`; a zero axis, or
+/// one that cannot be normalized, is an error (named as "a zero rotation axis", ...).
+pub(crate) fn rotation(axis: DVec3, angle: f64) -> Result<DMat4, &'static str> {
     if axis == DVec3::ZERO {
-        return Err(
-            Error::input(&element.location, "<rotate> has a zero rotation axis")
-                .with_help("give the axis with x, y, z (for example z=\"1\") or value=\"0, 0, 1\""),
-        );
+        return Err("a zero rotation axis");
     }
     let unit = axis.normalize();
     if !unit.is_finite() {
-        return Err(Error::input(
-            &element.location,
-            "the axis of <rotate> is too large or too small to normalize",
-        ));
+        return Err("an axis too large or too small to normalize");
     }
     Ok(DMat4::from_axis_angle(unit, angle.to_radians()))
 }
@@ -141,7 +154,7 @@ fn three_numbers(element: &Element, attribute: &Attribute) -> Result<DVec3> {
 /// `left = normalize(cross(up, dir))`, `new_up = cross(dir, left)`, `dir = normalize(target -
 /// origin)` and `origin`. A zero `up` is replaced by the first vector of
 /// [`coordinate_system`]`(dir)`, as Mitsuba does when `up` is missing.
-pub(super) fn look_at(origin: DVec3, target: DVec3, up: DVec3) -> Result<DMat4, &'static str> {
+pub(crate) fn look_at(origin: DVec3, target: DVec3, up: DVec3) -> Result<DMat4, &'static str> {
     if origin == target {
         return Err("origin and target coincide");
     }

@@ -6,6 +6,7 @@
 //!     <string name="material" value="Au"/>       <!-- a preset; default "none": 100 % mirror -->
 //!     <!-- or: <spectrum name="eta" value="..."/> <spectrum name="k" value="..."/> (or <rgb>, textures) -->
 //!     <rgb name="specular_reflectance" value="1"/>   <!-- optional factor, default 1 -->
+//!     <float name="ext_eta" value="1.33"/>           <!-- Mitsuba 0.6: exterior index, default 1 -->
 //! </bsdf>
 //! ```
 //! A single specular lobe: `sample` returns the mirror direction with weight
@@ -24,6 +25,8 @@ pub struct Conductor {
     pub eta: Texture,
     pub k: Texture,
     pub specular_reflectance: Texture,
+    /// The exterior medium's index (Mitsuba 0.6's `extEta`); 1 when the scene gives none.
+    pub ext_eta: f32,
 }
 
 /// A conductor's complex index of refraction at a point, at each of a path's wavelengths
@@ -35,17 +38,21 @@ pub struct ConductorIor {
 }
 
 impl ConductorIor {
-    /// η and k read from textures at `at`.
+    /// η and k read from textures at `at`, relative to an exterior medium of index `ext_eta`:
+    /// the Fresnel equations depend on (η + ik)/η_ext only (Mitsuba 0.6, `conductor.cpp`, which
+    /// divides both parts by `extEta`).
     #[inline]
     pub fn at(
         eta: &Texture,
         k: &Texture,
+        ext_eta: f32,
         at: TexturePoint,
         lambda: &SampledWavelengths,
     ) -> ConductorIor {
+        let inv_ext = 1.0 / ext_eta;
         ConductorIor {
-            eta: eta.eval(at, lambda),
-            k: k.eval(at, lambda),
+            eta: eta.eval(at, lambda) * inv_ext,
+            k: k.eval(at, lambda) * inv_ext,
         }
     }
 
@@ -82,7 +89,7 @@ impl BsdfModel for Conductor {
         tree: &mut BxdfTree<'a>,
     ) -> NodeId {
         tree.push(ConductorLobes {
-            ior: ConductorIor::at(&self.eta, &self.k, point.at(), lambda),
+            ior: ConductorIor::at(&self.eta, &self.k, self.ext_eta, point.at(), lambda),
             specular_reflectance: self.specular_reflectance.eval(point.at(), lambda),
         })
     }

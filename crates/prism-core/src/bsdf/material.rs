@@ -64,6 +64,12 @@ impl Material {
         Scattering::new(bsdf, &point, frame.to_local(wo), lambda, tree)
     }
 
+    /// Whether light passes through unchanged from both sides (the `null` BSDF): an
+    /// index-matched boundary, which volumetric path tracing crosses without a bounce.
+    pub fn is_null(&self) -> bool {
+        matches!(self.front, Bsdf::Null(_)) && matches!(self.back, None | Some(Bsdf::Null(_)))
+    }
+
     /// The most [`BxdfTree`] nodes either side takes.
     pub fn node_count(&self) -> usize {
         let back = self.back.as_ref().map_or(0, Bsdf::node_count);

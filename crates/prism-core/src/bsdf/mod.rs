@@ -45,9 +45,13 @@
 //! | `plastic` | [`plastic`] | specular and diffuse reflection |
 //! | `roughplastic` | [`roughplastic`] | glossy and diffuse reflection |
 //! | `phong` | [`phong`] | glossy and diffuse reflection |
+//! | `pplastic` | [`pplastic`] | glossy and diffuse reflection |
+//! | `ward` | [`ward`] | glossy and diffuse reflection |
 //! | `twosided` | [`twosided`] | those of the nested BSDFs, on both sides |
 //! | `mask` | [`mask`] | the nested BSDF's, and null transmission |
+//! | `null` | [`null`] | null transmission only (a medium's boundary) |
 //! | `blendbsdf` | [`blend`] | both nested BSDFs' |
+//! | `null` | [`null`] | null transmission |
 //! | `bumpmap`, `normalmap` | [`bumpmap`], [`normalmap`] | the nested BSDF's, in a perturbed frame |
 
 pub mod blend;
@@ -60,15 +64,18 @@ pub mod mask;
 pub mod material;
 pub mod microfacet;
 pub mod normalmap;
+pub mod null;
 pub mod perturbed;
 pub mod phong;
 pub mod plastic;
+pub mod pplastic;
 pub mod roughconductor;
 pub mod roughdielectric;
 pub mod roughdiffuse;
 pub mod roughplastic;
 pub mod thindielectric;
 pub mod twosided;
+pub mod ward;
 
 use arrayvec::ArrayVec;
 use glam::{Vec2, Vec3};
@@ -81,14 +88,17 @@ pub use diffuse::Diffuse;
 pub use mask::Mask;
 pub use material::{Material, Scattering};
 pub use normalmap::NormalMap;
+pub use null::Null;
 pub use phong::Phong;
 pub use plastic::Plastic;
+pub use pplastic::PolarizedPlastic;
 pub use roughconductor::RoughConductor;
 pub use roughdielectric::RoughDielectric;
 pub use roughdiffuse::RoughDiffuse;
 pub use roughplastic::RoughPlastic;
 pub use thindielectric::ThinDielectric;
 pub use twosided::TwoSided;
+pub use ward::{Ward, WardVariant};
 
 use crate::geometry::interaction::AttributeValues;
 use crate::math::Frame;
@@ -105,8 +115,9 @@ impl BsdfFlags {
     pub const GLOSSY: BsdfFlags = BsdfFlags(2);
     /// A Dirac delta lobe (mirror or clear glass): cannot be evaluated, only sampled.
     pub const SPECULAR: BsdfFlags = BsdfFlags(4);
-    /// Light passing straight through, unchanged in direction (Mitsuba's `Null`: the transparent
-    /// part of `mask`, the transmission of `thindielectric`); a delta lobe too.
+    /// Light passing straight through, unchanged in direction (Mitsuba's `Null`: the `null`
+    /// BSDF, the transparent part of `mask`, the transmission of `thindielectric`); a delta lobe
+    /// too.
     pub const NULL: BsdfFlags = BsdfFlags(32);
     pub const REFLECTION: BsdfFlags = BsdfFlags(8);
     pub const TRANSMISSION: BsdfFlags = BsdfFlags(16);
@@ -424,11 +435,14 @@ bsdfs! {
         Plastic(Plastic),
         RoughPlastic(RoughPlastic),
         Phong(Phong),
+        PolarizedPlastic(PolarizedPlastic),
+        Ward(Ward),
         TwoSided(TwoSided),
         Mask(Mask),
         Blend(Blend),
         BumpMap(BumpMap),
         NormalMap(NormalMap),
+        Null(Null),
     }
     lobes {
         Diffuse(diffuse::DiffuseLobes),
@@ -441,9 +455,12 @@ bsdfs! {
         Plastic(plastic::PlasticLobes<'a>),
         RoughPlastic(roughplastic::RoughPlasticLobes<'a>),
         Phong(phong::PhongLobes),
+        PolarizedPlastic(pplastic::PolarizedPlasticLobes),
+        Ward(ward::WardLobes),
         BackSide(twosided::BackSideLobes),
         Mask(mask::MaskLobes),
         Blend(blend::BlendLobes),
         Perturbed(perturbed::PerturbedLobes),
+        Null(null::NullLobes),
     }
 }

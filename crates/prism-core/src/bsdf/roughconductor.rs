@@ -9,6 +9,7 @@
 //!     <float name="alpha_u" value="0.05"/>           <!-- or alpha for both; default 0.1 -->
 //!     <float name="alpha_v" value="0.3"/>            <!-- (floats or textures) -->
 //!     <rgb name="specular_reflectance" value="1"/>   <!-- optional factor -->
+//!     <float name="ext_eta" value="1.33"/>           <!-- Mitsuba 0.6: exterior index, default 1 -->
 //! </bsdf>
 //! ```
 //! f(wo, wi) cos θi = F(wo·h) D(h) G(wo, wi, h) / (4 cos θo) with h the half vector; sampled by
@@ -32,6 +33,8 @@ pub struct RoughConductor {
     pub eta: Texture,
     pub k: Texture,
     pub specular_reflectance: Texture,
+    /// The exterior medium's index (Mitsuba 0.6's `extEta`); 1 when the scene gives none.
+    pub ext_eta: f32,
 }
 
 const FLAGS: BsdfFlags = BsdfFlags::GLOSSY.union(BsdfFlags::REFLECTION);
@@ -63,7 +66,7 @@ impl BsdfModel for RoughConductor {
                 self.alpha_u.eval_1(point.at()),
                 self.alpha_v.eval_1(point.at()),
             ),
-            ior: ConductorIor::at(&self.eta, &self.k, point.at(), lambda),
+            ior: ConductorIor::at(&self.eta, &self.k, self.ext_eta, point.at(), lambda),
             specular_reflectance: self.specular_reflectance.eval(point.at(), lambda),
         })
     }

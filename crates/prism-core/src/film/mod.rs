@@ -1,11 +1,14 @@
 //! The film: reconstruction filters and their samplers, per-pixel accumulation of XYZ, the
-//! error estimated from the samples, and the images written at the end.
+//! error estimated from the samples, and the images written at the end (an EXR, and an 8-bit
+//! image tonemapped as the film asks).
 
 pub mod accumulation;
 pub mod filter;
+pub mod ldr;
 pub mod output;
 pub mod stats;
 
 pub use accumulation::{CropWindow, Film, PixelSums};
 pub use filter::{Filter, FilterSampler};
-pub use output::write_images;
+pub use ldr::{LdrFormat, LdrOutput, Tonemap, TransferCurve};
+pub use output::{FilmImages, write_images, write_images_with};

@@ -3,8 +3,14 @@
 //!
 //! Rays are brought into object space at their time, intersected with the object's hierarchy
 //! and the hit is carried back to the world; the scene's BVH holds the instance as a single
-//! primitive bounded by its sweep over the animation. Shapes whose transform does not change
-//! are baked into world space instead, so static geometry pays nothing for motion blur.
+//! primitive bounded by its sweep over the animation, so that the scene's hierarchy is a BVH
+//! over instances above each object's own BVH (two levels, as in pbrt-v4's
+//! `TransformedPrimitive` and Mitsuba's `instance`). An instance is either one moving shape
+//! (shapes whose transform does not change are baked into world space instead, so static
+//! geometry pays nothing for motion blur) or a placement of a shape group (Mitsuba's
+//! `shapegroup`), whose shapes and hierarchy every instance of it shares.
+
+use std::sync::Arc;
 
 use glam::{Vec2, Vec3};
 
@@ -13,30 +19,53 @@ use super::interaction::SurfaceInteraction;
 use super::shape::{Shape, SurfaceSample};
 use crate::math::{AnimatedTransform, Frame, Ray};
 
-/// A shape placed by an animated transform.
+/// A shape, or a group of shapes, placed by an animated transform.
 #[derive(Clone, Debug)]
 pub struct Instance {
-    /// The shape in object space, alone in its own hierarchy.
-    pub object: Box<Aggregate<Shape>>,
+    /// The shapes in object space, in their own hierarchy, shared by the instances of a group.
+    pub object: Arc<Aggregate<Shape>>,
     pub to_world: AnimatedTransform,
     /// World-space bounds of the object over the whole animation.
     pub swept_bounds: (Vec3, Vec3),
+    /// How hits are recorded: for one moving shape, as the instance's own primitive; for a
+    /// group, as shape `first_shape + k` for the group's k-th shape (a group's shapes take
+    /// consecutive shape ids after the scene's primitives, so that each has its material).
+    pub first_shape: Option<u32>,
 }
 
 impl Instance {
+    /// One shape that moves during the exposure.
     pub fn new(shape: Shape, to_world: AnimatedTransform) -> Instance {
-        let (lo, hi) = shape.object_bounds();
+        Self::place(Arc::new(Aggregate::new(vec![shape])), to_world, None)
+    }
+
+    /// A placement of a shape group whose shapes are known as shapes `first_shape..`.
+    pub fn of_group(
+        object: Arc<Aggregate<Shape>>,
+        to_world: AnimatedTransform,
+        first_shape: u32,
+    ) -> Instance {
+        Self::place(object, to_world, Some(first_shape))
+    }
+
+    fn place(
+        object: Arc<Aggregate<Shape>>,
+        to_world: AnimatedTransform,
+        first_shape: Option<u32>,
+    ) -> Instance {
+        let (lo, hi) = object.bounds().unwrap_or((Vec3::ZERO, Vec3::ZERO));
         let times: Vec<f32> = to_world.key_times().collect();
         let (t0, t1) = (times[0], times[times.len() - 1]);
         let swept_bounds = to_world.swept_bounds(lo, hi, t0, t1);
         Instance {
-            object: Box::new(Aggregate::new(vec![shape])),
+            object,
             to_world,
             swept_bounds,
+            first_shape,
         }
     }
 
-    /// The object's shape.
+    /// The object's first (for a moving shape, only) shape.
     pub fn shape(&self) -> &Shape {
         &self.object.primitives[0]
     }
@@ -60,7 +89,8 @@ impl Instance {
         self.object.closest_hit(&local).map(|hit| hit.triangle.t)
     }
 
-    /// The world-space interaction of the nearest hit, recorded as shape `shape`.
+    /// The world-space interaction of the nearest hit, recorded as shape `shape` (the instance's
+    /// primitive) or as its group's shape.
     pub fn interaction(&self, ray: &Ray, t_max: f32, shape: u32) -> Option<SurfaceInteraction> {
         let local = Ray {
             t_max,
@@ -72,8 +102,10 @@ impl Instance {
         Some(SurfaceInteraction {
             p: transform.point(si.p),
             n: transform.normal(si.n).normalize(),
-            shading: Frame::from_normal(shading_n),
-            shape,
+            shading: Frame::from_normal_and_tangent(shading_n, transform.vector(si.shading.s)),
+            dp_du: transform.vector(si.dp_du),
+            dp_dv: transform.vector(si.dp_dv),
+            shape: self.first_shape.map_or(shape, |first| first + si.shape),
             ..si
         })
     }
@@ -97,6 +129,8 @@ impl Instance {
             p: transform.point(s.p),
             n: transform.normal(s.n).normalize(),
             shading_n: transform.normal(s.shading_n).normalize(),
+            uv: s.uv,
+            primitive: s.primitive,
             pdf: s.pdf,
         })
     }

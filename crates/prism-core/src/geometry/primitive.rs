@@ -14,7 +14,7 @@ use crate::math::Ray;
 pub enum Primitive {
     /// A shape in world space.
     Shape(Shape),
-    /// A shape that moves during the exposure.
+    /// A shape that moves during the exposure, or a placed shape group.
     Instance(Instance),
 }
 
@@ -98,6 +98,8 @@ impl AggregateElement for Primitive {
     fn heap_bytes(&self) -> usize {
         match self {
             Primitive::Shape(shape) => shape.heap_bytes(),
+            // A group's object is shared by its instances and is not counted in any of them.
+            Primitive::Instance(instance) if instance.first_shape.is_some() => 0,
             Primitive::Instance(instance) => instance.object.memory_bytes(),
         }
     }

@@ -9,6 +9,8 @@
 //! zᵢ = (aᵢ − bᵢ)/√(σ²_a + σ²_b), Σ zᵢ² is χ²-distributed over the pixels if the images differ
 //! only by noise, and the largest |zᵢ| is judged with a Bonferroni correction.
 
+use std::fmt;
+
 use super::ChannelImage;
 use crate::error::{Error, Result};
 use crate::math::special::regularized_gamma_q;
@@ -33,6 +35,45 @@ impl Comparison {
     /// The relative MSE averaged over the compared channels.
     pub fn rel_mse(&self) -> f64 {
         self.channels.iter().map(|d| d.rel_mse).sum::<f64>() / self.channels.len().max(1) as f64
+    }
+}
+
+/// The table `prism compare` prints: per channel the means, their ratio, the MSE, the relative
+/// MSE and the largest difference, the averages over channels, and the z-test's verdict.
+impl fmt::Display for Comparison {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        writeln!(
+            f,
+            "{:>8} {:>12} {:>12} {:>9} {:>12} {:>12} {:>12}",
+            "channel", "mean test", "mean ref", "ratio", "MSE", "relMSE", "max |diff|"
+        )?;
+        for d in &self.channels {
+            writeln!(
+                f,
+                "{:>8} {:>12.6} {:>12.6} {:>9.5} {:>12.4e} {:>12.4e} {:>12.4e}",
+                d.name,
+                d.mean_test,
+                d.mean_reference,
+                d.mean_test / d.mean_reference,
+                d.mse,
+                d.rel_mse,
+                d.max_abs
+            )?;
+        }
+        write!(
+            f,
+            "{:>8} {:>12} {:>12} {:>9} {:>12.4e} {:>12.4e}",
+            "all",
+            "",
+            "",
+            "",
+            self.mse(),
+            self.rel_mse()
+        )?;
+        if let Some(z) = &self.z_test {
+            write!(f, "\n{z}")?;
+        }
+        Ok(())
     }
 }
 
@@ -141,6 +182,26 @@ impl ZTest {
     }
 }
 
+impl fmt::Display for ZTest {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let verdict = if self.consistent_with_noise() {
+            "consistent with noise"
+        } else {
+            "NOT consistent with noise"
+        };
+        write!(
+            f,
+            "z-test of Y over {} pixels: chi² {:.1} (p = {:.3}), max |z| {:.2} (Bonferroni p = {:.3}), {:.2} % beyond |z| = 3 (0.27 % expected): {verdict}",
+            self.pixels,
+            self.chi2,
+            self.p_value,
+            self.max_z,
+            self.max_z_p_value,
+            100.0 * self.beyond_three
+        )
+    }
+}
+
 /// Two-sided tail probability of a standard normal beyond |z|: erfc(|z|/√2) = Q(1/2, z²/2).
 fn normal_tail(z: f64) -> f64 {
     regularized_gamma_q(0.5, 0.5 * z * z)
@@ -212,6 +273,18 @@ pub fn chosen_channels(
         Error::usage("the images share neither R, G, B nor X, Y, Z channels")
             .with_help("name them with --channels"),
     )
+}
+
+/// Writes [`difference_image`] of the channels `comparison` compared as an sRGB PNG.
+pub fn write_difference_png(
+    test: &ChannelImage,
+    reference: &ChannelImage,
+    comparison: &Comparison,
+    path: &std::path::Path,
+) -> Result<()> {
+    let names: Vec<String> = comparison.channels.iter().map(|d| d.name.clone()).collect();
+    let rgb = difference_image(test, reference, &names);
+    super::write_png_srgb(path, test.width, test.height, &rgb)
 }
 
 /// The signed difference of the channels' mean in false colour, as linear RGB triples: red where

@@ -19,7 +19,7 @@ use std::path::{Path, PathBuf};
 
 pub use bitmap::{Bitmap, Encoding, read_bitmap};
 pub use exr::{ChannelImage, read_exr, write_exr};
-pub use png::write_png_srgb;
+pub use png::{Channels, png_srgb_bytes, write_jpeg_u8, write_png_srgb, write_png_u8};
 
 use crate::error::{Error, Result};
 

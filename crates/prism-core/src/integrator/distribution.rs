@@ -191,7 +191,7 @@ impl Estimate<'_, '_> {
             && let Some(light_index) = info.light
             && let Light::Area(light) = &world.lights[light_index as usize]
         {
-            result += light.emitted(si.shading.n, wo_world, lambda);
+            result += light.emitted(si.uv, si.shading.n, wo_world, lambda);
         }
         if self.integrator.depth_allows_next_vertex(depth) {
             result += self.reflected(&si, wo_world, depth, potential, lambda);

@@ -1,5 +1,5 @@
 //! Integrators: estimators of the radiance arriving along a camera ray: the path tracer and the
-//! lecture's distribution ray tracer with splitting.
+//! lecture's distribution ray tracer with splitting, and the volumetric path tracers.
 //!
 //! An [`Integrator`] is what a scene asks for: an estimator and its parameters. Before a render
 //! it is prepared for the world ([`Integrator::prepare`]), which builds the light sampler it
@@ -7,9 +7,15 @@
 
 pub mod distribution;
 pub mod path;
+pub mod volpath;
+pub mod volpathmis;
 
 pub use distribution::DistributionIntegrator;
 pub use path::PathIntegrator;
+pub use volpath::{Tracking, VolPathIntegrator};
+
+use volpath::SpectralTracking;
+use volpathmis::SpectralMis;
 
 use crate::bsdf::{BsdfEval, Scattering};
 use crate::geometry::SurfaceInteraction;
@@ -24,6 +30,13 @@ use crate::world::World;
 pub enum Integrator {
     Path(PathIntegrator),
     Distribution(DistributionIntegrator),
+    VolPath(VolPathIntegrator),
+}
+
+impl From<VolPathIntegrator> for Integrator {
+    fn from(integrator: VolPathIntegrator) -> Integrator {
+        Integrator::VolPath(integrator)
+    }
 }
 
 impl From<PathIntegrator> for Integrator {
@@ -58,6 +71,7 @@ impl Integrator {
         match self {
             Integrator::Path(path) => path.light_selection,
             Integrator::Distribution(distrib) => distrib.light_selection(),
+            Integrator::VolPath(volpath) => volpath.light_selection,
         }
     }
 
@@ -68,6 +82,7 @@ impl Integrator {
             world,
             light_sampler: LightSampler::with_selection(
                 &world.light_powers,
+                &world.light_sampling_weights,
                 self.light_selection(),
             ),
         }
@@ -94,6 +109,19 @@ impl PreparedIntegrator<'_> {
             Integrator::Distribution(integrator) => {
                 integrator.radiance(self, ray, lambda, sampler, count)
             }
+            Integrator::VolPath(integrator) => match integrator.tracking {
+                Tracking::Spectral => {
+                    integrator.trace(SpectralTracking::new(), self, ray, lambda, sampler, count)
+                }
+                Tracking::HeroMis { spectral_mis } => integrator.trace(
+                    SpectralMis::new(spectral_mis),
+                    self,
+                    ray,
+                    lambda,
+                    sampler,
+                    count,
+                ),
+            },
         }
     }
 }

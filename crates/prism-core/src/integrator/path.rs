@@ -29,7 +29,7 @@
 //! * Depth follows Mitsuba: the camera ray's hit is depth 0; a path of depth d has d bounces.
 
 use crate::bsdf::{BxdfTree, Scattering};
-use crate::geometry::SurfaceInteraction;
+use crate::geometry::{SurfaceInteraction, SurfaceSample};
 use crate::integrator::{PreparedIntegrator, RayCount, hero_only, unoccluded};
 use crate::light::{Light, LightSelection};
 use crate::math::Ray;
@@ -131,13 +131,17 @@ impl PathIntegrator {
                 let Light::Area(light) = &world.lights[light_index as usize] else {
                     unreachable!("only area lights are attached to shapes");
                 };
-                let emitted = light.emitted(si.shading.n, wo_world, &lambda);
+                let emitted = light.emitted(si.uv, si.shading.n, wo_world, &lambda);
                 if !emitted.is_black() {
                     let weight = match &previous {
                         Some(prev) if !prev.specular => {
-                            let shape = &world.geometry.primitives[si.shape as usize];
                             let light_pdf = prepared.light_sampler.pmf(light_index as usize)
-                                * shape.pdf_from(prev.interaction.p, si.time, si.p, si.n);
+                                * light.pdf_from(
+                                    &world.geometry.primitives,
+                                    prev.interaction.p,
+                                    si.time,
+                                    &SurfaceSample::at(&si),
+                                );
                             power_heuristic(prev.pdf, light_pdf)
                         }
                         _ => 1.0,

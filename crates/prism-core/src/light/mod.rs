@@ -2,16 +2,17 @@
 //!
 //! Direct lighting follows the lecture's split of the reflection integral into a sum over lights
 //! ("Direct Light Sampling"): area lights are integrated over their surface (or, for spheres,
-//! over the cone they subtend); point and spot lights are single points and directional lights
+//! over the cone they subtend); point, spot and projector lights are single points and directional lights
 //! single directions (Dirac deltas, reached only by light sampling); environment lights
 //! (`constant`, `envmap`) surround the scene at infinity and are also found by rays that leave
 //! it, so they take part in multiple importance sampling like area lights.
 //!
 //! | Mitsuba emitter | file | sampled by |
 //! | --- | --- | --- |
-//! | `area` | [`area`] | the shape: spheres by visible cone, other shapes by area |
+//! | `area` | [`area`] | the shape: spheres by visible cone, other shapes by area; a textured radiance by the texture through the uv map |
 //! | `point` | [`point`] | its position (delta) |
 //! | `spot` | [`spot`] | its position (delta) |
+//! | `projector` | [`projector`] | its position (delta) |
 //! | `directional` | [`directional`] | its direction (delta) |
 //! | `constant` | [`constant`] | uniform directions |
 //! | `envmap` | [`envmap`] | directions ∝ luminance · sin θ in the lat-long image |
@@ -21,6 +22,7 @@ pub mod constant;
 pub mod directional;
 pub mod envmap;
 pub mod point;
+pub mod projector;
 pub mod sampler;
 pub mod spot;
 
@@ -33,6 +35,7 @@ pub use constant::ConstantLight;
 pub use directional::DirectionalLight;
 pub use envmap::EnvironmentMap;
 pub use point::PointLight;
+pub use projector::Projector;
 pub use sampler::{LightSampler, LightSelection};
 pub use spot::SpotLight;
 
@@ -42,6 +45,7 @@ pub enum Light {
     Area(AreaLight),
     Point(PointLight),
     Spot(SpotLight),
+    Projector(Projector),
     Directional(DirectionalLight),
     Constant(ConstantLight),
     Envmap(EnvironmentMap),
@@ -129,6 +133,7 @@ impl Light {
             }
             Light::Point(light) => light.sample_incident(reference, lambda),
             Light::Spot(light) => light.sample_incident(reference, lambda),
+            Light::Projector(light) => light.sample_incident(reference, lambda),
             Light::Directional(light) => light.sample_incident(reference, lambda),
             Light::Constant(light) => light.sample_incident(reference, u, lambda),
             Light::Envmap(light) => light.sample_incident(reference, u, lambda),
@@ -143,6 +148,7 @@ impl Light {
             Light::Area(light) => light.power(shapes),
             Light::Point(light) => light.power(),
             Light::Spot(light) => light.power(),
+            Light::Projector(light) => light.power(),
             Light::Directional(light) => light.power(),
             Light::Constant(light) => light.power(),
             Light::Envmap(light) => light.power(),
@@ -155,7 +161,7 @@ impl Light {
             Light::Directional(light) => light.scene = bounds,
             Light::Constant(light) => light.scene = bounds,
             Light::Envmap(light) => light.scene = bounds,
-            Light::Area(_) | Light::Point(_) | Light::Spot(_) => {}
+            Light::Area(_) | Light::Point(_) | Light::Spot(_) | Light::Projector(_) => {}
         }
     }
 

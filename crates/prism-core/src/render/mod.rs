@@ -66,9 +66,60 @@ impl StopRule {
         }
     }
 
+    /// The rule for a render asked for `spp` samples per pixel (None: the scene's `scene_spp`),
+    /// a time limit in seconds and a target for the mean relative error. Without a time limit
+    /// or target error the render takes exactly the samples; with either, `spp` (if given) only
+    /// caps them. Messages call the three settings by `names`, as the caller's user knows them.
+    pub fn requested(
+        spp: Option<u32>,
+        scene_spp: u32,
+        time_limit: Option<f64>,
+        target_error: Option<f64>,
+        names: &StopRuleNames,
+    ) -> Result<StopRule> {
+        if spp == Some(0) {
+            return Err(Error::usage(format!("{} must be at least 1", names.spp)));
+        }
+        let time_limit = match time_limit {
+            Some(t) if !(t > 0.0 && t.is_finite()) => {
+                return Err(Error::usage(format!(
+                    "{} must be a positive number of seconds, not {t}",
+                    names.time_limit
+                )));
+            }
+            t => t.map(Duration::from_secs_f64),
+        };
+        if let Some(e) = target_error
+            && !(e > 0.0 && e.is_finite())
+        {
+            return Err(Error::usage(format!(
+                "{} must be positive, not {e}",
+                names.target_error
+            )));
+        }
+        let open_ended = time_limit.is_some() || target_error.is_some();
+        Ok(StopRule {
+            sample_end: if open_ended {
+                spp
+            } else {
+                Some(spp.unwrap_or(scene_spp))
+            },
+            time_limit,
+            target_error,
+        })
+    }
+
     fn is_open_ended(&self) -> bool {
         self.time_limit.is_some() || self.target_error.is_some()
     }
+}
+
+/// What the settings of [`StopRule::requested`] are called where they were given (command-line
+/// options, or a function's arguments).
+pub struct StopRuleNames {
+    pub spp: &'static str,
+    pub time_limit: &'static str,
+    pub target_error: &'static str,
 }
 
 /// How to render.
@@ -90,8 +141,51 @@ pub struct RenderOptions {
     pub threads: Option<usize>,
     /// Seed of every random stream.
     pub seed: u64,
-    /// Whether to draw a progress bar on standard error.
-    pub progress: bool,
+    /// How to report progress.
+    pub progress: Progress,
+}
+
+/// How a render reports its progress.
+#[derive(Clone, Debug, Default)]
+pub enum Progress {
+    #[default]
+    Hidden,
+    /// A progress bar on standard error.
+    Terminal,
+    /// Counts kept in a shared [`ProgressCounter`], read by a caller that shows them itself
+    /// (the Python module's progress bar).
+    Counter(Arc<ProgressCounter>),
+}
+
+/// A render's progress, updated by the render as tiles finish and readable from any thread.
+#[derive(Debug, Default)]
+pub struct ProgressCounter {
+    samples: AtomicU64,
+    /// The camera samples the render will take, or 0 when it is open-ended.
+    total: AtomicU64,
+    /// The image's mean relative error after the last pass, as `f64` bits.
+    error_bits: AtomicU64,
+}
+
+impl ProgressCounter {
+    /// Camera samples taken so far.
+    pub fn samples(&self) -> u64 {
+        self.samples.load(Ordering::Relaxed)
+    }
+
+    /// Camera samples the render will take; None when a time limit or target error ends it.
+    pub fn total(&self) -> Option<u64> {
+        Some(self.total.load(Ordering::Relaxed)).filter(|&t| t > 0)
+    }
+
+    /// The image's mean relative standard error after the last finished pass (infinite
+    /// before).
+    pub fn relative_error(&self) -> f64 {
+        match self.error_bits.load(Ordering::Relaxed) {
+            0 => f64::INFINITY,
+            bits => f64::from_bits(bits),
+        }
+    }
 }
 
 impl RenderOptions {
@@ -105,7 +199,7 @@ impl RenderOptions {
             interrupt: None,
             threads,
             seed,
-            progress: false,
+            progress: Progress::Hidden,
         }
     }
 
@@ -222,7 +316,7 @@ impl<'a> SampleEstimator<'a> {
         let scene = self.scene;
         sampler.start_pixel_sample(pixel, index);
         let primary = sampler.camera_sample();
-        let lambda = SampledWavelengths::sample(primary.wavelength, scene.wavelength_sampling);
+        let lambda = SampledWavelengths::sample(primary.wavelength, scene.film.wavelength_sampling);
         let (offset, filter_weight) = self.filter.sample(primary.film);
         let (time, time_weight) = scene.shutter.sample(primary.time);
         let film_position = pixel.as_vec2() + Vec2::splat(0.5) + offset;
@@ -330,7 +424,7 @@ pub fn render_with_checkpoints(
         .map_err(|e| Error::usage(format!("could not start the worker threads: {e}")))?;
 
     let mut sums = tile_major(&tiles, crop.size, options.initial.as_deref())?;
-    let progress = progress_bar(&options, pixel_count);
+    let progress = ProgressSink::new(&options, pixel_count);
     let rays = AtomicU64::new(0);
     let abort = AtomicBool::new(false);
     let start = Instant::now();
@@ -384,7 +478,7 @@ pub fn render_with_checkpoints(
                         &cancel,
                     );
                     if result.is_some() {
-                        progress.inc(u64::from(tile.size.x * tile.size.y) * u64::from(pass));
+                        progress.add(u64::from(tile.size.x * tile.size.y) * u64::from(pass));
                     }
                     result
                 })
@@ -408,7 +502,7 @@ pub fn render_with_checkpoints(
         }
         next += pass;
         error = relative_error(sums.iter().flatten());
-        progress.set_message(format!("{} spp, error {error:.4}", next - first));
+        progress.pass_done(next - first, error);
         if let Some(checkpoint) = &mut checkpoints
             && last_checkpoint.elapsed() >= checkpoint.every
         {
@@ -421,7 +515,7 @@ pub fn render_with_checkpoints(
         }
     };
     let elapsed = start.elapsed();
-    progress.finish_and_clear();
+    progress.finish();
 
     let mut film = Film::new(scene.film.size, crop);
     film.pixels = row_major(&tiles, crop.size, &sums);
@@ -484,15 +578,62 @@ fn row_major(tiles: &[Tile], size: UVec2, sums: &[Vec<PixelSums>]) -> Vec<PixelS
     pixels
 }
 
-fn progress_bar(options: &RenderOptions, pixel_count: u64) -> ProgressBar {
-    if !options.progress {
-        return ProgressBar::hidden();
+/// Where a render's progress goes: a terminal bar, a shared counter, or nowhere.
+struct ProgressSink {
+    bar: ProgressBar,
+    counter: Option<Arc<ProgressCounter>>,
+}
+
+impl ProgressSink {
+    fn new(options: &RenderOptions, pixel_count: u64) -> ProgressSink {
+        let total = options
+            .stop
+            .sample_end
+            .filter(|_| !options.stop.is_open_ended())
+            .map(|end| pixel_count * u64::from(end.saturating_sub(options.first_sample)));
+        match &options.progress {
+            Progress::Hidden => ProgressSink {
+                bar: ProgressBar::hidden(),
+                counter: None,
+            },
+            Progress::Terminal => ProgressSink {
+                bar: terminal_bar(total),
+                counter: None,
+            },
+            Progress::Counter(counter) => {
+                counter.samples.store(0, Ordering::Relaxed);
+                counter.total.store(total.unwrap_or(0), Ordering::Relaxed);
+                counter.error_bits.store(0, Ordering::Relaxed);
+                ProgressSink {
+                    bar: ProgressBar::hidden(),
+                    counter: Some(counter.clone()),
+                }
+            }
+        }
     }
-    let total = options
-        .stop
-        .sample_end
-        .filter(|_| !options.stop.is_open_ended())
-        .map(|end| pixel_count * u64::from(end.saturating_sub(options.first_sample)));
+
+    /// A tile of `samples` camera samples is done.
+    fn add(&self, samples: u64) {
+        self.bar.inc(samples);
+        if let Some(counter) = &self.counter {
+            counter.samples.fetch_add(samples, Ordering::Relaxed);
+        }
+    }
+
+    /// A pass is done: `spp` samples per pixel so far, with the image's mean relative `error`.
+    fn pass_done(&self, spp: u32, error: f64) {
+        self.bar.set_message(format!("{spp} spp, error {error:.4}"));
+        if let Some(counter) = &self.counter {
+            counter.error_bits.store(error.to_bits(), Ordering::Relaxed);
+        }
+    }
+
+    fn finish(&self) {
+        self.bar.finish_and_clear();
+    }
+}
+
+fn terminal_bar(total: Option<u64>) -> ProgressBar {
     let template = if total.is_some() {
         "{bar:40.cyan/blue} {percent:>3}% {human_pos}/{human_len} samples, {per_sec}, ETA {eta} — {msg}"
     } else {

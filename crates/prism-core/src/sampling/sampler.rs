@@ -12,7 +12,26 @@
 //! | `stratified` (Mitsuba) | 1-D: N strata, 2-D: √N × √N jittered grid | the same |
 //! | `multijitter` (Mitsuba) | 1-D: N strata, 2-D: correlated multi-jittered | the same |
 //! | `nrooks` (ours) | every one of the 6 coordinates in N strata (Latin hypercube) | uniform |
+//! | `ldsampler` (Mitsuba) | 1-D: scrambled van der Corput, 2-D: scrambled (0, 2)-sequence | the same |
+//! | `orthogonal` (Mitsuba) | an orthogonal array of strength t, every dimension a factor | the same |
 //!
+//! `ldsampler` is Mitsuba 3's low-discrepancy sampler (Kollig and Keller 2002, "Efficient
+//! Multidimensional Sampling", after Mitsuba 0.6's sampler of the same name): N, a square of a
+//! power of two, points of the (0, 2)-sequence (the van der Corput radical inverse in base 2
+//! and the second Sobol' dimension), each coordinate scrambled by an XOR with a random 32-bit
+//! number (a random digit scrambling, so each point is uniform), and the order of the points
+//! shuffled anew for each dimension. The scrambles are drawn per pixel and per dimension, as in
+//! Mitsuba 0.6; Mitsuba 3 shares one per pixel across dimensions, which leaves all of a
+//! sample's 1-D numbers with the same low bits (their joint density is not uniform).
+//!
+//! `orthogonal` is Mitsuba 3's orthogonal array sampler (Jarosz, Enayet, Kensler, Kilpatrick and
+//! Christensen 2019, "Orthogonal Array Sampling for Monte Carlo Rendering"): the N = p^t runs of
+//! an orthogonal array OA(p^t, ·, p, t) over the prime p, whose every t dimensions together are
+//! stratified into the p^t cells of their grid; each dimension is also stratified into N strata
+//! (the "multi-jittered" flavour). Strength 2 uses Bose's construction (its run i = (a₀, a₁) in
+//! base p gives dimension j the level a₀ + (j − 1) a₁ mod p), other strengths Bush's (the level
+//! of dimension j is the polynomial with i's t base-p digits as coefficients, evaluated at j, mod
+//! p). The run order is shuffled per pixel, the levels of each dimension per dimension.
 //! In every stratified sampler the strata of each dimension are assigned to the N samples of a
 //! pixel by an independent pseudo-random permutation (the lecture's `*_stratified_and_shuffle`),
 //! computed on the fly by Kensler's hash-based permutation, so no table is stored and any sample
@@ -21,10 +40,11 @@
 //! image is the same whatever the thread count or the order of tiles.
 //!
 //! ```xml
-//! <sampler type="nrooks">             <!-- or independent, stratified, multijitter -->
+//! <sampler type="nrooks">             <!-- or independent, stratified, multijitter, ldsampler, orthogonal -->
 //!     <integer name="sample_count" value="64"/>
 //!     <integer name="seed" value="0"/>
-//!     <boolean name="jitter" value="true"/>   <!-- stratified and multijitter -->
+//!     <boolean name="jitter" value="true"/>   <!-- stratified, multijitter and orthogonal -->
+//!     <integer name="strength" value="2"/>     <!-- orthogonal -->
 //! </sampler>
 //! ```
 
@@ -39,7 +59,12 @@ pub enum SamplerKind {
     Stratified { jitter: bool },
     MultiJitter { jitter: bool },
     NRooks,
+    LowDiscrepancy,
+    Orthogonal { strength: u32, jitter: bool },
 }
+
+/// The largest `strength` of the `orthogonal` sampler.
+pub const MAX_ORTHOGONAL_STRENGTH: u32 = 4;
 
 impl SamplerKind {
     /// The sample count the sampler really takes for a requested one: `stratified` rounds up to
@@ -62,9 +87,35 @@ impl SamplerKind {
                 let rows = (f64::from(requested).sqrt() as u32).max(1);
                 (requested.div_ceil(rows), rows)
             }
+            SamplerKind::LowDiscrepancy => {
+                let mut side = 2u32;
+                while u64::from(side) * u64::from(side) < u64::from(requested) {
+                    side = (side + 1).next_power_of_two();
+                }
+                (side * side, 1)
+            }
+            SamplerKind::Orthogonal { strength, .. } => {
+                let p = orthogonal_array_base(requested, strength);
+                (p.pow(strength), 1)
+            }
             SamplerKind::Independent | SamplerKind::NRooks => (requested, 1),
         }
     }
+}
+
+/// The smallest prime p ≥ max(2, `strength`) with p^strength ≥ `requested` (Bush's construction
+/// needs p ≥ t).
+fn orthogonal_array_base(requested: u32, strength: u32) -> u32 {
+    let is_prime = |x: u32| {
+        (2..)
+            .take_while(|d| d * d <= x)
+            .all(|d| !x.is_multiple_of(d))
+    };
+    let mut p = strength.max(2);
+    while u64::from(p).pow(strength) < u64::from(requested) || !is_prime(p) {
+        p += 1;
+    }
+    p
 }
 
 /// The primary dimensions of a camera ray, each in [0, 1).
@@ -86,6 +137,8 @@ pub struct Sampler {
     columns: u32,
     rows: u32,
     jitter: bool,
+    /// The orthogonal array's base p (1 for other samplers).
+    levels: u32,
     seed: u64,
     /// Hash of (seed, pixel): selects the pixel's permutations and random stream.
     pixel_seed: u64,
@@ -120,8 +173,16 @@ impl Sampler {
     pub fn new(kind: SamplerKind, requested: u32, seed: u64) -> Sampler {
         let (columns, rows) = kind.grid(requested);
         let jitter = match kind {
-            SamplerKind::Stratified { jitter } | SamplerKind::MultiJitter { jitter } => jitter,
+            SamplerKind::Stratified { jitter }
+            | SamplerKind::MultiJitter { jitter }
+            | SamplerKind::Orthogonal { jitter, .. } => jitter,
             _ => true,
+        };
+        let levels = match kind {
+            SamplerKind::Orthogonal { strength, .. } => {
+                orthogonal_array_base(requested.max(1), strength)
+            }
+            _ => 1,
         };
         Sampler {
             kind,
@@ -129,6 +190,7 @@ impl Sampler {
             columns,
             rows,
             jitter,
+            levels,
             seed,
             pixel_seed: 0,
             index: 0,
@@ -230,6 +292,20 @@ impl Sampler {
                 );
                 (stratum as f32 + self.jitter_value()) / self.sample_count as f32
             }
+            SamplerKind::LowDiscrepancy => {
+                let dimension = self.next_dimension();
+                let i = permute(
+                    self.index,
+                    self.sample_count,
+                    self.permutation_seed(dimension, 0),
+                );
+                let scramble = self.permutation_seed(dimension, 1);
+                unit_from_bits(radical_inverse_2(i, scramble))
+            }
+            SamplerKind::Orthogonal { strength, .. } => {
+                let dimension = self.next_dimension();
+                self.orthogonal_array(dimension, strength)
+            }
         }
     }
 
@@ -258,6 +334,27 @@ impl Sampler {
             SamplerKind::MultiJitter { .. } => {
                 let dimension = self.next_dimension();
                 self.correlated_multi_jittered(dimension)
+            }
+            SamplerKind::LowDiscrepancy => {
+                let dimension = self.next_dimension();
+                let i = permute(
+                    self.index,
+                    self.sample_count,
+                    self.permutation_seed(dimension, 0),
+                );
+                let (scramble_x, scramble_y) = (
+                    self.permutation_seed(dimension, 1),
+                    self.permutation_seed(dimension, 2),
+                );
+                Vec2::new(
+                    unit_from_bits(radical_inverse_2(i, scramble_x)),
+                    unit_from_bits(sobol_2(i, scramble_y)),
+                )
+            }
+            SamplerKind::Orthogonal { .. } => {
+                let x = self.next_1d();
+                let y = self.next_1d();
+                Vec2::new(x, y)
             }
         }
     }
@@ -311,6 +408,82 @@ impl Sampler {
             (y as f32 + (sx as f32 + jy) / m as f32) / n as f32,
         )
     }
+}
+
+impl Sampler {
+    /// Dimension `dimension` of the current sample in the pixel's orthogonal array of
+    /// `strength` t over p = `levels` levels: the sample is run r = π(i) of the array (the same
+    /// shuffle π in every dimension), the dimension's level a(r) is shuffled among the p
+    /// levels, and the sub-stratum within the level, b(r) of N/p, is chosen so that the N runs
+    /// also fall into N distinct strata of the dimension:
+    /// x = (π_a(a) + (π_b(b) + ξ) p / N) / p.
+    fn orthogonal_array(&mut self, dimension: u32, strength: u32) -> f32 {
+        let p = self.levels;
+        let n = self.sample_count;
+        let run = permute(self.index, n, self.permutation_seed(u32::MAX, 0));
+        let (level, sub_stratum, sub_strata) = if strength == 2 {
+            // Bose: the run's digits (a₀, a₁); dimension j's level a₀ + (j − 1) a₁, its
+            // sub-stratum the level of its partner dimension, so pairs (j, partner) are
+            // correlated multi-jittered.
+            let (a0, a1) = (run / p, run % p);
+            let combination = |j: u32| (a0 + (j + p - 1) % p * a1) % p;
+            match dimension {
+                0 => (a0, a1, p),
+                1 => (a1, a0, p),
+                j => {
+                    let partner = if j % 2 == 1 { j - 1 } else { j + 1 };
+                    (combination(j), combination(partner), p)
+                }
+            }
+        } else {
+            // Bush: the t base-p digits of the run as the coefficients of a polynomial,
+            // evaluated at j mod p (Horner's rule, mod p); the sub-stratum the run's other
+            // digits, which together with the level determine the run.
+            let x = dimension % p;
+            let mut digits = [0u32; MAX_ORTHOGONAL_STRENGTH as usize];
+            let mut rest = run;
+            for digit in digits.iter_mut().take(strength as usize) {
+                *digit = rest % p;
+                rest /= p;
+            }
+            let level = digits[..strength as usize]
+                .iter()
+                .rev()
+                .fold(0u32, |acc, &d| (acc * x + d) % p);
+            (level, run / p, n / p)
+        };
+        let stratum = permute(level, p, self.permutation_seed(dimension, 1));
+        let sub = permute(sub_stratum, sub_strata, self.permutation_seed(dimension, 2));
+        let jitter = self.jitter_value();
+        ((stratum as f32 + (sub as f32 + jitter) / sub_strata as f32) / p as f32)
+            .min(1.0f32.next_down())
+    }
+}
+
+/// The radical inverse of `index` in base 2 (its bits reversed), XOR-scrambled, as 32 bits of
+/// a fraction.
+fn radical_inverse_2(index: u32, scramble: u32) -> u32 {
+    index.reverse_bits() ^ scramble
+}
+
+/// The second dimension of the Sobol' sequence (direction numbers v_k = 2^31 ⊕ … of the
+/// primitive polynomial x + 1), XOR-scrambled, as 32 bits of a fraction.
+fn sobol_2(mut index: u32, scramble: u32) -> u32 {
+    let mut result = scramble;
+    let mut v = 1u32 << 31;
+    while index != 0 {
+        if index & 1 != 0 {
+            result ^= v;
+        }
+        index >>= 1;
+        v ^= v >> 1;
+    }
+    result
+}
+
+/// A 32-bit fraction as a number in [0, 1): its top 24 bits, exactly representable.
+fn unit_from_bits(bits: u32) -> f32 {
+    (bits >> 8) as f32 * (1.0 / (1u32 << 24) as f32)
 }
 
 /// A pseudo-random permutation of [0, length), evaluated at `index` (Kensler 2013, §3): a

@@ -51,6 +51,43 @@ pub enum Texels {
     Spectral(Vec<RgbSigmoidPolynomial>),
     /// Raw RGB (normal maps).
     Rgb(Vec<[f32; 3]>),
+    /// Emitted colours: each texel's spectrum is `scale` times its polynomial. As Mitsuba 3
+    /// reads an emitter's bitmap, a colour is upsampled as a reflectance would be, with no D65
+    /// factor (unlike an `<rgb>` radiance); where Mitsuba clamps components above 1 to 1,
+    /// brighter texels keep their value here.
+    Emission(Vec<EmissionTexel>),
+}
+
+/// An emitted colour: the spectrum `scale · polynomial(λ)`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EmissionTexel {
+    pub polynomial: RgbSigmoidPolynomial,
+    pub scale: f32,
+}
+
+impl EmissionTexel {
+    /// The texel of linear sRGB colour `rgb` (components at least 0): a colour within [0, 1]
+    /// fitted as a reflectance; a brighter one divided by twice its largest component, which
+    /// keeps the fit inside the table, and scaled back (Mitsuba's unbounded upsampling).
+    fn new(table: &RgbToSpectrumTable, rgb: [f32; 3]) -> EmissionTexel {
+        let max = rgb[0].max(rgb[1]).max(rgb[2]);
+        if max <= 1.0 {
+            return EmissionTexel {
+                polynomial: table.fetch(rgb),
+                scale: 1.0,
+            };
+        }
+        let scale = 2.0 * max;
+        EmissionTexel {
+            polynomial: table.fetch(rgb.map(|c| c / scale)),
+            scale,
+        }
+    }
+
+    /// The linear sRGB colour the texel stands for.
+    fn linear_srgb(&self) -> [f32; 3] {
+        self.polynomial.linear_srgb().map(|c| c * self.scale)
+    }
 }
 
 /// How a bitmap will be read.
@@ -59,6 +96,8 @@ pub enum TextureUse {
     Spectral,
     Scalar,
     Rgb,
+    /// Emitted radiance (see [`Texels::Emission`]).
+    Emission,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -112,6 +151,14 @@ impl BitmapTexture {
                 Texels::Spectral(pixels.map(|p| table.fetch(rgb(p))).collect())
             }
             TextureUse::Rgb => Texels::Rgb(pixels.map(rgb).collect()),
+            TextureUse::Emission => {
+                let table = RgbToSpectrumTable::srgb();
+                Texels::Emission(
+                    pixels
+                        .map(|p| EmissionTexel::new(table, rgb(p).map(|c| c.max(0.0))))
+                        .collect(),
+                )
+            }
         };
         BitmapTexture {
             width: bitmap.width,
@@ -186,21 +233,45 @@ impl BitmapTexture {
                 }
                 result
             }
+            Texels::Emission(texels) => {
+                let mut result = SampledSpectrum::ZERO;
+                for (i, w) in index.into_iter().zip(weight) {
+                    if w != 0.0 {
+                        let texel = &texels[i];
+                        result +=
+                            SampledSpectrum::from_fn(|k| texel.polynomial.eval(lambda.lambda(k)))
+                                * (w * texel.scale);
+                    }
+                }
+                result
+            }
             _ => SampledSpectrum::splat(self.eval_1(uv)),
+        }
+    }
+
+    /// The luminance (or value) of texel `i`.
+    #[inline]
+    fn texel_value(&self, i: usize) -> f32 {
+        match &self.texels {
+            Texels::Scalar(t) => t[i],
+            Texels::Rgb(t) => luminance(t[i]),
+            Texels::Spectral(t) => luminance(t[i].linear_srgb()),
+            Texels::Emission(t) => luminance(t[i].linear_srgb()),
         }
     }
 
     pub fn eval_1(&self, uv: Vec2) -> f32 {
         let (index, weight, _) = self.footprint(uv);
-        let value = |i: usize| match &self.texels {
-            Texels::Scalar(t) => t[i],
-            Texels::Rgb(t) => luminance(t[i]),
-            Texels::Spectral(t) => luminance(t[i].linear_srgb()),
-        };
         index
             .into_iter()
             .zip(weight)
-            .map(|(i, w)| if w != 0.0 { w * value(i) } else { 0.0 })
+            .map(|(i, w)| {
+                if w != 0.0 {
+                    w * self.texel_value(i)
+                } else {
+                    0.0
+                }
+            })
             .sum()
     }
 
@@ -212,12 +283,7 @@ impl BitmapTexture {
             return Vec2::ZERO;
         }
         let (index, _, f) = self.footprint(uv);
-        let value = |i: usize| match &self.texels {
-            Texels::Scalar(t) => t[i],
-            Texels::Rgb(t) => luminance(t[i]),
-            Texels::Spectral(t) => luminance(t[i].linear_srgb()),
-        };
-        let [v00, v10, v01, v11] = index.map(value);
+        let [v00, v10, v01, v11] = index.map(|i| self.texel_value(i));
         let d_texel = Vec2::new(
             (1.0 - f.y) * (v10 - v00) + f.y * (v11 - v01),
             (1.0 - f.x) * (v01 - v00) + f.x * (v11 - v10),
@@ -237,6 +303,7 @@ impl BitmapTexture {
                 Texels::Rgb(t) => Vec3::from_array(t[i]),
                 Texels::Scalar(t) => Vec3::splat(t[i]),
                 Texels::Spectral(t) => Vec3::from_array(t[i].linear_srgb()),
+                Texels::Emission(t) => Vec3::from_array(t[i].linear_srgb()),
             };
             result += texel * w;
         }
@@ -249,6 +316,8 @@ impl BitmapTexture {
             Texels::Rgb(t) => t.iter().flatten().copied().fold(0.0, f32::max),
             // Upsampled reflectances never exceed 1.
             Texels::Spectral(_) => 1.0,
+            // The polynomials lie in [0, 1].
+            Texels::Emission(t) => t.iter().map(|t| t.scale).fold(0.0, f32::max),
         }
     }
 
@@ -256,7 +325,7 @@ impl BitmapTexture {
         match &self.texels {
             Texels::Scalar(t) => t.iter().copied().fold(f32::INFINITY, f32::min),
             Texels::Rgb(t) => t.iter().flatten().copied().fold(f32::INFINITY, f32::min),
-            Texels::Spectral(_) => 0.0,
+            Texels::Spectral(_) | Texels::Emission(_) => 0.0,
         }
     }
 }

@@ -7,9 +7,10 @@
 //!     <transform name="to_uv"> <scale x="8" y="8"/> </transform>
 //! </texture>
 //! ```
-//! With (u, v) = to_uv(uv), `color0` is used where frac(u) > ½ and frac(v) > ½ agree and
-//! `color1` where they differ (Mitsuba 3, `src/textures/checkerboard.cpp`, `eval`; its `eval_1`
-//! swaps the two, which we do not copy).
+//! With (u, v) = to_uv(uv), a colour lookup uses `color0` where frac(u) > ½ and frac(v) > ½
+//! agree and `color1` where they differ (Mitsuba 3, `src/textures/checkerboard.cpp`, `eval`).
+//! Read as a number (a roughness, an opacity) the phase is the opposite one: `color0` where
+//! they differ (Mitsuba 3's `eval_1` tests inequality), so the same XML gives the same image.
 
 use glam::Vec2;
 
@@ -24,24 +25,32 @@ pub struct Checkerboard {
 }
 
 impl Checkerboard {
-    /// The texture of the square that `uv` falls in.
+    /// Whether `uv` falls in a square where frac(u) > ½ and frac(v) > ½ agree.
     #[inline]
-    fn select(&self, uv: Vec2) -> &Texture {
+    fn in_even_square(&self, uv: Vec2) -> bool {
         let p = self.to_uv.apply(uv);
         let upper = |x: f32| x - x.floor() > 0.5;
-        if upper(p.x) == upper(p.y) {
+        upper(p.x) == upper(p.y)
+    }
+
+    /// The colour at `at`: `color0` on the even squares.
+    pub fn eval(&self, at: &TexturePoint, lambda: &SampledWavelengths) -> SampledSpectrum {
+        let texture = if self.in_even_square(at.uv) {
             &self.color0
         } else {
             &self.color1
-        }
+        };
+        texture.eval(*at, lambda)
     }
 
-    pub fn eval(&self, at: &TexturePoint, lambda: &SampledWavelengths) -> SampledSpectrum {
-        self.select(at.uv).eval(*at, lambda)
-    }
-
+    /// The number at `at`: `color0` on the odd squares, Mitsuba 3's phase for `eval_1`.
     pub fn eval_1(&self, at: &TexturePoint) -> f32 {
-        self.select(at.uv).eval_1(*at)
+        let texture = if self.in_even_square(at.uv) {
+            &self.color1
+        } else {
+            &self.color0
+        };
+        texture.eval_1(*at)
     }
 
     pub fn max_value(&self) -> f32 {
@@ -57,17 +66,25 @@ impl Checkerboard {
 mod tests {
     use super::*;
 
+    /// The values Mitsuba 3.9.1 (`scalar_spectral`) gives at these points: `eval` 0.4, 0.4, 0.2
+    /// and `eval_1` 0.2, 0.2, 0.4 for color0 = 0.4, color1 = 0.2.
     #[test]
-    fn squares_alternate() {
+    fn squares_alternate_with_mitsubas_phases() {
         let c = Checkerboard {
             color0: Texture::constant(0.4),
             color1: Texture::constant(0.2),
             to_uv: UvTransform::IDENTITY,
         };
-        let at = |u, v| TexturePoint::from(Vec2::new(u, v));
-        assert_eq!(c.eval_1(&at(0.25, 0.25)), 0.4);
-        assert_eq!(c.eval_1(&at(0.75, 0.75)), 0.4);
-        assert_eq!(c.eval_1(&at(0.75, 0.25)), 0.2);
-        assert_eq!(c.eval_1(&at(1.25, -0.25)), 0.2);
+        let lambda = SampledWavelengths::single(550.0);
+        let at = |u: f32, v: f32| TexturePoint::from(Vec2::new(u, v));
+        let colour = |u: f32, v: f32| c.eval(&at(u, v), &lambda)[0];
+        assert_eq!(colour(0.25, 0.25), 0.4);
+        assert_eq!(colour(0.75, 0.75), 0.4);
+        assert_eq!(colour(0.75, 0.25), 0.2);
+        assert_eq!(colour(1.25, -0.25), 0.2);
+        assert_eq!(c.eval_1(&at(0.25, 0.25)), 0.2);
+        assert_eq!(c.eval_1(&at(0.75, 0.75)), 0.2);
+        assert_eq!(c.eval_1(&at(0.75, 0.25)), 0.4);
+        assert_eq!(c.eval_1(&at(1.25, -0.25)), 0.4);
     }
 }

@@ -126,6 +126,28 @@ impl Texture {
         }
     }
 
+    /// The mean of [`Self::eval_1`] over [0, 1]²: at an image's texel centres, or on a grid of
+    /// 256 × 256 cell centres for a pattern.
+    pub fn mean_value(&self) -> f32 {
+        let (nx, ny) = match self {
+            Texture::Constant(_) => return self.eval_1(Vec2::ZERO),
+            Texture::Bitmap(bitmap) => (bitmap.width.max(1), bitmap.height.max(1)),
+            Texture::Checkerboard(_) => (256, 256),
+            // No (u, v) map: its bound (the scene reader reads mesh attributes only as colours).
+            Texture::MeshAttribute(attribute) => return attribute.scale,
+        };
+        let sum: f64 = (0..nx * ny)
+            .map(|cell| {
+                let uv = Vec2::new(
+                    ((cell % nx) as f32 + 0.5) / nx as f32,
+                    ((cell / nx) as f32 + 0.5) / ny as f32,
+                );
+                f64::from(self.eval_1(uv))
+            })
+            .sum();
+        (sum / (nx * ny) as f64) as f32
+    }
+
     /// The smallest value the texture takes (for validating scalar parameters).
     pub fn min_value(&self) -> f32 {
         match self {

@@ -1,12 +1,15 @@
 //! Integrator plugins: `path` (with Prism's `emitter_sampling`, see
-//! [`prism_core::light::sampler`]) and the lecture's `distrib`.
+//! [`prism_core::light::sampler`]), the lecture's `distrib`, and `volpath` and `volpathmis`
+//! for media.
 
 use crate::description::{PluginClass, PluginNode};
 use crate::params::Params;
 use crate::registry::{Default, Origin, ParamKind, ParamSpec, Plugin, Registry};
 use prism_core::error::{Error, Result};
 use prism_core::integrator::distribution::DirectLights;
-use prism_core::integrator::{DistributionIntegrator, Integrator, PathIntegrator};
+use prism_core::integrator::{
+    DistributionIntegrator, Integrator, PathIntegrator, Tracking, VolPathIntegrator,
+};
 use prism_core::light::LightSelection;
 
 type Build = fn(&Params) -> Result<Integrator>;
@@ -40,6 +43,33 @@ pub static INTEGRATORS: Registry<Build> = Registry {
             ],
             build: build_distrib,
         },
+        Plugin {
+            name: "volpath",
+            origin: Origin::Mitsuba3,
+            summary: "Volumetric path tracing: `path` with participating media between the \
+                      surfaces, free flights by spectral tracking with one majorant for the \
+                      path's four wavelengths, shadow rays through media (closed-form or \
+                      ratio-tracking transmittance) and `null` boundaries, light and phase \
+                      samples in media combined by MIS.",
+            params: &[MAX_DEPTH, RR_DEPTH, HIDE_EMITTERS, EMITTER_SAMPLING],
+            build: build_volpath,
+        },
+        Plugin {
+            name: "volpathmis",
+            origin: Origin::Mitsuba3,
+            summary: "Volumetric path tracing with spectral MIS (Miller, Georgiev & Jarosz \
+                      2019): `volpath`'s path loop with the hero wavelength's free flights, \
+                      combined over the path's four wavelengths and with light samples by the \
+                      balance heuristic, so chromatic media stay free of fireflies.",
+            params: &[
+                MAX_DEPTH,
+                RR_DEPTH,
+                HIDE_EMITTERS,
+                EMITTER_SAMPLING,
+                USE_SPECTRAL_MIS,
+            ],
+            build: build_volpathmis,
+        },
     ],
 };
 
@@ -65,8 +95,15 @@ const EMITTER_SAMPLING: ParamSpec = ParamSpec::new(
     "emitter_sampling",
     ParamKind::Choice(&["power", "uniform"]),
     Default::Str("power"),
-    "Prism only (Mitsuba rejects it): one light per shading point chosen ∝ its power, or \
-     uniformly (as Mitsuba's default equal `sampling_weight`s)",
+    "Prism only (Mitsuba rejects it): one light per shading point chosen ∝ its power × \
+     `sampling_weight`, or ∝ `sampling_weight` alone (Mitsuba's rule; uniform by default)",
+);
+const USE_SPECTRAL_MIS: ParamSpec = ParamSpec::new(
+    "use_spectral_mis",
+    ParamKind::Boolean,
+    Default::Boolean(true),
+    "combine the four wavelengths' free-flight densities by MIS; false weights every \
+     wavelength by the hero's densities alone",
 );
 const BOUNCE_SAMPLES: ParamSpec = ParamSpec::new(
     "bounce_samples",
@@ -144,6 +181,31 @@ fn build_path(params: &Params) -> Result<Integrator> {
         rr_depth: rr_depth as i32,
         hide_emitters: params.boolean(&HIDE_EMITTERS)?,
         light_selection,
+    }))
+}
+
+fn build_volpath(params: &Params) -> Result<Integrator> {
+    let Integrator::Path(path) = build_path(params)? else {
+        unreachable!("build_path builds a path integrator");
+    };
+    Ok(Integrator::VolPath(VolPathIntegrator {
+        max_depth: path.max_depth,
+        rr_depth: path.rr_depth,
+        hide_emitters: path.hide_emitters,
+        light_selection: path.light_selection,
+        tracking: Tracking::Spectral,
+    }))
+}
+
+fn build_volpathmis(params: &Params) -> Result<Integrator> {
+    let Integrator::VolPath(volpath) = build_volpath(params)? else {
+        unreachable!("build_volpath builds a volumetric path integrator");
+    };
+    Ok(Integrator::VolPath(VolPathIntegrator {
+        tracking: Tracking::HeroMis {
+            spectral_mis: params.boolean(&USE_SPECTRAL_MIS)?,
+        },
+        ..volpath
     }))
 }
 

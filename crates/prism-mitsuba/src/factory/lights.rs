@@ -1,13 +1,18 @@
-//! Emitter plugins: `area` (nested in a shape), and at the top level of the scene `point`,
-//! `spot`, `directional`, `constant` and `envmap` (see each light's module in [`prism_core::light`]
-//! for its parameters). Emission may be given as `<rgb>` (an illuminant: the upsampled colour
+//! Emitter plugins: `area` (nested in a shape, or declared with an id and referenced from one),
+//! and at the top level of the scene `point`, `spot`, `projector`, `directional`, `constant` and
+//! `envmap` (see each light's module in [`prism_core::light`] for its parameters). Emission may be given as `<rgb>` (an illuminant: the upsampled colour
 //! times D65), `<float>` (D65 scaled), `<spectrum>` (as written) or a nested
-//! `<spectrum type="blackbody">` with a `temperature` in kelvin.
+//! `<spectrum type="blackbody">` with a `temperature` in kelvin; an area emitter's radiance may
+//! also be a `<texture>` (as a projector's `irradiance` and a spot's `texture`), whose colours
+//! are upsampled as reflectances are, without the D65 factor of an `<rgb>` radiance (as
+//! Mitsuba 3 reads them).
 
 use glam::{DMat4, DVec3, Vec3};
 
+use super::fov::{FOCAL_LENGTH, FOV, FOV_AXIS, horizontal_fov_param};
 use super::spectra::{NestedSpectrum, build_nested_spectrum, spectrum_param};
-use crate::description::{PluginClass, PluginNode};
+use super::textures::{TextureCache, build_texture};
+use crate::description::{NestedPlugin, PluginClass, PluginNode};
 use crate::params::Params;
 use crate::registry::Range;
 use crate::registry::{Default, Origin, ParamKind, ParamSpec, Plugin, Registry};
@@ -15,13 +20,16 @@ use prism_core::bsdf::{Diffuse, Material};
 use prism_core::error::{Error, Result, SourceLocation};
 use prism_core::image::read_bitmap;
 use prism_core::light::{
-    AreaLight, ConstantLight, DirectionalLight, EnvironmentMap, Light, PointLight, SpotLight,
+    AreaLight, ConstantLight, DirectionalLight, EnvironmentMap, Light, PointLight, Projector,
+    SpotLight,
 };
 use prism_core::math::Transform;
 use prism_core::spectrum::{RgbIntent, Spectrum};
+use prism_core::texture::{Texture, TextureUse};
 
-/// Builds an emitter: nested in the shape with this index (`Some`), or at the top level.
-type Build = fn(&Params, Option<u32>) -> Result<Light>;
+/// Builds an emitter: nested in the shape with this index (`Some`), or at the top level, with
+/// the scene's textures.
+type Build = fn(&Params, Option<u32>, &mut TextureCache) -> Result<Light>;
 
 pub static EMITTERS: Registry<Build> = Registry {
     class: PluginClass::Emitter,
@@ -29,42 +37,66 @@ pub static EMITTERS: Registry<Build> = Registry {
         Plugin {
             name: "area",
             origin: Origin::Mitsuba3,
-            summary: "Nested in a shape: emits `radiance` from the side the normal points to.                       Spheres are sampled by the cone they subtend, other shapes by area.",
-            params: &[RADIANCE],
-            build: |params, shape| {
-                Ok(Light::Area(AreaLight {
-                    shape: shape.unwrap_or(0),
-                    radiance: emission_param(params, &RADIANCE)?,
-                }))
-            },
+            summary: "Nested in a shape, or declared with an `id` and referenced from one shape: emits \
+                      `radiance` (a value or a texture) from the side the normal points to. \
+                      Spheres are sampled by the cone they subtend, other shapes by area; \
+                      textured radiance by the texture's luminance mapped through the uv \
+                      parametrisation.",
+            params: &[AREA_RADIANCE, SAMPLING_WEIGHT],
+            build: build_area,
         },
         Plugin {
             name: "point",
             origin: Origin::Mitsuba3,
             summary: "A point light.",
-            params: &[INTENSITY, POSITION, TO_WORLD],
-            build: |params, _| build_point(params),
+            params: &[INTENSITY, POSITION, TO_WORLD, SAMPLING_WEIGHT],
+            build: |params, _, _| build_point(params),
         },
         Plugin {
             name: "spot",
             origin: Origin::Mitsuba3,
-            summary: "A spot light shining along its +z: full intensity within the beam, linear in                       angle to zero at the cutoff. No projected texture.",
-            params: &[INTENSITY, CUTOFF_ANGLE, BEAM_WIDTH, TO_WORLD],
-            build: |params, _| build_spot(params),
+            summary: "A spot light shining along its +z: full intensity within the beam, linear in \
+                      angle to zero at the cutoff; optionally projecting a `texture`.",
+            params: &[
+                INTENSITY,
+                CUTOFF_ANGLE,
+                BEAM_WIDTH,
+                SPOT_TEXTURE,
+                TO_WORLD,
+                SAMPLING_WEIGHT,
+            ],
+            build: |params, _, textures| build_spot(params, textures),
+        },
+        Plugin {
+            name: "projector",
+            origin: Origin::Mitsuba3,
+            summary: "A pinhole projecting `irradiance` (an image) along its +z with the \
+                      perspective camera's field of view; a plane at distance z facing it \
+                      receives π · scale · irradiance / z².",
+            params: &[
+                PROJECTOR_IRRADIANCE,
+                PROJECTOR_SCALE,
+                FOV,
+                FOV_AXIS,
+                FOCAL_LENGTH,
+                TO_WORLD,
+                SAMPLING_WEIGHT,
+            ],
+            build: |params, _, textures| build_projector(params, textures),
         },
         Plugin {
             name: "directional",
             origin: Origin::Mitsuba3,
             summary: "Light from one direction, at infinity.",
-            params: &[IRRADIANCE, DIRECTION, TO_WORLD],
-            build: |params, _| build_directional(params),
+            params: &[IRRADIANCE, DIRECTION, TO_WORLD, SAMPLING_WEIGHT],
+            build: |params, _, _| build_directional(params),
         },
         Plugin {
             name: "constant",
             origin: Origin::Mitsuba3,
             summary: "Uniform light from every direction, at infinity.",
-            params: &[RADIANCE],
-            build: |params, _| {
+            params: &[RADIANCE, SAMPLING_WEIGHT],
+            build: |params, _, _| {
                 Ok(Light::Constant(ConstantLight::new(emission_param(
                     params, &RADIANCE,
                 )?)))
@@ -74,12 +106,19 @@ pub static EMITTERS: Registry<Build> = Registry {
             name: "envmap",
             origin: Origin::Mitsuba3,
             summary: "An environment map: a latitude–longitude image with Mitsuba's orientation                       (+y up, u = 0 looks along −z), pixel-node bilinear lookup and spectral                       upsampling; importance sampled ∝ luminance · sin θ.",
-            params: &[ENVMAP_FILENAME, ENVMAP_SCALE, TO_WORLD],
-            build: |params, _| build_envmap(params),
+            params: &[ENVMAP_FILENAME, ENVMAP_SCALE, TO_WORLD, SAMPLING_WEIGHT],
+            build: |params, _, _| build_envmap(params),
         },
     ],
 };
 
+const SAMPLING_WEIGHT: ParamSpec = ParamSpec::new(
+    "sampling_weight",
+    ParamKind::Float,
+    Default::Float(1.0),
+    "relative weight of choosing this emitter for direct light: P ∝ weight (uniform \
+     `emitter_sampling`, Mitsuba's rule) or ∝ power × weight (by power); 0 never chooses it",
+);
 const D65: Default = Default::Text("D65 of luminance 1");
 const RADIANCE: ParamSpec = ParamSpec::new(
     "radiance",
@@ -89,6 +128,16 @@ const RADIANCE: ParamSpec = ParamSpec::new(
     },
     D65,
     "emitted radiance; or a nested `<spectrum type=\"blackbody\">`",
+);
+const AREA_RADIANCE: ParamSpec = ParamSpec::new(
+    "radiance",
+    ParamKind::Spectrum {
+        range: Range::Emission,
+        textured: true,
+    },
+    D65,
+    "emitted radiance; or a nested `<spectrum type=\"blackbody\">`, or a `<texture>` (its \
+     colours upsampled as reflectances, without D65, as Mitsuba 3 reads them)",
 );
 const INTENSITY: ParamSpec = ParamSpec::new(
     "intensity",
@@ -107,6 +156,29 @@ const IRRADIANCE: ParamSpec = ParamSpec::new(
     },
     D65,
     "irradiance on a surface facing the light; or a nested blackbody",
+);
+const SPOT_TEXTURE: ParamSpec = ParamSpec::new(
+    "texture",
+    ParamKind::Nested(PluginClass::Texture),
+    Default::Text("none"),
+    "a texture projected along the light, spanning the square around the cone at z = 1 (its \
+     colours read as for textured emission); needs `cutoff_angle` below 90",
+);
+const PROJECTOR_IRRADIANCE: ParamSpec = ParamSpec::new(
+    "irradiance",
+    ParamKind::Spectrum {
+        range: Range::Emission,
+        textured: true,
+    },
+    D65,
+    "the image on the plane z = 1 (a `<texture>`, its colours read as for textured emission, \
+     which sets the aspect ratio), or a value",
+);
+const PROJECTOR_SCALE: ParamSpec = ParamSpec::new(
+    "scale",
+    ParamKind::Float,
+    Default::Float(1.0),
+    "factor on the irradiance",
 );
 const POSITION: ParamSpec = ParamSpec::new(
     "position",
@@ -151,8 +223,12 @@ const ENVMAP_SCALE: ParamSpec = ParamSpec::new(
     "factor on the image's values",
 );
 
-/// Builds the area light nested in the shape with index `shape`.
-pub fn build_area_light(node: &PluginNode, shape: u32) -> Result<Light> {
+/// Builds the area light nested in the shape with index `shape`, with its sampling weight.
+pub fn build_area_light(
+    node: &PluginNode,
+    shape: u32,
+    textures: &mut TextureCache,
+) -> Result<(Light, f32)> {
     let plugin = EMITTERS.find(node)?;
     if plugin.name != "area" {
         return Err(Error::input(
@@ -167,9 +243,10 @@ pub fn build_area_light(node: &PluginNode, shape: u32) -> Result<Light> {
         ));
     }
     let params = Params::new(node, plugin.params);
-    let light = (plugin.build)(&params, Some(shape))?;
+    let light = (plugin.build)(&params, Some(shape), textures)?;
+    let weight = sampling_weight(&params)?;
     params.finish()?;
-    Ok(light)
+    Ok((light, weight))
 }
 
 /// The material of an emitting shape that names no BSDF: Mitsuba 3 gives such shapes a black
@@ -180,20 +257,41 @@ pub fn default_emitter_material() -> Material {
     })
 }
 
-/// Builds an emitter declared at the top level of the scene.
-pub fn build_scene_light(node: &PluginNode) -> Result<Light> {
+/// Whether `node` is an `area` emitter, which emits from the shape it is attached to.
+pub fn is_area(node: &PluginNode) -> bool {
+    node.class == PluginClass::Emitter && node.plugin_type == "area"
+}
+
+/// Builds an emitter declared at the top level of the scene, other than `area`, with its
+/// sampling weight.
+pub fn build_scene_light(node: &PluginNode, textures: &mut TextureCache) -> Result<(Light, f32)> {
     let plugin = EMITTERS.find(node)?;
-    if plugin.name == "area" {
-        return Err(Error::input(
-            &node.location,
-            "an \"area\" emitter must be nested in a shape",
-        )
-        .with_help("move it inside the <shape> that should emit light"));
-    }
     let params = Params::new(node, plugin.params);
-    let light = (plugin.build)(&params, None)?;
+    let light = (plugin.build)(&params, None, textures)?;
+    let weight = sampling_weight(&params)?;
     params.finish()?;
-    Ok(light)
+    Ok((light, weight))
+}
+
+/// The emitter's `sampling_weight`: finite and at least 0.
+fn sampling_weight(params: &Params) -> Result<f32> {
+    let weight = params.float_in(&SAMPLING_WEIGHT, 1.0, 0.0, f64::from(f32::MAX))?;
+    Ok(weight as f32)
+}
+
+/// Mitsuba's `area`: a value, a nested spectrum, or a texture read as emission.
+fn build_area(params: &Params, shape: Option<u32>, textures: &mut TextureCache) -> Result<Light> {
+    let shape = shape.unwrap_or(0);
+    if let Some(child) = params.named_child(&AREA_RADIANCE)
+        && child.node.class == PluginClass::Texture
+    {
+        let texture = build_texture(&child.node, TextureUse::Emission, textures)?;
+        return Ok(Light::Area(AreaLight::new(shape, texture)));
+    }
+    Ok(Light::Area(AreaLight::uniform(
+        shape,
+        emission_param(params, &AREA_RADIANCE)?,
+    )))
 }
 
 fn build_point(params: &Params) -> Result<Light> {
@@ -216,7 +314,7 @@ fn build_point(params: &Params) -> Result<Light> {
     }))
 }
 
-fn build_spot(params: &Params) -> Result<Light> {
+fn build_spot(params: &Params, textures: &mut TextureCache) -> Result<Light> {
     let intensity = emission_param(params, &INTENSITY)?;
     let cutoff = params.float_in(&CUTOFF_ANGLE, 20.0, 0.0, 180.0)?;
     if cutoff == 0.0 {
@@ -227,11 +325,77 @@ fn build_spot(params: &Params) -> Result<Light> {
     }
     let beam = params.float_in(&BEAM_WIDTH, 0.75 * cutoff, 0.0, cutoff)?;
     let to_world = invertible(params, &TO_WORLD)?;
-    Ok(Light::Spot(SpotLight::new(
+    let light = SpotLight::new(
         to_world,
         intensity,
         cutoff.to_radians() as f32,
         beam.to_radians() as f32,
+    );
+    let Some(child) = params.named_child(&SPOT_TEXTURE) else {
+        return Ok(Light::Spot(light));
+    };
+    let texture = emission_texture_child(params, &SPOT_TEXTURE, child, textures)?;
+    if cutoff >= 90.0 {
+        return Err(Error::input(
+            params.location_of(&CUTOFF_ANGLE),
+            format!(
+                "a spot light with a texture projects it onto the plane before it, so its \
+                 cutoff_angle must be below 90 degrees, not {cutoff}"
+            ),
+        ));
+    }
+    Ok(Light::Spot(light.with_texture(texture)))
+}
+
+/// The nested plugin `child` given for parameter `spec`, which must be a texture, read as
+/// emission.
+fn emission_texture_child(
+    params: &Params,
+    spec: &ParamSpec,
+    child: &NestedPlugin,
+    textures: &mut TextureCache,
+) -> Result<Texture> {
+    if child.node.class != PluginClass::Texture {
+        return Err(Error::input(
+            &child.node.location,
+            format!(
+                "{} cannot give parameter \"{}\" of {}",
+                child.node.describe(),
+                spec.name,
+                params.node().describe()
+            ),
+        )
+        .with_help("give a <texture>, such as <texture type=\"bitmap\">"));
+    }
+    build_texture(&child.node, TextureUse::Emission, textures)
+}
+
+/// Mitsuba's `projector`: the irradiance image (or value), its scale, the field of view along
+/// the image's aspect ratio (1 for a value), and the placement.
+fn build_projector(params: &Params, textures: &mut TextureCache) -> Result<Light> {
+    let (irradiance, aspect) = match params.named_child(&PROJECTOR_IRRADIANCE) {
+        Some(child) if child.node.class == PluginClass::Texture => {
+            let texture = emission_texture_child(params, &PROJECTOR_IRRADIANCE, child, textures)?;
+            let aspect = match &texture {
+                Texture::Bitmap(bitmap) => bitmap.width as f64 / bitmap.height as f64,
+                _ => 1.0,
+            };
+            (texture, aspect)
+        }
+        _ => (
+            Texture::Constant(emission_param(params, &PROJECTOR_IRRADIANCE)?),
+            1.0,
+        ),
+    };
+    let scale = params.float_in(&PROJECTOR_SCALE, 1.0, 0.0, f64::from(f32::MAX))?;
+    let fov_x = horizontal_fov_param(params, aspect)?;
+    let to_world = invertible(params, &TO_WORLD)?;
+    Ok(Light::Projector(Projector::new(
+        to_world,
+        irradiance,
+        scale as f32,
+        fov_x.to_radians() as f32,
+        aspect as f32,
     )))
 }
 
@@ -262,9 +426,9 @@ fn build_directional(params: &Params) -> Result<Light> {
 
 /// Checks that a scene has at most one environment emitter (`constant` or `envmap`), as
 /// Mitsuba requires; `lights` are the top-level emitters with their elements' locations.
-pub fn check_single_environment(lights: &[(Light, SourceLocation)]) -> Result<()> {
-    let mut environments = lights.iter().filter(|(light, _)| light.is_environment());
-    if let (Some(_), Some((_, second))) = (environments.next(), environments.next()) {
+pub fn check_single_environment(lights: &[(Light, f32, SourceLocation)]) -> Result<()> {
+    let mut environments = lights.iter().filter(|(light, _, _)| light.is_environment());
+    if let (Some(_), Some((_, _, second))) = (environments.next(), environments.next()) {
         return Err(
             Error::input(second, "the scene has more than one environment emitter")
                 .with_help("keep one \"constant\" or \"envmap\" emitter; Mitsuba allows only one"),
@@ -334,7 +498,11 @@ fn emission_param(params: &Params, spec: &ParamSpec) -> Result<Spectrum> {
                 params.node().describe()
             ),
         )
-        .with_help("give the value as <rgb>, <spectrum>, <float> or <spectrum type=\"blackbody\">")
+        .with_help(if matches!(spec.kind, ParamKind::Spectrum { textured: true, .. }) {
+            "give the value as <rgb>, <spectrum>, <float>, <spectrum type=\"blackbody\"> or <texture>"
+        } else {
+            "give the value as <rgb>, <spectrum>, <float> or <spectrum type=\"blackbody\">"
+        })
     };
     if child.node.class != PluginClass::Spectrum {
         return Err(unsupported());

@@ -1,16 +1,22 @@
-//! The sensor and what it carries: the `perspective` and `thinlens` cameras with their shutter,
-//! the `hdrfilm` film with its `rfilter`, and the sampler.
+//! The sensor and what it carries: the `perspective`, `thinlens` and `orthographic` cameras with
+//! their shutter,
+//! the `hdrfilm` and `ldrfilm` films with their `rfilter`, and the sampler.
+
+use std::sync::Arc;
 
 use glam::{UVec2, Vec2};
 
+use super::fov::{FOCAL_LENGTH, FOV, FOV_AXIS, horizontal_fov_param};
 use crate::description::{PluginClass, PluginNode};
-use crate::params::Params;
+use crate::params::{Params, Warning};
 use crate::registry::{Default, Origin, ParamKind, ParamSpec, Plugin, Registry};
-use prism_core::camera::perspective::{FovAxis, focal_length_to_diagonal_fov, horizontal_fov};
-use prism_core::camera::{Camera, PerspectiveCamera, Shutter};
+use prism_core::camera::{Camera, OrthographicCamera, PerspectiveCamera, Shutter};
 use prism_core::error::{Error, Result};
-use prism_core::film::{CropWindow, Filter};
+use prism_core::film::{CropWindow, Filter, LdrFormat, LdrOutput, Tonemap, TransferCurve};
+use prism_core::image::Channels;
+use prism_core::sampling::sampler::MAX_ORTHOGONAL_STRENGTH;
 use prism_core::scene::{FilmSettings, SamplerKind, SamplerSettings};
+use prism_core::spectrum::WavelengthSampling;
 
 /// Builds a sensor; `thinlens` says whether it has a lens.
 type SensorBuild = fn(&Params, bool) -> Result<SensorSettings>;
@@ -32,27 +38,16 @@ pub static SENSORS: Registry<SensorBuild> = Registry {
             params: THINLENS_PARAMS,
             build: build_sensor_of,
         },
+        Plugin {
+            name: "orthographic",
+            origin: Origin::Mitsuba3,
+            summary: "Parallel rays along +z from the square [−1, 1] × [−1/a, 1/a] (a = width / height) of the camera's near plane, placed and scaled by `to_world`.",
+            params: ORTHOGRAPHIC_PARAMS,
+            build: build_orthographic,
+        },
     ],
 };
 
-const FOV: ParamSpec = ParamSpec::new(
-    "fov",
-    ParamKind::Float,
-    Default::Text("from `focal_length`"),
-    "field of view in degrees, along `fov_axis`",
-);
-const FOV_AXIS: ParamSpec = ParamSpec::new(
-    "fov_axis",
-    ParamKind::Choice(&["x", "y", "diagonal", "smaller", "larger"]),
-    Default::Str("x"),
-    "the film axis `fov` is measured along",
-);
-const FOCAL_LENGTH: ParamSpec = ParamSpec::new(
-    "focal_length",
-    ParamKind::String,
-    Default::Str("50mm"),
-    "the field of view as the focal length of a lens on 35 mm film (diagonal); instead of `fov`",
-);
 const NEAR_CLIP: ParamSpec = ParamSpec::new(
     "near_clip",
     ParamKind::Float,
@@ -99,6 +94,11 @@ const SAMPLER: ParamSpec = ParamSpec::nested(
     Default::Text("`independent`, 4 samples"),
     "the sampler",
 );
+const SENSOR_MEDIUM: ParamSpec = ParamSpec::nested(
+    PluginClass::Medium,
+    Default::None,
+    "the medium the camera sits in (for `volpath`)",
+);
 const APERTURE_RADIUS: ParamSpec = ParamSpec::new(
     "aperture_radius",
     ParamKind::Float,
@@ -117,6 +117,12 @@ const FOCUS_DISTANCE: ParamSpec = ParamSpec::new(
     Default::Text("`far_clip`"),
     "distance of the plane in focus",
 );
+const PINHOLE_FOCUS_DISTANCE: ParamSpec = ParamSpec::new(
+    "focus_distance",
+    ParamKind::Float,
+    Default::Text("`far_clip`"),
+    "read as Mitsuba 3 reads it on every projective camera; a pinhole has everything in focus",
+);
 const FOCAL_DISTANCE: ParamSpec = ParamSpec::new(
     "focal_distance",
     ParamKind::Float,
@@ -124,6 +130,24 @@ const FOCAL_DISTANCE: ParamSpec = ParamSpec::new(
     "Prism only, the lecture's name for `focus_distance`",
 );
 
+const ORTHOGRAPHIC_TO_WORLD: ParamSpec = ParamSpec::new(
+    "to_world",
+    ParamKind::AnimatedTransform,
+    Default::Text("identity"),
+    "camera to world, scales included (they set the film's extent in the scene), or an `<animation>` of them",
+);
+const ORTHOGRAPHIC_PARAMS: &[ParamSpec] = &[
+    NEAR_CLIP,
+    FAR_CLIP,
+    ORTHOGRAPHIC_TO_WORLD,
+    SHUTTER_OPEN,
+    SHUTTER_CLOSE,
+    SHUTTER_FILTER,
+    FILM,
+    SAMPLER,
+    PINHOLE_FOCUS_DISTANCE,
+    SENSOR_MEDIUM,
+];
 const PERSPECTIVE_PARAMS: &[ParamSpec] = &[
     FOV,
     FOV_AXIS,
@@ -136,6 +160,8 @@ const PERSPECTIVE_PARAMS: &[ParamSpec] = &[
     SHUTTER_FILTER,
     FILM,
     SAMPLER,
+    PINHOLE_FOCUS_DISTANCE,
+    SENSOR_MEDIUM,
 ];
 const THINLENS_PARAMS: &[ParamSpec] = &[
     FOV,
@@ -149,34 +175,69 @@ const THINLENS_PARAMS: &[ParamSpec] = &[
     SHUTTER_FILTER,
     FILM,
     SAMPLER,
+    SENSOR_MEDIUM,
     APERTURE_RADIUS,
     APERTURE_AREA,
     FOCUS_DISTANCE,
     FOCAL_DISTANCE,
 ];
 
-type FilmBuild = fn(&Params) -> Result<FilmSettings>;
+type FilmBuild = fn(&Params) -> Result<(FilmSettings, LdrOutput)>;
 
 pub static FILMS: Registry<FilmBuild> = Registry {
     class: PluginClass::Film,
-    plugins: &[Plugin {
-        name: "hdrfilm",
-        origin: Origin::Mitsuba3,
-        summary: "A high dynamic range film; Prism writes it as 32-bit OpenEXR (RGB, XYZ, per-pixel                   variance and relative error) and an sRGB PNG.",
-        params: &[
-            WIDTH,
-            HEIGHT,
-            CROP_OFFSET_X,
-            CROP_OFFSET_Y,
-            CROP_WIDTH,
-            CROP_HEIGHT,
-            FILE_FORMAT,
-            PIXEL_FORMAT,
-            COMPONENT_FORMAT,
-            RFILTER,
-        ],
-        build: build_hdrfilm,
-    }],
+    plugins: &[
+        Plugin {
+            name: "hdrfilm",
+            origin: Origin::Mitsuba3,
+            summary: "A high dynamic range film; Prism writes it as 32-bit OpenEXR (RGB, XYZ, per-pixel \
+                      variance and relative error) and an sRGB PNG.",
+            params: &[
+                WIDTH,
+                HEIGHT,
+                CROP_OFFSET_X,
+                CROP_OFFSET_Y,
+                CROP_WIDTH,
+                CROP_HEIGHT,
+                FILE_FORMAT,
+                PIXEL_FORMAT,
+                COMPONENT_FORMAT,
+                RFILTER,
+                WAVELENGTH_SAMPLING,
+                BANNER,
+                ATTACH_LOG,
+                HIGH_QUALITY_EDGES,
+                HDR_GAMMA,
+            ],
+            build: build_hdrfilm,
+        },
+        Plugin {
+            name: "ldrfilm",
+            origin: Origin::Mitsuba06,
+            summary: "Mitsuba 0.6's low dynamic range film: Prism writes its usual OpenEXR and, in \
+                      place of the sRGB PNG, the 8-bit PNG or JPEG tonemapped as the film asks.",
+            params: &[
+                WIDTH,
+                HEIGHT,
+                CROP_OFFSET_X,
+                CROP_OFFSET_Y,
+                CROP_WIDTH,
+                CROP_HEIGHT,
+                LDR_FILE_FORMAT,
+                LDR_PIXEL_FORMAT,
+                TONEMAP_METHOD,
+                LDR_GAMMA,
+                EXPOSURE,
+                KEY,
+                BURN,
+                RFILTER,
+                WAVELENGTH_SAMPLING,
+                BANNER,
+                HIGH_QUALITY_EDGES,
+            ],
+            build: build_ldrfilm,
+        },
+    ],
 };
 
 const WIDTH: ParamSpec = ParamSpec::new(
@@ -227,11 +288,85 @@ const PIXEL_FORMAT: ParamSpec = ParamSpec::new(
     Default::Str("rgb"),
     "accepted; the output always holds RGB and XYZ",
 );
+const WAVELENGTH_SAMPLING: ParamSpec = ParamSpec::new(
+    "wavelength_sampling",
+    ParamKind::Choice(&WavelengthSampling::NAMES),
+    Default::Str("balanced"),
+    "Prism only (Mitsuba rejects it): the density wavelengths are drawn from: `balanced` \
+     (least error of luminance and linear sRGB under white light), `cie_sum` (∝ x̄+ȳ+z̄, the \
+     lecture's), `visible` (Mitsuba's and pbrt's), `uniform`; see docs/wavelengths.md",
+);
 const COMPONENT_FORMAT: ParamSpec = ParamSpec::new(
     "component_format",
     ParamKind::Choice(&["float16", "float32", "uint32"]),
     Default::Str("float32"),
     "accepted; the output is always 32-bit float",
+);
+const BANNER: ParamSpec = ParamSpec::new(
+    "banner",
+    ParamKind::Boolean,
+    Default::Ignored,
+    "Mitsuba 0.6's \"rendered by Mitsuba\" banner; Prism writes none",
+);
+const ATTACH_LOG: ParamSpec = ParamSpec::new(
+    "attach_log",
+    ParamKind::Boolean,
+    Default::Ignored,
+    "Mitsuba 0.6's render log in the image's metadata; Prism attaches none",
+);
+const HIGH_QUALITY_EDGES: ParamSpec = ParamSpec::new(
+    "high_quality_edges",
+    ParamKind::Boolean,
+    Default::Ignored,
+    "Mitsuba 0.6's sampling of a margin outside the film; Prism samples the film's pixels only",
+);
+const HDR_GAMMA: ParamSpec = ParamSpec::new(
+    "gamma",
+    ParamKind::Float,
+    Default::Ignored,
+    "a gamma on an HDR film, as Mitsuba 0.6 scenes give it; the EXR is linear",
+);
+const LDR_FILE_FORMAT: ParamSpec = ParamSpec::new(
+    "file_format",
+    ParamKind::Choice(&["png", "jpeg", "jpg"]),
+    Default::Str("png"),
+    "the 8-bit file: PNG, or JPEG of quality 100 (extension `.jpg`)",
+);
+const LDR_PIXEL_FORMAT: ParamSpec = ParamSpec::new(
+    "pixel_format",
+    ParamKind::Choice(&["rgb", "rgba", "luminance", "luminanceAlpha"]),
+    Default::Str("rgb"),
+    "the 8-bit image's channels; Prism's alpha is opaque (its film records no coverage), and a JPEG drops it, as Mitsuba 0.6 does",
+);
+const TONEMAP_METHOD: ParamSpec = ParamSpec::new(
+    "tonemap_method",
+    ParamKind::Choice(&["gamma", "reinhard"]),
+    Default::Str("gamma"),
+    "`gamma`: scale by 2^`exposure`; `reinhard`: Reinhard et al. 2002's global operator with `key` and `burn`",
+);
+const LDR_GAMMA: ParamSpec = ParamSpec::new(
+    "gamma",
+    ParamKind::Float,
+    Default::Float(-1.0),
+    "the transfer curve v^(1/γ) of the 8-bit values; −1 is the sRGB curve",
+);
+const EXPOSURE: ParamSpec = ParamSpec::new(
+    "exposure",
+    ParamKind::Float,
+    Default::Float(0.0),
+    "with `gamma` tonemapping, the exposure in f-stops: values are scaled by 2^exposure",
+);
+const KEY: ParamSpec = ParamSpec::new(
+    "key",
+    ParamKind::Float,
+    Default::Float(0.18),
+    "with `reinhard`, the value the log-average luminance maps to, in (0, 1]",
+);
+const BURN: ParamSpec = ParamSpec::new(
+    "burn",
+    ParamKind::Float,
+    Default::Float(0.0),
+    "with `reinhard`, how much highlights may burn out, in [0, 1]",
 );
 const RFILTER: ParamSpec = ParamSpec::nested(
     PluginClass::Rfilter,
@@ -395,8 +530,43 @@ pub static SAMPLERS: Registry<SamplerBuild> = Registry {
             params: &[SAMPLE_COUNT, SEED],
             build: |_| Ok(SamplerKind::NRooks),
         },
+        Plugin {
+            name: "ldsampler",
+            origin: Origin::Mitsuba3,
+            summary: "Mitsuba 3's low-discrepancy sampler (and Mitsuba 0.6's of the same name): a scrambled (0, 2)-sequence shuffled per dimension; `sample_count` is rounded up to a square of a power of two.",
+            params: &[SAMPLE_COUNT, SEED],
+            build: |_| Ok(SamplerKind::LowDiscrepancy),
+        },
+        Plugin {
+            name: "orthogonal",
+            origin: Origin::Mitsuba3,
+            summary: "Orthogonal array sampling (Jarosz et al. 2019), as Mitsuba 3 does: `sample_count` is rounded up to p^`strength` for a prime p.",
+            params: &[SAMPLE_COUNT, SEED, JITTER, STRENGTH],
+            build: |params| {
+                let strength = params.integer(&STRENGTH)?;
+                if !(1..=i64::from(MAX_ORTHOGONAL_STRENGTH)).contains(&strength) {
+                    return Err(Error::input(
+                        params.location_of(&STRENGTH),
+                        format!(
+                            "the orthogonal array's strength must be between 1 and {MAX_ORTHOGONAL_STRENGTH}, not {strength}"
+                        ),
+                    ));
+                }
+                Ok(SamplerKind::Orthogonal {
+                    strength: strength as u32,
+                    jitter: params.boolean(&JITTER)?,
+                })
+            },
+        },
     ],
 };
+
+const STRENGTH: ParamSpec = ParamSpec::new(
+    "strength",
+    ParamKind::Integer,
+    Default::Integer(2),
+    "the orthogonal array's strength t: every t dimensions together are stratified (1 to 4)",
+);
 
 const SAMPLE_COUNT: ParamSpec = ParamSpec::new(
     "sample_count",
@@ -429,6 +599,12 @@ pub struct SensorSettings {
     pub film: FilmSettings,
     pub sampler: SamplerSettings,
     pub seed: u64,
+    /// How the 8-bit image is written (`ldrfilm`), or the default sRGB PNG.
+    pub ldr_output: LdrOutput,
+    /// The parameters read and ignored, one warning each.
+    pub warnings: Vec<Warning>,
+    /// The nested `<medium>` the camera sits in, built with the scene's other media.
+    pub medium: Option<Arc<PluginNode>>,
 }
 
 /// Builds the sensor a node describes.
@@ -440,10 +616,20 @@ pub fn build_sensor(node: &PluginNode) -> Result<SensorSettings> {
     Ok(sensor)
 }
 
-fn build_sensor_of(params: &Params, thinlens: bool) -> Result<SensorSettings> {
-    let film = match params.single_child(&FILM)? {
+/// What every sensor carries: its film (with the 8-bit output and the warnings of its ignored
+/// parameters), its sampler and the sampler's seed.
+struct SensorParts {
+    film: FilmSettings,
+    ldr_output: LdrOutput,
+    warnings: Vec<Warning>,
+    sampler: SamplerSettings,
+    seed: u64,
+}
+
+fn sensor_parts(params: &Params) -> Result<SensorParts> {
+    let (film, ldr_output, warnings) = match params.single_child(&FILM)? {
         Some(child) => build_film(&child.node)?,
-        None => default_film(),
+        None => (default_film(), LdrOutput::default(), Vec::new()),
     };
     let (sampler, seed) = match params.single_child(&SAMPLER)? {
         Some(child) => build_sampler(&child.node)?,
@@ -455,56 +641,17 @@ fn build_sensor_of(params: &Params, thinlens: bool) -> Result<SensorSettings> {
             0,
         ),
     };
+    Ok(SensorParts {
+        film,
+        ldr_output,
+        warnings,
+        sampler,
+        seed,
+    })
+}
 
-    let aspect = f64::from(film.size.x) / f64::from(film.size.y);
-    let fov_x = match (params.float_opt(&FOV)?, params.string_opt(&FOCAL_LENGTH)?) {
-        (Some(_), Some(_)) => {
-            return Err(Error::input(
-                params.location_of(&FOCAL_LENGTH),
-                "give either \"fov\" or \"focal_length\", not both",
-            ));
-        }
-        (Some(fov), None) => {
-            let axis = match params.choice(&FOV_AXIS)? {
-                "y" => FovAxis::Y,
-                "diagonal" => FovAxis::Diagonal,
-                "smaller" => FovAxis::Smaller,
-                "larger" => FovAxis::Larger,
-                _ => FovAxis::X,
-            };
-            horizontal_fov(fov, axis, aspect)
-        }
-        (None, focal_length) => {
-            let text = focal_length.unwrap_or("50mm");
-            let mm: f64 = text
-                .trim()
-                .trim_end_matches("mm")
-                .trim()
-                .parse()
-                .map_err(|_| {
-                    Error::input(
-                        params.location_of(&FOCAL_LENGTH),
-                        format!("could not read the focal length \"{text}\""),
-                    )
-                    .with_help("write it as a number of millimetres, e.g. \"35mm\"")
-                })?;
-            if !(mm > 0.0) {
-                return Err(Error::input(
-                    params.location_of(&FOCAL_LENGTH),
-                    "the focal length must be positive",
-                ));
-            }
-            horizontal_fov(focal_length_to_diagonal_fov(mm), FovAxis::Diagonal, aspect)
-        }
-    };
-    if !(fov_x > 0.0 && fov_x < 180.0) {
-        return Err(Error::input(
-            params.location_of(&FOV),
-            format!(
-                "the horizontal field of view is {fov_x} degrees; it must lie strictly between 0 and 180"
-            ),
-        ));
-    }
+/// `near_clip` and `far_clip`, as Mitsuba 3's projective cameras check them.
+fn clip_distances(params: &Params) -> Result<(f64, f64)> {
     let near_clip = params.float(&NEAR_CLIP)?;
     let far_clip = params.float(&FAR_CLIP)?;
     if !(near_clip > 0.0) || !(far_clip > near_clip) || !far_clip.is_finite() {
@@ -515,11 +662,52 @@ fn build_sensor_of(params: &Params, thinlens: bool) -> Result<SensorSettings> {
             ),
         ));
     }
+    Ok((near_clip, far_clip))
+}
+
+/// `orthographic` (Mitsuba 3's `orthographic.cpp`).
+fn build_orthographic(params: &Params, _thinlens: bool) -> Result<SensorSettings> {
+    let parts = sensor_parts(params)?;
+    let (near_clip, far_clip) = clip_distances(params)?;
+    params.float_opt(&PINHOLE_FOCUS_DISTANCE)?;
+    let to_world = params.animated_transform(&ORTHOGRAPHIC_TO_WORLD)?;
+    let shutter = shutter(params)?;
+    let camera = Camera::Orthographic(OrthographicCamera {
+        to_world,
+        film_size: Vec2::new(parts.film.size.x as f32, parts.film.size.y as f32),
+        near_clip: near_clip as f32,
+        far_clip: far_clip as f32,
+    });
+    Ok(SensorSettings {
+        camera,
+        shutter,
+        film: parts.film,
+        sampler: parts.sampler,
+        seed: parts.seed,
+        ldr_output: parts.ldr_output,
+        warnings: parts.warnings,
+        medium: params.single_child(&SENSOR_MEDIUM)?.map(|c| c.node.clone()),
+    })
+}
+
+fn build_sensor_of(params: &Params, thinlens: bool) -> Result<SensorSettings> {
+    let SensorParts {
+        film,
+        ldr_output,
+        warnings,
+        sampler,
+        seed,
+    } = sensor_parts(params)?;
+
+    let aspect = f64::from(film.size.x) / f64::from(film.size.y);
+    let fov_x = horizontal_fov_param(params, aspect)?;
+    let (near_clip, far_clip) = clip_distances(params)?;
     let to_world = params.animated_transform(&SENSOR_TO_WORLD)?;
     let (lens_radius, focus_distance) = if thinlens {
         lens(params, far_clip)?
     } else {
-        (0.0, far_clip)
+        let focus_distance = params.float_opt(&PINHOLE_FOCUS_DISTANCE)?;
+        (0.0, focus_distance.unwrap_or(far_clip))
     };
     if lens_radius > 0.0 && !to_world.is_similarity() || to_world.uniform_scale(0.0) > 1.0 + 1e-4 {
         return Err(Error::input(
@@ -545,6 +733,9 @@ fn build_sensor_of(params: &Params, thinlens: bool) -> Result<SensorSettings> {
         film,
         sampler,
         seed,
+        ldr_output,
+        warnings,
+        medium: params.single_child(&SENSOR_MEDIUM)?.map(|c| c.node.clone()),
     })
 }
 
@@ -636,21 +827,100 @@ fn default_film() -> FilmSettings {
             size,
         },
         filter: Filter::Gaussian { stddev: 0.5 },
+        wavelength_sampling: WavelengthSampling::default(),
     }
+}
+
+/// The film a node describes, how its 8-bit image is written, and a warning for each ignored
+/// parameter it gives.
+fn build_film(node: &PluginNode) -> Result<(FilmSettings, LdrOutput, Vec<Warning>)> {
+    let plugin = FILMS.find(node)?;
+    let params = Params::new(node, plugin.params);
+    let (film, ldr) = (plugin.build)(&params)?;
+    let warnings = params.finish_with_warnings()?;
+    Ok((film, ldr, warnings))
 }
 
 /// `hdrfilm`: `width` (768), `height` (576), `crop_offset_x/y`, `crop_width/height`, a nested
 /// `rfilter` (Gaussian by default). `file_format`, `pixel_format` and `component_format` are
 /// accepted for compatibility; Prism always writes 32-bit linear RGB and XYZ to EXR.
-fn build_film(node: &PluginNode) -> Result<FilmSettings> {
-    let plugin = FILMS.find(node)?;
-    let params = Params::new(node, plugin.params);
-    let film = (plugin.build)(&params)?;
-    params.finish()?;
-    Ok(film)
+fn build_hdrfilm(params: &Params) -> Result<(FilmSettings, LdrOutput)> {
+    let film = film_settings(params)?;
+    for spec in [&FILE_FORMAT, &PIXEL_FORMAT, &COMPONENT_FORMAT] {
+        params.choice(spec)?;
+    }
+    Ok((film, LdrOutput::default()))
 }
 
-fn build_hdrfilm(params: &Params) -> Result<FilmSettings> {
+/// `ldrfilm` (Mitsuba 0.6's `src/films/ldrfilm.cpp`): the film of `hdrfilm`, and how its 8-bit
+/// image is tonemapped ([`prism_core::film::ldr`]).
+fn build_ldrfilm(params: &Params) -> Result<(FilmSettings, LdrOutput)> {
+    let film = film_settings(params)?;
+    let format = match params.choice(&LDR_FILE_FORMAT)? {
+        "png" => LdrFormat::Png,
+        _ => LdrFormat::Jpeg,
+    };
+    let channels = match (params.choice(&LDR_PIXEL_FORMAT)?, format) {
+        ("rgba", LdrFormat::Png) => Channels::Rgba,
+        ("luminanceAlpha", LdrFormat::Png) => Channels::LuminanceAlpha,
+        ("luminance" | "luminanceAlpha", _) => Channels::Luminance,
+        _ => Channels::Rgb,
+    };
+    let gamma = params.float(&LDR_GAMMA)?;
+    let curve = if gamma == -1.0 {
+        TransferCurve::Srgb
+    } else if gamma > 0.0 && gamma.is_finite() {
+        TransferCurve::Gamma(gamma as f32)
+    } else {
+        return Err(Error::input(
+            params.location_of(&LDR_GAMMA),
+            format!("the film's gamma must be positive, or −1 for the sRGB curve, not {gamma}"),
+        ));
+    };
+    // Mitsuba 0.6 reads all three whichever the method, so a scene may give them all.
+    let exposure = params.float(&EXPOSURE)?;
+    let key = params.float(&KEY)?;
+    let burn = params.float(&BURN)?;
+    let out_of_range = |spec: &ParamSpec, range: &str, value: f64| {
+        Error::input(
+            params.location_of(spec),
+            format!(
+                "the film's \"{}\" must lie in {range}, not {value}",
+                spec.name
+            ),
+        )
+    };
+    if !(exposure.abs() <= 100.0) {
+        return Err(out_of_range(&EXPOSURE, "[−100, 100] f-stops", exposure));
+    }
+    if !(key > 0.0 && key <= 1.0) {
+        return Err(out_of_range(&KEY, "(0, 1]", key));
+    }
+    if !(0.0..=1.0).contains(&burn) {
+        return Err(out_of_range(&BURN, "[0, 1]", burn));
+    }
+    let tonemap = match params.choice(&TONEMAP_METHOD)? {
+        "reinhard" => Tonemap::Reinhard {
+            key: key as f32,
+            burn: burn as f32,
+        },
+        _ => Tonemap::Exposure {
+            exposure: exposure as f32,
+        },
+    };
+    Ok((
+        film,
+        LdrOutput {
+            tonemap,
+            curve,
+            format,
+            channels,
+        },
+    ))
+}
+
+/// The size, crop window, filter and wavelength density that `hdrfilm` and `ldrfilm` share.
+fn film_settings(params: &Params) -> Result<FilmSettings> {
     let width = params.integer(&WIDTH)?;
     let height = params.integer(&HEIGHT)?;
     if !(1..=MAX_FILM_SIDE).contains(&width)
@@ -683,13 +953,12 @@ fn build_hdrfilm(params: &Params) -> Result<FilmSettings> {
             ),
         ));
     }
-    for spec in [&FILE_FORMAT, &PIXEL_FORMAT, &COMPONENT_FORMAT] {
-        params.choice(spec)?;
-    }
     let filter = match params.single_child(&RFILTER)? {
         Some(child) => build_filter(&child.node)?,
         None => Filter::Gaussian { stddev: 0.5 },
     };
+    let wavelength_sampling = WavelengthSampling::from_name(params.choice(&WAVELENGTH_SAMPLING)?)
+        .expect("the choice is one of the names");
     let size = UVec2::new(width as u32, height as u32);
     Ok(FilmSettings {
         size,
@@ -698,6 +967,7 @@ fn build_hdrfilm(params: &Params) -> Result<FilmSettings> {
             size: UVec2::new(crop_width as u32, crop_height as u32),
         },
         filter,
+        wavelength_sampling,
     })
 }
 
@@ -725,7 +995,7 @@ fn filter_size(params: &Params, spec: &ParamSpec) -> Result<f32> {
 }
 
 /// The sampler a node describes, with its seed.
-fn build_sampler(node: &PluginNode) -> Result<(SamplerSettings, u64)> {
+pub(crate) fn build_sampler(node: &PluginNode) -> Result<(SamplerSettings, u64)> {
     let plugin = SAMPLERS.find(node)?;
     let params = Params::new(node, plugin.params);
     let kind = (plugin.build)(&params)?;
@@ -735,6 +1005,18 @@ fn build_sampler(node: &PluginNode) -> Result<(SamplerSettings, u64)> {
             params.location_of(&SAMPLE_COUNT),
             format!("sample_count must be between 1 and {}, not {spp}", 1 << 24),
         ));
+    }
+    if kind.sample_count(spp as u32) > 1 << 24 {
+        return Err(Error::input(
+            params.location_of(&SAMPLE_COUNT),
+            format!(
+                "{} sampler rounds {spp} samples up to {}, more than {}",
+                plugin.name,
+                kind.sample_count(spp as u32),
+                1 << 24
+            ),
+        )
+        .with_help("ask for fewer samples, or a lower strength"));
     }
     let seed = params.integer(&SEED)?;
     params.finish()?;

@@ -1,5 +1,6 @@
 //! Shape plugins: `obj`, `ply`, `serialized`, `rectangle`, `cube`, `sphere`, `disk` and
-//! `cylinder`. Any shape whose
+//! `cylinder`, and the instancing plugins `shapegroup` and `instance` (built by the scene,
+//! [`super::instancing`]). Any shape whose
 //! `to_world` is an `<animation>` moves while the shutter is open: it is built in object space
 //! and placed by an [`Instance`].
 
@@ -34,6 +35,8 @@ pub static SHAPES: Registry<Build> = Registry {
                 TO_WORLD,
                 BSDF,
                 EMITTER,
+                INTERIOR,
+                EXTERIOR,
             ],
             build: |params, to_world| build_mesh_file(params, to_world, MeshFormat::Obj),
         },
@@ -48,6 +51,8 @@ pub static SHAPES: Registry<Build> = Registry {
                 TO_WORLD,
                 BSDF,
                 EMITTER,
+                INTERIOR,
+                EXTERIOR,
             ],
             build: |params, to_world| build_mesh_file(params, to_world, MeshFormat::Ply),
         },
@@ -65,6 +70,8 @@ pub static SHAPES: Registry<Build> = Registry {
                 TO_WORLD,
                 BSDF,
                 EMITTER,
+                INTERIOR,
+                EXTERIOR,
             ],
             build: |params, to_world| build_mesh_file(params, to_world, MeshFormat::Serialized),
         },
@@ -72,7 +79,7 @@ pub static SHAPES: Registry<Build> = Registry {
             name: "rectangle",
             origin: Origin::Mitsuba3,
             summary: "[−1, 1]² in the z = 0 plane, normal +z.",
-            params: &[FLIP_NORMALS, TO_WORLD, BSDF, EMITTER],
+            params: &[FLIP_NORMALS, TO_WORLD, BSDF, EMITTER, INTERIOR, EXTERIOR],
             build: |params, to_world| {
                 Ok(Shape::Mesh(transform_mesh(
                     rectangle(),
@@ -86,7 +93,7 @@ pub static SHAPES: Registry<Build> = Registry {
             name: "cube",
             origin: Origin::Mitsuba3,
             summary: "[−1, 1]³ with outward normals, each face flat.",
-            params: &[FLIP_NORMALS, TO_WORLD, BSDF, EMITTER],
+            params: &[FLIP_NORMALS, TO_WORLD, BSDF, EMITTER, INTERIOR, EXTERIOR],
             build: |params, to_world| {
                 Ok(Shape::Mesh(transform_mesh(
                     cube(),
@@ -101,14 +108,23 @@ pub static SHAPES: Registry<Build> = Registry {
             origin: Origin::Mitsuba3,
             summary: "A sphere; light sampled by the cone it subtends. `to_world` may rotate, \
                       translate and scale uniformly.",
-            params: &[CENTER, RADIUS, FLIP_NORMALS, TO_WORLD, BSDF, EMITTER],
+            params: &[
+                CENTER,
+                RADIUS,
+                FLIP_NORMALS,
+                TO_WORLD,
+                BSDF,
+                EMITTER,
+                INTERIOR,
+                EXTERIOR,
+            ],
             build: build_sphere,
         },
         Plugin {
             name: "disk",
             origin: Origin::Mitsuba3,
             summary: "The unit disk in the z = 0 plane, normal +z.",
-            params: &[FLIP_NORMALS, TO_WORLD, BSDF, EMITTER],
+            params: &[FLIP_NORMALS, TO_WORLD, BSDF, EMITTER, INTERIOR, EXTERIOR],
             build: |params, to_world| {
                 Ok(Shape::Disk(Disk::new(
                     *to_world,
@@ -130,8 +146,27 @@ pub static SHAPES: Registry<Build> = Registry {
                 TO_WORLD,
                 BSDF,
                 EMITTER,
+                INTERIOR,
+                EXTERIOR,
             ],
             build: build_cylinder,
+        },
+        Plugin {
+            name: "shapegroup",
+            origin: Origin::Mitsuba3,
+            summary: "Shapes to be placed by `instance`s, which share their geometry and \
+                      hierarchy; renders nothing itself. No emitters, no nested groups or \
+                      instances (as in Mitsuba 3).",
+            params: &[GROUP_SHAPES],
+            build: |params, _| Err(nested_instancing(params, "a shapegroup")),
+        },
+        Plugin {
+            name: "instance",
+            origin: Origin::Mitsuba3,
+            summary: "A `shapegroup` (by `<ref id=\"...\"/>`) placed by `to_world`; the scene's \
+                      hierarchy holds it as one primitive over the group's own.",
+            params: &[INSTANCE_GROUP, INSTANCE_TO_WORLD],
+            build: |params, _| Err(nested_instancing(params, "an instance")),
         },
     ],
 };
@@ -154,6 +189,39 @@ const CYLINDER_RADIUS: ParamSpec = ParamSpec::new(
     Default::Float(1.0),
     "radius of the cylinder",
 );
+
+/// The shapes of a `shapegroup`.
+pub const GROUP_SHAPES: ParamSpec = ParamSpec::nested(
+    PluginClass::Shape,
+    Default::None,
+    "the group's shapes, each with its BSDF and media",
+);
+/// The group an `instance` places.
+pub const INSTANCE_GROUP: ParamSpec = ParamSpec::nested(
+    PluginClass::Shape,
+    Default::Required,
+    "the `shapegroup` placed, usually `<ref id=\"...\"/>`",
+);
+/// The transform of an `instance`.
+pub const INSTANCE_TO_WORLD: ParamSpec = ParamSpec::new(
+    "to_world",
+    ParamKind::AnimatedTransform,
+    Default::Text("identity"),
+    "group to world; an `<animation>` moves the instance during the exposure (Prism; Mitsuba 3 \
+     takes a fixed transform)",
+);
+
+/// The error for a `shapegroup` or `instance` inside a `shapegroup` (a shape built as a
+/// group's member; the scene builds top-level groups and instances itself).
+fn nested_instancing(params: &Params, what: &str) -> Error {
+    Error::input(
+        params.location(),
+        format!("{what} cannot be part of a shapegroup: instancing does not nest"),
+    )
+    .with_help(
+        "declare shapegroups and instances at the top level of the scene (as Mitsuba 3 requires)",
+    )
+}
 
 const FILENAME: ParamSpec = ParamSpec::new(
     "filename",
@@ -202,6 +270,20 @@ pub const BSDF: ParamSpec = ParamSpec::nested(
 /// The emitter of every shape.
 pub const EMITTER: ParamSpec =
     ParamSpec::nested(PluginClass::Emitter, Default::None, "an `area` emitter");
+/// The medium inside a shape (the side its normals point away from).
+pub const INTERIOR: ParamSpec = ParamSpec::new(
+    "interior",
+    ParamKind::Nested(PluginClass::Medium),
+    Default::None,
+    "a `<medium name=\"interior\">` (or `<ref name=\"interior\" id=\"...\"/>`) inside the shape",
+);
+/// The medium outside a shape.
+pub const EXTERIOR: ParamSpec = ParamSpec::new(
+    "exterior",
+    ParamKind::Nested(PluginClass::Medium),
+    Default::None,
+    "a `<medium name=\"exterior\">` outside the shape",
+);
 const CENTER: ParamSpec = ParamSpec::new(
     "center",
     ParamKind::Point,
@@ -225,6 +307,11 @@ pub fn shape_params(node: &PluginNode) -> Result<(&'static Plugin<Build>, Params
 /// whose `to_world` is an `<animation>` is built in object space and placed by an [`Instance`];
 /// a fixed `to_world` is applied to the shape once.
 pub fn build_shape(plugin: &Plugin<Build>, params: &Params) -> Result<Primitive> {
+    // A `shapegroup` has no transform: the scene builds it, so it only gets here nested, where
+    // its builder refuses it.
+    if plugin.params.iter().all(|p| p.name != TO_WORLD.name) {
+        return (plugin.build)(params, &Transform::IDENTITY).map(Primitive::Shape);
+    }
     let to_world = params.animated_transform(&TO_WORLD)?;
     if to_world.is_animated() {
         let shape = (plugin.build)(params, &Transform::IDENTITY)?;

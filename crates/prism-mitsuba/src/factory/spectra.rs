@@ -157,8 +157,9 @@ pub fn build_nested_spectrum(node: &crate::description::PluginNode) -> Result<Ne
 /// absent.
 pub fn spectrum_param(params: &Params, spec: &ParamSpec) -> Result<Spectrum> {
     let name = spec.name;
-    let ParamKind::Spectrum { range, .. } = spec.kind else {
-        panic!("\"{name}\" is not a spectrum");
+    let range = match spec.kind {
+        ParamKind::Spectrum { range, .. } | ParamKind::Volume(range) => range,
+        _ => panic!("\"{name}\" is not a spectrum"),
     };
     if let Some(child) = params.named_child(spec) {
         return Err(Error::input(
@@ -189,7 +190,7 @@ pub fn spectrum_param(params: &Params, spec: &ParamSpec) -> Result<Spectrum> {
         .with_help("spectral values must be finite and at least 0")
     };
     let intent = match range {
-        Range::Albedo => RgbIntent::Albedo,
+        Range::Albedo | Range::Coefficient => RgbIntent::Albedo,
         Range::Emission => RgbIntent::Illuminant,
         Range::Unbounded => RgbIntent::Unbounded,
     };
@@ -200,7 +201,9 @@ pub fn spectrum_param(params: &Params, spec: &ParamSpec) -> Result<Spectrum> {
                 return Err(negative());
             }
             match range {
-                Range::Albedo | Range::Unbounded => Spectrum::Constant(v as f32),
+                Range::Albedo | Range::Unbounded | Range::Coefficient => {
+                    Spectrum::Constant(v as f32)
+                }
                 Range::Emission => Spectrum::from_rgb([v as f32; 3], RgbIntent::Illuminant),
             }
         }

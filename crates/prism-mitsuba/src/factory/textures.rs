@@ -1,4 +1,4 @@
-//! Texture plugins (`bitmap`, `checkerboard`, `mesh_attribute`) and texture-valued parameters: any colour or
+//! Texture plugins (`bitmap`, `checkerboard`, `mesh_attribute`, `rawconstant`) and texture-valued parameters: any colour or
 //! number a BSDF takes may be given as a value (`<rgb>`, `<spectrum>`, `<float>`) or as a nested
 //! `<texture>` (inline or a `<ref name="..." id="..."/>` to a texture declared at the top level).
 //!
@@ -16,7 +16,8 @@ use crate::registry::Range;
 use crate::registry::{Bounds, Default, Origin, ParamKind, ParamSpec, Plugin, Registry};
 use prism_core::error::{Error, Result};
 use prism_core::geometry::interaction::MAX_MESH_ATTRIBUTES;
-use prism_core::image::{Encoding, read_bitmap};
+use prism_core::image::{Bitmap, Encoding, read_bitmap};
+use prism_core::spectrum::{LAMBDA_MAX, LAMBDA_MIN, RgbIntent, Spectrum};
 use prism_core::texture::{
     BitmapTexture, Checkerboard, FilterType, TextureUse, UvTransform, WrapMode,
 };
@@ -41,7 +42,8 @@ pub static TEXTURES: Registry<Build> = Registry {
             name: "checkerboard",
             origin: Origin::Mitsuba3,
             summary: "Two textures alternating: `color0` where frac(u) > ½ and frac(v) > ½ agree, \
-                      `color1` where they differ.",
+                      `color1` where they differ; read as a number, the opposite phase, as in \
+                      Mitsuba 3.",
             params: &[COLOR0, COLOR1, TO_UV],
             build: build_checkerboard,
         },
@@ -55,6 +57,15 @@ pub static TEXTURES: Registry<Build> = Registry {
                       else); a shape whose mesh lacks the attribute is an error.",
             params: &[ATTRIBUTE_NAME, ATTRIBUTE_SCALE],
             build: build_mesh_attribute,
+        },
+        Plugin {
+            name: "rawconstant",
+            origin: Origin::Mitsuba3,
+            summary: "A constant used as it is, never upsampled: a `<float>` (read as a number, or \
+                      as the same value at every wavelength) or a `<vector>` of three values \
+                      (read only as raw RGB, as by `normalmap`).",
+            params: &[RAW_VALUE],
+            build: |params, usage, _| build_rawconstant(params, usage),
         },
     ],
 };
@@ -80,9 +91,10 @@ const FILENAME: ParamSpec = ParamSpec::new(
 );
 const FILTER_TYPE: ParamSpec = ParamSpec::new(
     "filter_type",
-    ParamKind::Choice(&["bilinear", "nearest"]),
+    ParamKind::Choice(&["bilinear", "nearest", "trilinear", "ewa"]),
     Default::Str("bilinear"),
-    "interpolate the four nearest texels, or take the one containing the point",
+    "interpolate the four nearest texels, or take the one containing the point; Mitsuba 0.6's \
+     mip-mapped `trilinear` and `ewa` are read as `bilinear` (docs/mitsuba-compatibility.md)",
 );
 const WRAP_MODE: ParamSpec = ParamSpec::new(
     "wrap_mode",
@@ -133,6 +145,13 @@ const COLOR1: ParamSpec = ParamSpec::new(
     "the second colour",
 );
 
+const RAW_VALUE: ParamSpec = ParamSpec::new(
+    "value",
+    ParamKind::FloatOrVector,
+    Default::Required,
+    "the value: one number, or three",
+);
+
 /// Textures built so far, by element and use.
 #[derive(Default)]
 pub struct TextureCache {
@@ -141,6 +160,8 @@ pub struct TextureCache {
     attribute_slots: Vec<String>,
     /// The slots read by the textures built or fetched since [`Self::take_used_slots`].
     used_slots: Vec<u8>,
+    /// The mesh attributes (slot, name) each material's textures read, by material index.
+    material_attributes: HashMap<u32, Vec<(u8, String)>>,
 }
 
 impl TextureCache {
@@ -154,6 +175,20 @@ impl TextureCache {
             .into_iter()
             .map(|slot| (slot, self.attribute_slots[usize::from(slot)].clone()))
             .collect()
+    }
+
+    /// Records the mesh attributes that material `index` reads.
+    pub fn set_material_attributes(&mut self, index: u32, attributes: Vec<(u8, String)>) {
+        if !attributes.is_empty() {
+            self.material_attributes.insert(index, attributes);
+        }
+    }
+
+    /// The mesh attributes (slot, name) that material `index` reads; none for most.
+    pub fn material_attributes(&self, index: u32) -> &[(u8, String)] {
+        self.material_attributes
+            .get(&index)
+            .map_or(&[], |attributes| attributes.as_slice())
     }
 
     fn note_use(&mut self, texture: &Texture) {
@@ -194,9 +229,10 @@ pub fn optional_spectrum_texture(
     spectrum_texture(params, spec, cache).map(Some)
 }
 
-/// The scalar parameter `spec`: a `<float>` (or a uniform `<spectrum>`), or a nested texture
-/// read as numbers. Constants are checked to lie within the declared bounds; textures are
-/// clamped where they are used.
+/// The scalar parameter `spec`: a `<float>` (or a uniform `<spectrum>`), an `<rgb>` read as
+/// Mitsuba 3 reads a colour where it wants a number, or a nested texture read as numbers.
+/// Constants are checked to lie within the declared bounds; textures are clamped where they are
+/// used.
 pub fn float_texture(
     params: &Params,
     spec: &ParamSpec,
@@ -208,7 +244,40 @@ pub fn float_texture(
     if let Some(child) = params.named_child(spec) {
         return nested_texture(params, spec.name, &child.node, TextureUse::Scalar, cache);
     }
+    if let Some(property) = params.property(spec)
+        && let PropertyValue::Rgb(rgb) = &property.value
+    {
+        let value = rgb_as_number(rgb.map(|c| c as f32));
+        if !(rgb.iter().all(|c| c.is_finite() && *c >= 0.0) && bounds.contains(value)) {
+            return Err(Error::input(
+                &property.location,
+                format!(
+                    "parameter \"{}\" of {} is the colour {rgb:?}, whose mean {value} must be {}",
+                    spec.name,
+                    params.node().describe(),
+                    bounds.describe()
+                ),
+            ));
+        }
+        return Ok(Texture::constant(value));
+    }
     float_value(params, spec, bounds).map(Texture::constant)
+}
+
+/// The number an `<rgb>` gives where a number is wanted (an opacity, a weight): Mitsuba 3's
+/// spectral variants upsample it as a reflectance and take `srgb_model_mean`, the mean of the
+/// spectrum at 16 wavelengths spaced evenly over 360–830 nm (`include/mitsuba/render/srgb.h`).
+/// Grey gives its value exactly.
+fn rgb_as_number(rgb: [f32; 3]) -> f32 {
+    const SAMPLES: usize = 16;
+    let spectrum = Spectrum::from_rgb(rgb, RgbIntent::Albedo);
+    let sum: f32 = (0..SAMPLES)
+        .map(|i| {
+            let t = i as f32 / (SAMPLES - 1) as f32;
+            spectrum.value(LAMBDA_MIN + t * (LAMBDA_MAX - LAMBDA_MIN))
+        })
+        .sum();
+    sum / SAMPLES as f32
 }
 
 /// The number given for `spec` as a `<float>` (or a uniform `<spectrum>`), or its declared
@@ -351,6 +420,20 @@ fn build_mesh_attribute(
     }))
 }
 
+/// A colour `spec` of a texture that an emitter reads: a value as a reflectance (Mitsuba 3
+/// reads an emitter's checkerboard so, without a D65 factor, and refuses values above 1), a
+/// nested texture read as emission.
+fn emission_texture(
+    params: &Params,
+    spec: &ParamSpec,
+    cache: &mut TextureCache,
+) -> Result<Texture> {
+    if let Some(child) = params.named_child(spec) {
+        return nested_texture(params, spec.name, &child.node, TextureUse::Emission, cache);
+    }
+    Ok(Texture::Constant(spectrum_param(params, spec)?))
+}
+
 /// Read as a number, a checkerboard's colours are numbers too.
 const SCALAR_COLOR0: ParamSpec = ParamSpec::new(
     "color0",
@@ -379,12 +462,87 @@ fn build_checkerboard(
             spectrum_texture(params, &COLOR0, cache)?,
             spectrum_texture(params, &COLOR1, cache)?,
         ),
+        TextureUse::Emission => (
+            emission_texture(params, &COLOR0, cache)?,
+            emission_texture(params, &COLOR1, cache)?,
+        ),
     };
     Ok(Texture::Checkerboard(Box::new(Checkerboard {
         color0,
         color1,
         to_uv: UvTransform::from_matrix(&params.transform(&TO_UV)?),
     })))
+}
+
+fn build_rawconstant(params: &Params, usage: TextureUse) -> Result<Texture> {
+    let node = params.node();
+    let Some(property) = params.property(&RAW_VALUE) else {
+        return Err(Error::input(
+            &node.location,
+            format!("{} needs a \"value\"", node.describe()),
+        )
+        .with_help(
+            "add <float name=\"value\" .../> or <vector name=\"value\" x=... y=... z=.../>",
+        ));
+    };
+    let location = &property.location;
+    let not_finite = || {
+        Error::input(
+            location,
+            format!("the value of {} must be finite", node.describe()),
+        )
+    };
+    match &property.value {
+        PropertyValue::Float(_) | PropertyValue::Integer(_) => {
+            let Some(v) = params.float_opt(&RAW_VALUE)? else {
+                return Err(not_finite());
+            };
+            let v = v as f32;
+            if !v.is_finite() {
+                return Err(not_finite());
+            }
+            Ok(Texture::constant(v))
+        }
+        PropertyValue::Vector(v) => {
+            let rgb = v.as_vec3().to_array();
+            if !rgb.iter().all(|c| c.is_finite()) {
+                return Err(not_finite());
+            }
+            if usage != TextureUse::Rgb {
+                return Err(Error::input(
+                    location,
+                    format!(
+                        "{} holds three values, which can only be read as raw RGB (a normal map)",
+                        node.describe()
+                    ),
+                )
+                .with_help("give one <float name=\"value\"/> where a colour or a number is wanted, as Mitsuba 3 requires"));
+            }
+            // A one-texel image of the raw triple.
+            let bitmap = Bitmap {
+                width: 1,
+                height: 1,
+                channels: 3,
+                data: rgb.to_vec(),
+                encoding: Encoding::Linear,
+            };
+            Ok(Texture::Bitmap(Arc::new(BitmapTexture::new(
+                &bitmap,
+                usage,
+                FilterType::Nearest,
+                WrapMode::Clamp,
+                UvTransform::IDENTITY,
+            ))))
+        }
+        other => Err(Error::input(
+            location,
+            format!(
+                "the value of {} must be a <float> or a <vector>, but a {} was given",
+                node.describe(),
+                other.type_name()
+            ),
+        )),
+    }
 }
 
 fn build_bitmap(params: &Params, usage: TextureUse) -> Result<Texture> {
@@ -399,6 +557,7 @@ fn build_bitmap(params: &Params, usage: TextureUse) -> Result<Texture> {
     let location = params.location_of(&FILENAME);
     let filter = match params.choice(&FILTER_TYPE)? {
         "nearest" => FilterType::Nearest,
+        // "trilinear" and "ewa": at full resolution, the limit of their mip-map pyramids.
         _ => FilterType::Bilinear,
     };
     let wrap = match params.choice(&WRAP_MODE)? {

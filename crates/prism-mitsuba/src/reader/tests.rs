@@ -402,6 +402,62 @@ fn reference_errors() {
     assert_error(&err, &["missing the attribute \"id\""]);
 }
 
+/// Ids as Mitsuba 3.9.1 reads them (each case checked with Mitsuba): in a version 0.x file as in
+/// a 3.x one, declared in an included file, before or after the reference, nested anywhere;
+/// matched exactly (no renaming in old files, no trimming, letter case counts); a `name` is not
+/// an id, and properties take none.
+#[test]
+fn ids_resolve_as_in_mitsuba() {
+    let include = TempDir::new("ids-include");
+    include.write(
+        "materials.xml",
+        r#"<scene version="0.5.0"><bsdf type="diffuse" id="fromInclude"/></scene>"#,
+    );
+    let main = include.write(
+        "main.xml",
+        r#"<scene version="0.5.0">
+            <shape type="sphere"><ref id="laterMat"/></shape>
+            <shape type="sphere"><ref name="bsdf" id="fromInclude"/></shape>
+            <include filename="materials.xml"/>
+            <shape type="cube"><bsdf type="twosided" id="outerMat"><bsdf type="diffuse" id="laterMat"/></bsdf></shape>
+        </scene>"#,
+    );
+    let root = read_scene_file(&main, &[]).unwrap();
+    let shape = |i: usize| &root.children[i].node.children[0].node;
+    assert_eq!(shape(0).id.as_deref(), Some("laterMat"));
+    assert_eq!(shape(1).id.as_deref(), Some("fromInclude"));
+    assert!(Arc::ptr_eq(shape(0), &shape(3).children[0].node));
+
+    for (body, missing) in [
+        (
+            r#"<bsdf type="diffuse" id="myMat"/><shape type="cube"><ref id="my_mat"/></shape>"#,
+            "my_mat",
+        ),
+        (
+            r#"<bsdf type="diffuse" id="m "/><shape type="cube"><ref id="m"/></shape>"#,
+            "m",
+        ),
+        (
+            r#"<bsdf type="diffuse" id="m"/><shape type="cube"><ref id="M"/></shape>"#,
+            "M",
+        ),
+        (
+            r#"<bsdf type="diffuse" name="m"/><shape type="cube"><ref id="m"/></shape>"#,
+            "m",
+        ),
+    ] {
+        let xml = format!("<scene version=\"0.5.0\">{body}</scene>");
+        assert_error(
+            &error(&xml),
+            &[&format!("no object has the id \"{missing}\"")],
+        );
+    }
+    assert_error(
+        &error(&scene(r#"<rgb name="x" value="0.5" id="c"/>"#)),
+        &["unexpected attribute \"id\""],
+    );
+}
+
 #[test]
 fn aliases_name_earlier_objects() {
     let root = read(&scene(
@@ -1040,4 +1096,62 @@ fn columns_are_counted_in_characters_in_any_order() {
     assert_eq!(at(b + 2), (2, 6));
     assert_eq!(at(4), (2, 1));
     assert_eq!(at(text.len()), (3, 1));
+}
+
+/// Mitsuba 0.6's `<srgb>` (sRGB-encoded, decoded to linear `<rgb>`) and `<spectrum>` values
+/// without wavelengths: three are linear RGB, N others N bins of equal width over 360–830 nm.
+#[test]
+fn reads_mitsuba_06_colour_forms() {
+    let root = read(&scene(
+        r##"<bsdf type="test">
+            <srgb name="hex" value="#ff0080"/>
+            <srgb name="triple" value="0.5, 0, 1"/>
+            <srgb name="grey" value="0.04045"/>
+            <spectrum name="rgb" value="0.1 0.4 0.9"/>
+            <spectrum name="bins" value="0.2, 0.4, 0.6, 0.8"/>
+        </bsdf>"##,
+    ))
+    .unwrap();
+    let bsdf = &root.children[0].node;
+    let rgb = |name: &str| match property(bsdf, name) {
+        PropertyValue::Rgb(c) => *c,
+        other => panic!("{name}: {other:?}"),
+    };
+    let [r, g, b] = rgb("hex");
+    assert_eq!((r, g), (1.0, 0.0));
+    assert!((b - 0.2158605).abs() < 1e-6, "sRGB-decoded 0x80 is {b}");
+    let [r, g, b] = rgb("triple");
+    assert!((r - 0.2140411).abs() < 1e-6, "sRGB-decoded 0.5 is {r}");
+    assert_eq!((g, b), (0.0, 1.0));
+    for v in rgb("grey") {
+        assert!((v - 0.04045 / 12.92).abs() < 1e-7, "{v}");
+    }
+    assert_eq!(rgb("rgb"), [0.1, 0.4, 0.9]);
+    let PropertyValue::Spectrum(SpectrumValue::Samples(samples)) = property(bsdf, "bins") else {
+        panic!("bins")
+    };
+    // Bins of 117.5 nm from 360 nm: each value at both ends, the steps 1e-6 nm wide.
+    let expected = [
+        (360.0, 0.2),
+        (477.5 - 1e-6, 0.2),
+        (477.5, 0.4),
+        (595.0 - 1e-6, 0.4),
+        (595.0, 0.6),
+        (712.5 - 1e-6, 0.6),
+        (712.5, 0.8),
+        (830.0, 0.8),
+    ];
+    assert_eq!(samples.len(), expected.len());
+    for (&(wavelength, value), &(w, v)) in samples.iter().zip(&expected) {
+        assert!((wavelength - w).abs() < 1e-9 && value == v, "{samples:?}");
+    }
+    // Bad values are errors at their attribute.
+    for (xml, says) in [
+        (r#"<srgb name="c" value="0.1, 0.2"/>"#, "2 numbers"),
+        (r##"<srgb name="c" value="#12345"/>"##, "not a colour"),
+        (r#"<spectrum name="c" value="0.1 x 0.3"/>"#, "x"),
+    ] {
+        let err = error(&scene(&format!(r#"<bsdf type="test">{xml}</bsdf>"#)));
+        assert_error(&err, &[says]);
+    }
 }

@@ -122,17 +122,33 @@ impl Cylinder {
         if self.flip_normals { -n } else { n }
     }
 
-    /// A uniform point: φ = 2π u₀, z = u₁ in the object frame, which a similarity of the tube
-    /// keeps uniform in area; pdf 1/(2π r L) per unit area.
-    pub fn sample_area(&self, u: Vec2) -> SurfaceSample {
-        let (sin_phi, cos_phi) = (2.0 * PI * u.x).sin_cos();
-        let local = Vec3::new(cos_phi, sin_phi, u.y);
+    /// The point with texture coordinates `uv` (φ = 2π u, z = v in the object frame).
+    fn point_at_uv(&self, uv: Vec2, pdf: f32) -> SurfaceSample {
+        let (sin_phi, cos_phi) = (2.0 * PI * uv.x).sin_cos();
+        let local = Vec3::new(cos_phi, sin_phi, uv.y);
         let n = self.normal_at(local);
         SurfaceSample {
             p: self.to_world.point(local),
             n,
             shading_n: n,
-            pdf: 1.0 / self.area,
+            uv,
+            primitive: 0,
+            pdf,
         }
+    }
+
+    /// A uniform point: (u, v) uniform, which a similarity of the tube keeps uniform in area;
+    /// pdf 1/(2π r L) per unit area.
+    pub fn sample_area(&self, u: Vec2) -> SurfaceSample {
+        self.point_at_uv(u, 1.0 / self.area)
+    }
+
+    /// The point at `uv` in [0, 1]² and |∂p/∂u × ∂p/∂v| = 2π r L there (Mitsuba's
+    /// `eval_parameterization`); None outside [0, 1]².
+    pub fn at_uv(&self, uv: Vec2) -> Option<(SurfaceSample, f32)> {
+        if !(uv.x >= 0.0 && uv.x <= 1.0 && uv.y >= 0.0 && uv.y <= 1.0) {
+            return None;
+        }
+        Some((self.point_at_uv(uv, 0.0), self.area))
     }
 }

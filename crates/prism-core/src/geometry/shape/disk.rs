@@ -85,11 +85,43 @@ impl Disk {
     /// A uniform point (a linear map keeps the concentric map's uniformity); pdf per unit area.
     pub fn sample_area(&self, u: Vec2) -> SurfaceSample {
         let d = sample_uniform_disk_concentric(u);
+        let mut phi = d.y.atan2(d.x);
+        if phi < 0.0 {
+            phi += 2.0 * PI;
+        }
         SurfaceSample {
             p: self.to_world.point(Vec3::new(d.x, d.y, 0.0)),
             n: self.normal,
             shading_n: self.normal,
+            uv: Vec2::new(d.length(), phi / (2.0 * PI)),
+            primitive: 0,
             pdf: 1.0 / self.area,
         }
+    }
+
+    /// |∂p/∂u × ∂p/∂v| = 2π r |X × Y| = 2 r · area at texture coordinates `uv` (r = u), from the
+    /// tangents of [`Self::interaction`] (X, Y: the images of the object frame's x and y axes).
+    pub fn uv_jacobian(&self, uv: Vec2) -> f32 {
+        2.0 * uv.x.abs() * self.area
+    }
+
+    /// The surface point with texture coordinates `uv` = (r, φ/2π) in [0, 1]², with its
+    /// [`Self::uv_jacobian`]. The sample's pdf is 0.
+    pub fn at_uv(&self, uv: Vec2) -> Option<(SurfaceSample, f32)> {
+        if !(uv.x >= 0.0 && uv.x <= 1.0 && uv.y >= 0.0 && uv.y <= 1.0) {
+            return None;
+        }
+        let (sin_phi, cos_phi) = (2.0 * PI * uv.y).sin_cos();
+        let sample = SurfaceSample {
+            p: self
+                .to_world
+                .point(Vec3::new(uv.x * cos_phi, uv.x * sin_phi, 0.0)),
+            n: self.normal,
+            shading_n: self.normal,
+            uv,
+            primitive: 0,
+            pdf: 0.0,
+        };
+        Some((sample, self.uv_jacobian(uv)))
     }
 }

@@ -4,7 +4,8 @@ use std::sync::OnceLock;
 
 use glam::{Vec2, Vec3};
 
-use crate::geometry::interaction::{AttributeValues, SurfaceInteraction};
+use super::uv_grid::UvGrid;
+use crate::geometry::interaction::{AttributeValues, MAX_MESH_ATTRIBUTES, SurfaceInteraction};
 use crate::geometry::triangle::TriangleHit;
 use crate::math::Frame;
 use crate::sampling::distribution::AliasTable;
@@ -28,11 +29,15 @@ pub struct TriangleMesh {
     /// Triangles chosen in proportion to their area (None when the area is zero). Built on the
     /// first area sample, so that only meshes that are lights pay its 12 bytes per triangle.
     area_table: OnceLock<Option<AliasTable>>,
+    /// The triangles by texture coordinates, built on the first uv query (only meshes whose
+    /// emission is textured make one).
+    uv_grid: OnceLock<UvGrid>,
     area: f32,
     /// The attributes the mesh carries (Mitsuba's `vertex_color`, `face_color`, ...).
     attributes: Vec<MeshAttribute>,
-    /// The attributes the scene's textures read: (slot, index into `attributes`).
-    bound: Vec<(u8, u8)>,
+    /// By slot, 1 + the index into `attributes` of the attribute the scene's textures read in
+    /// that slot (0: none).
+    bound: [u8; MAX_MESH_ATTRIBUTES],
 }
 
 /// Values a mesh carries per vertex or per triangle, under a Mitsuba attribute name
@@ -53,8 +58,26 @@ pub struct SurfaceSample {
     pub n: Vec3,
     /// Unit shading normal at the point (decides the side a one-sided emitter lights).
     pub shading_n: Vec3,
+    /// Texture coordinates at the point (as a ray hit there would report them).
+    pub uv: Vec2,
+    /// The triangle of a mesh the point lies on (0 for other shapes).
+    pub primitive: u32,
     /// Density of the point, per unit area or per unit solid angle (said by the method).
     pub pdf: f32,
+}
+
+impl SurfaceSample {
+    /// The surface point of a ray hit (with pdf 0).
+    pub fn at(si: &SurfaceInteraction) -> SurfaceSample {
+        SurfaceSample {
+            p: si.p,
+            n: si.n,
+            shading_n: si.shading.n,
+            uv: si.uv,
+            primitive: si.primitive,
+            pdf: 0.0,
+        }
+    }
 }
 
 impl TriangleMesh {
@@ -74,9 +97,10 @@ impl TriangleMesh {
             face_normals: Vec::new(),
             flip_normals,
             area_table: OnceLock::new(),
+            uv_grid: OnceLock::new(),
             area: 0.0,
             attributes: Vec::new(),
-            bound: Vec::new(),
+            bound: [0; MAX_MESH_ATTRIBUTES],
         };
         mesh.area = mesh.triangle_areas().iter().sum::<f64>() as f32;
         mesh.positions.shrink_to_fit();
@@ -99,7 +123,7 @@ impl TriangleMesh {
                 }
         }));
         self.attributes = attributes;
-        self.bound.clear();
+        self.bound = [0; MAX_MESH_ATTRIBUTES];
     }
 
     /// The names of the mesh's attributes.
@@ -113,9 +137,7 @@ impl TriangleMesh {
         let Some(index) = self.attributes.iter().position(|a| a.name == name) else {
             return false;
         };
-        if !self.bound.iter().any(|&(s, _)| s == slot) {
-            self.bound.push((slot, index as u8));
-        }
+        self.bound[usize::from(slot)] = index as u8 + 1;
         true
     }
 
@@ -124,9 +146,15 @@ impl TriangleMesh {
     #[inline]
     fn attributes_at(&self, triangle: usize, b: [f32; 3]) -> AttributeValues {
         let mut values = AttributeValues::default();
-        for &(slot, index) in &self.bound {
-            let attribute = &self.attributes[usize::from(index)];
-            values.0[usize::from(slot)] = if attribute.per_face {
+        if self.attributes.is_empty() {
+            return values;
+        }
+        for (slot, &bound) in self.bound.iter().enumerate() {
+            let Some(index) = usize::from(bound).checked_sub(1) else {
+                continue;
+            };
+            let attribute = &self.attributes[index];
+            values.0[slot] = if attribute.per_face {
                 attribute.values[triangle]
             } else {
                 let [i, j, k] = self.triangles[triangle].map(|v| v as usize);
@@ -194,6 +222,7 @@ impl TriangleMesh {
                 .get()
                 .and_then(Option::as_ref)
                 .map_or(0, AliasTable::heap_bytes)
+            + self.uv_grid.get().map_or(0, UvGrid::heap_bytes)
     }
 
     /// The unit geometric normal of a triangle: (p1 − p0) × (p2 − p0), counter-clockwise
@@ -290,12 +319,70 @@ impl TriangleMesh {
         let b = [b.x, b.y, 1.0 - b.x - b.y];
         let p = p0 * b[0] + p1 * b[1] + p2 * b[2];
         let n = self.face_normal(triangle);
+        let [t0, t1, t2] = self.uv_triangle(triangle);
         Some(SurfaceSample {
             p,
             n,
             shading_n: self.shading_normal(triangle, b, n),
+            uv: t0 * b[0] + t1 * b[1] + t2 * b[2],
+            primitive: triangle as u32,
             pdf: 1.0 / self.area,
         })
+    }
+
+    /// The texture coordinates of a triangle's vertices; without them, (0, 0), (1, 0), (0, 1)
+    /// (the barycentrics of p1 and p2, as [`Self::interaction`] reports them).
+    #[inline]
+    fn uv_triangle(&self, triangle: usize) -> [Vec2; 3] {
+        match &self.uvs {
+            Some(uvs) => self.triangles[triangle].map(|i| uvs[i as usize]),
+            None => [Vec2::ZERO, Vec2::X, Vec2::Y],
+        }
+    }
+
+    /// |∂p/∂u × ∂p/∂v| on a triangle, the area it covers per unit uv area (its area over its uv
+    /// triangle's area); None for a triangle of zero uv area, which the uv map cannot reach.
+    pub fn uv_jacobian(&self, triangle: usize) -> Option<f32> {
+        let [t0, t1, t2] = self.uv_triangle(triangle);
+        let uv_area = 0.5 * (t1 - t0).perp_dot(t2 - t0).abs();
+        (uv_area > 0.0).then(|| self.triangle_area(triangle) / uv_area)
+    }
+
+    fn uv_grid(&self) -> &UvGrid {
+        self.uv_grid.get_or_init(|| {
+            let uv_triangles: Vec<[Vec2; 3]> = (0..self.triangles.len())
+                .map(|t| self.uv_triangle(t))
+                .collect();
+            UvGrid::new(&uv_triangles)
+        })
+    }
+
+    /// The surface point with texture coordinates `uv` (Mitsuba's `eval_parameterization`), on
+    /// the lowest-numbered triangle whose uv triangle contains it, with that triangle's
+    /// [`Self::uv_jacobian`]; None where no triangle covers `uv`. The sample's pdf is 0.
+    pub fn at_uv(&self, uv: Vec2) -> Option<(SurfaceSample, f32)> {
+        let hit = self.uv_grid().find(uv, |t| self.uv_triangle(t))?;
+        let triangle = hit.triangle;
+        let jacobian = self.uv_jacobian(triangle)?;
+        let [p0, p1, p2] = self.vertices(triangle);
+        let b = hit.barycentrics;
+        let n = self.face_normal(triangle);
+        let sample = SurfaceSample {
+            p: p0 * b[0] + p1 * b[1] + p2 * b[2],
+            n,
+            shading_n: self.shading_normal(triangle, b, n),
+            uv,
+            primitive: triangle as u32,
+            pdf: 0.0,
+        };
+        Some((sample, jacobian))
+    }
+
+    /// The triangle [`Self::at_uv`] maps `uv` to.
+    pub fn triangle_at_uv(&self, uv: Vec2) -> Option<usize> {
+        self.uv_grid()
+            .find(uv, |t| self.uv_triangle(t))
+            .map(|hit| hit.triangle)
     }
 }
 

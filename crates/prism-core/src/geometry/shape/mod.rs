@@ -7,6 +7,7 @@ pub mod cylinder;
 pub mod disk;
 pub mod mesh;
 pub mod sphere;
+pub mod uv_grid;
 
 use glam::{Vec2, Vec3};
 
@@ -129,6 +130,36 @@ impl Shape {
             Shape::Mesh(_) | Shape::Disk(_) | Shape::Cylinder(_) => {
                 area_to_solid_angle(1.0 / self.area(), reference, p, n).unwrap_or(0.0)
             }
+        }
+    }
+
+    /// The surface point with texture coordinates `uv` in [0, 1]² (Mitsuba's
+    /// `eval_parameterization`) and |∂p/∂u × ∂p/∂v| there, the area per unit uv area; None
+    /// where the uv map does not reach `uv`. A point several mesh triangles share in uv space
+    /// lies on the lowest-numbered of them. The sample's pdf is 0.
+    pub fn at_uv(&self, uv: Vec2) -> Option<(SurfaceSample, f32)> {
+        match self {
+            Shape::Mesh(mesh) => mesh.at_uv(uv),
+            Shape::Sphere(sphere) => sphere.at_uv(uv),
+            Shape::Disk(disk) => disk.at_uv(uv),
+            Shape::Cylinder(cylinder) => cylinder.at_uv(uv),
+        }
+    }
+
+    /// |∂p/∂u × ∂p/∂v| at the point with texture coordinates `uv` on triangle `primitive` (0 for
+    /// a sphere or disk), if [`Self::at_uv`] maps `uv` to that point; None otherwise.
+    pub fn uv_jacobian_at(&self, primitive: u32, uv: Vec2) -> Option<f32> {
+        match self {
+            Shape::Mesh(mesh) => {
+                let triangle = mesh.triangle_at_uv(uv)?;
+                if triangle != primitive as usize {
+                    return None;
+                }
+                mesh.uv_jacobian(triangle)
+            }
+            Shape::Sphere(sphere) => sphere.at_uv(uv).map(|(_, j)| j),
+            Shape::Disk(disk) => disk.at_uv(uv).map(|(_, j)| j),
+            Shape::Cylinder(cylinder) => cylinder.at_uv(uv).map(|(_, j)| j),
         }
     }
 

@@ -115,8 +115,33 @@ impl Sphere {
             p: self.center + outward * self.radius,
             n,
             shading_n: n,
+            uv: self.uv(outward),
+            primitive: 0,
             pdf: 0.0,
         }
+    }
+
+    /// |∂p/∂u × ∂p/∂v| = 2π² r² sin θ at texture coordinates `uv` (θ = π v), from
+    /// [`Self::tangents`].
+    pub fn uv_jacobian(&self, uv: Vec2) -> f32 {
+        2.0 * PI * PI * self.radius * self.radius * (PI * uv.y).sin().abs()
+    }
+
+    /// The surface point with texture coordinates `uv` in [0, 1]² (the inverse of
+    /// [`Self::uv`]), with its [`Self::uv_jacobian`]. The sample's pdf is 0.
+    pub fn at_uv(&self, uv: Vec2) -> Option<(SurfaceSample, f32)> {
+        if !(uv.x >= 0.0 && uv.x <= 1.0 && uv.y >= 0.0 && uv.y <= 1.0) {
+            return None;
+        }
+        let (sin_phi, cos_phi) = (2.0 * PI * uv.x).sin_cos();
+        let (sin_theta, cos_theta) = (PI * uv.y).sin_cos();
+        let outward =
+            self.rotation * Vec3::new(sin_theta * cos_phi, sin_theta * sin_phi, cos_theta);
+        let sample = SurfaceSample {
+            uv,
+            ..self.surface_point(outward.normalize())
+        };
+        Some((sample, self.uv_jacobian(uv)))
     }
 
     /// Whether a point at squared distance `dc2` from the centre is clearly outside the sphere.

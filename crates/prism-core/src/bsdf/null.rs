@@ -1,0 +1,58 @@
+//! Mitsuba's `null` BSDF: a surface that light passes straight through, unchanged. It marks an
+//! index-matched boundary (the outline of a participating medium) or makes a shape invisible.
+//!
+//! ```xml
+//! <bsdf type="null"/>
+//! ```
+//! A single null lobe δ(wi + wo) on both sides, with weight 1: `sample` returns −wo with
+//! probability 1, nothing can be evaluated. As in Mitsuba 3's `path` integrator, passing through
+//! counts as a bounce towards `max_depth`, and shadow rays see the surface as opaque (light
+//! beyond it is found by BSDF sampling alone), as for `mask`. As in Mitsuba 3's `volpath`, the
+//! volumetric path tracer crosses it without a bounce and lets shadow rays through
+//! ([`crate::integrator::volpath`]).
+
+use glam::{Vec2, Vec3};
+
+use super::{BsdfFlags, BsdfModel, BsdfSample, Bxdf, BxdfTree, NodeId, ShadingPoint};
+use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+
+/// The `null` BSDF (no parameters).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Null;
+
+const FLAGS: BsdfFlags = BsdfFlags::NULL;
+
+impl BsdfModel for Null {
+    fn flags(&self) -> BsdfFlags {
+        FLAGS
+    }
+
+    fn is_dispersive(&self) -> bool {
+        false
+    }
+
+    fn node_count(&self) -> usize {
+        1
+    }
+
+    #[inline]
+    fn resolve<'a>(
+        &'a self,
+        _point: &ShadingPoint,
+        _wo: Vec3,
+        _lambda: &SampledWavelengths,
+        tree: &mut BxdfTree<'a>,
+    ) -> NodeId {
+        tree.push(NullLobes)
+    }
+}
+
+/// The pass-through lobe.
+#[derive(Clone, Copy, Debug)]
+pub struct NullLobes;
+
+impl Bxdf for NullLobes {
+    fn sample(&self, _tree: &BxdfTree, wo: Vec3, _u_lobe: f32, _u: Vec2) -> Option<BsdfSample> {
+        Some(BsdfSample::new(-wo, SampledSpectrum::ONE, 1.0, FLAGS))
+    }
+}

@@ -1,0 +1,165 @@
+//! Mitsuba 3's `pplastic` BSDF in its unpolarised form: a rough specular reflection added to a
+//! diffuse base seen through two smooth refractions (after Baek et al. 2018, "Simultaneous
+//! Acquisition of Polarimetric SVBRDF and Normals", as Mitsuba's `pplastic.cpp` evaluates it
+//! for unpolarised light).
+//!
+//! ```xml
+//! <bsdf type="pplastic">
+//!     <rgb name="diffuse_reflectance" value="0.05, 0.03, 0.1"/>  <!-- or a texture; default 0.5 -->
+//!     <float name="alpha" value="0.06"/>               <!-- or alpha_u and alpha_v; default 0.1 -->
+//!     <string name="distribution" value="beckmann"/>   <!-- or ggx -->
+//!     <string name="int_ior" value="polypropylene"/>
+//!     <string name="ext_ior" value="air"/>
+//!     <rgb name="specular_reflectance" value="1"/>     <!-- optional factor -->
+//! </bsdf>
+//! ```
+//! f cos θi = s F(wo·h) D(h) G(wo, wi, h) / (4 cos θo)                     (rough specular)
+//!          + (1 − F(cos θo)) ρ (1 − F(cos θi)) cos θi / π                  (diffuse base)
+//!
+//! with F the dielectric Fresnel reflectance for the relative index η. Unlike `roughplastic`
+//! the two parts are simply added: the base sees the coating as smooth, and no light bounces
+//! between base and coating, so the model loses energy but never creates it. The specular part
+//! is sampled by visible normals, the base by the cosine; the specular part is chosen with
+//! probability s̄ / (s̄ + ρ̄) (Mitsuba takes the textures' means over the surface, Prism their
+//! averages at the point over the path's wavelengths; only the noise differs). One-sided.
+
+use std::f32::consts::FRAC_1_PI;
+
+use glam::{Vec2, Vec3};
+
+use super::dielectric::optional_factor;
+use super::fresnel::{fresnel_dielectric, reflect};
+use super::microfacet::{Microfacet, MicrofacetKind};
+use super::{
+    BsdfEval, BsdfFlags, BsdfModel, BsdfSample, Bxdf, BxdfTree, NodeId, ShadingPoint,
+    mixture_sample,
+};
+use crate::sampling::warp::{cosine_hemisphere_pdf, sample_cosine_hemisphere};
+use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+use crate::texture::Texture;
+
+#[derive(Clone, Debug)]
+pub struct PolarizedPlastic {
+    /// The relative index η = int_ior / ext_ior.
+    pub eta: f32,
+    pub distribution: MicrofacetKind,
+    pub alpha_u: Texture,
+    pub alpha_v: Texture,
+    pub diffuse_reflectance: Texture,
+    pub specular_reflectance: Option<Texture>,
+}
+
+const FLAGS: BsdfFlags = BsdfFlags::GLOSSY
+    .union(BsdfFlags::DIFFUSE)
+    .union(BsdfFlags::REFLECTION);
+
+impl BsdfModel for PolarizedPlastic {
+    fn flags(&self) -> BsdfFlags {
+        FLAGS
+    }
+
+    fn is_dispersive(&self) -> bool {
+        false
+    }
+
+    fn node_count(&self) -> usize {
+        1
+    }
+
+    #[inline]
+    fn resolve<'a>(
+        &'a self,
+        point: &ShadingPoint,
+        _wo: Vec3,
+        lambda: &SampledWavelengths,
+        tree: &mut BxdfTree<'a>,
+    ) -> NodeId {
+        let diffuse = self.diffuse_reflectance.eval(point.at(), lambda);
+        let specular = optional_factor(&self.specular_reflectance, point.at(), lambda);
+        let (s, d) = (specular.average(), diffuse.average());
+        tree.push(PolarizedPlasticLobes {
+            eta: self.eta,
+            distribution: Microfacet::new(
+                self.distribution,
+                self.alpha_u.eval_1(point.at()),
+                self.alpha_v.eval_1(point.at()),
+            ),
+            diffuse,
+            specular,
+            p_specular: if s + d > 0.0 { s / (s + d) } else { 1.0 },
+        })
+    }
+}
+
+/// The specular and diffuse parts at a point.
+#[derive(Clone, Copy, Debug)]
+pub struct PolarizedPlasticLobes {
+    pub eta: f32,
+    pub distribution: Microfacet,
+    pub diffuse: SampledSpectrum,
+    pub specular: SampledSpectrum,
+    /// The probability of sampling the specular part.
+    pub p_specular: f32,
+}
+
+impl PolarizedPlasticLobes {
+    #[inline]
+    fn value(&self, wo: Vec3, wi: Vec3) -> SampledSpectrum {
+        let h = (wo + wi).normalize();
+        let d = self.distribution.d(h);
+        let specular = if d > 0.0 {
+            let f = fresnel_dielectric(wo.dot(h), self.eta).reflectance;
+            self.specular * (f * d * self.distribution.g(wo, wi, h) / (4.0 * wo.z))
+        } else {
+            SampledSpectrum::ZERO
+        };
+        let t_o = 1.0 - fresnel_dielectric(wo.z, self.eta).reflectance;
+        let t_i = 1.0 - fresnel_dielectric(wi.z, self.eta).reflectance;
+        specular + self.diffuse * (t_o * t_i * wi.z * FRAC_1_PI)
+    }
+
+    #[inline]
+    fn mixture_pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        let h = (wo + wi).normalize();
+        let (cos_oh, cos_ih) = (wo.dot(h), wi.dot(h));
+        let specular = if cos_oh > 0.0 && cos_ih > 0.0 {
+            self.distribution.pdf_visible(wo, h) / (4.0 * cos_oh)
+        } else {
+            0.0
+        };
+        self.p_specular * specular + (1.0 - self.p_specular) * cosine_hemisphere_pdf(wi)
+    }
+}
+
+impl Bxdf for PolarizedPlasticLobes {
+    fn eval(&self, _tree: &BxdfTree, wo: Vec3, wi: Vec3) -> BsdfEval {
+        if !(wo.z > 0.0 && wi.z > 0.0) {
+            return BsdfEval::ZERO;
+        }
+        BsdfEval {
+            value: self.value(wo, wi),
+            pdf: self.mixture_pdf(wo, wi),
+        }
+    }
+
+    fn sample(&self, _tree: &BxdfTree, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<BsdfSample> {
+        if !(wo.z > 0.0) {
+            return None;
+        }
+        let (wi, flags) = if u_lobe < self.p_specular {
+            (
+                reflect(wo, self.distribution.sample_visible(wo, u)),
+                BsdfFlags::GLOSSY.union(BsdfFlags::REFLECTION),
+            )
+        } else {
+            (
+                sample_cosine_hemisphere(u),
+                BsdfFlags::DIFFUSE.union(BsdfFlags::REFLECTION),
+            )
+        };
+        if !(wi.z > 0.0) {
+            return None;
+        }
+        mixture_sample(wi, self.value(wo, wi), self.mixture_pdf(wo, wi), flags)
+    }
+}

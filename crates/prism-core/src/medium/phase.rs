@@ -1,0 +1,110 @@
+//! Phase functions: the angular distribution of light scattered in a medium (Mitsuba 3's
+//! `isotropic`, `hg` and `blendphase`).
+//!
+//! Conventions follow the BSDFs': `wo` points back along the path (towards the camera), `wi`
+//! towards where the light comes from, both unit vectors in world space. Every phase function
+//! here is a normalised density on the sphere, p(wo, wi), so its value and its sampling density
+//! agree and a sample's weight p/pdf is 1.
+
+use std::f32::consts::PI;
+
+use glam::{Vec2, Vec3};
+
+use crate::math::Frame;
+use crate::sampling::warp::{sample_uniform_sphere, uniform_sphere_pdf};
+
+/// A phase function as the scene describes it.
+#[derive(Clone, Debug, PartialEq)]
+pub enum PhaseFunction {
+    /// p = 1/(4π).
+    Isotropic,
+    /// Henyey & Greenstein 1941: p(θ) = (1 − g²) / (4π (1 + g² + 2g cos θ)^{3/2}), with θ the
+    /// angle between `wo` and `wi` (pbrt-v4 §11.3.1), so that g > 0 scatters forward (`wi`
+    /// close to the direction the path came from, −`wo`); |g| < 1.
+    HenyeyGreenstein { g: f32 },
+    /// (1 − weight)·first + weight·second, Mitsuba's `blendphase`; weight in [0, 1].
+    Blend {
+        weight: f32,
+        first: Box<PhaseFunction>,
+        second: Box<PhaseFunction>,
+    },
+}
+
+/// A direction drawn from a phase function.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PhaseSample {
+    /// The incident direction (world space, unit).
+    pub wi: Vec3,
+    /// Density of `wi` per unit solid angle, which is also the phase function's value there.
+    pub pdf: f32,
+}
+
+/// The Henyey–Greenstein density for cos θ = wo·wi.
+#[inline]
+pub fn henyey_greenstein(cos_theta: f32, g: f32) -> f32 {
+    let denom = 1.0 + g * g + 2.0 * g * cos_theta;
+    (1.0 - g * g) / (4.0 * PI * denom * denom.max(0.0).sqrt())
+}
+
+impl PhaseFunction {
+    /// p(wo, wi), which is also the density [`PhaseFunction::sample`] draws `wi` with.
+    pub fn eval(&self, wo: Vec3, wi: Vec3) -> f32 {
+        match self {
+            PhaseFunction::Isotropic => uniform_sphere_pdf(),
+            PhaseFunction::HenyeyGreenstein { g } => henyey_greenstein(wo.dot(wi), *g),
+            PhaseFunction::Blend {
+                weight,
+                first,
+                second,
+            } => (1.0 - weight) * first.eval(wo, wi) + weight * second.eval(wo, wi),
+        }
+    }
+
+    /// Draws `wi` given `wo` from the uniform numbers `u`.
+    ///
+    /// Henyey–Greenstein is sampled by inverting the CDF of cos θ (pbrt-v4 §11.3.1):
+    /// cos θ = −(1 + g² − ((1 − g²)/(1 + g − 2g·u₀))²) / (2g), φ = 2π·u₁. A blend chooses its
+    /// first component with probability 1 − weight by u₀ (rescaled to [0, 1) for the chosen
+    /// one), so the mixture's density is the blend of the components'.
+    pub fn sample(&self, wo: Vec3, u: Vec2) -> PhaseSample {
+        match self {
+            PhaseFunction::Isotropic => PhaseSample {
+                wi: sample_uniform_sphere(u),
+                pdf: uniform_sphere_pdf(),
+            },
+            PhaseFunction::HenyeyGreenstein { g } => {
+                let g = *g;
+                let cos_theta = if g.abs() < 1e-3 {
+                    1.0 - 2.0 * u.x
+                } else {
+                    let s = (1.0 - g * g) / (1.0 + g - 2.0 * g * u.x);
+                    (-(1.0 + g * g - s * s) / (2.0 * g)).clamp(-1.0, 1.0)
+                };
+                let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
+                let phi = 2.0 * PI * u.y;
+                let local = Vec3::new(sin_theta * phi.cos(), sin_theta * phi.sin(), cos_theta);
+                let wi = Frame::from_normal(wo).to_world(local).normalize();
+                PhaseSample {
+                    wi,
+                    pdf: henyey_greenstein(cos_theta, g),
+                }
+            }
+            PhaseFunction::Blend {
+                weight,
+                first,
+                second,
+            } => {
+                let (chosen, u0) = if u.x < 1.0 - weight {
+                    (first, u.x / (1.0 - weight))
+                } else {
+                    (second, (u.x - (1.0 - weight)) / weight)
+                };
+                let sample = chosen.sample(wo, Vec2::new(u0.min(1.0 - f32::EPSILON), u.y));
+                PhaseSample {
+                    wi: sample.wi,
+                    pdf: self.eval(wo, sample.wi),
+                }
+            }
+        }
+    }
+}

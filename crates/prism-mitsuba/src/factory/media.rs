@@ -1,0 +1,497 @@
+//! Participating media, their phase functions and volumes: Mitsuba 3's `homogeneous` and
+//! `heterogeneous` media, `isotropic`, `hg` and `blendphase` phase functions, and `constvolume`
+//! and `gridvolume` volumes (Mitsuba's binary `.vol` files).
+
+use glam::DMat4;
+
+use super::spectra::spectrum_param;
+use crate::description::{PluginClass, PluginNode, PropertyValue};
+use crate::params::Params;
+use crate::registry::{Default, Origin, ParamKind, ParamSpec, Plugin, Range, Registry};
+use prism_core::error::{Error, Result};
+use prism_core::math::Transform;
+use prism_core::medium::volume::parse_vol;
+use prism_core::medium::{GridFilter, GridVolume, Medium, MediumKind, PhaseFunction, Volume};
+use prism_core::spectrum::Spectrum;
+
+type BuildMedium = fn(&Params) -> Result<Medium>;
+type BuildPhase = fn(&Params) -> Result<PhaseFunction>;
+type BuildVolume = fn(&Params, Range) -> Result<Volume>;
+
+pub static MEDIA: Registry<BuildMedium> = Registry {
+    class: PluginClass::Medium,
+    plugins: &[
+        Plugin {
+            name: "homogeneous",
+            origin: Origin::Mitsuba3,
+            summary: "The same extinction σ_t = scale · sigma_t and albedo everywhere; or, in \
+                      Mitsuba 0.6's form, σ_a = scale · sigma_a and σ_s = scale · sigma_s \
+                      (which Mitsuba 3 refuses). A shape takes it as its `interior` or \
+                      `exterior`, the sensor as the medium it sits in.",
+            params: &[
+                SIGMA_T,
+                ALBEDO,
+                SIGMA_A,
+                SIGMA_S,
+                SCALE,
+                SAMPLE_EMITTERS,
+                PHASE,
+            ],
+            build: build_homogeneous,
+        },
+        Plugin {
+            name: "heterogeneous",
+            origin: Origin::Mitsuba3,
+            summary: "σ_t(x) = scale · sigma_t(x) and albedo(x) from volumes (a `gridvolume` is \
+                      empty outside its box); free flights by spectral tracking with the \
+                      grid's maximum as majorant, shadow rays by ratio tracking.",
+            params: &[SIGMA_T_VOLUME, ALBEDO_VOLUME, SCALE, SAMPLE_EMITTERS, PHASE],
+            build: build_heterogeneous,
+        },
+    ],
+};
+
+pub static PHASES: Registry<BuildPhase> = Registry {
+    class: PluginClass::Phase,
+    plugins: &[
+        Plugin {
+            name: "isotropic",
+            origin: Origin::Mitsuba3,
+            summary: "Scattering into every direction alike, p = 1/(4π).",
+            params: &[],
+            build: |_| Ok(PhaseFunction::Isotropic),
+        },
+        Plugin {
+            name: "hg",
+            origin: Origin::Mitsuba3,
+            summary: "Henyey–Greenstein, p = (1 − g²)/(4π (1 + g² − 2g cos θ)^{3/2}) with θ the \
+                      deflection; sampled exactly.",
+            params: &[G],
+            build: build_hg,
+        },
+        Plugin {
+            name: "blendphase",
+            origin: Origin::Mitsuba3,
+            summary: "(1 − weight) · p₀ + weight · p₁ of two nested phase functions.",
+            params: &[PHASE_WEIGHT, BLENDED_PHASES],
+            build: build_blendphase,
+        },
+    ],
+};
+
+pub static VOLUMES: Registry<BuildVolume> = Registry {
+    class: PluginClass::Volume,
+    plugins: &[
+        Plugin {
+            name: "constvolume",
+            origin: Origin::Mitsuba3,
+            summary: "The same value everywhere.",
+            params: &[VALUE],
+            build: build_constvolume,
+        },
+        Plugin {
+            name: "gridvolume",
+            origin: Origin::Mitsuba3,
+            summary: "A single-channel grid from a Mitsuba `.vol` file (32-bit floats) over the \
+                      unit cube placed by `to_world`, interpolated trilinearly between voxel \
+                      centres and clamped at its faces.",
+            params: &[FILENAME, FILTER_TYPE, VOLUME_TO_WORLD, USE_GRID_BBOX],
+            build: build_gridvolume,
+        },
+    ],
+};
+
+const SIGMA_T: ParamSpec = ParamSpec::new(
+    "sigma_t",
+    ParamKind::Spectrum {
+        range: Range::Coefficient,
+        textured: false,
+    },
+    Default::Float(1.0),
+    "extinction coefficient per scene unit",
+);
+const ALBEDO: ParamSpec = ParamSpec::new(
+    "albedo",
+    ParamKind::Spectrum {
+        range: Range::Albedo,
+        textured: false,
+    },
+    Default::Float(0.75),
+    "single-scattering albedo σ_s/σ_t, in [0, 1]",
+);
+const SIGMA_A: ParamSpec = ParamSpec::new(
+    "sigma_a",
+    ParamKind::Spectrum {
+        range: Range::Coefficient,
+        textured: false,
+    },
+    Default::None,
+    "Mitsuba 0.6: absorption coefficient, with `sigma_s` in place of `sigma_t` and `albedo`",
+);
+const SIGMA_S: ParamSpec = ParamSpec::new(
+    "sigma_s",
+    ParamKind::Spectrum {
+        range: Range::Coefficient,
+        textured: false,
+    },
+    Default::None,
+    "Mitsuba 0.6: scattering coefficient, with `sigma_a`",
+);
+const SIGMA_T_VOLUME: ParamSpec = ParamSpec::new(
+    "sigma_t",
+    ParamKind::Volume(Range::Coefficient),
+    Default::Float(1.0),
+    "extinction coefficient per scene unit",
+);
+const ALBEDO_VOLUME: ParamSpec = ParamSpec::new(
+    "albedo",
+    ParamKind::Volume(Range::Albedo),
+    Default::Float(0.75),
+    "single-scattering albedo σ_s/σ_t, in [0, 1]",
+);
+const SCALE: ParamSpec = ParamSpec::new(
+    "scale",
+    ParamKind::Float,
+    Default::Float(1.0),
+    "factor on the coefficients (a change of units)",
+);
+const SAMPLE_EMITTERS: ParamSpec = ParamSpec::new(
+    "sample_emitters",
+    ParamKind::Boolean,
+    Default::Boolean(true),
+    "sample lights at scattering points in the medium (next-event estimation)",
+);
+const PHASE: ParamSpec = ParamSpec::nested(
+    PluginClass::Phase,
+    Default::Text("`isotropic`"),
+    "the phase function",
+);
+const G: ParamSpec = ParamSpec::new(
+    "g",
+    ParamKind::Float,
+    Default::Float(0.8),
+    "mean cosine of the deflection, in (−1, 1): > 0 forward, < 0 backward",
+);
+const PHASE_WEIGHT: ParamSpec = ParamSpec::new(
+    "weight",
+    ParamKind::Float,
+    Default::Float(0.5),
+    "weight of the second phase function, in [0, 1]",
+);
+const BLENDED_PHASES: ParamSpec = ParamSpec::nested(
+    PluginClass::Phase,
+    Default::Required,
+    "the two phase functions",
+);
+const VALUE: ParamSpec = ParamSpec::new(
+    "value",
+    ParamKind::Spectrum {
+        range: Range::Coefficient,
+        textured: false,
+    },
+    Default::Float(1.0),
+    "the value",
+);
+const FILENAME: ParamSpec = ParamSpec::new(
+    "filename",
+    ParamKind::String,
+    Default::Required,
+    "the `.vol` file",
+);
+const FILTER_TYPE: ParamSpec = ParamSpec::new(
+    "filter_type",
+    ParamKind::Choice(&["bilinear", "nearest"]),
+    Default::Str("bilinear"),
+    "interpolation between voxels: `bilinear` (trilinear in 3D, Mitsuba's name) or `nearest`",
+);
+const VOLUME_TO_WORLD: ParamSpec = ParamSpec::new(
+    "to_world",
+    ParamKind::Transform,
+    Default::Text("identity"),
+    "from the unit cube [0, 1]³ to the world",
+);
+const USE_GRID_BBOX: ParamSpec = ParamSpec::new(
+    "use_grid_bbox",
+    ParamKind::Boolean,
+    Default::Boolean(false),
+    "place the grid in the box its file gives (then transformed by `to_world`)",
+);
+
+/// Builds the medium a `<medium>` node describes.
+pub fn build_medium(node: &PluginNode) -> Result<Medium> {
+    let plugin = MEDIA.find(node)?;
+    let params = Params::new(node, plugin.params);
+    let medium = (plugin.build)(&params)?;
+    params.finish()?;
+    Ok(medium)
+}
+
+fn build_phase(node: &PluginNode) -> Result<PhaseFunction> {
+    let plugin = PHASES.find(node)?;
+    let params = Params::new(node, plugin.params);
+    let phase = (plugin.build)(&params)?;
+    params.finish()?;
+    Ok(phase)
+}
+
+/// The nested phase function, isotropic when absent.
+fn phase(params: &Params) -> Result<PhaseFunction> {
+    match params.single_child(&PHASE)? {
+        Some(child) => build_phase(&child.node),
+        None => Ok(PhaseFunction::Isotropic),
+    }
+}
+
+/// `scale`: finite and at least 0.
+fn scale(params: &Params) -> Result<f32> {
+    let scale = params.float(&SCALE)?;
+    if !(scale >= 0.0 && scale.is_finite()) {
+        return Err(Error::input(
+            params.location_of(&SCALE),
+            format!("scale must be a finite number of at least 0, not {scale}"),
+        ));
+    }
+    Ok(scale as f32)
+}
+
+/// An albedo above 1 would scatter more light than the medium removes; Mitsuba refuses RGB
+/// albedos above 1 too.
+fn check_albedo(params: &Params, spec: &ParamSpec, max: f32) -> Result<()> {
+    if max > 1.0 {
+        return Err(Error::input(
+            params.location_of(spec),
+            format!(
+                "the albedo of {} reaches {max}, above 1: the medium would scatter more light than it removes",
+                params.node().describe()
+            ),
+        )
+        .with_help("use values between 0 and 1"));
+    }
+    Ok(())
+}
+
+/// The largest value of an `<rgb>` property, which the spectrum's upsampling may round.
+fn given_max(params: &Params, spec: &ParamSpec, spectrum: &Spectrum) -> f32 {
+    match params.property(spec).map(|p| &p.value) {
+        Some(PropertyValue::Rgb(rgb)) => rgb.iter().copied().fold(0.0, f64::max) as f32,
+        _ => spectrum.max_value(),
+    }
+}
+
+fn build_homogeneous(params: &Params) -> Result<Medium> {
+    let scale = scale(params)?;
+    let kind = if params.has(&SIGMA_A) || params.has(&SIGMA_S) {
+        for spec in [&SIGMA_T, &ALBEDO] {
+            if params.has(spec) {
+                return Err(Error::input(
+                    params.location_of(spec),
+                    format!(
+                        "{} is given both sigma_a/sigma_s and \"{}\"",
+                        params.node().describe(),
+                        spec.name
+                    ),
+                )
+                .with_help("give either sigma_t and albedo (Mitsuba 3) or sigma_a and sigma_s"));
+            }
+        }
+        for (spec, other) in [(&SIGMA_A, &SIGMA_S), (&SIGMA_S, &SIGMA_A)] {
+            if !params.has(spec) {
+                return Err(Error::input(
+                    params.location_of(other),
+                    format!(
+                        "{} gives \"{}\" without \"{}\"",
+                        params.node().describe(),
+                        other.name,
+                        spec.name
+                    ),
+                )
+                .with_help("give both sigma_a and sigma_s, or sigma_t and albedo"));
+            }
+        }
+        MediumKind::HomogeneousAbsorbingScattering {
+            sigma_a: spectrum_param(params, &SIGMA_A)?,
+            sigma_s: spectrum_param(params, &SIGMA_S)?,
+            scale,
+        }
+    } else {
+        let albedo = spectrum_param(params, &ALBEDO)?;
+        check_albedo(params, &ALBEDO, given_max(params, &ALBEDO, &albedo))?;
+        MediumKind::Homogeneous {
+            sigma_t: spectrum_param(params, &SIGMA_T)?,
+            albedo,
+            scale,
+        }
+    };
+    Ok(Medium {
+        kind,
+        phase: phase(params)?,
+        sample_emitters: params.boolean(&SAMPLE_EMITTERS)?,
+    })
+}
+
+/// A volume parameter: a nested `<volume name="...">` or a plain value.
+fn volume_param(params: &Params, spec: &ParamSpec) -> Result<Volume> {
+    let ParamKind::Volume(range) = spec.kind else {
+        panic!("\"{}\" is not a volume", spec.name);
+    };
+    if let Some(child) = params.named_child(spec) {
+        if child.node.class != PluginClass::Volume {
+            return Err(Error::input(
+                &child.location,
+                format!(
+                    "parameter \"{}\" of {} takes a <volume>, not a {}",
+                    spec.name,
+                    params.node().describe(),
+                    child.node.describe()
+                ),
+            )
+            .with_help("give a <volume type=\"gridvolume\"> or a plain value"));
+        }
+        let plugin = VOLUMES.find(&child.node)?;
+        let volume_params = Params::new(&child.node, plugin.params);
+        let volume = (plugin.build)(&volume_params, range)?;
+        volume_params.finish()?;
+        return Ok(volume);
+    }
+    let spectrum = spectrum_param(params, spec)?;
+    if range == Range::Albedo {
+        check_albedo(params, spec, given_max(params, spec, &spectrum))?;
+    }
+    Ok(Volume::Constant(spectrum))
+}
+
+fn build_heterogeneous(params: &Params) -> Result<Medium> {
+    let sigma_t = volume_param(params, &SIGMA_T_VOLUME)?;
+    let albedo = volume_param(params, &ALBEDO_VOLUME)?;
+    Ok(Medium {
+        kind: MediumKind::Heterogeneous {
+            sigma_t,
+            albedo,
+            scale: scale(params)?,
+        },
+        phase: phase(params)?,
+        sample_emitters: params.boolean(&SAMPLE_EMITTERS)?,
+    })
+}
+
+fn build_hg(params: &Params) -> Result<PhaseFunction> {
+    let g = params.float(&G)?;
+    if !(g > -1.0 && g < 1.0) {
+        return Err(Error::input(
+            params.location_of(&G),
+            format!("the asymmetry g of an hg phase function must lie in (-1, 1), not {g}"),
+        )
+        .with_help("g = 0 is isotropic; values near ±1 scatter almost straight on or back"));
+    }
+    Ok(PhaseFunction::HenyeyGreenstein { g: g as f32 })
+}
+
+fn build_blendphase(params: &Params) -> Result<PhaseFunction> {
+    let weight = params.float_in(&PHASE_WEIGHT, 0.5, 0.0, 1.0)? as f32;
+    let children = params.children(&BLENDED_PHASES);
+    let [first, second] = children.as_slice() else {
+        return Err(Error::input(
+            params.location(),
+            format!(
+                "{} needs exactly two nested phase functions, but {} were given",
+                params.node().describe(),
+                children.len()
+            ),
+        )
+        .with_help("nest two <phase> elements"));
+    };
+    Ok(PhaseFunction::Blend {
+        weight,
+        first: Box::new(build_phase(&first.node)?),
+        second: Box::new(build_phase(&second.node)?),
+    })
+}
+
+fn build_constvolume(params: &Params, range: Range) -> Result<Volume> {
+    let value = spectrum_param(params, &VALUE)?;
+    if range == Range::Albedo {
+        check_albedo(params, &VALUE, given_max(params, &VALUE, &value))?;
+    }
+    Ok(Volume::Constant(value))
+}
+
+fn build_gridvolume(params: &Params, range: Range) -> Result<Volume> {
+    let node = params.node();
+    let filename = params.string_opt(&FILENAME)?.ok_or_else(|| {
+        Error::input(
+            &node.location,
+            format!("{} needs a \"filename\"", node.describe()),
+        )
+        .with_help("add <string name=\"filename\" value=\"density.vol\"/>")
+    })?;
+    let location = params.location_of(&FILENAME);
+    let path = node.resolve_file(filename, location)?;
+    let bytes = std::fs::read(&path).map_err(|e| {
+        Error::input(
+            location,
+            format!("cannot read the grid \"{}\": {e}", path.display()),
+        )
+    })?;
+    let file = parse_vol(&bytes).map_err(|message| {
+        Error::input(
+            location,
+            format!("the grid \"{}\" is unreadable: {message}", path.display()),
+        )
+        .with_help("write the grid in Mitsuba's .vol format (version 3, 32-bit floats)")
+    })?;
+    if file.channels != 1 {
+        return Err(Error::input(
+            location,
+            format!(
+                "the grid \"{}\" has {} channels; Prism reads single-channel grids",
+                path.display(),
+                file.channels
+            ),
+        )
+        .with_help("store one quantity (a density or an albedo) per grid"));
+    }
+    if let Some(bad) = file.data.iter().find(|v| !(v.is_finite() && **v >= 0.0)) {
+        return Err(Error::input(
+            location,
+            format!(
+                "the grid \"{}\" holds the value {bad}: coefficients must be finite and at least 0",
+                path.display()
+            ),
+        ));
+    }
+    let mut to_world = params.transform(&VOLUME_TO_WORLD)?;
+    if params.boolean(&USE_GRID_BBOX)? {
+        let min = file.bbox_min.as_dvec3();
+        let extent = (file.bbox_max - file.bbox_min).as_dvec3();
+        to_world *= DMat4::from_translation(min) * DMat4::from_scale(extent);
+    }
+    let singular = || {
+        Error::input(
+            params.location_of(&VOLUME_TO_WORLD),
+            format!(
+                "the grid of {} is placed by a singular transform",
+                node.describe()
+            ),
+        )
+        .with_help("check to_world (and the grid's bounding box with use_grid_bbox)")
+    };
+    let to_world = Transform::new(to_world).ok_or_else(singular)?;
+    let filter = match params.choice(&FILTER_TYPE)? {
+        "nearest" => GridFilter::Nearest,
+        _ => GridFilter::Trilinear,
+    };
+    let grid = GridVolume::new(file.resolution, file.data, to_world, filter)
+        .expect("a parsed grid holds its voxels");
+    if range == Range::Albedo && grid.max_value() > 1.0 {
+        return Err(Error::input(
+            location,
+            format!(
+                "the albedo grid \"{}\" reaches {}, above 1: the medium would scatter more light than it removes",
+                path.display(),
+                grid.max_value()
+            ),
+        )
+        .with_help("use values between 0 and 1"));
+    }
+    Ok(Volume::Grid(Box::new(grid)))
+}

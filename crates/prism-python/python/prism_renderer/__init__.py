@@ -1,0 +1,191 @@
+"""Prism, a spectral Monte Carlo path tracer for Mitsuba 3 scenes, from Python.
+
+    import prism_renderer as pr
+    scene = pr.load_file("scenes/cornell-box/scene.xml", spp=16)
+    image = pr.render(scene, seed=1)
+    image.rgb            # numpy array, H x W x 3, linear sRGB
+    image.write("cornell.exr")
+
+The API follows Mitsuba's (``load_file``, ``load_dict``, ``render``); the scene is read, checked
+and rendered by the same Rust code as the ``prism`` command, so the images and error messages
+are the same. See docs/python.md.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import sys
+import time
+from typing import Any, Callable, Optional, Sequence, Union
+
+from ._native import (
+    ChannelDifference,
+    Comparison,
+    Image,
+    PrismError,
+    Scene,
+    Transform,
+    ZTest,
+    load_dict,
+)
+from . import _native
+
+__all__ = [
+    "ChannelDifference",
+    "Comparison",
+    "Image",
+    "PrismError",
+    "Scene",
+    "Transform",
+    "ZTest",
+    "compare",
+    "load_dict",
+    "load_file",
+    "render",
+]
+
+ProgressCallback = Callable[[int, Optional[int], float], object]
+
+
+def load_file(path: Union[str, os.PathLike], **defines: object) -> Scene:
+    """Loads the Mitsuba XML scene at ``path``.
+
+    Each keyword sets a ``<default>`` parameter of the scene, like ``prism render -D name=value``
+    (``load_file("scene.xml", spp=16, resx=64)``); values are written as text, booleans as
+    ``true``/``false``. A scene that is not valid raises :class:`PrismError` with the ``file``,
+    ``line`` and ``column`` of the problem.
+    """
+    pairs = [(name, _define_text(value)) for name, value in defines.items()]
+    return _native.load_file(os.fspath(path), pairs)
+
+
+def _define_text(value: object) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    return str(value)
+
+
+def render(
+    scene: Scene,
+    spp: Optional[int] = None,
+    seed: Optional[int] = None,
+    threads: Optional[int] = None,
+    progress: Union[bool, ProgressCallback] = True,
+    time_limit: Optional[float] = None,
+    target_error: Optional[float] = None,
+) -> Image:
+    """Renders ``scene`` and returns its :class:`Image`.
+
+    ``spp``: samples per pixel (default: the sampler's ``sample_count``). ``seed``: the seed of
+    every random stream (default: the sampler's ``seed``, 0 unless the scene sets it); the image
+    is the same for a seed whatever the number of ``threads`` (default: one per core) and equal
+    to ``prism render --seed``'s. With ``time_limit`` (seconds) or ``target_error`` (the image's
+    mean relative standard error) the render stops at whichever comes first, ``spp`` then only
+    capping the samples.
+
+    ``progress``: True shows a progress bar (tqdm's, in a terminal or a notebook, if tqdm is
+    installed; else a line on standard error), False none; a callable is called as
+    ``progress(samples, total, error)`` about ten times a second.
+
+    The render runs on worker threads without the GIL, so other Python threads keep running.
+    Ctrl-C stops it: the worker threads finish their tiles and are joined, and
+    KeyboardInterrupt is raised.
+    """
+    callback: Optional[ProgressCallback]
+    bar: Optional[_ProgressBar] = None
+    if callable(progress):
+        callback = progress
+    elif progress:
+        bar = _ProgressBar()
+        callback = bar
+    else:
+        callback = None
+    try:
+        return _native.render(
+            scene,
+            spp=spp,
+            seed=seed,
+            threads=threads,
+            progress=callback,
+            time_limit=time_limit,
+            target_error=target_error,
+        )
+    finally:
+        if bar is not None:
+            bar.close()
+
+
+def compare(
+    test: Union[Image, str, os.PathLike],
+    reference: Union[Image, str, os.PathLike],
+    channels: Optional[Sequence[str]] = None,
+    diff: Optional[Union[str, os.PathLike]] = None,
+) -> Comparison:
+    """Compares ``test`` with ``reference`` (each an :class:`Image` or an EXR file's path) as
+    ``prism compare`` does: per channel the means, MSE, relative MSE and largest difference,
+    and the per-pixel z-test of luminance when the test image has variances. ``str()`` of the
+    result is ``prism compare``'s table. ``diff``: a PNG file to write the signed difference
+    to in false colour (red where the test is brighter, blue where darker), as
+    ``prism compare --diff``."""
+
+    def operand(value: Union[Image, str, os.PathLike]) -> Union[Image, str]:
+        return value if isinstance(value, Image) else os.fspath(value)
+
+    return _native.compare(
+        operand(test),
+        operand(reference),
+        None if channels is None else list(channels),
+        None if diff is None else os.fspath(diff),
+    )
+
+
+class _ProgressBar:
+    """tqdm's bar (``tqdm.auto``: a widget in Jupyter) if tqdm is installed, else a line on
+    standard error rewritten twice a second."""
+
+    def __init__(self) -> None:
+        self._tqdm: Any = None
+        try:
+            from tqdm.auto import tqdm
+
+            self._tqdm = tqdm
+        except ImportError:
+            pass
+        self._bar: Any = None
+        self._samples = 0
+        self._last_line = -math.inf
+        self._line_shown = False
+
+    def __call__(self, samples: int, total: Optional[int], error: float) -> None:
+        message = f"error {error:.4f}" if math.isfinite(error) else ""
+        if self._tqdm is not None:
+            if self._bar is None:
+                self._bar = self._tqdm(
+                    total=total, unit=" samples", unit_scale=True, desc="prism", leave=False
+                )
+            self._bar.update(samples - self._samples)
+            self._samples = samples
+            if message:
+                self._bar.set_postfix_str(message, refresh=False)
+            return
+        now = time.monotonic()
+        if now - self._last_line < 0.5 and (total is None or samples < total):
+            return
+        self._last_line = now
+        if total:
+            line = f"prism: {100.0 * samples / total:5.1f} % of {total} samples"
+        else:
+            line = f"prism: {samples} samples"
+        if message:
+            line += ", " + message
+        sys.stderr.write("\r" + line)
+        sys.stderr.flush()
+        self._line_shown = True
+
+    def close(self) -> None:
+        if self._bar is not None:
+            self._bar.close()
+        elif self._line_shown:
+            sys.stderr.write("\n")
+            sys.stderr.flush()

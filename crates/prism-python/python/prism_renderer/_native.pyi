@@ -1,0 +1,198 @@
+"""Type stubs of the native module (crates/prism-python/src); the package re-exports these."""
+
+import os
+from typing import Callable, List, Optional, Sequence, Tuple, Union
+
+import numpy as np
+import numpy.typing as npt
+
+class PrismError(Exception):
+    """An error in a scene, a file it uses or an argument. ``str()`` is the message the
+    ``prism`` command prints."""
+
+    file: Optional[str]
+    """The file where the problem is; for a dictionary, the entry's key path, such as
+    ``scene.sphere.bsdf.reflectance``; None when no input is to blame."""
+    line: Optional[int]
+    """1-based line in ``file``; None for a dictionary."""
+    column: Optional[int]
+    """1-based column in ``file``; None for a dictionary."""
+    message: str
+    """What is wrong."""
+    help: Optional[str]
+    """What to do about it, with a "did you mean" where a name is misspelled."""
+    kind: str
+    """``"input"`` (the scene or an argument is invalid) or ``"io"`` (reading or writing
+    failed)."""
+
+class Scene:
+    """A scene ready to render, from :func:`load_file` or :func:`load_dict`."""
+
+    @property
+    def width(self) -> int:
+        """The film's width in pixels."""
+    @property
+    def height(self) -> int:
+        """The film's height in pixels."""
+    @property
+    def spp(self) -> int:
+        """The sampler's ``sample_count``."""
+    @property
+    def seed(self) -> int:
+        """The sampler's ``seed``."""
+
+class Transform:
+    """A 4 × 4 transform acting on column vectors, composed like Mitsuba's
+    ``ScalarTransform4f``: each method multiplies on the right, so
+    ``Transform().translate(t).scale(s)`` scales first, then translates. Give it as a
+    ``to_world`` value in :func:`load_dict`."""
+
+    def __init__(self, matrix: Optional[npt.ArrayLike] = None) -> None:
+        """The identity, or the 4 × 4 ``matrix`` (rows first)."""
+    def translate(self, offset: Union[float, Sequence[float]]) -> Transform:
+        """This transform times the translation by ``offset`` (three numbers)."""
+    def scale(self, factors: Union[float, Sequence[float]]) -> Transform:
+        """This transform times the scaling by ``factors`` (one number or three)."""
+    def rotate(self, axis: Sequence[float], angle: float) -> Transform:
+        """This transform times the right-handed rotation by ``angle`` degrees about
+        ``axis``. Raises ValueError for a zero axis."""
+    def look_at(
+        self,
+        origin: Sequence[float],
+        target: Sequence[float],
+        up: Optional[Sequence[float]] = None,
+    ) -> Transform:
+        """This transform times the camera-to-world transform of a camera at ``origin``
+        looking at ``target`` with ``up`` (None: any perpendicular direction), as Mitsuba's
+        ``look_at``. Raises ValueError when origin and target coincide or up is parallel to
+        the view."""
+    def inverse(self) -> Transform:
+        """The inverse. Raises ValueError if there is none."""
+    @property
+    def matrix(self) -> npt.NDArray[np.float64]:
+        """The 4 × 4 matrix, rows first (a new array)."""
+    def __matmul__(self, other: Transform) -> Transform: ...
+
+class Image:
+    """A rendered image. The arrays are the render's own memory (no copy); ``write`` and
+    ``_repr_png_`` use their current values."""
+
+    @property
+    def rgb(self) -> npt.NDArray[np.float32]:
+        """H × W × 3, linear sRGB (D65 white)."""
+    @property
+    def xyz(self) -> npt.NDArray[np.float32]:
+        """H × W × 3, CIE 1931 XYZ."""
+    @property
+    def variance(self) -> npt.NDArray[np.float32]:
+        """H × W × 3, the estimated variance of each pixel's mean of X, Y and Z."""
+    @property
+    def relative_error(self) -> npt.NDArray[np.float32]:
+        """H × W, each pixel's relative standard error of luminance (Y)."""
+    @property
+    def spp(self) -> int:
+        """Samples per pixel taken (0 for an image read from a file)."""
+    @property
+    def seconds(self) -> float:
+        """How long the render took (0 for an image read from a file)."""
+    @property
+    def width(self) -> int: ...
+    @property
+    def height(self) -> int: ...
+    @staticmethod
+    def read(path: Union[str, os.PathLike]) -> Image:
+        """Reads an OpenEXR file that Prism wrote (``prism render`` or :meth:`write`)."""
+    def write(self, path: Union[str, os.PathLike]) -> None:
+        """Writes ``.exr`` (every array, the channels ``prism render`` writes) or ``.png``
+        (the RGB image, 8-bit sRGB)."""
+    def _repr_png_(self) -> bytes:
+        """The PNG that :meth:`write` writes, for Jupyter."""
+
+class ChannelDifference:
+    """How one channel of two images differs."""
+
+    @property
+    def name(self) -> str: ...
+    @property
+    def mean_test(self) -> float: ...
+    @property
+    def mean_reference(self) -> float: ...
+    @property
+    def mse(self) -> float: ...
+    @property
+    def rel_mse(self) -> float:
+        """Mean of (a − b)² / (b² + 0.01)."""
+    @property
+    def max_abs(self) -> float:
+        """The largest |a − b|."""
+
+class ZTest:
+    """The per-pixel z-test zᵢ = (aᵢ − bᵢ)/√(σ²_a + σ²_b) of luminance."""
+
+    @property
+    def pixels(self) -> int: ...
+    @property
+    def chi2(self) -> float:
+        """Σ zᵢ²."""
+    @property
+    def p_value(self) -> float:
+        """The χ² p-value of ``chi2`` with ``pixels`` degrees of freedom."""
+    @property
+    def max_z(self) -> float: ...
+    @property
+    def max_z_p_value(self) -> float:
+        """The two-sided p-value of ``max_z`` times ``pixels`` (Bonferroni)."""
+    @property
+    def beyond_three(self) -> float:
+        """The fraction of pixels with |z| > 3 (0.27 % expected from noise)."""
+    @property
+    def consistent_with_noise(self) -> bool:
+        """Whether both p-values exceed 0.01."""
+
+class Comparison:
+    """The outcome of :func:`compare`; ``str()`` is ``prism compare``'s table."""
+
+    @property
+    def channels(self) -> List[ChannelDifference]: ...
+    @property
+    def mse(self) -> float:
+        """The MSE averaged over the channels."""
+    @property
+    def rel_mse(self) -> float:
+        """The relative MSE averaged over the channels."""
+    @property
+    def z_test(self) -> Optional[ZTest]:
+        """None when the test image has no variances."""
+
+def load_file(path: Union[str, os.PathLike], defines: List[Tuple[str, str]] = ...) -> Scene:
+    """Loads a Mitsuba XML scene with ``(name, value)`` defines."""
+
+def load_dict(scene: dict) -> Scene:
+    """Loads a scene in Mitsuba's dictionary form: ``{"type": "scene", "ball": {"type":
+    "sphere", ...}}``. Values: bool, int, float, str, path-like, three numbers (a point or
+    vector), a 4 × 4 matrix (nested lists, numpy array or :class:`Transform`),
+    ``{"type": "rgb", "value": ...}``, ``{"type": "spectrum", "value": ...}`` (one number or
+    (wavelength, value) pairs) or ``{"type": "spectrum", "filename": ...}``,
+    ``{"type": "ref", "id": ...}``, and nested plugins. Plugins directly in the scene can be
+    referred to by their key. Raises :class:`PrismError` with ``file`` the key path."""
+
+def render(
+    scene: Scene,
+    spp: Optional[int] = None,
+    seed: Optional[int] = None,
+    threads: Optional[int] = None,
+    progress: Optional[Callable[[int, Optional[int], float], object]] = None,
+    time_limit: Optional[float] = None,
+    target_error: Optional[float] = None,
+) -> Image:
+    """Renders ``scene`` (see :func:`prism_renderer.render`); ``progress`` is a callable or
+    None."""
+
+def compare(
+    test: Union[Image, str, os.PathLike],
+    reference: Union[Image, str, os.PathLike],
+    channels: Optional[List[str]] = None,
+    diff: Optional[Union[str, os.PathLike]] = None,
+) -> Comparison:
+    """``prism compare``'s statistics of ``test`` against ``reference``; with ``diff``, the
+    false-colour difference PNG written there."""

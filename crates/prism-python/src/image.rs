@@ -1,0 +1,357 @@
+//! A rendered image as numpy arrays, written as OpenEXR or PNG and shown by notebooks, and the
+//! comparison of two images (`prism compare`'s statistics).
+
+use std::path::{Path, PathBuf};
+
+use numpy::ndarray::{Array2, Array3};
+use numpy::{IntoPyArray, PyArray2, PyArray3, PyArrayMethods, PyUntypedArrayMethods};
+use pyo3::prelude::*;
+use pyo3::types::PyBytes;
+
+use crate::error::{IntoPyResult, to_py};
+use prism_core::error::{Error, ErrorKind};
+use prism_core::film::FilmImages;
+use prism_core::image::compare as stats;
+use prism_core::image::{ChannelImage, read_exr};
+
+/// A rendered image: H × W × 3 float32 arrays `rgb` (linear sRGB), `xyz` (CIE 1931) and
+/// `variance` (the estimated variance of each pixel's mean of X, Y and Z), and the H × W array
+/// `relative_error` (each pixel's relative standard error of luminance). The arrays are the
+/// render's own memory (no copy); `write` and `_repr_png_` use their current values.
+#[pyclass(module = "prism_renderer", frozen)]
+pub struct Image {
+    #[pyo3(get)]
+    rgb: Py<PyArray3<f32>>,
+    #[pyo3(get)]
+    xyz: Py<PyArray3<f32>>,
+    #[pyo3(get)]
+    variance: Py<PyArray3<f32>>,
+    #[pyo3(get)]
+    relative_error: Py<PyArray2<f32>>,
+    /// Samples per pixel taken.
+    #[pyo3(get)]
+    spp: u32,
+    /// The render's duration in seconds (0 for an image read from a file).
+    #[pyo3(get)]
+    seconds: f64,
+}
+
+impl Image {
+    /// The image of `images`, which the arrays take over.
+    pub fn new(py: Python<'_>, images: FilmImages, spp: u32, seconds: f64) -> Image {
+        let (h, w) = (images.height, images.width);
+        let three = |values: Vec<f32>| {
+            Array3::from_shape_vec((h, w, 3), values)
+                .expect("FilmImages holds three values per pixel")
+                .into_pyarray(py)
+                .unbind()
+        };
+        Image {
+            rgb: three(images.rgb),
+            xyz: three(images.xyz),
+            variance: three(images.variance),
+            relative_error: Array2::from_shape_vec((h, w), images.relative_error)
+                .expect("FilmImages holds one relative error per pixel")
+                .into_pyarray(py)
+                .unbind(),
+            spp,
+            seconds,
+        }
+    }
+
+    /// The arrays' current values.
+    fn images(&self, py: Python<'_>) -> FilmImages {
+        let rgb = self.rgb.bind(py).readonly();
+        let values = |array: &Py<PyArray3<f32>>| -> Vec<f32> {
+            array
+                .bind(py)
+                .readonly()
+                .as_array()
+                .iter()
+                .copied()
+                .collect()
+        };
+        let shape = rgb.shape();
+        FilmImages {
+            width: shape[1],
+            height: shape[0],
+            rgb: values(&self.rgb),
+            xyz: values(&self.xyz),
+            variance: values(&self.variance),
+            relative_error: self
+                .relative_error
+                .bind(py)
+                .readonly()
+                .as_array()
+                .iter()
+                .copied()
+                .collect(),
+        }
+    }
+}
+
+#[pymethods]
+impl Image {
+    /// Reads an OpenEXR image that Prism wrote (channels R, G, B, X, Y, Z, variance.X/Y/Z and
+    /// relative_error.Y).
+    #[staticmethod]
+    fn read(py: Python<'_>, path: PathBuf) -> PyResult<Image> {
+        let exr = py.detach(|| load_exr(&path)).into_py_result(py)?;
+        let images = FilmImages::from_channels(&exr).map_err(|missing| {
+            to_py(
+                py,
+                &Error::usage(format!("\"{}\" has no channel {missing}", path.display()))
+                    .with_help("read an image that Prism rendered; compare() reads any EXR"),
+            )
+        })?;
+        Ok(Image::new(py, images, 0, 0.0))
+    }
+
+    /// The width in pixels.
+    #[getter]
+    fn width(&self, py: Python<'_>) -> usize {
+        self.rgb.bind(py).shape()[1]
+    }
+
+    /// The height in pixels.
+    #[getter]
+    fn height(&self, py: Python<'_>) -> usize {
+        self.rgb.bind(py).shape()[0]
+    }
+
+    /// Writes the image: `.exr` gives OpenEXR with every array as channels (as `prism render`
+    /// writes), `.png` the RGB image as 8-bit sRGB.
+    fn write(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
+        let images = self.images(py);
+        let extension = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase);
+        let result = match extension.as_deref() {
+            Some("exr") => py.detach(|| images.write_exr(&path)),
+            Some("png") => py.detach(|| images.write_png(&path)),
+            _ => Err(Error::usage(format!(
+                "cannot write \"{}\": the name must end in .exr or .png",
+                path.display()
+            ))),
+        };
+        result.into_py_result(py)
+    }
+
+    /// The RGB image as the bytes of an sRGB PNG file (Jupyter shows it).
+    fn _repr_png_<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyBytes>> {
+        let bytes = self
+            .images(py)
+            .png_bytes()
+            .map_err(|e| to_py(py, &Error::usage(format!("cannot encode the PNG: {e}"))))?;
+        Ok(PyBytes::new(py, &bytes))
+    }
+
+    fn __repr__(&self, py: Python<'_>) -> String {
+        format!(
+            "Image({}×{} pixels, {} spp)",
+            self.width(py),
+            self.height(py),
+            self.spp
+        )
+    }
+}
+
+/// An EXR file given to read, whose failures are the input's fault.
+fn load_exr(path: &Path) -> prism_core::error::Result<ChannelImage> {
+    read_exr(path).map_err(|mut e| {
+        e.kind = ErrorKind::Input;
+        e
+    })
+}
+
+/// One side of a comparison: a rendered image or the path of an EXR file.
+#[derive(FromPyObject)]
+pub enum Operand<'py> {
+    Image(Bound<'py, Image>),
+    Path(PathBuf),
+}
+
+impl Operand<'_> {
+    fn channels(&self, py: Python<'_>) -> PyResult<ChannelImage> {
+        match self {
+            Operand::Image(image) => Ok(image.get().images(py).channels()),
+            Operand::Path(path) => py.detach(|| load_exr(path)).into_py_result(py),
+        }
+    }
+}
+
+/// Compares a test image with a reference, each an `Image` or the path of an EXR file, on
+/// `channels` (default: R, G, B if both have them, else X, Y, Z): `prism compare`'s
+/// statistics, with the z-test where the test image has variances; with `diff`, writes the
+/// false-colour difference PNG there, as `prism compare --diff`.
+#[pyfunction]
+#[pyo3(signature = (test, reference, channels = None, diff = None))]
+pub fn compare(
+    py: Python<'_>,
+    test: Operand<'_>,
+    reference: Operand<'_>,
+    channels: Option<Vec<String>>,
+    diff: Option<PathBuf>,
+) -> PyResult<Comparison> {
+    let test = test.channels(py)?;
+    let reference = reference.channels(py)?;
+    let comparison = stats::compare(&test, &reference, channels.as_deref()).into_py_result(py)?;
+    if let Some(path) = diff {
+        py.detach(|| stats::write_difference_png(&test, &reference, &comparison, &path))
+            .into_py_result(py)?;
+    }
+    Ok(Comparison { comparison })
+}
+
+/// The outcome of `compare`; `str()` gives the table `prism compare` prints.
+#[pyclass(module = "prism_renderer", frozen)]
+pub struct Comparison {
+    comparison: stats::Comparison,
+}
+
+#[pymethods]
+impl Comparison {
+    /// Per compared channel: means, MSE, relative MSE, largest difference.
+    #[getter]
+    fn channels(&self) -> Vec<ChannelDifference> {
+        self.comparison
+            .channels
+            .iter()
+            .map(|d| ChannelDifference {
+                difference: d.clone(),
+            })
+            .collect()
+    }
+
+    /// The MSE averaged over the channels.
+    #[getter]
+    fn mse(&self) -> f64 {
+        self.comparison.mse()
+    }
+
+    /// The relative MSE, (a − b)² / (b² + 0.01), averaged over the channels.
+    #[getter]
+    fn rel_mse(&self) -> f64 {
+        self.comparison.rel_mse()
+    }
+
+    /// The per-pixel z-test of luminance, or None when the test image has no variances.
+    #[getter]
+    fn z_test(&self) -> Option<ZTest> {
+        self.comparison.z_test.clone().map(|test| ZTest { test })
+    }
+
+    fn __str__(&self) -> String {
+        self.comparison.to_string()
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Comparison(rel_mse={:.4e}, consistent_with_noise={})",
+            self.rel_mse(),
+            match &self.comparison.z_test {
+                Some(z) =>
+                    if z.consistent_with_noise() {
+                        "True"
+                    } else {
+                        "False"
+                    },
+                None => "None",
+            }
+        )
+    }
+}
+
+/// How one channel of two images differs.
+#[pyclass(module = "prism_renderer", frozen)]
+pub struct ChannelDifference {
+    difference: stats::ChannelDifference,
+}
+
+#[pymethods]
+impl ChannelDifference {
+    #[getter]
+    fn name(&self) -> &str {
+        &self.difference.name
+    }
+    #[getter]
+    fn mean_test(&self) -> f64 {
+        self.difference.mean_test
+    }
+    #[getter]
+    fn mean_reference(&self) -> f64 {
+        self.difference.mean_reference
+    }
+    #[getter]
+    fn mse(&self) -> f64 {
+        self.difference.mse
+    }
+    #[getter]
+    fn rel_mse(&self) -> f64 {
+        self.difference.rel_mse
+    }
+    #[getter]
+    fn max_abs(&self) -> f64 {
+        self.difference.max_abs
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "ChannelDifference(name={:?}, mean_test={}, mean_reference={}, rel_mse={:.4e})",
+            self.difference.name,
+            self.difference.mean_test,
+            self.difference.mean_reference,
+            self.difference.rel_mse
+        )
+    }
+}
+
+/// The per-pixel z-test zᵢ = (aᵢ − bᵢ)/√(σ²_a + σ²_b) of luminance.
+#[pyclass(module = "prism_renderer", frozen)]
+pub struct ZTest {
+    test: stats::ZTest,
+}
+
+#[pymethods]
+impl ZTest {
+    /// Pixels tested.
+    #[getter]
+    fn pixels(&self) -> usize {
+        self.test.pixels
+    }
+    /// Σ zᵢ².
+    #[getter]
+    fn chi2(&self) -> f64 {
+        self.test.chi2
+    }
+    /// The p-value of `chi2` for a χ² distribution with `pixels` degrees of freedom.
+    #[getter]
+    fn p_value(&self) -> f64 {
+        self.test.p_value
+    }
+    /// The largest |zᵢ|.
+    #[getter]
+    fn max_z(&self) -> f64 {
+        self.test.max_z
+    }
+    /// The two-sided p-value of `max_z` times the number of pixels (Bonferroni).
+    #[getter]
+    fn max_z_p_value(&self) -> f64 {
+        self.test.max_z_p_value
+    }
+    /// The fraction of pixels with |z| > 3 (0.27 % expected from noise alone).
+    #[getter]
+    fn beyond_three(&self) -> f64 {
+        self.test.beyond_three
+    }
+    /// Whether both p-values exceed 0.01.
+    #[getter]
+    fn consistent_with_noise(&self) -> bool {
+        self.test.consistent_with_noise()
+    }
+
+    fn __str__(&self) -> String {
+        self.test.to_string()
+    }
+}

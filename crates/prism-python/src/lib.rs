@@ -1,0 +1,30 @@
+//! The native module of the `prism_renderer` Python package: a thin layer over the renderer's
+//! Rust API (scene loading from files and dictionaries, rendering, the film's images and their
+//! comparison) with no rendering logic of its own. The Python package around it
+//! (`python/prism_renderer`) adds the keyword-argument forms and the progress bar; its `.pyi`
+//! stubs document every call.
+
+mod dict;
+mod error;
+mod image;
+mod render;
+mod scene;
+mod transform;
+
+use pyo3::prelude::*;
+
+#[pymodule]
+fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("PrismError", m.py().get_type::<error::PrismError>())?;
+    m.add_class::<scene::Scene>()?;
+    m.add_class::<transform::Transform>()?;
+    m.add_class::<image::Image>()?;
+    m.add_class::<image::Comparison>()?;
+    m.add_class::<image::ChannelDifference>()?;
+    m.add_class::<image::ZTest>()?;
+    m.add_function(wrap_pyfunction!(scene::load_file, m)?)?;
+    m.add_function(wrap_pyfunction!(scene::load_dict, m)?)?;
+    m.add_function(wrap_pyfunction!(render::render, m)?)?;
+    m.add_function(wrap_pyfunction!(image::compare, m)?)?;
+    Ok(())
+}

@@ -1,0 +1,116 @@
+//! `render`: the scene rendered on worker threads while the calling thread, holding the GIL
+//! only briefly, reports progress and watches for Ctrl-C. An interruption (or an exception
+//! from the progress callback) raises the render's stop flag; the render finishes the tiles in
+//! flight, its threads are joined, and the exception is raised.
+
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Duration;
+
+use pyo3::exceptions::PyRuntimeError;
+use pyo3::prelude::*;
+
+use crate::error::{IntoPyResult, to_py};
+use crate::image::Image;
+use crate::scene::Scene;
+use prism_core::error::Error;
+use prism_core::film::FilmImages;
+use prism_core::render::{
+    Progress, ProgressCounter, RenderOptions, StopRule, StopRuleNames, render as render_scene,
+};
+
+/// How often the calling thread checks for signals and reports progress.
+const POLL: Duration = Duration::from_millis(100);
+
+/// Renders `scene` with `spp` samples per pixel (None: the sampler's `sample_count`) from the
+/// random streams of `seed` (None: the sampler's `seed`) on `threads` worker threads (None:
+/// one per core). With a `time_limit` in seconds or a `target_error` (the image's mean relative
+/// standard error) the render stops at whichever comes first, `spp` then only capping the
+/// samples. `progress`, if given, is called as `progress(samples, total, error)` about ten
+/// times a second and once at the end, with the camera samples taken, those the render will
+/// take (None when open-ended) and the image's mean relative error (infinite before the first
+/// pass). The image is the same for every number of threads.
+#[pyfunction]
+#[pyo3(signature = (scene, spp = None, seed = None, threads = None, progress = None, time_limit = None, target_error = None))]
+#[allow(clippy::too_many_arguments)]
+pub fn render(
+    py: Python<'_>,
+    scene: &Scene,
+    spp: Option<u32>,
+    seed: Option<u64>,
+    threads: Option<usize>,
+    progress: Option<Bound<'_, PyAny>>,
+    time_limit: Option<f64>,
+    target_error: Option<f64>,
+) -> PyResult<Image> {
+    if threads == Some(0) {
+        return Err(to_py(py, &Error::usage("threads must be at least 1")));
+    }
+    let loaded = &scene.loaded;
+    let samples_per_pixel = loaded
+        .scene
+        .sampler
+        .kind
+        .sample_count(spp.unwrap_or(loaded.scene.sampler.samples_per_pixel));
+    let names = StopRuleNames {
+        spp: "spp",
+        time_limit: "time_limit",
+        target_error: "target_error",
+    };
+    let stop = StopRule::requested(spp, samples_per_pixel, time_limit, target_error, &names)
+        .into_py_result(py)?;
+    let interrupt = Arc::new(AtomicBool::new(false));
+    let counter = Arc::new(ProgressCounter::default());
+    let options = RenderOptions {
+        samples_per_pixel,
+        first_sample: 0,
+        initial: None,
+        stop,
+        interrupt: Some(interrupt.clone()),
+        threads,
+        seed: seed.unwrap_or(loaded.seed),
+        progress: Progress::Counter(counter.clone()),
+    };
+    let report = || -> PyResult<()> {
+        match &progress {
+            Some(callback) => callback
+                .call1((counter.samples(), counter.total(), counter.relative_error()))
+                .map(drop),
+            None => Ok(()),
+        }
+    };
+
+    let caller = std::thread::current();
+    let done = AtomicBool::new(false);
+    let (outcome, raised) = std::thread::scope(|scope| {
+        let worker = scope.spawn(|| {
+            let output = render_scene(&loaded.scene, &options);
+            done.store(true, Ordering::Release);
+            caller.unpark();
+            output
+        });
+        let mut raised: Option<PyErr> = None;
+        // `is_finished` too, in case the render panics before saying it is done.
+        while !done.load(Ordering::Acquire) && !worker.is_finished() {
+            py.detach(|| std::thread::park_timeout(POLL));
+            if raised.is_none()
+                && let Err(error) = py.check_signals().and_then(|()| report())
+            {
+                interrupt.store(true, Ordering::SeqCst);
+                raised = Some(error);
+            }
+        }
+        (py.detach(|| worker.join()), raised)
+    });
+    if let Some(error) = raised {
+        return Err(error);
+    }
+    let output = outcome
+        .map_err(|_| PyRuntimeError::new_err("the render's thread panicked"))?
+        .into_py_result(py)?;
+    report()?;
+    let spp = output.samples.end - output.samples.start;
+    let seconds = output.elapsed.as_secs_f64();
+    let images = py.detach(|| FilmImages::of(&output.film));
+    Ok(Image::new(py, images, spp, seconds))
+}
