@@ -203,6 +203,68 @@ fn cases() -> Vec<Case> {
             "max_depth",
         ),
         render_scene(
+            "direct with shading_samples and emitter_samples",
+            scene!(
+                "    <integrator type=\"direct\"><integer name=\"shading_samples\" value=\"2\"/><integer name=\"emitter_samples\" value=\"1\"/></integrator>"
+            ),
+            "scene.xml:3:",
+            "cannot be given with \"shading_samples\"",
+        ),
+        render_scene(
+            "direct without samples",
+            scene!(
+                "    <integrator type=\"direct\"><integer name=\"shading_samples\" value=\"0\"/></integrator>"
+            ),
+            "scene.xml:3:",
+            "at least one emitter or BSDF sample",
+        ),
+        render_scene(
+            "moment without nested integrators",
+            scene!("    <integrator type=\"moment\"/>"),
+            "scene.xml:3:",
+            "at least one nested integrator",
+        ),
+        render_scene(
+            "moment with a nested integrator named as an unnamed one is",
+            scene!(
+                "    <integrator type=\"moment\"><integrator type=\"path\" name=\"_arg_0\"/>\n<integrator type=\"direct\"/></integrator>"
+            ),
+            "scene.xml:4:",
+            "named \"_arg_0\"",
+        ),
+        render_scene(
+            "aov of an unknown type",
+            scene!(
+                "    <integrator type=\"aov\"><string name=\"aovs\" value=\"nn:sh_normals\"/></integrator>"
+            ),
+            "scene.xml:3:",
+            "did you mean \"sh_normal\"",
+        ),
+        render_scene(
+            "aov without a type",
+            scene!(
+                "    <integrator type=\"aov\"><string name=\"aovs\" value=\"nn\"/></integrator>"
+            ),
+            "scene.xml:3:",
+            "not a name:type pair",
+        ),
+        render_scene(
+            "aov of a type Prism cannot produce",
+            scene!(
+                "    <integrator type=\"aov\"><string name=\"aovs\" value=\"d:duv_dx\"/></integrator>"
+            ),
+            "scene.xml:3:",
+            "ray differentials",
+        ),
+        render_scene(
+            "aov named as an image channel",
+            scene!(
+                "    <integrator type=\"aov\"><string name=\"aovs\" value=\"variance:position\"/></integrator>"
+            ),
+            "scene.xml:3:",
+            "would replace the image's own",
+        ),
+        render_scene(
             "NaN float",
             scene!("    <shape type=\"sphere\"><float name=\"radius\" value=\"nan\"/></shape>"),
             "scene.xml:3:",

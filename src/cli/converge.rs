@@ -17,7 +17,8 @@ use prism_core::error::{Error, Result};
 use prism_core::image::compare::rel_mse_rgb;
 use prism_core::image::read_exr;
 use prism_core::integrator::{
-    DistributionIntegrator, Integrator, PathIntegrator, Tracking, VolPathIntegrator,
+    DirectIntegrator, DistributionIntegrator, Integrator, PathIntegrator, Tracking,
+    VolPathIntegrator,
 };
 use prism_core::render::{RenderOptions, render};
 use prism_core::sampling::sampler::SamplerKind;
@@ -79,13 +80,17 @@ impl Series {
 }
 
 fn integrator_named(name: &str, scene: &Scene) -> Result<Integrator> {
-    let max_depth = match &scene.integrator {
+    let image = scene.integrator.image_integrator();
+    let max_depth = match image {
         Integrator::Path(p) => p.max_depth,
+        // Direct illumination is the path tracer's estimate of paths of two vertices.
+        Integrator::Direct(_) => 2,
         Integrator::Distribution(d) => d.max_depth,
         Integrator::VolPath(v) => v.max_depth,
+        Integrator::Moment(_) | Integrator::Aov(_) => -1,
     };
     match name {
-        "path" => Ok(match &scene.integrator {
+        "path" => Ok(match image {
             Integrator::Path(p) => Integrator::Path(p.clone()),
             _ => PathIntegrator {
                 max_depth,
@@ -93,7 +98,11 @@ fn integrator_named(name: &str, scene: &Scene) -> Result<Integrator> {
             }
             .into(),
         }),
-        "distrib" => Ok(match &scene.integrator {
+        "direct" => Ok(match image {
+            Integrator::Direct(d) => Integrator::Direct(d.clone()),
+            _ => DirectIntegrator::default().into(),
+        }),
+        "distrib" => Ok(match image {
             Integrator::Distribution(d) => Integrator::Distribution(d.clone()),
             _ => DistributionIntegrator {
                 max_depth,
@@ -101,7 +110,7 @@ fn integrator_named(name: &str, scene: &Scene) -> Result<Integrator> {
             }
             .into(),
         }),
-        "volpath" => Ok(match &scene.integrator {
+        "volpath" => Ok(match image {
             Integrator::VolPath(v) if v.tracking == Tracking::Spectral => {
                 Integrator::VolPath(v.clone())
             }
@@ -111,7 +120,7 @@ fn integrator_named(name: &str, scene: &Scene) -> Result<Integrator> {
             }
             .into(),
         }),
-        "volpathmis" => Ok(match &scene.integrator {
+        "volpathmis" => Ok(match image {
             Integrator::VolPath(v) if v.tracking != Tracking::Spectral => {
                 Integrator::VolPath(v.clone())
             }
@@ -123,7 +132,7 @@ fn integrator_named(name: &str, scene: &Scene) -> Result<Integrator> {
             .into(),
         }),
         other => Err(Error::usage(format!("unknown integrator \"{other}\""))
-            .with_help("use path, distrib, volpath or volpathmis")),
+            .with_help("use path, direct, distrib, volpath or volpathmis")),
     }
 }
 
@@ -149,9 +158,12 @@ fn sampler_named(name: &str) -> Result<SamplerKind> {
 fn integrator_label(integrator: &Integrator) -> &'static str {
     match integrator {
         Integrator::Path(_) => "path",
+        Integrator::Direct(_) => "direct",
         Integrator::Distribution(_) => "distrib",
         Integrator::VolPath(v) if v.tracking == Tracking::Spectral => "volpath",
         Integrator::VolPath(_) => "volpathmis",
+        Integrator::Moment(_) => "moment",
+        Integrator::Aov(_) => "aov",
     }
 }
 

@@ -34,13 +34,14 @@ pub fn run(args: &MergeArgs) -> Result<()> {
     let paths: Vec<&std::path::Path> = args.states.iter().map(PathBuf::as_path).collect();
     let merged = RenderState::merge(&states, &paths)?;
     let identity = &merged.identity;
-    let mut film = Film::new(identity.film_size, identity.crop);
-    if film.pixels.len() != merged.pixels.len() {
+    let mut film = Film::with_aovs(identity.film_size, identity.crop, merged.aov_names.clone());
+    if film.pixels.len() != merged.pixels.len() || film.aovs.len() != merged.aovs.len() {
         return Err(Error::usage(
             "the merged state does not match its crop window",
         ));
     }
     film.pixels = merged.pixels.clone();
+    film.aovs = merged.aovs.clone();
     let exr = if args
         .output
         .extension()

@@ -332,9 +332,15 @@ pub fn run(args: &RenderArgs) -> Result<()> {
                 range.end
             )));
         }
+        if state.aov_names != scene.integrator.aov_names() {
+            return Err(Error::usage(format!(
+                "cannot resume from \"{}\": its integrator wrote other extra channels",
+                path.display()
+            )));
+        }
         first_sample = range.end;
         previous_ranges.push(range.clone());
-        initial = Some(state.pixels);
+        initial = Some((state.pixels, state.aovs));
     }
     let stop = stop_rule(args, strata)?;
     if let Some(end) = stop.sample_end
@@ -370,6 +376,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         .clone()
         .or_else(|| args.resume.clone())
         .unwrap_or_else(|| exr_path.with_extension("state"));
+    let aov_names = scene.integrator.aov_names();
     let state_of = |snapshot: &Snapshot| {
         let mut ranges = previous_ranges.clone();
         if !snapshot.samples.is_empty() {
@@ -382,6 +389,8 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             identity: identity.clone(),
             ranges,
             pixels: snapshot.pixels.to_vec(),
+            aov_names: aov_names.clone(),
+            aovs: snapshot.aovs.to_vec(),
         }
     };
     let mut write_checkpoint = |snapshot: &Snapshot| -> Result<()> {
@@ -407,6 +416,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         state_of(&Snapshot {
             samples: output.samples.clone(),
             pixels: &output.film.pixels,
+            aovs: &output.film.aovs,
         })
         .write(&state_path)?;
     }
@@ -500,13 +510,14 @@ fn trace_pixel(
     let mut count = RayCount::default();
     let range = args.sample_range.clone().unwrap_or(0..strata);
     let mut sums = PixelSums::default();
+    let mut aovs = vec![0.0f32; estimator.aov_count()];
     println!(
         "pixel ({}, {}), samples {}..{}, seed {seed}:",
         pixel.x, pixel.y, range.start, range.end
     );
     println!("{:>8} {:>14} {:>14} {:>14}", "sample", "X", "Y", "Z");
     for index in range {
-        let xyz = estimator.estimate(&mut sampler, pixel, index, &mut count);
+        let xyz = estimator.estimate(&mut sampler, pixel, index, &mut count, &mut aovs);
         let bad = !xyz.iter().all(|v| v.is_finite());
         println!(
             "{index:>8} {:>14.6e} {:>14.6e} {:>14.6e}{}",

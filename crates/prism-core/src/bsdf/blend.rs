@@ -16,7 +16,7 @@ use glam::{Vec2, Vec3};
 use super::{
     Bsdf, BsdfEval, BsdfFlags, BsdfModel, BsdfSample, Bxdf, BxdfTree, NodeId, ShadingPoint,
 };
-use crate::spectrum::SampledWavelengths;
+use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use crate::texture::Texture;
 
 #[derive(Clone, Debug)]
@@ -36,6 +36,18 @@ impl BsdfModel for Blend {
 
     fn node_count(&self) -> usize {
         1 + self.nested[0].node_count() + self.nested[1].node_count()
+    }
+
+    /// The nested BSDFs' blended by the weight.
+    fn diffuse_reflectance(
+        &self,
+        point: &ShadingPoint,
+        wo: Vec3,
+        lambda: &SampledWavelengths,
+    ) -> SampledSpectrum {
+        let weight = self.weight.eval_1(point.at()).clamp(0.0, 1.0);
+        (1.0 - weight) * self.nested[0].diffuse_reflectance(point, wo, lambda)
+            + weight * self.nested[1].diffuse_reflectance(point, wo, lambda)
     }
 
     #[inline]

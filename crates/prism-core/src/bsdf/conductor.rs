@@ -80,6 +80,16 @@ impl BsdfModel for Conductor {
         1
     }
 
+    /// None: a mirror has only a specular lobe.
+    fn diffuse_reflectance(
+        &self,
+        _point: &ShadingPoint,
+        _wo: Vec3,
+        _lambda: &SampledWavelengths,
+    ) -> SampledSpectrum {
+        SampledSpectrum::ZERO
+    }
+
     #[inline]
     fn resolve<'a>(
         &'a self,

@@ -94,6 +94,16 @@ impl BsdfModel for Dielectric {
         1
     }
 
+    /// None: only specular lobes.
+    fn diffuse_reflectance(
+        &self,
+        _point: &ShadingPoint,
+        _wo: Vec3,
+        _lambda: &SampledWavelengths,
+    ) -> SampledSpectrum {
+        SampledSpectrum::ZERO
+    }
+
     #[inline]
     fn resolve<'a>(
         &'a self,

@@ -37,6 +37,16 @@ impl BsdfModel for Diffuse {
         1
     }
 
+    /// The reflectance.
+    fn diffuse_reflectance(
+        &self,
+        point: &ShadingPoint,
+        _wo: Vec3,
+        lambda: &SampledWavelengths,
+    ) -> SampledSpectrum {
+        self.reflectance.eval(point.at(), lambda)
+    }
+
     #[inline]
     fn resolve<'a>(
         &'a self,

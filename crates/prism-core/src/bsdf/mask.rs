@@ -39,6 +39,16 @@ impl BsdfModel for Mask {
         1 + self.nested.node_count()
     }
 
+    /// The nested BSDF's (the opacity aside, as in Mitsuba).
+    fn diffuse_reflectance(
+        &self,
+        point: &ShadingPoint,
+        wo: Vec3,
+        lambda: &SampledWavelengths,
+    ) -> SampledSpectrum {
+        self.nested.diffuse_reflectance(point, wo, lambda)
+    }
+
     #[inline]
     fn resolve<'a>(
         &'a self,

@@ -5,7 +5,7 @@ use glam::{Vec2, Vec3};
 use super::{Bsdf, BsdfEval, BsdfFlags, BsdfModel, BsdfSample, BxdfTree, NodeId, ShadingPoint};
 use crate::geometry::SurfaceInteraction;
 use crate::math::Frame;
-use crate::spectrum::SampledWavelengths;
+use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 
 /// What a surface is made of: a BSDF for the front (the side of the shading normal) and, for
 /// top-level `twosided` materials, one for the back. Mitsuba's reflecting BSDFs are one-sided
@@ -47,6 +47,25 @@ impl Material {
         lambda: &SampledWavelengths,
         tree: &'t mut BxdfTree<'m>,
     ) -> Scattering<'t, 'm> {
+        let (bsdf, point) = self.seen_from(si, wo);
+        Scattering::new(bsdf, &point, point.frame.to_local(wo), lambda, tree)
+    }
+
+    /// The albedo at the hit `si` seen from `wo` (world space, unit): the diffuse reflectance
+    /// of the side `wo` sees (see [`BsdfModel::diffuse_reflectance`]).
+    pub fn diffuse_reflectance(
+        &self,
+        si: &SurfaceInteraction,
+        wo: Vec3,
+        lambda: &SampledWavelengths,
+    ) -> SampledSpectrum {
+        let (bsdf, point) = self.seen_from(si, wo);
+        bsdf.diffuse_reflectance(&point, point.frame.to_local(wo), lambda)
+    }
+
+    /// The BSDF of the side of `si` that `wo` sees, and the shading point in that side's frame.
+    #[inline]
+    fn seen_from(&self, si: &SurfaceInteraction, wo: Vec3) -> (&Bsdf, ShadingPoint) {
         let (bsdf, flip) = self.side(si.shading.to_local(wo).z);
         let frame = if flip {
             si.shading.flipped()
@@ -61,7 +80,7 @@ impl Material {
             dp_du: si.dp_du,
             dp_dv: si.dp_dv,
         };
-        Scattering::new(bsdf, &point, frame.to_local(wo), lambda, tree)
+        (bsdf, point)
     }
 
     /// Whether light passes through unchanged from both sides (the `null` BSDF): an

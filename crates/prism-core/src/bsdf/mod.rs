@@ -262,6 +262,15 @@ pub trait BsdfModel {
     fn is_dispersive(&self) -> bool;
     /// The nodes its lobes take in a [`BxdfTree`] (1 for a BSDF that nests none).
     fn node_count(&self) -> usize;
+    /// The albedo a denoiser wants (Mitsuba's `eval_diffuse_reflectance`): the reflectance of
+    /// the diffuse part at `point` for the wavelengths `lambda`, seen from `wo` (local), which
+    /// `twosided` needs to choose a side; zero for BSDFs without a diffuse part.
+    fn diffuse_reflectance(
+        &self,
+        point: &ShadingPoint,
+        wo: Vec3,
+        lambda: &SampledWavelengths,
+    ) -> SampledSpectrum;
     /// Evaluates the textures at `point` for the wavelengths `lambda` and adds the lobes there
     /// to `tree`, for the outgoing direction `wo` (local to `point.frame`), which adapters need
     /// to choose a side or tilt a frame. Returns the index of the node added last, its root.
@@ -370,6 +379,17 @@ macro_rules! bsdfs {
             fn node_count(&self) -> usize {
                 match self {
                     $(Bsdf::$variant(b) => b.node_count(),)+
+                }
+            }
+
+            fn diffuse_reflectance(
+                &self,
+                point: &ShadingPoint,
+                wo: Vec3,
+                lambda: &SampledWavelengths,
+            ) -> SampledSpectrum {
+                match self {
+                    $(Bsdf::$variant(b) => b.diffuse_reflectance(point, wo, lambda),)+
                 }
             }
 

@@ -19,7 +19,7 @@ use glam::Vec3;
 
 use super::perturbed::{Tilt, resolve_perturbed};
 use super::{Bsdf, BsdfFlags, BsdfModel, BxdfTree, NodeId, ShadingPoint};
-use crate::spectrum::SampledWavelengths;
+use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use crate::texture::Texture;
 
 #[derive(Clone, Debug)]
@@ -41,6 +41,16 @@ impl BsdfModel for NormalMap {
 
     fn node_count(&self) -> usize {
         1 + self.nested.node_count()
+    }
+
+    /// The nested BSDF's.
+    fn diffuse_reflectance(
+        &self,
+        point: &ShadingPoint,
+        wo: Vec3,
+        lambda: &SampledWavelengths,
+    ) -> SampledSpectrum {
+        self.nested.diffuse_reflectance(point, wo, lambda)
     }
 
     #[inline]

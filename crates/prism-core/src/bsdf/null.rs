@@ -35,6 +35,16 @@ impl BsdfModel for Null {
         1
     }
 
+    /// None: light passes straight through.
+    fn diffuse_reflectance(
+        &self,
+        _point: &ShadingPoint,
+        _wo: Vec3,
+        _lambda: &SampledWavelengths,
+    ) -> SampledSpectrum {
+        SampledSpectrum::ZERO
+    }
+
     #[inline]
     fn resolve<'a>(
         &'a self,

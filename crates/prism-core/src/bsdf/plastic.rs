@@ -83,6 +83,16 @@ impl BsdfModel for Plastic {
         1
     }
 
+    /// The diffuse reflectance under the coating.
+    fn diffuse_reflectance(
+        &self,
+        point: &ShadingPoint,
+        _wo: Vec3,
+        lambda: &SampledWavelengths,
+    ) -> SampledSpectrum {
+        self.diffuse_reflectance.eval(point.at(), lambda)
+    }
+
     #[inline]
     fn resolve<'a>(
         &'a self,

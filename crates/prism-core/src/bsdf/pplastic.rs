@@ -66,6 +66,16 @@ impl BsdfModel for PolarizedPlastic {
         1
     }
 
+    /// The diffuse reflectance of the base.
+    fn diffuse_reflectance(
+        &self,
+        point: &ShadingPoint,
+        _wo: Vec3,
+        lambda: &SampledWavelengths,
+    ) -> SampledSpectrum {
+        self.diffuse_reflectance.eval(point.at(), lambda)
+    }
+
     #[inline]
     fn resolve<'a>(
         &'a self,

@@ -52,6 +52,16 @@ impl BsdfModel for RoughConductor {
         1
     }
 
+    /// None: only a glossy lobe (Mitsuba 3 evaluates the BSDF towards the normal instead, see docs/mitsuba-compatibility.md).
+    fn diffuse_reflectance(
+        &self,
+        _point: &ShadingPoint,
+        _wo: Vec3,
+        _lambda: &SampledWavelengths,
+    ) -> SampledSpectrum {
+        SampledSpectrum::ZERO
+    }
+
     #[inline]
     fn resolve<'a>(
         &'a self,

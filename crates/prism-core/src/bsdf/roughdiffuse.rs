@@ -48,6 +48,16 @@ impl BsdfModel for RoughDiffuse {
         1
     }
 
+    /// The reflectance (Oren–Nayar's ρ).
+    fn diffuse_reflectance(
+        &self,
+        point: &ShadingPoint,
+        _wo: Vec3,
+        lambda: &SampledWavelengths,
+    ) -> SampledSpectrum {
+        self.reflectance.eval(point.at(), lambda)
+    }
+
     #[inline]
     fn resolve<'a>(
         &'a self,

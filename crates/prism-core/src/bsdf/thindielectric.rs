@@ -50,6 +50,16 @@ impl BsdfModel for ThinDielectric {
         1
     }
 
+    /// None: only specular and null lobes.
+    fn diffuse_reflectance(
+        &self,
+        _point: &ShadingPoint,
+        _wo: Vec3,
+        _lambda: &SampledWavelengths,
+    ) -> SampledSpectrum {
+        SampledSpectrum::ZERO
+    }
+
     #[inline]
     fn resolve<'a>(
         &'a self,

@@ -15,7 +15,7 @@ use super::{
     Bsdf, BsdfEval, BsdfFlags, BsdfModel, BsdfSample, Bxdf, BxdfTree, NodeId, ShadingPoint,
 };
 use crate::math::Frame;
-use crate::spectrum::SampledWavelengths;
+use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 
 #[derive(Clone, Debug)]
 pub struct TwoSided {
@@ -54,6 +54,21 @@ impl BsdfModel for TwoSided {
 
     fn node_count(&self) -> usize {
         1 + self.front.node_count().max(self.back.node_count())
+    }
+
+    /// That of the side `wo` sees.
+    fn diffuse_reflectance(
+        &self,
+        point: &ShadingPoint,
+        wo: Vec3,
+        lambda: &SampledWavelengths,
+    ) -> SampledSpectrum {
+        if wo.z >= 0.0 {
+            self.front.diffuse_reflectance(point, wo, lambda)
+        } else {
+            self.back
+                .diffuse_reflectance(&back_side(point), flip(wo), lambda)
+        }
     }
 
     /// The side that `wo` sees: the front BSDF's lobes as they are, or the back BSDF's with

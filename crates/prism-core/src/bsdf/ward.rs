@@ -75,6 +75,16 @@ impl BsdfModel for Ward {
         1
     }
 
+    /// The diffuse reflectance, scaled as the lobes are.
+    fn diffuse_reflectance(
+        &self,
+        point: &ShadingPoint,
+        _wo: Vec3,
+        lambda: &SampledWavelengths,
+    ) -> SampledSpectrum {
+        self.scale * self.diffuse_reflectance.eval(point.at(), lambda)
+    }
+
     #[inline]
     fn resolve<'a>(
         &'a self,

@@ -1,4 +1,5 @@
-//! The film: per-pixel sums of the CIE XYZ estimates and of their squares, kept exactly.
+//! The film: per-pixel sums of the CIE XYZ estimates and of their squares, kept exactly, and the
+//! sums of the extra channels (AOVs) an integrator may write beside the image.
 
 use glam::UVec2;
 
@@ -113,6 +114,18 @@ impl PixelSums {
     }
 }
 
+/// Adds one sample of a pixel's extra channels to their sums: a value that is not finite (or is
+/// absurdly large) adds nothing, so the channel's mean counts it as zero, as the image does with
+/// a rejected sample.
+#[inline]
+pub fn add_aov_sample(sums: &mut [ValueSum], values: &[f32]) {
+    for (sum, &v) in sums.iter_mut().zip(values) {
+        if v.is_finite() && f64::from(v.abs()) < LARGEST_SAMPLE {
+            sum.add(f64::from(v));
+        }
+    }
+}
+
 /// The image being rendered.
 #[derive(Clone, Debug)]
 pub struct Film {
@@ -121,15 +134,46 @@ pub struct Film {
     pub crop: CropWindow,
     /// Pixels of the crop window, row-major, top row first.
     pub pixels: Vec<PixelSums>,
+    /// Names of the extra channels (AOVs) beside the image, as the EXR names them.
+    pub aov_names: Vec<String>,
+    /// Sums of the filter-weighted samples of the extra channels: pixel i's K channels at
+    /// i·K .. (i + 1)·K, K = `aov_names.len()`. A channel's value is its sum over the pixel's
+    /// sample count, as the image's.
+    pub aovs: Vec<ValueSum>,
 }
 
 impl Film {
+    /// A film without extra channels.
     pub fn new(size: UVec2, crop: CropWindow) -> Film {
+        Film::with_aovs(size, crop, Vec::new())
+    }
+
+    /// A film with the extra channels `aov_names`.
+    pub fn with_aovs(size: UVec2, crop: CropWindow, aov_names: Vec<String>) -> Film {
+        let pixel_count = (crop.size.x * crop.size.y) as usize;
         Film {
             size,
             crop,
-            pixels: vec![PixelSums::default(); (crop.size.x * crop.size.y) as usize],
+            pixels: vec![PixelSums::default(); pixel_count],
+            aovs: vec![ValueSum::default(); pixel_count * aov_names.len()],
+            aov_names,
         }
+    }
+
+    /// Every pixel's value of extra channel `channel`, row-major.
+    pub fn aov(&self, channel: usize) -> Vec<f32> {
+        let k = self.aov_names.len();
+        self.pixels
+            .iter()
+            .enumerate()
+            .map(|(i, p)| {
+                if p.samples == 0 {
+                    0.0
+                } else {
+                    (self.aovs[i * k + channel].value() / p.samples as f64) as f32
+                }
+            })
+            .collect()
     }
 
     /// Index in `pixels` of a pixel given relative to the crop window.

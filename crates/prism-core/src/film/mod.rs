@@ -8,7 +8,7 @@ pub mod ldr;
 pub mod output;
 pub mod stats;
 
-pub use accumulation::{CropWindow, Film, PixelSums};
+pub use accumulation::{CropWindow, Film, PixelSums, ValueSum};
 pub use filter::{Filter, FilterSampler};
 pub use ldr::{LdrFormat, LdrOutput, Tonemap, TransferCurve};
 pub use output::{FilmImages, write_images, write_images_with};

@@ -10,6 +10,21 @@ use super::stats::{pixel_relative_error, variance_of_mean};
 use crate::error::Result;
 use crate::image::{ChannelImage, png_srgb_bytes, write_exr, write_png_srgb};
 
+/// The EXR channels of the image (see [`FilmImages::channels`]), which the integrator's extra
+/// channels may not reuse.
+pub const IMAGE_CHANNELS: [&str; 10] = [
+    "R",
+    "G",
+    "B",
+    "X",
+    "Y",
+    "Z",
+    "variance.X",
+    "variance.Y",
+    "variance.Z",
+    "relative_error.Y",
+];
+
 /// A film's values, row-major with the top row first, each array interleaved per pixel.
 #[derive(Clone, Debug, PartialEq)]
 pub struct FilmImages {
@@ -54,24 +69,26 @@ impl FilmImages {
     pub fn channels(&self) -> ChannelImage {
         let channel =
             |values: &[f32], c: usize| values.iter().skip(c).step_by(3).copied().collect();
-        let mut channels = Vec::with_capacity(10);
-        for (c, name) in ["R", "G", "B"].into_iter().enumerate() {
-            channels.push((name.to_string(), channel(&self.rgb, c)));
-        }
-        for (c, name) in ["X", "Y", "Z"].into_iter().enumerate() {
-            channels.push((name.to_string(), channel(&self.xyz, c)));
-        }
-        for (c, name) in ["variance.X", "variance.Y", "variance.Z"]
-            .into_iter()
-            .enumerate()
-        {
-            channels.push((name.to_string(), channel(&self.variance, c)));
-        }
-        channels.push(("relative_error.Y".to_string(), self.relative_error.clone()));
+        let values = [
+            channel(&self.rgb, 0),
+            channel(&self.rgb, 1),
+            channel(&self.rgb, 2),
+            channel(&self.xyz, 0),
+            channel(&self.xyz, 1),
+            channel(&self.xyz, 2),
+            channel(&self.variance, 0),
+            channel(&self.variance, 1),
+            channel(&self.variance, 2),
+            self.relative_error.clone(),
+        ];
         ChannelImage {
             width: self.width,
             height: self.height,
-            channels,
+            channels: IMAGE_CHANNELS
+                .iter()
+                .map(|name| name.to_string())
+                .zip(values)
+                .collect(),
         }
     }
 
@@ -109,7 +126,8 @@ impl FilmImages {
     }
 }
 
-/// Writes the film as an EXR and as an sRGB PNG (see [`FilmImages`]).
+/// Writes the film as an EXR and as an sRGB PNG (see [`FilmImages`]); the EXR also holds the
+/// integrator's extra channels under their own names.
 pub fn write_images(film: &Film, exr_path: &Path, png_path: &Path) -> Result<()> {
     write_images_with(film, exr_path, png_path, &LdrOutput::default())
 }
@@ -121,7 +139,11 @@ pub fn write_images_with(
     ldr_path: &Path,
     ldr: &LdrOutput,
 ) -> Result<()> {
-    FilmImages::of(film).write_exr(exr_path)?;
+    let mut image = FilmImages::of(film).channels();
+    for (c, name) in film.aov_names.iter().enumerate() {
+        image.channels.push((name.clone(), film.aov(c)));
+    }
+    write_exr(exr_path, &image)?;
     ldr.write(
         ldr_path,
         film.crop.size.x,

@@ -1,16 +1,27 @@
-//! Integrators: estimators of the radiance arriving along a camera ray: the path tracer and the
-//! lecture's distribution ray tracer with splitting, and the volumetric path tracers.
+//! Integrators: estimators of the radiance arriving along a camera ray: the path tracer, direct
+//! illumination, the lecture's distribution ray tracer with splitting and the volumetric path
+//! tracers; `moment` runs nested
+//! integrators and writes their estimates and second moments as extra film channels, `aov` the
+//! albedo, normals, depth and other variables of the first hit beside nested integrators'
+//! images.
 //!
 //! An [`Integrator`] is what a scene asks for: an estimator and its parameters. Before a render
 //! it is prepared for the world ([`Integrator::prepare`]), which builds the light sampler it
 //! chooses lights with, so the sampler always follows the integrator's own settings.
 
+pub mod aov;
+pub mod direct;
 pub mod distribution;
+pub mod mis;
+pub mod moment;
 pub mod path;
 pub mod volpath;
 pub mod volpathmis;
 
+pub use aov::AovIntegrator;
+pub use direct::DirectIntegrator;
 pub use distribution::DistributionIntegrator;
+pub use moment::MomentIntegrator;
 pub use path::PathIntegrator;
 pub use volpath::{Tracking, VolPathIntegrator};
 
@@ -29,8 +40,29 @@ use crate::world::World;
 #[derive(Clone, Debug)]
 pub enum Integrator {
     Path(PathIntegrator),
+    Direct(DirectIntegrator),
     Distribution(DistributionIntegrator),
+    Moment(MomentIntegrator),
+    Aov(AovIntegrator),
     VolPath(VolPathIntegrator),
+}
+
+impl From<AovIntegrator> for Integrator {
+    fn from(integrator: AovIntegrator) -> Integrator {
+        Integrator::Aov(integrator)
+    }
+}
+
+impl From<DirectIntegrator> for Integrator {
+    fn from(integrator: DirectIntegrator) -> Integrator {
+        Integrator::Direct(integrator)
+    }
+}
+
+impl From<MomentIntegrator> for Integrator {
+    fn from(integrator: MomentIntegrator) -> Integrator {
+        Integrator::Moment(integrator)
+    }
 }
 
 impl From<VolPathIntegrator> for Integrator {
@@ -63,6 +95,10 @@ pub struct PreparedIntegrator<'a> {
     integrator: &'a Integrator,
     world: &'a World,
     light_sampler: LightSampler,
+    /// How many extra channels a sample writes.
+    aov_count: usize,
+    /// The nested integrators (of `moment`), prepared in turn.
+    nested: Vec<PreparedIntegrator<'a>>,
 }
 
 impl Integrator {
@@ -70,8 +106,58 @@ impl Integrator {
     fn light_selection(&self) -> LightSelection {
         match self {
             Integrator::Path(path) => path.light_selection,
+            Integrator::Direct(_) => LightSelection::Power,
             Integrator::Distribution(distrib) => distrib.light_selection(),
             Integrator::VolPath(volpath) => volpath.light_selection,
+            Integrator::Moment(_) | Integrator::Aov(_) => LightSelection::Power,
+        }
+    }
+
+    /// The integrators nested in this one.
+    fn nested(&self) -> impl Iterator<Item = &Integrator> {
+        let nested: &[(String, Integrator)] = match self {
+            Integrator::Moment(moment) => &moment.integrators,
+            Integrator::Aov(aov) => &aov.integrators,
+            Integrator::Path(_)
+            | Integrator::Direct(_)
+            | Integrator::Distribution(_)
+            | Integrator::VolPath(_) => &[],
+        };
+        nested.iter().map(|(_, integrator)| integrator)
+    }
+
+    /// Whether the emitters the camera sees directly are left out of the image.
+    pub fn hides_emitters(&self) -> bool {
+        match self {
+            Integrator::Path(path) => path.hide_emitters,
+            Integrator::Direct(direct) => direct.hide_emitters,
+            Integrator::Distribution(distrib) => distrib.hide_emitters,
+            Integrator::VolPath(volpath) => volpath.hide_emitters,
+            Integrator::Moment(_) | Integrator::Aov(_) => match self.nested().next() {
+                Some(first) => first.hides_emitters(),
+                None => true,
+            },
+        }
+    }
+
+    /// The integrator whose estimate is the image: this one, or the first nested one's.
+    pub fn image_integrator(&self) -> &Integrator {
+        match self.nested().next() {
+            Some(first) => first.image_integrator(),
+            None => self,
+        }
+    }
+
+    /// Names of the extra film channels (AOVs) the integrator writes beside the image, as
+    /// Mitsuba names them in its EXR files; none for the plain estimators.
+    pub fn aov_names(&self) -> Vec<String> {
+        match self {
+            Integrator::Path(_)
+            | Integrator::Direct(_)
+            | Integrator::Distribution(_)
+            | Integrator::VolPath(_) => Vec::new(),
+            Integrator::Moment(moment) => moment.aov_names(),
+            Integrator::Aov(aov) => aov.aov_names(),
         }
     }
 
@@ -85,29 +171,48 @@ impl Integrator {
                 &world.light_sampling_weights,
                 self.light_selection(),
             ),
+            aov_count: self.aov_names().len(),
+            nested: self.nested().map(|i| i.prepare(world)).collect(),
         }
     }
 }
 
 impl PreparedIntegrator<'_> {
+    /// How many extra channels each sample writes.
+    pub fn aov_count(&self) -> usize {
+        self.aov_count
+    }
+
     /// The light sampler the integrator chooses lights with.
     pub fn light_sampler(&self) -> &LightSampler {
         &self.light_sampler
     }
 
     /// An estimate of the radiance arriving at the camera along `ray` at the wavelengths
-    /// `lambda`, drawing random numbers from `sampler`.
+    /// `lambda`, drawing random numbers from `sampler`; the sample's extra channels are written
+    /// to `aovs` (as many as [`Integrator::aov_names`] names).
     pub fn radiance(
         &self,
         ray: Ray,
         lambda: &SampledWavelengths,
         sampler: &mut Sampler,
         count: &mut RayCount,
+        aovs: &mut [f32],
     ) -> SampledSpectrum {
+        debug_assert_eq!(aovs.len(), self.aov_count);
         match self.integrator {
             Integrator::Path(integrator) => integrator.radiance(self, ray, lambda, sampler, count),
+            Integrator::Direct(integrator) => {
+                integrator.radiance(self, ray, lambda, sampler, count)
+            }
             Integrator::Distribution(integrator) => {
                 integrator.radiance(self, ray, lambda, sampler, count)
+            }
+            Integrator::Moment(_) => {
+                MomentIntegrator::radiance(self, ray, lambda, sampler, count, aovs)
+            }
+            Integrator::Aov(integrator) => {
+                integrator.radiance(self, ray, lambda, sampler, count, aovs)
             }
             Integrator::VolPath(integrator) => match integrator.tracking {
                 Tracking::Spectral => {
@@ -145,6 +250,14 @@ fn unoccluded(
         return None;
     }
     Some(f)
+}
+
+/// Whether the geometric and the shading normal at `si` put direction `d` on the same side of
+/// the surface (Mitsuba 0.6's `strictNormals` test, which stops light leaking through surfaces
+/// whose shading normals bend far from the geometry).
+#[inline]
+fn normals_agree(si: &SurfaceInteraction, d: glam::Vec3) -> bool {
+    si.n.dot(d) * si.shading.n.dot(d) > 0.0
 }
 
 /// A path's estimate for the caller's wavelengths once the path has kept only its hero

@@ -8,6 +8,7 @@
 //!     <integer name="rr_depth" value="5"/>       <!-- depth at which Russian roulette starts -->
 //!     <boolean name="hide_emitters" value="false"/>
 //!     <string name="emitter_sampling" value="power"/>   <!-- or "uniform" (Prism only) -->
+//!     <boolean name="strict_normals" value="false"/>    <!-- Mitsuba 0.6's strictNormals -->
 //! </integrator>
 //! ```
 //!
@@ -27,11 +28,16 @@
 //! * Dispersion: where a BSDF refracts each wavelength its own way, the path keeps only its hero
 //!   wavelength from there on (`SampledWavelengths::terminate_secondary`).
 //! * Depth follows Mitsuba: the camera ray's hit is depth 0; a path of depth d has d bounces.
+//! * `strict_normals` (Mitsuba 0.6; Mitsuba 3 has no such parameter): where the geometric and
+//!   the shading normal put a direction on different sides of the surface, the path ends on
+//!   arriving from it, a light sample towards it adds nothing, and a BSDF sample into it ends
+//!   the path, as in Mitsuba 0.6's `path`: no light leaks through surfaces whose shading
+//!   normals bend across the geometry, at the price of some energy.
 
-use crate::bsdf::{BxdfTree, Scattering};
-use crate::geometry::{SurfaceInteraction, SurfaceSample};
-use crate::integrator::{PreparedIntegrator, RayCount, hero_only, unoccluded};
-use crate::light::{Light, LightSelection};
+use crate::bsdf::BxdfTree;
+use crate::integrator::mis::{BsdfSampleOrigin, Strategies, emission_found, sample_light};
+use crate::integrator::{PreparedIntegrator, RayCount, hero_only, normals_agree};
+use crate::light::LightSelection;
 use crate::math::Ray;
 use crate::sampling::sampler::Sampler;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
@@ -46,6 +52,8 @@ pub struct PathIntegrator {
     pub hide_emitters: bool,
     /// How one light is chosen for each light sample.
     pub light_selection: LightSelection,
+    /// Whether directions the geometric and shading normals disagree about end the path.
+    pub strict_normals: bool,
 }
 
 impl Default for PathIntegrator {
@@ -55,29 +63,9 @@ impl Default for PathIntegrator {
             rr_depth: 5,
             hide_emitters: false,
             light_selection: LightSelection::Power,
+            strict_normals: false,
         }
     }
-}
-
-/// The power heuristic with β = 2: w = p_a² / (p_a² + p_b²).
-#[inline]
-pub fn power_heuristic(pdf_a: f32, pdf_b: f32) -> f32 {
-    let (a, b) = (pdf_a * pdf_a, pdf_b * pdf_b);
-    if a.is_infinite() {
-        return 1.0;
-    }
-    let w = a / (a + b);
-    if w.is_finite() { w } else { 0.0 }
-}
-
-/// What the next vertex needs to know about the BSDF sample that led to it.
-struct PreviousBounce {
-    /// The vertex the ray left from.
-    interaction: SurfaceInteraction,
-    /// Solid-angle density of the BSDF sample.
-    pdf: f32,
-    /// Whether it came from a delta lobe (then emitters it finds are not light-sampled).
-    specular: bool,
 }
 
 impl PathIntegrator {
@@ -101,7 +89,7 @@ impl PathIntegrator {
         let mut throughput = SampledSpectrum::ONE;
         // Product of the relative indices of refraction crossed (Mitsuba's η).
         let mut eta_scale = 1.0f32;
-        let mut previous: Option<PreviousBounce> = None;
+        let mut previous: Option<BsdfSampleOrigin> = None;
         let mut depth = 0i32;
         // The lobes of the vertex at hand, rewritten at every bounce.
         let mut lobes = BxdfTree::empty();
@@ -110,47 +98,29 @@ impl PathIntegrator {
         }
         loop {
             count.rays += 1;
-            let Some(si) = world.geometry.intersect(&ray) else {
-                // The ray leaves the scene: the environment's emission, weighted like an area
-                // light's against the light sample that could have found it.
-                if let Some(env) = world.environment
-                    && !(self.hide_emitters && depth == 0)
-                {
-                    result +=
-                        throughput * Self::environment(prepared, env, &ray, &previous, &lambda);
-                }
+            let hit = world.geometry.intersect(&ray);
+            // Emission found by the previous BSDF sample (or by the camera ray), weighted
+            // against the light sample that could have found it.
+            if !(self.hide_emitters && depth == 0) {
+                result += throughput
+                    * emission_found(
+                        prepared,
+                        &ray,
+                        hit.as_ref(),
+                        previous.as_ref(),
+                        &lambda,
+                        Strategies::ONE_EACH,
+                    );
+            }
+            let Some(si) = hit else {
                 break;
             };
             let wo_world = -ray.d.normalize();
             let info = world.shape_info[si.shape as usize];
 
-            // Emission found by the previous BSDF sample (or by the camera ray).
-            if let Some(light_index) = info.light
-                && !(self.hide_emitters && depth == 0)
+            if !self.depth_allows_next_vertex(depth)
+                || (self.strict_normals && !normals_agree(&si, wo_world))
             {
-                let Light::Area(light) = &world.lights[light_index as usize] else {
-                    unreachable!("only area lights are attached to shapes");
-                };
-                let emitted = light.emitted(si.uv, si.shading.n, wo_world, &lambda);
-                if !emitted.is_black() {
-                    let weight = match &previous {
-                        Some(prev) if !prev.specular => {
-                            let light_pdf = prepared.light_sampler.pmf(light_index as usize)
-                                * light.pdf_from(
-                                    &world.geometry.primitives,
-                                    prev.interaction.p,
-                                    si.time,
-                                    &SurfaceSample::at(&si),
-                                );
-                            power_heuristic(prev.pdf, light_pdf)
-                        }
-                        _ => 1.0,
-                    };
-                    result += throughput * emitted * weight;
-                }
-            }
-
-            if !self.depth_allows_next_vertex(depth) {
                 break;
             }
 
@@ -167,7 +137,16 @@ impl PathIntegrator {
             // Direct light sampling.
             if smooth {
                 result += throughput
-                    * Self::sample_direct(prepared, &si, &scattering, &lambda, sampler, count);
+                    * sample_light(
+                        prepared,
+                        &si,
+                        &scattering,
+                        &lambda,
+                        sampler,
+                        count,
+                        Strategies::ONE_EACH,
+                        self.strict_normals,
+                    );
             }
 
             // BSDF sampling for the next direction.
@@ -176,6 +155,9 @@ impl PathIntegrator {
             let Some(bs) = scattering.sample(u_lobe, u) else {
                 break;
             };
+            if self.strict_normals && !normals_agree(&si, bs.wi) {
+                break;
+            }
             if bs.terminates_secondary {
                 lambda.terminate_secondary();
             }
@@ -185,8 +167,8 @@ impl PathIntegrator {
                 break;
             }
             ray = si.spawn_ray(bs.wi);
-            previous = Some(PreviousBounce {
-                interaction: si,
+            previous = Some(BsdfSampleOrigin {
+                p: si.p,
                 pdf: bs.pdf,
                 specular: bs.flags.is_delta(),
             });
@@ -205,66 +187,5 @@ impl PathIntegrator {
             return hero_only(result);
         }
         result
-    }
-
-    /// The MIS-weighted radiance of environment light `env` along the escaped `ray`.
-    fn environment(
-        prepared: &PreparedIntegrator,
-        env: u32,
-        ray: &Ray,
-        previous: &Option<PreviousBounce>,
-        lambda: &SampledWavelengths,
-    ) -> SampledSpectrum {
-        let light = &prepared.world.lights[env as usize];
-        let d = ray.d.normalize();
-        let emitted = light.environment_radiance(d, lambda);
-        let weight = match previous {
-            Some(prev) if !prev.specular && !emitted.is_black() => {
-                let light_pdf = prepared.light_sampler.pmf(env as usize) * light.environment_pdf(d);
-                power_heuristic(prev.pdf, light_pdf)
-            }
-            _ => 1.0,
-        };
-        emitted * weight
-    }
-
-    /// One light sample at `si`: a light chosen by the light sampler, a point on it, the shadow
-    /// ray, and the MIS-weighted contribution f·L·w / (p_light · p_choice).
-    fn sample_direct(
-        prepared: &PreparedIntegrator,
-        si: &SurfaceInteraction,
-        scattering: &Scattering,
-        lambda: &SampledWavelengths,
-        sampler: &mut Sampler,
-        count: &mut RayCount,
-    ) -> SampledSpectrum {
-        let world = prepared.world;
-        let u_light = sampler.next_1d();
-        let u_choice = sampler.next_1d();
-        let u = sampler.next_2d();
-        let Some((light_index, choice_pmf)) = prepared.light_sampler.sample(u_light) else {
-            return SampledSpectrum::ZERO;
-        };
-        let light = &world.lights[light_index];
-        let Some(ls) = light.sample_incident(
-            &world.geometry.primitives,
-            si.p,
-            si.time,
-            u_choice,
-            u,
-            lambda,
-        ) else {
-            return SampledSpectrum::ZERO;
-        };
-        let Some(f) = unoccluded(world, si, scattering, &ls, count) else {
-            return SampledSpectrum::ZERO;
-        };
-        let light_pdf = choice_pmf * ls.pdf;
-        let weight = if ls.is_delta {
-            1.0
-        } else {
-            power_heuristic(light_pdf, f.pdf)
-        };
-        f.value * ls.radiance * (weight / light_pdf)
     }
 }

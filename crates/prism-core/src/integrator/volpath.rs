@@ -41,7 +41,7 @@ use crate::bsdf::{BxdfTree, Scattering};
 use crate::geometry::interaction::SHADOW_EPSILON;
 use crate::geometry::offset::offset_ray_origin;
 use crate::geometry::{SurfaceInteraction, SurfaceSample};
-use crate::integrator::path::power_heuristic;
+use crate::integrator::mis::power_heuristic;
 use crate::integrator::{PreparedIntegrator, RayCount, hero_only};
 use crate::light::{Light, LightSample, LightSelection};
 use crate::math::Ray;

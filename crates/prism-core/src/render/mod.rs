@@ -27,8 +27,9 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
 
 use crate::error::{Error, Result};
+use crate::film::accumulation::add_aov_sample;
 pub use crate::film::stats::relative_error;
-use crate::film::{Film, FilterSampler, PixelSums};
+use crate::film::{Film, FilterSampler, PixelSums, ValueSum};
 use crate::integrator::{PreparedIntegrator, RayCount};
 use crate::sampling::sampler::Sampler;
 use crate::scene::Scene;
@@ -132,8 +133,9 @@ pub struct RenderOptions {
     /// Index of the first sample to take in every pixel (past a checkpoint, or the start of a
     /// range given to this render).
     pub first_sample: u32,
-    /// Sums the render starts from (a resumed render's), row-major over the crop window.
-    pub initial: Option<Vec<PixelSums>>,
+    /// Sums the render starts from (a resumed render's), row-major over the crop window: the
+    /// image's, and the extra channels' (K per pixel).
+    pub initial: Option<(Vec<PixelSums>, Vec<ValueSum>)>,
     pub stop: StopRule,
     /// Raised from outside (by a signal handler) to stop the render after dropping its pass.
     pub interrupt: Option<Arc<AtomicBool>>,
@@ -225,6 +227,8 @@ pub struct Snapshot<'a> {
     pub samples: Range<u32>,
     /// Pixel sums, row-major over the crop window (including the initial state).
     pub pixels: &'a [PixelSums],
+    /// The extra channels' sums, K per pixel in the same order.
+    pub aovs: &'a [ValueSum],
 }
 
 /// Something that saves the render's state every so often.
@@ -305,13 +309,20 @@ impl<'a> SampleEstimator<'a> {
         }
     }
 
-    /// The filter-weighted CIE XYZ of sample `index` of `pixel` (full-film coordinates).
+    /// How many extra channels each sample writes.
+    pub fn aov_count(&self) -> usize {
+        self.integrator.aov_count()
+    }
+
+    /// The filter-weighted CIE XYZ of sample `index` of `pixel` (full-film coordinates); the
+    /// sample's extra channels, weighted by the same filter weight, go to `aovs`.
     pub fn estimate(
         &self,
         sampler: &mut Sampler,
         pixel: UVec2,
         index: u32,
         count: &mut RayCount,
+        aovs: &mut [f32],
     ) -> [f32; 3] {
         let scene = self.scene;
         sampler.start_pixel_sample(pixel, index);
@@ -321,10 +332,21 @@ impl<'a> SampleEstimator<'a> {
         let (time, time_weight) = scene.shutter.sample(primary.time);
         let film_position = pixel.as_vec2() + Vec2::splat(0.5) + offset;
         let ray = scene.camera.generate_ray(film_position, primary.lens, time);
-        let radiance = self.integrator.radiance(ray, &lambda, sampler, count);
+        let radiance = self.integrator.radiance(ray, &lambda, sampler, count, aovs);
         let weight = filter_weight * time_weight;
+        for v in aovs.iter_mut() {
+            *v *= weight;
+        }
         lambda.to_xyz(&radiance).map(|v| v * weight)
     }
+}
+
+/// The sums of a tile's pixels, row-major within the tile: the image's and the extra channels'
+/// (K per pixel).
+#[derive(Clone, Debug, Default)]
+struct TileSums {
+    pixels: Vec<PixelSums>,
+    aovs: Vec<ValueSum>,
 }
 
 /// Adds the samples `range` of every pixel of a tile to a copy of its sums; None when the pass
@@ -332,15 +354,18 @@ impl<'a> SampleEstimator<'a> {
 fn render_tile(
     estimator: &SampleEstimator,
     tile: Tile,
-    sums: &[PixelSums],
+    sums: &TileSums,
     range: Range<u32>,
     options: &RenderOptions,
     cancel: &Cancel,
-) -> Option<(Vec<PixelSums>, u64)> {
+) -> Option<(TileSums, u64)> {
     let scene = estimator.scene;
     let mut sampler = Sampler::new(scene.sampler.kind, options.samples_per_pixel, options.seed);
     let mut count = RayCount::default();
-    let mut pixels = sums.to_vec();
+    let mut sums = sums.clone();
+    let k = estimator.aov_count();
+    // One sample's extra channels, reused for every sample of the tile.
+    let mut aovs = vec![0.0f32; k];
     let crop_offset = scene.film.crop.offset;
     for y in 0..tile.size.y {
         if cancel.raised() {
@@ -348,13 +373,16 @@ fn render_tile(
         }
         for x in 0..tile.size.x {
             let pixel = crop_offset + tile.origin + UVec2::new(x, y);
-            let pixel_sums = &mut pixels[(y * tile.size.x + x) as usize];
+            let i = (y * tile.size.x + x) as usize;
             for index in range.clone() {
-                pixel_sums.add(estimator.estimate(&mut sampler, pixel, index, &mut count));
+                aovs.fill(0.0);
+                let xyz = estimator.estimate(&mut sampler, pixel, index, &mut count, &mut aovs);
+                sums.pixels[i].add(xyz);
+                add_aov_sample(&mut sums.aovs[i * k..(i + 1) * k], &aovs);
             }
         }
     }
-    Some((pixels, count.rays))
+    Some((sums, count.rays))
 }
 
 /// The number of samples per pixel of the next pass.
@@ -423,7 +451,8 @@ pub fn render_with_checkpoints(
         .build()
         .map_err(|e| Error::usage(format!("could not start the worker threads: {e}")))?;
 
-    let mut sums = tile_major(&tiles, crop.size, options.initial.as_deref())?;
+    let k = estimator.aov_count();
+    let mut sums = tile_major(&tiles, crop.size, k, options.initial.as_ref())?;
     let progress = ProgressSink::new(&options, pixel_count);
     let rays = AtomicU64::new(0);
     let abort = AtomicBool::new(false);
@@ -432,7 +461,7 @@ pub fn render_with_checkpoints(
     let first = options.first_sample;
     let mut next = first;
     let mut error = if options.initial.is_some() {
-        relative_error(sums.iter().flatten())
+        relative_error(sums.iter().flat_map(|t| &t.pixels))
     } else {
         f64::INFINITY
     };
@@ -464,7 +493,7 @@ pub fn render_with_checkpoints(
             external: options.interrupt.as_deref(),
             deadline: stop.time_limit.map(|limit| start + limit),
         };
-        let results: Vec<Option<(Vec<PixelSums>, u64)>> = pool.install(|| {
+        let results: Vec<Option<(TileSums, u64)>> = pool.install(|| {
             tiles
                 .par_iter()
                 .zip(&sums)
@@ -501,15 +530,16 @@ pub fn render_with_checkpoints(
             rays.fetch_add(tile_rays, Ordering::Relaxed);
         }
         next += pass;
-        error = relative_error(sums.iter().flatten());
+        error = relative_error(sums.iter().flat_map(|t| &t.pixels));
         progress.pass_done(next - first, error);
         if let Some(checkpoint) = &mut checkpoints
             && last_checkpoint.elapsed() >= checkpoint.every
         {
-            let pixels = row_major(&tiles, crop.size, &sums);
+            let (pixels, aovs) = row_major(&tiles, crop.size, k, &sums);
             (checkpoint.write)(&Snapshot {
                 samples: first..next,
                 pixels: &pixels,
+                aovs: &aovs,
             })?;
             last_checkpoint = Instant::now();
         }
@@ -517,12 +547,13 @@ pub fn render_with_checkpoints(
     let elapsed = start.elapsed();
     progress.finish();
 
-    let mut film = Film::new(scene.film.size, crop);
-    film.pixels = row_major(&tiles, crop.size, &sums);
+    let mut film = Film::with_aovs(scene.film.size, crop, scene.integrator.aov_names());
+    (film.pixels, film.aovs) = row_major(&tiles, crop.size, k, &sums);
     if let Some(checkpoint) = &mut checkpoints {
         (checkpoint.write)(&Snapshot {
             samples: first..next,
             pixels: &film.pixels,
+            aovs: &film.aovs,
         })?;
     }
     Ok(RenderOutput {
@@ -536,27 +567,44 @@ pub fn render_with_checkpoints(
     })
 }
 
-/// Pixel sums regrouped by tile (each tile's pixels row-major), from row-major sums or empty.
+/// Pixel sums regrouped by tile (each tile's pixels row-major), from row-major sums with `k`
+/// extra channels per pixel, or empty.
 fn tile_major(
     tiles: &[Tile],
     size: UVec2,
-    initial: Option<&[PixelSums]>,
-) -> Result<Vec<Vec<PixelSums>>> {
-    if let Some(pixels) = initial
-        && pixels.len() != (size.x * size.y) as usize
+    k: usize,
+    initial: Option<&(Vec<PixelSums>, Vec<ValueSum>)>,
+) -> Result<Vec<TileSums>> {
+    let pixel_count = (size.x * size.y) as usize;
+    if let Some((pixels, aovs)) = initial
+        && (pixels.len() != pixel_count || aovs.len() != pixel_count * k)
     {
         return Err(Error::usage(
-            "the initial state does not match the crop window",
+            "the initial state does not match the crop window and the integrator's channels",
         ));
     }
     Ok(tiles
         .iter()
         .map(|t| {
-            let mut sums = Vec::with_capacity((t.size.x * t.size.y) as usize);
+            let tile_pixels = (t.size.x * t.size.y) as usize;
+            let mut sums = TileSums {
+                pixels: Vec::with_capacity(tile_pixels),
+                aovs: Vec::with_capacity(tile_pixels * k),
+            };
             for y in 0..t.size.y {
                 for x in 0..t.size.x {
                     let index = ((t.origin.y + y) * size.x + t.origin.x + x) as usize;
-                    sums.push(initial.map_or(PixelSums::default(), |p| p[index]));
+                    match initial {
+                        Some((pixels, aovs)) => {
+                            sums.pixels.push(pixels[index]);
+                            sums.aovs
+                                .extend_from_slice(&aovs[index * k..(index + 1) * k]);
+                        }
+                        None => {
+                            sums.pixels.push(PixelSums::default());
+                            sums.aovs.resize(sums.aovs.len() + k, ValueSum::default());
+                        }
+                    }
                 }
             }
             sums
@@ -564,18 +612,28 @@ fn tile_major(
         .collect())
 }
 
-/// Row-major pixel sums from tile-major ones.
-fn row_major(tiles: &[Tile], size: UVec2, sums: &[Vec<PixelSums>]) -> Vec<PixelSums> {
-    let mut pixels = vec![PixelSums::default(); (size.x * size.y) as usize];
+/// Row-major pixel sums and extra channels' sums (`k` per pixel) from tile-major ones.
+fn row_major(
+    tiles: &[Tile],
+    size: UVec2,
+    k: usize,
+    sums: &[TileSums],
+) -> (Vec<PixelSums>, Vec<ValueSum>) {
+    let pixel_count = (size.x * size.y) as usize;
+    let mut pixels = vec![PixelSums::default(); pixel_count];
+    let mut aovs = vec![ValueSum::default(); pixel_count * k];
     for (tile, tile_sums) in tiles.iter().zip(sums) {
         for y in 0..tile.size.y {
             for x in 0..tile.size.x {
                 let index = ((tile.origin.y + y) * size.x + tile.origin.x + x) as usize;
-                pixels[index] = tile_sums[(y * tile.size.x + x) as usize];
+                let i = (y * tile.size.x + x) as usize;
+                pixels[index] = tile_sums.pixels[i];
+                aovs[index * k..(index + 1) * k]
+                    .copy_from_slice(&tile_sums.aovs[i * k..(i + 1) * k]);
             }
         }
     }
-    pixels
+    (pixels, aovs)
 }
 
 /// Where a render's progress goes: a terminal bar, a shared counter, or nowhere.

@@ -3,8 +3,10 @@
 //!
 //! Layout (little endian): the magic `PRISMRS\0`, a format version (u32), the identity of the
 //! render (scene fingerprint, seed, sampler, samples per pixel of the stratification, film size
-//! and crop window), the sample index ranges the pixels hold, the pixel count and the pixels'
-//! exact sums (112 bytes each), and a CRC-32 of all of it. A state is written to a temporary file,
+//! and crop window), the sample index ranges the pixels hold, the names of the integrator's extra
+//! channels (K), the pixel count and each pixel's exact sums (112 bytes, then 16 for each extra
+//! channel), and a CRC-32 of all of it. Version 2 added the extra channels; a state of another
+//! version is refused with its version named. A state is written to a temporary file,
 //! flushed to disk and renamed over the old one, so a crash while writing leaves the previous
 //! state intact.
 
@@ -16,14 +18,17 @@ use glam::UVec2;
 
 use crate::error::{Error, ErrorKind, Result};
 use crate::film::CropWindow;
-use crate::film::accumulation::{ExactSum, PixelSums};
+use crate::film::accumulation::{ExactSum, PixelSums, ValueSum};
 
 const MAGIC: &[u8; 8] = b"PRISMRS\0";
-const VERSION: u32 = 1;
+const VERSION: u32 = 2;
 /// Bytes per pixel: six 128-bit sums and two 64-bit counts.
 const PIXEL_BYTES: usize = 6 * 16 + 2 * 8;
 /// At most this many separate sample ranges (a merge of many farm tasks).
 const MAX_RANGES: usize = 1 << 16;
+/// At most this many extra channels, each name at most this long.
+const MAX_AOVS: usize = 1 << 12;
+const MAX_AOV_NAME: usize = 256;
 
 /// What a render state belongs to: two states can be continued or merged only if they agree.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -85,6 +90,10 @@ pub struct RenderState {
     pub ranges: Vec<Range<u32>>,
     /// Pixel sums, row-major over the crop window.
     pub pixels: Vec<PixelSums>,
+    /// Names of the integrator's extra channels (K).
+    pub aov_names: Vec<String>,
+    /// Their sums, K per pixel in the pixels' order.
+    pub aovs: Vec<ValueSum>,
 }
 
 fn corrupt(path: &Path, what: impl std::fmt::Display) -> Error {
@@ -161,8 +170,14 @@ impl RenderState {
             out.extend_from_slice(&r.start.to_le_bytes());
             out.extend_from_slice(&r.end.to_le_bytes());
         }
+        out.extend_from_slice(&(self.aov_names.len() as u32).to_le_bytes());
+        for name in &self.aov_names {
+            out.extend_from_slice(&(name.len() as u32).to_le_bytes());
+            out.extend_from_slice(name.as_bytes());
+        }
+        let k = self.aov_names.len();
         out.extend_from_slice(&(self.pixels.len() as u64).to_le_bytes());
-        for p in &self.pixels {
+        for (i, p) in self.pixels.iter().enumerate() {
             for s in &p.xyz {
                 out.extend_from_slice(&s.0.to_le_bytes());
             }
@@ -171,6 +186,9 @@ impl RenderState {
             }
             out.extend_from_slice(&p.samples.to_le_bytes());
             out.extend_from_slice(&p.rejected.to_le_bytes());
+            for s in &self.aovs[i * k..(i + 1) * k] {
+                out.extend_from_slice(&s.0.to_le_bytes());
+            }
         }
         let checksum = crc32fast::hash(&out);
         out.extend_from_slice(&checksum.to_le_bytes());
@@ -200,10 +218,20 @@ impl RenderState {
         let truncated = || corrupt(path, "it ends too early");
         let version = r.u32().ok_or_else(truncated)?;
         if version != VERSION {
-            return Err(corrupt(
-                path,
-                format!("it has format version {version}; this Prism reads version {VERSION}"),
-            ));
+            return Err(Error {
+                kind: ErrorKind::Input,
+                location: None,
+                message: format!(
+                    "\"{}\" is a render state of format version {version}; this Prism reads \
+                     version {VERSION} only (version 2 holds the integrator's extra channels)",
+                    path.display()
+                ),
+                help: Some(
+                    "render the scene again, or finish this render with the Prism that \
+                     started it"
+                        .into(),
+                ),
+            });
         }
         let scene = r.u64().ok_or_else(truncated)?;
         let seed = r.u64().ok_or_else(truncated)?;
@@ -255,10 +283,27 @@ impl RenderState {
             }
             ranges.push(start..end);
         }
+        let aov_count = r.u32().ok_or_else(truncated)? as usize;
+        if aov_count > MAX_AOVS || aov_count * 4 > r.left() {
+            return Err(corrupt(
+                path,
+                format!("it declares {aov_count} extra channels"),
+            ));
+        }
+        let mut aov_names = Vec::with_capacity(aov_count);
+        for _ in 0..aov_count {
+            let length = r.u32().ok_or_else(truncated)? as usize;
+            if length > MAX_AOV_NAME {
+                return Err(corrupt(path, "an extra channel's name is too long"));
+            }
+            let name = std::str::from_utf8(r.take(length).ok_or_else(truncated)?)
+                .map_err(|_| corrupt(path, "an extra channel's name is not text"))?;
+            aov_names.push(name.to_string());
+        }
+        let pixel_bytes = (PIXEL_BYTES + 16 * aov_count) as u64;
         let pixel_count = r.u64().ok_or_else(truncated)?;
         let expected = u64::from(identity.crop.size.x) * u64::from(identity.crop.size.y);
-        if pixel_count != expected
-            || pixel_count.checked_mul(PIXEL_BYTES as u64) != Some(r.left() as u64)
+        if pixel_count != expected || pixel_count.checked_mul(pixel_bytes) != Some(r.left() as u64)
         {
             return Err(corrupt(
                 path,
@@ -271,6 +316,7 @@ impl RenderState {
             ));
         }
         let mut pixels = Vec::with_capacity(pixel_count as usize);
+        let mut aovs = Vec::with_capacity(pixel_count as usize * aov_count);
         for _ in 0..pixel_count {
             let mut p = PixelSums::default();
             for s in &mut p.xyz {
@@ -282,11 +328,16 @@ impl RenderState {
             p.samples = r.u64().ok_or_else(truncated)?;
             p.rejected = r.u64().ok_or_else(truncated)?;
             pixels.push(p);
+            for _ in 0..aov_count {
+                aovs.push(ExactSum(r.i128().ok_or_else(truncated)?));
+            }
         }
         Ok(RenderState {
             identity,
             ranges,
             pixels,
+            aov_names,
+            aovs,
         })
     }
 
@@ -341,6 +392,15 @@ impl RenderState {
             }
             ranges.extend(state.ranges.iter().map(|r| (r.clone(), i)));
         }
+        for (i, state) in states.iter().enumerate() {
+            if state.aov_names != first.aov_names {
+                return Err(Error::usage(format!(
+                    "\"{}\" cannot be merged with \"{}\": their integrators write different extra channels",
+                    paths[i].display(),
+                    paths[0].display()
+                )));
+            }
+        }
         ranges.sort_by_key(|(r, _)| r.start);
         for w in ranges.windows(2) {
             if w[0].0.end > w[1].0.start {
@@ -357,9 +417,13 @@ impl RenderState {
             }
         }
         let mut pixels = first.pixels.clone();
+        let mut aovs = first.aovs.clone();
         for state in &states[1..] {
             for (p, q) in pixels.iter_mut().zip(&state.pixels) {
                 p.merge(q);
+            }
+            for (a, b) in aovs.iter_mut().zip(&state.aovs) {
+                a.merge(*b);
             }
         }
         // Adjacent ranges become one.
@@ -374,6 +438,8 @@ impl RenderState {
             identity: first.identity.clone(),
             ranges: merged,
             pixels,
+            aov_names: first.aov_names.clone(),
+            aovs,
         })
     }
 }
@@ -390,8 +456,11 @@ mod tests {
             size: UVec2::new(3, 2),
         };
         let mut pixels = vec![PixelSums::default(); 6];
+        let mut aovs = vec![ValueSum::default(); 12];
         for (i, p) in pixels.iter_mut().enumerate() {
             p.add([i as f32, 0.5, -1.0]);
+            aovs[2 * i].add(i as f64 * 0.25);
+            aovs[2 * i + 1].add(-3.0);
         }
         RenderState {
             identity: RenderIdentity {
@@ -404,6 +473,8 @@ mod tests {
             },
             ranges,
             pixels,
+            aov_names: vec!["dd.T".into(), "m2_dd.T".into()],
+            aovs,
         }
     }
 
@@ -435,6 +506,20 @@ mod tests {
         }
     }
 
+    /// A state of the format before the extra channels is refused, naming its version.
+    #[test]
+    fn an_older_version_is_refused_clearly() {
+        let mut bytes = state(vec![0..4]).encode();
+        bytes[8..12].copy_from_slice(&1u32.to_le_bytes());
+        let body = bytes.len() - 4;
+        let checksum = crc32fast::hash(&bytes[..body]);
+        bytes[body..].copy_from_slice(&checksum.to_le_bytes());
+        let error = RenderState::decode(&bytes, Path::new("old.state")).unwrap_err();
+        assert!(error.message.contains("format version 1"), "{error}");
+        assert!(error.message.contains("reads version 2 only"), "{error}");
+        assert!(error.help.unwrap().contains("render the scene again"));
+    }
+
     #[test]
     fn merge_checks_identity_and_overlap() {
         let (a, b) = (state(vec![0..4]), state(vec![4..8]));
@@ -442,11 +527,16 @@ mod tests {
         let merged = RenderState::merge(&[a.clone(), b.clone()], &paths).unwrap();
         assert_eq!(merged.ranges, vec![0..8]);
         assert_eq!(merged.pixels[1].samples, 2);
+        assert_eq!(merged.aovs[2].value(), 0.5);
         let overlapping = state(vec![2..6]);
         assert!(RenderState::merge(&[a.clone(), overlapping], &paths).is_err());
         let mut other_seed = b.clone();
         other_seed.identity.seed = 8;
-        let error = RenderState::merge(&[a, other_seed], &paths).unwrap_err();
+        let error = RenderState::merge(&[a.clone(), other_seed], &paths).unwrap_err();
         assert!(error.message.contains("seed"), "{error}");
+        let mut other_channels = b;
+        other_channels.aov_names[1] = "m2_other.T".into();
+        let error = RenderState::merge(&[a, other_channels], &paths).unwrap_err();
+        assert!(error.message.contains("extra channels"), "{error}");
     }
 }

@@ -1,14 +1,18 @@
 //! Integrator plugins: `path` (with Prism's `emitter_sampling`, see
-//! [`prism_core::light::sampler`]), the lecture's `distrib`, and `volpath` and `volpathmis`
-//! for media.
+//! [`prism_core::light::sampler`]), `direct`, `moment`, `aov`, the lecture's `distrib`, and
+//! `volpath` and `volpathmis` for media.
 
 use crate::description::{PluginClass, PluginNode};
 use crate::params::Params;
 use crate::registry::{Default, Origin, ParamKind, ParamSpec, Plugin, Registry};
-use prism_core::error::{Error, Result};
+use crate::suggest::closest_match;
+use prism_core::error::{Error, Result, SourceLocation};
+use prism_core::film::output::IMAGE_CHANNELS;
+use prism_core::integrator::aov::{Aov, AovKind};
 use prism_core::integrator::distribution::DirectLights;
 use prism_core::integrator::{
-    DistributionIntegrator, Integrator, PathIntegrator, Tracking, VolPathIntegrator,
+    AovIntegrator, DirectIntegrator, DistributionIntegrator, Integrator, MomentIntegrator,
+    PathIntegrator, Tracking, VolPathIntegrator,
 };
 use prism_core::light::LightSelection;
 
@@ -22,8 +26,48 @@ pub static INTEGRATORS: Registry<Build> = Registry {
             origin: Origin::Mitsuba3,
             summary: "Path tracing with next-event estimation, multiple importance sampling \
                       (power heuristic) and Russian roulette on the path's potential.",
-            params: &[MAX_DEPTH, RR_DEPTH, HIDE_EMITTERS, EMITTER_SAMPLING],
+            params: &[
+                MAX_DEPTH,
+                RR_DEPTH,
+                HIDE_EMITTERS,
+                EMITTER_SAMPLING,
+                STRICT_NORMALS,
+            ],
             build: build_path,
+        },
+        Plugin {
+            name: "direct",
+            origin: Origin::Mitsuba3,
+            summary: "Direct illumination: light samples and BSDF samples at the first hit, \
+                      combined by multiple importance sampling (power heuristic with the sample \
+                      counts).",
+            params: &[
+                SHADING_SAMPLES,
+                EMITTER_SAMPLES,
+                BSDF_SAMPLES,
+                HIDE_EMITTERS,
+            ],
+            build: build_direct,
+        },
+        Plugin {
+            name: "moment",
+            origin: Origin::Mitsuba3,
+            summary: "Runs its nested integrators on each camera ray and writes, for each one \
+                      named n (unnamed ones are _arg_0, _arg_1, ...), its XYZ estimate as the \
+                      EXR channels n.X, n.Y, n.Z and their second moments as m2_n.X, m2_n.Y, \
+                      m2_n.Z; the image is the first one's.",
+            params: &[NESTED_INTEGRATORS],
+            build: build_moment,
+        },
+        Plugin {
+            name: "aov",
+            origin: Origin::Mitsuba3,
+            summary: "Arbitrary output variables of the first hit (albedo, depth, position, uv, \
+                      geo_normal, sh_normal, dp_du, dp_dv, prim_index, shape_index) as EXR \
+                      channels, beside each nested integrator's image as n.R, n.G, n.B, n.A; \
+                      the image is the first nested integrator's.",
+            params: &[AOVS, NESTED_IMAGE_INTEGRATORS],
+            build: build_aov,
         },
         Plugin {
             name: "distrib",
@@ -105,6 +149,47 @@ const USE_SPECTRAL_MIS: ParamSpec = ParamSpec::new(
     "combine the four wavelengths' free-flight densities by MIS; false weights every \
      wavelength by the hero's densities alone",
 );
+const STRICT_NORMALS: ParamSpec = ParamSpec::new(
+    "strict_normals",
+    ParamKind::Boolean,
+    Default::Boolean(false),
+    "Mitsuba 0.6 (`strictNormals`; Mitsuba 3 has none): end paths at directions the geometric \
+     and shading normals put on different sides",
+);
+const SHADING_SAMPLES: ParamSpec = ParamSpec::new(
+    "shading_samples",
+    ParamKind::Integer,
+    Default::Integer(1),
+    "sets both emitter_samples and bsdf_samples (not with either of them)",
+);
+const EMITTER_SAMPLES: ParamSpec = ParamSpec::new(
+    "emitter_samples",
+    ParamKind::Integer,
+    Default::Text("shading_samples"),
+    "light samples per camera ray",
+);
+const BSDF_SAMPLES: ParamSpec = ParamSpec::new(
+    "bsdf_samples",
+    ParamKind::Integer,
+    Default::Text("shading_samples"),
+    "BSDF samples per camera ray",
+);
+const NESTED_INTEGRATORS: ParamSpec = ParamSpec::nested(
+    PluginClass::Integrator,
+    Default::Required,
+    "the integrators whose moments are recorded (at least one), in order",
+);
+const NESTED_IMAGE_INTEGRATORS: ParamSpec = ParamSpec::nested(
+    PluginClass::Integrator,
+    Default::Text("none (a black image)"),
+    "the integrators whose images are written beside the variables, in order",
+);
+const AOVS: ParamSpec = ParamSpec::new(
+    "aovs",
+    ParamKind::String,
+    Default::Required,
+    "comma-separated name:type pairs, e.g. \"dd.y:depth,nn:sh_normal,alb:albedo\"",
+);
 const BOUNCE_SAMPLES: ParamSpec = ParamSpec::new(
     "bounce_samples",
     ParamKind::Integer,
@@ -139,6 +224,25 @@ pub fn build_integrator(node: &PluginNode) -> Result<Integrator> {
     Ok(integrator)
 }
 
+/// Refuses a scene integrator whose extra channels would take the name of an image channel.
+pub fn check_channel_names(integrator: &Integrator, location: &SourceLocation) -> Result<()> {
+    match integrator
+        .aov_names()
+        .into_iter()
+        .find(|name| IMAGE_CHANNELS.contains(&name.as_str()))
+    {
+        Some(name) => Err(Error::input(
+            location,
+            format!("the integrator's channel \"{name}\" would replace the image's own"),
+        )
+        .with_help(format!(
+            "rename the variable or nested integrator; the image's channels are {}",
+            IMAGE_CHANNELS.join(", ")
+        ))),
+        None => Ok(()),
+    }
+}
+
 /// `max_depth`: −1 (unbounded) or at least 0.
 fn max_depth(params: &Params) -> Result<i32> {
     let max_depth = params.integer(&MAX_DEPTH)?;
@@ -164,6 +268,14 @@ fn count(params: &Params, spec: &ParamSpec) -> Result<u32> {
 }
 
 fn build_path(params: &Params) -> Result<Integrator> {
+    Ok(Integrator::Path(PathIntegrator {
+        strict_normals: params.boolean(&STRICT_NORMALS)?,
+        ..path_settings(params)?
+    }))
+}
+
+/// The settings `path` shares with `volpath` and `volpathmis`.
+fn path_settings(params: &Params) -> Result<PathIntegrator> {
     let max_depth = max_depth(params)?;
     let rr_depth = params.integer(&RR_DEPTH)?;
     if rr_depth < 1 || rr_depth > i64::from(i32::MAX) {
@@ -176,18 +288,183 @@ fn build_path(params: &Params) -> Result<Integrator> {
         "uniform" => LightSelection::Uniform,
         _ => LightSelection::Power,
     };
-    Ok(Integrator::Path(PathIntegrator {
+    Ok(PathIntegrator {
         max_depth,
         rr_depth: rr_depth as i32,
         hide_emitters: params.boolean(&HIDE_EMITTERS)?,
         light_selection,
+        strict_normals: false,
+    })
+}
+
+/// A sample count of `direct`: 0 to 1024.
+fn shading_count(params: &Params, spec: &ParamSpec, default: i64) -> Result<u32> {
+    let value = params.integer_opt(spec)?.unwrap_or(default);
+    if !(0..=1024).contains(&value) {
+        return Err(Error::input(
+            params.location_of(spec),
+            format!("\"{}\" must be between 0 and 1024, not {value}", spec.name),
+        ));
+    }
+    Ok(value as u32)
+}
+
+fn build_direct(params: &Params) -> Result<Integrator> {
+    if params.has(&SHADING_SAMPLES) {
+        for spec in [&EMITTER_SAMPLES, &BSDF_SAMPLES] {
+            if params.has(spec) {
+                return Err(Error::input(
+                    params.location_of(spec),
+                    format!("\"{}\" cannot be given with \"shading_samples\"", spec.name),
+                )
+                .with_help("give either shading_samples, or emitter_samples and bsdf_samples"));
+            }
+        }
+    }
+    let shading_samples = shading_count(params, &SHADING_SAMPLES, 1)?;
+    let emitter_samples = shading_count(params, &EMITTER_SAMPLES, i64::from(shading_samples))?;
+    let bsdf_samples = shading_count(params, &BSDF_SAMPLES, i64::from(shading_samples))?;
+    if emitter_samples + bsdf_samples == 0 {
+        return Err(Error::input(
+            params.location(),
+            "the direct integrator needs at least one emitter or BSDF sample",
+        ));
+    }
+    Ok(Integrator::Direct(DirectIntegrator {
+        emitter_samples,
+        bsdf_samples,
+        hide_emitters: params.boolean(&HIDE_EMITTERS)?,
     }))
 }
 
-fn build_volpath(params: &Params) -> Result<Integrator> {
-    let Integrator::Path(path) = build_path(params)? else {
-        unreachable!("build_path builds a path integrator");
+/// The nested integrators of `spec`, each with the name its channels carry: its `name`
+/// attribute, or `_arg_i` for the i-th unnamed one (as Mitsuba names unnamed nested objects).
+fn named_integrators(params: &Params, spec: &ParamSpec) -> Result<Vec<(String, Integrator)>> {
+    let children = params.children(spec);
+    let mut integrators: Vec<(String, Integrator)> = Vec::with_capacity(children.len());
+    let mut unnamed = 0;
+    for child in children {
+        let name = match &child.name {
+            Some(name) => name.clone(),
+            None => {
+                unnamed += 1;
+                format!("_arg_{}", unnamed - 1)
+            }
+        };
+        if integrators.iter().any(|(n, _)| *n == name) {
+            return Err(Error::input(
+                &child.location,
+                format!(
+                    "two nested integrators of {} are named \"{name}\"",
+                    params.node().describe()
+                ),
+            )
+            .with_help(
+                "give each nested integrator its own name (unnamed ones are called _arg_0, \
+                 _arg_1, ... in order)",
+            ));
+        }
+        integrators.push((name, build_integrator(&child.node)?));
+    }
+    Ok(integrators)
+}
+
+fn build_moment(params: &Params) -> Result<Integrator> {
+    let integrators = named_integrators(params, &NESTED_INTEGRATORS)?;
+    if integrators.is_empty() {
+        return Err(Error::input(
+            params.location(),
+            "the moment integrator needs at least one nested integrator",
+        )
+        .with_help(
+            "nest the integrator whose moments you want, e.g. <integrator type=\"path\"/>",
+        ));
+    }
+    Ok(MomentIntegrator { integrators }.into())
+}
+
+/// Mitsuba's AOV types that Prism cannot produce, and why.
+const UNSUPPORTED_AOVS: [(&str, &str); 3] = [
+    ("duv_dx", "Prism's cameras trace no ray differentials"),
+    ("duv_dy", "Prism's cameras trace no ray differentials"),
+    (
+        "boundary_test",
+        "it serves differentiable rendering, which Prism does not do",
+    ),
+];
+
+/// `aovs`: `name:type` pairs separated by commas (or spaces, as Mitsuba's tokenizer allows).
+fn parse_aovs(params: &Params) -> Result<Vec<Aov>> {
+    let location = params.location_of(&AOVS);
+    let Some(list) = params.string_opt(&AOVS)? else {
+        return Err(Error::input(
+            params.location(),
+            "the aov integrator needs \"aovs\", the variables to write",
+        )
+        .with_help("add e.g. <string name=\"aovs\" value=\"nn:sh_normal,alb:albedo\"/>"));
     };
+    let names: Vec<&str> = AovKind::ALL.iter().map(|(name, _)| *name).collect();
+    let mut aovs = Vec::new();
+    for item in list.split([',', ' ']).filter(|item| !item.is_empty()) {
+        let (name, kind) = match item.split(':').collect::<Vec<&str>>()[..] {
+            [name, kind] if !name.is_empty() && !kind.is_empty() => (name, kind),
+            _ => {
+                return Err(Error::input(
+                    location,
+                    format!("\"{item}\" in \"aovs\" is not a name:type pair"),
+                )
+                .with_help("write each variable as name:type, e.g. nn:sh_normal"));
+            }
+        };
+        if let Some((_, why)) = UNSUPPORTED_AOVS.iter().find(|(n, _)| *n == kind) {
+            return Err(Error::input(
+                location,
+                format!("the AOV type \"{kind}\" is not supported: {why}"),
+            )
+            .with_help(format!("remove \"{item}\" from \"aovs\"")));
+        }
+        let Some((_, kind)) = AovKind::ALL.iter().find(|(n, _)| *n == kind) else {
+            let mut error =
+                Error::input(location, format!("unknown AOV type \"{kind}\" in \"aovs\""));
+            error = match closest_match(kind, &names) {
+                Some(close) => error.with_help(format!("did you mean \"{close}\"?")),
+                None => error.with_help(format!("the types are {}", names.join(", "))),
+            };
+            return Err(error);
+        };
+        aovs.push(Aov {
+            name: name.to_string(),
+            kind: *kind,
+        });
+    }
+    Ok(aovs)
+}
+
+fn build_aov(params: &Params) -> Result<Integrator> {
+    let aovs = parse_aovs(params)?;
+    let integrators = named_integrators(params, &NESTED_IMAGE_INTEGRATORS)?;
+    let integrator = AovIntegrator { aovs, integrators };
+    let names = integrator.aov_names();
+    if names.is_empty() {
+        return Err(Error::input(
+            params.location_of(&AOVS),
+            "the aov integrator has nothing to write: \"aovs\" is empty and no integrator is nested",
+        ));
+    }
+    for (i, name) in names.iter().enumerate() {
+        if names[..i].contains(name) {
+            return Err(Error::input(
+                params.location_of(&AOVS),
+                format!("two of the aov integrator's channels are named \"{name}\""),
+            )
+            .with_help("give each variable and nested integrator its own name"));
+        }
+    }
+    Ok(integrator.into())
+}
+
+fn build_volpath(params: &Params) -> Result<Integrator> {
+    let path = path_settings(params)?;
     Ok(Integrator::VolPath(VolPathIntegrator {
         max_depth: path.max_depth,
         rr_depth: path.rr_depth,

@@ -252,7 +252,11 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
     let mut attached_emitters: HashMap<*const PluginNode, &SourceLocation> = HashMap::new();
 
     let integrator = match params.single_child(&INTEGRATOR)? {
-        Some(child) => integrators::build_integrator(&child.node)?,
+        Some(child) => {
+            let integrator = integrators::build_integrator(&child.node)?;
+            integrators::check_channel_names(&integrator, &child.location)?;
+            integrator
+        }
         None => Integrator::Path(PathIntegrator::default()),
     };
     let sensors = params.children(&SENSOR);
