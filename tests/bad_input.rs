@@ -629,6 +629,77 @@ fn cases() -> Vec<Case> {
             location: "",
             says: "missing.state",
         },
+        // Cylinders.
+        render_scene(
+            "cylinder: p0 and p1 the same point",
+            scene!(
+                "    <shape type=\"cylinder\"><point name=\"p1\" x=\"0\" y=\"0\" z=\"0\"/></shape>"
+            ),
+            "scene.xml:3:5",
+            "are the same point",
+        ),
+        render_scene(
+            "cylinder: negative radius",
+            scene!("    <shape type=\"cylinder\"><float name=\"radius\" value=\"-1\"/></shape>"),
+            "scene.xml:3:",
+            "radius must be positive",
+        ),
+        render_scene(
+            "cylinder: an elliptic to_world",
+            scene!(
+                "    <shape type=\"cylinder\"><transform name=\"to_world\"><scale x=\"2\"/></transform></shape>"
+            ),
+            "scene.xml:3:",
+            "may not make it elliptic",
+        ),
+        // mesh_attribute textures.
+        Case {
+            name: "mesh_attribute: the mesh has no such attribute",
+            files: &[
+                (
+                    "scene.xml",
+                    scene!(
+                        "    <shape type=\"obj\"><string name=\"filename\" value=\"mesh.obj\"/><bsdf type=\"diffuse\"><texture type=\"mesh_attribute\" name=\"reflectance\"><string name=\"name\" value=\"vertex_color\"/></texture></bsdf></shape>"
+                    ),
+                ),
+                ("mesh.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"),
+            ],
+            arguments: RENDER,
+            location: "scene.xml:3:5",
+            says: "has no attribute \"vertex_color\" (Mitsuba: invalid attribute requested); it has none",
+        },
+        render_scene(
+            "mesh_attribute: a shape that is not a mesh",
+            scene!(
+                "    <shape type=\"sphere\"><bsdf type=\"diffuse\"><texture type=\"mesh_attribute\" name=\"reflectance\"><string name=\"name\" value=\"vertex_color\"/></texture></bsdf></shape>"
+            ),
+            "scene.xml:3:5",
+            "which a shape that is not a mesh does not carry",
+        ),
+        render_scene(
+            "mesh_attribute: a name without vertex_ or face_",
+            scene!(
+                "    <shape type=\"sphere\"><bsdf type=\"diffuse\"><texture type=\"mesh_attribute\" name=\"reflectance\"><string name=\"name\" value=\"color\"/></texture></bsdf></shape>"
+            ),
+            "scene.xml:3:",
+            "must start with \"vertex_\" or \"face_\"",
+        ),
+        render_scene(
+            "mesh_attribute: a colour read as a number",
+            scene!(
+                "    <shape type=\"sphere\"><bsdf type=\"roughconductor\"><texture type=\"mesh_attribute\" name=\"alpha\"><string name=\"name\" value=\"vertex_color\"/></texture></bsdf></shape>"
+            ),
+            "scene.xml:3:",
+            "only as a colour",
+        ),
+        render_scene(
+            "mesh_attribute: no name",
+            scene!(
+                "    <shape type=\"sphere\"><bsdf type=\"diffuse\"><texture type=\"mesh_attribute\" name=\"reflectance\"/></bsdf></shape>"
+            ),
+            "scene.xml:3:",
+            "needs the \"name\"",
+        ),
         render_scene(
             "rawconstant of three values read as a colour",
             scene!(

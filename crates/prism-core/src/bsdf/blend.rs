@@ -45,7 +45,7 @@ impl BsdfModel for Blend {
         wo: Vec3,
         lambda: &SampledWavelengths,
     ) -> SampledSpectrum {
-        let weight = self.weight.eval_1(point.uv).clamp(0.0, 1.0);
+        let weight = self.weight.eval_1(point.at()).clamp(0.0, 1.0);
         (1.0 - weight) * self.nested[0].diffuse_reflectance(point, wo, lambda)
             + weight * self.nested[1].diffuse_reflectance(point, wo, lambda)
     }
@@ -61,7 +61,7 @@ impl BsdfModel for Blend {
         let first = self.nested[0].resolve(point, wo, lambda, tree);
         let second = self.nested[1].resolve(point, wo, lambda, tree);
         tree.push(BlendLobes {
-            weight: self.weight.eval_1(point.uv).clamp(0.0, 1.0),
+            weight: self.weight.eval_1(point.at()).clamp(0.0, 1.0),
             nested: [first, second],
         })
     }

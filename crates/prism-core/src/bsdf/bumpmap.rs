@@ -37,7 +37,7 @@ impl BumpMap {
     /// The bump-mapped normal in the local shading frame (not normalised).
     #[inline]
     fn perturbed_normal(&self, sp: &ShadingPoint) -> Vec3 {
-        let gradient = self.height.eval_1_grad(sp.uv) * self.scale;
+        let gradient = self.height.eval_1_grad(sp.at()) * self.scale;
         let n = sp.frame.n;
         let dp_du = sp.dp_du + n * (gradient.x - n.dot(sp.dp_du));
         let dp_dv = sp.dp_dv + n * (gradient.y - n.dot(sp.dp_dv));

@@ -18,7 +18,7 @@ use wide::f32x4;
 use super::fresnel::{fresnel_conductor4, reflect_z};
 use super::{BsdfFlags, BsdfModel, BsdfSample, Bxdf, BxdfTree, NodeId, ShadingPoint};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
-use crate::texture::Texture;
+use crate::texture::{Texture, TexturePoint};
 
 #[derive(Clone, Debug)]
 pub struct Conductor {
@@ -38,7 +38,7 @@ pub struct ConductorIor {
 }
 
 impl ConductorIor {
-    /// η and k read from textures at `uv`, relative to an exterior medium of index `ext_eta`:
+    /// η and k read from textures at `at`, relative to an exterior medium of index `ext_eta`:
     /// the Fresnel equations depend on (η + ik)/η_ext only (Mitsuba 0.6, `conductor.cpp`, which
     /// divides both parts by `extEta`).
     #[inline]
@@ -46,13 +46,13 @@ impl ConductorIor {
         eta: &Texture,
         k: &Texture,
         ext_eta: f32,
-        uv: Vec2,
+        at: TexturePoint,
         lambda: &SampledWavelengths,
     ) -> ConductorIor {
         let inv_ext = 1.0 / ext_eta;
         ConductorIor {
-            eta: eta.eval(uv, lambda) * inv_ext,
-            k: k.eval(uv, lambda) * inv_ext,
+            eta: eta.eval(at, lambda) * inv_ext,
+            k: k.eval(at, lambda) * inv_ext,
         }
     }
 
@@ -99,8 +99,8 @@ impl BsdfModel for Conductor {
         tree: &mut BxdfTree<'a>,
     ) -> NodeId {
         tree.push(ConductorLobes {
-            ior: ConductorIor::at(&self.eta, &self.k, self.ext_eta, point.uv, lambda),
-            specular_reflectance: self.specular_reflectance.eval(point.uv, lambda),
+            ior: ConductorIor::at(&self.eta, &self.k, self.ext_eta, point.at(), lambda),
+            specular_reflectance: self.specular_reflectance.eval(point.at(), lambda),
         })
     }
 }

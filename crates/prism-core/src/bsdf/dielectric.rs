@@ -25,7 +25,7 @@ use super::fresnel::{fresnel_dielectric, reflect_z, refract_z};
 use super::{BsdfFlags, BsdfModel, BsdfSample, Bxdf, BxdfTree, NodeId, ShadingPoint};
 use crate::spectrum::ior::RelativeIor;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
-use crate::texture::Texture;
+use crate::texture::{Texture, TexturePoint};
 
 #[derive(Clone, Debug)]
 pub struct Dielectric {
@@ -39,11 +39,11 @@ pub struct Dielectric {
 #[inline]
 pub(crate) fn optional_factor(
     texture: &Option<Texture>,
-    uv: Vec2,
+    at: TexturePoint,
     lambda: &SampledWavelengths,
 ) -> SampledSpectrum {
     match texture {
-        Some(t) => t.eval(uv, lambda),
+        Some(t) => t.eval(at, lambda),
         None => SampledSpectrum::ONE,
     }
 }
@@ -114,8 +114,12 @@ impl BsdfModel for Dielectric {
     ) -> NodeId {
         tree.push(DielectricLobes {
             eta: SampledIor::at(&self.eta, lambda),
-            specular_reflectance: optional_factor(&self.specular_reflectance, point.uv, lambda),
-            specular_transmittance: optional_factor(&self.specular_transmittance, point.uv, lambda),
+            specular_reflectance: optional_factor(&self.specular_reflectance, point.at(), lambda),
+            specular_transmittance: optional_factor(
+                &self.specular_transmittance,
+                point.at(),
+                lambda,
+            ),
         })
     }
 }

@@ -44,7 +44,7 @@ impl BsdfModel for Diffuse {
         _wo: Vec3,
         lambda: &SampledWavelengths,
     ) -> SampledSpectrum {
-        self.reflectance.eval(point.uv, lambda)
+        self.reflectance.eval(point.at(), lambda)
     }
 
     #[inline]
@@ -56,7 +56,7 @@ impl BsdfModel for Diffuse {
         tree: &mut BxdfTree<'a>,
     ) -> NodeId {
         tree.push(DiffuseLobes {
-            reflectance: self.reflectance.eval(point.uv, lambda),
+            reflectance: self.reflectance.eval(point.at(), lambda),
         })
     }
 }

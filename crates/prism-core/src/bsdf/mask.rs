@@ -59,7 +59,7 @@ impl BsdfModel for Mask {
     ) -> NodeId {
         let nested = self.nested.resolve(point, wo, lambda, tree);
         tree.push(MaskLobes {
-            opacity: self.opacity.eval_1(point.uv).clamp(0.0, 1.0),
+            opacity: self.opacity.eval_1(point.at()).clamp(0.0, 1.0),
             nested,
         })
     }

@@ -107,8 +107,10 @@ pub use thindielectric::ThinDielectric;
 pub use twosided::TwoSided;
 pub use ward::{Ward, WardVariant};
 
+use crate::geometry::interaction::AttributeValues;
 use crate::math::Frame;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+use crate::texture::TexturePoint;
 
 /// Which kind of lobe a sample or BSDF has (the lecture's split into diffuse, glossy and mirror
 /// parts) and whether it reflects or transmits.
@@ -219,6 +221,8 @@ pub(crate) fn mixture_sample(
 #[derive(Clone, Copy, Debug)]
 pub struct ShadingPoint {
     pub uv: Vec2,
+    /// The hit mesh's attributes at the point (for `mesh_attribute` textures).
+    pub attributes: AttributeValues,
     /// The shading frame that the local directions refer to (world space).
     pub frame: Frame,
     /// The geometric normal, on the side of `frame.n`.
@@ -229,11 +233,21 @@ pub struct ShadingPoint {
 }
 
 impl ShadingPoint {
+    /// Where the point's textures are looked up.
+    #[inline]
+    pub fn at(&self) -> TexturePoint {
+        TexturePoint {
+            uv: self.uv,
+            attributes: self.attributes,
+        }
+    }
+
     /// A point whose shading frame is the world frame (for tests and BSDF queries out of scene
     /// context).
     pub fn local(uv: Vec2) -> ShadingPoint {
         ShadingPoint {
             uv,
+            attributes: AttributeValues::default(),
             frame: Frame {
                 s: Vec3::X,
                 t: Vec3::Y,

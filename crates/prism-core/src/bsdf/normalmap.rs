@@ -62,7 +62,7 @@ impl BsdfModel for NormalMap {
         tree: &mut BxdfTree<'a>,
     ) -> NodeId {
         let tilt = Tilt {
-            normal: self.normals.eval_3(point.uv) * 2.0 - Vec3::ONE,
+            normal: self.normals.eval_3(point.at()) * 2.0 - Vec3::ONE,
             flip_invalid_normals: self.flip_invalid_normals,
             use_shadowing_function: self.use_shadowing_function,
         };

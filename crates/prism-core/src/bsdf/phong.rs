@@ -62,7 +62,7 @@ impl BsdfModel for Phong {
         _wo: Vec3,
         lambda: &SampledWavelengths,
     ) -> SampledSpectrum {
-        self.scale * self.diffuse_reflectance.eval(point.uv, lambda)
+        self.scale * self.diffuse_reflectance.eval(point.at(), lambda)
     }
 
     #[inline]
@@ -73,11 +73,11 @@ impl BsdfModel for Phong {
         lambda: &SampledWavelengths,
         tree: &mut BxdfTree<'a>,
     ) -> NodeId {
-        let specular = self.specular_reflectance.eval(point.uv, lambda) * self.scale;
-        let diffuse = self.diffuse_reflectance.eval(point.uv, lambda) * self.scale;
+        let specular = self.specular_reflectance.eval(point.at(), lambda) * self.scale;
+        let diffuse = self.diffuse_reflectance.eval(point.at(), lambda) * self.scale;
         let (s, d) = (specular.average(), diffuse.average());
         tree.push(PhongLobes {
-            exponent: self.exponent.eval_1(point.uv),
+            exponent: self.exponent.eval_1(point.at()),
             specular,
             diffuse,
             p_glossy: if s + d > 0.0 { s / (s + d) } else { 1.0 },

@@ -90,7 +90,7 @@ impl BsdfModel for Plastic {
         _wo: Vec3,
         lambda: &SampledWavelengths,
     ) -> SampledSpectrum {
-        self.diffuse_reflectance.eval(point.uv, lambda)
+        self.diffuse_reflectance.eval(point.at(), lambda)
     }
 
     #[inline]
@@ -102,7 +102,7 @@ impl BsdfModel for Plastic {
         tree: &mut BxdfTree<'a>,
     ) -> NodeId {
         // ρ / (1 − F_dr) or, nonlinear, ρ / (1 − ρ F_dr).
-        let rho = self.diffuse_reflectance.eval(point.uv, lambda);
+        let rho = self.diffuse_reflectance.eval(point.at(), lambda);
         let diffuse = SampledSpectrum::from_fn(|i| {
             let bounce = if self.nonlinear {
                 rho[i] * self.fdr_internal
@@ -114,7 +114,7 @@ impl BsdfModel for Plastic {
         tree.push(PlasticLobes {
             plastic: self,
             diffuse,
-            specular_reflectance: optional_factor(&self.specular_reflectance, point.uv, lambda),
+            specular_reflectance: optional_factor(&self.specular_reflectance, point.at(), lambda),
         })
     }
 }

@@ -73,7 +73,7 @@ impl BsdfModel for PolarizedPlastic {
         _wo: Vec3,
         lambda: &SampledWavelengths,
     ) -> SampledSpectrum {
-        self.diffuse_reflectance.eval(point.uv, lambda)
+        self.diffuse_reflectance.eval(point.at(), lambda)
     }
 
     #[inline]
@@ -84,15 +84,15 @@ impl BsdfModel for PolarizedPlastic {
         lambda: &SampledWavelengths,
         tree: &mut BxdfTree<'a>,
     ) -> NodeId {
-        let diffuse = self.diffuse_reflectance.eval(point.uv, lambda);
-        let specular = optional_factor(&self.specular_reflectance, point.uv, lambda);
+        let diffuse = self.diffuse_reflectance.eval(point.at(), lambda);
+        let specular = optional_factor(&self.specular_reflectance, point.at(), lambda);
         let (s, d) = (specular.average(), diffuse.average());
         tree.push(PolarizedPlasticLobes {
             eta: self.eta,
             distribution: Microfacet::new(
                 self.distribution,
-                self.alpha_u.eval_1(point.uv),
-                self.alpha_v.eval_1(point.uv),
+                self.alpha_u.eval_1(point.at()),
+                self.alpha_v.eval_1(point.at()),
             ),
             diffuse,
             specular,

@@ -73,11 +73,11 @@ impl BsdfModel for RoughConductor {
         tree.push(RoughConductorLobes {
             distribution: Microfacet::new(
                 self.distribution,
-                self.alpha_u.eval_1(point.uv),
-                self.alpha_v.eval_1(point.uv),
+                self.alpha_u.eval_1(point.at()),
+                self.alpha_v.eval_1(point.at()),
             ),
-            ior: ConductorIor::at(&self.eta, &self.k, self.ext_eta, point.uv, lambda),
-            specular_reflectance: self.specular_reflectance.eval(point.uv, lambda),
+            ior: ConductorIor::at(&self.eta, &self.k, self.ext_eta, point.at(), lambda),
+            specular_reflectance: self.specular_reflectance.eval(point.at(), lambda),
         })
     }
 }

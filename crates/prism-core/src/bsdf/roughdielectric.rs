@@ -83,11 +83,15 @@ impl BsdfModel for RoughDielectric {
             dispersive: self.eta.is_dispersive(),
             distribution: Microfacet::new(
                 self.distribution,
-                self.alpha_u.eval_1(point.uv),
-                self.alpha_v.eval_1(point.uv),
+                self.alpha_u.eval_1(point.at()),
+                self.alpha_v.eval_1(point.at()),
             ),
-            specular_reflectance: optional_factor(&self.specular_reflectance, point.uv, lambda),
-            specular_transmittance: optional_factor(&self.specular_transmittance, point.uv, lambda),
+            specular_reflectance: optional_factor(&self.specular_reflectance, point.at(), lambda),
+            specular_transmittance: optional_factor(
+                &self.specular_transmittance,
+                point.at(),
+                lambda,
+            ),
         })
     }
 }

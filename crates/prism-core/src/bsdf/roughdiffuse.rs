@@ -55,7 +55,7 @@ impl BsdfModel for RoughDiffuse {
         _wo: Vec3,
         lambda: &SampledWavelengths,
     ) -> SampledSpectrum {
-        self.reflectance.eval(point.uv, lambda)
+        self.reflectance.eval(point.at(), lambda)
     }
 
     #[inline]
@@ -67,8 +67,8 @@ impl BsdfModel for RoughDiffuse {
         tree: &mut BxdfTree<'a>,
     ) -> NodeId {
         tree.push(RoughDiffuseLobes {
-            reflectance: self.reflectance.eval(point.uv, lambda),
-            sigma: self.alpha.eval_1(point.uv) * FRAC_1_SQRT_2,
+            reflectance: self.reflectance.eval(point.at(), lambda),
+            sigma: self.alpha.eval_1(point.at()) * FRAC_1_SQRT_2,
             use_fast_approx: self.use_fast_approx,
         })
     }

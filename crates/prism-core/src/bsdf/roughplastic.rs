@@ -172,7 +172,7 @@ impl BsdfModel for RoughPlastic {
         _wo: Vec3,
         lambda: &SampledWavelengths,
     ) -> SampledSpectrum {
-        self.diffuse_reflectance.eval(point.uv, lambda)
+        self.diffuse_reflectance.eval(point.at(), lambda)
     }
 
     #[inline]
@@ -184,7 +184,7 @@ impl BsdfModel for RoughPlastic {
         tree: &mut BxdfTree<'a>,
     ) -> NodeId {
         // ρ / (1 − R_i) or, nonlinear, ρ / (1 − ρ R_i).
-        let rho = self.diffuse_reflectance.eval(point.uv, lambda);
+        let rho = self.diffuse_reflectance.eval(point.at(), lambda);
         let diffuse = SampledSpectrum::from_fn(|i| {
             let bounce = if self.nonlinear {
                 rho[i] * self.internal_reflectance
@@ -196,7 +196,7 @@ impl BsdfModel for RoughPlastic {
         tree.push(RoughPlasticLobes {
             plastic: self,
             diffuse,
-            specular_reflectance: optional_factor(&self.specular_reflectance, point.uv, lambda),
+            specular_reflectance: optional_factor(&self.specular_reflectance, point.at(), lambda),
         })
     }
 }

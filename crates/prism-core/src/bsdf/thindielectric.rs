@@ -70,8 +70,12 @@ impl BsdfModel for ThinDielectric {
     ) -> NodeId {
         tree.push(ThinDielectricLobes {
             eta: SampledIor::at(&self.eta, lambda),
-            specular_reflectance: optional_factor(&self.specular_reflectance, point.uv, lambda),
-            specular_transmittance: optional_factor(&self.specular_transmittance, point.uv, lambda),
+            specular_reflectance: optional_factor(&self.specular_reflectance, point.at(), lambda),
+            specular_transmittance: optional_factor(
+                &self.specular_transmittance,
+                point.at(),
+                lambda,
+            ),
         })
     }
 }

@@ -82,7 +82,7 @@ impl BsdfModel for Ward {
         _wo: Vec3,
         lambda: &SampledWavelengths,
     ) -> SampledSpectrum {
-        self.scale * self.diffuse_reflectance.eval(point.uv, lambda)
+        self.scale * self.diffuse_reflectance.eval(point.at(), lambda)
     }
 
     #[inline]
@@ -93,13 +93,13 @@ impl BsdfModel for Ward {
         lambda: &SampledWavelengths,
         tree: &mut BxdfTree<'a>,
     ) -> NodeId {
-        let specular = self.specular_reflectance.eval(point.uv, lambda) * self.scale;
-        let diffuse = self.diffuse_reflectance.eval(point.uv, lambda) * self.scale;
+        let specular = self.specular_reflectance.eval(point.at(), lambda) * self.scale;
+        let diffuse = self.diffuse_reflectance.eval(point.at(), lambda) * self.scale;
         let (s, d) = (specular.average(), diffuse.average());
         tree.push(WardLobes {
             variant: self.variant,
-            alpha_u: self.alpha_u.eval_1(point.uv),
-            alpha_v: self.alpha_v.eval_1(point.uv),
+            alpha_u: self.alpha_u.eval_1(point.at()),
+            alpha_v: self.alpha_v.eval_1(point.at()),
             specular,
             diffuse,
             p_glossy: if s + d > 0.0 { s / (s + d) } else { 1.0 },

@@ -5,6 +5,15 @@ use glam::{Vec2, Vec3};
 use super::offset::offset_ray_origin;
 use crate::math::{Frame, Ray};
 
+/// How many distinct mesh attributes (Mitsuba's `vertex_color`, `face_color`, ...) the textures
+/// of one scene may read.
+pub const MAX_MESH_ATTRIBUTES: usize = 4;
+
+/// Mesh attribute values at a surface point (a colour: linear RGB), by the slot the scene gave
+/// each attribute name.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct AttributeValues(pub [Vec3; MAX_MESH_ATTRIBUTES]);
+
 /// A point on a surface where a ray arrived, with its local geometry.
 #[derive(Clone, Copy, Debug)]
 pub struct SurfaceInteraction {
@@ -28,6 +37,9 @@ pub struct SurfaceInteraction {
     pub primitive: u32,
     /// The time of the ray that found the point; rays leaving it keep it.
     pub time: f32,
+    /// The mesh attributes that the scene's textures read, interpolated at the point (zero
+    /// for shapes without them).
+    pub attributes: AttributeValues,
 }
 
 impl SurfaceInteraction {

@@ -14,7 +14,7 @@
 
 use glam::Vec2;
 
-use super::{Texture, UvTransform};
+use super::{Texture, TexturePoint, UvTransform};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 
 #[derive(Clone, Debug)]
@@ -33,24 +33,24 @@ impl Checkerboard {
         upper(p.x) == upper(p.y)
     }
 
-    /// The colour at `uv`: `color0` on the even squares.
-    pub fn eval(&self, uv: Vec2, lambda: &SampledWavelengths) -> SampledSpectrum {
-        let texture = if self.in_even_square(uv) {
+    /// The colour at `at`: `color0` on the even squares.
+    pub fn eval(&self, at: &TexturePoint, lambda: &SampledWavelengths) -> SampledSpectrum {
+        let texture = if self.in_even_square(at.uv) {
             &self.color0
         } else {
             &self.color1
         };
-        texture.eval(uv, lambda)
+        texture.eval(*at, lambda)
     }
 
-    /// The number at `uv`: `color0` on the odd squares, Mitsuba 3's phase for `eval_1`.
-    pub fn eval_1(&self, uv: Vec2) -> f32 {
-        let texture = if self.in_even_square(uv) {
+    /// The number at `at`: `color0` on the odd squares, Mitsuba 3's phase for `eval_1`.
+    pub fn eval_1(&self, at: &TexturePoint) -> f32 {
+        let texture = if self.in_even_square(at.uv) {
             &self.color1
         } else {
             &self.color0
         };
-        texture.eval_1(uv)
+        texture.eval_1(*at)
     }
 
     pub fn max_value(&self) -> f32 {
@@ -76,14 +76,15 @@ mod tests {
             to_uv: UvTransform::IDENTITY,
         };
         let lambda = SampledWavelengths::single(550.0);
-        let colour = |u: f32, v: f32| c.eval(Vec2::new(u, v), &lambda)[0];
+        let at = |u: f32, v: f32| TexturePoint::from(Vec2::new(u, v));
+        let colour = |u: f32, v: f32| c.eval(&at(u, v), &lambda)[0];
         assert_eq!(colour(0.25, 0.25), 0.4);
         assert_eq!(colour(0.75, 0.75), 0.4);
         assert_eq!(colour(0.75, 0.25), 0.2);
         assert_eq!(colour(1.25, -0.25), 0.2);
-        assert_eq!(c.eval_1(Vec2::new(0.25, 0.25)), 0.2);
-        assert_eq!(c.eval_1(Vec2::new(0.75, 0.75)), 0.2);
-        assert_eq!(c.eval_1(Vec2::new(0.75, 0.25)), 0.4);
-        assert_eq!(c.eval_1(Vec2::new(1.25, -0.25)), 0.4);
+        assert_eq!(c.eval_1(&at(0.25, 0.25)), 0.2);
+        assert_eq!(c.eval_1(&at(0.75, 0.75)), 0.2);
+        assert_eq!(c.eval_1(&at(0.75, 0.25)), 0.4);
+        assert_eq!(c.eval_1(&at(1.25, -0.25)), 0.4);
     }
 }

@@ -6,9 +6,13 @@
 //! * as a spectrum ([`Texture::eval`]): colours, upsampled from RGB by Jakob & Hanika's model;
 //! * as a number ([`Texture::eval_1`]): roughness, opacity, weights, heights;
 //! * as a raw RGB triple ([`Texture::eval_3`]): normal maps.
+//!
+//! A texture is looked up at a [`TexturePoint`]: the surface's (u, v) and the mesh attributes
+//! interpolated there (for `mesh_attribute`); a bare `Vec2` is a point without attributes.
 
 pub mod bitmap;
 pub mod checkerboard;
+pub mod mesh_attribute;
 
 use std::sync::Arc;
 
@@ -16,7 +20,9 @@ use glam::{DMat4, Vec2, Vec3};
 
 pub use bitmap::{BitmapTexture, FilterType, TextureUse, WrapMode};
 pub use checkerboard::Checkerboard;
+pub use mesh_attribute::MeshAttributeTexture;
 
+use crate::geometry::interaction::AttributeValues;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths, Spectrum};
 
 /// A texture, dispatched by `match`.
@@ -28,6 +34,26 @@ pub enum Texture {
     Bitmap(Arc<BitmapTexture>),
     /// Two textures in a checkerboard pattern.
     Checkerboard(Box<Checkerboard>),
+    /// A colour the mesh carries per vertex or per face (Mitsuba's `mesh_attribute`).
+    MeshAttribute(MeshAttributeTexture),
+}
+
+/// Where a texture is looked up.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct TexturePoint {
+    pub uv: Vec2,
+    /// The hit mesh's attributes, interpolated at the point (zero where the mesh has none).
+    pub attributes: AttributeValues,
+}
+
+impl From<Vec2> for TexturePoint {
+    /// A point of a surface without mesh attributes.
+    fn from(uv: Vec2) -> TexturePoint {
+        TexturePoint {
+            uv,
+            attributes: AttributeValues::default(),
+        }
+    }
 }
 
 impl Texture {
@@ -38,43 +64,55 @@ impl Texture {
 
     /// The spectral value at `uv` and the wavelengths `lambda`.
     #[inline]
-    pub fn eval(&self, uv: Vec2, lambda: &SampledWavelengths) -> SampledSpectrum {
+    pub fn eval(
+        &self,
+        at: impl Into<TexturePoint>,
+        lambda: &SampledWavelengths,
+    ) -> SampledSpectrum {
+        let at = at.into();
         match self {
             Texture::Constant(spectrum) => spectrum.sample(lambda),
-            Texture::Bitmap(bitmap) => bitmap.eval(uv, lambda),
-            Texture::Checkerboard(checkerboard) => checkerboard.eval(uv, lambda),
+            Texture::Bitmap(bitmap) => bitmap.eval(at.uv, lambda),
+            Texture::Checkerboard(checkerboard) => checkerboard.eval(&at, lambda),
+            Texture::MeshAttribute(attribute) => attribute.eval(&at.attributes, lambda),
         }
     }
 
     /// The scalar value at `uv` (a constant spectrum's value; a non-constant one's mean over
     /// 360–830 nm).
     #[inline]
-    pub fn eval_1(&self, uv: Vec2) -> f32 {
+    pub fn eval_1(&self, at: impl Into<TexturePoint>) -> f32 {
+        let at = at.into();
         match self {
             Texture::Constant(Spectrum::Constant(v)) => *v,
             Texture::Constant(spectrum) => spectrum.mean(),
-            Texture::Bitmap(bitmap) => bitmap.eval_1(uv),
-            Texture::Checkerboard(checkerboard) => checkerboard.eval_1(uv),
+            Texture::Bitmap(bitmap) => bitmap.eval_1(at.uv),
+            Texture::Checkerboard(checkerboard) => checkerboard.eval_1(&at),
+            Texture::MeshAttribute(attribute) => attribute.eval_1(&at.attributes),
         }
     }
 
     /// The gradient (∂/∂u, ∂/∂v) of [`Self::eval_1`] (for bump mapping); zero where the texture
     /// is piecewise constant.
     #[inline]
-    pub fn eval_1_grad(&self, uv: Vec2) -> Vec2 {
+    pub fn eval_1_grad(&self, at: impl Into<TexturePoint>) -> Vec2 {
         match self {
-            Texture::Bitmap(bitmap) => bitmap.eval_1_grad(uv),
-            Texture::Constant(_) | Texture::Checkerboard(_) => Vec2::ZERO,
+            Texture::Bitmap(bitmap) => bitmap.eval_1_grad(at.into().uv),
+            Texture::Constant(_) | Texture::Checkerboard(_) | Texture::MeshAttribute(_) => {
+                Vec2::ZERO
+            }
         }
     }
 
     /// The raw RGB value at `uv` (normal maps); a constant or checkerboard gives its scalar value
-    /// in all three components.
+    /// in all three components, a mesh attribute the linear sRGB colour of its spectrum.
     #[inline]
-    pub fn eval_3(&self, uv: Vec2) -> Vec3 {
+    pub fn eval_3(&self, at: impl Into<TexturePoint>) -> Vec3 {
+        let at = at.into();
         match self {
-            Texture::Bitmap(bitmap) => bitmap.eval_3(uv),
-            _ => Vec3::splat(self.eval_1(uv)),
+            Texture::Bitmap(bitmap) => bitmap.eval_3(at.uv),
+            Texture::MeshAttribute(attribute) => attribute.eval_3(&at.attributes),
+            _ => Vec3::splat(self.eval_1(at)),
         }
     }
 
@@ -84,6 +122,7 @@ impl Texture {
             Texture::Constant(spectrum) => spectrum.max_value(),
             Texture::Bitmap(bitmap) => bitmap.max_value(),
             Texture::Checkerboard(checkerboard) => checkerboard.max_value(),
+            Texture::MeshAttribute(attribute) => attribute.scale,
         }
     }
 
@@ -94,6 +133,8 @@ impl Texture {
             Texture::Constant(_) => return self.eval_1(Vec2::ZERO),
             Texture::Bitmap(bitmap) => (bitmap.width.max(1), bitmap.height.max(1)),
             Texture::Checkerboard(_) => (256, 256),
+            // No (u, v) map: its bound (the scene reader reads mesh attributes only as colours).
+            Texture::MeshAttribute(attribute) => return attribute.scale,
         };
         let sum: f64 = (0..nx * ny)
             .map(|cell| {
@@ -114,6 +155,7 @@ impl Texture {
             Texture::Constant(spectrum) => spectrum.min_value(),
             Texture::Bitmap(bitmap) => bitmap.min_value(),
             Texture::Checkerboard(checkerboard) => checkerboard.min_value(),
+            Texture::MeshAttribute(_) => 0.0,
         }
     }
 }

@@ -25,7 +25,7 @@ use crate::params::{Params, Warning};
 use crate::registry::{Default, ParamSpec};
 use prism_core::bsdf::Material;
 use prism_core::error::{Error, Result, SourceLocation};
-use prism_core::geometry::{Geometry, Primitive};
+use prism_core::geometry::{Geometry, Primitive, Shape};
 use prism_core::integrator::{Integrator, PathIntegrator};
 use prism_core::scene::Scene;
 use prism_core::world::{ShapeInfo, World};
@@ -122,9 +122,12 @@ fn shape_material(
         if let Some(&index) = material_ids.get(&key) {
             return Ok(index);
         }
+        textures.take_used_slots();
         materials.push(materials::build_material(&bsdf.node, textures)?);
         let index = (materials.len() - 1) as u32;
         material_ids.insert(key, index);
+        let attributes = textures.take_used_slots();
+        textures.set_material_attributes(index, attributes);
         return Ok(index);
     }
     materials.push(if emits {
@@ -165,7 +168,70 @@ fn group_member(
         material_ids,
         textures,
     )?;
+    if let Some((_, name)) = textures.material_attributes(material).first() {
+        let node = member.node();
+        return Err(Error::input(
+            &node.location,
+            format!(
+                "{} in a shapegroup has a BSDF that reads the mesh attribute \"{name}\"; Prism's \
+                 instanced shapes carry no attributes",
+                node.describe()
+            ),
+        )
+        .with_help("place the mesh directly in the scene instead of through an instance"));
+    }
     Ok((material, shape_media(member, media)?))
+}
+
+/// Makes the shape's mesh fill the attribute slots its BSDF's `mesh_attribute` textures read;
+/// a shape without one of those attributes is an error (Mitsuba's "invalid attribute
+/// requested", which it reports while rendering).
+fn bind_mesh_attributes(
+    shape: &mut Primitive,
+    attributes: &[(u8, String)],
+    node: &PluginNode,
+) -> Result<()> {
+    let Some((_, first)) = attributes.first() else {
+        return Ok(());
+    };
+    let Primitive::Shape(Shape::Mesh(mesh)) = shape else {
+        let what = if matches!(shape, Primitive::Instance(_)) {
+            "a moving shape"
+        } else {
+            "a shape that is not a mesh"
+        };
+        return Err(Error::input(
+            &node.location,
+            format!(
+                "{} has no attribute \"{first}\" (Mitsuba: invalid attribute requested): its \
+                 BSDF reads mesh attributes, which {what} does not carry",
+                node.describe()
+            ),
+        )
+        .with_help("give the attribute to a ply or serialized mesh that has it"));
+    };
+    for (slot, name) in attributes {
+        if !mesh.bind_attribute(name, *slot) {
+            let names: Vec<&str> = mesh.attribute_names().collect();
+            let has = if names.is_empty() {
+                "it has none".to_string()
+            } else {
+                format!("it has {}", names.join(", "))
+            };
+            return Err(Error::input(
+                &node.location,
+                format!(
+                    "{} has no attribute \"{name}\" (Mitsuba: invalid attribute requested); \
+                     {has}",
+                    node.describe()
+                ),
+            )
+            .with_help(
+                "use a mesh with per-vertex colours (PLY red green blue, or serialized colours)",
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// Builds the scene described by the root `<scene>` node.
@@ -241,7 +307,7 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
             _ => {}
         }
         let (plugin, shape_params) = shapes::shape_params(&child.node)?;
-        let shape = shapes::build_shape(plugin, &shape_params)?;
+        let mut shape = shapes::build_shape(plugin, &shape_params)?;
         let area = shape.area();
         if !area.is_finite() {
             return Err(Error::input(
@@ -310,6 +376,11 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
             }
             None => None,
         };
+        bind_mesh_attributes(
+            &mut shape,
+            textures.material_attributes(material),
+            &child.node,
+        )?;
         let interface = shape_media(&shape_params, &mut media)?;
         shape_params.finish()?;
         if area == 0.0 {

@@ -1,15 +1,18 @@
-//! Shape plugins: `obj`, `ply`, `serialized`, `rectangle`, `cube`, `sphere` and `disk`, and the
-//! instancing plugins `shapegroup` and `instance` (built by the scene, [`super::instancing`]). Any shape whose
+//! Shape plugins: `obj`, `ply`, `serialized`, `rectangle`, `cube`, `sphere`, `disk` and
+//! `cylinder`, and the instancing plugins `shapegroup` and `instance` (built by the scene,
+//! [`super::instancing`]). Any shape whose
 //! `to_world` is an `<animation>` moves while the shutter is open: it is built in object space
 //! and placed by an [`Instance`].
 
-use glam::{DVec3, Mat3, Vec2, Vec3};
+use glam::{DMat4, DVec3, Mat3, Vec2, Vec3};
 
 use crate::description::{PluginClass, PluginNode};
 use crate::mesh::{MeshData, load_obj, load_ply, load_serialized};
 use crate::params::Params;
 use crate::registry::{Default, Origin, ParamKind, ParamSpec, Plugin, Registry};
 use prism_core::error::{Error, Result};
+use prism_core::geometry::shape::Cylinder;
+use prism_core::geometry::shape::MeshAttribute;
 use prism_core::geometry::{Disk, Instance, Primitive, Shape, Sphere, TriangleMesh};
 use prism_core::math::Transform;
 
@@ -130,6 +133,25 @@ pub static SHAPES: Registry<Build> = Registry {
             },
         },
         Plugin {
+            name: "cylinder",
+            origin: Origin::Mitsuba3,
+            summary: "An open tube (no caps) from `p0` to `p1`; (u, v) = (φ/2π, height along \
+                      the axis, 0 to 1) as in Mitsuba. `to_world` may not make it elliptic or \
+                      shear it.",
+            params: &[
+                P0,
+                P1,
+                CYLINDER_RADIUS,
+                FLIP_NORMALS,
+                TO_WORLD,
+                BSDF,
+                EMITTER,
+                INTERIOR,
+                EXTERIOR,
+            ],
+            build: build_cylinder,
+        },
+        Plugin {
             name: "shapegroup",
             origin: Origin::Mitsuba3,
             summary: "Shapes to be placed by `instance`s, which share their geometry and \
@@ -148,6 +170,25 @@ pub static SHAPES: Registry<Build> = Registry {
         },
     ],
 };
+
+const P0: ParamSpec = ParamSpec::new(
+    "p0",
+    ParamKind::Point,
+    Default::Text("(0, 0, 0)"),
+    "centre of the cylinder's start",
+);
+const P1: ParamSpec = ParamSpec::new(
+    "p1",
+    ParamKind::Point,
+    Default::Text("(0, 0, 1)"),
+    "centre of the cylinder's end",
+);
+const CYLINDER_RADIUS: ParamSpec = ParamSpec::new(
+    "radius",
+    ParamKind::Float,
+    Default::Float(1.0),
+    "radius of the cylinder",
+);
 
 /// The shapes of a `shapegroup`.
 pub const GROUP_SHAPES: ParamSpec = ParamSpec::nested(
@@ -388,6 +429,66 @@ fn build_sphere(params: &Params, to_world: &Transform) -> Result<Shape> {
     }))
 }
 
+/// Mitsuba's `cylinder`: the unit tube of the object frame placed by
+/// to_world · translate(p0) · frame(p1 − p0) · scale(r, r, |p1 − p0|), where frame(d) turns z
+/// into d with Mitsuba's orthonormal basis (Duff et al. 2017, "Building an Orthonormal Basis,
+/// Revisited"), so that φ starts where Mitsuba's does.
+fn build_cylinder(params: &Params, to_world: &Transform) -> Result<Shape> {
+    let flip_normals = params.boolean(&FLIP_NORMALS)?;
+    let p0 = params.point_opt(&P0)?.unwrap_or(DVec3::ZERO);
+    let p1 = params.point_opt(&P1)?.unwrap_or(DVec3::Z);
+    let radius = params.float(&CYLINDER_RADIUS)?;
+    if !(radius > 0.0 && radius.is_finite()) {
+        return Err(Error::input(
+            params.location_of(&CYLINDER_RADIUS),
+            format!("the cylinder's radius must be positive, not {radius}"),
+        ));
+    }
+    let axis = p1 - p0;
+    let length = axis.length();
+    if !(length > 0.0 && length.is_finite()) {
+        return Err(Error::input(
+            &params.node().location,
+            "the cylinder's \"p0\" and \"p1\" are the same point",
+        )
+        .with_help("give the two ends of its axis"));
+    }
+    let n = axis / length;
+    let sign = 1.0f64.copysign(n.z);
+    let a = -1.0 / (sign + n.z);
+    let b = n.x * n.y * a;
+    let s = DVec3::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x);
+    let t = DVec3::new(b, sign + n.y * n.y * a, -n.y);
+    let frame = DMat4::from_cols(
+        (s * radius).extend(0.0),
+        (t * radius).extend(0.0),
+        (n * length).extend(0.0),
+        p0.extend(1.0),
+    );
+    let matrix = to_world.matrix.as_dmat4() * frame;
+    let [x, y, z] = [matrix.x_axis, matrix.y_axis, matrix.z_axis].map(|c| c.truncate());
+    let r = x.length();
+    let tolerance = 1e-5 * r * (r + z.length());
+    let circular = (y.length() - r).abs() <= 1e-5 * r
+        && x.dot(y).abs() <= tolerance
+        && x.dot(z).abs() <= tolerance
+        && y.dot(z).abs() <= tolerance;
+    if !circular {
+        return Err(Error::input(
+            params.location_of(&TO_WORLD),
+            "a cylinder's \"to_world\" may not make it elliptic or shear it",
+        )
+        .with_help("rotate, translate and scale it uniformly (or along its axis only)"));
+    }
+    let transform = Transform::new(matrix).ok_or_else(|| {
+        Error::input(
+            params.location_of(&TO_WORLD),
+            "the cylinder's \"to_world\" is singular",
+        )
+    })?;
+    Ok(Shape::Cylinder(Cylinder::new(transform, flip_normals)))
+}
+
 /// Makes a mesh reading error an input error (the scene names the file) that also says which
 /// scene element loaded the mesh; errors without a place in the mesh file get the element's.
 fn mesh_error(error: Error, node: &PluginNode) -> Error {
@@ -425,7 +526,20 @@ pub fn transform_mesh(
             t.swap(1, 2);
         }
     }
-    TriangleMesh::new(positions, normals, data.uvs, triangles, flip_normals)
+    let mut mesh = TriangleMesh::new(positions, normals, data.uvs, triangles, flip_normals);
+    if let Some(colors) = data.colors {
+        mesh.set_attributes(vec![vertex_color_attribute(colors)]);
+    }
+    mesh
+}
+
+/// Mitsuba's `vertex_color` attribute: the vertices' linear RGB colours.
+fn vertex_color_attribute(colors: Vec<Vec3>) -> MeshAttribute {
+    MeshAttribute {
+        name: "vertex_color".to_string(),
+        per_face: false,
+        values: colors,
+    }
 }
 
 /// Mitsuba's `rectangle`: [−1, 1]² in the z = 0 plane, normal +z, uv from (0, 0) to (1, 1).

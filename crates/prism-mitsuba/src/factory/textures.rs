@@ -1,4 +1,4 @@
-//! Texture plugins (`bitmap`, `checkerboard`, `rawconstant`) and texture-valued parameters: any colour or
+//! Texture plugins (`bitmap`, `checkerboard`, `mesh_attribute`, `rawconstant`) and texture-valued parameters: any colour or
 //! number a BSDF takes may be given as a value (`<rgb>`, `<spectrum>`, `<float>`) or as a nested
 //! `<texture>` (inline or a `<ref name="..." id="..."/>` to a texture declared at the top level).
 //!
@@ -15,12 +15,13 @@ use crate::params::Params;
 use crate::registry::Range;
 use crate::registry::{Bounds, Default, Origin, ParamKind, ParamSpec, Plugin, Registry};
 use prism_core::error::{Error, Result};
+use prism_core::geometry::interaction::MAX_MESH_ATTRIBUTES;
 use prism_core::image::{Bitmap, Encoding, read_bitmap};
 use prism_core::spectrum::{LAMBDA_MAX, LAMBDA_MIN, RgbIntent, Spectrum};
-use prism_core::texture::Texture;
 use prism_core::texture::{
     BitmapTexture, Checkerboard, FilterType, TextureUse, UvTransform, WrapMode,
 };
+use prism_core::texture::{MeshAttributeTexture, Texture};
 
 type Build = fn(&Params, TextureUse, &mut TextureCache) -> Result<Texture>;
 
@@ -47,6 +48,17 @@ pub static TEXTURES: Registry<Build> = Registry {
             build: build_checkerboard,
         },
         Plugin {
+            name: "mesh_attribute",
+            origin: Origin::Mitsuba3,
+            summary: "A colour the shape's mesh carries: `vertex_color` (PLY `red green blue` \
+                      or `r g b`, serialized colours) interpolated barycentrically, then \
+                      upsampled, as Mitsuba 3.9 does, times `scale`. \
+                      Read as a colour only (Mitsuba reads a three-channel attribute as nothing \
+                      else); a shape whose mesh lacks the attribute is an error.",
+            params: &[ATTRIBUTE_NAME, ATTRIBUTE_SCALE],
+            build: build_mesh_attribute,
+        },
+        Plugin {
             name: "rawconstant",
             origin: Origin::Mitsuba3,
             summary: "A constant used as it is, never upsampled: a `<float>` (read as a number, or \
@@ -57,6 +69,19 @@ pub static TEXTURES: Registry<Build> = Registry {
         },
     ],
 };
+
+const ATTRIBUTE_NAME: ParamSpec = ParamSpec::new(
+    "name",
+    ParamKind::String,
+    Default::Required,
+    "the attribute, starting with `vertex_` or `face_`",
+);
+const ATTRIBUTE_SCALE: ParamSpec = ParamSpec::new(
+    "scale",
+    ParamKind::Float,
+    Default::Float(1.0),
+    "a factor applied to the attribute's value",
+);
 
 const FILENAME: ParamSpec = ParamSpec::new(
     "filename",
@@ -131,9 +156,47 @@ const RAW_VALUE: ParamSpec = ParamSpec::new(
 #[derive(Default)]
 pub struct TextureCache {
     built: HashMap<(*const PluginNode, TextureUse), Texture>,
+    /// The mesh attribute names the textures read, by slot.
+    attribute_slots: Vec<String>,
+    /// The slots read by the textures built or fetched since [`Self::take_used_slots`].
+    used_slots: Vec<u8>,
+    /// The mesh attributes (slot, name) each material's textures read, by material index.
+    material_attributes: HashMap<u32, Vec<(u8, String)>>,
 }
 
 impl TextureCache {
+    /// The mesh attribute slots read by the textures built or fetched since the last call, and
+    /// the attribute name of each.
+    pub fn take_used_slots(&mut self) -> Vec<(u8, String)> {
+        let mut slots = std::mem::take(&mut self.used_slots);
+        slots.sort_unstable();
+        slots.dedup();
+        slots
+            .into_iter()
+            .map(|slot| (slot, self.attribute_slots[usize::from(slot)].clone()))
+            .collect()
+    }
+
+    /// Records the mesh attributes that material `index` reads.
+    pub fn set_material_attributes(&mut self, index: u32, attributes: Vec<(u8, String)>) {
+        if !attributes.is_empty() {
+            self.material_attributes.insert(index, attributes);
+        }
+    }
+
+    /// The mesh attributes (slot, name) that material `index` reads; none for most.
+    pub fn material_attributes(&self, index: u32) -> &[(u8, String)] {
+        self.material_attributes
+            .get(&index)
+            .map_or(&[], |attributes| attributes.as_slice())
+    }
+
+    fn note_use(&mut self, texture: &Texture) {
+        if let Texture::MeshAttribute(attribute) = texture {
+            self.used_slots.push(attribute.slot);
+        }
+    }
+
     /// Whether the element has been built for any use.
     pub fn contains(&self, node: &PluginNode) -> bool {
         let key = node as *const PluginNode;
@@ -286,15 +349,75 @@ pub fn build_texture(
     cache: &mut TextureCache,
 ) -> Result<Texture> {
     let key = (node as *const PluginNode, usage);
-    if let Some(texture) = cache.built.get(&key) {
-        return Ok(texture.clone());
+    if let Some(texture) = cache.built.get(&key).cloned() {
+        cache.note_use(&texture);
+        return Ok(texture);
     }
     let plugin = TEXTURES.find(node)?;
     let params = Params::new(node, plugin.params);
     let texture = (plugin.build)(&params, usage, cache)?;
     params.finish()?;
+    cache.note_use(&texture);
     cache.built.insert(key, texture.clone());
     Ok(texture)
+}
+
+/// Mitsuba's `mesh_attribute`: the attribute gets a slot (shared by every texture reading the
+/// same name); the shapes are checked to have it when their BSDFs are built.
+fn build_mesh_attribute(
+    params: &Params,
+    usage: TextureUse,
+    cache: &mut TextureCache,
+) -> Result<Texture> {
+    let name = params.string_opt(&ATTRIBUTE_NAME)?.ok_or_else(|| {
+        Error::input(
+            &params.node().location,
+            "a \"mesh_attribute\" texture needs the \"name\" of the attribute",
+        )
+        .with_help("add <string name=\"name\" value=\"vertex_color\"/>")
+    })?;
+    let location = params.location_of(&ATTRIBUTE_NAME);
+    if !name.starts_with("vertex_") && !name.starts_with("face_") {
+        return Err(Error::input(
+            location,
+            format!(
+                "invalid mesh attribute name \"{name}\": it must start with \"vertex_\" or \
+                 \"face_\""
+            ),
+        )
+        .with_help("Prism's meshes carry \"vertex_color\" (PLY and serialized colours)"));
+    }
+    if usage != TextureUse::Spectral {
+        return Err(Error::input(
+            &params.node().location,
+            format!(
+                "the mesh attribute \"{name}\" is a colour of three channels; Mitsuba reads \
+                 such an attribute only as a colour, not as a number or a normal map"
+            ),
+        )
+        .with_help("use it for a colour parameter such as a reflectance"));
+    }
+    let scale = params.float(&ATTRIBUTE_SCALE)? as f32;
+    let slot = match cache.attribute_slots.iter().position(|n| n == name) {
+        Some(slot) => slot,
+        None if cache.attribute_slots.len() < MAX_MESH_ATTRIBUTES => {
+            cache.attribute_slots.push(name.to_string());
+            cache.attribute_slots.len() - 1
+        }
+        None => {
+            return Err(Error::input(
+                location,
+                format!(
+                    "a scene may read at most {MAX_MESH_ATTRIBUTES} different mesh attributes; \
+                     this is one more"
+                ),
+            ));
+        }
+    };
+    Ok(Texture::MeshAttribute(MeshAttributeTexture {
+        slot: slot as u8,
+        scale,
+    }))
 }
 
 /// A colour `spec` of a texture that an emitter reads: a value as a reflectance (Mitsuba 3

@@ -22,7 +22,10 @@
 //!   coordinates named `u v`, `texture_u texture_v`, `s t` or `texture_s texture_t` (the first
 //!   complete pair, in that order). These must have floating-point types: Mitsuba would rescale
 //!   integers to [0, 1], which is never what a position means. Texture coordinates are not
-//!   flipped (Mitsuba flips only OBJ's). Other properties, colours say, are skipped.
+//!   flipped (Mitsuba flips only OBJ's). Vertex colours `r g b` or `red green blue` become the
+//!   `vertex_color` attribute, read as their values whatever their type: like Mitsuba (which
+//!   warns about it), integer channels are not rescaled, so a `uchar` 0–255 colour reads as
+//!   values above 1, clamped to 1 when upsampled. Other properties are skipped.
 //! - Element `face`: the list `vertex_indices` (or `vertex_index`) of integer indices into the
 //!   vertices; each polygon, of 3 to 65536 vertices, is triangulated as a fan. Other properties
 //!   are skipped.
@@ -337,6 +340,7 @@ enum Attribute {
     Position = 0,
     Normal = 1,
     Uv = 2,
+    Color = 3,
 }
 
 /// How to read one property of a record.
@@ -365,7 +369,11 @@ struct Layout {
     vertex_count: u64,
     has_normals: bool,
     has_uvs: bool,
+    has_colors: bool,
 }
+
+/// Alternative names of the vertex colour channels, in order of preference.
+const COLOR_NAMES: [[&str; 3]; 2] = [["r", "g", "b"], ["red", "green", "blue"]];
 
 /// Alternative names of the texture coordinate pair, in order of preference.
 const UV_NAMES: [[&str; 2]; 4] = [
@@ -430,7 +438,7 @@ impl Layout {
                         ),
                     ));
                 };
-                if ty.is_integer() {
+                if ty.is_integer() && attribute != Attribute::Color {
                     return Err(line_error(
                         path,
                         property.line,
@@ -465,6 +473,14 @@ impl Layout {
             }
         }
 
+        let mut has_colors = false;
+        for names in COLOR_NAMES {
+            if read(Attribute::Color, &names)? {
+                has_colors = true;
+                break;
+            }
+        }
+
         let faces = &header.elements[face_element];
         let (index, property) = faces
             .property("vertex_indices")
@@ -495,6 +511,7 @@ impl Layout {
             vertex_count: vertices.count,
             has_normals,
             has_uvs,
+            has_colors,
         })
     }
 }
@@ -581,7 +598,9 @@ fn read_body(reader: &mut impl BodyReader, header: &Header, layout: &Layout) -> 
             .has_normals
             .then(|| Vec::with_capacity(vertex_capacity)),
         uvs: layout.has_uvs.then(|| Vec::with_capacity(vertex_capacity)),
-        colors: None,
+        colors: layout
+            .has_colors
+            .then(|| Vec::with_capacity(vertex_capacity)),
         triangles: Vec::new(),
     };
     let mut polygon = Vec::new();
@@ -593,7 +612,7 @@ fn read_body(reader: &mut impl BodyReader, header: &Header, layout: &Layout) -> 
             mesh.triangles.reserve(capacity(element.count));
         }
         for _ in 0..element.count {
-            let mut vertex = [[0.0f32; 3]; 3];
+            let mut vertex = [[0.0f32; 3]; 4];
             for field in fields {
                 match *field {
                     Field::Vertex {
@@ -607,6 +626,7 @@ fn read_body(reader: &mut impl BodyReader, header: &Header, layout: &Layout) -> 
                                 Attribute::Position => "vertex coordinate",
                                 Attribute::Normal => "normal",
                                 Attribute::Uv => "texture coordinate",
+                                Attribute::Color => "colour",
                             };
                             return Err(reader.error(format!("{what} is not a finite number")));
                         }
@@ -623,13 +643,16 @@ fn read_body(reader: &mut impl BodyReader, header: &Header, layout: &Layout) -> 
                 }
             }
             if i == layout.vertex_element {
-                let [position, normal, uv] = vertex;
+                let [position, normal, uv, color] = vertex;
                 mesh.positions.push(Vec3::from(position));
                 if let Some(normals) = &mut mesh.normals {
                     normals.push(Vec3::from(normal));
                 }
                 if let Some(uvs) = &mut mesh.uvs {
                     uvs.push(Vec2::new(uv[0], uv[1]));
+                }
+                if let Some(colors) = &mut mesh.colors {
+                    colors.push(Vec3::from(color));
                 }
             }
         }

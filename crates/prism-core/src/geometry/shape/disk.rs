@@ -5,7 +5,7 @@ use std::f32::consts::PI;
 use glam::{Vec2, Vec3};
 
 use super::mesh::SurfaceSample;
-use crate::geometry::interaction::SurfaceInteraction;
+use crate::geometry::interaction::{AttributeValues, SurfaceInteraction};
 use crate::math::{Frame, Transform};
 use crate::sampling::warp::sample_uniform_disk_concentric;
 
@@ -78,6 +78,7 @@ impl Disk {
             shape,
             primitive: 0,
             time: 0.0,
+            attributes: AttributeValues::default(),
         }
     }
 

@@ -5,7 +5,7 @@ use std::sync::OnceLock;
 use glam::{Vec2, Vec3};
 
 use super::uv_grid::UvGrid;
-use crate::geometry::interaction::SurfaceInteraction;
+use crate::geometry::interaction::{AttributeValues, MAX_MESH_ATTRIBUTES, SurfaceInteraction};
 use crate::geometry::triangle::TriangleHit;
 use crate::math::Frame;
 use crate::sampling::distribution::AliasTable;
@@ -33,6 +33,21 @@ pub struct TriangleMesh {
     /// emission is textured make one).
     uv_grid: OnceLock<UvGrid>,
     area: f32,
+    /// The attributes the mesh carries (Mitsuba's `vertex_color`, `face_color`, ...).
+    attributes: Vec<MeshAttribute>,
+    /// By slot, 1 + the index into `attributes` of the attribute the scene's textures read in
+    /// that slot (0: none).
+    bound: [u8; MAX_MESH_ATTRIBUTES],
+}
+
+/// Values a mesh carries per vertex or per triangle, under a Mitsuba attribute name
+/// (`vertex_...` or `face_...`); a colour is linear RGB.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MeshAttribute {
+    pub name: String,
+    /// One value per triangle (else one per vertex).
+    pub per_face: bool,
+    pub values: Vec<Vec3>,
 }
 
 /// A point drawn on a surface.
@@ -84,6 +99,8 @@ impl TriangleMesh {
             area_table: OnceLock::new(),
             uv_grid: OnceLock::new(),
             area: 0.0,
+            attributes: Vec::new(),
+            bound: [0; MAX_MESH_ATTRIBUTES],
         };
         mesh.area = mesh.triangle_areas().iter().sum::<f64>() as f32;
         mesh.positions.shrink_to_fit();
@@ -92,6 +109,59 @@ impl TriangleMesh {
             .map(|i| mesh.computed_face_normal(i))
             .collect();
         mesh
+    }
+
+    /// Gives the mesh its attributes; each has one value per vertex, or per triangle when
+    /// `per_face` (the mesh readers validate the counts).
+    pub fn set_attributes(&mut self, attributes: Vec<MeshAttribute>) {
+        debug_assert!(attributes.iter().all(|a| {
+            a.values.len()
+                == if a.per_face {
+                    self.triangles.len()
+                } else {
+                    self.positions.len()
+                }
+        }));
+        self.attributes = attributes;
+        self.bound = [0; MAX_MESH_ATTRIBUTES];
+    }
+
+    /// The names of the mesh's attributes.
+    pub fn attribute_names(&self) -> impl Iterator<Item = &str> {
+        self.attributes.iter().map(|a| a.name.as_str())
+    }
+
+    /// Makes every hit fill `slot` with the attribute `name`; false when the mesh has none of
+    /// that name.
+    pub fn bind_attribute(&mut self, name: &str, slot: u8) -> bool {
+        let Some(index) = self.attributes.iter().position(|a| a.name == name) else {
+            return false;
+        };
+        self.bound[usize::from(slot)] = index as u8 + 1;
+        true
+    }
+
+    /// The bound attributes at barycentrics `b` of `triangle`: a vertex attribute interpolated,
+    /// a face attribute as it is.
+    #[inline]
+    fn attributes_at(&self, triangle: usize, b: [f32; 3]) -> AttributeValues {
+        let mut values = AttributeValues::default();
+        if self.attributes.is_empty() {
+            return values;
+        }
+        for (slot, &bound) in self.bound.iter().enumerate() {
+            let Some(index) = usize::from(bound).checked_sub(1) else {
+                continue;
+            };
+            let attribute = &self.attributes[index];
+            values.0[slot] = if attribute.per_face {
+                attribute.values[triangle]
+            } else {
+                let [i, j, k] = self.triangles[triangle].map(|v| v as usize);
+                attribute.values[i] * b[0] + attribute.values[j] * b[1] + attribute.values[k] * b[2]
+            };
+        }
+        values
     }
 
     pub fn positions(&self) -> &[Vec3] {
@@ -142,6 +212,11 @@ impl TriangleMesh {
                 .map_or(0, |uv| uv.capacity() * size_of::<Vec2>())
             + self.triangles.capacity() * size_of::<[u32; 3]>()
             + self.face_normals.capacity() * size_of::<Vec3>()
+            + self
+                .attributes
+                .iter()
+                .map(|a| a.values.capacity() * size_of::<Vec3>())
+                .sum::<usize>()
             + self
                 .area_table
                 .get()
@@ -226,6 +301,7 @@ impl TriangleMesh {
             shape,
             primitive: triangle as u32,
             time: 0.0,
+            attributes: self.attributes_at(triangle, b),
         }
     }
 

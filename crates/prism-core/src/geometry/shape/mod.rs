@@ -1,8 +1,9 @@
-//! The shapes a scene is made of: triangle meshes, spheres and disks, in world space (or in the
+//! The shapes a scene is made of: triangle meshes, spheres, disks and cylinders, in world space (or in the
 //! object space of an [`super::instance::Instance`]), dispatched by `match` (DESIGN.md §3.1).
 //! Shapes know their own intersection, surface points and sampling; the hierarchies over them
 //! ([`super::aggregate`]) and the shapes placed by transforms ([`super::primitive`]) sit above.
 
+pub mod cylinder;
 pub mod disk;
 pub mod mesh;
 pub mod sphere;
@@ -10,8 +11,9 @@ pub mod uv_grid;
 
 use glam::{Vec2, Vec3};
 
+pub use cylinder::Cylinder;
 pub use disk::Disk;
-pub use mesh::{SurfaceSample, TriangleMesh};
+pub use mesh::{MeshAttribute, SurfaceSample, TriangleMesh};
 pub use sphere::{Sphere, area_to_solid_angle};
 
 use crate::geometry::interaction::SurfaceInteraction;
@@ -24,6 +26,7 @@ pub enum Shape {
     Mesh(TriangleMesh),
     Sphere(Sphere),
     Disk(Disk),
+    Cylinder(Cylinder),
 }
 
 impl Shape {
@@ -32,6 +35,7 @@ impl Shape {
             Shape::Mesh(mesh) => mesh.area(),
             Shape::Sphere(sphere) => sphere.area(),
             Shape::Disk(disk) => disk.area(),
+            Shape::Cylinder(cylinder) => cylinder.area(),
         }
     }
 
@@ -50,6 +54,17 @@ impl Shape {
                     (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
                     |(lo, hi), p| (lo.min(p), hi.max(p)),
                 ),
+            Shape::Cylinder(cylinder) => (0..8)
+                .map(|corner| {
+                    let bit = |b: u32| if corner & (1 << b) != 0 { 1.0 } else { 0.0 };
+                    let x = 2.0 * bit(0) - 1.0;
+                    let y = 2.0 * bit(1) - 1.0;
+                    cylinder.to_world.point(Vec3::new(x, y, bit(2)))
+                })
+                .fold(
+                    (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+                    |(lo, hi), p| (lo.min(p), hi.max(p)),
+                ),
         }
     }
 
@@ -59,6 +74,7 @@ impl Shape {
         match self {
             Shape::Sphere(sphere) => sphere.intersect(ray.o, ray.d, t_max),
             Shape::Disk(disk) => disk.intersect(ray.o, ray.d, t_max),
+            Shape::Cylinder(cylinder) => cylinder.intersect(ray.o, ray.d, t_max),
             Shape::Mesh(_) => None,
         }
     }
@@ -78,6 +94,7 @@ impl Shape {
             Shape::Mesh(mesh) => mesh.interaction(primitive as usize, hit, index),
             Shape::Sphere(sphere) => sphere.interaction(ray.o, ray.d, hit.t, index),
             Shape::Disk(disk) => disk.interaction(ray.o, ray.d, hit.t, index),
+            Shape::Cylinder(cylinder) => cylinder.interaction(ray.o, ray.d, hit.t, index),
         }
     }
 
@@ -88,6 +105,7 @@ impl Shape {
             Shape::Mesh(mesh) => mesh.sample_area(u_choice, u),
             Shape::Sphere(sphere) => Some(sphere.sample_area(u)),
             Shape::Disk(disk) => Some(disk.sample_area(u)),
+            Shape::Cylinder(cylinder) => Some(cylinder.sample_area(u)),
         }
     }
 
@@ -96,7 +114,7 @@ impl Shape {
     pub fn sample_from(&self, reference: Vec3, u_choice: f32, u: Vec2) -> Option<SurfaceSample> {
         match self {
             Shape::Sphere(sphere) => sphere.sample_from(reference, u),
-            Shape::Mesh(_) | Shape::Disk(_) => {
+            Shape::Mesh(_) | Shape::Disk(_) | Shape::Cylinder(_) => {
                 let s = self.sample_area(u_choice, u)?;
                 let pdf = area_to_solid_angle(s.pdf, reference, s.p, s.n)?;
                 Some(SurfaceSample { pdf, ..s })
@@ -109,7 +127,7 @@ impl Shape {
     pub fn pdf_from(&self, reference: Vec3, p: Vec3, n: Vec3) -> f32 {
         match self {
             Shape::Sphere(sphere) => sphere.pdf_from(reference, p, n),
-            Shape::Mesh(_) | Shape::Disk(_) => {
+            Shape::Mesh(_) | Shape::Disk(_) | Shape::Cylinder(_) => {
                 area_to_solid_angle(1.0 / self.area(), reference, p, n).unwrap_or(0.0)
             }
         }
@@ -124,6 +142,7 @@ impl Shape {
             Shape::Mesh(mesh) => mesh.at_uv(uv),
             Shape::Sphere(sphere) => sphere.at_uv(uv),
             Shape::Disk(disk) => disk.at_uv(uv),
+            Shape::Cylinder(cylinder) => cylinder.at_uv(uv),
         }
     }
 
@@ -140,6 +159,7 @@ impl Shape {
             }
             Shape::Sphere(sphere) => sphere.at_uv(uv).map(|(_, j)| j),
             Shape::Disk(disk) => disk.at_uv(uv).map(|(_, j)| j),
+            Shape::Cylinder(cylinder) => cylinder.at_uv(uv).map(|(_, j)| j),
         }
     }
 
@@ -147,7 +167,7 @@ impl Shape {
     pub fn heap_bytes(&self) -> usize {
         match self {
             Shape::Mesh(mesh) => mesh.heap_bytes(),
-            Shape::Sphere(_) | Shape::Disk(_) => 0,
+            Shape::Sphere(_) | Shape::Disk(_) | Shape::Cylinder(_) => 0,
         }
     }
 }

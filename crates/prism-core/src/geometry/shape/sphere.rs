@@ -5,7 +5,7 @@ use std::f32::consts::PI;
 use glam::{DVec3, Mat3, Vec2, Vec3};
 
 use super::mesh::SurfaceSample;
-use crate::geometry::interaction::SurfaceInteraction;
+use crate::geometry::interaction::{AttributeValues, SurfaceInteraction};
 use crate::math::Frame;
 use crate::sampling::warp::sample_uniform_sphere;
 
@@ -79,6 +79,7 @@ impl Sphere {
             shape,
             primitive: 0,
             time: 0.0,
+            attributes: AttributeValues::default(),
         }
     }
 
