@@ -9,6 +9,13 @@ use std::f32::consts::PI;
 use glam::{Vec2, Vec3};
 
 use crate::spectrum::{SampledSpectrum, SampledWavelengths, cie::cie_y};
+use crate::texture::{Texture, TexturePoint};
+
+/// An optional parameter's value at a point (absent: the lobe it scales is off).
+#[inline]
+pub fn optional_value(texture: &Option<Texture>, at: TexturePoint) -> Option<f32> {
+    texture.as_ref().map(|t| t.eval_1(at))
+}
 
 /// Schlick's weight (1 − cos θ)⁵ (Schlick 1994), with 1 − cos θ clamped to [0, 1].
 #[inline]

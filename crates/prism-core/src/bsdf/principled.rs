@@ -47,7 +47,7 @@ use std::f32::consts::FRAC_1_PI;
 use glam::{Vec2, Vec3};
 
 use super::burley::{
-    Gtr1, clearcoat_alpha, schlick_fresnel, schlick_r0, schlick_weight, smith_ggx1,
+    Gtr1, clearcoat_alpha, optional_value, schlick_fresnel, schlick_r0, schlick_weight, smith_ggx1,
     specular_alphas, tint, tint_luminance,
 };
 use super::fresnel::{fresnel_dielectric, reflect, refract};
@@ -85,10 +85,6 @@ pub struct Principled {
     pub rates: SamplingRates,
 }
 
-fn optional_1(texture: &Option<Texture>, uv: Vec2) -> Option<f32> {
-    texture.as_ref().map(|t| t.eval_1(uv))
-}
-
 impl BsdfModel for Principled {
     fn flags(&self) -> BsdfFlags {
         let reflection = BsdfFlags::DIFFUSE
@@ -116,7 +112,7 @@ impl BsdfModel for Principled {
         _wo: Vec3,
         lambda: &SampledWavelengths,
     ) -> SampledSpectrum {
-        self.base_color.eval(point.uv, lambda)
+        self.base_color.eval(point.at(), lambda)
     }
 
     #[inline]
@@ -127,35 +123,35 @@ impl BsdfModel for Principled {
         lambda: &SampledWavelengths,
         tree: &mut BxdfTree<'a>,
     ) -> NodeId {
-        let uv = point.uv;
-        let base_color = self.base_color.eval(uv, lambda);
-        let roughness = self.roughness.eval_1(uv);
-        let (alpha_u, alpha_v) = specular_alphas(roughness, optional_1(&self.anisotropic, uv));
-        let spec_tint = optional_1(&self.spec_tint, uv);
-        let sheen_tint = optional_1(&self.sheen_tint, uv);
+        let at = point.at();
+        let base_color = self.base_color.eval(at, lambda);
+        let roughness = self.roughness.eval_1(at);
+        let (alpha_u, alpha_v) = specular_alphas(roughness, optional_value(&self.anisotropic, at));
+        let spec_tint = optional_value(&self.spec_tint, at);
+        let sheen_tint = optional_value(&self.sheen_tint, at);
         let luminance = if spec_tint.is_some() || sheen_tint.is_some() {
             tint_luminance(&base_color, lambda)
         } else {
             1.0
         };
-        let clearcoat = optional_1(&self.clearcoat, uv);
+        let clearcoat = optional_value(&self.clearcoat, at);
         tree.push(PrincipledLobes {
             distribution: Microfacet::new(MicrofacetKind::Ggx, alpha_u, alpha_v),
             base_color,
             tint: tint(&base_color, luminance),
             eta: self.eta,
             roughness,
-            metallic: optional_1(&self.metallic, uv),
-            spec_trans: optional_1(&self.spec_trans, uv),
+            metallic: optional_value(&self.metallic, at),
+            spec_trans: optional_value(&self.spec_trans, at),
             spec_tint,
-            sheen: optional_1(&self.sheen, uv),
+            sheen: optional_value(&self.sheen, at),
             sheen_tint,
-            flatness: optional_1(&self.flatness, uv),
+            flatness: optional_value(&self.flatness, at),
             clearcoat: clearcoat.map(|c| {
                 (
                     c,
                     Gtr1 {
-                        alpha: clearcoat_alpha(self.clearcoat_gloss.eval_1(uv)),
+                        alpha: clearcoat_alpha(self.clearcoat_gloss.eval_1(at)),
                     },
                 )
             }),

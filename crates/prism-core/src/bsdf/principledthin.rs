@@ -35,7 +35,8 @@ use std::f32::consts::FRAC_1_PI;
 use glam::{Vec2, Vec3};
 
 use super::burley::{
-    schlick_fresnel, schlick_r0, schlick_weight, specular_alphas, tint, tint_luminance,
+    optional_value, schlick_fresnel, schlick_r0, schlick_weight, specular_alphas, tint,
+    tint_luminance,
 };
 use super::fresnel::{fresnel_dielectric, reflect};
 use super::microfacet::{Microfacet, MicrofacetKind};
@@ -71,10 +72,6 @@ pub struct PrincipledThin {
     pub rates: ThinSamplingRates,
 }
 
-fn optional_1(texture: &Option<Texture>, uv: Vec2) -> Option<f32> {
-    texture.as_ref().map(|t| t.eval_1(uv))
-}
-
 impl BsdfModel for PrincipledThin {
     /// Always transmitting, as Mitsuba declares it (so it cannot be nested in `twosided`).
     fn flags(&self) -> BsdfFlags {
@@ -99,7 +96,7 @@ impl BsdfModel for PrincipledThin {
         _wo: Vec3,
         lambda: &SampledWavelengths,
     ) -> SampledSpectrum {
-        self.base_color.eval(point.uv, lambda)
+        self.base_color.eval(point.at(), lambda)
     }
 
     #[inline]
@@ -110,15 +107,15 @@ impl BsdfModel for PrincipledThin {
         lambda: &SampledWavelengths,
         tree: &mut BxdfTree<'a>,
     ) -> NodeId {
-        let uv = point.uv;
-        let base_color = self.base_color.eval(uv, lambda);
-        let roughness = self.roughness.eval_1(uv);
-        let anisotropic = optional_1(&self.anisotropic, uv);
-        let eta = self.eta.eval_1(uv);
+        let at = point.at();
+        let base_color = self.base_color.eval(at, lambda);
+        let roughness = self.roughness.eval_1(at);
+        let anisotropic = optional_value(&self.anisotropic, at);
+        let eta = self.eta.eval_1(at);
         let (alpha_u, alpha_v) = specular_alphas(roughness, anisotropic);
         let (scaled_u, scaled_v) = specular_alphas((0.65 * eta - 0.35) * roughness, anisotropic);
-        let spec_tint = optional_1(&self.spec_tint, uv);
-        let sheen_tint = optional_1(&self.sheen_tint, uv);
+        let spec_tint = optional_value(&self.spec_tint, at);
+        let sheen_tint = optional_value(&self.sheen_tint, at);
         let luminance = if spec_tint.is_some() || sheen_tint.is_some() {
             tint_luminance(&base_color, lambda)
         } else {
@@ -131,12 +128,12 @@ impl BsdfModel for PrincipledThin {
             tint: tint(&base_color, luminance),
             eta,
             roughness,
-            spec_trans: optional_1(&self.spec_trans, uv),
+            spec_trans: optional_value(&self.spec_trans, at),
             spec_tint,
-            sheen: optional_1(&self.sheen, uv),
+            sheen: optional_value(&self.sheen, at),
             sheen_tint,
-            flatness: optional_1(&self.flatness, uv),
-            diff_trans: optional_1(&self.diff_trans, uv).map(|t| 0.5 * t),
+            flatness: optional_value(&self.flatness, at),
+            diff_trans: optional_value(&self.diff_trans, at).map(|t| 0.5 * t),
             rates: self.rates,
         })
     }
