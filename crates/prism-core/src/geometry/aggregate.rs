@@ -33,6 +33,20 @@ pub trait AggregateElement {
     fn interaction(&self, ray: &Ray, hit: &Hit) -> Option<SurfaceInteraction>;
     /// Bytes of heap memory the element holds.
     fn heap_bytes(&self) -> usize;
+    /// The number of parts (curve segments) of an element that enters the hierarchy part by
+    /// part, each intersected by [`Self::intersect_part`]; None for other elements.
+    fn part_count(&self) -> Option<usize> {
+        None
+    }
+    /// The bounds of part `part` of an element made of parts.
+    fn part_bounds(&self, _part: u32) -> (Vec3, Vec3) {
+        self.bounds()
+    }
+    /// Distance to the nearest hit in (0, t_max) on part `part` (0 for an element intersected
+    /// as a whole).
+    fn intersect_part(&self, ray: &Ray, _part: u32, t_max: f32) -> Option<f32> {
+        self.intersect_whole(ray, t_max)
+    }
 }
 
 /// Ray queries answered by a structure other than our BVH, over the same elements.
@@ -93,6 +107,17 @@ impl<P: AggregateElement> Aggregate<P> {
                         });
                     }
                     next_id += mesh.triangles().len() as u64;
+                }
+                None if element.part_count().is_some() => {
+                    let parts = element.part_count().unwrap_or(0);
+                    for i in 0..parts {
+                        let (lo, hi) = element.part_bounds(i as u32);
+                        build.push(BuildPrimitive {
+                            id: (next_id + i as u64) as u32,
+                            kind: PrimitiveKind::Analytic { lo, hi },
+                        });
+                    }
+                    next_id += parts as u64;
                 }
                 None => {
                     let (lo, hi) = element.bounds();
@@ -160,11 +185,12 @@ impl<P: AggregateElement> Aggregate<P> {
         self.bvh.as_ref().map(Bvh::bounds)
     }
 
-    /// Intersects the element of primitive `id` as a whole in (0, t_max).
+    /// Intersects primitive `id` (an element intersected as a whole, or one part of an
+    /// element) in (0, t_max).
     #[inline]
     fn whole_hit(&self, ray: &Ray, id: u32, t_max: f32) -> Option<f32> {
-        let (element, _) = self.element_of(id);
-        self.primitives[element as usize].intersect_whole(ray, t_max)
+        let (element, part) = self.element_of(id);
+        self.primitives[element as usize].intersect_part(ray, part, t_max)
     }
 
     /// The closest hit in (0, t_max), found by the structure answering the queries.
@@ -240,5 +266,18 @@ impl AggregateElement for Shape {
 
     fn heap_bytes(&self) -> usize {
         Shape::heap_bytes(self)
+    }
+
+    fn part_count(&self) -> Option<usize> {
+        Shape::part_count(self)
+    }
+
+    fn part_bounds(&self, part: u32) -> (Vec3, Vec3) {
+        Shape::part_bounds(self, part)
+    }
+
+    #[inline]
+    fn intersect_part(&self, ray: &Ray, part: u32, t_max: f32) -> Option<f32> {
+        Shape::intersect_part(self, ray, part, t_max)
     }
 }

@@ -95,6 +95,28 @@ impl AggregateElement for Primitive {
         }
     }
 
+    fn part_count(&self) -> Option<usize> {
+        match self {
+            Primitive::Shape(shape) => shape.part_count(),
+            Primitive::Instance(_) => None,
+        }
+    }
+
+    fn part_bounds(&self, part: u32) -> (Vec3, Vec3) {
+        match self {
+            Primitive::Shape(shape) => shape.part_bounds(part),
+            Primitive::Instance(instance) => instance.swept_bounds,
+        }
+    }
+
+    #[inline]
+    fn intersect_part(&self, ray: &Ray, part: u32, t_max: f32) -> Option<f32> {
+        match self {
+            Primitive::Shape(shape) => shape.intersect_part(ray, part, t_max),
+            Primitive::Instance(instance) => instance.intersect(ray, t_max),
+        }
+    }
+
     fn heap_bytes(&self) -> usize {
         match self {
             Primitive::Shape(shape) => shape.heap_bytes(),

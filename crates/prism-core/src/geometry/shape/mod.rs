@@ -1,10 +1,11 @@
-//! The shapes a scene is made of: triangle meshes, spheres, disks and cylinders, in world space (or in the
+//! The shapes a scene is made of: triangle meshes, spheres, disks, cylinders and linear curves, in world space (or in the
 //! object space of an [`super::instance::Instance`]), dispatched by `match` (DESIGN.md §3.1).
 //! Shapes know their own intersection, surface points and sampling; the hierarchies over them
 //! ([`super::aggregate`]) and the shapes placed by transforms ([`super::primitive`]) sit above.
 
 pub mod cylinder;
 pub mod disk;
+pub mod linear_curve;
 pub mod mesh;
 pub mod sphere;
 pub mod uv_grid;
@@ -13,6 +14,7 @@ use glam::{Vec2, Vec3};
 
 pub use cylinder::Cylinder;
 pub use disk::Disk;
+pub use linear_curve::LinearCurve;
 pub use mesh::{MeshAttribute, SurfaceSample, TriangleMesh};
 pub use sphere::{Sphere, area_to_solid_angle};
 
@@ -27,6 +29,8 @@ pub enum Shape {
     Sphere(Sphere),
     Disk(Disk),
     Cylinder(Cylinder),
+    /// Round linear curves; each segment is one primitive of the hierarchy.
+    LinearCurve(LinearCurve),
 }
 
 impl Shape {
@@ -36,6 +40,8 @@ impl Shape {
             Shape::Sphere(sphere) => sphere.area(),
             Shape::Disk(disk) => disk.area(),
             Shape::Cylinder(cylinder) => cylinder.area(),
+            // Mitsuba gives curves no area or sampling: they cannot be area lights.
+            Shape::LinearCurve(_) => 0.0,
         }
     }
 
@@ -65,6 +71,35 @@ impl Shape {
                     (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
                     |(lo, hi), p| (lo.min(p), hi.max(p)),
                 ),
+            Shape::LinearCurve(curve) => curve.bounds(),
+        }
+    }
+
+    /// The number of primitives a shape made of parts (curve segments) puts in the hierarchy,
+    /// each intersected by [`Self::intersect_part`]; None for other shapes.
+    pub fn part_count(&self) -> Option<usize> {
+        match self {
+            Shape::LinearCurve(curve) => Some(curve.segment_count()),
+            _ => None,
+        }
+    }
+
+    /// The bounds of part `part` of a shape made of parts; the whole shape's bounds otherwise.
+    pub fn part_bounds(&self, part: u32) -> (Vec3, Vec3) {
+        match self {
+            Shape::LinearCurve(curve) => curve.segment_bounds(part as usize),
+            _ => self.object_bounds(),
+        }
+    }
+
+    /// Distance to the nearest hit in (0, t_max) on part `part` of a shape made of parts; the
+    /// same as [`Self::intersect_analytic`] for other shapes.
+    pub fn intersect_part(&self, ray: &Ray, part: u32, t_max: f32) -> Option<f32> {
+        match self {
+            Shape::LinearCurve(curve) => curve
+                .intersect_segment(part as usize, ray.o, ray.d, t_max)
+                .map(|hit| hit.t),
+            _ => self.intersect_analytic(ray, t_max),
         }
     }
 
@@ -75,6 +110,7 @@ impl Shape {
             Shape::Sphere(sphere) => sphere.intersect(ray.o, ray.d, t_max),
             Shape::Disk(disk) => disk.intersect(ray.o, ray.d, t_max),
             Shape::Cylinder(cylinder) => cylinder.intersect(ray.o, ray.d, t_max),
+            Shape::LinearCurve(curve) => curve.intersect(ray.o, ray.d, t_max).map(|(_, h)| h.t),
             Shape::Mesh(_) => None,
         }
     }
@@ -95,6 +131,7 @@ impl Shape {
             Shape::Sphere(sphere) => sphere.interaction(ray.o, ray.d, hit.t, index),
             Shape::Disk(disk) => disk.interaction(ray.o, ray.d, hit.t, index),
             Shape::Cylinder(cylinder) => cylinder.interaction(ray.o, ray.d, hit.t, index),
+            Shape::LinearCurve(curve) => curve.interaction(ray.o, ray.d, hit.t, primitive, index),
         }
     }
 
@@ -106,6 +143,7 @@ impl Shape {
             Shape::Sphere(sphere) => Some(sphere.sample_area(u)),
             Shape::Disk(disk) => Some(disk.sample_area(u)),
             Shape::Cylinder(cylinder) => Some(cylinder.sample_area(u)),
+            Shape::LinearCurve(_) => None,
         }
     }
 
@@ -114,7 +152,7 @@ impl Shape {
     pub fn sample_from(&self, reference: Vec3, u_choice: f32, u: Vec2) -> Option<SurfaceSample> {
         match self {
             Shape::Sphere(sphere) => sphere.sample_from(reference, u),
-            Shape::Mesh(_) | Shape::Disk(_) | Shape::Cylinder(_) => {
+            Shape::Mesh(_) | Shape::Disk(_) | Shape::Cylinder(_) | Shape::LinearCurve(_) => {
                 let s = self.sample_area(u_choice, u)?;
                 let pdf = area_to_solid_angle(s.pdf, reference, s.p, s.n)?;
                 Some(SurfaceSample { pdf, ..s })
@@ -127,6 +165,7 @@ impl Shape {
     pub fn pdf_from(&self, reference: Vec3, p: Vec3, n: Vec3) -> f32 {
         match self {
             Shape::Sphere(sphere) => sphere.pdf_from(reference, p, n),
+            Shape::LinearCurve(_) => 0.0,
             Shape::Mesh(_) | Shape::Disk(_) | Shape::Cylinder(_) => {
                 area_to_solid_angle(1.0 / self.area(), reference, p, n).unwrap_or(0.0)
             }
@@ -143,6 +182,7 @@ impl Shape {
             Shape::Sphere(sphere) => sphere.at_uv(uv),
             Shape::Disk(disk) => disk.at_uv(uv),
             Shape::Cylinder(cylinder) => cylinder.at_uv(uv),
+            Shape::LinearCurve(_) => None,
         }
     }
 
@@ -160,6 +200,7 @@ impl Shape {
             Shape::Sphere(sphere) => sphere.at_uv(uv).map(|(_, j)| j),
             Shape::Disk(disk) => disk.at_uv(uv).map(|(_, j)| j),
             Shape::Cylinder(cylinder) => cylinder.at_uv(uv).map(|(_, j)| j),
+            Shape::LinearCurve(_) => None,
         }
     }
 
@@ -167,6 +208,7 @@ impl Shape {
     pub fn heap_bytes(&self) -> usize {
         match self {
             Shape::Mesh(mesh) => mesh.heap_bytes(),
+            Shape::LinearCurve(curve) => curve.heap_bytes(),
             Shape::Sphere(_) | Shape::Disk(_) | Shape::Cylinder(_) => 0,
         }
     }
