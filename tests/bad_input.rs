@@ -629,6 +629,37 @@ fn cases() -> Vec<Case> {
             location: "",
             says: "missing.state",
         },
+        // Linear curves.
+        Case {
+            name: "linearcurve: a malformed control point",
+            files: Box::leak(Box::new([
+                (
+                    "scene.xml",
+                    scene!(
+                        "    <shape type=\"linearcurve\"><string name=\"filename\" value=\"c.txt\"/></shape>"
+                    ),
+                ),
+                ("c.txt", "0 0 0 0.1\n1 0 z 0.1\n"),
+            ])),
+            arguments: RENDER,
+            location: "c.txt:2:5",
+            says: "not a finite number",
+        },
+        Case {
+            name: "linearcurve: an area emitter",
+            files: Box::leak(Box::new([
+                (
+                    "scene.xml",
+                    scene!(
+                        "    <shape type=\"linearcurve\"><string name=\"filename\" value=\"c.txt\"/><emitter type=\"area\"/></shape>"
+                    ),
+                ),
+                ("c.txt", "0 0 0 0.1\n1 0 0 0.1\n"),
+            ])),
+            arguments: RENDER,
+            location: "scene.xml:3:",
+            says: "curves have no area sampling",
+        },
         // Cylinders.
         render_scene(
             "cylinder: p0 and p1 the same point",

@@ -321,6 +321,19 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
         }
         let shape_index = shapes.len() as u32;
         let emitter = shape_params.single_child(&shapes::EMITTER)?;
+        // Curves are hit but have no area sampling in Mitsuba, which refuses to make them
+        // emit; so does Prism.
+        let curve = shapes::is_curve(plugin);
+        if curve && let Some(emitter) = &emitter {
+            return Err(Error::input(
+                &emitter.location,
+                format!(
+                    "{} cannot emit: curves have no area sampling (as in Mitsuba 3)",
+                    child.node.describe()
+                ),
+            )
+            .with_help("remove the emitter, or light the curves with another shape"));
+        }
         // A shape of zero area is never hit, so it contributes nothing; like Mitsuba, Prism
         // reads it (its BSDF included) and renders without it, but an emitter needs an area
         // to send its power from (Mitsuba refuses it too).
@@ -383,7 +396,7 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
         )?;
         let interface = shape_media(&shape_params, &mut media)?;
         shape_params.finish()?;
-        if area == 0.0 {
+        if area == 0.0 && !curve {
             continue;
         }
         shapes.push(shape);

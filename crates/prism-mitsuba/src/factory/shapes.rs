@@ -1,5 +1,5 @@
-//! Shape plugins: `obj`, `ply`, `serialized`, `rectangle`, `cube`, `sphere`, `disk` and
-//! `cylinder`, and the instancing plugins `shapegroup` and `instance` (built by the scene,
+//! Shape plugins: `obj`, `ply`, `serialized`, `rectangle`, `cube`, `sphere`, `disk`,
+//! `cylinder` and `linearcurve`, and the instancing plugins `shapegroup` and `instance` (built by the scene,
 //! [`super::instancing`]). Any shape whose
 //! `to_world` is an `<animation>` moves while the shutter is open: it is built in object space
 //! and placed by an [`Instance`].
@@ -7,12 +7,13 @@
 use glam::{DMat4, DVec3, Mat3, Vec2, Vec3};
 
 use crate::description::{PluginClass, PluginNode};
+use crate::mesh::curves::load_curves;
 use crate::mesh::{MeshData, load_obj, load_ply, load_serialized};
 use crate::params::Params;
 use crate::registry::{Default, Origin, ParamKind, ParamSpec, Plugin, Registry};
 use prism_core::error::{Error, Result};
-use prism_core::geometry::shape::Cylinder;
 use prism_core::geometry::shape::MeshAttribute;
+use prism_core::geometry::shape::{Cylinder, LinearCurve};
 use prism_core::geometry::{Disk, Instance, Primitive, Shape, Sphere, TriangleMesh};
 use prism_core::math::Transform;
 
@@ -152,6 +153,17 @@ pub static SHAPES: Registry<Build> = Registry {
             build: build_cylinder,
         },
         Plugin {
+            name: "linearcurve",
+            origin: Origin::Mitsuba3,
+            summary: "Round linear curves from a text file of control points `x y z radius` (a \
+                      blank line between curves): each segment the sweep of a sphere of \
+                      linearly varying radius, joints and ends round. `to_world` moves the \
+                      points, not the radii (as in Mitsuba); back faces are culled; no area \
+                      emitter (Mitsuba gives curves no area sampling).",
+            params: &[CURVE_FILENAME, TO_WORLD, BSDF, EMITTER, INTERIOR, EXTERIOR],
+            build: build_linear_curve,
+        },
+        Plugin {
             name: "shapegroup",
             origin: Origin::Mitsuba3,
             summary: "Shapes to be placed by `instance`s, which share their geometry and \
@@ -229,6 +241,12 @@ const FILENAME: ParamSpec = ParamSpec::new(
     Default::Required,
     "the mesh file",
 );
+const CURVE_FILENAME: ParamSpec = ParamSpec::new(
+    "filename",
+    ParamKind::String,
+    Default::Required,
+    "the curve file",
+);
 const SHAPE_INDEX: ParamSpec = ParamSpec::new(
     "shape_index",
     ParamKind::Integer,
@@ -296,6 +314,11 @@ const RADIUS: ParamSpec = ParamSpec::new(
     Default::Float(1.0),
     "radius of the sphere",
 );
+
+/// Whether `plugin` makes curves: shapes that are hit but have no area (nor area sampling).
+pub fn is_curve(plugin: &Plugin<Build>) -> bool {
+    plugin.name == "linearcurve"
+}
 
 /// The plugin a `<shape>` names, and its parameters.
 pub fn shape_params(node: &PluginNode) -> Result<(&'static Plugin<Build>, Params<'_>)> {
@@ -487,6 +510,38 @@ fn build_cylinder(params: &Params, to_world: &Transform) -> Result<Shape> {
         )
     })?;
     Ok(Shape::Cylinder(Cylinder::new(transform, flip_normals)))
+}
+
+/// Round linear curves read from a file, their points placed by `to_world` (radii unchanged).
+fn build_linear_curve(params: &Params, to_world: &Transform) -> Result<Shape> {
+    let node = params.node();
+    let filename = params.string_opt(&CURVE_FILENAME)?.ok_or_else(|| {
+        Error::input(
+            &node.location,
+            format!("{} needs a \"filename\"", node.describe()),
+        )
+        .with_help("add <string name=\"filename\" value=\"curves.txt\"/>")
+    })?;
+    let path = node.resolve_file(filename, params.location_of(&CURVE_FILENAME))?;
+    let mut data = load_curves(&path).map_err(|e| mesh_error(e, node))?;
+    for point in &mut data.points {
+        let p = to_world.point(point.truncate());
+        if !p.is_finite() {
+            return Err(Error::input(
+                params.location_of(&TO_WORLD),
+                format!("\"to_world\" moves a control point of \"{filename}\" to infinity"),
+            ));
+        }
+        *point = p.extend(point.w);
+    }
+    LinearCurve::new(data.points, &data.curves)
+        .ok_or_else(|| {
+            Error::input(
+                params.location_of(&CURVE_FILENAME),
+                format!("the curves of \"{filename}\" are not valid"),
+            )
+        })
+        .map(Shape::LinearCurve)
 }
 
 /// Makes a mesh reading error an input error (the scene names the file) that also says which

@@ -1,5 +1,6 @@
 //! Triangle meshes read from files: Wavefront OBJ ([`obj`]), Stanford PLY ([`ply`]) and
-//! Mitsuba's compressed format ([`serialized`]).
+//! Mitsuba's compressed format ([`serialized`]); and the control points of curve files
+//! ([`curves`]).
 //!
 //! A reader turns a file into a [`MeshData`] in object space: positions, optional per-vertex
 //! normals, texture coordinates and colours, and triangles indexing them. Polygons are triangulated as a
@@ -12,6 +13,7 @@
 //! `src/render/mesh.cpp`); the scene builder decides when to call it (not with
 //! `face_normals="true"`).
 
+pub mod curves;
 pub mod obj;
 pub mod ply;
 pub mod serialized;
