@@ -131,7 +131,21 @@ impl Shape {
             Shape::Sphere(sphere) => sphere.interaction(ray.o, ray.d, hit.t, index),
             Shape::Disk(disk) => disk.interaction(ray.o, ray.d, hit.t, index),
             Shape::Cylinder(cylinder) => cylinder.interaction(ray.o, ray.d, hit.t, index),
-            Shape::LinearCurve(curve) => curve.interaction(ray.o, ray.d, hit.t, primitive, index),
+            Shape::LinearCurve(curve) => {
+                // A structure that intersects the curve as a whole (Embree's, through
+                // `intersect_analytic`) does not name the segment: find it again.
+                let named = curve
+                    .intersect_segment(primitive as usize, ray.o, ray.d, f32::INFINITY)
+                    .is_some_and(|h| h.t == hit.t);
+                let segment = if named {
+                    primitive
+                } else {
+                    curve
+                        .intersect(ray.o, ray.d, f32::INFINITY)
+                        .map_or(primitive, |(segment, _)| segment as u32)
+                };
+                curve.interaction(ray.o, ray.d, hit.t, segment, index)
+            }
         }
     }
 
