@@ -1,6 +1,6 @@
 //! `mesh_attribute` textures: a mesh's attribute is interpolated barycentrically at a hit (and
-//! a face attribute is constant over its triangle); a PLY or serialized mesh whose vertices all
-//! have one colour renders as the same colour given as `<rgb>`.
+//! a face attribute is constant over its triangle); a PLY or serialized mesh whose vertices (or
+//! a PLY whose faces) all have one colour renders as the same colour given as `<rgb>`.
 
 mod common;
 
@@ -81,10 +81,16 @@ fn quad_scene(mesh: (&str, &str), reflectance: &str) -> String {
     )
 }
 
-/// Renders the scene with `reflectance` and with the same colour as `<rgb>`, from the same
-/// random numbers: the images agree to rounding (the interpolated coefficients of equal corners
-/// equal the corners' up to a few ulps).
-fn assert_renders_as_rgb(name: &str, files: &[(&str, Vec<u8>)], mesh: (&str, &str), rgb: &str) {
+/// Renders the scene with the mesh attribute `attribute` as reflectance and with the same colour
+/// as `<rgb>`, from the same random numbers: the images agree to rounding (the interpolated
+/// coefficients of equal corners equal the corners' up to a few ulps).
+fn assert_renders_as_rgb(
+    name: &str,
+    files: &[(&str, Vec<u8>)],
+    mesh: (&str, &str),
+    attribute: &str,
+    rgb: &str,
+) {
     let dir = std::env::temp_dir().join(format!(
         "prism-mesh-attribute-{name}-{}",
         std::process::id()
@@ -94,9 +100,11 @@ fn assert_renders_as_rgb(name: &str, files: &[(&str, Vec<u8>)], mesh: (&str, &st
     for (file, contents) in files {
         std::fs::write(folder.0.join(file), contents).unwrap();
     }
-    let attribute = r#"<texture type="mesh_attribute" name="reflectance"><string name="name" value="vertex_color"/></texture>"#;
+    let attribute = format!(
+        r#"<texture type="mesh_attribute" name="reflectance"><string name="name" value="{attribute}"/></texture>"#
+    );
     let constant = format!(r#"<rgb name="reflectance" value="{rgb}"/>"#);
-    let films: Vec<_> = [attribute, constant.as_str()]
+    let films: Vec<_> = [attribute.as_str(), constant.as_str()]
         .iter()
         .map(|reflectance| {
             let path = folder.0.join("scene.xml");
@@ -134,6 +142,7 @@ fn a_uniform_ply_colour_renders_as_that_rgb() {
         "ply",
         &[("quad.ply", ply)],
         ("ply", "quad.ply"),
+        "vertex_color",
         "0.2, 0.5, 0.8",
     );
 }
@@ -148,6 +157,28 @@ fn serialized_colours_are_the_vertex_color_attribute() {
         "serialized",
         &[("tri.serialized", file)],
         ("serialized", "tri.serialized"),
+        "vertex_color",
         "0.7, 0.3, 0.1",
+    );
+}
+
+/// PLY face colours (`r g b` on the face element) are the `face_color` attribute, one colour
+/// for every triangle of a polygon's fan.
+#[test]
+fn a_uniform_ply_face_colour_renders_as_that_rgb() {
+    let mut ply = b"ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n\
+        property float z\nelement face 1\nproperty list uchar int vertex_indices\n\
+        property float r\nproperty float g\nproperty float b\nend_header\n"
+        .to_vec();
+    for (x, y) in [(-1, -1), (1, -1), (1, 1), (-1, 1)] {
+        ply.extend_from_slice(format!("{x} {y} 0\n").as_bytes());
+    }
+    ply.extend_from_slice(b"4 0 1 2 3 0.6 0.1 0.3\n");
+    assert_renders_as_rgb(
+        "ply-face",
+        &[("quad.ply", ply)],
+        ("ply", "quad.ply"),
+        "face_color",
+        "0.6, 0.1, 0.3",
     );
 }

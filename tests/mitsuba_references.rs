@@ -1,4 +1,4 @@
-//! Renders of the new BSDFs and shapes against Mitsuba 3's images of the same scenes
+//! Renders of new BSDFs, shapes and PLY face colours against Mitsuba 3's images of the same scenes
 //! (`tests/references/README.md`): the image means of X, Y and Z agree within four standard
 //! errors of their difference. Prism's standard error comes from its pixels' sample variances;
 //! the reference's, rendered with the same estimator at 2048 spp, is taken as Prism's scaled
@@ -66,4 +66,9 @@ fn principledthin_matches_mitsuba() {
 #[test]
 fn linearcurve_matches_mitsuba() {
     assert_matches_reference("linearcurve");
+}
+
+#[test]
+fn ply_face_colours_match_mitsuba() {
+    assert_matches_reference("face_color");
 }

@@ -21,6 +21,7 @@ fn expected(shape: &SerializedShape) -> MeshData {
             .as_ref()
             .map(|uvs| uvs.iter().map(|&uv| Vec2::from(uv)).collect()),
         colors: shape.colors.as_ref().map(vec3),
+        face_colors: None,
         triangles: shape.triangles.clone(),
     }
 }

@@ -35,7 +35,8 @@ pub struct BenchScene {
 /// The fixed suite, of the scenes bundled in the repository's `scenes/`: the Cornell box
 /// (256 × 256), Veach's MIS and bidirectional scenes (at 320 × 180 and 256 × 256, a twentieth
 /// and a sixteenth of their pixels, so that references take minutes), a heterogeneous medium
-/// (`scenes/media/smoke-box.xml`, 128 × 128, rendered by `volpath`), and the generated
+/// (`scenes/media/smoke-box.xml`, 128 × 128, rendered by `volpath` and, as
+/// `smoke-box-volpathmis`, by `volpathmis`), and the generated
 /// million-triangle scene (256 × 256), written into `cache` on first use. Only the scenes
 /// `wanted` accepts are set up.
 pub fn suite(
@@ -50,17 +51,28 @@ pub fn suite(
         ]
     };
     let mut scenes = Vec::new();
-    for (name, file, x, y) in [
-        ("cornell-box", "cornell-box/scene.xml", 256, 256),
-        ("veach-mis", "veach-mis/scene.xml", 320, 180),
-        ("veach-bidir", "veach-bidir/scene.xml", 256, 256),
-        ("smoke-box", "media/smoke-box.xml", 128, 128),
+    for (name, file, x, y, integrator) in [
+        ("cornell-box", "cornell-box/scene.xml", 256, 256, None),
+        ("veach-mis", "veach-mis/scene.xml", 320, 180, None),
+        ("veach-bidir", "veach-bidir/scene.xml", 256, 256, None),
+        ("smoke-box", "media/smoke-box.xml", 128, 128, None),
+        (
+            "smoke-box-volpathmis",
+            "media/smoke-box.xml",
+            128,
+            128,
+            Some("volpathmis"),
+        ),
     ] {
         if wanted(name) {
+            let mut defines = resolution(x, y);
+            if let Some(integrator) = integrator {
+                defines.push(("integrator".to_string(), integrator.to_string()));
+            }
             scenes.push(BenchScene {
                 name,
                 path: repository.join("scenes").join(file),
-                defines: resolution(x, y),
+                defines,
             });
         }
     }

@@ -71,7 +71,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     if scenes.is_empty() {
         return Err(
             Error::usage("--only matches none of the suite's scenes").with_help(
-                "the scenes are cornell-box, veach-mis, veach-bidir, smoke-box, million-triangles",
+                "the scenes are cornell-box, veach-mis, veach-bidir, smoke-box, smoke-box-volpathmis, million-triangles",
             ),
         );
     }
@@ -97,7 +97,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             args.threads, args.seconds, args.reference_spp
         );
         println!(
-            "{:<18} {:>10} {:>9} {:>8} {:>9} {:>10} {:>6} {:>10} {:>10}",
+            "{:<20} {:>10} {:>9} {:>8} {:>9} {:>10} {:>6} {:>10} {:>10}",
             "scene",
             "primitives",
             "build s",
@@ -115,7 +115,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             println!("{}", json(&m, args.threads));
         } else {
             println!(
-                "{:<18} {:>10} {:>9.3} {:>8.1} {:>9.3} {:>10.3} {:>6} {:>10.3e} {:>10.1}",
+                "{:<20} {:>10} {:>9.3} {:>8.1} {:>9.3} {:>10.3} {:>6} {:>10.3e} {:>10.1}",
                 m.scene,
                 m.primitives,
                 m.bvh_build_seconds,
@@ -127,7 +127,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
                 m.efficiency
             );
             println!(
-                "{:<18} shadow rays: {:.3} Mrays/s",
+                "{:<20} shadow rays: {:.3} Mrays/s",
                 "",
                 m.shadow_rays_per_second / 1e6
             );
@@ -135,7 +135,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
                 (m.embree_rays_per_second, m.embree_shadow_rays_per_second)
             {
                 println!(
-                    "{:<18} Embree {:.3} Mrays/s on the same rays: ours are {:.2}x; \
+                    "{:<20} Embree {:.3} Mrays/s on the same rays: ours are {:.2}x; \
                      shadow rays {:.3} Mrays/s: ours are {:.2}x",
                     "",
                     rate / 1e6,

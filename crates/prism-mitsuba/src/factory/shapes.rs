@@ -582,17 +582,30 @@ pub fn transform_mesh(
         }
     }
     let mut mesh = TriangleMesh::new(positions, normals, data.uvs, triangles, flip_normals);
+    let mut attributes = Vec::new();
     if let Some(colors) = data.colors {
-        mesh.set_attributes(vec![vertex_color_attribute(colors)]);
+        attributes.push(color_attribute(colors, false));
+    }
+    if let Some(colors) = data.face_colors {
+        attributes.push(color_attribute(colors, true));
+    }
+    if !attributes.is_empty() {
+        mesh.set_attributes(attributes);
     }
     mesh
 }
 
-/// Mitsuba's `vertex_color` attribute: the vertices' linear RGB colours.
-fn vertex_color_attribute(colors: Vec<Vec3>) -> MeshAttribute {
+/// Mitsuba's `vertex_color` (the vertices' linear RGB colours) or `face_color` (the
+/// triangles') attribute.
+fn color_attribute(colors: Vec<Vec3>, per_face: bool) -> MeshAttribute {
     MeshAttribute {
-        name: "vertex_color".to_string(),
-        per_face: false,
+        name: if per_face {
+            "face_color"
+        } else {
+            "vertex_color"
+        }
+        .to_string(),
+        per_face,
         values: colors,
     }
 }
@@ -614,6 +627,7 @@ pub fn rectangle() -> MeshData {
             Vec2::new(0.0, 1.0),
         ]),
         colors: None,
+        face_colors: None,
         triangles: vec![[0, 1, 2], [2, 3, 0]],
     }
 }
@@ -626,6 +640,7 @@ pub fn cube() -> MeshData {
         normals: Some(Vec::new()),
         uvs: Some(Vec::new()),
         colors: None,
+        face_colors: None,
         triangles: Vec::new(),
     };
     let axes = [Vec3::X, Vec3::Y, Vec3::Z];

@@ -51,7 +51,8 @@ pub static TEXTURES: Registry<Build> = Registry {
             name: "mesh_attribute",
             origin: Origin::Mitsuba3,
             summary: "A colour the shape's mesh carries: `vertex_color` (PLY `red green blue` \
-                      or `r g b`, serialized colours) interpolated barycentrically, then \
+                      or `r g b`, serialized colours) interpolated barycentrically, or \
+                      `face_color` (a PLY face's `r g b`) constant over each face, then \
                       upsampled, as Mitsuba 3.9 does, times `scale`. \
                       Read as a colour only (Mitsuba reads a three-channel attribute as nothing \
                       else); a shape whose mesh lacks the attribute is an error.",
@@ -385,7 +386,10 @@ fn build_mesh_attribute(
                  \"face_\""
             ),
         )
-        .with_help("Prism's meshes carry \"vertex_color\" (PLY and serialized colours)"));
+        .with_help(
+            "Prism's meshes carry \"vertex_color\" (PLY and serialized vertex colours) and \
+             \"face_color\" (PLY face colours)",
+        ));
     }
     if usage != TextureUse::Spectral {
         return Err(Error::input(

@@ -41,6 +41,9 @@ pub struct MeshData {
     pub uvs: Option<Vec<Vec2>>,
     /// One linear RGB colour per vertex when present (Mitsuba's `vertex_color` attribute).
     pub colors: Option<Vec<Vec3>>,
+    /// One linear RGB colour per triangle when present (Mitsuba's `face_color` attribute; a
+    /// polygon's colour is repeated for each triangle of its fan).
+    pub face_colors: Option<Vec<Vec3>>,
     /// Counter-clockwise seen from the side the face normal points to.
     pub triangles: Vec<[u32; 3]>,
 }
@@ -138,6 +141,24 @@ impl MeshData {
                 return Err(file_error(
                     path,
                     format!("the colour of vertex {i} is not a finite number"),
+                ));
+            }
+        }
+        if let Some(colors) = &self.face_colors {
+            let triangle_count = self.triangles.len();
+            if colors.len() != triangle_count {
+                return Err(file_error(
+                    path,
+                    format!(
+                        "{} face colours for {triangle_count} triangles",
+                        colors.len()
+                    ),
+                ));
+            }
+            if let Some(i) = colors.iter().position(|c| !c.is_finite()) {
+                return Err(file_error(
+                    path,
+                    format!("the colour of triangle {i} is not a finite number"),
                 ));
             }
         }

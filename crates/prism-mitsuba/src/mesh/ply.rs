@@ -27,8 +27,10 @@
 //!   warns about it), integer channels are not rescaled, so a `uchar` 0–255 colour reads as
 //!   values above 1, clamped to 1 when upsampled. Other properties are skipped.
 //! - Element `face`: the list `vertex_indices` (or `vertex_index`) of integer indices into the
-//!   vertices; each polygon, of 3 to 65536 vertices, is triangulated as a fan. Other properties
-//!   are skipped.
+//!   vertices; each polygon, of 3 to 65536 vertices, is triangulated as a fan. Face colours
+//!   `r g b` or `red green blue` become the `face_color` attribute (as Mitsuba's
+//!   `find_other_fields` names them), one per triangle of the fan, read as their values like the
+//!   vertex colours. Other properties are skipped.
 //! - Other elements are skipped. A file without faces is an error, and so is anything after the
 //!   last element (as in Mitsuba).
 //!
@@ -334,19 +336,20 @@ fn scalar_type(name: &str, line: usize, path: &Path) -> Result<ScalarType> {
 // ---------------------------------------------------------------------------------------------
 // What to do with each property
 
-/// The per-vertex attributes Prism reads.
+/// The per-vertex attributes Prism reads, and the faces' colour.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Attribute {
     Position = 0,
     Normal = 1,
     Uv = 2,
     Color = 3,
+    FaceColor = 4,
 }
 
 /// How to read one property of a record.
 #[derive(Clone, Copy, Debug)]
 enum Field {
-    /// Coordinate `axis` of a vertex attribute.
+    /// Coordinate `axis` of a vertex attribute (or of the face colour).
     Vertex {
         attribute: Attribute,
         axis: usize,
@@ -370,9 +373,10 @@ struct Layout {
     has_normals: bool,
     has_uvs: bool,
     has_colors: bool,
+    has_face_colors: bool,
 }
 
-/// Alternative names of the vertex colour channels, in order of preference.
+/// Alternative names of the vertex and face colour channels, in order of preference.
 const COLOR_NAMES: [[&str; 3]; 2] = [["r", "g", "b"], ["red", "green", "blue"]];
 
 /// Alternative names of the texture coordinate pair, in order of preference.
@@ -422,8 +426,14 @@ impl Layout {
             .collect();
 
         let vertices = &header.elements[vertex_element];
+        let faces = &header.elements[face_element];
         let mut read = |attribute: Attribute, names: &[&str]| -> Result<bool> {
-            let found: Vec<_> = names.iter().filter_map(|n| vertices.property(n)).collect();
+            let (element_index, element, kind) = if attribute == Attribute::FaceColor {
+                (face_element, faces, "face")
+            } else {
+                (vertex_element, vertices, "vertex")
+            };
+            let found: Vec<_> = names.iter().filter_map(|n| element.property(n)).collect();
             if found.len() < names.len() {
                 return Ok(false);
             }
@@ -433,12 +443,13 @@ impl Layout {
                         path,
                         property.line,
                         format!(
-                            "vertex property \"{}\" must be a number, not a list",
+                            "{kind} property \"{}\" must be a number, not a list",
                             property.name
                         ),
                     ));
                 };
-                if ty.is_integer() && attribute != Attribute::Color {
+                if ty.is_integer() && !matches!(attribute, Attribute::Color | Attribute::FaceColor)
+                {
                     return Err(line_error(
                         path,
                         property.line,
@@ -449,7 +460,7 @@ impl Layout {
                         ),
                     ));
                 }
-                fields[vertex_element][index] = Field::Vertex {
+                fields[element_index][index] = Field::Vertex {
                     attribute,
                     axis,
                     ty,
@@ -481,7 +492,14 @@ impl Layout {
             }
         }
 
-        let faces = &header.elements[face_element];
+        let mut has_face_colors = false;
+        for names in COLOR_NAMES {
+            if read(Attribute::FaceColor, &names)? {
+                has_face_colors = true;
+                break;
+            }
+        }
+
         let (index, property) = faces
             .property("vertex_indices")
             .or_else(|| faces.property("vertex_index"))
@@ -512,6 +530,7 @@ impl Layout {
             has_normals,
             has_uvs,
             has_colors,
+            has_face_colors,
         })
     }
 }
@@ -601,6 +620,7 @@ fn read_body(reader: &mut impl BodyReader, header: &Header, layout: &Layout) -> 
         colors: layout
             .has_colors
             .then(|| Vec::with_capacity(vertex_capacity)),
+        face_colors: layout.has_face_colors.then(Vec::new),
         triangles: Vec::new(),
     };
     let mut polygon = Vec::new();
@@ -612,7 +632,8 @@ fn read_body(reader: &mut impl BodyReader, header: &Header, layout: &Layout) -> 
             mesh.triangles.reserve(capacity(element.count));
         }
         for _ in 0..element.count {
-            let mut vertex = [[0.0f32; 3]; 4];
+            let mut vertex = [[0.0f32; 3]; 5];
+            let triangles_before = mesh.triangles.len();
             for field in fields {
                 match *field {
                     Field::Vertex {
@@ -626,7 +647,7 @@ fn read_body(reader: &mut impl BodyReader, header: &Header, layout: &Layout) -> 
                                 Attribute::Position => "vertex coordinate",
                                 Attribute::Normal => "normal",
                                 Attribute::Uv => "texture coordinate",
-                                Attribute::Color => "colour",
+                                Attribute::Color | Attribute::FaceColor => "colour",
                             };
                             return Err(reader.error(format!("{what} is not a finite number")));
                         }
@@ -642,8 +663,13 @@ fn read_body(reader: &mut impl BodyReader, header: &Header, layout: &Layout) -> 
                     Field::Skip(ty) => skip(reader, ty)?,
                 }
             }
+            if let Some(face_colors) = &mut mesh.face_colors {
+                let triangles = mesh.triangles.len() - triangles_before;
+                let color = Vec3::from(vertex[Attribute::FaceColor as usize]);
+                face_colors.extend(std::iter::repeat_n(color, triangles));
+            }
             if i == layout.vertex_element {
-                let [position, normal, uv, color] = vertex;
+                let [position, normal, uv, color, _] = vertex;
                 mesh.positions.push(Vec3::from(position));
                 if let Some(normals) = &mut mesh.normals {
                     normals.push(Vec3::from(normal));
@@ -1005,6 +1031,7 @@ mod tests {
             normals: Some(vec![Vec3::Z; 4]),
             uvs: Some(corners.iter().map(|&c| Vec2::from(c)).collect()),
             colors: None,
+            face_colors: None,
             triangles: vec![[0, 1, 2], [0, 2, 3], [3, 1, 2]],
         }
     }
@@ -1033,6 +1060,67 @@ mod tests {
                 assert_eq!(mesh, expected_square(), "{format} {float} {length} {index}");
             }
         }
+    }
+
+    /// Face colours become one colour per triangle of each face's fan, wherever the colour
+    /// properties stand in the face record and whatever their names and types.
+    #[test]
+    fn face_colours_repeat_over_each_fan() {
+        let vertices = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]
+            .iter()
+            .flat_map(|&[x, y]| [("float", x), ("float", y), ("float", 0.0)])
+            .collect::<Vec<_>>();
+        let vertex_header = "element vertex 4\nproperty float x\nproperty float y\n\
+                             property float z\nelement face 2\n";
+        for format in FORMATS {
+            // Colours after the indices, as float r g b.
+            let header = format!(
+                "{vertex_header}property list uchar int vertex_indices\nproperty float r\n\
+                 property float g\nproperty float b\n"
+            );
+            let mut values = vertices.clone();
+            values.extend([("uchar", 4.0), ("int", 0.0), ("int", 1.0)]);
+            values.extend([("int", 2.0), ("int", 3.0)]);
+            values.extend([("float", 0.25), ("float", 0.5), ("float", 0.75)]);
+            values.extend([("uchar", 3.0), ("int", 3.0), ("int", 1.0), ("int", 2.0)]);
+            values.extend([("float", 1.0), ("float", 0.0), ("float", 0.125)]);
+            let mesh = parse(&ply(format, &header, &values)).unwrap();
+            assert_eq!(
+                mesh.triangles,
+                [[0, 1, 2], [0, 2, 3], [3, 1, 2]],
+                "{format}"
+            );
+            let (a, b) = (Vec3::new(0.25, 0.5, 0.75), Vec3::new(1.0, 0.0, 0.125));
+            assert_eq!(mesh.face_colors, Some(vec![a, a, b]), "{format}");
+            assert_eq!(mesh.colors, None, "{format}");
+            mesh.validate(Path::new("mesh.ply")).unwrap();
+
+            // Colours before the indices, as uchar red green blue: values, not rescaled.
+            let header = format!(
+                "{vertex_header}property uchar red\nproperty uchar green\n\
+                 property uchar blue\nproperty list uchar int vertex_indices\n"
+            );
+            let mut values = vertices.clone();
+            values.extend([("uchar", 1.0), ("uchar", 2.0), ("uchar", 255.0)]);
+            values.extend([("uchar", 3.0), ("int", 0.0), ("int", 1.0), ("int", 2.0)]);
+            values.extend([("uchar", 0.0), ("uchar", 0.0), ("uchar", 0.0)]);
+            values.extend([("uchar", 3.0), ("int", 0.0), ("int", 2.0), ("int", 3.0)]);
+            let mesh = parse(&ply(format, &header, &values)).unwrap();
+            assert_eq!(
+                mesh.face_colors,
+                Some(vec![Vec3::new(1.0, 2.0, 255.0), Vec3::ZERO]),
+                "{format}"
+            );
+        }
+        // A colour that is a list is refused with its header line.
+        let header = "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n\
+                      element face 1\nproperty list uchar int vertex_indices\n\
+                      property list uchar float r\nproperty float g\nproperty float b\n";
+        let message = error(&ply("ascii", header, &[]));
+        assert!(
+            message.contains("mesh.ply:9") && message.contains("face property \"r\""),
+            "{message}"
+        );
     }
 
     #[test]

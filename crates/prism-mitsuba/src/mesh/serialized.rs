@@ -141,6 +141,7 @@ pub fn parse_serialized(bytes: &[u8], shape_index: u32, path: &Path) -> Result<M
         normals,
         uvs,
         colors,
+        face_colors: None,
         triangles,
     };
     mesh.validate(path)?;
