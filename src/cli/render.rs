@@ -31,7 +31,7 @@ use prism_core::render::{
 use prism_core::sampling::sampler::{Sampler, SamplerKind};
 use prism_core::scene::Scene;
 use prism_core::spectrum::WavelengthSampling;
-use prism_mitsuba::fingerprint::Fnv64;
+use prism_mitsuba::fingerprint::override_wavelengths;
 use prism_mitsuba::load_scene;
 
 #[derive(Args, Debug)]
@@ -237,17 +237,6 @@ fn install_signal_handlers(interrupt: Arc<AtomicBool>, signal: Arc<AtomicI32>) -
         }
     });
     Ok(())
-}
-
-/// Draws the scene's wavelengths from `density`. The density joins the scene's fingerprint, so a
-/// render state records it: resuming or merging with another density is refused.
-pub(crate) fn override_wavelengths(scene: &mut Scene, density: WavelengthSampling) {
-    scene.film.wavelength_sampling = density;
-    let mut hash = Fnv64::default();
-    hash.write(&scene.fingerprint.to_le_bytes());
-    hash.write_str("wavelength_sampling");
-    hash.write_str(density.name());
-    scene.fingerprint = hash.finish();
 }
 
 pub fn run(args: &RenderArgs) -> Result<()> {

@@ -112,3 +112,89 @@ def test_without_tqdm_progress_is_a_line_on_stderr(cornell, monkeypatch, capsys)
     total = SIZE["spp"] * SIZE["resx"] * SIZE["resy"]
     assert f"prism: 100.0 % of {total} samples" in err
     assert err.endswith("\n")
+
+
+def test_the_wavelength_density_is_the_command_lines_option(cornell_path, prism_cli, tmp_path):
+    exr = tmp_path / "visible.exr"
+    size = [f"resx={SIZE['resx']}", f"resy={SIZE['resy']}"]
+    subprocess.run(
+        [str(prism_cli), "render", str(cornell_path), "-o", str(exr), "--spp", "3"]
+        + ["--seed", "7", "--wavelengths", "visible", "-D", size[0], "-D", size[1]],
+        check=True,
+        capture_output=True,
+    )
+    scene = pr.load_file(cornell_path, resx=SIZE["resx"], resy=SIZE["resy"])
+    assert scene.wavelengths == "balanced"
+    default = pr.render(scene, spp=3, seed=7, progress=False)
+    scene.wavelengths = "visible"
+    assert scene.wavelengths == "visible"
+    visible = pr.render(scene, spp=3, seed=7, progress=False)
+    assert_same_image(visible, pr.Image.read(exr))
+    assert not np.array_equal(default.xyz, visible.xyz)
+
+
+def test_an_unknown_wavelength_density_is_an_error(cornell_path):
+    scene = pr.load_file(cornell_path, resx=SIZE["resx"], resy=SIZE["resy"])
+    with pytest.raises(pr.PrismError) as raised:
+        scene.wavelengths = "visibel"
+    assert "visibel" in raised.value.message
+    assert "visible" in (raised.value.help or "")
+    assert scene.wavelengths == "balanced"
+
+
+AOV_INTEGRATOR = """<integrator type="aov">
+        <string name="aovs" value="dd.y:depth,nn:sh_normal"/>
+        <integrator type="path" name="image"/>
+    </integrator>"""
+
+
+@pytest.fixture(scope="module")
+def aov_scene_path(cornell_path, tmp_path_factory):
+    """The Cornell box with the aov integrator around its path tracer, beside its meshes."""
+    text = cornell_path.read_text()
+    start = text.index('<integrator type="path">')
+    end = text.index("</integrator>", start) + len("</integrator>")
+    written = text[:start] + AOV_INTEGRATOR + text[end:]
+    directory = tmp_path_factory.mktemp("aov")
+    for entry in cornell_path.parent.iterdir():
+        if entry.name != cornell_path.name:
+            (directory / entry.name).symlink_to(entry)
+    path = directory / "scene.xml"
+    path.write_text(written)
+    return path
+
+
+def test_aov_channels_are_arrays_named_as_in_the_exr(aov_scene_path, prism_cli, tmp_path):
+    exr = tmp_path / "aov.exr"
+    size = [f"resx={SIZE['resx']}", f"resy={SIZE['resy']}"]
+    subprocess.run(
+        [str(prism_cli), "render", str(aov_scene_path), "-o", str(exr), "--spp", "2"]
+        + ["--seed", "3", "-D", size[0], "-D", size[1]],
+        check=True,
+        capture_output=True,
+    )
+    scene = pr.load_file(aov_scene_path, resx=SIZE["resx"], resy=SIZE["resy"])
+    image = pr.render(scene, spp=2, seed=3, progress=False)
+    names = ["dd.y.T", "nn.X", "nn.Y", "nn.Z"] + [f"image.{c}" for c in "RGBA"]
+    assert sorted(image.aovs) == sorted(names)
+    for name in names:
+        assert image.aovs[name].shape == (SIZE["resy"], SIZE["resx"])
+        assert image.aovs[name].dtype == np.float32
+    assert (image.aovs["dd.y.T"] >= 0).all() and (image.aovs["dd.y.T"] > 0).mean() > 0.5
+    from_cli = pr.Image.read(exr)
+    assert_same_image(image, from_cli)
+    for name in names:
+        assert np.array_equal(image.aovs[name], from_cli.aovs[name]), name
+    written = tmp_path / "written.exr"
+    image.aovs["dd.y.T"][0, 0] = -1.0
+    image.write(written)
+    assert pr.Image.read(written).aovs["dd.y.T"][0, 0] == -1.0
+
+
+def test_an_aov_that_is_no_longer_an_image_is_an_error(aov_scene_path, tmp_path):
+    scene = pr.load_file(aov_scene_path, resx=SIZE["resx"], resy=SIZE["resy"])
+    image = pr.render(scene, spp=1, progress=False)
+    image.aovs["dd.y.T"] = np.zeros((2, 2), dtype=np.float32)
+    with pytest.raises(pr.PrismError) as raised:
+        image.write(tmp_path / "bad.exr")
+    assert "dd.y.T" in raised.value.message

@@ -2,6 +2,9 @@
 //! not where the files are) and of the contents of every file it names, so that a render state
 //! can tell whether it belongs to the scene it is resumed or merged with, on any machine.
 
+use prism_core::scene::Scene;
+use prism_core::spectrum::WavelengthSampling;
+
 use crate::description::{PluginNode, PropertyValue};
 
 /// FNV-1a, 64 bits (Fowler, Noll & Vo): simple and stable across platforms and versions.
@@ -30,6 +33,18 @@ impl Fnv64 {
     pub fn finish(self) -> u64 {
         self.0
     }
+}
+
+/// Draws the scene's wavelengths from `density` in place of the film's own. The density joins
+/// the scene's fingerprint, so a render state records it: resuming or merging with another
+/// density is refused.
+pub fn override_wavelengths(scene: &mut Scene, density: WavelengthSampling) {
+    scene.film.wavelength_sampling = density;
+    let mut hash = Fnv64::default();
+    hash.write(&scene.fingerprint.to_le_bytes());
+    hash.write_str("wavelength_sampling");
+    hash.write_str(density.name());
+    scene.fingerprint = hash.finish();
 }
 
 /// Hashes a plugin tree: each node's class, type, properties and children, recursively, and the

@@ -4,20 +4,25 @@
 use std::path::{Path, PathBuf};
 
 use numpy::ndarray::{Array2, Array3};
-use numpy::{IntoPyArray, PyArray2, PyArray3, PyArrayMethods, PyUntypedArrayMethods};
+use numpy::{
+    IntoPyArray, PyArray2, PyArray3, PyArrayMethods, PyReadonlyArray2, PyUntypedArrayMethods,
+};
 use pyo3::prelude::*;
-use pyo3::types::PyBytes;
+use pyo3::types::{PyBytes, PyDict};
 
 use crate::error::{IntoPyResult, to_py};
 use prism_core::error::{Error, ErrorKind};
 use prism_core::film::FilmImages;
+use prism_core::film::output::IMAGE_CHANNELS;
 use prism_core::image::compare as stats;
-use prism_core::image::{ChannelImage, read_exr};
+use prism_core::image::{ChannelImage, read_exr, write_exr};
 
 /// A rendered image: H × W × 3 float32 arrays `rgb` (linear sRGB), `xyz` (CIE 1931) and
-/// `variance` (the estimated variance of each pixel's mean of X, Y and Z), and the H × W array
-/// `relative_error` (each pixel's relative standard error of luminance). The arrays are the
-/// render's own memory (no copy); `write` and `_repr_png_` use their current values.
+/// `variance` (the estimated variance of each pixel's mean of X, Y and Z), the H × W array
+/// `relative_error` (each pixel's relative standard error of luminance), and `aovs`, the
+/// integrator's extra channels (`aov`, `moment`) by their EXR names as H × W float32 arrays.
+/// The arrays are the render's own memory (no copy); `write` and `_repr_png_` use their
+/// current values.
 #[pyclass(module = "prism_renderer", frozen)]
 pub struct Image {
     #[pyo3(get)]
@@ -28,6 +33,8 @@ pub struct Image {
     variance: Py<PyArray3<f32>>,
     #[pyo3(get)]
     relative_error: Py<PyArray2<f32>>,
+    #[pyo3(get)]
+    aovs: Py<PyDict>,
     /// Samples per pixel taken.
     #[pyo3(get)]
     spp: u32,
@@ -37,26 +44,71 @@ pub struct Image {
 }
 
 impl Image {
-    /// The image of `images`, which the arrays take over.
-    pub fn new(py: Python<'_>, images: FilmImages, spp: u32, seconds: f64) -> Image {
+    /// The image of `images` and the extra channels `aovs` (name, one value per pixel), which
+    /// the arrays take over.
+    pub fn new(
+        py: Python<'_>,
+        images: FilmImages,
+        aovs: Vec<(String, Vec<f32>)>,
+        spp: u32,
+        seconds: f64,
+    ) -> PyResult<Image> {
         let (h, w) = (images.height, images.width);
+        let one = |values: Vec<f32>| {
+            Array2::from_shape_vec((h, w), values)
+                .expect("each channel holds one value per pixel")
+                .into_pyarray(py)
+        };
+        let channels = PyDict::new(py);
+        for (name, values) in aovs {
+            channels.set_item(name, one(values))?;
+        }
         let three = |values: Vec<f32>| {
             Array3::from_shape_vec((h, w, 3), values)
                 .expect("FilmImages holds three values per pixel")
                 .into_pyarray(py)
                 .unbind()
         };
-        Image {
+        Ok(Image {
             rgb: three(images.rgb),
             xyz: three(images.xyz),
             variance: three(images.variance),
-            relative_error: Array2::from_shape_vec((h, w), images.relative_error)
-                .expect("FilmImages holds one relative error per pixel")
-                .into_pyarray(py)
-                .unbind(),
+            relative_error: one(images.relative_error).unbind(),
+            aovs: channels.unbind(),
             spp,
             seconds,
+        })
+    }
+
+    /// Every array as named EXR channels: those of [`FilmImages::channels`], then the extra
+    /// channels. An extra channel that is no longer an H × W float32 array is an error.
+    fn channels(&self, py: Python<'_>) -> PyResult<ChannelImage> {
+        let mut image = self.images(py).channels();
+        for (name, values) in self.aovs.bind(py).iter() {
+            let name: String = name
+                .extract()
+                .map_err(|_| to_py(py, &Error::usage("the names in Image.aovs must be strings")))?;
+            let array: PyReadonlyArray2<'_, f32> = values.extract().map_err(|_| {
+                to_py(
+                    py,
+                    &Error::usage(format!("Image.aovs[\"{name}\"] is not a 2-D float32 array")),
+                )
+            })?;
+            if array.shape() != [image.height, image.width] {
+                return Err(to_py(
+                    py,
+                    &Error::usage(format!(
+                        "Image.aovs[\"{name}\"] has shape {:?}, the image {} × {}",
+                        array.shape(),
+                        image.height,
+                        image.width
+                    )),
+                ));
+            }
+            let values = array.as_array().iter().copied().collect();
+            image.channels.push((name, values));
         }
+        Ok(image)
     }
 
     /// The arrays' current values.
@@ -93,7 +145,7 @@ impl Image {
 #[pymethods]
 impl Image {
     /// Reads an OpenEXR image that Prism wrote (channels R, G, B, X, Y, Z, variance.X/Y/Z and
-    /// relative_error.Y).
+    /// relative_error.Y); its other channels are the `aovs`.
     #[staticmethod]
     fn read(py: Python<'_>, path: PathBuf) -> PyResult<Image> {
         let exr = py.detach(|| load_exr(&path)).into_py_result(py)?;
@@ -104,7 +156,12 @@ impl Image {
                     .with_help("read an image that Prism rendered; compare() reads any EXR"),
             )
         })?;
-        Ok(Image::new(py, images, 0, 0.0))
+        let aovs = exr
+            .channels
+            .into_iter()
+            .filter(|(name, _)| !IMAGE_CHANNELS.contains(&name.as_str()))
+            .collect();
+        Image::new(py, images, aovs, 0, 0.0)
     }
 
     /// The width in pixels.
@@ -119,17 +176,22 @@ impl Image {
         self.rgb.bind(py).shape()[0]
     }
 
-    /// Writes the image: `.exr` gives OpenEXR with every array as channels (as `prism render`
-    /// writes), `.png` the RGB image as 8-bit sRGB.
+    /// Writes the image: `.exr` gives OpenEXR with every array as channels, the `aovs` under
+    /// their names (as `prism render` writes), `.png` the RGB image as 8-bit sRGB.
     fn write(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
-        let images = self.images(py);
         let extension = path
             .extension()
             .and_then(|e| e.to_str())
             .map(str::to_ascii_lowercase);
         let result = match extension.as_deref() {
-            Some("exr") => py.detach(|| images.write_exr(&path)),
-            Some("png") => py.detach(|| images.write_png(&path)),
+            Some("exr") => {
+                let image = self.channels(py)?;
+                py.detach(|| write_exr(&path, &image))
+            }
+            Some("png") => {
+                let images = self.images(py);
+                py.detach(|| images.write_png(&path))
+            }
             _ => Err(Error::usage(format!(
                 "cannot write \"{}\": the name must end in .exr or .png",
                 path.display()
@@ -175,7 +237,7 @@ pub enum Operand<'py> {
 impl Operand<'_> {
     fn channels(&self, py: Python<'_>) -> PyResult<ChannelImage> {
         match self {
-            Operand::Image(image) => Ok(image.get().images(py).channels()),
+            Operand::Image(image) => image.get().channels(py),
             Operand::Path(path) => py.detach(|| load_exr(path)).into_py_result(py),
         }
     }

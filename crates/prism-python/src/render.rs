@@ -111,6 +111,13 @@ pub fn render(
     report()?;
     let spp = output.samples.end - output.samples.start;
     let seconds = output.elapsed.as_secs_f64();
-    let images = py.detach(|| FilmImages::of(&output.film));
-    Ok(Image::new(py, images, spp, seconds))
+    let film = &output.film;
+    let (images, aovs) = py.detach(|| {
+        let aovs = (film.aov_names.iter().cloned())
+            .enumerate()
+            .map(|(c, name)| (name, film.aov(c)))
+            .collect();
+        (FilmImages::of(film), aovs)
+    });
+    Image::new(py, images, aovs, spp, seconds)
 }

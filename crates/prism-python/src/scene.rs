@@ -2,19 +2,22 @@
 //! dictionary form; both build through prism-mitsuba's factory, with its checks and messages.
 
 use std::path::PathBuf;
-use std::sync::Arc;
 
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::dict::dict_of;
-use crate::error::IntoPyResult;
+use crate::error::{IntoPyResult, to_py};
+use prism_core::error::Error;
+use prism_core::spectrum::WavelengthSampling;
+use prism_mitsuba::fingerprint::override_wavelengths;
 use prism_mitsuba::{LoadedScene, load_scene, load_scene_dict};
 
-/// A scene ready to render.
-#[pyclass(module = "prism_renderer", frozen)]
+/// A scene ready to render. Its settings that `prism render` can override from the command
+/// line are properties that may be set (not while the scene renders).
+#[pyclass(module = "prism_renderer")]
 pub struct Scene {
-    pub loaded: Arc<LoadedScene>,
+    pub loaded: LoadedScene,
 }
 
 #[pymethods]
@@ -43,6 +46,27 @@ impl Scene {
         self.loaded.seed
     }
 
+    /// The density the wavelengths are drawn from (the film's `wavelength_sampling`); setting
+    /// it is `prism render --wavelengths`.
+    #[getter]
+    fn wavelengths(&self) -> &'static str {
+        self.loaded.scene.film.wavelength_sampling.name()
+    }
+
+    #[setter]
+    fn set_wavelengths(&mut self, py: Python<'_>, name: &str) -> PyResult<()> {
+        let density = WavelengthSampling::from_name(name).ok_or_else(|| {
+            to_py(
+                py,
+                &Error::usage(format!("no wavelength density is called \"{name}\"")).with_help(
+                    format!("choose one of {}", WavelengthSampling::NAMES.join(", ")),
+                ),
+            )
+        })?;
+        override_wavelengths(&mut self.loaded.scene, density);
+        Ok(())
+    }
+
     fn __repr__(&self) -> String {
         format!(
             "Scene({}×{} pixels, {} spp)",
@@ -61,9 +85,7 @@ pub fn load_file(py: Python<'_>, path: PathBuf, defines: Vec<(String, String)>) 
     let loaded = py
         .detach(|| load_scene(&path, &defines))
         .into_py_result(py)?;
-    Ok(Scene {
-        loaded: Arc::new(loaded),
-    })
+    Ok(Scene { loaded })
 }
 
 /// Loads a scene given in Mitsuba's dictionary form.
@@ -71,7 +93,5 @@ pub fn load_file(py: Python<'_>, path: PathBuf, defines: Vec<(String, String)>) 
 pub fn load_dict(py: Python<'_>, scene: &Bound<'_, PyDict>) -> PyResult<Scene> {
     let root = dict_of(scene, "scene")?;
     let loaded = py.detach(|| load_scene_dict(&root)).into_py_result(py)?;
-    Ok(Scene {
-        loaded: Arc::new(loaded),
-    })
+    Ok(Scene { loaded })
 }

@@ -1,7 +1,7 @@
 """Type stubs of the native module (crates/prism-python/src); the package re-exports these."""
 
 import os
-from typing import Callable, List, Optional, Sequence, Tuple, Union
+from typing import Callable, Dict, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -40,6 +40,13 @@ class Scene:
     @property
     def seed(self) -> int:
         """The sampler's ``seed``."""
+    @property
+    def wavelengths(self) -> str:
+        """The density the wavelengths are drawn from (the film's ``wavelength_sampling``):
+        ``"balanced"``, ``"cie_sum"``, ``"visible"`` or ``"uniform"``. Setting it is
+        ``prism render --wavelengths``; an unknown name raises :class:`PrismError`."""
+    @wavelengths.setter
+    def wavelengths(self, name: str) -> None: ...
 
 class Transform:
     """A 4 × 4 transform acting on column vectors, composed like Mitsuba's
@@ -90,6 +97,10 @@ class Image:
     def relative_error(self) -> npt.NDArray[np.float32]:
         """H × W, each pixel's relative standard error of luminance (Y)."""
     @property
+    def aovs(self) -> Dict[str, npt.NDArray[np.float32]]:
+        """The integrator's extra channels (``aov``, ``moment``) by their EXR names, each
+        H × W; empty for other integrators. :meth:`write` writes them."""
+    @property
     def spp(self) -> int:
         """Samples per pixel taken (0 for an image read from a file)."""
     @property
@@ -101,9 +112,11 @@ class Image:
     def height(self) -> int: ...
     @staticmethod
     def read(path: Union[str, os.PathLike]) -> Image:
-        """Reads an OpenEXR file that Prism wrote (``prism render`` or :meth:`write`)."""
+        """Reads an OpenEXR file that Prism wrote (``prism render`` or :meth:`write`); its
+        channels other than the image's are the ``aovs``."""
     def write(self, path: Union[str, os.PathLike]) -> None:
-        """Writes ``.exr`` (every array, the channels ``prism render`` writes) or ``.png``
+        """Writes ``.exr`` (every array and the ``aovs``, the channels ``prism render``
+        writes) or ``.png``
         (the RGB image, 8-bit sRGB)."""
     def _repr_png_(self) -> bytes:
         """The PNG that :meth:`write` writes, for Jupyter."""
