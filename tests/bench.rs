@@ -40,22 +40,36 @@ fn bench_lists_its_six_scenes_from_the_repository() {
         .lines()
         .map(|l| l.split('\t').next().unwrap())
         .collect();
-    assert_eq!(
-        names,
-        [
-            "cornell-box",
-            "veach-mis",
-            "veach-bidir",
-            "smoke-box",
-            "smoke-box-volpathmis",
-            "million-triangles"
-        ],
-        "{stdout}"
-    );
+    assert_eq!(names, prism::bench::SCENE_NAMES, "{stdout}");
     for line in stdout.lines() {
         let file = line.split('\t').nth(1).unwrap();
         assert!(std::path::Path::new(file).is_file(), "{line}");
     }
+    let _ = std::fs::remove_dir_all(&cache);
+}
+
+/// `--only` with a scene's whole name selects that scene alone; any other text, the names
+/// containing it.
+#[test]
+fn only_a_whole_name_selects_that_scene_alone() {
+    let cache = std::env::temp_dir().join(format!("prism-bench-only-{}", std::process::id()));
+    let listed = |pattern: &str| -> Vec<String> {
+        let output = Command::new(env!("CARGO_BIN_EXE_prism"))
+            .args(["bench", "--list", "--only", pattern, "--cache"])
+            .arg(&cache)
+            .current_dir(env!("CARGO_MANIFEST_DIR"))
+            .output()
+            .unwrap();
+        assert!(output.status.success(), "{output:?}");
+        String::from_utf8(output.stdout)
+            .unwrap()
+            .lines()
+            .map(|l| l.split('\t').next().unwrap().to_string())
+            .collect()
+    };
+    assert_eq!(listed("smoke-box"), ["smoke-box"]);
+    assert_eq!(listed("smoke"), ["smoke-box", "smoke-box-volpathmis"]);
+    assert_eq!(listed("veach"), ["veach-mis", "veach-bidir"]);
     let _ = std::fs::remove_dir_all(&cache);
 }
 

@@ -32,6 +32,16 @@ pub struct BenchScene {
     pub defines: Vec<(String, String)>,
 }
 
+/// The names of the suite's scenes, in its order.
+pub const SCENE_NAMES: [&str; 6] = [
+    "cornell-box",
+    "veach-mis",
+    "veach-bidir",
+    "smoke-box",
+    "smoke-box-volpathmis",
+    "million-triangles",
+];
+
 /// The fixed suite, of the scenes bundled in the repository's `scenes/`: the Cornell box
 /// (256 × 256), Veach's MIS and bidirectional scenes (at 320 × 180 and 256 × 256, a twentieth
 /// and a sixteenth of their pixels, so that references take minutes), a heterogeneous medium

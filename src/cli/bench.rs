@@ -6,7 +6,7 @@ use std::time::Duration;
 
 use clap::Args;
 
-use crate::bench::{BenchOptions, Measurement, measure, suite};
+use crate::bench::{BenchOptions, Measurement, SCENE_NAMES, measure, suite};
 use prism_core::error::{Error, Result};
 
 #[derive(Args, Debug)]
@@ -23,7 +23,8 @@ pub struct BenchArgs {
     /// Incoherent rays per pass of the traversal measurement
     #[arg(long, value_name = "N", default_value_t = 1 << 20)]
     pub rays: usize,
-    /// Only the scenes whose names contain this (repeatable)
+    /// Only the scene of this name, or if none has it, the scenes whose names contain it
+    /// (repeatable)
     #[arg(long, value_name = "NAME")]
     pub only: Vec<String>,
     /// Where the generated scene and the references are kept
@@ -36,6 +37,17 @@ pub struct BenchArgs {
     /// scene; tools/bench-vs-mitsuba reads this)
     #[arg(long)]
     pub list: bool,
+}
+
+/// Whether `--only pattern` selects the scene `name`: a pattern that is a scene's whole name
+/// selects that scene alone (`smoke-box`, not also `smoke-box-volpathmis`); any other selects
+/// the names containing it.
+fn selects(pattern: &str, name: &str) -> bool {
+    if SCENE_NAMES.contains(&pattern) {
+        name == pattern
+    } else {
+        name.contains(pattern)
+    }
 }
 
 pub fn run(args: &BenchArgs) -> Result<()> {
@@ -66,14 +78,11 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         PathBuf::from(env!("CARGO_MANIFEST_DIR"))
     };
     let scenes = suite(&repository, &args.cache, |name| {
-        args.only.is_empty() || args.only.iter().any(|o| name.contains(o.as_str()))
+        args.only.is_empty() || args.only.iter().any(|o| selects(o, name))
     })?;
     if scenes.is_empty() {
-        return Err(
-            Error::usage("--only matches none of the suite's scenes").with_help(
-                "the scenes are cornell-box, veach-mis, veach-bidir, smoke-box, smoke-box-volpathmis, million-triangles",
-            ),
-        );
+        return Err(Error::usage("--only matches none of the suite's scenes")
+            .with_help(format!("the scenes are {}", SCENE_NAMES.join(", "))));
     }
     if args.list {
         for scene in &scenes {
