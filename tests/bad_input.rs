@@ -660,6 +660,55 @@ fn cases() -> Vec<Case> {
             location: "scene.xml:3:",
             says: "curves have no area sampling",
         },
+        // B-spline curves.
+        Case {
+            name: "bsplinecurve: a curve of three points",
+            files: Box::leak(Box::new([
+                (
+                    "scene.xml",
+                    scene!(
+                        "    <shape type=\"bsplinecurve\"><string name=\"filename\" value=\"c.txt\"/></shape>"
+                    ),
+                ),
+                (
+                    "c.txt",
+                    "0 0 0 0.1\n1 0 0 0.1\n2 1 0 0.1\n3 0 0 0.1\n\n0 1 0 0.1\n1 1 0 0.1\n2 1 1 0.1\n",
+                ),
+            ])),
+            arguments: RENDER,
+            location: "c.txt:6:1",
+            says: "needs at least 4",
+        },
+        Case {
+            name: "bsplinecurve: a comment line",
+            files: Box::leak(Box::new([
+                (
+                    "scene.xml",
+                    scene!(
+                        "    <shape type=\"bsplinecurve\"><string name=\"filename\" value=\"c.txt\"/></shape>"
+                    ),
+                ),
+                ("c.txt", "0 0 0 0.1\n# a comment\n"),
+            ])),
+            arguments: RENDER,
+            location: "c.txt:2:1",
+            says: "3 numbers on a line",
+        },
+        Case {
+            name: "bsplinecurve: an area emitter",
+            files: Box::leak(Box::new([
+                (
+                    "scene.xml",
+                    scene!(
+                        "    <shape type=\"bsplinecurve\"><string name=\"filename\" value=\"c.txt\"/><emitter type=\"area\"/></shape>"
+                    ),
+                ),
+                ("c.txt", "0 0 0 0.1\n1 0 0 0.1\n2 0 0 0.1\n3 0 0 0.1\n"),
+            ])),
+            arguments: RENDER,
+            location: "scene.xml:3:",
+            says: "curves have no area sampling",
+        },
         // Cylinders.
         render_scene(
             "cylinder: p0 and p1 the same point",

@@ -69,6 +69,11 @@ fn linearcurve_matches_mitsuba() {
 }
 
 #[test]
+fn bsplinecurve_matches_mitsuba() {
+    assert_matches_reference("bsplinecurve");
+}
+
+#[test]
 fn ply_face_colours_match_mitsuba() {
     assert_matches_reference("face_color");
 }

@@ -1,5 +1,5 @@
-//! Any bytes given as a curve file (`linearcurve`) give control points or an error; never a
-//! panic.
+//! Any bytes given as a curve file (`linearcurve`, `bsplinecurve`) give control points or an
+//! error; never a panic.
 #![no_main]
 
 use std::path::Path;
@@ -7,5 +7,7 @@ use std::path::Path;
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {
-    let _ = prism_mitsuba::mesh::curves::parse_curves(data, Path::new("fuzz.txt"));
+    for min_points in [2, 4] {
+        let _ = prism_mitsuba::mesh::curves::parse_curves(data, Path::new("fuzz.txt"), min_points);
+    }
 });

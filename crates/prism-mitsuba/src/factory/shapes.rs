@@ -1,5 +1,5 @@
 //! Shape plugins: `obj`, `ply`, `serialized`, `rectangle`, `cube`, `sphere`, `disk`,
-//! `cylinder` and `linearcurve`, and the instancing plugins `shapegroup` and `instance` (built by the scene,
+//! `cylinder`, `linearcurve` and `bsplinecurve`, and the instancing plugins `shapegroup` and `instance` (built by the scene,
 //! [`super::instancing`]). Any shape whose
 //! `to_world` is an `<animation>` moves while the shutter is open: it is built in object space
 //! and placed by an [`Instance`].
@@ -7,13 +7,13 @@
 use glam::{DMat4, DVec3, Mat3, Vec2, Vec3};
 
 use crate::description::{PluginClass, PluginNode};
-use crate::mesh::curves::load_curves;
+use crate::mesh::curves::{CurveData, load_curves};
 use crate::mesh::{MeshData, load_obj, load_ply, load_serialized};
 use crate::params::Params;
 use crate::registry::{Default, Origin, ParamKind, ParamSpec, Plugin, Registry};
 use prism_core::error::{Error, Result};
 use prism_core::geometry::shape::MeshAttribute;
-use prism_core::geometry::shape::{Cylinder, LinearCurve};
+use prism_core::geometry::shape::{BSplineCurve, Cylinder, LinearCurve};
 use prism_core::geometry::{Disk, Instance, Primitive, Shape, Sphere, TriangleMesh};
 use prism_core::math::Transform;
 
@@ -162,6 +162,19 @@ pub static SHAPES: Registry<Build> = Registry {
                       emitter (Mitsuba gives curves no area sampling).",
             params: &[CURVE_FILENAME, TO_WORLD, BSDF, EMITTER, INTERIOR, EXTERIOR],
             build: build_linear_curve,
+        },
+        Plugin {
+            name: "bsplinecurve",
+            origin: Origin::Mitsuba3,
+            summary: "Round uniform cubic B-spline curves from a text file of control points \
+                      `x y z radius` (a blank line between curves, at least four points each; \
+                      n points make n − 3 segments): the sweep of circles of varying radius \
+                      orthogonal to the curve, open at both ends (Embree's round B-spline \
+                      curves). `to_world` moves the points, not the radii (as in Mitsuba); back \
+                      faces are culled; no area emitter (Mitsuba gives curves no area \
+                      sampling).",
+            params: &[CURVE_FILENAME, TO_WORLD, BSDF, EMITTER, INTERIOR, EXTERIOR],
+            build: build_bspline_curve,
         },
         Plugin {
             name: "shapegroup",
@@ -317,7 +330,7 @@ const RADIUS: ParamSpec = ParamSpec::new(
 
 /// Whether `plugin` makes curves: shapes that are hit but have no area (nor area sampling).
 pub fn is_curve(plugin: &Plugin<Build>) -> bool {
-    plugin.name == "linearcurve"
+    matches!(plugin.name, "linearcurve" | "bsplinecurve")
 }
 
 /// The plugin a `<shape>` names, and its parameters.
@@ -514,6 +527,28 @@ fn build_cylinder(params: &Params, to_world: &Transform) -> Result<Shape> {
 
 /// Round linear curves read from a file, their points placed by `to_world` (radii unchanged).
 fn build_linear_curve(params: &Params, to_world: &Transform) -> Result<Shape> {
+    let (data, filename) = read_curves(params, to_world, 2)?;
+    LinearCurve::new(data.points, &data.curves)
+        .ok_or_else(|| invalid_curves(params, filename))
+        .map(Shape::LinearCurve)
+}
+
+/// Round B-spline curves read from a file, their points placed by `to_world` (radii
+/// unchanged).
+fn build_bspline_curve(params: &Params, to_world: &Transform) -> Result<Shape> {
+    let (data, filename) = read_curves(params, to_world, 4)?;
+    BSplineCurve::new(&data.points, &data.curves)
+        .ok_or_else(|| invalid_curves(params, filename))
+        .map(Shape::BSplineCurve)
+}
+
+/// The control points of a curve shape's file (curves of at least `min_points` points),
+/// placed by `to_world`, and the file's name.
+fn read_curves<'a>(
+    params: &'a Params,
+    to_world: &Transform,
+    min_points: usize,
+) -> Result<(CurveData, &'a str)> {
     let node = params.node();
     let filename = params.string_opt(&CURVE_FILENAME)?.ok_or_else(|| {
         Error::input(
@@ -523,7 +558,7 @@ fn build_linear_curve(params: &Params, to_world: &Transform) -> Result<Shape> {
         .with_help("add <string name=\"filename\" value=\"curves.txt\"/>")
     })?;
     let path = node.resolve_file(filename, params.location_of(&CURVE_FILENAME))?;
-    let mut data = load_curves(&path).map_err(|e| mesh_error(e, node))?;
+    let mut data = load_curves(&path, min_points).map_err(|e| mesh_error(e, node))?;
     for point in &mut data.points {
         let p = to_world.point(point.truncate());
         if !p.is_finite() {
@@ -534,14 +569,15 @@ fn build_linear_curve(params: &Params, to_world: &Transform) -> Result<Shape> {
         }
         *point = p.extend(point.w);
     }
-    LinearCurve::new(data.points, &data.curves)
-        .ok_or_else(|| {
-            Error::input(
-                params.location_of(&CURVE_FILENAME),
-                format!("the curves of \"{filename}\" are not valid"),
-            )
-        })
-        .map(Shape::LinearCurve)
+    Ok((data, filename))
+}
+
+/// The error for curves the shape refuses after reading them.
+fn invalid_curves(params: &Params, filename: &str) -> Error {
+    Error::input(
+        params.location_of(&CURVE_FILENAME),
+        format!("the curves of \"{filename}\" are not valid"),
+    )
 }
 
 /// Makes a mesh reading error an input error (the scene names the file) that also says which

@@ -1,6 +1,7 @@
 //! Mitsuba's curve files, read by its `linearcurve` and `bsplinecurve` shapes
-//! (`src/shapes/linearcurve.cpp`): text, one control point `x y z radius` per line, blank lines
-//! (spaces, tabs and carriage returns only) between curves, each curve of at least two points.
+//! (`src/shapes/linearcurve.cpp`, `src/shapes/bsplinecurve.cpp`): text, one control point
+//! `x y z radius` per line, blank lines (spaces, tabs and carriage returns only) between
+//! curves, each curve of at least two points (linear) or four (B-spline).
 //!
 //! As Mitsuba, lines of 1024 characters or more are refused, and there are no comments. Prism is
 //! stricter where Mitsuba would read nonsense: a line must hold exactly four numbers (Mitsuba
@@ -24,25 +25,33 @@ pub struct CurveData {
     pub curves: Vec<u32>,
 }
 
-/// Reads a curve file (see the module documentation).
-pub fn load_curves(path: &Path) -> Result<CurveData> {
+/// Reads a curve file (see the module documentation) whose curves have at least `min_points`
+/// control points each.
+pub fn load_curves(path: &Path, min_points: usize) -> Result<CurveData> {
     let bytes = std::fs::read(path).map_err(|e| Error::io(path, &e, "read the curves"))?;
-    parse_curves(&bytes, path)
+    parse_curves(&bytes, path, min_points)
 }
 
-/// Parses the bytes of a curve file; `path` names it in errors, which give the line and column.
-pub fn parse_curves(bytes: &[u8], path: &Path) -> Result<CurveData> {
+/// Parses the bytes of a curve file whose curves have at least `min_points` control points
+/// each; `path` names it in errors, which give the line and column.
+pub fn parse_curves(bytes: &[u8], path: &Path, min_points: usize) -> Result<CurveData> {
     let mut data = CurveData::default();
     // The line where the curve being read began, to name it if it ends too short.
     let mut open: Option<usize> = None;
     let close = |data: &CurveData, open: Option<usize>| -> Result<()> {
         match (open, data.curves.last()) {
-            (Some(line), Some(&first)) if data.points.len() - first as usize == 1 => {
+            (Some(line), Some(&first)) if data.points.len() - (first as usize) < min_points => {
+                let count = data.points.len() - first as usize;
+                let has = if count == 1 {
+                    "a single control point".to_string()
+                } else {
+                    format!("{count} control points")
+                };
                 Err(Error::input(
                     &location(path, line, 1),
-                    "this curve has a single control point; a curve needs at least two",
+                    format!("this curve has {has}; a curve here needs at least {min_points}"),
                 )
-                .with_help("add a second point, or remove the blank line that splits the curve"))
+                .with_help("add points, or remove the blank line that splits the curve"))
             }
             _ => Ok(()),
         }
@@ -139,7 +148,7 @@ mod tests {
     use super::*;
 
     fn parse(text: &str) -> Result<CurveData> {
-        parse_curves(text.as_bytes(), Path::new("c.txt"))
+        parse_curves(text.as_bytes(), Path::new("c.txt"), 2)
     }
 
     #[test]
@@ -175,5 +184,21 @@ mod tests {
         assert!(m.contains("c.txt:1:1") && m.contains("1023"), "{m}");
         let m = message("\n\n");
         assert!(m.contains("no control points"), "{m}");
+    }
+
+    #[test]
+    fn b_spline_curves_need_four_points() {
+        let four = "0 0 0 1\n1 0 0 1\n2 0 0 1\n3 0 0 1\n";
+        let path = Path::new("b.txt");
+        let data = parse_curves(four.as_bytes(), path, 4).unwrap();
+        assert_eq!((data.points.len(), data.curves.clone()), (4, vec![0]));
+        let text = format!("{four}\n4 0 0 1\n5 0 0 1\n6 0 0 1\n");
+        let m = parse_curves(text.as_bytes(), path, 4)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            m.contains("b.txt:6:1") && m.contains("3 control points") && m.contains("at least 4"),
+            "{m}"
+        );
     }
 }

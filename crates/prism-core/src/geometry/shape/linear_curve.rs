@@ -164,7 +164,7 @@ impl LinearCurve {
 /// Mitsuba's frame around a segment's unit axis: the rotation axis is the projection of +z
 /// orthogonal to the axis (+y when the axis is ±z), the radial axis its cross product with
 /// the axis.
-fn local_frame(axis: DVec3) -> (DVec3, DVec3) {
+pub(super) fn local_frame(axis: DVec3) -> (DVec3, DVec3) {
     let guide = DVec3::Z;
     let u_rot = if axis.dot(guide).abs() == 1.0 {
         DVec3::Y

@@ -1,8 +1,9 @@
-//! The shapes a scene is made of: triangle meshes, spheres, disks, cylinders and linear curves, in world space (or in the
+//! The shapes a scene is made of: triangle meshes, spheres, disks, cylinders, linear and B-spline curves, in world space (or in the
 //! object space of an [`super::instance::Instance`]), dispatched by `match` (DESIGN.md §3.1).
 //! Shapes know their own intersection, surface points and sampling; the hierarchies over them
 //! ([`super::aggregate`]) and the shapes placed by transforms ([`super::primitive`]) sit above.
 
+pub mod bspline_curve;
 pub mod cylinder;
 pub mod disk;
 pub mod linear_curve;
@@ -12,6 +13,7 @@ pub mod uv_grid;
 
 use glam::{Vec2, Vec3};
 
+pub use bspline_curve::BSplineCurve;
 pub use cylinder::Cylinder;
 pub use disk::Disk;
 pub use linear_curve::LinearCurve;
@@ -31,6 +33,8 @@ pub enum Shape {
     Cylinder(Cylinder),
     /// Round linear curves; each segment is one primitive of the hierarchy.
     LinearCurve(LinearCurve),
+    /// Round uniform cubic B-spline curves; each segment is one primitive of the hierarchy.
+    BSplineCurve(BSplineCurve),
 }
 
 impl Shape {
@@ -41,7 +45,7 @@ impl Shape {
             Shape::Disk(disk) => disk.area(),
             Shape::Cylinder(cylinder) => cylinder.area(),
             // Mitsuba gives curves no area or sampling: they cannot be area lights.
-            Shape::LinearCurve(_) => 0.0,
+            Shape::LinearCurve(_) | Shape::BSplineCurve(_) => 0.0,
         }
     }
 
@@ -72,6 +76,7 @@ impl Shape {
                     |(lo, hi), p| (lo.min(p), hi.max(p)),
                 ),
             Shape::LinearCurve(curve) => curve.bounds(),
+            Shape::BSplineCurve(curve) => curve.bounds(),
         }
     }
 
@@ -80,6 +85,7 @@ impl Shape {
     pub fn part_count(&self) -> Option<usize> {
         match self {
             Shape::LinearCurve(curve) => Some(curve.segment_count()),
+            Shape::BSplineCurve(curve) => Some(curve.segment_count()),
             _ => None,
         }
     }
@@ -88,6 +94,7 @@ impl Shape {
     pub fn part_bounds(&self, part: u32) -> (Vec3, Vec3) {
         match self {
             Shape::LinearCurve(curve) => curve.segment_bounds(part as usize),
+            Shape::BSplineCurve(curve) => curve.segment_bounds(part as usize),
             _ => self.object_bounds(),
         }
     }
@@ -97,6 +104,9 @@ impl Shape {
     pub fn intersect_part(&self, ray: &Ray, part: u32, t_max: f32) -> Option<f32> {
         match self {
             Shape::LinearCurve(curve) => curve
+                .intersect_segment(part as usize, ray.o, ray.d, t_max)
+                .map(|hit| hit.t),
+            Shape::BSplineCurve(curve) => curve
                 .intersect_segment(part as usize, ray.o, ray.d, t_max)
                 .map(|hit| hit.t),
             _ => self.intersect_analytic(ray, t_max),
@@ -111,6 +121,7 @@ impl Shape {
             Shape::Disk(disk) => disk.intersect(ray.o, ray.d, t_max),
             Shape::Cylinder(cylinder) => cylinder.intersect(ray.o, ray.d, t_max),
             Shape::LinearCurve(curve) => curve.intersect(ray.o, ray.d, t_max).map(|(_, h)| h.t),
+            Shape::BSplineCurve(curve) => curve.intersect(ray.o, ray.d, t_max).map(|(_, h)| h.t),
             Shape::Mesh(_) => None,
         }
     }
@@ -146,6 +157,8 @@ impl Shape {
                 };
                 curve.interaction(ray.o, ray.d, hit.t, segment, index)
             }
+            // Finds its segment again itself when the named one was not hit.
+            Shape::BSplineCurve(curve) => curve.interaction(ray.o, ray.d, hit.t, primitive, index),
         }
     }
 
@@ -157,7 +170,7 @@ impl Shape {
             Shape::Sphere(sphere) => Some(sphere.sample_area(u)),
             Shape::Disk(disk) => Some(disk.sample_area(u)),
             Shape::Cylinder(cylinder) => Some(cylinder.sample_area(u)),
-            Shape::LinearCurve(_) => None,
+            Shape::LinearCurve(_) | Shape::BSplineCurve(_) => None,
         }
     }
 
@@ -166,7 +179,11 @@ impl Shape {
     pub fn sample_from(&self, reference: Vec3, u_choice: f32, u: Vec2) -> Option<SurfaceSample> {
         match self {
             Shape::Sphere(sphere) => sphere.sample_from(reference, u),
-            Shape::Mesh(_) | Shape::Disk(_) | Shape::Cylinder(_) | Shape::LinearCurve(_) => {
+            Shape::Mesh(_)
+            | Shape::Disk(_)
+            | Shape::Cylinder(_)
+            | Shape::LinearCurve(_)
+            | Shape::BSplineCurve(_) => {
                 let s = self.sample_area(u_choice, u)?;
                 let pdf = area_to_solid_angle(s.pdf, reference, s.p, s.n)?;
                 Some(SurfaceSample { pdf, ..s })
@@ -179,7 +196,7 @@ impl Shape {
     pub fn pdf_from(&self, reference: Vec3, p: Vec3, n: Vec3) -> f32 {
         match self {
             Shape::Sphere(sphere) => sphere.pdf_from(reference, p, n),
-            Shape::LinearCurve(_) => 0.0,
+            Shape::LinearCurve(_) | Shape::BSplineCurve(_) => 0.0,
             Shape::Mesh(_) | Shape::Disk(_) | Shape::Cylinder(_) => {
                 area_to_solid_angle(1.0 / self.area(), reference, p, n).unwrap_or(0.0)
             }
@@ -196,7 +213,7 @@ impl Shape {
             Shape::Sphere(sphere) => sphere.at_uv(uv),
             Shape::Disk(disk) => disk.at_uv(uv),
             Shape::Cylinder(cylinder) => cylinder.at_uv(uv),
-            Shape::LinearCurve(_) => None,
+            Shape::LinearCurve(_) | Shape::BSplineCurve(_) => None,
         }
     }
 
@@ -214,7 +231,7 @@ impl Shape {
             Shape::Sphere(sphere) => sphere.at_uv(uv).map(|(_, j)| j),
             Shape::Disk(disk) => disk.at_uv(uv).map(|(_, j)| j),
             Shape::Cylinder(cylinder) => cylinder.at_uv(uv).map(|(_, j)| j),
-            Shape::LinearCurve(_) => None,
+            Shape::LinearCurve(_) | Shape::BSplineCurve(_) => None,
         }
     }
 
@@ -223,6 +240,7 @@ impl Shape {
         match self {
             Shape::Mesh(mesh) => mesh.heap_bytes(),
             Shape::LinearCurve(curve) => curve.heap_bytes(),
+            Shape::BSplineCurve(curve) => curve.heap_bytes(),
             Shape::Sphere(_) | Shape::Disk(_) | Shape::Cylinder(_) => 0,
         }
     }
