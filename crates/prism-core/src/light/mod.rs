@@ -4,7 +4,7 @@
 //! ("Direct Light Sampling"): area lights are integrated over their surface (or, for spheres,
 //! over the cone they subtend); point, spot and projector lights are single points and directional lights
 //! single directions (Dirac deltas, reached only by light sampling); environment lights
-//! (`constant`, `envmap`) surround the scene at infinity and are also found by rays that leave
+//! (`constant`, `envmap`, `sunsky`) surround the scene at infinity and are also found by rays that leave
 //! it, so they take part in multiple importance sampling like area lights.
 //!
 //! | Mitsuba emitter | file | sampled by |
@@ -16,6 +16,7 @@
 //! | `directional` | [`directional`] | its direction (delta) |
 //! | `constant` | [`constant`] | uniform directions |
 //! | `envmap` | [`envmap`] | directions ∝ luminance · sin θ in the lat-long image |
+//! | `sunsky` | [`sunsky`] | the sky's luminance over (φ, cos θ), and the sun's cone |
 
 pub mod area;
 pub mod constant;
@@ -25,6 +26,7 @@ pub mod point;
 pub mod projector;
 pub mod sampler;
 pub mod spot;
+pub mod sunsky;
 
 use glam::{Vec2, Vec3};
 
@@ -38,6 +40,7 @@ pub use point::PointLight;
 pub use projector::Projector;
 pub use sampler::{LightSampler, LightSelection};
 pub use spot::SpotLight;
+pub use sunsky::{Sunsky, SunskySettings};
 
 /// A light source of the scene.
 #[derive(Clone, Debug)]
@@ -49,6 +52,7 @@ pub enum Light {
     Directional(DirectionalLight),
     Constant(ConstantLight),
     Envmap(EnvironmentMap),
+    Sunsky(Box<Sunsky>),
 }
 
 /// Incident light sampled at a point: where it comes from and how much arrives.
@@ -137,6 +141,7 @@ impl Light {
             Light::Directional(light) => light.sample_incident(reference, lambda),
             Light::Constant(light) => light.sample_incident(reference, u, lambda),
             Light::Envmap(light) => light.sample_incident(reference, u, lambda),
+            Light::Sunsky(light) => light.sample_incident(reference, u, lambda),
         }
     }
 
@@ -152,6 +157,7 @@ impl Light {
             Light::Directional(light) => light.power(),
             Light::Constant(light) => light.power(),
             Light::Envmap(light) => light.power(),
+            Light::Sunsky(light) => light.power(),
         }
     }
 
@@ -161,6 +167,7 @@ impl Light {
             Light::Directional(light) => light.scene = bounds,
             Light::Constant(light) => light.scene = bounds,
             Light::Envmap(light) => light.scene = bounds,
+            Light::Sunsky(light) => light.scene = bounds,
             Light::Area(_) | Light::Point(_) | Light::Spot(_) | Light::Projector(_) => {}
         }
     }
@@ -168,7 +175,10 @@ impl Light {
     /// Whether this light surrounds the scene and is seen by rays that leave it (Mitsuba's
     /// "environment emitter", of which a scene has at most one).
     pub fn is_environment(&self) -> bool {
-        matches!(self, Light::Constant(_) | Light::Envmap(_))
+        matches!(
+            self,
+            Light::Constant(_) | Light::Envmap(_) | Light::Sunsky(_)
+        )
     }
 
     /// Radiance arriving along a ray that leaves the scene in direction `d` (unit): the
@@ -178,6 +188,7 @@ impl Light {
         match self {
             Light::Constant(light) => light.radiance(lambda),
             Light::Envmap(light) => light.radiance(d, lambda),
+            Light::Sunsky(light) => light.radiance(d, lambda),
             _ => SampledSpectrum::ZERO,
         }
     }
@@ -189,6 +200,7 @@ impl Light {
         match self {
             Light::Constant(light) => light.pdf(),
             Light::Envmap(light) => light.pdf(d),
+            Light::Sunsky(light) => light.pdf(d),
             _ => 0.0,
         }
     }
