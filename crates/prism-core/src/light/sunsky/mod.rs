@@ -205,6 +205,13 @@ impl Sunsky {
                 cells.push(luminance(uv_to_direction(uv)));
             }
         }
+        // A table of other data than Mitsuba's may overflow: such cells weigh nothing.
+        let limit = f64::from(f32::MAX) / cells.len() as f64;
+        for y in &mut cells {
+            if !(*y <= limit) {
+                *y = 0.0;
+            }
+        }
         let mean = cells.iter().sum::<f64>() / cells.len() as f64;
         // Every cell keeps a little density, so that no direction the sky lights is missed.
         let floor = 1e-3 * mean;
@@ -217,6 +224,9 @@ impl Sunsky {
         let solid_angle = 2.0 * std::f64::consts::PI * f64::from(self.one_minus_cos_aperture);
         self.sun_luminous =
             f64::from(self.sun_scale) * sun_y * f64::from(self.area_ratio) * solid_angle;
+        if !(self.sun_luminous.is_finite() && self.sun_luminous >= 0.0) {
+            self.sun_luminous = 0.0;
+        }
         let total = self.sky_luminous + self.sun_luminous;
         self.sky_weight = if total > 0.0 {
             (self.sky_luminous / total) as f32
