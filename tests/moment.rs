@@ -9,6 +9,7 @@ mod common;
 use common::scenes::{Object, build, camera, render_film};
 use glam::{DMat4, DVec3, Mat3, UVec2, Vec3};
 use prism_core::film::Film;
+use prism_core::film::accumulation::AOV_SUMS_PER_CHANNEL;
 use prism_core::geometry::{Shape, Sphere};
 use prism_core::integrator::{DirectIntegrator, Integrator, MomentIntegrator, PathIntegrator};
 use prism_core::light::{ConstantLight, Light};
@@ -113,7 +114,7 @@ fn moments_are_the_images_sums_and_sums_of_squares() {
     let moment = render_film(&room(two_nested()), spp, 7, Some(2));
     let plain = render_film(&room(PathIntegrator::default().into()), spp, 7, Some(2));
     assert_eq!(moment.pixels, plain.pixels);
-    let k = moment.aov_names.len();
+    let k = AOV_SUMS_PER_CHANNEL * moment.aov_names.len();
     for (c, axis) in ["X", "Y", "Z"].iter().enumerate() {
         let first = channel(&moment, &format!("pt.{axis}"));
         let second = channel(&moment, &format!("m2_pt.{axis}"));

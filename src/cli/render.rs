@@ -21,7 +21,7 @@ use crate::accel::Accel;
 use prism_core::error::{Error, Result};
 use prism_core::film::stats::rejected_report;
 use prism_core::film::write_images_with;
-use prism_core::film::{CropWindow, PixelSums};
+use prism_core::film::{CropWindow, PixelSums, Reconstruction};
 use prism_core::integrator::RayCount;
 use prism_core::render::state::{RenderIdentity, RenderState};
 use prism_core::render::{
@@ -31,7 +31,7 @@ use prism_core::render::{
 use prism_core::sampling::sampler::{Sampler, SamplerKind};
 use prism_core::scene::Scene;
 use prism_core::spectrum::WavelengthSampling;
-use prism_mitsuba::fingerprint::override_wavelengths;
+use prism_mitsuba::fingerprint::{override_reconstruction, override_wavelengths};
 use prism_mitsuba::load_scene;
 
 #[derive(Args, Debug)]
@@ -88,6 +88,10 @@ pub struct RenderArgs {
     /// balanced, cie_sum, visible or uniform
     #[arg(long, value_name = "DENSITY", value_parser = parse_wavelengths)]
     pub wavelengths: Option<WavelengthSampling>,
+    /// How samples become pixels, instead of the film's `reconstruction`: filter_mis (every
+    /// sample feeds every pixel its filter covers) or pixel (the lecture's one-pixel estimator)
+    #[arg(long, value_name = "METHOD", value_parser = parse_reconstruction)]
+    pub reconstruction: Option<Reconstruction>,
 }
 
 pub(crate) fn parse_define(text: &str) -> Result<(String, String), String> {
@@ -112,6 +116,15 @@ fn parse_numbers(
         return Err(format!("expected {what}, got \"{text}\""));
     }
     Ok(numbers)
+}
+
+pub(crate) fn parse_reconstruction(text: &str) -> Result<Reconstruction, String> {
+    Reconstruction::from_name(text).ok_or_else(|| {
+        format!(
+            "expected one of {}, got \"{text}\"",
+            Reconstruction::NAMES.join(", ")
+        )
+    })
 }
 
 pub(crate) fn parse_wavelengths(text: &str) -> Result<WavelengthSampling, String> {
@@ -280,11 +293,11 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     if let Some(density) = args.wavelengths {
         override_wavelengths(&mut scene, density);
     }
+    if let Some(reconstruction) = args.reconstruction {
+        override_reconstruction(&mut scene, reconstruction);
+    }
     let seed = args.seed.unwrap_or(loaded.seed);
-    let strata = scene
-        .sampler
-        .kind
-        .sample_count(args.spp.unwrap_or(scene.sampler.samples_per_pixel));
+    let strata = scene.strata(args.spp.unwrap_or(scene.sampler.samples_per_pixel));
     if let Some([x, y]) = args.pixel {
         return trace_pixel(&scene, UVec2::new(x, y), strata, seed, args);
     }
@@ -305,7 +318,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         let state = RenderState::read(path)?;
         if let Some(reason) = identity.mismatch(&state.identity) {
             return Err(Error::usage(format!("cannot resume from \"{}\": {reason}", path.display()))
-                .with_help("resume with the same scene, -D values, --spp, --seed, --crop and --wavelengths as the interrupted render"));
+                .with_help("resume with the same scene, -D values, --spp, --seed, --crop, --wavelengths and --reconstruction as the interrupted render"));
         }
         let [range] = state.ranges.as_slice() else {
             return Err(Error::usage(format!(

@@ -4,6 +4,7 @@ stopping rules; progress reports."""
 import math
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -140,6 +141,30 @@ def test_an_unknown_wavelength_density_is_an_error(cornell_path):
     assert "visibel" in raised.value.message
     assert "visible" in (raised.value.help or "")
     assert scene.wavelengths == "balanced"
+
+
+def test_the_reconstruction_is_the_command_lines_option(prism_cli, tmp_path):
+    bar = Path(__file__).resolve().parents[2] / "scenes" / "filters" / "mitchell-bar.xml"
+    assert bar.is_file(), f"{bar} is missing"
+    exr = tmp_path / "pixel.exr"
+    subprocess.run(
+        [str(prism_cli), "render", str(bar), "-o", str(exr), "--spp", "3", "--seed", "7"]
+        + ["--reconstruction", "pixel", "-D", "resx=16", "-D", "resy=12"],
+        check=True,
+        capture_output=True,
+    )
+    scene = pr.load_file(bar, resx=16, resy=12)
+    assert scene.reconstruction == "filter_mis"
+    shared = pr.render(scene, spp=3, seed=7, progress=False)
+    scene.reconstruction = "pixel"
+    assert scene.reconstruction == "pixel"
+    pixel = pr.render(scene, spp=3, seed=7, progress=False)
+    assert_same_image(pixel, pr.Image.read(exr))
+    assert not np.array_equal(shared.xyz, pixel.xyz)
+    with pytest.raises(pr.PrismError) as raised:
+        scene.reconstruction = "splat"
+    assert "splat" in raised.value.message
+    assert "filter_mis" in (raised.value.help or "")
 
 
 AOV_INTEGRATOR = """<integrator type="aov">

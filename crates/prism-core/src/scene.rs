@@ -4,7 +4,7 @@
 use glam::UVec2;
 
 use crate::camera::{Camera, Shutter};
-use crate::film::{CropWindow, Filter, LdrOutput};
+use crate::film::{CropWindow, Filter, LdrOutput, Reconstruction};
 use crate::integrator::Integrator;
 pub use crate::sampling::sampler::SamplerKind;
 use crate::spectrum::WavelengthSampling;
@@ -16,6 +16,8 @@ pub struct FilmSettings {
     pub size: UVec2,
     pub crop: CropWindow,
     pub filter: Filter,
+    /// How samples become pixel values.
+    pub reconstruction: Reconstruction,
     /// The density the wavelengths of each camera sample are drawn from.
     pub wavelength_sampling: WavelengthSampling,
 }
@@ -64,6 +66,20 @@ impl Scene {
             shutter: Shutter::instant(),
             ldr_output: LdrOutput::default(),
             fingerprint: 0,
+        }
+    }
+
+    /// The samples per pixel of one stratified block of the sampler, for a render asked for
+    /// `requested` samples per pixel: the sampler's count for that many
+    /// ([`crate::sampling::sampler::SamplerKind::sample_count`]), or for half as many when the
+    /// film shares samples between pixels, whose control variate takes alternate blocks as
+    /// its two independent halves ([`crate::film::reconstruction`]).
+    pub fn strata(&self, requested: u32) -> u32 {
+        let kind = self.sampler.kind;
+        if self.film.reconstruction.shares_samples(self.film.filter) {
+            kind.sample_count(requested.div_ceil(2))
+        } else {
+            kind.sample_count(requested)
         }
     }
 }

@@ -2,6 +2,7 @@
 //! not where the files are) and of the contents of every file it names, so that a render state
 //! can tell whether it belongs to the scene it is resumed or merged with, on any machine.
 
+use prism_core::film::Reconstruction;
 use prism_core::scene::Scene;
 use prism_core::spectrum::WavelengthSampling;
 
@@ -40,10 +41,21 @@ impl Fnv64 {
 /// density is refused.
 pub fn override_wavelengths(scene: &mut Scene, density: WavelengthSampling) {
     scene.film.wavelength_sampling = density;
+    mix_into_fingerprint(scene, "wavelength_sampling", density.name());
+}
+
+/// Sets the film's reconstruction in place of the scene's (a command-line override), and mixes
+/// it into the fingerprint so that a render state records it.
+pub fn override_reconstruction(scene: &mut Scene, reconstruction: Reconstruction) {
+    scene.film.reconstruction = reconstruction;
+    mix_into_fingerprint(scene, "reconstruction", reconstruction.name());
+}
+
+fn mix_into_fingerprint(scene: &mut Scene, setting: &str, value: &str) {
     let mut hash = Fnv64::default();
     hash.write(&scene.fingerprint.to_le_bytes());
-    hash.write_str("wavelength_sampling");
-    hash.write_str(density.name());
+    hash.write_str(setting);
+    hash.write_str(value);
     scene.fingerprint = hash.finish();
 }
 

@@ -9,8 +9,9 @@ use pyo3::types::PyDict;
 use crate::dict::dict_of;
 use crate::error::{IntoPyResult, to_py};
 use prism_core::error::Error;
+use prism_core::film::Reconstruction;
 use prism_core::spectrum::WavelengthSampling;
-use prism_mitsuba::fingerprint::override_wavelengths;
+use prism_mitsuba::fingerprint::{override_reconstruction, override_wavelengths};
 use prism_mitsuba::{LoadedScene, load_scene, load_scene_dict};
 
 /// A scene ready to render. Its settings that `prism render` can override from the command
@@ -64,6 +65,27 @@ impl Scene {
             )
         })?;
         override_wavelengths(&mut self.loaded.scene, density);
+        Ok(())
+    }
+
+    /// How samples become pixel values (the film's `reconstruction`): `filter_mis` or `pixel`;
+    /// setting it is `prism render --reconstruction`.
+    #[getter]
+    fn reconstruction(&self) -> &'static str {
+        self.loaded.scene.film.reconstruction.name()
+    }
+
+    #[setter]
+    fn set_reconstruction(&mut self, py: Python<'_>, name: &str) -> PyResult<()> {
+        let reconstruction = Reconstruction::from_name(name).ok_or_else(|| {
+            to_py(
+                py,
+                &Error::usage(format!("no reconstruction is called \"{name}\"")).with_help(
+                    format!("choose one of {}", Reconstruction::NAMES.join(", ")),
+                ),
+            )
+        })?;
+        override_reconstruction(&mut self.loaded.scene, reconstruction);
         Ok(())
     }
 

@@ -55,7 +55,9 @@ pub type SquareSum = ExactSum<36>;
 pub const LARGEST_SAMPLE: f64 = (1u64 << 40) as f64;
 
 /// Running sums for one pixel. With N samples of (filter-weighted) XYZ values vᵢ, the pixel is
-/// Σvᵢ/N; Σvᵢ² gives the variance of that mean.
+/// Σvᵢ/N; Σvᵢ² gives the variance of that mean. Under filter MIS a "sample" is the total Tₛ that
+/// one sample index brings the pixel from all the pixels around it, and [`ControlSums`] hold
+/// what its control variate needs (see [`crate::film::reconstruction`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub struct PixelSums {
     pub xyz: [ValueSum; 3],
@@ -63,6 +65,33 @@ pub struct PixelSums {
     pub samples: u64,
     /// Samples whose value was NaN, infinite or absurdly large, dropped from the sums.
     pub rejected: u64,
+    /// Zero under the one-pixel reconstruction.
+    pub control: ControlSums,
+}
+
+/// The sums of filter MIS's control variate for one pixel: with Tₛ the pixel's total of sample
+/// index s and Wₛ its total filter weight (E[Wₛ] = 1), and the indices split into two
+/// independent halves A and B.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct ControlSums {
+    /// Σ Tₛ over half A.
+    pub xyz_first_half: [ValueSum; 3],
+    /// Σ (Wₛ − 1) over half A, and over half B.
+    pub excess: [ValueSum; 2],
+    /// Σ Tₛ (Wₛ − 1) of each channel.
+    pub xyz_excess: [SquareSum; 3],
+    /// Σ (Wₛ − 1)².
+    pub excess_squared: SquareSum,
+    /// How many of the samples are in half A.
+    pub first_half_samples: u64,
+}
+
+/// Whether every value is finite and not absurdly large.
+#[inline]
+pub fn acceptable_sample(values: &[f32]) -> bool {
+    values
+        .iter()
+        .all(|v| v.is_finite() && f64::from(v.abs()) < LARGEST_SAMPLE)
 }
 
 impl PixelSums {
@@ -70,10 +99,7 @@ impl PixelSums {
     #[inline]
     pub fn add(&mut self, xyz: [f32; 3]) {
         self.samples += 1;
-        if !xyz
-            .iter()
-            .all(|v| v.is_finite() && f64::from(v.abs()) < LARGEST_SAMPLE)
-        {
+        if !acceptable_sample(&xyz) {
             self.rejected += 1;
             return;
         }
@@ -84,12 +110,58 @@ impl PixelSums {
         }
     }
 
+    /// Adds the total `xyz` of one sample index under filter MIS, with its weight's excess
+    /// W − 1, to half A (`second_half` false) or B. Its sources were screened already
+    /// ([`Self::count_rejected`]); a total that is still not finite is counted and dropped.
+    #[inline]
+    pub fn add_shared(&mut self, xyz: [f64; 3], excess: f64, second_half: bool) {
+        self.samples += 1;
+        if !(xyz
+            .iter()
+            .all(|v| v.is_finite() && v.abs() < LARGEST_SAMPLE)
+            && excess.is_finite())
+        {
+            self.rejected += 1;
+            return;
+        }
+        let control = &mut self.control;
+        for (c, v) in xyz.into_iter().enumerate() {
+            self.xyz[c].add(v);
+            self.xyz_squared[c].add(v * v);
+            control.xyz_excess[c].add(v * excess);
+            if !second_half {
+                control.xyz_first_half[c].add(v);
+            }
+        }
+        control.excess[usize::from(second_half)].add(excess);
+        control.excess_squared.add(excess * excess);
+        if !second_half {
+            control.first_half_samples += 1;
+        }
+    }
+
+    /// One of the samples drawn in this pixel was rejected: under filter MIS it adds nothing to
+    /// any pixel, and is counted here, where it was drawn.
+    #[inline]
+    pub fn count_rejected(&mut self) {
+        self.rejected += 1;
+    }
+
     /// Adds the sums of other samples of the same pixel.
     pub fn merge(&mut self, other: &PixelSums) {
         for c in 0..3 {
             self.xyz[c].merge(other.xyz[c]);
             self.xyz_squared[c].merge(other.xyz_squared[c]);
+            self.control.xyz_first_half[c].merge(other.control.xyz_first_half[c]);
+            self.control.xyz_excess[c].merge(other.control.xyz_excess[c]);
         }
+        for h in 0..2 {
+            self.control.excess[h].merge(other.control.excess[h]);
+        }
+        self.control
+            .excess_squared
+            .merge(other.control.excess_squared);
+        self.control.first_half_samples += other.control.first_half_samples;
         self.samples += other.samples;
         self.rejected += other.rejected;
     }
@@ -104,13 +176,57 @@ impl PixelSums {
         self.xyz_squared[c].value()
     }
 
-    /// The pixel's estimate of XYZ: the mean over all samples taken (a rejected sample counts as
-    /// zero, which keeps the estimate unbiased for integrands that are finite almost everywhere).
-    pub fn mean(&self) -> [f64; 3] {
+    /// The estimate of a quantity whose sum over all samples is `sum` and over half A
+    /// `first_half`: (sum − β_B Σ_A (W − 1) − β_A Σ_B (W − 1)) / N, where β of a half is its
+    /// ratio Σ T / Σ W (its plain mean where Σ W is under half its sample count). Each half's
+    /// correction has mean zero given the other half, so this is unbiased; without a control
+    /// variate (the excesses are zero) it is sum / N exactly.
+    pub fn controlled_mean(&self, sum: f64, first_half: f64) -> f64 {
         if self.samples == 0 {
-            return [0.0; 3];
+            return 0.0;
         }
-        [0, 1, 2].map(|c| self.sum(c) / self.samples as f64)
+        let n = self.samples as f64;
+        let [excess_a, excess_b] = self.control.excess.map(ExactSum::value);
+        if excess_a == 0.0 && excess_b == 0.0 {
+            return sum / n;
+        }
+        let n_a = self.control.first_half_samples as f64;
+        let ratio = |total: f64, count: f64, excess: f64| {
+            if count == 0.0 {
+                0.0
+            } else if count + excess >= 0.5 * count {
+                total / (count + excess)
+            } else {
+                total / count
+            }
+        };
+        let beta_a = ratio(first_half, n_a, excess_a);
+        let beta_b = ratio(sum - first_half, n - n_a, excess_b);
+        (sum - beta_b * excess_a - beta_a * excess_b) / n
+    }
+
+    /// The pixel's estimate of XYZ: the mean over all samples taken, with filter MIS's control
+    /// variate (a rejected sample counts as zero, which keeps the estimate unbiased for
+    /// integrands that are finite almost everywhere).
+    pub fn mean(&self) -> [f64; 3] {
+        [0, 1, 2].map(|c| self.controlled_mean(self.sum(c), self.control.xyz_first_half[c].value()))
+    }
+
+    /// The variance of [`Self::mean`] of channel `c`, infinite with fewer than two samples: the
+    /// sample variance over N of the residuals rₛ = Tₛ − Î (Wₛ − 1) (the delta method for the
+    /// ratio; Tₛ itself without a control variate), unbiased for independent sample indices.
+    pub fn variance_of_mean(&self, c: usize) -> f64 {
+        if self.samples < 2 {
+            return f64::INFINITY;
+        }
+        let n = self.samples as f64;
+        let beta = self.mean()[c];
+        let excess: f64 = self.control.excess.iter().map(|e| e.value()).sum();
+        let sum = self.sum(c) - beta * excess;
+        let squares = self.sum_of_squares(c) - 2.0 * beta * self.control.xyz_excess[c].value()
+            + beta * beta * self.control.excess_squared.value();
+        let mean = sum / n;
+        ((squares / n - mean * mean) / (n - 1.0)).max(0.0)
     }
 }
 
@@ -126,6 +242,24 @@ pub fn add_aov_sample(sums: &mut [ValueSum], values: &[f32]) {
     }
 }
 
+/// Adds one sample index's totals of a pixel's K extra channels under filter MIS: `sums` holds
+/// the K sums over all samples, then the K over half A ([`Film::aovs`]).
+#[inline]
+pub fn add_shared_aov_sample(sums: &mut [ValueSum], values: &[f64], second_half: bool) {
+    let (all, first_half) = sums.split_at_mut(values.len());
+    for ((sum, half), &v) in all.iter_mut().zip(first_half).zip(values) {
+        if v.is_finite() && v.abs() < LARGEST_SAMPLE {
+            sum.add(v);
+            if !second_half {
+                half.add(v);
+            }
+        }
+    }
+}
+
+/// The sums kept per pixel and extra channel: over all samples, and over half A.
+pub const AOV_SUMS_PER_CHANNEL: usize = 2;
+
 /// The image being rendered.
 #[derive(Clone, Debug)]
 pub struct Film {
@@ -136,9 +270,10 @@ pub struct Film {
     pub pixels: Vec<PixelSums>,
     /// Names of the extra channels (AOVs) beside the image, as the EXR names them.
     pub aov_names: Vec<String>,
-    /// Sums of the filter-weighted samples of the extra channels: pixel i's K channels at
-    /// i·K .. (i + 1)·K, K = `aov_names.len()`. A channel's value is its sum over the pixel's
-    /// sample count, as the image's.
+    /// Sums of the filter-weighted samples of the extra channels, 2K per pixel (K =
+    /// `aov_names.len()`): pixel i's K sums over all its samples at 2iK .. 2iK + K, then their K
+    /// sums over half A of filter MIS's control variate (zero under the one-pixel
+    /// reconstruction). A channel's value is controlled as the image's ([`PixelSums::mean`]).
     pub aovs: Vec<ValueSum>,
 }
 
@@ -155,7 +290,7 @@ impl Film {
             size,
             crop,
             pixels: vec![PixelSums::default(); pixel_count],
-            aovs: vec![ValueSum::default(); pixel_count * aov_names.len()],
+            aovs: vec![ValueSum::default(); pixel_count * AOV_SUMS_PER_CHANNEL * aov_names.len()],
             aov_names,
         }
     }
@@ -167,11 +302,8 @@ impl Film {
             .iter()
             .enumerate()
             .map(|(i, p)| {
-                if p.samples == 0 {
-                    0.0
-                } else {
-                    (self.aovs[i * k + channel].value() / p.samples as f64) as f32
-                }
+                let sums = &self.aovs[i * 2 * k..(i + 1) * 2 * k];
+                p.controlled_mean(sums[channel].value(), sums[k + channel].value()) as f32
             })
             .collect()
     }

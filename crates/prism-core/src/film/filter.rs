@@ -151,6 +151,16 @@ impl FilterSampler {
         self.filter
     }
 
+    /// ∫ k(x) dx over the support (tabulated by Simpson's rule for kernels other than the box
+    /// and the tent).
+    pub fn integral_1d(&self) -> f32 {
+        match (&self.table, self.filter) {
+            (Some((_, integral)), _) => *integral,
+            (None, Filter::Tent { radius }) => radius,
+            (None, filter) => 2.0 * filter.radius(),
+        }
+    }
+
     /// One coordinate of an offset, with density ∝ |k|, and its weight k(x) / (p(x) ∫k): 1 for
     /// the box and the tent, whose densities are exactly k/∫k.
     #[inline]

@@ -1,4 +1,4 @@
-//! The film: reconstruction filters and their samplers, per-pixel accumulation of XYZ, the
+//! The film: reconstruction filters and their samplers, how samples become pixel values, per-pixel accumulation of XYZ, the
 //! error estimated from the samples, and the images written at the end (an EXR, and an 8-bit
 //! image tonemapped as the film asks).
 
@@ -6,9 +6,11 @@ pub mod accumulation;
 pub mod filter;
 pub mod ldr;
 pub mod output;
+pub mod reconstruction;
 pub mod stats;
 
 pub use accumulation::{CropWindow, Film, PixelSums, ValueSum};
 pub use filter::{Filter, FilterSampler};
 pub use ldr::{LdrFormat, LdrOutput, Tonemap, TransferCurve};
 pub use output::{FilmImages, write_images, write_images_with};
+pub use reconstruction::{FilterMis, Reconstruction};

@@ -3,7 +3,8 @@
 //!
 //! For a pixel with n samples vᵢ (filter-weighted luminance Y) the estimate is the mean m and the
 //! variance of that mean is estimated by s²/n with s² = (Σvᵢ² − n m²)/(n − 1), unbiased for
-//! independent samples. With a stratified sampler the samples of a pixel are negatively
+//! independent samples. Under filter MIS the vᵢ are the totals of whole sample indices over the
+//! pixels around, less the control variate's share ([`crate::film::reconstruction`]). With a stratified sampler the samples of a pixel are negatively
 //! correlated and s²/n overestimates the true variance: the error is then conservative.
 //!
 //! The pixel's relative standard error is √(s²/n / (m² + 0.01)): the same regularised
@@ -14,14 +15,10 @@ use super::{Film, PixelSums};
 use crate::image::compare::RELATIVE_EPSILON;
 
 /// Variance of the pixel mean of channel `c` (0 = X, 1 = Y, 2 = Z); infinite with fewer than two
-/// samples.
+/// samples ([`PixelSums::variance_of_mean`], which also accounts for filter MIS's control
+/// variate).
 pub fn variance_of_mean(pixel: &PixelSums, c: usize) -> f64 {
-    let n = pixel.samples as f64;
-    if pixel.samples < 2 {
-        return f64::INFINITY;
-    }
-    let mean = pixel.sum(c) / n;
-    ((pixel.sum_of_squares(c) / n - mean * mean) / (n - 1.0)).max(0.0)
+    pixel.variance_of_mean(c)
 }
 
 /// The relative standard error of a pixel's luminance: √(var / (Y² + 0.01)).

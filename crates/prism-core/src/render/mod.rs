@@ -2,10 +2,14 @@
 //! within a pass the tiles of the crop window are rendered in parallel on a rayon pool.
 //!
 //! Every pixel sample draws its random numbers from the sampler's stream for (seed, pixel,
-//! sample index), every sample lands in its own pixel, and pixel sums are exact (order-free) — so
-//! the image is bit-identical whatever the number of threads, the order in which tiles finish,
-//! the way the samples are split into passes, and whether the render was interrupted, resumed
-//! or assembled from several renders of disjoint sample ranges.
+//! sample index), and pixel sums are exact (order-free). Under the one-pixel reconstruction
+//! every sample lands in its own pixel; under filter MIS ([`crate::film::reconstruction`]) the
+//! samples of a batch of indices are first traced for every pixel within the filter's reach of
+//! the crop window and kept, then every pixel gathers, index by index, what its neighbours'
+//! samples bring it, always in the same order. Either way the image is bit-identical whatever
+//! the number of threads, the order in which tiles finish, the way the samples are split into
+//! passes and batches, the crop window, and whether the render was interrupted, resumed or
+//! assembled from several renders of disjoint sample ranges.
 //!
 //! A pass is committed only when all its tiles are done: a pass cut short (by the time limit or
 //! an interruption) is dropped whole, so every pixel always has the same number of samples and
@@ -27,9 +31,11 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
 
 use crate::error::{Error, Result};
-use crate::film::accumulation::add_aov_sample;
+use crate::film::accumulation::{
+    AOV_SUMS_PER_CHANNEL, acceptable_sample, add_aov_sample, add_shared_aov_sample,
+};
 pub use crate::film::stats::relative_error;
-use crate::film::{Film, FilterSampler, PixelSums, ValueSum};
+use crate::film::{Film, FilterMis, FilterSampler, PixelSums, ValueSum};
 use crate::integrator::{PreparedIntegrator, RayCount};
 use crate::sampling::sampler::Sampler;
 use crate::scene::Scene;
@@ -42,6 +48,10 @@ const WORKER_STACK_BYTES: usize = 64 << 20;
 
 /// Edge length of the square tiles the image is divided into.
 const TILE_SIZE: u32 = 16;
+
+/// Under filter MIS, the samples kept for one batch of sample indices take at most about this
+/// many bytes (a batch has at least one index).
+const SHARED_SAMPLES_BYTES: usize = 64 << 20;
 
 /// A render made of several passes aims at passes of about this length, so that stopping rules,
 /// checkpoints and interruptions are acted on promptly and little work is dropped.
@@ -134,7 +144,7 @@ pub struct RenderOptions {
     /// range given to this render).
     pub first_sample: u32,
     /// Sums the render starts from (a resumed render's), row-major over the crop window: the
-    /// image's, and the extra channels' (K per pixel).
+    /// image's, and the extra channels' (2K per pixel, as [`Film::aovs`] holds them).
     pub initial: Option<(Vec<PixelSums>, Vec<ValueSum>)>,
     pub stop: StopRule,
     /// Raised from outside (by a signal handler) to stop the render after dropping its pass.
@@ -227,7 +237,7 @@ pub struct Snapshot<'a> {
     pub samples: Range<u32>,
     /// Pixel sums, row-major over the crop window (including the initial state).
     pub pixels: &'a [PixelSums],
-    /// The extra channels' sums, K per pixel in the same order.
+    /// The extra channels' sums, 2K per pixel in the same order.
     pub aovs: &'a [ValueSum],
 }
 
@@ -293,19 +303,26 @@ impl Cancel<'_> {
 }
 
 /// What every camera sample of a render uses: the scene, its integrator prepared for the
-/// scene's world, and the sampler of the reconstruction filter.
+/// scene's world, the sampler of the reconstruction filter, and filter MIS's weights when the
+/// samples are shared between pixels.
 pub struct SampleEstimator<'a> {
     scene: &'a Scene,
     integrator: PreparedIntegrator<'a>,
     filter: FilterSampler,
+    shared: Option<FilterMis>,
 }
 
 impl<'a> SampleEstimator<'a> {
     pub fn new(scene: &'a Scene) -> SampleEstimator<'a> {
+        let film = &scene.film;
         SampleEstimator {
             scene,
             integrator: scene.integrator.prepare(&scene.world),
-            filter: FilterSampler::new(scene.film.filter),
+            filter: FilterSampler::new(film.filter),
+            shared: film
+                .reconstruction
+                .shares_samples(film.filter)
+                .then(|| FilterMis::new(film.filter, film.size.x, film.size.y)),
         }
     }
 
@@ -314,16 +331,17 @@ impl<'a> SampleEstimator<'a> {
         self.integrator.aov_count()
     }
 
-    /// The filter-weighted CIE XYZ of sample `index` of `pixel` (full-film coordinates); the
-    /// sample's extra channels, weighted by the same filter weight, go to `aovs`.
-    pub fn estimate(
+    /// Traces sample `index` of `pixel` (full-film coordinates): its film offset from the
+    /// pixel's centre, the filter weight the one-pixel estimator gives it, and its CIE XYZ
+    /// weighted by the shutter's filter; its extra channels, weighted alike, go to `aovs`.
+    fn trace(
         &self,
         sampler: &mut Sampler,
         pixel: UVec2,
         index: u32,
         count: &mut RayCount,
         aovs: &mut [f32],
-    ) -> [f32; 3] {
+    ) -> (Vec2, f32, [f32; 3]) {
         let scene = self.scene;
         sampler.start_pixel_sample(pixel, index);
         let primary = sampler.camera_sample();
@@ -333,16 +351,34 @@ impl<'a> SampleEstimator<'a> {
         let film_position = pixel.as_vec2() + Vec2::splat(0.5) + offset;
         let ray = scene.camera.generate_ray(film_position, primary.lens, time);
         let radiance = self.integrator.radiance(ray, &lambda, sampler, count, aovs);
-        let weight = filter_weight * time_weight;
+        for v in aovs.iter_mut() {
+            *v *= time_weight;
+        }
+        let xyz = lambda.to_xyz(&radiance).map(|v| v * time_weight);
+        (offset, filter_weight, xyz)
+    }
+
+    /// The one-pixel estimate of sample `index` of `pixel` (full-film coordinates): its
+    /// filter-weighted CIE XYZ; the sample's extra channels, weighted by the same filter weight,
+    /// go to `aovs`. Under filter MIS the same sample also feeds the pixels around.
+    pub fn estimate(
+        &self,
+        sampler: &mut Sampler,
+        pixel: UVec2,
+        index: u32,
+        count: &mut RayCount,
+        aovs: &mut [f32],
+    ) -> [f32; 3] {
+        let (_, weight, xyz) = self.trace(sampler, pixel, index, count, aovs);
         for v in aovs.iter_mut() {
             *v *= weight;
         }
-        lambda.to_xyz(&radiance).map(|v| v * weight)
+        xyz.map(|v| v * weight)
     }
 }
 
 /// The sums of a tile's pixels, row-major within the tile: the image's and the extra channels'
-/// (K per pixel).
+/// (2K per pixel).
 #[derive(Clone, Debug, Default)]
 struct TileSums {
     pixels: Vec<PixelSums>,
@@ -364,6 +400,7 @@ fn render_tile(
     let mut count = RayCount::default();
     let mut sums = sums.clone();
     let k = estimator.aov_count();
+    let stride = AOV_SUMS_PER_CHANNEL * k;
     // One sample's extra channels, reused for every sample of the tile.
     let mut aovs = vec![0.0f32; k];
     let crop_offset = scene.film.crop.offset;
@@ -378,11 +415,277 @@ fn render_tile(
                 aovs.fill(0.0);
                 let xyz = estimator.estimate(&mut sampler, pixel, index, &mut count, &mut aovs);
                 sums.pixels[i].add(xyz);
-                add_aov_sample(&mut sums.aovs[i * k..(i + 1) * k], &aovs);
+                add_aov_sample(&mut sums.aovs[i * stride..i * stride + k], &aovs);
             }
         }
     }
     Some((sums, count.rays))
+}
+
+/// One pass of the one-pixel reconstruction: every tile's pixels take the samples `range`, in
+/// parallel. None when the pass was cancelled.
+fn render_pass(
+    estimator: &SampleEstimator,
+    tiles: &[Tile],
+    sums: &[TileSums],
+    range: Range<u32>,
+    options: &RenderOptions,
+    cancel: &Cancel,
+    progress: &ProgressSink,
+) -> Option<(Vec<TileSums>, u64)> {
+    let pass = u64::from(range.end - range.start);
+    let results: Vec<Option<(TileSums, u64)>> = tiles
+        .par_iter()
+        .zip(sums)
+        .map(|(&tile, tile_sums)| {
+            let result = render_tile(estimator, tile, tile_sums, range.clone(), options, cancel);
+            if result.is_some() {
+                progress.add(u64::from(tile.size.x * tile.size.y) * pass);
+            }
+            result
+        })
+        .collect();
+    let mut rays = 0;
+    let mut new_sums = Vec::with_capacity(results.len());
+    for result in results {
+        let (tile_sums, tile_rays) = result?;
+        new_sums.push(tile_sums);
+        rays += tile_rays;
+    }
+    Some((new_sums, rays))
+}
+
+/// The samples of one batch of sample indices, traced for every pixel of a rectangle of the
+/// film (the crop window and the filter's reach around it): per pixel, per index, the offset
+/// from the pixel's centre (x NaN: the sample was rejected), the factor 1 / ((∫k)² D) and the
+/// XYZ and extra channels times that factor.
+struct SharedSamples {
+    origin: UVec2,
+    size: UVec2,
+    indices: u32,
+    /// Floats per sample: 6 + K.
+    stride: usize,
+    values: Vec<f32>,
+}
+
+impl SharedSamples {
+    const OFFSET_X: usize = 0;
+    const OFFSET_Y: usize = 1;
+    const SCALE: usize = 2;
+    const XYZ: usize = 3;
+    const AOVS: usize = 6;
+
+    /// The sample of batch index `s` of film pixel `pixel` (inside the rectangle).
+    #[inline]
+    fn sample(&self, pixel: UVec2, s: u32) -> &[f32] {
+        let local = pixel - self.origin;
+        let i = ((local.y * self.size.x + local.x) * self.indices + s) as usize * self.stride;
+        &self.values[i..i + self.stride]
+    }
+
+    /// Traces the samples `range` (at most `self.indices` of them) of every pixel, in parallel
+    /// over rows. None when the pass was cancelled.
+    fn trace(
+        &mut self,
+        estimator: &SampleEstimator,
+        mis: &FilterMis,
+        range: Range<u32>,
+        options: &RenderOptions,
+        cancel: &Cancel,
+    ) -> Option<u64> {
+        let (stride, origin, indices) = (self.stride, self.origin, self.indices as usize);
+        let row_len = self.size.x as usize * indices * stride;
+        let k = stride - Self::AOVS;
+        let rays: Vec<Option<u64>> = self
+            .values
+            .par_chunks_mut(row_len)
+            .enumerate()
+            .map(|(row, values)| {
+                if cancel.raised() {
+                    return None;
+                }
+                let kind = estimator.scene.sampler.kind;
+                let mut sampler = Sampler::new(kind, options.samples_per_pixel, options.seed);
+                let mut count = RayCount::default();
+                let mut aovs = vec![0.0f32; k];
+                for (i, record) in values.chunks_exact_mut(stride).enumerate() {
+                    let pixel = origin + UVec2::new((i / indices) as u32, row as u32);
+                    let index = range.start + (i % indices) as u32;
+                    if index >= range.end {
+                        continue;
+                    }
+                    aovs.fill(0.0);
+                    let (offset, _, xyz) =
+                        estimator.trace(&mut sampler, pixel, index, &mut count, &mut aovs);
+                    let scale = mis.sample_scale(pixel, offset);
+                    record[Self::OFFSET_X] = offset.x;
+                    record[Self::OFFSET_Y] = offset.y;
+                    if !acceptable_sample(&xyz) {
+                        record[Self::OFFSET_X] = f32::NAN;
+                        continue;
+                    }
+                    // A point the density misses (none, for a sampled one) adds nothing.
+                    let scale = if scale.is_finite() { scale } else { 0.0 };
+                    record[Self::SCALE] = scale;
+                    for c in 0..3 {
+                        record[Self::XYZ + c] = xyz[c] * scale;
+                    }
+                    for (r, &v) in record[Self::AOVS..].iter_mut().zip(&aovs) {
+                        *r = if acceptable_sample(&[v]) {
+                            v * scale
+                        } else {
+                            0.0
+                        };
+                    }
+                }
+                Some(count.rays)
+            })
+            .collect();
+        rays.into_iter().sum()
+    }
+}
+
+/// One pass of filter MIS: for each batch of sample indices, the samples of every pixel within
+/// reach of the crop window are traced, then every pixel of the crop gathers what each index
+/// brings it from the (2·reach + 1)² pixels around, always in the same order, and adds the
+/// totals of each index to its sums ([`PixelSums::add_shared`]). None when the pass was
+/// cancelled.
+#[allow(clippy::too_many_arguments)]
+fn render_shared_pass(
+    estimator: &SampleEstimator,
+    mis: &FilterMis,
+    tiles: &[Tile],
+    sums: &[TileSums],
+    range: Range<u32>,
+    options: &RenderOptions,
+    cancel: &Cancel,
+    progress: &ProgressSink,
+) -> Option<(Vec<TileSums>, u64)> {
+    let film = &estimator.scene.film;
+    let reach = UVec2::splat(mis.reach());
+    let origin = film.crop.offset.saturating_sub(reach);
+    let end = (film.crop.offset + film.crop.size + reach).min(film.size);
+    let size = end - origin;
+    let k = estimator.aov_count();
+    let stride = SharedSamples::AOVS + k;
+    let bytes_per_index = size.x as usize * size.y as usize * stride * 4;
+    let batch = (SHARED_SAMPLES_BYTES / bytes_per_index)
+        .clamp(1, (range.end - range.start) as usize) as u32;
+    let mut samples = SharedSamples {
+        origin,
+        size,
+        indices: batch,
+        stride,
+        values: vec![0.0; bytes_per_index / 4 * batch as usize],
+    };
+    let mut new_sums = sums.to_vec();
+    let mut rays = 0;
+    let mut start = range.start;
+    while start < range.end {
+        let batch_range = start..(start + batch).min(range.end);
+        rays += samples.trace(estimator, mis, batch_range.clone(), options, cancel)?;
+        new_sums
+            .par_iter_mut()
+            .zip(tiles)
+            .for_each(|(tile_sums, &tile)| {
+                gather_tile(
+                    estimator,
+                    mis,
+                    &samples,
+                    tile,
+                    tile_sums,
+                    batch_range.clone(),
+                    options,
+                );
+                let pixels = u64::from(tile.size.x * tile.size.y);
+                progress.add(pixels * u64::from(batch_range.end - batch_range.start));
+            });
+        start = batch_range.end;
+    }
+    Some((new_sums, rays))
+}
+
+/// Adds to every pixel of `tile` the totals of the sample indices `range` over the samples of
+/// the pixels within reach, with its control variate's weight excess.
+fn gather_tile(
+    estimator: &SampleEstimator,
+    mis: &FilterMis,
+    samples: &SharedSamples,
+    tile: Tile,
+    sums: &mut TileSums,
+    range: Range<u32>,
+    options: &RenderOptions,
+) {
+    let film = &estimator.scene.film;
+    let k = estimator.aov_count();
+    let aov_stride = AOV_SUMS_PER_CHANNEL * k;
+    let n = (range.end - range.start) as usize;
+    let reach = mis.reach();
+    let first = samples.origin;
+    let last = samples.origin + samples.size - UVec2::ONE;
+    let mut xyz = vec![[0.0f64; 3]; n];
+    let mut weight = vec![0.0f64; n];
+    let mut aovs = vec![0.0f64; n * k];
+    let mut rejected = vec![false; n];
+    for y in 0..tile.size.y {
+        for x in 0..tile.size.x {
+            let pixel = film.crop.offset + tile.origin + UVec2::new(x, y);
+            xyz.fill([0.0; 3]);
+            weight.fill(0.0);
+            aovs.fill(0.0);
+            rejected.fill(false);
+            let from = pixel.saturating_sub(UVec2::splat(reach)).max(first);
+            let to = (pixel + UVec2::splat(reach)).min(last);
+            for sy in from.y..=to.y {
+                let dy = sy as f32 - pixel.y as f32;
+                for sx in from.x..=to.x {
+                    let dx = sx as f32 - pixel.x as f32;
+                    let source = UVec2::new(sx, sy);
+                    for s in 0..n {
+                        let record = samples.sample(source, s as u32);
+                        let offset_x = record[SharedSamples::OFFSET_X];
+                        if offset_x.is_nan() {
+                            rejected[s] |= source == pixel;
+                            continue;
+                        }
+                        let kx = mis.kernel(offset_x + dx);
+                        if kx == 0.0 {
+                            continue;
+                        }
+                        let w = f64::from(kx * mis.kernel(record[SharedSamples::OFFSET_Y] + dy));
+                        if w == 0.0 {
+                            continue;
+                        }
+                        weight[s] += w * f64::from(record[SharedSamples::SCALE]);
+                        for c in 0..3 {
+                            xyz[s][c] += w * f64::from(record[SharedSamples::XYZ + c]);
+                        }
+                        for (a, &v) in aovs[s * k..(s + 1) * k]
+                            .iter_mut()
+                            .zip(&record[SharedSamples::AOVS..])
+                        {
+                            *a += w * f64::from(v);
+                        }
+                    }
+                }
+            }
+            let i = (y * tile.size.x + x) as usize;
+            for s in 0..n {
+                let index = range.start + s as u32;
+                let second_half = (index / options.samples_per_pixel) % 2 == 1;
+                let pixel_sums = &mut sums.pixels[i];
+                pixel_sums.add_shared(xyz[s], weight[s] - 1.0, second_half);
+                if rejected[s] {
+                    pixel_sums.count_rejected();
+                }
+                add_shared_aov_sample(
+                    &mut sums.aovs[i * aov_stride..(i + 1) * aov_stride],
+                    &aovs[s * k..(s + 1) * k],
+                    second_half,
+                );
+            }
+        }
+    }
 }
 
 /// The number of samples per pixel of the next pass.
@@ -437,7 +740,7 @@ pub fn render_with_checkpoints(
     let tiles = tiles(crop.size);
     let pixel_count = u64::from(crop.size.x) * u64::from(crop.size.y);
     let options = RenderOptions {
-        samples_per_pixel: scene.sampler.kind.sample_count(options.samples_per_pixel),
+        samples_per_pixel: scene.strata(options.samples_per_pixel),
         ..options.clone()
     };
     let stop = options.stop;
@@ -451,7 +754,8 @@ pub fn render_with_checkpoints(
         .build()
         .map_err(|e| Error::usage(format!("could not start the worker threads: {e}")))?;
 
-    let k = estimator.aov_count();
+    // Sums of extra channels per pixel.
+    let k = AOV_SUMS_PER_CHANNEL * estimator.aov_count();
     let mut sums = tile_major(&tiles, crop.size, k, options.initial.as_ref())?;
     let progress = ProgressSink::new(&options, pixel_count);
     let rays = AtomicU64::new(0);
@@ -493,27 +797,29 @@ pub fn render_with_checkpoints(
             external: options.interrupt.as_deref(),
             deadline: stop.time_limit.map(|limit| start + limit),
         };
-        let results: Vec<Option<(TileSums, u64)>> = pool.install(|| {
-            tiles
-                .par_iter()
-                .zip(&sums)
-                .map(|(&tile, tile_sums)| {
-                    let result = render_tile(
-                        &estimator,
-                        tile,
-                        tile_sums,
-                        range.clone(),
-                        &options,
-                        &cancel,
-                    );
-                    if result.is_some() {
-                        progress.add(u64::from(tile.size.x * tile.size.y) * u64::from(pass));
-                    }
-                    result
-                })
-                .collect()
+        let pass_result = pool.install(|| match &estimator.shared {
+            Some(mis) => render_shared_pass(
+                &estimator,
+                mis,
+                &tiles,
+                &sums,
+                range.clone(),
+                &options,
+                &cancel,
+                &progress,
+            ),
+            None => render_pass(
+                &estimator,
+                &tiles,
+                &sums,
+                range.clone(),
+                &options,
+                &cancel,
+                &progress,
+            ),
         });
-        if abort.load(Ordering::Relaxed) || results.iter().any(Option::is_none) {
+        let Some((new_sums, pass_rays)) = pass_result.filter(|_| !abort.load(Ordering::Relaxed))
+        else {
             let interrupted = options
                 .interrupt
                 .as_ref()
@@ -523,12 +829,9 @@ pub fn render_with_checkpoints(
             } else {
                 StopReason::TimeLimit
             };
-        }
-        for (tile_sums, (new_sums, tile_rays)) in sums.iter_mut().zip(results.into_iter().flatten())
-        {
-            *tile_sums = new_sums;
-            rays.fetch_add(tile_rays, Ordering::Relaxed);
-        }
+        };
+        sums = new_sums;
+        rays.fetch_add(pass_rays, Ordering::Relaxed);
         next += pass;
         error = relative_error(sums.iter().flat_map(|t| &t.pixels));
         progress.pass_done(next - first, error);

@@ -4,9 +4,10 @@
 //! Layout (little endian): the magic `PRISMRS\0`, a format version (u32), the identity of the
 //! render (scene fingerprint, seed, sampler, samples per pixel of the stratification, film size
 //! and crop window), the sample index ranges the pixels hold, the names of the integrator's extra
-//! channels (K), the pixel count and each pixel's exact sums (112 bytes, then 16 for each extra
-//! channel), and a CRC-32 of all of it. Version 2 added the extra channels; a state of another
-//! version is refused with its version named. A state is written to a temporary file,
+//! channels (K), the pixel count and each pixel's exact sums (264 bytes: the image's, then those
+//! of filter MIS's control variate; then 32 for each extra channel, its sum over all samples and
+//! over half A), and a CRC-32 of all of it. Version 2 added the extra channels, version 3 the
+//! control variate's sums; a state of another version is refused with its version named. A state is written to a temporary file,
 //! flushed to disk and renamed over the old one, so a crash while writing leaves the previous
 //! state intact.
 
@@ -18,12 +19,14 @@ use glam::UVec2;
 
 use crate::error::{Error, ErrorKind, Result};
 use crate::film::CropWindow;
-use crate::film::accumulation::{ExactSum, PixelSums, ValueSum};
+use crate::film::accumulation::{AOV_SUMS_PER_CHANNEL, ExactSum, PixelSums, ValueSum};
 
 const MAGIC: &[u8; 8] = b"PRISMRS\0";
-const VERSION: u32 = 2;
-/// Bytes per pixel: six 128-bit sums and two 64-bit counts.
-const PIXEL_BYTES: usize = 6 * 16 + 2 * 8;
+const VERSION: u32 = 3;
+/// Bytes per pixel: fifteen 128-bit sums and three 64-bit counts.
+const PIXEL_BYTES: usize = 15 * 16 + 3 * 8;
+/// Bytes per pixel and extra channel: two 128-bit sums.
+const AOV_BYTES: usize = 2 * 16;
 /// At most this many separate sample ranges (a merge of many farm tasks).
 const MAX_RANGES: usize = 1 << 16;
 /// At most this many extra channels, each name at most this long.
@@ -92,7 +95,7 @@ pub struct RenderState {
     pub pixels: Vec<PixelSums>,
     /// Names of the integrator's extra channels (K).
     pub aov_names: Vec<String>,
-    /// Their sums, K per pixel in the pixels' order.
+    /// Their sums, 2K per pixel in the pixels' order, as [`crate::film::Film::aovs`] holds them.
     pub aovs: Vec<ValueSum>,
 }
 
@@ -175,17 +178,24 @@ impl RenderState {
             out.extend_from_slice(&(name.len() as u32).to_le_bytes());
             out.extend_from_slice(name.as_bytes());
         }
-        let k = self.aov_names.len();
+        let k = self.aov_names.len() * AOV_SUMS_PER_CHANNEL;
         out.extend_from_slice(&(self.pixels.len() as u64).to_le_bytes());
         for (i, p) in self.pixels.iter().enumerate() {
-            for s in &p.xyz {
+            let c = &p.control;
+            for s in p.xyz.iter().chain(&c.xyz_first_half).chain(&c.excess) {
                 out.extend_from_slice(&s.0.to_le_bytes());
             }
-            for s in &p.xyz_squared {
+            for s in p
+                .xyz_squared
+                .iter()
+                .chain(&c.xyz_excess)
+                .chain([&c.excess_squared])
+            {
                 out.extend_from_slice(&s.0.to_le_bytes());
             }
             out.extend_from_slice(&p.samples.to_le_bytes());
             out.extend_from_slice(&p.rejected.to_le_bytes());
+            out.extend_from_slice(&c.first_half_samples.to_le_bytes());
             for s in &self.aovs[i * k..(i + 1) * k] {
                 out.extend_from_slice(&s.0.to_le_bytes());
             }
@@ -223,7 +233,8 @@ impl RenderState {
                 location: None,
                 message: format!(
                     "\"{}\" is a render state of format version {version}; this Prism reads \
-                     version {VERSION} only (version 2 holds the integrator's extra channels)",
+                     version {VERSION} only (version 3 holds the sums of filter MIS's control \
+                     variate)",
                     path.display()
                 ),
                 help: Some(
@@ -300,7 +311,7 @@ impl RenderState {
                 .map_err(|_| corrupt(path, "an extra channel's name is not text"))?;
             aov_names.push(name.to_string());
         }
-        let pixel_bytes = (PIXEL_BYTES + 16 * aov_count) as u64;
+        let pixel_bytes = (PIXEL_BYTES + AOV_BYTES * aov_count) as u64;
         let pixel_count = r.u64().ok_or_else(truncated)?;
         let expected = u64::from(identity.crop.size.x) * u64::from(identity.crop.size.y);
         if pixel_count != expected || pixel_count.checked_mul(pixel_bytes) != Some(r.left() as u64)
@@ -316,19 +327,38 @@ impl RenderState {
             ));
         }
         let mut pixels = Vec::with_capacity(pixel_count as usize);
-        let mut aovs = Vec::with_capacity(pixel_count as usize * aov_count);
+        let aov_sums = aov_count * AOV_SUMS_PER_CHANNEL;
+        let mut aovs = Vec::with_capacity(pixel_count as usize * aov_sums);
         for _ in 0..pixel_count {
             let mut p = PixelSums::default();
-            for s in &mut p.xyz {
+            let c = &mut p.control;
+            for s in p
+                .xyz
+                .iter_mut()
+                .chain(&mut c.xyz_first_half)
+                .chain(&mut c.excess)
+            {
                 *s = ExactSum(r.i128().ok_or_else(truncated)?);
             }
-            for s in &mut p.xyz_squared {
+            for s in p
+                .xyz_squared
+                .iter_mut()
+                .chain(&mut c.xyz_excess)
+                .chain([&mut c.excess_squared])
+            {
                 *s = ExactSum(r.i128().ok_or_else(truncated)?);
             }
             p.samples = r.u64().ok_or_else(truncated)?;
             p.rejected = r.u64().ok_or_else(truncated)?;
+            p.control.first_half_samples = r.u64().ok_or_else(truncated)?;
+            if p.control.first_half_samples > p.samples {
+                return Err(corrupt(
+                    path,
+                    "a pixel has more samples in one half than in all",
+                ));
+            }
             pixels.push(p);
-            for _ in 0..aov_count {
+            for _ in 0..aov_sums {
                 aovs.push(ExactSum(r.i128().ok_or_else(truncated)?));
             }
         }
@@ -456,11 +486,13 @@ mod tests {
             size: UVec2::new(3, 2),
         };
         let mut pixels = vec![PixelSums::default(); 6];
-        let mut aovs = vec![ValueSum::default(); 12];
+        let mut aovs = vec![ValueSum::default(); 24];
         for (i, p) in pixels.iter_mut().enumerate() {
             p.add([i as f32, 0.5, -1.0]);
-            aovs[2 * i].add(i as f64 * 0.25);
-            aovs[2 * i + 1].add(-3.0);
+            p.add_shared([0.25, i as f64, 2.0], 0.125 - i as f64 * 0.01, i % 2 == 1);
+            aovs[4 * i].add(i as f64 * 0.25);
+            aovs[4 * i + 1].add(-3.0);
+            aovs[4 * i + 2].add(i as f64 * 0.125);
         }
         RenderState {
             identity: RenderIdentity {
@@ -506,17 +538,17 @@ mod tests {
         }
     }
 
-    /// A state of the format before the extra channels is refused, naming its version.
+    /// A state of the format before the control variate is refused, naming its version.
     #[test]
     fn an_older_version_is_refused_clearly() {
         let mut bytes = state(vec![0..4]).encode();
-        bytes[8..12].copy_from_slice(&1u32.to_le_bytes());
+        bytes[8..12].copy_from_slice(&2u32.to_le_bytes());
         let body = bytes.len() - 4;
         let checksum = crc32fast::hash(&bytes[..body]);
         bytes[body..].copy_from_slice(&checksum.to_le_bytes());
         let error = RenderState::decode(&bytes, Path::new("old.state")).unwrap_err();
-        assert!(error.message.contains("format version 1"), "{error}");
-        assert!(error.message.contains("reads version 2 only"), "{error}");
+        assert!(error.message.contains("format version 2"), "{error}");
+        assert!(error.message.contains("reads version 3 only"), "{error}");
         assert!(error.help.unwrap().contains("render the scene again"));
     }
 
@@ -526,8 +558,8 @@ mod tests {
         let paths = [Path::new("a"), Path::new("b")];
         let merged = RenderState::merge(&[a.clone(), b.clone()], &paths).unwrap();
         assert_eq!(merged.ranges, vec![0..8]);
-        assert_eq!(merged.pixels[1].samples, 2);
-        assert_eq!(merged.aovs[2].value(), 0.5);
+        assert_eq!(merged.pixels[1].samples, 4);
+        assert_eq!(merged.aovs[4].value(), 0.5);
         let overlapping = state(vec![2..6]);
         assert!(RenderState::merge(&[a.clone(), overlapping], &paths).is_err());
         let mut other_seed = b.clone();

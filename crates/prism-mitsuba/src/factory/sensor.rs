@@ -12,7 +12,9 @@ use crate::params::{Params, Warning};
 use crate::registry::{Default, Origin, ParamKind, ParamSpec, Plugin, Registry};
 use prism_core::camera::{Camera, OrthographicCamera, PerspectiveCamera, Shutter};
 use prism_core::error::{Error, Result};
-use prism_core::film::{CropWindow, Filter, LdrFormat, LdrOutput, Tonemap, TransferCurve};
+use prism_core::film::{
+    CropWindow, Filter, LdrFormat, LdrOutput, Reconstruction, Tonemap, TransferCurve,
+};
 use prism_core::image::Channels;
 use prism_core::sampling::sampler::MAX_ORTHOGONAL_STRENGTH;
 use prism_core::scene::{FilmSettings, SamplerKind, SamplerSettings};
@@ -203,6 +205,7 @@ pub static FILMS: Registry<FilmBuild> = Registry {
                 PIXEL_FORMAT,
                 COMPONENT_FORMAT,
                 RFILTER,
+                RECONSTRUCTION,
                 WAVELENGTH_SAMPLING,
                 BANNER,
                 ATTACH_LOG,
@@ -231,6 +234,7 @@ pub static FILMS: Registry<FilmBuild> = Registry {
                 KEY,
                 BURN,
                 RFILTER,
+                RECONSTRUCTION,
                 WAVELENGTH_SAMPLING,
                 BANNER,
                 HIGH_QUALITY_EDGES,
@@ -287,6 +291,15 @@ const PIXEL_FORMAT: ParamSpec = ParamSpec::new(
     ParamKind::Choice(&["rgb", "rgba", "xyz", "xyza", "luminance", "luminance_alpha"]),
     Default::Str("rgb"),
     "accepted; the output always holds RGB and XYZ",
+);
+const RECONSTRUCTION: ParamSpec = ParamSpec::new(
+    "reconstruction",
+    ParamKind::Choice(&Reconstruction::NAMES),
+    Default::Str("filter_mis"),
+    "Prism only (Mitsuba rejects it): how samples become pixels: `filter_mis` (every sample \
+     feeds every pixel its filter covers, unbiased, with less noise than Mitsuba's splatting) or \
+     `pixel` (each sample counts for its own pixel, the lecture's estimator); the same for a \
+     `box` filter; see docs/reconstruction.md",
 );
 const WAVELENGTH_SAMPLING: ParamSpec = ParamSpec::new(
     "wavelength_sampling",
@@ -827,6 +840,7 @@ fn default_film() -> FilmSettings {
             size,
         },
         filter: Filter::Gaussian { stddev: 0.5 },
+        reconstruction: Reconstruction::default(),
         wavelength_sampling: WavelengthSampling::default(),
     }
 }
@@ -957,6 +971,8 @@ fn film_settings(params: &Params) -> Result<FilmSettings> {
         Some(child) => build_filter(&child.node)?,
         None => Filter::Gaussian { stddev: 0.5 },
     };
+    let reconstruction = Reconstruction::from_name(params.choice(&RECONSTRUCTION)?)
+        .expect("the choice is one of the names");
     let wavelength_sampling = WavelengthSampling::from_name(params.choice(&WAVELENGTH_SAMPLING)?)
         .expect("the choice is one of the names");
     let size = UVec2::new(width as u32, height as u32);
@@ -967,6 +983,7 @@ fn film_settings(params: &Params) -> Result<FilmSettings> {
             size: UVec2::new(crop_width as u32, crop_height as u32),
         },
         filter,
+        reconstruction,
         wavelength_sampling,
     })
 }
