@@ -456,24 +456,48 @@ fn render_pass(
 }
 
 /// The samples of one batch of sample indices, traced for every pixel of a rectangle of the
-/// film (the crop window and the filter's reach around it): per pixel, per index, the offset
-/// from the pixel's centre (x NaN: the sample was rejected), the factor 1 / ((∫k)² D) and the
-/// XYZ and extra channels times that factor.
+/// film (the crop window and the filter's reach m around it). Per pixel and index: the factor
+/// 1 / ((∫k)² D) of the sample (NaN: the sample was rejected), its XYZ and extra channels times
+/// that factor, and the filter's values k(o − j) on each axis for the pixels j = −m..m away
+/// (o the sample's offset from its pixel's centre), computed once here rather than by each of
+/// the (2m + 1)² pixels that gather the sample.
 struct SharedSamples {
     origin: UVec2,
     size: UVec2,
     indices: u32,
-    /// Floats per sample: 6 + K.
+    /// Extra channels per sample (K).
+    aovs: usize,
+    /// Pixels the filter reaches on each side (m).
+    reach: usize,
+    /// Floats per sample: 4 + K + 2 (2m + 1).
     stride: usize,
     values: Vec<f32>,
 }
 
 impl SharedSamples {
-    const OFFSET_X: usize = 0;
-    const OFFSET_Y: usize = 1;
-    const SCALE: usize = 2;
-    const XYZ: usize = 3;
-    const AOVS: usize = 6;
+    const SCALE: usize = 0;
+    const XYZ: usize = 1;
+    const AOVS: usize = 4;
+
+    fn new(origin: UVec2, size: UVec2, indices: u32, aovs: usize, reach: u32) -> SharedSamples {
+        let reach = reach as usize;
+        let stride = Self::AOVS + aovs + 2 * (2 * reach + 1);
+        SharedSamples {
+            origin,
+            size,
+            indices,
+            aovs,
+            reach,
+            stride,
+            values: vec![0.0; size.x as usize * size.y as usize * indices as usize * stride],
+        }
+    }
+
+    /// The bytes a batch takes per sample index.
+    fn bytes_per_index(size: UVec2, aovs: usize, reach: u32) -> usize {
+        let stride = Self::AOVS + aovs + 2 * (2 * reach as usize + 1);
+        size.x as usize * size.y as usize * stride * std::mem::size_of::<f32>()
+    }
 
     /// The sample of batch index `s` of film pixel `pixel` (inside the rectangle).
     #[inline]
@@ -481,6 +505,18 @@ impl SharedSamples {
         let local = pixel - self.origin;
         let i = ((local.y * self.size.x + local.x) * self.indices + s) as usize * self.stride;
         &self.values[i..i + self.stride]
+    }
+
+    /// The filter's values on the x axis (then the y axis) in a sample, for j = −m..m.
+    #[inline]
+    fn kernel_x<'r>(&self, record: &'r [f32]) -> &'r [f32] {
+        let start = Self::AOVS + self.aovs;
+        &record[start..start + 2 * self.reach + 1]
+    }
+
+    #[inline]
+    fn kernel_y<'r>(&self, record: &'r [f32]) -> &'r [f32] {
+        &record[Self::AOVS + self.aovs + 2 * self.reach + 1..]
     }
 
     /// Traces the samples `range` (at most `self.indices` of them) of every pixel, in parallel
@@ -494,8 +530,8 @@ impl SharedSamples {
         cancel: &Cancel,
     ) -> Option<u64> {
         let (stride, origin, indices) = (self.stride, self.origin, self.indices as usize);
+        let (k, reach) = (self.aovs, self.reach);
         let row_len = self.size.x as usize * indices * stride;
-        let k = stride - Self::AOVS;
         let rays: Vec<Option<u64>> = self
             .values
             .par_chunks_mut(row_len)
@@ -517,25 +553,30 @@ impl SharedSamples {
                     aovs.fill(0.0);
                     let (offset, _, xyz) =
                         estimator.trace(&mut sampler, pixel, index, &mut count, &mut aovs);
-                    let scale = mis.sample_scale(pixel, offset);
-                    record[Self::OFFSET_X] = offset.x;
-                    record[Self::OFFSET_Y] = offset.y;
                     if !acceptable_sample(&xyz) {
-                        record[Self::OFFSET_X] = f32::NAN;
+                        record[Self::SCALE] = f32::NAN;
                         continue;
                     }
                     // A point the density misses (none, for a sampled one) adds nothing.
+                    let scale = mis.sample_scale(pixel, offset);
                     let scale = if scale.is_finite() { scale } else { 0.0 };
                     record[Self::SCALE] = scale;
                     for c in 0..3 {
                         record[Self::XYZ + c] = xyz[c] * scale;
                     }
-                    for (r, &v) in record[Self::AOVS..].iter_mut().zip(&aovs) {
+                    let (channels, kernels) = record[Self::AOVS..].split_at_mut(k);
+                    for (r, &v) in channels.iter_mut().zip(&aovs) {
                         *r = if acceptable_sample(&[v]) {
                             v * scale
                         } else {
                             0.0
                         };
+                    }
+                    let (kx, ky) = kernels.split_at_mut(2 * reach + 1);
+                    for j in 0..=2 * reach {
+                        let d = j as f32 - reach as f32;
+                        kx[j] = mis.kernel(offset.x - d);
+                        ky[j] = mis.kernel(offset.y - d);
                     }
                 }
                 Some(count.rays)
@@ -567,17 +608,10 @@ fn render_shared_pass(
     let end = (film.crop.offset + film.crop.size + reach).min(film.size);
     let size = end - origin;
     let k = estimator.aov_count();
-    let stride = SharedSamples::AOVS + k;
-    let bytes_per_index = size.x as usize * size.y as usize * stride * 4;
+    let bytes_per_index = SharedSamples::bytes_per_index(size, k, mis.reach());
     let batch = (SHARED_SAMPLES_BYTES / bytes_per_index)
         .clamp(1, (range.end - range.start) as usize) as u32;
-    let mut samples = SharedSamples {
-        origin,
-        size,
-        indices: batch,
-        stride,
-        values: vec![0.0; bytes_per_index / 4 * batch as usize],
-    };
+    let mut samples = SharedSamples::new(origin, size, batch, k, mis.reach());
     let mut new_sums = sums.to_vec();
     let mut rays = 0;
     let mut start = range.start;
@@ -637,32 +671,29 @@ fn gather_tile(
             let from = pixel.saturating_sub(UVec2::splat(reach)).max(first);
             let to = (pixel + UVec2::splat(reach)).min(last);
             for sy in from.y..=to.y {
-                let dy = sy as f32 - pixel.y as f32;
+                let jy = (pixel.y + reach - sy) as usize;
                 for sx in from.x..=to.x {
-                    let dx = sx as f32 - pixel.x as f32;
+                    let jx = (pixel.x + reach - sx) as usize;
                     let source = UVec2::new(sx, sy);
                     for s in 0..n {
                         let record = samples.sample(source, s as u32);
-                        let offset_x = record[SharedSamples::OFFSET_X];
-                        if offset_x.is_nan() {
+                        let scale = record[SharedSamples::SCALE];
+                        if scale.is_nan() {
                             rejected[s] |= source == pixel;
                             continue;
                         }
-                        let kx = mis.kernel(offset_x + dx);
-                        if kx == 0.0 {
-                            continue;
-                        }
-                        let w = f64::from(kx * mis.kernel(record[SharedSamples::OFFSET_Y] + dy));
+                        let w = samples.kernel_x(record)[jx] * samples.kernel_y(record)[jy];
                         if w == 0.0 {
                             continue;
                         }
-                        weight[s] += w * f64::from(record[SharedSamples::SCALE]);
+                        let w = f64::from(w);
+                        weight[s] += w * f64::from(scale);
                         for c in 0..3 {
                             xyz[s][c] += w * f64::from(record[SharedSamples::XYZ + c]);
                         }
                         for (a, &v) in aovs[s * k..(s + 1) * k]
                             .iter_mut()
-                            .zip(&record[SharedSamples::AOVS..])
+                            .zip(&record[SharedSamples::AOVS..SharedSamples::AOVS + k])
                         {
                             *a += w * f64::from(v);
                         }
