@@ -6,6 +6,7 @@
 mod common;
 
 use std::path::PathBuf;
+use std::sync::atomic::{AtomicU32, Ordering};
 
 use prism_core::film::{Film, Filter, PixelSums};
 use prism_core::render::{RenderOptions, StopRule, render};
@@ -38,8 +39,11 @@ const EDGE_SCENE: &str = r#"<scene version="3.0.0">
 "#;
 
 fn edge_scene(defines: &[(&str, &str)]) -> Scene {
+    // One directory per call: the tests run in parallel.
+    static CALLS: AtomicU32 = AtomicU32::new(0);
+    let call = CALLS.fetch_add(1, Ordering::Relaxed);
     let dir: PathBuf =
-        std::env::temp_dir().join(format!("prism-filter-mis-{}", std::process::id()));
+        std::env::temp_dir().join(format!("prism-filter-mis-{}-{call}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join("edge.xml");
     std::fs::write(&path, EDGE_SCENE).unwrap();
