@@ -48,7 +48,8 @@ impl<const FRACTION_BITS: i32> ExactSum<FRACTION_BITS> {
 /// Sums of sample values: resolution 2⁻⁵⁶ (1.4·10⁻¹⁷), range ±2⁷¹ (2.4·10²¹).
 pub type ValueSum = ExactSum<56>;
 /// Sums of squared sample values: resolution 2⁻³⁶ (1.5·10⁻¹¹), range ±2⁹¹.
-pub type SquareSum = ExactSum<36>;
+pub type SquareSum = ExactSum<SQUARE_FRACTION_BITS>;
+const SQUARE_FRACTION_BITS: i32 = 36;
 
 /// Samples larger than this (or not finite) are rejected as numerical failures, so that no
 /// single sample can overflow the sums.
@@ -212,23 +213,42 @@ impl PixelSums {
         [0, 1, 2].map(|c| self.controlled_mean(self.sum(c), self.control.xyz_first_half[c].value()))
     }
 
-    /// The variance of [`Self::mean`] of channel `c`, infinite with fewer than two samples: the
-    /// sample variance over N of the residuals rₛ = Tₛ − Î (Wₛ − 1) (the delta method for the
-    /// ratio; Tₛ itself without a control variate), unbiased for independent sample indices.
+    /// The variance of [`Self::mean`] of channel `c`, infinite with fewer than two samples.
+    ///
+    /// Without a control variate it is the sample variance over N, s²/N with
+    /// s² = (Σvₛ² − N m²)/(N − 1). With it, the residuals rₛ = eₛ + Î with eₛ = Tₛ − Î Wₛ take the
+    /// place of the vₛ (the delta method for the ratio), and the cross-fitting adds a term: with
+    /// halves of N/2, Î − I ≈ (ē_A + ē_B)/2 − (ē_B w̄_A + ē_A w̄_B)/2 (w̄ the halves' mean weight
+    /// excess), whose variance is σₑ²/N · (1 + 2 σ_W²/N). Both are unbiased to first order for
+    /// independent sample indices.
+    ///
+    /// It is at least 2⁻³⁷/(N − 1), the most by which rounding each square to the resolution of
+    /// its sum ([`SquareSum`]) can change it: a pixel whose values are so small that their
+    /// squares round to zero (a dark pixel at the edge of its neighbours' filter support) is
+    /// not reported as exact.
     pub fn variance_of_mean(&self, c: usize) -> f64 {
         if self.samples < 2 {
             return f64::INFINITY;
         }
         let n = self.samples as f64;
         let beta = self.mean()[c];
-        let excess: f64 = self.control.excess.iter().map(|e| e.value()).sum();
+        let control = &self.control;
+        let excess: f64 = control.excess.iter().map(|e| e.value()).sum();
         let sum = self.sum(c) - beta * excess;
-        let squares = self.sum_of_squares(c) - 2.0 * beta * self.control.xyz_excess[c].value()
-            + beta * beta * self.control.excess_squared.value();
+        let squares = self.sum_of_squares(c) - 2.0 * beta * control.xyz_excess[c].value()
+            + beta * beta * control.excess_squared.value();
         let mean = sum / n;
-        ((squares / n - mean * mean) / (n - 1.0)).max(0.0)
+        let residual = ((squares / n - mean * mean) / (n - 1.0)).max(0.0);
+        let mean_excess = excess / n;
+        let weight_variance =
+            (control.excess_squared.value() / n - mean_excess * mean_excess).max(0.0);
+        let cross_fitting = 1.0 + 2.0 * weight_variance / n;
+        (residual * cross_fitting).max(SQUARE_RESOLUTION / 2.0 / (n - 1.0))
     }
 }
+
+/// The resolution of a [`SquareSum`].
+const SQUARE_RESOLUTION: f64 = 1.0 / (1u64 << SQUARE_FRACTION_BITS) as f64;
 
 /// Adds one sample of a pixel's extra channels to their sums: a value that is not finite (or is
 /// absurdly large) adds nothing, so the channel's mean counts it as zero, as the image does with

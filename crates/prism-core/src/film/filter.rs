@@ -5,8 +5,9 @@
 //! Normalisation: the pixel value is (1/N) Σ wᵢ Lᵢ, dividing by the number of samples N, which is
 //! an unbiased estimate of ∫∫ k(x)k(y) L / (∫k)²; pbrt instead divides by Σ wᵢ, which is biased
 //! but consistent. For filters without negative lobes sampled exactly, every weight is 1 and the
-//! two agree. Each sample lands in its own pixel only, so pixels are independent and the image
-//! does not depend on the order in which samples are taken.
+//! two agree. This is the `pixel` reconstruction, where each sample lands in its own pixel only;
+//! the default, filter MIS, lets each sample feed every pixel whose filter covers it, with the
+//! same densities ([`super::reconstruction`]).
 //!
 //! Filters with negative lobes (Mitchell–Netravali, Catmull–Rom, Lanczos) keep them: a sample
 //! drawn where k(x)k(y) < 0 gets a negative weight instead of being clipped, so the estimate

@@ -204,6 +204,9 @@ impl fmt::Display for ZTest {
 
 /// Two-sided tail probability of a standard normal beyond |z|: erfc(|z|/√2) = Q(1/2, z²/2).
 fn normal_tail(z: f64) -> f64 {
+    if z.is_infinite() {
+        return 0.0;
+    }
     regularized_gamma_q(0.5, 0.5 * z * z)
 }
 
