@@ -55,12 +55,17 @@ Z_TEST = re.compile(
 
 def z_test(text):
     """The z-test line of `prism compare`'s output as a dict (pixels, chi2, p_value, max_z,
-    max_z_p_value, beyond_three in percent, consistent, verdict), or None when it printed none
-    (the test image has no `variance.Y` channel, as Mitsuba's have not)."""
+    max_z_p_value, beyond_three in percent, consistent, verdict; max_z None where it is
+    infinite), or None when it printed none (the test image has no `variance.Y` channel, as
+    Mitsuba's have not)."""
     match = Z_TEST.search(text)
     if not match:
         return None
     z = {k: float(v) for k, v in match.groupdict().items() if k not in ("pixels", "verdict")}
+    if z["max_z"] == float("inf"):
+        # A pixel differs where both variances are 0; `prism compare` then prints a Bonferroni p
+        # of 1, which is wrong (its verdict rests on the chi-square sum alone): no p here.
+        z["max_z"] = z["max_z_p_value"] = None
     z["pixels"] = int(match["pixels"])
     z["verdict"] = match["verdict"]
     z["consistent"] = not match["verdict"].startswith("NOT")
