@@ -297,9 +297,11 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         override_reconstruction(&mut scene, reconstruction);
     }
     let seed = args.seed.unwrap_or(loaded.seed);
-    let strata = scene.strata(args.spp.unwrap_or(scene.sampler.samples_per_pixel));
+    let spp = args.spp.unwrap_or(scene.sampler.samples_per_pixel);
+    let strata = scene.strata(spp);
     if let Some([x, y]) = args.pixel {
-        return trace_pixel(&scene, UVec2::new(x, y), strata, seed, args);
+        let samples = args.sample_range.clone().unwrap_or(0..spp);
+        return trace_pixel(&scene, UVec2::new(x, y), strata, samples, seed);
     }
     let identity = RenderIdentity {
         scene: scene.fingerprint,
@@ -499,18 +501,19 @@ fn report(
     }
 }
 
-/// `--pixel x,y`: renders one pixel and prints every sample, marking the non-finite ones.
+/// `--pixel x,y`: renders the samples `range` drawn for one pixel and prints each with its
+/// one-pixel weight, marking the non-finite ones (under filter MIS the same samples also feed
+/// the pixels around).
 fn trace_pixel(
     scene: &Scene,
     pixel: UVec2,
     strata: u32,
+    range: Range<u32>,
     seed: u64,
-    args: &RenderArgs,
 ) -> Result<()> {
     let estimator = SampleEstimator::new(scene);
     let mut sampler = Sampler::new(scene.sampler.kind, strata, seed);
     let mut count = RayCount::default();
-    let range = args.sample_range.clone().unwrap_or(0..strata);
     let mut sums = PixelSums::default();
     let mut aovs = vec![0.0f32; estimator.aov_count()];
     println!(
