@@ -26,7 +26,7 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::time::{Duration, Instant};
 
-use glam::{UVec2, Vec2};
+use glam::{UVec2, Vec2, Vec4};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
 
@@ -544,12 +544,17 @@ impl SharedSamples {
                 let mut sampler = Sampler::new(kind, options.samples_per_pixel, options.seed);
                 let mut count = RayCount::default();
                 let mut aovs = vec![0.0f32; k];
-                for (i, record) in values.chunks_exact_mut(stride).enumerate() {
-                    let pixel = origin + UVec2::new((i / indices) as u32, row as u32);
-                    let index = range.start + (i % indices) as u32;
-                    if index >= range.end {
-                        continue;
-                    }
+                let batch = (range.end - range.start) as usize;
+                let records = values
+                    .chunks_exact_mut(indices * stride)
+                    .enumerate()
+                    .flat_map(|(column, records)| {
+                        let pixel = origin + UVec2::new(column as u32, row as u32);
+                        let records = records.chunks_exact_mut(stride).take(batch);
+                        records.enumerate().map(move |(s, r)| (pixel, s, r))
+                    });
+                for (pixel, s, record) in records {
+                    let index = range.start + s as u32;
                     aovs.fill(0.0);
                     let (offset, _, xyz) =
                         estimator.trace(&mut sampler, pixel, index, &mut count, &mut aovs);
@@ -657,15 +662,15 @@ fn gather_tile(
     let reach = mis.reach();
     let first = samples.origin;
     let last = samples.origin + samples.size - UVec2::ONE;
-    let mut xyz = vec![[0.0f64; 3]; n];
-    let mut weight = vec![0.0f64; n];
-    let mut aovs = vec![0.0f64; n * k];
+    // Per index: the weight total W and the XYZ total T, in the records' order (scale, XYZ).
+    let mut totals = vec![Vec4::ZERO; n];
+    let mut aovs = vec![0.0f32; n * k];
     let mut rejected = vec![false; n];
+    let mut channels = vec![0.0f64; k];
     for y in 0..tile.size.y {
         for x in 0..tile.size.x {
             let pixel = film.crop.offset + tile.origin + UVec2::new(x, y);
-            xyz.fill([0.0; 3]);
-            weight.fill(0.0);
+            totals.fill(Vec4::ZERO);
             aovs.fill(0.0);
             rejected.fill(false);
             let from = pixel.saturating_sub(UVec2::splat(reach)).max(first);
@@ -677,8 +682,7 @@ fn gather_tile(
                     let source = UVec2::new(sx, sy);
                     for s in 0..n {
                         let record = samples.sample(source, s as u32);
-                        let scale = record[SharedSamples::SCALE];
-                        if scale.is_nan() {
+                        if record[SharedSamples::SCALE].is_nan() {
                             rejected[s] |= source == pixel;
                             continue;
                         }
@@ -686,16 +690,12 @@ fn gather_tile(
                         if w == 0.0 {
                             continue;
                         }
-                        let w = f64::from(w);
-                        weight[s] += w * f64::from(scale);
-                        for c in 0..3 {
-                            xyz[s][c] += w * f64::from(record[SharedSamples::XYZ + c]);
-                        }
+                        totals[s] += w * Vec4::from_slice(&record[SharedSamples::SCALE..]);
                         for (a, &v) in aovs[s * k..(s + 1) * k]
                             .iter_mut()
                             .zip(&record[SharedSamples::AOVS..SharedSamples::AOVS + k])
                         {
-                            *a += w * f64::from(v);
+                            *a += w * v;
                         }
                     }
                 }
@@ -705,13 +705,17 @@ fn gather_tile(
                 let index = range.start + s as u32;
                 let second_half = (index / options.samples_per_pixel) % 2 == 1;
                 let pixel_sums = &mut sums.pixels[i];
-                pixel_sums.add_shared(xyz[s], weight[s] - 1.0, second_half);
+                let [weight, tx, ty, tz] = totals[s].to_array().map(f64::from);
+                pixel_sums.add_shared([tx, ty, tz], weight - 1.0, second_half);
                 if rejected[s] {
                     pixel_sums.count_rejected();
                 }
+                for (c, &v) in channels.iter_mut().zip(&aovs[s * k..(s + 1) * k]) {
+                    *c = f64::from(v);
+                }
                 add_shared_aov_sample(
                     &mut sums.aovs[i * aov_stride..(i + 1) * aov_stride],
-                    &aovs[s * k..(s + 1) * k],
+                    &channels,
                     second_half,
                 );
             }
