@@ -499,24 +499,24 @@ impl SharedSamples {
         size.x as usize * size.y as usize * stride * std::mem::size_of::<f32>()
     }
 
-    /// The sample of batch index `s` of film pixel `pixel` (inside the rectangle).
+    /// The first `n` samples of the batch of film pixel `pixel` (inside the rectangle).
     #[inline]
-    fn sample(&self, pixel: UVec2, s: u32) -> &[f32] {
+    fn records(&self, pixel: UVec2, n: usize) -> &[f32] {
         let local = pixel - self.origin;
-        let i = ((local.y * self.size.x + local.x) * self.indices + s) as usize * self.stride;
-        &self.values[i..i + self.stride]
+        let i = (local.y * self.size.x + local.x) as usize * self.indices as usize * self.stride;
+        &self.values[i..i + n * self.stride]
     }
 
-    /// The filter's values on the x axis (then the y axis) in a sample, for j = −m..m.
+    /// Where in a sample the filter's value on the x axis (then the y axis) for the pixel j − m
+    /// away is, j = 0..2m.
     #[inline]
-    fn kernel_x<'r>(&self, record: &'r [f32]) -> &'r [f32] {
-        let start = Self::AOVS + self.aovs;
-        &record[start..start + 2 * self.reach + 1]
+    fn kernel_x_at(&self, j: usize) -> usize {
+        Self::AOVS + self.aovs + j
     }
 
     #[inline]
-    fn kernel_y<'r>(&self, record: &'r [f32]) -> &'r [f32] {
-        &record[Self::AOVS + self.aovs + 2 * self.reach + 1..]
+    fn kernel_y_at(&self, j: usize) -> usize {
+        Self::AOVS + self.aovs + 2 * self.reach + 1 + j
     }
 
     /// Traces the samples `range` (at most `self.indices` of them) of every pixel, in parallel
@@ -577,6 +577,7 @@ impl SharedSamples {
                             0.0
                         };
                     }
+                    // The layout of kernel_x_at and kernel_y_at.
                     let (kx, ky) = kernels.split_at_mut(2 * reach + 1);
                     for j in 0..=2 * reach {
                         let d = j as f32 - reach as f32;
@@ -676,26 +677,29 @@ fn gather_tile(
             let from = pixel.saturating_sub(UVec2::splat(reach)).max(first);
             let to = (pixel + UVec2::splat(reach)).min(last);
             for sy in from.y..=to.y {
-                let jy = (pixel.y + reach - sy) as usize;
+                let ky = samples.kernel_y_at((pixel.y + reach - sy) as usize);
                 for sx in from.x..=to.x {
-                    let jx = (pixel.x + reach - sx) as usize;
+                    let kx = samples.kernel_x_at((pixel.x + reach - sx) as usize);
                     let source = UVec2::new(sx, sy);
-                    for s in 0..n {
-                        let record = samples.sample(source, s as u32);
-                        if record[SharedSamples::SCALE].is_nan() {
+                    let records = samples.records(source, n);
+                    for (s, record) in records.chunks_exact(samples.stride).enumerate() {
+                        let [scale, x, y, z] = [record[0], record[1], record[2], record[3]];
+                        if scale.is_nan() {
                             rejected[s] |= source == pixel;
                             continue;
                         }
-                        let w = samples.kernel_x(record)[jx] * samples.kernel_y(record)[jy];
+                        let w = record[kx] * record[ky];
                         if w == 0.0 {
                             continue;
                         }
-                        totals[s] += w * Vec4::from_slice(&record[SharedSamples::SCALE..]);
-                        for (a, &v) in aovs[s * k..(s + 1) * k]
-                            .iter_mut()
-                            .zip(&record[SharedSamples::AOVS..SharedSamples::AOVS + k])
-                        {
-                            *a += w * v;
+                        totals[s] += w * Vec4::new(scale, x, y, z);
+                        if k > 0 {
+                            for (a, &v) in aovs[s * k..(s + 1) * k]
+                                .iter_mut()
+                                .zip(&record[SharedSamples::AOVS..SharedSamples::AOVS + k])
+                            {
+                                *a += w * v;
+                            }
                         }
                     }
                 }
