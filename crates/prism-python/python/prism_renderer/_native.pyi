@@ -47,6 +47,13 @@ class Scene:
         ``prism render --wavelengths``; an unknown name raises :class:`PrismError`."""
     @wavelengths.setter
     def wavelengths(self, name: str) -> None: ...
+    @property
+    def reconstruction(self) -> str:
+        """How samples become pixel values (the film's ``reconstruction``): ``"filter_mis"``
+        or ``"pixel"``. Setting it is ``prism render --reconstruction``; an unknown name raises
+        :class:`PrismError`."""
+    @reconstruction.setter
+    def reconstruction(self, name: str) -> None: ...
 
 class Transform:
     """A 4 × 4 transform acting on column vectors, composed like Mitsuba's
