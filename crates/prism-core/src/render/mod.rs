@@ -688,10 +688,9 @@ fn gather_tile(
                             rejected[s] |= source == pixel;
                             continue;
                         }
+                        // Without a branch on w = 0 (half the neighbours' samples fall outside
+                        // the pixel's support, unpredictably): adding zero is cheaper.
                         let w = record[kx] * record[ky];
-                        if w == 0.0 {
-                            continue;
-                        }
                         totals[s] += w * Vec4::new(scale, x, y, z);
                         if k > 0 {
                             for (a, &v) in aovs[s * k..(s + 1) * k]
