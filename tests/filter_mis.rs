@@ -9,6 +9,7 @@ use std::path::PathBuf;
 use std::sync::atomic::{AtomicU32, Ordering};
 
 use prism_core::film::{Film, Filter, PixelSums};
+use prism_core::math::quadrature::simpson;
 use prism_core::render::{RenderOptions, StopRule, render};
 use prism_core::scene::Scene;
 use prism_mitsuba::load_scene;
@@ -60,24 +61,13 @@ fn edge_scene(defines: &[(&str, &str)]) -> Scene {
 /// F(t) = ∫_{−r}^{t} k / ∫ k (Simpson's rule on 4096 intervals).
 fn edge_value(filter: Filter, column: u32) -> f64 {
     let r = f64::from(filter.radius());
-    let integral = |to: f64| -> f64 {
-        let to = to.clamp(-r, r);
-        let n = 4096;
-        let h = (to + r) / f64::from(n);
-        (0..=n)
-            .map(|j| {
-                let w = if j == 0 || j == n {
-                    1.0
-                } else if j % 2 == 1 {
-                    4.0
-                } else {
-                    2.0
-                };
-                w * f64::from(filter.eval((-r + f64::from(j) * h) as f32))
-            })
-            .sum::<f64>()
-            * h
-            / 3.0
+    let integral = |to: f64| {
+        simpson(
+            |x| f64::from(filter.eval(x as f32)),
+            -r,
+            to.clamp(-r, r),
+            4096,
+        )
     };
     let t = 5.5 - (f64::from(column) + 0.5);
     0.25 + 0.75 * integral(t) / integral(r)

@@ -24,6 +24,7 @@
 
 use glam::Vec2;
 
+use crate::math::quadrature::simpson;
 use crate::sampling::distribution::PiecewiseConstant1D;
 
 /// A separable reconstruction filter k(x)k(y).
@@ -121,23 +122,8 @@ impl FilterSampler {
         // Each cell's weight is the mean of |k| over it (Simpson's rule on 8 sub-intervals), so
         // the tabulated density follows the kernel closely even where it changes quickly.
         let cell_integral = |i: usize, f: &dyn Fn(f32) -> f32| -> f64 {
-            let a = -r + i as f32 * width;
-            let m = 8;
-            let h = width / m as f32;
-            (0..=m)
-                .map(|j| {
-                    let w = if j == 0 || j == m {
-                        1.0
-                    } else if j % 2 == 1 {
-                        4.0
-                    } else {
-                        2.0
-                    };
-                    w * f64::from(f(a + j as f32 * h))
-                })
-                .sum::<f64>()
-                * f64::from(h)
-                / 3.0
+            let a = f64::from(-r + i as f32 * width);
+            simpson(|x| f64::from(f(x as f32)), a, a + f64::from(width), 8)
         };
         let weights: Vec<f32> = (0..cells)
             .map(|i| (cell_integral(i, &|x| filter.eval(x).abs()) / f64::from(width)) as f32)

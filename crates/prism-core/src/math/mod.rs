@@ -1,10 +1,11 @@
-//! Vectors, matrices, shading frames, transforms and rays.
+//! Vectors, matrices, shading frames, transforms and rays, and numerical integration.
 //!
 //! Geometry is single precision (as in Mitsuba 3's scalar variants and pbrt-v4); transforms are
 //! composed in double precision by the scene reader and rounded once.
 
 pub mod animated;
 pub mod frame;
+pub mod quadrature;
 pub mod ray;
 pub mod special;
 pub mod transform;

@@ -422,37 +422,111 @@ fn render_tile(
     Some((sums, count.rays))
 }
 
-/// One pass of the one-pixel reconstruction: every tile's pixels take the samples `range`, in
-/// parallel. None when the pass was cancelled.
-fn render_pass(
-    estimator: &SampleEstimator,
-    tiles: &[Tile],
-    sums: &[TileSums],
-    range: Range<u32>,
-    options: &RenderOptions,
-    cancel: &Cancel,
-    progress: &ProgressSink,
-) -> Option<(Vec<TileSums>, u64)> {
-    let pass = u64::from(range.end - range.start);
-    let results: Vec<Option<(TileSums, u64)>> = tiles
-        .par_iter()
-        .zip(sums)
-        .map(|(&tile, tile_sums)| {
-            let result = render_tile(estimator, tile, tile_sums, range.clone(), options, cancel);
-            if result.is_some() {
-                progress.add(u64::from(tile.size.x * tile.size.y) * pass);
-            }
-            result
-        })
-        .collect();
-    let mut rays = 0;
-    let mut new_sums = Vec::with_capacity(results.len());
-    for result in results {
-        let (tile_sums, tile_rays) = result?;
-        new_sums.push(tile_sums);
-        rays += tile_rays;
+/// What every pass of a render works with.
+struct Pass<'p, 's> {
+    estimator: &'p SampleEstimator<'s>,
+    tiles: &'p [Tile],
+    options: &'p RenderOptions,
+    cancel: &'p Cancel<'p>,
+    progress: &'p ProgressSink,
+}
+
+impl Pass<'_, '_> {
+    /// Adds the samples `range` of every pixel to copies of the tiles' `sums`, in parallel; None
+    /// when the pass was cancelled.
+    fn render(&self, sums: &[TileSums], range: Range<u32>) -> Option<(Vec<TileSums>, u64)> {
+        match &self.estimator.shared {
+            Some(mis) => self.render_shared(mis, sums, range),
+            None => self.render_one_pixel(sums, range),
+        }
     }
-    Some((new_sums, rays))
+
+    /// The one-pixel reconstruction: every tile's pixels take their own samples.
+    fn render_one_pixel(
+        &self,
+        sums: &[TileSums],
+        range: Range<u32>,
+    ) -> Option<(Vec<TileSums>, u64)> {
+        let pass = u64::from(range.end - range.start);
+        let (estimator, options, cancel) = (self.estimator, self.options, self.cancel);
+        let results: Vec<Option<(TileSums, u64)>> = self
+            .tiles
+            .par_iter()
+            .zip(sums)
+            .map(|(&tile, tile_sums)| {
+                let result =
+                    render_tile(estimator, tile, tile_sums, range.clone(), options, cancel);
+                if result.is_some() {
+                    self.progress
+                        .add(u64::from(tile.size.x * tile.size.y) * pass);
+                }
+                result
+            })
+            .collect();
+        let mut rays = 0;
+        let mut new_sums = Vec::with_capacity(results.len());
+        for result in results {
+            let (tile_sums, tile_rays) = result?;
+            new_sums.push(tile_sums);
+            rays += tile_rays;
+        }
+        Some((new_sums, rays))
+    }
+
+    /// Filter MIS: for each batch of sample indices, the samples of every pixel within reach of
+    /// the crop window are traced, then every pixel of the crop gathers what each index brings
+    /// it from the (2·reach + 1)² pixels around, always in the same order, and adds the totals
+    /// of each index to its sums ([`PixelSums::add_shared`]).
+    fn render_shared(
+        &self,
+        mis: &FilterMis,
+        sums: &[TileSums],
+        range: Range<u32>,
+    ) -> Option<(Vec<TileSums>, u64)> {
+        let estimator = self.estimator;
+        let film = &estimator.scene.film;
+        let reach = UVec2::splat(mis.reach());
+        let origin = film.crop.offset.saturating_sub(reach);
+        let end = (film.crop.offset + film.crop.size + reach).min(film.size);
+        let size = end - origin;
+        let k = estimator.aov_count();
+        let bytes_per_index = SharedSamples::bytes_per_index(size, k, mis.reach());
+        let batch = (SHARED_SAMPLES_BYTES / bytes_per_index)
+            .clamp(1, (range.end - range.start) as usize) as u32;
+        let mut samples = SharedSamples::new(origin, size, batch, k, mis.reach());
+        let mut new_sums = sums.to_vec();
+        let mut rays = 0;
+        let mut start = range.start;
+        while start < range.end {
+            let batch_range = start..(start + batch).min(range.end);
+            rays += samples.trace(
+                estimator,
+                mis,
+                batch_range.clone(),
+                self.options,
+                self.cancel,
+            )?;
+            new_sums
+                .par_iter_mut()
+                .zip(self.tiles)
+                .for_each(|(tile_sums, &tile)| {
+                    gather_tile(
+                        estimator,
+                        mis,
+                        &samples,
+                        tile,
+                        tile_sums,
+                        batch_range.clone(),
+                        self.options,
+                    );
+                    let pixels = u64::from(tile.size.x * tile.size.y);
+                    self.progress
+                        .add(pixels * u64::from(batch_range.end - batch_range.start));
+                });
+            start = batch_range.end;
+        }
+        Some((new_sums, rays))
+    }
 }
 
 /// The samples of one batch of sample indices, traced for every pixel of a rectangle of the
@@ -590,59 +664,6 @@ impl SharedSamples {
             .collect();
         rays.into_iter().sum()
     }
-}
-
-/// One pass of filter MIS: for each batch of sample indices, the samples of every pixel within
-/// reach of the crop window are traced, then every pixel of the crop gathers what each index
-/// brings it from the (2·reach + 1)² pixels around, always in the same order, and adds the
-/// totals of each index to its sums ([`PixelSums::add_shared`]). None when the pass was
-/// cancelled.
-#[allow(clippy::too_many_arguments)]
-fn render_shared_pass(
-    estimator: &SampleEstimator,
-    mis: &FilterMis,
-    tiles: &[Tile],
-    sums: &[TileSums],
-    range: Range<u32>,
-    options: &RenderOptions,
-    cancel: &Cancel,
-    progress: &ProgressSink,
-) -> Option<(Vec<TileSums>, u64)> {
-    let film = &estimator.scene.film;
-    let reach = UVec2::splat(mis.reach());
-    let origin = film.crop.offset.saturating_sub(reach);
-    let end = (film.crop.offset + film.crop.size + reach).min(film.size);
-    let size = end - origin;
-    let k = estimator.aov_count();
-    let bytes_per_index = SharedSamples::bytes_per_index(size, k, mis.reach());
-    let batch = (SHARED_SAMPLES_BYTES / bytes_per_index)
-        .clamp(1, (range.end - range.start) as usize) as u32;
-    let mut samples = SharedSamples::new(origin, size, batch, k, mis.reach());
-    let mut new_sums = sums.to_vec();
-    let mut rays = 0;
-    let mut start = range.start;
-    while start < range.end {
-        let batch_range = start..(start + batch).min(range.end);
-        rays += samples.trace(estimator, mis, batch_range.clone(), options, cancel)?;
-        new_sums
-            .par_iter_mut()
-            .zip(tiles)
-            .for_each(|(tile_sums, &tile)| {
-                gather_tile(
-                    estimator,
-                    mis,
-                    &samples,
-                    tile,
-                    tile_sums,
-                    batch_range.clone(),
-                    options,
-                );
-                let pixels = u64::from(tile.size.x * tile.size.y);
-                progress.add(pixels * u64::from(batch_range.end - batch_range.start));
-            });
-        start = batch_range.end;
-    }
-    Some((new_sums, rays))
 }
 
 /// Adds to every pixel of `tile` the totals of the sample indices `range` over the samples of
@@ -799,6 +820,18 @@ pub fn render_with_checkpoints(
     let rays = AtomicU64::new(0);
     let abort = AtomicBool::new(false);
     let start = Instant::now();
+    let cancel = Cancel {
+        flag: &abort,
+        external: options.interrupt.as_deref(),
+        deadline: stop.time_limit.map(|limit| start + limit),
+    };
+    let pass = Pass {
+        estimator: &estimator,
+        tiles: &tiles,
+        options: &options,
+        cancel: &cancel,
+        progress: &progress,
+    };
     let mut last_checkpoint = start;
     let first = options.first_sample;
     let mut next = first;
@@ -828,34 +861,9 @@ pub fn render_with_checkpoints(
             break StopReason::Interrupted;
         }
         let left = stop.sample_end.map_or(u32::MAX - next, |end| end - next);
-        let pass = next_pass(in_passes, next - first, left, &stop, start.elapsed(), error);
-        let range = next..next + pass;
-        let cancel = Cancel {
-            flag: &abort,
-            external: options.interrupt.as_deref(),
-            deadline: stop.time_limit.map(|limit| start + limit),
-        };
-        let pass_result = pool.install(|| match &estimator.shared {
-            Some(mis) => render_shared_pass(
-                &estimator,
-                mis,
-                &tiles,
-                &sums,
-                range.clone(),
-                &options,
-                &cancel,
-                &progress,
-            ),
-            None => render_pass(
-                &estimator,
-                &tiles,
-                &sums,
-                range.clone(),
-                &options,
-                &cancel,
-                &progress,
-            ),
-        });
+        let count = next_pass(in_passes, next - first, left, &stop, start.elapsed(), error);
+        let range = next..next + count;
+        let pass_result = pool.install(|| pass.render(&sums, range.clone()));
         let Some((new_sums, pass_rays)) = pass_result.filter(|_| !abort.load(Ordering::Relaxed))
         else {
             let interrupted = options
@@ -870,7 +878,7 @@ pub fn render_with_checkpoints(
         };
         sums = new_sums;
         rays.fetch_add(pass_rays, Ordering::Relaxed);
-        next += pass;
+        next += count;
         error = relative_error(sums.iter().flat_map(|t| &t.pixels));
         progress.pass_done(next - first, error);
         if let Some(checkpoint) = &mut checkpoints
