@@ -814,3 +814,31 @@ fn transmitting_principled_is_a_rough_dielectric() {
         }
     }
 }
+
+/// An `<rgb>` η or k is read as Mitsuba 3.9.1's spectral variants read it: each component
+/// clamped to [0, 1], then upsampled as a reflectance. The expected values are Mitsuba's, from
+/// its fitted coefficients for these colours (`mi.traverse(bsdf)["eta.value"]`, evaluated at
+/// each wavelength); the two renderers' coefficient tables differ by about 10⁻³.
+#[test]
+fn rgb_conductor_indices_are_clamped_as_mitsuba_reads_them() {
+    let bsdf = bsdf_from_xml(
+        r#"<bsdf type="conductor"><rgb name="eta" value="0.200438, 0.924033, 1.10221"/>
+           <rgb name="k" value="3.91295, 2.45285, 2.14219"/></bsdf>"#,
+    );
+    let Bsdf::Conductor(c) = &bsdf else { panic!() };
+    let value = |t: &prism_core::texture::Texture, lambda: f32| match t {
+        prism_core::texture::Texture::Constant(s) => s.value(lambda),
+        other => panic!("{other:?}"),
+    };
+    for (lambda, mitsuba_eta) in [(450.0, 0.97995), (550.0, 0.90732), (650.0, 0.06969)] {
+        let eta = value(&c.eta, lambda);
+        assert!((eta - mitsuba_eta).abs() < 0.01, "η({lambda}) = {eta}");
+        assert_eq!(value(&c.k, lambda), 1.0);
+    }
+    // A <spectrum> keeps its values.
+    let bsdf = bsdf_from_xml(
+        r#"<bsdf type="conductor"><spectrum name="eta" value="0.924"/><spectrum name="k" value="2.45"/></bsdf>"#,
+    );
+    let Bsdf::Conductor(c) = &bsdf else { panic!() };
+    assert_eq!((value(&c.eta, 500.0), value(&c.k, 500.0)), (0.924, 2.45));
+}

@@ -38,9 +38,11 @@ pub enum Range {
     Albedo,
     /// Emitted radiance or intensity: non-negative.
     Emission,
-    /// Any non-negative value, such as the real and imaginary parts of an index of refraction;
-    /// `<rgb>` is upsampled without bounds ([`RgbIntent::Unbounded`]).
-    Unbounded,
+    /// The real or imaginary part of a conductor's index of refraction: any non-negative
+    /// value, but an `<rgb>` is read as Mitsuba 3's spectral variants read it, each component
+    /// clamped to [0, 1] and the result upsampled as a reflectance (so (3.9, 2.5, 2.1) is the
+    /// constant 1). The same XML then gives the same image; docs/mitsuba-compatibility.md.
+    IndexPart,
     /// A medium's coefficient: any non-negative value, with `<rgb>` upsampled as a reflectance
     /// (as Mitsuba 3's spectral variants read it) and components above 1 let through unbounded.
     Coefficient,
@@ -96,7 +98,7 @@ impl ParamKind {
                 let what = match range {
                     Range::Albedo => "reflectance",
                     Range::Emission => "emission",
-                    Range::Unbounded => "spectrum",
+                    Range::IndexPart => "spectrum",
                     Range::Coefficient => "coefficient",
                 };
                 if *textured {

@@ -462,15 +462,16 @@ const MATERIAL: ParamSpec = ParamSpec::new(
 );
 const ETA: ParamSpec = colour(
     "eta",
-    Range::Unbounded,
+    Range::IndexPart,
     0.0,
-    "real part of the index (instead of `material`); an `<rgb>` is upsampled without bounds",
+    "real part of the index (instead of `material`); an `<rgb>` is read as Mitsuba 3's spectral \
+     variants read it: components clamped to [0, 1], upsampled as a reflectance",
 );
 const K: ParamSpec = colour(
     "k",
-    Range::Unbounded,
+    Range::IndexPart,
     1.0,
-    "imaginary part of the index (instead of `material`)",
+    "imaginary part of the index (instead of `material`); an `<rgb>` as for `eta`",
 );
 const CONDUCTOR_SPECULAR: ParamSpec = colour(
     "specular_reflectance",

@@ -190,9 +190,8 @@ pub fn spectrum_param(params: &Params, spec: &ParamSpec) -> Result<Spectrum> {
         .with_help("spectral values must be finite and at least 0")
     };
     let intent = match range {
-        Range::Albedo | Range::Coefficient => RgbIntent::Albedo,
+        Range::Albedo | Range::Coefficient | Range::IndexPart => RgbIntent::Albedo,
         Range::Emission => RgbIntent::Illuminant,
-        Range::Unbounded => RgbIntent::Unbounded,
     };
     let spectrum = match &property.value {
         PropertyValue::Float(_) | PropertyValue::Integer(_) => {
@@ -201,7 +200,7 @@ pub fn spectrum_param(params: &Params, spec: &ParamSpec) -> Result<Spectrum> {
                 return Err(negative());
             }
             match range {
-                Range::Albedo | Range::Unbounded | Range::Coefficient => {
+                Range::Albedo | Range::IndexPart | Range::Coefficient => {
                     Spectrum::Constant(v as f32)
                 }
                 Range::Emission => Spectrum::from_rgb([v as f32; 3], RgbIntent::Illuminant),
@@ -211,7 +210,11 @@ pub fn spectrum_param(params: &Params, spec: &ParamSpec) -> Result<Spectrum> {
             if !rgb.iter().all(|c| *c >= 0.0 && c.is_finite()) {
                 return Err(negative());
             }
-            Spectrum::from_rgb(rgb.map(|c| c as f32), intent)
+            let rgb = rgb.map(|c| c as f32);
+            match range {
+                Range::IndexPart => Spectrum::from_rgb(rgb.map(|c| c.min(1.0)), intent),
+                _ => Spectrum::from_rgb(rgb, intent),
+            }
         }
         PropertyValue::Spectrum(SpectrumValue::Uniform(v)) => {
             if !(*v >= 0.0 && v.is_finite()) {
