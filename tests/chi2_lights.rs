@@ -1,5 +1,6 @@
 //! Chi-square tests (DESIGN.md §6) of the lights' sampling routines: sphere lights by visible
-//! cone in its small-angle and near regimes, triangle-mesh lights by area as seen from a point,
+//! cone in its small-angle and near regimes, rectangle lights by solid angle and other
+//! triangle-mesh lights by area as seen from a point,
 //! environment maps by luminance · sin θ, and the choice of a light by power or uniformly. Each
 //! test works in coordinates where the density is continuous within every cell.
 
@@ -7,11 +8,11 @@ mod common;
 
 use std::f64::consts::PI;
 
-use common::chi2::{assert_passes, chi2_discrete, chi2_from_counts, chi2_rectangle};
+use common::chi2::{assert_passes, chi2_discrete, chi2_from_counts, chi2_rectangle, simpson_2d};
 use common::scenes::{Object, build, camera};
 use glam::{DMat4, DVec3, Mat3, UVec2, Vec2, Vec3};
-use prism_core::geometry::Shape;
 use prism_core::geometry::Sphere;
+use prism_core::geometry::{Shape, ShapeSampling};
 use prism_core::image::{Bitmap, Encoding};
 use prism_core::integrator::PathIntegrator;
 use prism_core::light::{
@@ -24,7 +25,7 @@ use prism_core::spectrum::{SampledWavelengths, Spectrum};
 use prism_mitsuba::factory::shapes::{rectangle, transform_mesh};
 
 /// Number of chi-square tests in this file, for Šidák's correction.
-const TESTS: usize = 6;
+const TESTS: usize = 9;
 const SAMPLES: usize = 1_000_000;
 
 fn u2(rng: &mut Pcg32) -> Vec2 {
@@ -89,27 +90,103 @@ fn sphere_cone_sampling_close_to_the_sphere() {
     cone_chi2(1.05, 22, "sphere cone, close");
 }
 
-/// A rectangle light of 2 × 1.2 seen obliquely from a point: the area light's solid-angle
-/// samples, mapped back to the rectangle's (x, y), must be uniform, and the claimed solid-angle
-/// pdf times cos/d² must be 1/area at every point (the density the chi-square integrates).
-#[test]
-fn mesh_light_sampling_is_uniform_in_area() {
+/// The rectangle light x ∈ [−0.7, 1.3], y ∈ [−0.4, 0.8] at z = 2 (Mitsuba's `rectangle`,
+/// scaled and moved; `shear` slants it into a parallelogram with the same area, 2.4).
+fn rectangle_light(shear: f64) -> Vec<prism_core::geometry::Primitive> {
+    let slant = DMat4::from_cols_array(&[
+        1.0, 0.0, 0.0, 0.0, shear, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0,
+    ]);
     let to_world = Transform::new(
         DMat4::from_translation(DVec3::new(0.3, 0.2, 2.0))
+            * slant
             * DMat4::from_scale(DVec3::new(1.0, 0.6, 1.0)),
     )
     .unwrap();
-    let shapes = vec![Shape::Mesh(transform_mesh(rectangle(), &to_world, true, true)).into()];
+    vec![Shape::Mesh(transform_mesh(rectangle(), &to_world, true, true)).into()]
+}
+
+/// A rectangle light seen from `reference`: its samples, in the rectangle's (x, y), must have
+/// the density of directions uniform in the solid angle S it subtends, cos θ / (d² S), with S
+/// integrated here by Simpson's rule (independently of the sampler's closed form), and the
+/// claimed pdf must be 1/S to 10⁻⁴.
+fn rectangle_light_chi2(reference: Vec3, seed: u64, name: &str) {
+    let shapes = rectangle_light(0.0);
     let light = Light::Area(AreaLight::uniform(0, Spectrum::Constant(1.0)));
-    let reference = Vec3::new(-0.7, 0.4, 0.5);
     let lambda = SampledWavelengths::single(550.0);
+    let r = reference.as_dvec3();
+    let h = 2.0 - r.z;
+    let directional = move |x: f64, y: f64| {
+        let d2 = (x - r.x).powi(2) + (y - r.y).powi(2) + h * h;
+        h.abs() / (d2 * d2.sqrt())
+    };
+    let solid_angle = simpson_2d(directional, (-0.7, 1.3), (-0.4, 0.8), 800);
     let outcome = chi2_rectangle(
         SAMPLES,
         (-0.7, 1.3),
         (-0.4, 0.8),
         40,
         24,
-        23,
+        seed,
+        |rng| {
+            let ls =
+                light.sample_incident(&shapes, reference, 0.0, rng.next_f32(), u2(rng), &lambda)?;
+            let claimed = f64::from(ls.pdf) * solid_angle;
+            assert!((claimed - 1.0).abs() < 1e-4, "{name}: pdf × S = {claimed}");
+            assert!((f64::from(ls.p.z) - 2.0).abs() < 1e-5, "{name}: {}", ls.p);
+            // Points on an edge may round to just outside it.
+            let (x, y) = (f64::from(ls.p.x), f64::from(ls.p.y));
+            assert!(x > -0.7 - 1e-5 && x < 1.3 + 1e-5 && y > -0.4 - 1e-5 && y < 0.8 + 1e-5);
+            Some((x.clamp(-0.7, 1.3 - 1e-9), y.clamp(-0.4, 0.8 - 1e-9)))
+        },
+        |x, y| directional(x, y) / solid_angle,
+    )
+    .unwrap();
+    assert_passes(name, &outcome, TESTS);
+}
+
+/// Seen obliquely from 1.5 below: the density varies 3× over the rectangle.
+#[test]
+fn rectangle_light_sampling_is_uniform_in_solid_angle() {
+    rectangle_light_chi2(Vec3::new(-0.7, 0.4, 0.5), 23, "rectangle light, oblique");
+}
+
+/// Seen from just below the plane, beside an edge: the density varies a thousandfold, the case
+/// area sampling is noisiest for (a wall next to a ceiling light).
+#[test]
+fn rectangle_light_sampling_close_to_the_plane() {
+    rectangle_light_chi2(Vec3::new(-0.9, 0.0, 1.9), 24, "rectangle light, grazing");
+}
+
+/// A light that is not a rectangle (a parallelogram) is sampled by area.
+#[test]
+fn parallelogram_light_sampling_is_uniform_in_area() {
+    by_area_chi2(0.5, ShapeSampling::SolidAngle, 25, "parallelogram light");
+}
+
+/// A rectangle light with `sampling="area"` (the lecture's) is sampled by area too.
+#[test]
+fn rectangle_light_sampling_by_area_is_uniform_in_area() {
+    by_area_chi2(0.0, ShapeSampling::Area, 26, "rectangle light by area");
+}
+
+/// The light of [`rectangle_light`] slanted by `shear` and sampled by `sampling` must be sampled
+/// uniformly by area: its samples, in its own coordinates (s, t) ∈ [0, 1]², uniform, and the
+/// claimed solid-angle pdf times cos/d² 1/area at every point.
+fn by_area_chi2(shear: f64, sampling: ShapeSampling, seed: u64, name: &str) {
+    let shapes = rectangle_light(shear);
+    let light = Light::Area(AreaLight::uniform(0, Spectrum::Constant(1.0)).sampled_by(sampling));
+    let reference = Vec3::new(-0.7, 0.4, 0.5);
+    let lambda = SampledWavelengths::single(550.0);
+    // The corners (−1, −1), (1, −1), (−1, 1) of the unit rectangle, scaled, slanted and moved.
+    let corner = DVec3::new(0.3 - 1.0 - 0.6 * shear, 0.2 - 0.6, 2.0);
+    let (e1, e2) = (DVec3::new(2.0, 0.0, 0.0), DVec3::new(1.2 * shear, 1.2, 0.0));
+    let outcome = chi2_rectangle(
+        SAMPLES,
+        (0.0, 1.0),
+        (0.0, 1.0),
+        30,
+        20,
+        seed,
         |rng| {
             let ls =
                 light.sample_incident(&shapes, reference, 0.0, rng.next_f32(), u2(rng), &lambda)?;
@@ -117,12 +194,15 @@ fn mesh_light_sampling_is_uniform_in_area() {
             let cos = d.normalize().dot(Vec3::Z).abs();
             let area_pdf = f64::from(ls.pdf * cos / d.length_squared());
             assert!((area_pdf * 2.4 - 1.0).abs() < 1e-3, "area pdf {area_pdf}");
-            Some((f64::from(ls.p.x), f64::from(ls.p.y)))
+            let w = ls.p.as_dvec3() - corner;
+            let t = w.y / e2.y;
+            let s = (w.x - t * e2.x) / e1.x;
+            Some((s.clamp(0.0, 1.0 - 1e-12), t.clamp(0.0, 1.0 - 1e-12)))
         },
-        |_, _| 1.0 / 2.4,
+        |_, _| 1.0,
     )
     .unwrap();
-    assert_passes("mesh light by area", &outcome, TESTS);
+    assert_passes(name, &outcome, TESTS);
 }
 
 /// A linear greyscale bitmap from a function of the pixel.

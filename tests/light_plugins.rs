@@ -252,3 +252,32 @@ fn emitter_textures_as_mitsuba_reads_them() {
     }
     std::fs::remove_dir_all(&folder).ok();
 }
+
+/// The `area` emitter's `sampling` chooses how light samples find its shape: by solid angle
+/// (the default) or, as the lecture samples lights, by area.
+#[test]
+fn area_emitter_sampling_is_a_scene_choice() {
+    let sampling = |emitter: &str| {
+        let scene = load(
+            Path::new("."),
+            &format!(r#"<shape type="rectangle">{emitter}</shape>"#),
+        );
+        match &scene.world.lights[0] {
+            Light::Area(area) => area.sampling,
+            other => panic!("{other:?}"),
+        }
+    };
+    use prism_core::geometry::ShapeSampling;
+    assert_eq!(
+        sampling(r#"<emitter type="area"/>"#),
+        ShapeSampling::SolidAngle
+    );
+    assert_eq!(
+        sampling(r#"<emitter type="area"><string name="sampling" value="area"/></emitter>"#),
+        ShapeSampling::Area
+    );
+    assert_eq!(
+        sampling(r#"<emitter type="area"><string name="sampling" value="solid_angle"/></emitter>"#),
+        ShapeSampling::SolidAngle
+    );
+}

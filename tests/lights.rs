@@ -17,7 +17,7 @@ use glam::{DMat4, DVec3, Mat3, UVec2, Vec2, Vec3};
 use prism_core::camera::Camera;
 use prism_core::film::Film;
 use prism_core::geometry::Sphere;
-use prism_core::geometry::{Primitive, Shape};
+use prism_core::geometry::{Primitive, Shape, ShapeSampling};
 use prism_core::image::{Bitmap, Encoding};
 use prism_core::integrator::{DistributionIntegrator, Integrator, PathIntegrator};
 use prism_core::light::{
@@ -177,7 +177,8 @@ fn lambert_polygon(x: DVec3, n: DVec3, vertices: &[DVec3], radiance: f64) -> f64
 }
 
 /// A 1 × 0.6 rectangle light facing down at height 1 over a diffuse plane; the irradiance by
-/// Lambert's polygon formula. Light and BSDF samples both find the rectangle (MIS).
+/// Lambert's polygon formula. Light and BSDF samples both find the rectangle (MIS), the light
+/// samples by solid angle and, in a second render, by area.
 #[test]
 fn rectangle_light_by_lamberts_formula() {
     let (rho, radiance) = (0.5f64, 4.0f64);
@@ -212,10 +213,23 @@ fn rectangle_light_by_lamberts_formula() {
         size,
         PathIntegrator::default(),
     );
-    let film = render_film(&scene, 512, 33, None);
-    assert_pixels("rectangle light", &film, &camera, |ray| {
-        rho / PI * lambert_polygon(on_floor(ray), DVec3::Z, &vertices, radiance)
-    });
+    // Both ways of sampling the rectangle: by the solid angle it subtends (the default) and
+    // by area (the lecture's, `sampling="area"`).
+    let mut scene = scene;
+    for (sampling, seed) in [(ShapeSampling::SolidAngle, 33), (ShapeSampling::Area, 34)] {
+        for light in &mut scene.world.lights {
+            if let Light::Area(area) = light {
+                area.sampling = sampling;
+            }
+        }
+        let film = render_film(&scene, 512, seed, None);
+        assert_pixels(
+            &format!("rectangle light, {sampling:?}"),
+            &film,
+            &camera,
+            |ray| rho / PI * lambert_polygon(on_floor(ray), DVec3::Z, &vertices, radiance),
+        );
+    }
 }
 
 /// The rectangle light of [`rectangle_light_by_lamberts_formula`] with a 2 × 2 texture of

@@ -438,7 +438,7 @@ fn simpson(f: impl Fn(f64) -> f64, (a, b): (f64, f64), n: usize) -> f64 {
 }
 
 /// The tensor product of [`simpson`] on [a, b] x [c, d], `n` sub-intervals per axis.
-fn simpson_2d(
+pub fn simpson_2d(
     f: impl Fn(f64, f64) -> f64,
     (a, b): (f64, f64),
     (c, d): (f64, f64),

@@ -16,7 +16,7 @@ use glam::{Vec2, Vec3};
 
 use super::aggregate::Aggregate;
 use super::interaction::SurfaceInteraction;
-use super::shape::{Shape, SurfaceSample};
+use super::shape::{Shape, ShapeSampling, SurfaceSample};
 use crate::math::{AnimatedTransform, Frame, Ray};
 
 /// A shape, or a group of shapes, placed by an animated transform.
@@ -120,11 +120,12 @@ impl Instance {
         time: f32,
         u_choice: f32,
         u: Vec2,
+        sampling: ShapeSampling,
     ) -> Option<SurfaceSample> {
         let transform = self.to_world.at(time);
-        let s = self
-            .shape()
-            .sample_from(transform.inverse_point(reference), u_choice, u)?;
+        let s =
+            self.shape()
+                .sample_from(transform.inverse_point(reference), u_choice, u, sampling)?;
         Some(SurfaceSample {
             p: transform.point(s.p),
             n: transform.normal(s.n).normalize(),
@@ -136,7 +137,14 @@ impl Instance {
     }
 
     /// Density of [`Self::sample_from`] for the world point `p` with normal `n`.
-    pub fn pdf_from(&self, reference: Vec3, time: f32, p: Vec3, n: Vec3) -> f32 {
+    pub fn pdf_from(
+        &self,
+        reference: Vec3,
+        time: f32,
+        p: Vec3,
+        n: Vec3,
+        sampling: ShapeSampling,
+    ) -> f32 {
         let transform = self.to_world.at(time);
         // n = normalize(M⁻ᵀ n_object), so n_object ∝ Mᵀ n.
         let local_n = Vec3::new(
@@ -149,6 +157,7 @@ impl Instance {
             transform.inverse_point(reference),
             transform.inverse_point(p),
             local_n,
+            sampling,
         )
     }
 

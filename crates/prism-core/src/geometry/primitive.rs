@@ -6,7 +6,7 @@ use glam::{Vec2, Vec3};
 use super::aggregate::{Aggregate, AggregateElement, Hit};
 use super::instance::Instance;
 use super::interaction::SurfaceInteraction;
-use super::shape::{Shape, SurfaceSample, TriangleMesh};
+use super::shape::{Shape, ShapeSampling, SurfaceSample, TriangleMesh};
 use crate::math::Ray;
 
 /// One primitive of the scene, dispatched by `match`.
@@ -44,20 +44,30 @@ impl Primitive {
         time: f32,
         u_choice: f32,
         u: Vec2,
+        sampling: ShapeSampling,
     ) -> Option<SurfaceSample> {
         match self {
-            Primitive::Shape(shape) => shape.sample_from(reference, u_choice, u),
-            Primitive::Instance(instance) => instance.sample_from(reference, time, u_choice, u),
+            Primitive::Shape(shape) => shape.sample_from(reference, u_choice, u, sampling),
+            Primitive::Instance(instance) => {
+                instance.sample_from(reference, time, u_choice, u, sampling)
+            }
         }
     }
 
     /// Density of [`Self::sample_from`] for the surface point `p` with geometric normal `n`, per
     /// unit solid angle at `reference`, at `time`.
     #[inline]
-    pub fn pdf_from(&self, reference: Vec3, time: f32, p: Vec3, n: Vec3) -> f32 {
+    pub fn pdf_from(
+        &self,
+        reference: Vec3,
+        time: f32,
+        p: Vec3,
+        n: Vec3,
+        sampling: ShapeSampling,
+    ) -> f32 {
         match self {
-            Primitive::Shape(shape) => shape.pdf_from(reference, p, n),
-            Primitive::Instance(instance) => instance.pdf_from(reference, time, p, n),
+            Primitive::Shape(shape) => shape.pdf_from(reference, p, n, sampling),
+            Primitive::Instance(instance) => instance.pdf_from(reference, time, p, n, sampling),
         }
     }
 }

@@ -37,7 +37,7 @@ use glam::{Vec2, Vec3};
 
 use super::LightSample;
 use crate::geometry::shape::area_to_solid_angle;
-use crate::geometry::{Primitive, Shape, SurfaceSample};
+use crate::geometry::{Primitive, Shape, ShapeSampling, SurfaceSample};
 use crate::sampling::distribution::PiecewiseConstant2D;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths, Spectrum};
 use crate::texture::Texture;
@@ -60,6 +60,8 @@ pub struct AreaLight {
     texture_density: Option<Box<PiecewiseConstant2D>>,
     /// The mean luminance of the radiance over [0, 1]² (its luminance, if uniform).
     mean_luminance: f32,
+    /// How the shape is sampled from a reference point.
+    pub sampling: ShapeSampling,
 }
 
 /// The density over [0, 1]² in proportion to the texture's luminance at cell centres, with the
@@ -103,6 +105,7 @@ impl AreaLight {
                     texture_density: Some(Box::new(density)),
                     mean_luminance,
                     radiance,
+                    sampling: ShapeSampling::default(),
                 }
             }
         }
@@ -115,7 +118,13 @@ impl AreaLight {
             mean_luminance: radiance.luminance(),
             radiance: Texture::Constant(radiance),
             texture_density: None,
+            sampling: ShapeSampling::default(),
         }
+    }
+
+    /// The same emitter, its shape sampled by `sampling`.
+    pub fn sampled_by(self, sampling: ShapeSampling) -> AreaLight {
+        AreaLight { sampling, ..self }
     }
 
     /// Radiance leaving the point with texture coordinates `uv` and shading normal `n` in
@@ -176,13 +185,14 @@ impl AreaLight {
     ) -> Option<LightSample> {
         let primitive = &shapes[self.shape as usize];
         let s = match self.texture_strategy(primitive) {
-            None => primitive.sample_from(reference, time, u_choice, u)?,
+            None => primitive.sample_from(reference, time, u_choice, u, self.sampling)?,
             Some((density, shape)) if u_choice < SHAPE_STRATEGY_FRACTION => {
                 let s = primitive.sample_from(
                     reference,
                     time,
                     u_choice / SHAPE_STRATEGY_FRACTION,
                     u,
+                    self.sampling,
                 )?;
                 let texture_pdf = Self::texture_pdf(density, shape, reference, &s);
                 SurfaceSample {
@@ -199,7 +209,7 @@ impl AreaLight {
                 }
                 let texture_pdf =
                     area_to_solid_angle(density.pdf(uv) / jacobian, reference, s.p, s.n)?;
-                let shape_pdf = primitive.pdf_from(reference, time, s.p, s.n);
+                let shape_pdf = primitive.pdf_from(reference, time, s.p, s.n, self.sampling);
                 SurfaceSample {
                     pdf: SHAPE_STRATEGY_FRACTION * shape_pdf
                         + (1.0 - SHAPE_STRATEGY_FRACTION) * texture_pdf,
@@ -238,7 +248,7 @@ impl AreaLight {
         s: &SurfaceSample,
     ) -> f32 {
         let primitive = &shapes[self.shape as usize];
-        let shape_pdf = primitive.pdf_from(reference, time, s.p, s.n);
+        let shape_pdf = primitive.pdf_from(reference, time, s.p, s.n, self.sampling);
         match self.texture_strategy(primitive) {
             None => shape_pdf,
             Some((density, shape)) => {

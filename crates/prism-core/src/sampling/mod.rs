@@ -3,4 +3,5 @@
 pub mod distribution;
 pub mod rng;
 pub mod sampler;
+pub mod spherical_rectangle;
 pub mod warp;

@@ -18,6 +18,7 @@ use crate::registry::Range;
 use crate::registry::{Default, Origin, ParamKind, ParamSpec, Plugin, Registry};
 use prism_core::bsdf::{Diffuse, Material};
 use prism_core::error::{Error, Result, SourceLocation};
+use prism_core::geometry::ShapeSampling;
 use prism_core::image::read_bitmap;
 use prism_core::light::sunsky::sun_position::{DateTime, Location, sun_angles};
 use prism_core::light::{
@@ -40,10 +41,12 @@ pub static EMITTERS: Registry<Build> = Registry {
             origin: Origin::Mitsuba3,
             summary: "Nested in a shape, or declared with an `id` and referenced from one shape: emits \
                       `radiance` (a value or a texture) from the side the normal points to. \
-                      Spheres are sampled by the cone they subtend, other shapes by area; \
+                      Spheres are sampled by the cone they subtend, rectangles (two triangles \
+                      tiling one) seen from within two diagonals by the solid angle they subtend, \
+                      other shapes by area; \
                       textured radiance by the texture's luminance mapped through the uv \
                       parametrisation.",
-            params: &[AREA_RADIANCE, SAMPLING_WEIGHT],
+            params: &[AREA_RADIANCE, SAMPLING_WEIGHT, AREA_SAMPLING],
             build: build_area,
         },
         Plugin {
@@ -148,6 +151,14 @@ const SAMPLING_WEIGHT: ParamSpec = ParamSpec::new(
     Default::Float(1.0),
     "relative weight of choosing this emitter for direct light: P ∝ weight (uniform \
      `emitter_sampling`, Mitsuba's rule) or ∝ power × weight (by power); 0 never chooses it",
+);
+const AREA_SAMPLING: ParamSpec = ParamSpec::new(
+    "sampling",
+    ParamKind::Choice(&["solid_angle", "area"]),
+    Default::Str("solid_angle"),
+    "(Prism) how light samples find the shape: `solid_angle` (spheres by their cone, rectangles \
+     by the spherical rectangle from within two diagonals, other shapes by area) or `area` (every \
+     shape uniformly by area, the lecture's direct light sampling)",
 );
 const D65: Default = Default::Text("D65 of luminance 1");
 const RADIANCE: ParamSpec = ParamSpec::new(
@@ -383,16 +394,18 @@ fn sampling_weight(params: &Params) -> Result<f32> {
 /// Mitsuba's `area`: a value, a nested spectrum, or a texture read as emission.
 fn build_area(params: &Params, shape: Option<u32>, textures: &mut TextureCache) -> Result<Light> {
     let shape = shape.unwrap_or(0);
-    if let Some(child) = params.named_child(&AREA_RADIANCE)
-        && child.node.class == PluginClass::Texture
-    {
-        let texture = build_texture(&child.node, TextureUse::Emission, textures)?;
-        return Ok(Light::Area(AreaLight::new(shape, texture)));
-    }
-    Ok(Light::Area(AreaLight::uniform(
-        shape,
-        emission_param(params, &AREA_RADIANCE)?,
-    )))
+    let sampling = match params.string(&AREA_SAMPLING)? {
+        "area" => ShapeSampling::Area,
+        _ => ShapeSampling::SolidAngle,
+    };
+    let light = match params.named_child(&AREA_RADIANCE) {
+        Some(child) if child.node.class == PluginClass::Texture => {
+            let texture = build_texture(&child.node, TextureUse::Emission, textures)?;
+            AreaLight::new(shape, texture)
+        }
+        _ => AreaLight::uniform(shape, emission_param(params, &AREA_RADIANCE)?),
+    };
+    Ok(Light::Area(light.sampled_by(sampling)))
 }
 
 fn build_point(params: &Params) -> Result<Light> {

@@ -9,7 +9,13 @@ use crate::geometry::interaction::{AttributeValues, MAX_MESH_ATTRIBUTES, Surface
 use crate::geometry::triangle::TriangleHit;
 use crate::math::Frame;
 use crate::sampling::distribution::AliasTable;
+use crate::sampling::spherical_rectangle::RectangleFrame;
 use crate::sampling::warp::sample_uniform_triangle;
+
+/// A rectangle is sampled by solid angle from points closer to its centre than this many times
+/// its diagonal, by area from farther ones: there the 1/r² and the light's cosine vary across
+/// it by less than (diagonal / distance)², so the gain would not pay for the cost.
+const SOLID_ANGLE_SAMPLING_DISTANCE: f32 = 2.0;
 
 /// A triangle mesh in world space. Positions and triangles are fixed at construction (the face
 /// normals are computed from them there).
@@ -26,9 +32,9 @@ pub struct TriangleMesh {
     face_normals: Vec<Vec3>,
     /// Whether the geometric and shading normals are reversed (Mitsuba's `flip_normals`).
     flip_normals: bool,
-    /// Triangles chosen in proportion to their area (None when the area is zero). Built on the
-    /// first area sample, so that only meshes that are lights pay its 12 bytes per triangle.
-    area_table: OnceLock<Option<AliasTable>>,
+    /// What light samples need, built on the first, so that only meshes that are lights pay
+    /// for it.
+    light_sampling: OnceLock<Box<LightSampling>>,
     /// The triangles by texture coordinates, built on the first uv query (only meshes whose
     /// emission is textured make one).
     uv_grid: OnceLock<UvGrid>,
@@ -38,6 +44,28 @@ pub struct TriangleMesh {
     /// By slot, 1 + the index into `attributes` of the attribute the scene's textures read in
     /// that slot (0: none).
     bound: [u8; MAX_MESH_ATTRIBUTES],
+}
+
+/// What a mesh's light samples need.
+#[derive(Clone, Debug)]
+struct LightSampling {
+    /// Triangles chosen in proportion to their area (None when the area is zero).
+    area_table: Option<AliasTable>,
+    /// The mesh as one rectangle, when it is two triangles that tile one (Mitsuba's
+    /// `rectangle`, an OBJ quad): it is sampled by solid angle.
+    rectangle: Option<Rectangle>,
+}
+
+/// A rectangle a mesh's two triangles tile: a corner a and two orthogonal edges.
+#[derive(Clone, Copy, Debug)]
+struct Rectangle {
+    frame: RectangleFrame,
+    center: Vec3,
+    /// (SOLID_ANGLE_SAMPLING_DISTANCE × diagonal)².
+    near_distance_squared: f32,
+    /// For triangle 0 (the one with the corner a) and triangle 1 (with b = a + edge_x +
+    /// edge_y), the vertex slots of (its own corner, a + edge_x, a + edge_y).
+    slots: [[usize; 3]; 2],
 }
 
 /// Values a mesh carries per vertex or per triangle, under a Mitsuba attribute name
@@ -96,7 +124,7 @@ impl TriangleMesh {
             triangles,
             face_normals: Vec::new(),
             flip_normals,
-            area_table: OnceLock::new(),
+            light_sampling: OnceLock::new(),
             uv_grid: OnceLock::new(),
             area: 0.0,
             attributes: Vec::new(),
@@ -217,11 +245,9 @@ impl TriangleMesh {
                 .iter()
                 .map(|a| a.values.capacity() * size_of::<Vec3>())
                 .sum::<usize>()
-            + self
-                .area_table
-                .get()
-                .and_then(Option::as_ref)
-                .map_or(0, AliasTable::heap_bytes)
+            + self.light_sampling.get().map_or(0, |l| {
+                size_of::<LightSampling>() + l.area_table.as_ref().map_or(0, AliasTable::heap_bytes)
+            })
             + self.uv_grid.get().map_or(0, UvGrid::heap_bytes)
     }
 
@@ -309,24 +335,129 @@ impl TriangleMesh {
     /// area by `u_choice`, then a uniform point in it. The pdf is 1/area. None for a mesh of zero
     /// area.
     pub fn sample_area(&self, u_choice: f32, u: Vec2) -> Option<SurfaceSample> {
-        let table = self
-            .area_table
-            .get_or_init(|| AliasTable::new(&self.triangle_areas()))
-            .as_ref()?;
+        let table = self.light_sampling().area_table.as_ref()?;
         let (triangle, _) = table.sample(u_choice);
-        let [p0, p1, p2] = self.vertices(triangle);
         let b = sample_uniform_triangle(u);
-        let b = [b.x, b.y, 1.0 - b.x - b.y];
-        let p = p0 * b[0] + p1 * b[1] + p2 * b[2];
+        Some(self.surface_sample(triangle, [b.x, b.y, 1.0 - b.x - b.y], 1.0 / self.area))
+    }
+
+    /// The point at barycentric coordinates `b` of a triangle, with its normals, texture
+    /// coordinates and the density `pdf`.
+    fn surface_sample(&self, triangle: usize, b: [f32; 3], pdf: f32) -> SurfaceSample {
+        let [p0, p1, p2] = self.vertices(triangle);
         let n = self.face_normal(triangle);
         let [t0, t1, t2] = self.uv_triangle(triangle);
-        Some(SurfaceSample {
-            p,
+        SurfaceSample {
+            p: p0 * b[0] + p1 * b[1] + p2 * b[2],
             n,
             shading_n: self.shading_normal(triangle, b, n),
             uv: t0 * b[0] + t1 * b[1] + t2 * b[2],
             primitive: triangle as u32,
-            pdf: 1.0 / self.area,
+            pdf,
+        }
+    }
+
+    /// A point of the mesh as seen from `reference`, with its density per unit solid angle: a
+    /// rectangle seen from near it is sampled uniformly in the solid angle it subtends
+    /// ([`crate::sampling::spherical_rectangle`]; density 1/S), any other mesh, and a rectangle from afar, by area.
+    pub fn sample_from(&self, reference: Vec3, u_choice: f32, u: Vec2) -> Option<SurfaceSample> {
+        let Some(r) = self.near_rectangle(reference) else {
+            return self.sample_from_by_area(reference, u_choice, u);
+        };
+        let Some(projection) = r.frame.spherical(reference) else {
+            return self.sample_from_by_area(reference, u_choice, u);
+        };
+        let (_, st) = projection.sample(u);
+        let pdf = 1.0 / projection.solid_angle();
+        // p = a + s·edge_x + t·edge_y lies on triangle 0 when s + t ≤ 1, else on triangle 1.
+        let (s, t) = (st.x, st.y);
+        let (triangle, weights) = if s + t <= 1.0 {
+            (0, [1.0 - s - t, s, t])
+        } else {
+            (1, [s + t - 1.0, 1.0 - t, 1.0 - s])
+        };
+        let mut b = [0.0; 3];
+        for (slot, weight) in r.slots[triangle].into_iter().zip(weights) {
+            b[slot] = weight;
+        }
+        Some(self.surface_sample(triangle, b, pdf))
+    }
+
+    /// Density of [`Self::sample_from`] for the point `p` of the mesh with geometric normal `n`,
+    /// per unit solid angle at `reference`.
+    pub fn pdf_from(&self, reference: Vec3, p: Vec3, n: Vec3) -> f32 {
+        match self
+            .near_rectangle(reference)
+            .and_then(|r| r.frame.solid_angle(reference))
+        {
+            Some(solid_angle) => 1.0 / solid_angle,
+            None => super::area_to_solid_angle(1.0 / self.area, reference, p, n).unwrap_or(0.0),
+        }
+    }
+
+    /// An area sample, with its density per unit solid angle at `reference`.
+    fn sample_from_by_area(
+        &self,
+        reference: Vec3,
+        u_choice: f32,
+        u: Vec2,
+    ) -> Option<SurfaceSample> {
+        let s = self.sample_area(u_choice, u)?;
+        let pdf = super::area_to_solid_angle(s.pdf, reference, s.p, s.n)?;
+        Some(SurfaceSample { pdf, ..s })
+    }
+
+    fn light_sampling(&self) -> &LightSampling {
+        self.light_sampling.get_or_init(|| {
+            Box::new(LightSampling {
+                area_table: AliasTable::new(&self.triangle_areas()),
+                rectangle: self.find_rectangle(),
+            })
+        })
+    }
+
+    /// The mesh's rectangle, when the mesh is one and `reference` is near enough to sample it
+    /// by solid angle ([`SOLID_ANGLE_SAMPLING_DISTANCE`]).
+    fn near_rectangle(&self, reference: Vec3) -> Option<&Rectangle> {
+        let r = self.light_sampling().rectangle.as_ref()?;
+        (reference.distance_squared(r.center) <= r.near_distance_squared).then_some(r)
+    }
+
+    /// The rectangle two triangles tile: they share a diagonal (two positions), and with a
+    /// and b the corners each has alone and s₀, s₁ the shared ones, s₀ − a ⊥ s₁ − a and
+    /// b = a + (s₀ − a) + (s₁ − a), to a relative 10⁻⁴.
+    fn find_rectangle(&self) -> Option<Rectangle> {
+        if self.triangles.len() != 2 {
+            return None;
+        }
+        let (first, second) = (self.vertices(0), self.vertices(1));
+        let lone = |mine: &[Vec3; 3], other: &[Vec3; 3]| {
+            let lone: Vec<usize> = (0..3).filter(|&i| !other.contains(&mine[i])).collect();
+            (lone.len() == 1).then(|| lone[0])
+        };
+        let (a_slot, b_slot) = (lone(&first, &second)?, lone(&second, &first)?);
+        let (a, b) = (first[a_slot], second[b_slot]);
+        let (s0, s1) = (first[(a_slot + 1) % 3], first[(a_slot + 2) % 3]);
+        let (edge_x, edge_y) = (s0 - a, s1 - a);
+        let (lx, ly) = (edge_x.length(), edge_y.length());
+        let tolerance = 1e-4;
+        let is_rectangle = lx > 0.0
+            && ly > 0.0
+            && edge_x.dot(edge_y).abs() <= tolerance * lx * ly
+            && (a + edge_x + edge_y - b).length() <= tolerance * (lx + ly);
+        if !is_rectangle {
+            return None;
+        }
+        let slot_in_second = |p: Vec3| second.iter().position(|&q| q == p);
+        Some(Rectangle {
+            frame: RectangleFrame::new(a, edge_x, edge_y)?,
+            center: a + 0.5 * (edge_x + edge_y),
+            near_distance_squared: SOLID_ANGLE_SAMPLING_DISTANCE.powi(2)
+                * (edge_x + edge_y).length_squared(),
+            slots: [
+                [a_slot, (a_slot + 1) % 3, (a_slot + 2) % 3],
+                [b_slot, slot_in_second(s0)?, slot_in_second(s1)?],
+            ],
         })
     }
 

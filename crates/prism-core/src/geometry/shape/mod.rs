@@ -37,6 +37,18 @@ pub enum Shape {
     BSplineCurve(BSplineCurve),
 }
 
+/// How an area light samples its shape from a reference point (the `area` emitter's
+/// `sampling`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum ShapeSampling {
+    /// By the solid angle the shape subtends where Prism knows how (spheres: their cone;
+    /// rectangles: the spherical rectangle, from within two diagonals), else by area.
+    #[default]
+    SolidAngle,
+    /// Uniformly by area, every shape (the lecture's "Direct light sampling").
+    Area,
+}
+
 impl Shape {
     pub fn area(&self) -> f32 {
         match self {
@@ -175,12 +187,25 @@ impl Shape {
     }
 
     /// A point of the surface as seen from `reference`, with its density per unit solid angle.
-    /// Spheres sample the cone they subtend; other shapes sample their area uniformly.
-    pub fn sample_from(&self, reference: Vec3, u_choice: f32, u: Vec2) -> Option<SurfaceSample> {
+    /// By [`ShapeSampling::SolidAngle`], spheres sample the cone they subtend and rectangles
+    /// the spherical rectangle; other shapes, and every shape by [`ShapeSampling::Area`],
+    /// sample their area uniformly.
+    pub fn sample_from(
+        &self,
+        reference: Vec3,
+        u_choice: f32,
+        u: Vec2,
+        sampling: ShapeSampling,
+    ) -> Option<SurfaceSample> {
+        if sampling == ShapeSampling::Area {
+            let s = self.sample_area(u_choice, u)?;
+            let pdf = area_to_solid_angle(s.pdf, reference, s.p, s.n)?;
+            return Some(SurfaceSample { pdf, ..s });
+        }
         match self {
             Shape::Sphere(sphere) => sphere.sample_from(reference, u),
-            Shape::Mesh(_)
-            | Shape::Disk(_)
+            Shape::Mesh(mesh) => mesh.sample_from(reference, u_choice, u),
+            Shape::Disk(_)
             | Shape::Cylinder(_)
             | Shape::LinearCurve(_)
             | Shape::BSplineCurve(_) => {
@@ -193,11 +218,18 @@ impl Shape {
 
     /// Density of [`Self::sample_from`] for the surface point `p` with geometric normal `n`, per
     /// unit solid angle at `reference`.
-    pub fn pdf_from(&self, reference: Vec3, p: Vec3, n: Vec3) -> f32 {
+    pub fn pdf_from(&self, reference: Vec3, p: Vec3, n: Vec3, sampling: ShapeSampling) -> f32 {
+        if sampling == ShapeSampling::Area {
+            return match self {
+                Shape::LinearCurve(_) | Shape::BSplineCurve(_) => 0.0,
+                _ => area_to_solid_angle(1.0 / self.area(), reference, p, n).unwrap_or(0.0),
+            };
+        }
         match self {
             Shape::Sphere(sphere) => sphere.pdf_from(reference, p, n),
             Shape::LinearCurve(_) | Shape::BSplineCurve(_) => 0.0,
-            Shape::Mesh(_) | Shape::Disk(_) | Shape::Cylinder(_) => {
+            Shape::Mesh(mesh) => mesh.pdf_from(reference, p, n),
+            Shape::Disk(_) | Shape::Cylinder(_) => {
                 area_to_solid_angle(1.0 / self.area(), reference, p, n).unwrap_or(0.0)
             }
         }
