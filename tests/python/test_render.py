@@ -120,18 +120,18 @@ def test_the_wavelength_density_is_the_command_lines_option(cornell_path, prism_
     size = [f"resx={SIZE['resx']}", f"resy={SIZE['resy']}"]
     subprocess.run(
         [str(prism_cli), "render", str(cornell_path), "-o", str(exr), "--spp", "3"]
-        + ["--seed", "7", "--wavelengths", "visible", "-D", size[0], "-D", size[1]],
+        + ["--seed", "7", "--wavelengths", "balanced", "-D", size[0], "-D", size[1]],
         check=True,
         capture_output=True,
     )
     scene = pr.load_file(cornell_path, resx=SIZE["resx"], resy=SIZE["resy"])
-    assert scene.wavelengths == "balanced"
-    default = pr.render(scene, spp=3, seed=7, progress=False)
-    scene.wavelengths = "visible"
     assert scene.wavelengths == "visible"
-    visible = pr.render(scene, spp=3, seed=7, progress=False)
-    assert_same_image(visible, pr.Image.read(exr))
-    assert not np.array_equal(default.xyz, visible.xyz)
+    default = pr.render(scene, spp=3, seed=7, progress=False)
+    scene.wavelengths = "balanced"
+    assert scene.wavelengths == "balanced"
+    balanced = pr.render(scene, spp=3, seed=7, progress=False)
+    assert_same_image(balanced, pr.Image.read(exr))
+    assert not np.array_equal(default.xyz, balanced.xyz)
 
 
 def test_an_unknown_wavelength_density_is_an_error(cornell_path):
@@ -140,7 +140,7 @@ def test_an_unknown_wavelength_density_is_an_error(cornell_path):
         scene.wavelengths = "visibel"
     assert "visibel" in raised.value.message
     assert "visible" in (raised.value.help or "")
-    assert scene.wavelengths == "balanced"
+    assert scene.wavelengths == "visible"
 
 
 def test_the_reconstruction_is_the_command_lines_option(prism_cli, tmp_path):

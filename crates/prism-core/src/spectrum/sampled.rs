@@ -118,7 +118,7 @@ impl MulAssign<f32> for SampledSpectrum {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum WavelengthSampling {
     /// The density that minimises the error of the image Prism writes, for white light, with
-    /// luminance and colour weighted equally (derived below); the default.
+    /// luminance and colour weighted equally (derived below).
     ///
     /// An estimate (1/N) Σ f_c(λ)/p(λ) of channels c with means I_c has relative variance
     /// Σ_c a_c Var_c/I_c² = ∫ (Σ_c a_c f_c²/I_c²)/p − Σ_c a_c, which over densities is smallest,
@@ -132,13 +132,14 @@ pub enum WavelengthSampling {
     ///
     /// tabulated on 1 nm cells as [`WavelengthSampling::CieSum`] is. docs/wavelengths.md gives the
     /// measurements against the other densities.
-    #[default]
     Balanced,
     /// p(λ) ∝ x̄(λ) + ȳ(λ) + z̄(λ) on 360–830 nm, the lecture's choice ("Sampling the spectrum"),
     /// tabulated as a piecewise-constant density on 1 nm cells and sampled by its inverse CDF.
     CieSum,
     /// p(λ) ∝ 1 / cosh²(0.0072 (λ − 538)), the "visible" density of Radziszewski et al. 2009
-    /// used by Mitsuba 3 and pbrt-v4.
+    /// used by Mitsuba 3 and pbrt-v4; the default, which measured quieter than `Balanced` on
+    /// the benchmark scenes (docs/wavelengths.md).
+    #[default]
     Visible,
     /// Uniform on 360–830 nm.
     Uniform,

@@ -304,10 +304,11 @@ const RECONSTRUCTION: ParamSpec = ParamSpec::new(
 const WAVELENGTH_SAMPLING: ParamSpec = ParamSpec::new(
     "wavelength_sampling",
     ParamKind::Choice(&WavelengthSampling::NAMES),
-    Default::Str("balanced"),
-    "Prism only (Mitsuba rejects it): the density wavelengths are drawn from: `balanced` \
-     (least error of luminance and linear sRGB under white light), `cie_sum` (∝ x̄+ȳ+z̄, the \
-     lecture's), `visible` (Mitsuba's and pbrt's), `uniform`; see docs/wavelengths.md",
+    Default::Str("visible"),
+    "Prism only (Mitsuba rejects it): the density wavelengths are drawn from: `visible` \
+     (Mitsuba's and pbrt's, the quietest on the benchmark scenes), `balanced` (least error of \
+     luminance and linear sRGB under white light), `cie_sum` (∝ x̄+ȳ+z̄, the lecture's), \
+     `uniform`; see docs/wavelengths.md",
 );
 const COMPONENT_FORMAT: ParamSpec = ParamSpec::new(
     "component_format",
