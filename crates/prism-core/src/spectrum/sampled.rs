@@ -138,7 +138,7 @@ pub enum WavelengthSampling {
     CieSum,
     /// p(λ) ∝ 1 / cosh²(0.0072 (λ − 538)), the "visible" density of Radziszewski et al. 2009
     /// used by Mitsuba 3 and pbrt-v4, tabulated on 1 nm cells as the others; the default, which measured quieter than `Balanced` on
-    /// the benchmark scenes (docs/wavelengths.md).
+    /// the Cornell boxes (docs/wavelengths.md).
     #[default]
     Visible,
     /// Uniform on 360–830 nm.

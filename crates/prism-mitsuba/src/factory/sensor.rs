@@ -306,7 +306,7 @@ const WAVELENGTH_SAMPLING: ParamSpec = ParamSpec::new(
     ParamKind::Choice(&WavelengthSampling::NAMES),
     Default::Str("visible"),
     "Prism only (Mitsuba rejects it): the density wavelengths are drawn from: `visible` \
-     (Mitsuba's and pbrt's, the quietest on the benchmark scenes), `balanced` (least error of \
+     (Mitsuba's and pbrt's, the quietest on the Cornell boxes), `balanced` (least error of \
      luminance and linear sRGB under white light), `cie_sum` (∝ x̄+ȳ+z̄, the lecture's), \
      `uniform`; see docs/wavelengths.md",
 );
