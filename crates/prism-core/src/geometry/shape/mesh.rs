@@ -359,7 +359,8 @@ impl TriangleMesh {
 
     /// A point of the mesh as seen from `reference`, with its density per unit solid angle: a
     /// rectangle seen from near it is sampled uniformly in the solid angle it subtends
-    /// ([`crate::sampling::spherical_rectangle`]; density 1/S), any other mesh, and a rectangle from afar, by area.
+    /// ([`crate::sampling::spherical_rectangle`]; density 1/S), any other mesh, and a
+    /// rectangle from afar, by area.
     pub fn sample_from(&self, reference: Vec3, u_choice: f32, u: Vec2) -> Option<SurfaceSample> {
         let Some(r) = self.near_rectangle(reference) else {
             return self.sample_from_by_area(reference, u_choice, u);
@@ -407,6 +408,7 @@ impl TriangleMesh {
         Some(SurfaceSample { pdf, ..s })
     }
 
+    /// The mesh's light-sampling tables, built on first use.
     fn light_sampling(&self) -> &LightSampling {
         self.light_sampling.get_or_init(|| {
             Box::new(LightSampling {
