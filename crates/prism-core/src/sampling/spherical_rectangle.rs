@@ -18,10 +18,10 @@
 //!
 //! A point drawn so has density 1/S per unit solid angle at o, whatever its distance and
 //! orientation: the 1/r² and the rectangle's cosine, which make area sampling noisy for points
-//! near a light, leave the estimate. Angles are carried as complex numbers (cos γ, sin γ) (see
-//! [`SphericalRectangle::new`]), so that a sample costs one arctangent (for S) and one sine and
-//! cosine; the arithmetic is in f32, where S (four angles near π/2 summing to little more than
-//! 2π) keeps ten digits down to S = 10⁻⁶ sr.
+//! near a light, leave the estimate. Angles are carried as complex numbers (cos γ, sin γ), so
+//! that a sample costs one arctangent (for S) and one sine and one cosine. The arithmetic is in
+//! f32: the products of complex numbers keep S's small excess over 2π without cancellation, to
+//! a relative 10⁻⁶ in the unit tests down to 10⁻⁶ sr.
 
 use std::f32::consts::PI;
 
@@ -42,10 +42,8 @@ pub struct RectangleFrame {
 /// A rectangle's spherical projection from one point, ready to sample.
 #[derive(Clone, Copy, Debug)]
 pub struct SphericalRectangle {
-    origin: Vec3,
-    frame: RectangleFrame,
-    /// ẑ turned towards the origin's side: the plane lies at z = z₀ < 0.
-    z: Vec3,
+    width: f32,
+    height: f32,
     z0: f32,
     x0: f32,
     x1: f32,
@@ -59,10 +57,9 @@ pub struct SphericalRectangle {
     solid_angle: f32,
 }
 
-/// The corner coordinates of a rectangle seen from a point, and the four interior angles of its
-/// projection.
+/// The corner coordinates of a rectangle seen from a point (z₀ < 0 on the point's side), and
+/// the interior angles of its projection.
 struct Projection {
-    z: Vec3,
     z0: f32,
     x0: f32,
     y0: f32,
@@ -117,7 +114,8 @@ impl RectangleFrame {
         })
     }
 
-    /// The solid angle the rectangle subtends at `origin`; None in its plane.
+    /// The solid angle the rectangle subtends at `origin`, from the interior angles as complex
+    /// numbers (the derivation is at `project`); None in its plane.
     pub fn solid_angle(&self, origin: Vec3) -> Option<f32> {
         self.project(origin).map(|p| p.solid_angle)
     }
@@ -126,9 +124,8 @@ impl RectangleFrame {
     pub fn spherical(&self, origin: Vec3) -> Option<SphericalRectangle> {
         let p = self.project(origin)?;
         Some(SphericalRectangle {
-            origin,
-            frame: *self,
-            z: p.z,
+            width: self.width,
+            height: self.height,
             z0: p.z0,
             x0: p.x0,
             x1: p.x1,
@@ -150,11 +147,8 @@ impl RectangleFrame {
     /// the argument γ₀ + γ₁ + γ₂ + γ₃ = S + 2π, so S costs four square roots and one arctangent.
     fn project(&self, origin: Vec3) -> Option<Projection> {
         let d = self.corner - origin;
-        let (mut z, mut z0) = (self.z, d.dot(self.z));
-        if z0 > 0.0 {
-            z = -z;
-            z0 = -z0;
-        }
+        // In the frame with ẑ turned towards the origin, so that the plane lies at z₀ < 0.
+        let z0 = -d.dot(self.z).abs();
         if !(z0 < 0.0) {
             return None;
         }
@@ -170,7 +164,6 @@ impl RectangleFrame {
         let whole = gamma0.times(gamma1).times(last);
         let solid_angle = whole.im.atan2(whole.re).rem_euclid(2.0 * PI);
         (solid_angle > 0.0).then_some(Projection {
-            z,
             z0,
             x0,
             y0,
@@ -188,10 +181,10 @@ impl SphericalRectangle {
         self.solid_angle
     }
 
-    /// The point of the rectangle whose direction from the origin is the image of `u` under the
-    /// area-preserving map (density 1/S per unit solid angle), and its coordinates in [0, 1]²
-    /// along the two edges.
-    pub fn sample(&self, u: Vec2) -> (Vec3, Vec2) {
+    /// The coordinates (s, t) ∈ [0, 1]² of the point corner + s·edge_x + t·edge_y whose
+    /// direction from the origin is the image of `u` under the area-preserving map (density 1/S
+    /// per unit solid angle).
+    pub fn sample(&self, u: Vec2) -> Vec2 {
         let (u, v) = (u.x, u.y);
         let (sin_us, cos_us) = (u * self.solid_angle).sin_cos();
         let au = Complex::new(cos_us, sin_us).times(self.k);
@@ -217,10 +210,8 @@ impl SphericalRectangle {
         } else {
             self.y1
         };
-        let f = &self.frame;
-        let p = self.origin + xu * f.x + yv * f.y + self.z0 * self.z;
-        let st = Vec2::new((xu - self.x0) / f.width, (yv - self.y0) / f.height);
-        (p, st.clamp(Vec2::ZERO, Vec2::ONE))
+        let st = Vec2::new((xu - self.x0) / self.width, (yv - self.y0) / self.height);
+        st.clamp(Vec2::ZERO, Vec2::ONE)
     }
 }
 
@@ -248,28 +239,28 @@ mod tests {
         }
     }
 
-    /// Samples lie on the rectangle, and the corners of [0, 1]² map to its corners.
+    /// The map preserves solid angle along u: the part of the rectangle left of the sample's
+    /// x cuts off u·S (measured as the solid angle of that narrower rectangle), whatever v.
     #[test]
-    fn samples_lie_on_the_rectangle() {
+    fn u_cuts_off_its_share_of_the_solid_angle() {
         let corner = Vec3::new(0.3, -0.2, 1.0);
         let (ex, ey) = (Vec3::new(0.5, 0.0, 0.0), Vec3::new(0.0, 0.0, 0.8));
         let frame = RectangleFrame::new(corner, ex, ey).unwrap();
-        let r = frame.spherical(Vec3::new(-0.4, 0.7, 0.2)).unwrap();
-        for i in 0..=10 {
-            for j in 0..=10 {
-                let (p, st) = r.sample(Vec2::new(i as f32 / 10.0, j as f32 / 10.0));
-                let p = p - corner;
-                let (s, t) = (
-                    p.dot(ex) / ex.length_squared(),
-                    p.dot(ey) / ey.length_squared(),
-                );
-                assert!(
-                    (st - Vec2::new(s, t)).abs().max_element() < 1e-5,
-                    "{st} {s} {t}"
-                );
-                assert!(p.y.abs() < 1e-5, "{p}");
-                assert!((-1e-5..=1.0 + 1e-5).contains(&s), "{s}");
-                assert!((-1e-5..=1.0 + 1e-5).contains(&t), "{t}");
+        for origin in [Vec3::new(-0.4, 0.7, 0.2), Vec3::new(0.5, -0.25, 1.3)] {
+            let r = frame.spherical(origin).unwrap();
+            let total = r.solid_angle();
+            for i in 1..10 {
+                let u = i as f32 / 10.0;
+                for v in [0.1, 0.5, 0.9] {
+                    let s = r.sample(Vec2::new(u, v)).x;
+                    let left = RectangleFrame::new(corner, s * ex, ey).unwrap();
+                    let cut = left.solid_angle(origin).unwrap();
+                    assert!(
+                        (cut - u * total).abs() < 1e-4 * total,
+                        "{cut} {}",
+                        u * total
+                    );
+                }
             }
         }
         assert!(frame.spherical(Vec3::new(0.5, -0.2, 1.3)).is_none());

@@ -357,19 +357,14 @@ impl TriangleMesh {
         }
     }
 
-    /// A point of the mesh as seen from `reference`, with its density per unit solid angle: a
-    /// rectangle seen from near it is sampled uniformly in the solid angle it subtends
-    /// ([`crate::sampling::spherical_rectangle`]; density 1/S), any other mesh, and a
-    /// rectangle from afar, by area.
-    pub fn sample_from(&self, reference: Vec3, u_choice: f32, u: Vec2) -> Option<SurfaceSample> {
-        let Some(r) = self.near_rectangle(reference) else {
-            return self.sample_from_by_area(reference, u_choice, u);
-        };
-        let Some(projection) = r.frame.spherical(reference) else {
-            return self.sample_from_by_area(reference, u_choice, u);
-        };
-        let (_, st) = projection.sample(u);
-        let pdf = 1.0 / projection.solid_angle();
+    /// A point of the rectangle the mesh is, seen from `reference` near it, uniform in the solid
+    /// angle S it subtends ([`crate::sampling::spherical_rectangle`]; density 1/S); None when
+    /// the mesh is no rectangle or `reference` is too far ([`SOLID_ANGLE_SAMPLING_DISTANCE`]) or
+    /// in its plane, where the shape samples its area instead.
+    pub fn sample_by_solid_angle(&self, reference: Vec3, u: Vec2) -> Option<SurfaceSample> {
+        let r = self.near_rectangle(reference)?;
+        let projection = r.frame.spherical(reference)?;
+        let st = projection.sample(u);
         // p = a + s·edge_x + t·edge_y lies on triangle 0 when s + t ≤ 1, else on triangle 1.
         let (s, t) = (st.x, st.y);
         let (triangle, weights) = if s + t <= 1.0 {
@@ -381,31 +376,13 @@ impl TriangleMesh {
         for (slot, weight) in r.slots[triangle].into_iter().zip(weights) {
             b[slot] = weight;
         }
-        Some(self.surface_sample(triangle, b, pdf))
+        Some(self.surface_sample(triangle, b, 1.0 / projection.solid_angle()))
     }
 
-    /// Density of [`Self::sample_from`] for the point `p` of the mesh with geometric normal `n`,
-    /// per unit solid angle at `reference`.
-    pub fn pdf_from(&self, reference: Vec3, p: Vec3, n: Vec3) -> f32 {
-        match self
-            .near_rectangle(reference)
-            .and_then(|r| r.frame.solid_angle(reference))
-        {
-            Some(solid_angle) => 1.0 / solid_angle,
-            None => super::area_to_solid_angle(1.0 / self.area, reference, p, n).unwrap_or(0.0),
-        }
-    }
-
-    /// An area sample, with its density per unit solid angle at `reference`.
-    fn sample_from_by_area(
-        &self,
-        reference: Vec3,
-        u_choice: f32,
-        u: Vec2,
-    ) -> Option<SurfaceSample> {
-        let s = self.sample_area(u_choice, u)?;
-        let pdf = super::area_to_solid_angle(s.pdf, reference, s.p, s.n)?;
-        Some(SurfaceSample { pdf, ..s })
+    /// Density of [`Self::sample_by_solid_angle`] from `reference`, 1/S, where it samples.
+    pub fn solid_angle_pdf(&self, reference: Vec3) -> Option<f32> {
+        let r = self.near_rectangle(reference)?;
+        r.frame.solid_angle(reference).map(|s| 1.0 / s)
     }
 
     /// The mesh's light-sampling tables, built on first use.

@@ -197,41 +197,39 @@ impl Shape {
         u: Vec2,
         sampling: ShapeSampling,
     ) -> Option<SurfaceSample> {
-        if sampling == ShapeSampling::Area {
-            let s = self.sample_area(u_choice, u)?;
-            let pdf = area_to_solid_angle(s.pdf, reference, s.p, s.n)?;
-            return Some(SurfaceSample { pdf, ..s });
-        }
-        match self {
-            Shape::Sphere(sphere) => sphere.sample_from(reference, u),
-            Shape::Mesh(mesh) => mesh.sample_from(reference, u_choice, u),
-            Shape::Disk(_)
-            | Shape::Cylinder(_)
-            | Shape::LinearCurve(_)
-            | Shape::BSplineCurve(_) => {
-                let s = self.sample_area(u_choice, u)?;
-                let pdf = area_to_solid_angle(s.pdf, reference, s.p, s.n)?;
-                Some(SurfaceSample { pdf, ..s })
+        if sampling == ShapeSampling::SolidAngle {
+            match self {
+                Shape::Sphere(sphere) => return sphere.sample_from(reference, u),
+                Shape::Mesh(mesh) => {
+                    if let Some(s) = mesh.sample_by_solid_angle(reference, u) {
+                        return Some(s);
+                    }
+                }
+                _ => {}
             }
         }
+        let s = self.sample_area(u_choice, u)?;
+        let pdf = area_to_solid_angle(s.pdf, reference, s.p, s.n)?;
+        Some(SurfaceSample { pdf, ..s })
     }
 
     /// Density of [`Self::sample_from`] for the surface point `p` with geometric normal `n`, per
     /// unit solid angle at `reference`.
     pub fn pdf_from(&self, reference: Vec3, p: Vec3, n: Vec3, sampling: ShapeSampling) -> f32 {
-        if sampling == ShapeSampling::Area {
-            return match self {
-                Shape::LinearCurve(_) | Shape::BSplineCurve(_) => 0.0,
-                _ => area_to_solid_angle(1.0 / self.area(), reference, p, n).unwrap_or(0.0),
-            };
+        if sampling == ShapeSampling::SolidAngle {
+            match self {
+                Shape::Sphere(sphere) => return sphere.pdf_from(reference, p, n),
+                Shape::Mesh(mesh) => {
+                    if let Some(pdf) = mesh.solid_angle_pdf(reference) {
+                        return pdf;
+                    }
+                }
+                _ => {}
+            }
         }
         match self {
-            Shape::Sphere(sphere) => sphere.pdf_from(reference, p, n),
             Shape::LinearCurve(_) | Shape::BSplineCurve(_) => 0.0,
-            Shape::Mesh(mesh) => mesh.pdf_from(reference, p, n),
-            Shape::Disk(_) | Shape::Cylinder(_) => {
-                area_to_solid_angle(1.0 / self.area(), reference, p, n).unwrap_or(0.0)
-            }
+            _ => area_to_solid_angle(1.0 / self.area(), reference, p, n).unwrap_or(0.0),
         }
     }
 
