@@ -5,6 +5,7 @@ z-test of `prism compare`, and the mean over seeds of one renderer's time and er
 Standard library only; the tools put this folder on sys.path and `import benchlib`.
 """
 import json
+import math
 import os
 import re
 import subprocess
@@ -115,16 +116,23 @@ def measure(prism, render, reference, seeds, output):
         images.append((path, text))
     mean_seconds = sum(seconds) / len(seconds)
     error = sum(errors) / len(errors)
+    # The standard error of the mean relMSE over seeds (None for one seed): on scenes decided by
+    # rare fireflies it says whether two renderers' means differ by more than luck.
+    error_se = (math.sqrt(sum((e - error) ** 2 for e in errors) / (seeds - 1) / seeds)
+                if seeds > 1 else None)
     row = {"seeds": seeds, "seconds": mean_seconds,
            "samples_per_second": sum(samples) / len(samples) / mean_seconds,
            "rel_mse": error, "rel_mse_min": min(errors), "rel_mse_max": max(errors),
+           "rel_mse_standard_error": error_se, "rel_mse_per_seed": errors,
            "efficiency": 1.0 / (error * mean_seconds)}
     return row, images
 
 
 def summary(name, label, row):
-    """One line of a measured renderer: samples/s, relMSE (with its range over seeds), efficiency."""
-    spread = f" ({row['rel_mse_min']:.2e}-{row['rel_mse_max']:.2e})" if row["seeds"] > 1 else ""
+    """One line of a measured renderer: samples/s, relMSE (with its standard error and range over
+    seeds), efficiency."""
+    spread = (f" ± {row['rel_mse_standard_error']:.1e} ({row['rel_mse_min']:.2e}-{row['rel_mse_max']:.2e})"
+              if row["seeds"] > 1 else "")
     return (f"{name:<18} {label:<26} {row['samples_per_second'] / 1e6:7.3f} Msamples/s  "
             f"relMSE {row['rel_mse']:.3e}{spread}  efficiency {row['efficiency']:9.2f}")
 
