@@ -23,7 +23,7 @@ use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use glam::{Vec2, Vec3};
 use prism_core::geometry::{Primitive, Shape};
 use prism_core::image::{ChannelImage, write_exr};
-use prism_core::light::Light;
+use prism_core::light::{Light, Receiver};
 use prism_core::sampling::rng::Pcg32;
 use prism_core::scene::Scene;
 use prism_core::spectrum::{SampledWavelengths, WavelengthSampling};
@@ -151,7 +151,7 @@ fn lights(c: &mut Criterion) {
     group.bench_function("select_and_sample", |b| {
         b.iter(|| {
             for q in &queries {
-                if let Some((index, pmf)) = light_sampler.sample(q.u_light) {
+                if let Some((index, pmf)) = light_sampler.sample(q.u_light, &Receiver::point(q.p)) {
                     let light = &scene.world.lights[index];
                     black_box(pmf);
                     black_box(light.sample_incident(shapes, q.p, 0.0, q.u_choice, q.u, &q.lambda));

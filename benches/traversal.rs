@@ -26,6 +26,7 @@ use std::time::Duration;
 use criterion::{BatchSize, Criterion, SamplingMode, Throughput, criterion_group, criterion_main};
 use glam::{UVec2, Vec2};
 use prism_core::geometry::Geometry;
+use prism_core::light::Receiver;
 use prism_core::math::{Frame, Ray};
 use prism_core::sampling::rng::Pcg32;
 use prism_core::sampling::warp::sample_cosine_hemisphere;
@@ -85,7 +86,8 @@ impl Fixture {
             let lambda = SampledWavelengths::sample(rng.next_f32(), WavelengthSampling::CieSum);
             let (u_light, u_choice) = (rng.next_f32(), rng.next_f32());
             if shadow.len() < wanted
-                && let Some((light, _)) = light_sampler.sample(u_light)
+                && let Some((light, _)) =
+                    light_sampler.sample(u_light, &Receiver::surface(si.p, si.shading.n))
                 && let Some(ls) = scene.world.lights[light].sample_incident(
                     &scene.world.geometry.primitives,
                     si.p,

@@ -17,7 +17,7 @@ use prism_core::image::{Bitmap, Encoding};
 use prism_core::integrator::PathIntegrator;
 use prism_core::light::{
     AreaLight, ConstantLight, DirectionalLight, EnvironmentMap, Light, LightSelection, PointLight,
-    SpotLight,
+    Receiver, SpotLight,
 };
 use prism_core::math::{Frame, Transform};
 use prism_core::sampling::rng::Pcg32;
@@ -374,25 +374,153 @@ fn selection_chi2(selection: LightSelection, seed: u64) {
     let probabilities: Vec<f64> = match selection {
         LightSelection::Power => powers.iter().map(|p| p / total).collect(),
         LightSelection::Uniform => vec![1.0 / powers.len() as f64; powers.len()],
+        LightSelection::Exhaustive => unreachable!("tested by exhaustive_selection_*"),
     };
+    let receiver = Receiver::surface(Vec3::new(0.3, -0.2, 0.0), Vec3::Z);
     for (i, p) in probabilities.iter().enumerate() {
-        let reported = f64::from(light_sampler.pmf(i));
+        let reported = f64::from(light_sampler.pmf(i, &receiver));
         assert!(
             (reported / p - 1.0).abs() < 1e-4,
             "{selection:?}: light {i} has pmf {reported}, not {p}"
         );
     }
     let outcome = chi2_discrete(SAMPLES, &probabilities, seed, |rng| {
-        let (index, pmf) = light_sampler.sample(rng.next_f32()).unwrap();
+        let (index, pmf) = light_sampler.sample(rng.next_f32(), &receiver).unwrap();
         assert_eq!(
             pmf,
-            light_sampler.pmf(index),
+            light_sampler.pmf(index, &receiver),
             "the pmf returned with a sample is the reported pmf"
         );
         index
     })
     .unwrap();
     assert_passes(&format!("light selection {selection:?}"), &outcome, TESTS);
+}
+
+/// The closed form of the exhaustive selection at `receiver`: the lights at infinity (the
+/// directional and the constant one, the last two) by their share of the total power, the
+/// others by Φ cos θ'ᵢ / max(d², r²) of the boxes of `every_kind_of_light`.
+fn exhaustive_probabilities(powers: &[f64], receiver: &Receiver) -> Vec<f64> {
+    let (p, n) = (receiver.p.as_dvec3(), receiver.n.map(|n| n.as_dvec3()));
+    // Centres and squared radii: the floor [−2, 2]² × {0}, the sphere, the point, the spot.
+    let places = [
+        (DVec3::ZERO, 8.0),
+        (DVec3::new(0.0, 0.0, 1.0), 0.75),
+        (DVec3::new(0.0, 1.0, 1.0), 0.0),
+        (DVec3::ZERO, 0.0),
+    ];
+    let importance: Vec<f64> = places
+        .iter()
+        .zip(powers)
+        .map(|(&(c, r2), &power)| {
+            let d2: f64 = (c - p).length_squared();
+            let cosine = match n {
+                Some(n) if d2 > r2 => {
+                    let theta_i = (n.dot(c - p) / d2.sqrt()).abs().acos();
+                    let theta_b = (r2 / d2).sqrt().asin();
+                    (theta_i - theta_b).max(0.0).cos()
+                }
+                _ => 1.0,
+            };
+            power * cosine / d2.max(r2)
+        })
+        .collect();
+    let total: f64 = powers.iter().sum();
+    let infinite_share = (powers[4] + powers[5]) / total;
+    let finite: f64 = importance.iter().sum();
+    importance
+        .iter()
+        .map(|i| (1.0 - infinite_share) * i / finite)
+        .chain(powers[4..].iter().map(|p| p / total))
+        .collect()
+}
+
+/// Choosing by importance: at receivers on and off surfaces, each light's reported pmf is the
+/// closed form, the pmfs sum to one, and sampled lights follow them.
+#[test]
+fn exhaustive_selection_weighs_lights_by_importance_at_the_receiver() {
+    let (scene, powers) = every_kind_of_light(LightSelection::Exhaustive);
+    let integrator = scene.integrator.prepare(&scene.world);
+    let light_sampler = integrator.light_sampler();
+    let receivers = [
+        Receiver::surface(Vec3::new(0.3, -0.2, 0.05), Vec3::Z),
+        Receiver::surface(Vec3::new(1.5, 0.5, 0.8), Vec3::new(-0.6, 0.0, 0.8)),
+        Receiver::point(Vec3::new(-1.0, 3.0, 2.0)),
+        Receiver::surface(Vec3::new(0.0, 0.2, 1.0), Vec3::new(0.0, 0.6, 0.8)),
+    ];
+    for (k, receiver) in receivers.iter().enumerate() {
+        let probabilities = exhaustive_probabilities(&powers, receiver);
+        let mut sum = 0.0;
+        for (i, p) in probabilities.iter().enumerate() {
+            let reported = f64::from(light_sampler.pmf(i, receiver));
+            sum += reported;
+            assert!(
+                (reported / p - 1.0).abs() < 1e-4,
+                "receiver {k}: light {i} has pmf {reported}, not {p}"
+            );
+        }
+        assert!(
+            (sum - 1.0).abs() < 1e-5,
+            "receiver {k}: the pmfs sum to {sum}"
+        );
+        let outcome = chi2_discrete(SAMPLES, &probabilities, 40 + k as u64, |rng| {
+            let (index, pmf) = light_sampler.sample(rng.next_f32(), receiver).unwrap();
+            assert_eq!(
+                pmf,
+                light_sampler.pmf(index, receiver),
+                "the pmf returned with a sample is the reported pmf"
+            );
+            index
+        })
+        .unwrap();
+        assert_passes(
+            &format!("exhaustive selection at receiver {k}"),
+            &outcome,
+            TESTS,
+        );
+    }
+}
+
+/// The importance never rules out a light that can light the receiver: wherever a light sample
+/// arrives with radiance and a non-zero cosine, the light has a positive probability.
+#[test]
+fn exhaustive_selection_keeps_every_light_that_can_give_light() {
+    let (scene, _) = every_kind_of_light(LightSelection::Exhaustive);
+    let integrator = scene.integrator.prepare(&scene.world);
+    let light_sampler = integrator.light_sampler();
+    let lambda = SampledWavelengths::sample(0.3, Default::default());
+    let mut rng = Pcg32::seeded(41);
+    let mut checked = 0;
+    for _ in 0..2000 {
+        let p = Vec3::new(
+            4.0 * rng.next_f32() - 2.0,
+            4.0 * rng.next_f32() - 2.0,
+            2.0 * rng.next_f32() - 0.5,
+        );
+        let n = prism_core::sampling::warp::sample_uniform_sphere(u2(&mut rng));
+        let receiver = Receiver::surface(p, n);
+        for (i, light) in scene.world.lights.iter().enumerate() {
+            let Some(ls) = light.sample_incident(
+                &scene.world.geometry.primitives,
+                p,
+                0.0,
+                rng.next_f32(),
+                u2(&mut rng),
+                &lambda,
+            ) else {
+                continue;
+            };
+            if ls.radiance.is_black() || ls.wi.dot(n) == 0.0 {
+                continue;
+            }
+            checked += 1;
+            assert!(
+                light_sampler.pmf(i, &receiver) > 0.0,
+                "light {i} lights {p:?} (normal {n:?}) but has probability 0"
+            );
+        }
+    }
+    assert!(checked > 5000, "only {checked} samples arrived");
 }
 
 /// Lights of every kind in one scene are chosen in proportion to their closed-form powers:

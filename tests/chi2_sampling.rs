@@ -9,7 +9,7 @@ use common::chi2::{assert_passes, chi2_discrete, chi2_interval, chi2_rectangle, 
 use glam::{Mat3, Vec2, Vec3};
 use prism_core::geometry::Sphere;
 use prism_core::geometry::TriangleMesh;
-use prism_core::light::{LightSampler, LightSelection};
+use prism_core::light::{LightBounds, LightSampler, LightSelection, Receiver};
 use prism_core::sampling::rng::Pcg32;
 use prism_core::sampling::warp;
 use prism_core::spectrum::WavelengthSampling;
@@ -188,11 +188,12 @@ fn light_selection_is_proportional_to_power() {
     let sampler = LightSampler::new(&powers);
     let total: f32 = powers.iter().sum();
     let probabilities: Vec<f64> = powers.iter().map(|&p| f64::from(p / total)).collect();
+    let anywhere = Receiver::point(Vec3::ZERO);
     let outcome = chi2_discrete(SAMPLES, &probabilities, 6, |rng| {
-        let (index, pmf) = sampler.sample(rng.next_f32()).unwrap();
+        let (index, pmf) = sampler.sample(rng.next_f32(), &anywhere).unwrap();
         assert_eq!(
             pmf,
-            sampler.pmf(index),
+            sampler.pmf(index, &anywhere),
             "the pmf returned with a sample is the reported pmf"
         );
         index
@@ -202,27 +203,44 @@ fn light_selection_is_proportional_to_power() {
 }
 
 /// Mitsuba's `sampling_weight`s: uniform selection picks light i with P(i) = wᵢ/Σw, selection by
-/// power with P(i) = Φᵢwᵢ/ΣΦw; a light of weight 0 is never picked.
+/// power with P(i) = Φᵢwᵢ/ΣΦw, by importance (point lights on the x axis, seen from a point in
+/// a medium) with P(i) = (Φᵢwᵢ/dᵢ²)/Σ(Φw/d²); a light of weight 0 is never picked.
 #[test]
 fn light_selection_follows_the_sampling_weights() {
     let powers = [1.0f32, 5.0, 0.5, 3.0, 2.0, 12.0];
     let weights = [2.0f32, 0.25, 1.0, 0.0, 3.0, 1.0];
-    for selection in [LightSelection::Uniform, LightSelection::Power] {
-        let sampler = LightSampler::with_selection(&powers, &weights, selection);
+    let receiver = Receiver::point(Vec3::new(-1.0, 0.5, 0.0));
+    let places: Vec<Vec3> = (0..powers.len())
+        .map(|i| Vec3::new(i as f32, 0.0, 0.0))
+        .collect();
+    let bounds: Vec<_> = places
+        .iter()
+        .map(|&c| Some(LightBounds::at_point(c, 0.0)))
+        .collect();
+    for selection in [
+        LightSelection::Uniform,
+        LightSelection::Power,
+        LightSelection::Exhaustive,
+    ] {
+        let sampler = LightSampler::with_selection(&powers, &weights, &bounds, selection);
         let shares: Vec<f64> = powers
             .iter()
             .zip(&weights)
-            .map(|(&p, &w)| match selection {
+            .zip(&places)
+            .map(|((&p, &w), &c)| match selection {
                 LightSelection::Uniform => f64::from(w),
                 LightSelection::Power => f64::from(p * w),
+                LightSelection::Exhaustive => {
+                    f64::from(p * w) / (c - receiver.p).as_dvec3().length_squared()
+                }
             })
             .collect();
         let total: f64 = shares.iter().sum();
         let probabilities: Vec<f64> = shares.iter().map(|s| s / total).collect();
         let outcome = chi2_discrete(SAMPLES, &probabilities, 8, |rng| {
-            let (index, pmf) = sampler.sample(rng.next_f32()).unwrap();
+            let (index, pmf) = sampler.sample(rng.next_f32(), &receiver).unwrap();
             assert_ne!(index, 3, "a light of weight 0 is never chosen");
-            assert_eq!(pmf, sampler.pmf(index));
+            assert_eq!(pmf, sampler.pmf(index, &receiver));
             assert!((f64::from(pmf) - probabilities[index]).abs() < 1e-6);
             index
         })

@@ -7,7 +7,7 @@ use std::path::Path;
 
 use glam::{Vec2, Vec3};
 use prism_core::bsdf::Bsdf;
-use prism_core::light::{Light, LightSampler};
+use prism_core::light::{Light, LightSampler, Receiver};
 use prism_core::scene::Scene;
 use prism_core::spectrum::SampledWavelengths;
 use prism_core::spectrum::cie::d65_normalized;
@@ -188,8 +188,40 @@ fn blackbody_radiance_and_uniform_emitter_sampling() {
         integrator.light_sampler(),
         LightSampler::Uniform { count: 2 }
     ));
-    assert_eq!(integrator.light_sampler().pmf(1), 0.5);
+    assert_eq!(
+        integrator
+            .light_sampler()
+            .pmf(1, &Receiver::point(Vec3::ZERO)),
+        0.5
+    );
     assert_eq!(scene.world.environment, Some(0));
+}
+
+/// Lights are chosen by importance unless the scene asks for power (the lecture's rule) or
+/// uniform choice.
+#[test]
+fn emitter_sampling_is_exhaustive_by_default() {
+    let lights = r#"<emitter type="point"><rgb name="intensity" value="100"/></emitter>"#;
+    for (integrator, exhaustive) in [
+        (r#"<integrator type="path"/>"#, true),
+        (r#"<integrator type="volpath"/>"#, true),
+        (
+            r#"<integrator type="path"><string name="emitter_sampling" value="exhaustive"/></integrator>"#,
+            true,
+        ),
+        (
+            r#"<integrator type="path"><string name="emitter_sampling" value="power"/></integrator>"#,
+            false,
+        ),
+    ] {
+        let scene = load(Path::new("."), &format!("{integrator}\n    {lights}"));
+        let prepared = scene.integrator.prepare(&scene.world);
+        assert_eq!(
+            matches!(prepared.light_sampler(), LightSampler::Exhaustive(_)),
+            exhaustive,
+            "{integrator}"
+        );
+    }
 }
 
 /// A PNG environment map is decoded from sRGB, and scaled.

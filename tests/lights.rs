@@ -433,7 +433,7 @@ fn diffuse_plane_under_an_environment_map() {
 }
 
 /// Light selection must not change the answer (DESIGN.md §7): a point light and a sphere light
-/// over a plane, rendered with selection by power and uniformly, with equal and unequal
+/// over a plane, rendered with selection by importance, by power and uniformly, with equal and unequal
 /// `sampling_weight`s, against the sum of their closed forms; a point light of weight 0 is never
 /// sampled and so adds nothing (as in Mitsuba).
 #[test]
@@ -449,6 +449,9 @@ fn light_selection_does_not_change_the_answer() {
         (LightSelection::Power, [0.5, 2.0], 8192, 38),
         (LightSelection::Uniform, [0.5, 2.0], 8192, 39),
         (LightSelection::Uniform, [1.0, 0.0], 2048, 40),
+        (LightSelection::Exhaustive, [1.0, 1.0], 2048, 41),
+        (LightSelection::Exhaustive, [0.5, 2.0], 8192, 42),
+        (LightSelection::Exhaustive, [1.0, 0.0], 2048, 43),
     ] {
         let mut scene = build(
             vec![

@@ -13,6 +13,7 @@
 use glam::Vec2;
 
 use prism_core::geometry::SurfaceInteraction;
+use prism_core::light::Receiver;
 use prism_core::math::Ray;
 use prism_core::sampling::rng::Pcg32;
 use prism_core::sampling::warp::sample_uniform_sphere;
@@ -33,7 +34,10 @@ pub fn shadow_rays(scene: &Scene, count: usize, seed: u64) -> Vec<Ray> {
     let wavelengths = SampledWavelengths::sample(0.5, WavelengthSampling::default());
     let integrator = scene.integrator.prepare(&scene.world);
     rays_from_visible_surfaces(scene, count, seed, |hit, rng| {
-        let (light, _) = integrator.light_sampler().sample(rng.next_f32())?;
+        let receiver = Receiver::surface(hit.p, hit.shading.n);
+        let (light, _) = integrator
+            .light_sampler()
+            .sample(rng.next_f32(), &receiver)?;
         let (u_choice, u) = (rng.next_f32(), Vec2::new(rng.next_f32(), rng.next_f32()));
         let sample = scene.world.lights[light].sample_incident(
             &scene.world.geometry.primitives,

@@ -3,7 +3,7 @@
 
 use crate::bsdf::Material;
 use crate::geometry::Geometry;
-use crate::light::{BoundingSphere, Light};
+use crate::light::{BoundingSphere, Light, LightBounds};
 use crate::medium::{Medium, MediumInterface};
 
 /// What a shape is made of and whether it emits.
@@ -25,6 +25,8 @@ pub struct World {
     /// Each light's power (see [`Light::power`]), from which integrators build their light
     /// samplers.
     pub light_powers: Vec<f32>,
+    /// Each light's place (see [`Light::bounds`]), for choosing lights by importance.
+    pub light_bounds: Vec<Option<LightBounds>>,
     /// Each light's `sampling_weight` (1 unless the scene says otherwise), which scales its
     /// probability of being chosen (see [`crate::light::sampler`]).
     pub light_sampling_weights: Vec<f32>,
@@ -57,6 +59,10 @@ impl World {
             .iter()
             .map(|l| l.power(&geometry.primitives))
             .collect();
+        let light_bounds = lights
+            .iter()
+            .map(|l| l.bounds(&geometry.primitives))
+            .collect();
         let light_sampling_weights = vec![1.0; lights.len()];
         World {
             environment: lights
@@ -68,6 +74,7 @@ impl World {
             materials,
             lights,
             light_powers,
+            light_bounds,
             media: Vec::new(),
             medium_interfaces: Vec::new(),
             camera_medium: None,

@@ -124,6 +124,7 @@ impl DirectIntegrator {
             }
             let origin = BsdfSampleOrigin {
                 p: si.p,
+                n: si.shading.n,
                 pdf: bs.pdf,
                 specular: bs.flags.is_delta(),
             };

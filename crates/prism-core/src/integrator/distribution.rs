@@ -48,7 +48,7 @@ use glam::Vec3;
 use crate::bsdf::{BxdfTree, Scattering};
 use crate::geometry::SurfaceInteraction;
 use crate::integrator::{PreparedIntegrator, RayCount, hero_only, unoccluded};
-use crate::light::{Light, LightSelection};
+use crate::light::{Light, LightSelection, Receiver};
 use crate::math::Ray;
 use crate::sampling::sampler::Sampler;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
@@ -79,7 +79,7 @@ impl Default for DistributionIntegrator {
             max_depth: -1,
             bounce_samples: 4,
             shadow_rays: 4,
-            lights: DirectLights::One(LightSelection::Power),
+            lights: DirectLights::One(LightSelection::Exhaustive),
             rr_threshold: 0.1,
             hide_emitters: false,
         }
@@ -311,8 +311,10 @@ impl Estimate<'_, '_> {
                 total
             }
             DirectLights::One(_) => {
-                let Some((index, pmf)) = self.prepared.light_sampler.sample(self.sampler.next_1d())
-                else {
+                let Some((index, pmf)) = self.prepared.light_sampler.sample(
+                    self.sampler.next_1d(),
+                    &Receiver::surface(si.p, si.shading.n),
+                ) else {
                     return SampledSpectrum::ZERO;
                 };
                 estimate_light(&world.lights[index], self.sampler, self.count) * (1.0 / pmf)

@@ -20,7 +20,7 @@ use glam::Vec3;
 use crate::bsdf::Scattering;
 use crate::geometry::{SurfaceInteraction, SurfaceSample};
 use crate::integrator::{PreparedIntegrator, RayCount, normals_agree, unoccluded};
-use crate::light::{AreaLight, Light};
+use crate::light::{AreaLight, Light, Receiver};
 use crate::math::Ray;
 use crate::sampling::sampler::Sampler;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
@@ -54,8 +54,9 @@ impl Strategies {
 /// Where a BSDF sample came from, for weighing the emission it finds.
 #[derive(Clone, Copy, Debug)]
 pub struct BsdfSampleOrigin {
-    /// The vertex the sampled ray left from.
+    /// The vertex the sampled ray left from, and its shading normal.
     pub p: Vec3,
+    pub n: Vec3,
     /// Solid-angle density of the BSDF sample.
     pub pdf: f32,
     /// Whether it came from a delta lobe (no light sample could have found its direction).
@@ -102,7 +103,9 @@ pub fn emission_found(
     if emitted.is_black() {
         return emitted;
     }
-    let choice = prepared.light_sampler.pmf(light_index as usize);
+    let choice = prepared
+        .light_sampler
+        .pmf(light_index as usize, &Receiver::surface(origin.p, origin.n));
     let light_pdf = choice
         * match light_pdf {
             LightPdf::Environment(d) => world.lights[light_index as usize].environment_pdf(d),
@@ -146,7 +149,10 @@ pub fn sample_light(
     let u_light = sampler.next_1d();
     let u_choice = sampler.next_1d();
     let u = sampler.next_2d();
-    let Some((light_index, choice_pmf)) = prepared.light_sampler.sample(u_light) else {
+    let Some((light_index, choice_pmf)) = prepared
+        .light_sampler
+        .sample(u_light, &Receiver::surface(si.p, si.shading.n))
+    else {
         return SampledSpectrum::ZERO;
     };
     let light = &world.lights[light_index];

@@ -106,7 +106,7 @@ impl Integrator {
     fn light_selection(&self) -> LightSelection {
         match self {
             Integrator::Path(path) => path.light_selection,
-            Integrator::Direct(_) => LightSelection::Power,
+            Integrator::Direct(_) => LightSelection::Exhaustive,
             Integrator::Distribution(distrib) => distrib.light_selection(),
             Integrator::VolPath(volpath) => volpath.light_selection,
             Integrator::Moment(_) | Integrator::Aov(_) => LightSelection::Power,
@@ -169,6 +169,7 @@ impl Integrator {
             light_sampler: LightSampler::with_selection(
                 &world.light_powers,
                 &world.light_sampling_weights,
+                &world.light_bounds,
                 self.light_selection(),
             ),
             aov_count: self.aov_names().len(),

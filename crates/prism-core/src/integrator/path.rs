@@ -62,7 +62,7 @@ impl Default for PathIntegrator {
             max_depth: -1,
             rr_depth: 5,
             hide_emitters: false,
-            light_selection: LightSelection::Power,
+            light_selection: LightSelection::Exhaustive,
             strict_normals: false,
         }
     }
@@ -169,6 +169,7 @@ impl PathIntegrator {
             ray = si.spawn_ray(bs.wi);
             previous = Some(BsdfSampleOrigin {
                 p: si.p,
+                n: si.shading.n,
                 pdf: bs.pdf,
                 specular: bs.flags.is_delta(),
             });

@@ -43,7 +43,7 @@ use crate::geometry::offset::offset_ray_origin;
 use crate::geometry::{SurfaceInteraction, SurfaceSample};
 use crate::integrator::mis::power_heuristic;
 use crate::integrator::{PreparedIntegrator, RayCount, hero_only};
-use crate::light::{Light, LightSample, LightSelection};
+use crate::light::{Light, LightSample, LightSelection, Receiver};
 use crate::math::Ray;
 use crate::medium::{Collision, Medium, PhaseFunction, choose_collision, sample_free_flight};
 use crate::sampling::sampler::Sampler;
@@ -70,7 +70,7 @@ impl Default for VolPathIntegrator {
             max_depth: -1,
             rr_depth: 5,
             hide_emitters: false,
-            light_selection: LightSelection::Power,
+            light_selection: LightSelection::Exhaustive,
             tracking: Tracking::Spectral,
         }
     }
@@ -387,7 +387,7 @@ impl VolPathIntegrator {
         let lambda_was_whole = !wavelengths.secondary_terminated();
         let mut eta_scale = 1.0f32;
         // The last scattering vertex, which light sampling would have started from.
-        let mut previous = Vec3::ZERO;
+        let mut previous = Receiver::point(Vec3::ZERO);
         let mut depth = 0i32;
         let mut medium = world.camera_medium;
         let mut ray = Ray {
@@ -429,7 +429,7 @@ impl VolPathIntegrator {
                     }
                     ray = Ray::new(p, ps.wi, f32::INFINITY, ray.time);
                     weights.scatter(SampledSpectrum::ONE, ps.pdf, !med.sample_emitters);
-                    previous = p;
+                    previous = Receiver::point(p);
                     depth += 1;
                     if !self.survives_roulette(depth, &mut weights, eta_scale, sampler) {
                         break;
@@ -446,7 +446,8 @@ impl VolPathIntegrator {
                     let emitted = light.environment_radiance(ray.d, &lambda);
                     if !emitted.is_black() {
                         let light_pdf = if weights.weights_emission() {
-                            prepared.light_sampler.pmf(env as usize) * light.environment_pdf(ray.d)
+                            prepared.light_sampler.pmf(env as usize, &previous)
+                                * light.environment_pdf(ray.d)
                         } else {
                             0.0
                         };
@@ -468,10 +469,10 @@ impl VolPathIntegrator {
                 let emitted = light.emitted(si.uv, si.shading.n, wo, &lambda);
                 if !emitted.is_black() {
                     let light_pdf = if weights.weights_emission() {
-                        prepared.light_sampler.pmf(light_index as usize)
+                        prepared.light_sampler.pmf(light_index as usize, &previous)
                             * light.pdf_from(
                                 &world.geometry.primitives,
-                                previous,
+                                previous.p,
                                 si.time,
                                 &SurfaceSample::at(&si),
                             )
@@ -528,7 +529,7 @@ impl VolPathIntegrator {
             let wi = bs.wi.normalize();
             medium = medium_after(world, &si, wi, medium);
             ray = si.spawn_ray(wi);
-            previous = si.p;
+            previous = Receiver::surface(si.p, si.shading.n);
             depth += 1;
             if !self.survives_roulette(depth, &mut weights, eta_scale, sampler) {
                 break;
@@ -558,12 +559,12 @@ impl VolPathIntegrator {
         true
     }
 
-    /// A light chosen by the light sampler and a point on it, seen from `p`, with the
+    /// A light chosen by the light sampler and a point on it, seen from `receiver`, with the
     /// probability of having chosen that light.
     #[inline]
     fn sample_light(
         prepared: &PreparedIntegrator,
-        p: Vec3,
+        receiver: &Receiver,
         time: f32,
         lambda: &SampledWavelengths,
         sampler: &mut Sampler,
@@ -572,10 +573,10 @@ impl VolPathIntegrator {
         let u_light = sampler.next_1d();
         let u_choice = sampler.next_1d();
         let u = sampler.next_2d();
-        let (light_index, choice_pmf) = prepared.light_sampler.sample(u_light)?;
+        let (light_index, choice_pmf) = prepared.light_sampler.sample(u_light, receiver)?;
         let ls = world.lights[light_index].sample_incident(
             &world.geometry.primitives,
-            p,
+            receiver.p,
             time,
             u_choice,
             u,
@@ -596,7 +597,13 @@ impl VolPathIntegrator {
         count: &mut RayCount,
     ) -> Option<LightSampleTerms> {
         let world = prepared.world;
-        let (ls, choice_pmf) = Self::sample_light(prepared, si.p, si.time, lambda, sampler)?;
+        let (ls, choice_pmf) = Self::sample_light(
+            prepared,
+            &Receiver::surface(si.p, si.shading.n),
+            si.time,
+            lambda,
+            sampler,
+        )?;
         let f = scattering.eval(ls.wi);
         if f.value.is_black() {
             return None;
@@ -642,7 +649,8 @@ impl VolPathIntegrator {
         count: &mut RayCount,
     ) -> Option<LightSampleTerms> {
         let world = prepared.world;
-        let (ls, choice_pmf) = Self::sample_light(prepared, p, time, lambda, sampler)?;
+        let (ls, choice_pmf) =
+            Self::sample_light(prepared, &Receiver::point(p), time, lambda, sampler)?;
         let phase_value = phase.eval(wo, ls.wi);
         if !(phase_value > 0.0) {
             return None;

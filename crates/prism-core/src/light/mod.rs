@@ -19,6 +19,7 @@
 //! | `sunsky` | [`sunsky`] | the sky's luminance over (φ, cos θ), and the sun's cone |
 
 pub mod area;
+pub mod bounds;
 pub mod constant;
 pub mod directional;
 pub mod envmap;
@@ -33,6 +34,7 @@ use glam::{Vec2, Vec3};
 use crate::geometry::Primitive;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 pub use area::AreaLight;
+pub use bounds::{LightBounds, Receiver};
 pub use constant::ConstantLight;
 pub use directional::DirectionalLight;
 pub use envmap::EnvironmentMap;
@@ -142,6 +144,25 @@ impl Light {
             Light::Constant(light) => light.sample_incident(reference, u, lambda),
             Light::Envmap(light) => light.sample_incident(reference, u, lambda),
             Light::Sunsky(light) => light.sample_incident(reference, u, lambda),
+        }
+    }
+
+    /// Where the light is, for choosing it by importance ([`bounds`]): the box of its shape,
+    /// or its position; None for lights at infinity. The power is left 0 (the sampler fills
+    /// it in).
+    pub fn bounds(&self, shapes: &[Primitive]) -> Option<LightBounds> {
+        use crate::geometry::aggregate::AggregateElement;
+        match self {
+            Light::Area(light) => {
+                let (lo, hi) = shapes[light.shape as usize].bounds();
+                Some(LightBounds::around_box(lo, hi, 0.0))
+            }
+            Light::Point(light) => Some(LightBounds::at_point(light.position, 0.0)),
+            Light::Spot(light) => Some(LightBounds::at_point(light.position(), 0.0)),
+            Light::Projector(light) => Some(LightBounds::at_point(light.position(), 0.0)),
+            Light::Directional(_) | Light::Constant(_) | Light::Envmap(_) | Light::Sunsky(_) => {
+                None
+            }
         }
     }
 

@@ -123,6 +123,11 @@ impl Projector {
 
     /// Φ = π · scale · Ē · 4 t² / a: the irradiance π · scale · E on the plane z = 1 over the
     /// image's rectangle there, [−t, t] × [−t/a, t/a] (Ē the mean of the image's values).
+    /// Where the light sits.
+    pub fn position(&self) -> Vec3 {
+        self.position
+    }
+
     pub fn power(&self) -> f32 {
         let t = self.tan_half_fov;
         PI * self.scale * self.mean_irradiance * 4.0 * t * t / self.aspect

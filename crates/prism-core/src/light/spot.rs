@@ -123,6 +123,11 @@ impl SpotLight {
     ///   = 2π I [1 − (sin c − sin β)/(c − β)]   (integrating the ramp by parts),
     /// which tends to the cone's 2π I (1 − cos c) as the ramp's width c − β goes to 0; with a
     /// texture, times its mean value over the image (a weight for choosing the light).
+    /// Where the light sits.
+    pub fn position(&self) -> Vec3 {
+        self.position
+    }
+
     pub fn power(&self) -> f32 {
         let (c, b) = (f64::from(self.cutoff), f64::from(self.beam));
         let width = c - b;

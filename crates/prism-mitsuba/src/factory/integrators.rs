@@ -137,10 +137,12 @@ const HIDE_EMITTERS: ParamSpec = ParamSpec::new(
 );
 const EMITTER_SAMPLING: ParamSpec = ParamSpec::new(
     "emitter_sampling",
-    ParamKind::Choice(&["power", "uniform"]),
-    Default::Str("power"),
-    "Prism only (Mitsuba rejects it): one light per shading point chosen ∝ its power × \
-     `sampling_weight`, or ∝ `sampling_weight` alone (Mitsuba's rule; uniform by default)",
+    ParamKind::Choice(&LightSelection::NAMES),
+    Default::Str("exhaustive"),
+    "Prism only (Mitsuba rejects it): one light per shading point chosen ∝ its importance \
+     there (power × `sampling_weight` over squared distance, times the receiver's cosine \
+     bound; pbrt-v4's `exhaustive`), ∝ its power × `sampling_weight` everywhere alike (the \
+     lecture's), or ∝ `sampling_weight` alone (Mitsuba's rule; uniform by default)",
 );
 const USE_SPECTRAL_MIS: ParamSpec = ParamSpec::new(
     "use_spectral_mis",
@@ -204,9 +206,10 @@ const SHADOW_RAYS: ParamSpec = ParamSpec::new(
 );
 const LIGHTS: ParamSpec = ParamSpec::new(
     "lights",
-    ParamKind::Choice(&["power", "uniform", "all"]),
-    Default::Str("power"),
-    "one light per vertex chosen ∝ power or uniformly, or every light",
+    ParamKind::Choice(&["exhaustive", "power", "uniform", "all"]),
+    Default::Str("exhaustive"),
+    "one light per vertex chosen ∝ its importance there, ∝ power or uniformly (as the path \
+     integrator's `emitter_sampling`), or every light",
 );
 const RR_THRESHOLD: ParamSpec = ParamSpec::new(
     "rr_threshold",
@@ -284,10 +287,8 @@ fn path_settings(params: &Params) -> Result<PathIntegrator> {
             format!("rr_depth must be at least 1, not {rr_depth}"),
         ));
     }
-    let light_selection = match params.choice(&EMITTER_SAMPLING)? {
-        "uniform" => LightSelection::Uniform,
-        _ => LightSelection::Power,
-    };
+    let light_selection = LightSelection::from_name(params.choice(&EMITTER_SAMPLING)?)
+        .expect("the parameter's choices are the selections' names");
     Ok(PathIntegrator {
         max_depth,
         rr_depth: rr_depth as i32,
@@ -488,9 +489,10 @@ fn build_volpathmis(params: &Params) -> Result<Integrator> {
 
 fn build_distrib(params: &Params) -> Result<Integrator> {
     let lights = match params.choice(&LIGHTS)? {
-        "uniform" => DirectLights::One(LightSelection::Uniform),
         "all" => DirectLights::All,
-        _ => DirectLights::One(LightSelection::Power),
+        name => DirectLights::One(
+            LightSelection::from_name(name).expect("the parameter's choices name selections"),
+        ),
     };
     let rr_threshold = params.float(&RR_THRESHOLD)?;
     if !(rr_threshold > 0.0 && rr_threshold.is_finite()) {
