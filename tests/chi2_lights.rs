@@ -399,7 +399,7 @@ fn selection_chi2(selection: LightSelection, seed: u64) {
 
 /// The closed form of the exhaustive selection at `receiver`: the lights at infinity (the
 /// directional and the constant one, the last two) by their share of the total power, the
-/// others by Φ cos θ'ᵢ / max(d², r²) of the boxes of `every_kind_of_light`.
+/// others by Φ min(1, (|n·(c − p)| + r)/d) / max(d², r²) of the boxes of `every_kind_of_light`.
 fn exhaustive_probabilities(powers: &[f64], receiver: &Receiver) -> Vec<f64> {
     let (p, n) = (receiver.p.as_dvec3(), receiver.n.map(|n| n.as_dvec3()));
     // Centres and squared radii: the floor [−2, 2]² × {0}, the sphere, the point, the spot.
@@ -413,16 +413,12 @@ fn exhaustive_probabilities(powers: &[f64], receiver: &Receiver) -> Vec<f64> {
         .iter()
         .zip(powers)
         .map(|(&(c, r2), &power)| {
-            let d2: f64 = (c - p).length_squared();
+            let d2: f64 = (c - p).length_squared().max(r2);
             let cosine = match n {
-                Some(n) if d2 > r2 => {
-                    let theta_i = (n.dot(c - p) / d2.sqrt()).abs().acos();
-                    let theta_b = (r2 / d2).sqrt().asin();
-                    (theta_i - theta_b).max(0.0).cos()
-                }
-                _ => 1.0,
+                Some(n) => ((n.dot(c - p).abs() + r2.sqrt()) / d2.sqrt()).min(1.0),
+                None => 1.0,
             };
-            power * cosine / d2.max(r2)
+            power * cosine / d2
         })
         .collect();
     let total: f64 = powers.iter().sum();

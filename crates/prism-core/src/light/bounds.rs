@@ -3,18 +3,19 @@
 //! Many Lights with Adaptive Tree Splitting", §4.3; pbrt-v4, §12.6.3, `LightBounds::Importance`).
 //!
 //! A light at a finite place is bounded by a box (a point for point, spot and projector lights)
-//! with bounding sphere (c, r), and carries its power Φ. Seen from a receiver p with normal n,
-//! the light subtends at most the cone of half-angle θ_b around the direction ω = (c − p)/|c − p|,
-//! sin θ_b = r/|c − p| (the whole sphere of directions when p is inside the bounding sphere).
-//! Every direction towards the light is then within θ_b of ω, so the receiver's cosine is at most
-//! cos θ'ᵢ = cos(max(0, θᵢ − θ_b)) with cos θᵢ = |n · ω|, and the importance is
+//! with bounding sphere (c, r), and carries its power Φ. Seen from a receiver p with normal n at
+//! distance d = |c − p| > r, the light subtends at most the cone of half-angle θ_b around the
+//! direction ω = (c − p)/d, sin θ_b = r/d. Every direction towards the light is then within θ_b
+//! of ω, so the receiver's cosine is at most cos(max(0, θᵢ − θ_b)) ≤ min(1, cos θᵢ + sin θ_b),
+//! cos θᵢ = |n · ω| (pbrt-v4 takes the first bound; the second costs one square root and one
+//! division in all), and the importance is
 //!
 //! ```text
-//!     I(p, n) = Φ · cos θ'ᵢ / max(|c − p|², r²),
+//!     I(p, n) = Φ · min(1, (|n · (c − p)| + r) / d) / d²,
 //! ```
 //!
-//! the irradiance a point source of power Φ at c would give, with the distance clamped where p
-//! is near or inside the light. Emitters are counted as radiating in every direction: their own
+//! the irradiance a point source of power Φ at c would give, with its cosine widened by the
+//! light's extent; inside the bounding sphere (d ≤ r) it is Φ / r². Emitters are counted as radiating in every direction: their own
 //! orientation is not bounded (pbrt-v4's cone of normals θ_o, θ_e is left at π), which keeps I
 //! positive wherever the light can give light. Without a normal (a point in a medium) the cosine
 //! factor is 1.
@@ -26,8 +27,8 @@ use glam::Vec3;
 pub struct LightBounds {
     /// Centre c of the bounding sphere.
     pub center: Vec3,
-    /// Squared radius r² of the bounding sphere.
-    pub radius_squared: f32,
+    /// Radius r of the bounding sphere.
+    pub radius: f32,
     /// The power Φ (luminance-weighted, times the light's sampling weight).
     pub power: f32,
 }
@@ -57,7 +58,7 @@ impl LightBounds {
     pub fn around_box(lo: Vec3, hi: Vec3, power: f32) -> LightBounds {
         LightBounds {
             center: 0.5 * (lo + hi),
-            radius_squared: (0.5 * (hi - lo)).length_squared(),
+            radius: (0.5 * (hi - lo)).length(),
             power,
         }
     }
@@ -66,7 +67,7 @@ impl LightBounds {
     pub fn at_point(p: Vec3, power: f32) -> LightBounds {
         LightBounds {
             center: p,
-            radius_squared: 0.0,
+            radius: 0.0,
             power,
         }
     }
@@ -79,27 +80,18 @@ impl LightBounds {
             return 0.0;
         }
         let to_light = self.center - receiver.p;
-        let distance_squared = to_light.length_squared();
         // Below the smallest distance at which the product keeps its precision, the light is as
         // good as reached.
-        let clamped = distance_squared.max(self.radius_squared).max(1e-12);
+        let distance_squared = to_light
+            .length_squared()
+            .max(self.radius * self.radius)
+            .max(1e-12);
         let Some(n) = receiver.n else {
-            return self.power / clamped;
+            return self.power / distance_squared;
         };
-        if distance_squared <= self.radius_squared || !(distance_squared > 0.0) {
-            return self.power / clamped;
-        }
-        let cos_i = (n.dot(to_light) / distance_squared.sqrt()).abs().min(1.0);
-        let sin_b_squared = self.radius_squared / distance_squared;
-        let cos_b = (1.0 - sin_b_squared).max(0.0).sqrt();
-        // cos(max(0, θᵢ − θ_b)): 1 while θᵢ < θ_b, else cos θᵢ cos θ_b + sin θᵢ sin θ_b.
-        let cosine = if cos_i >= cos_b {
-            1.0
-        } else {
-            let sin_i = (1.0 - cos_i * cos_i).max(0.0).sqrt();
-            (cos_i * cos_b + sin_i * sin_b_squared.sqrt()).min(1.0)
-        };
-        self.power * cosine / clamped
+        let inverse_distance = distance_squared.sqrt().recip();
+        let cosine = ((n.dot(to_light).abs() + self.radius) * inverse_distance).min(1.0);
+        self.power * cosine * inverse_distance * inverse_distance
     }
 }
 
@@ -108,12 +100,12 @@ mod tests {
     use super::*;
 
     /// The importance bounds the irradiance cosine: for points spread over a sphere light, the
-    /// receiver's |cos| towards each is at most cos θ'ᵢ.
+    /// receiver's |cos| towards each is at most the importance's cosine factor.
     #[test]
     fn the_receiver_cosine_bounds_every_direction_to_the_light() {
         let bounds =
             LightBounds::around_box(Vec3::new(1.0, 2.0, 0.5), Vec3::new(1.6, 2.4, 1.5), 3.0);
-        let r = bounds.radius_squared.sqrt();
+        let r = bounds.radius;
         let receiver = Receiver::surface(Vec3::new(0.2, -0.3, 0.1), Vec3::new(0.0, 0.6, 0.8));
         let d2 = (bounds.center - receiver.p).length_squared();
         let bound = bounds.importance(&receiver) * d2 / bounds.power;
@@ -139,7 +131,7 @@ mod tests {
     fn near_and_inside_the_light_the_distance_is_clamped() {
         let bounds = LightBounds::around_box(Vec3::splat(-1.0), Vec3::splat(1.0), 6.0);
         let inside = Receiver::surface(Vec3::new(0.5, 0.0, 0.0), Vec3::X);
-        assert_eq!(bounds.importance(&inside), 6.0 / 3.0);
+        assert!((bounds.importance(&inside) - 6.0 / 3.0).abs() < 1e-5);
         let far = Receiver::point(Vec3::new(10.0, 0.0, 0.0));
         assert!((bounds.importance(&far) - 6.0 / 100.0).abs() < 1e-6);
         let point = LightBounds::at_point(Vec3::ZERO, 1.0);
