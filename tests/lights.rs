@@ -19,7 +19,9 @@ use prism_core::film::Film;
 use prism_core::geometry::Sphere;
 use prism_core::geometry::{Primitive, Shape, ShapeSampling};
 use prism_core::image::{Bitmap, Encoding};
-use prism_core::integrator::{DistributionIntegrator, Integrator, PathIntegrator};
+use prism_core::integrator::{
+    DistributionIntegrator, Integrator, PathIntegrator, VolPathIntegrator,
+};
 use prism_core::light::{
     AreaLight, BoundingSphere, ConstantLight, DirectionalLight, EnvironmentMap, Light,
     LightSelection, PointLight, SpotLight,
@@ -433,7 +435,8 @@ fn diffuse_plane_under_an_environment_map() {
 }
 
 /// Light selection must not change the answer (DESIGN.md §7): a point light and a sphere light
-/// over a plane, rendered with selection by importance, by power and uniformly, with equal and unequal
+/// over a plane, rendered with selection by importance (by the path and the volumetric path
+/// tracers), by power and uniformly, with equal and unequal
 /// `sampling_weight`s, against the sum of their closed forms; a point light of weight 0 is never
 /// sampled and so adds nothing (as in Mitsuba).
 #[test]
@@ -443,7 +446,7 @@ fn light_selection_does_not_change_the_answer() {
     let center = DVec3::new(0.5, 0.0, 1.5);
     let size = UVec2::new(10, 8);
     let camera = camera(DVec3::new(0.0, 0.0, 0.9), DVec3::ZERO, DVec3::Y, 80.0, size);
-    for (selection, weights, spp, seed) in [
+    for (selection, (name, integrator), weights, spp, seed) in [
         (LightSelection::Power, [1.0, 1.0], 2048, 36u64),
         (LightSelection::Uniform, [1.0, 1.0], 2048, 37),
         (LightSelection::Power, [0.5, 2.0], 8192, 38),
@@ -452,7 +455,28 @@ fn light_selection_does_not_change_the_answer() {
         (LightSelection::Exhaustive, [1.0, 1.0], 2048, 41),
         (LightSelection::Exhaustive, [0.5, 2.0], 8192, 42),
         (LightSelection::Exhaustive, [1.0, 0.0], 2048, 43),
-    ] {
+    ]
+    .into_iter()
+    .map(|(selection, weights, spp, seed)| {
+        let path: Integrator = PathIntegrator {
+            light_selection: selection,
+            ..PathIntegrator::default()
+        }
+        .into();
+        (selection, ("path", path), weights, spp, seed)
+    })
+    .chain(
+        [([1.0, 1.0], 2048, 44), ([0.5, 2.0], 8192, 45)].map(|(weights, spp, seed)| {
+            let volpath: Integrator = VolPathIntegrator::default().into();
+            (
+                LightSelection::Exhaustive,
+                ("volpath", volpath),
+                weights,
+                spp,
+                seed,
+            )
+        }),
+    ) {
         let mut scene = build(
             vec![
                 floor(rho as f32),
@@ -468,16 +492,13 @@ fn light_selection_does_not_change_the_answer() {
             })],
             camera.clone(),
             size,
-            PathIntegrator {
-                light_selection: selection,
-                ..PathIntegrator::default()
-            },
+            integrator.clone(),
         );
         assert!(matches!(scene.world.lights[0], Light::Area(_)));
         scene.world.light_sampling_weights = weights.to_vec();
         let film = render_film(&scene, spp, seed, None);
         assert_pixels(
-            &format!("two lights, {selection:?}, sampling weights {weights:?}"),
+            &format!("two lights, {name} {selection:?}, sampling weights {weights:?}"),
             &film,
             &camera,
             |ray| {
