@@ -15,10 +15,10 @@
 //! ```
 //!
 //! the irradiance a point source of power Φ at c would give, with its cosine widened by the
-//! light's extent; inside the bounding sphere (d ≤ r) it is Φ / r². Emitters are counted as radiating in every direction: their own
-//! orientation is not bounded (pbrt-v4's cone of normals θ_o, θ_e is left at π), which keeps I
-//! positive wherever the light can give light. Without a normal (a point in a medium) the cosine
-//! factor is 1.
+//! light's extent; inside the bounding sphere (d ≤ r) it is Φ / r². Emitters are counted as
+//! radiating in every direction: their own orientation is not bounded (pbrt-v4's cone of normals
+//! θ_o, θ_e is left at π), which keeps I positive wherever the light can give light. Without a
+//! normal (a point in a medium) the cosine factor is 1.
 
 use glam::Vec3;
 

@@ -174,23 +174,16 @@ impl LightSampler {
             sampling_weights.len(),
             "one sampling weight per light"
         );
+        let weighted_powers = || -> Vec<f32> {
+            powers
+                .iter()
+                .zip(sampling_weights)
+                .map(|(&p, &w)| p * w)
+                .collect()
+        };
         match selection {
-            LightSelection::Exhaustive => {
-                let weighted: Vec<f32> = powers
-                    .iter()
-                    .zip(sampling_weights)
-                    .map(|(&p, &w)| p * w)
-                    .collect();
-                LightSampler::exhaustive(&weighted, bounds)
-            }
-            LightSelection::Power => {
-                let weights: Vec<f32> = powers
-                    .iter()
-                    .zip(sampling_weights)
-                    .map(|(&p, &w)| p * w)
-                    .collect();
-                LightSampler::new(&weights)
-            }
+            LightSelection::Exhaustive => LightSampler::exhaustive(&weighted_powers(), bounds),
+            LightSelection::Power => LightSampler::new(&weighted_powers()),
             LightSelection::Uniform => match sampling_weights.split_first() {
                 Some((&first, rest)) if first > 0.0 && rest.iter().all(|&w| w == first) => {
                     LightSampler::uniform(sampling_weights.len())
@@ -242,7 +235,11 @@ impl ExhaustiveSampler {
             return Some((index, 1.0));
         }
         let mut rest = u;
-        let share = self.infinite_share_at(receiver);
+        let share = if self.infinite.is_some() {
+            self.share_given(self.any_finite_light_reaches(receiver))
+        } else {
+            0.0
+        };
         if let Some(table) = &self.infinite
             && rest < share
         {
@@ -277,21 +274,25 @@ impl ExhaustiveSampler {
         }
         match self.slots.get(index) {
             Some(&Slot::Finite(k)) => {
-                let importance = self.finite[k].1.importance(receiver);
+                // One pass: this light's importance and the sum, in `sample`'s order.
+                let (mut importance, mut total) = (0.0f32, 0.0f32);
+                for (j, (_, bounds)) in self.finite.iter().enumerate() {
+                    let i = bounds.importance(receiver);
+                    if j == k {
+                        importance = i;
+                    }
+                    if i > 0.0 {
+                        total += i;
+                    }
+                }
                 if !(importance > 0.0) {
                     return 0.0;
                 }
-                let total: f32 = self
-                    .finite
-                    .iter()
-                    .map(|(_, b)| b.importance(receiver))
-                    .sum();
-                (1.0 - self.infinite_share_at(receiver)) * importance / total
+                (1.0 - self.share_given(true)) * importance / total
             }
-            Some(&Slot::Infinite(k)) => self
-                .infinite
-                .as_ref()
-                .map_or(0.0, |t| self.infinite_share_at(receiver) * t.pmf(k)),
+            Some(&Slot::Infinite(k)) => self.infinite.as_ref().map_or(0.0, |t| {
+                self.share_given(self.any_finite_light_reaches(receiver)) * t.pmf(k)
+            }),
             Some(&Slot::Never) | None => 0.0,
         }
     }
@@ -306,19 +307,20 @@ impl ExhaustiveSampler {
         }
     }
 
-    /// The probability of choosing some light at infinity: Φ_∞/Φ, or 1 where no finite light
-    /// has importance.
-    fn infinite_share_at(&self, receiver: &Receiver) -> f32 {
-        if self.infinite.is_none() {
-            0.0
-        } else if self
-            .finite
+    /// Whether some finite light has importance at `receiver`.
+    fn any_finite_light_reaches(&self, receiver: &Receiver) -> bool {
+        self.finite
             .iter()
             .any(|(_, b)| b.importance(receiver) > 0.0)
-        {
-            self.infinite_share
-        } else {
-            1.0
+    }
+
+    /// The probability of choosing some light at infinity: Φ_∞/Φ where a finite light has
+    /// importance, else 1 (0 without lights at infinity).
+    fn share_given(&self, finite_light_reaches: bool) -> f32 {
+        match (&self.infinite, finite_light_reaches) {
+            (None, _) => 0.0,
+            (Some(_), true) => self.infinite_share,
+            (Some(_), false) => 1.0,
         }
     }
 }
