@@ -2,7 +2,7 @@
 //! It knows nothing of cameras, films or integrators; [`crate::scene::Scene`] adds those.
 
 use crate::bsdf::Material;
-use crate::geometry::Geometry;
+use crate::geometry::{Geometry, SurfaceInteraction};
 use crate::light::{BoundingSphere, Light, LightBounds};
 use crate::medium::{Medium, MediumInterface};
 
@@ -80,6 +80,12 @@ impl World {
             camera_medium: None,
             light_sampling_weights,
         }
+    }
+
+    /// What the surface hit `si` is made of.
+    #[inline]
+    pub fn material(&self, si: &SurfaceInteraction) -> &Material {
+        &self.materials[self.shape_info[si.shape as usize].material as usize]
     }
 
     /// The media on the two sides of primitive `shape`.

@@ -32,9 +32,8 @@
 //! none.
 
 use crate::geometry::SurfaceInteraction;
-use crate::integrator::{Integrator, PreparedIntegrator, RayCount};
+use crate::integrator::{Integrator, SampleContext};
 use crate::math::Ray;
-use crate::sampling::sampler::Sampler;
 use crate::spectrum::cie::xyz_to_linear_srgb;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use crate::world::World;
@@ -123,14 +122,13 @@ impl AovIntegrator {
     /// The first nested integrator's radiance; the nested images and the variables go to `aovs`.
     pub(super) fn radiance(
         &self,
-        prepared: &PreparedIntegrator,
+        ctx: &mut SampleContext,
         ray: Ray,
         lambda: &SampledWavelengths,
-        sampler: &mut Sampler,
-        count: &mut RayCount,
         aovs: &mut [f32],
     ) -> SampledSpectrum {
-        let world = prepared.world;
+        let prepared = ctx.prepared;
+        let world = ctx.world();
         let (images, rest) = aovs.split_at_mut(4 * prepared.nested.len());
         let mut image = SampledSpectrum::ZERO;
         let mut offset = 0;
@@ -141,16 +139,20 @@ impl AovIntegrator {
             .enumerate()
         {
             let k = nested.aov_count();
-            let radiance =
-                nested.radiance(ray, lambda, sampler, count, &mut rest[offset..offset + k]);
+            let radiance = nested.radiance(
+                ray,
+                lambda,
+                ctx.sampler,
+                ctx.count,
+                &mut rest[offset..offset + k],
+            );
             offset += k;
             rgba[..3].copy_from_slice(&xyz_to_linear_srgb(lambda.to_xyz(&radiance)));
             if i == 0 {
                 image = radiance;
             }
         }
-        count.rays += 1;
-        let hit = world.geometry.intersect(&ray);
+        let hit = ctx.intersect(&ray);
         // Coverage: the ray finds a surface, or an environment the integrator shows.
         for (rgba, (_, integrator)) in images.chunks_exact_mut(4).zip(&self.integrators) {
             let environment_seen = world.environment.is_some() && !integrator.hides_emitters();
@@ -189,8 +191,9 @@ fn variable(
     let v = |v: glam::Vec3| v.to_array();
     match kind {
         AovKind::Albedo => {
-            let material = &world.materials[world.shape_info[si.shape as usize].material as usize];
-            let albedo = material.diffuse_reflectance(si, -ray.d.normalize(), lambda);
+            let albedo = world
+                .material(si)
+                .diffuse_reflectance(si, -ray.d.normalize(), lambda);
             xyz_to_linear_srgb(lambda.to_xyz(&albedo))
         }
         AovKind::Depth => [si.t * ray.d.length(), 0.0, 0.0],

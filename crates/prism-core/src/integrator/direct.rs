@@ -7,14 +7,8 @@
 //! L = L_e + (1/n_l) Σ_l w_l f L / p_l + (1/n_b) Σ_b w_b f L / p_b
 //! ```
 //!
-//! ```xml
-//! <integrator type="direct">
-//!     <integer name="shading_samples" value="1"/>   <!-- sets both counts below -->
-//!     <integer name="emitter_samples" value="1"/>
-//!     <integer name="bsdf_samples" value="1"/>
-//!     <boolean name="hide_emitters" value="false"/>
-//! </integrator>
-//! ```
+//! Its parameters (`emitter_samples`, `bsdf_samples`, `shading_samples` setting both,
+//! `hide_emitters`) and their defaults are listed in docs/plugins.md.
 //!
 //! * Light samples are taken only where the BSDF has a smooth lobe; BSDF samples everywhere,
 //!   so mirrors and glass show the emitters they reflect or refract, but nothing beyond them.
@@ -26,10 +20,11 @@
 //!   sample refracted through a dispersive interface, keep only the hero wavelength.
 
 use crate::bsdf::BxdfTree;
-use crate::integrator::mis::{BsdfSampleOrigin, Strategies, emission_found, sample_light};
-use crate::integrator::{PreparedIntegrator, RayCount, hero_only};
+use crate::integrator::SampleContext;
+use crate::integrator::mis::{ScatterOrigin, Strategies, emission_found, sample_light_at_surface};
+use crate::integrator::vertex::{path_estimate, surface_scattering};
+use crate::light::Receiver;
 use crate::math::Ray;
-use crate::sampling::sampler::Sampler;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -62,55 +57,40 @@ impl DirectIntegrator {
 
     pub(super) fn radiance(
         &self,
-        prepared: &PreparedIntegrator,
+        ctx: &mut SampleContext,
         ray: Ray,
         wavelengths: &SampledWavelengths,
-        sampler: &mut Sampler,
-        count: &mut RayCount,
     ) -> SampledSpectrum {
-        let world = prepared.world;
+        let world = ctx.world();
         let strategies = self.strategies();
         let mut lambda = *wavelengths;
         let mut result = SampledSpectrum::ZERO;
-        count.rays += 1;
-        let hit = world.geometry.intersect(&ray);
+        let hit = ctx.intersect(&ray);
         if !self.hide_emitters {
-            result += emission_found(prepared, &ray, hit.as_ref(), None, &lambda, strategies);
+            result += emission_found(ctx, &ray, hit.as_ref(), None, &lambda, strategies);
         }
         let Some(si) = hit else {
             return result;
         };
         let wo_world = -ray.d.normalize();
         let mut lobes = BxdfTree::empty();
-        let material = &world.materials[world.shape_info[si.shape as usize].material as usize];
-        let scattering = material.scattering(&si, wo_world, &lambda, &mut lobes);
-        let smooth = scattering.flags().has_smooth_lobe();
-        // A dispersive BSDF that can be evaluated uses the hero's index for all its lobes.
-        if smooth && scattering.is_dispersive() {
-            lambda.terminate_secondary();
-        }
+        let scattering = surface_scattering(world, &si, wo_world, &mut lambda, &mut lobes);
 
-        if smooth && self.emitter_samples > 0 {
+        if scattering.flags().has_smooth_lobe() && self.emitter_samples > 0 {
             let mut light = SampledSpectrum::ZERO;
             for _ in 0..self.emitter_samples {
-                light += sample_light(
-                    prepared,
-                    &si,
-                    &scattering,
-                    &lambda,
-                    sampler,
-                    count,
-                    strategies,
-                    false,
-                );
+                if let Some(terms) = sample_light_at_surface(ctx, &si, &scattering, &lambda, false)
+                {
+                    light += terms.weighted(strategies);
+                }
             }
             result += light * (1.0 / self.emitter_samples as f32);
         }
 
         let mut bsdf = SampledSpectrum::ZERO;
         for _ in 0..self.bsdf_samples {
-            let u_lobe = sampler.next_1d();
-            let u = sampler.next_2d();
+            let u_lobe = ctx.sampler.next_1d();
+            let u = ctx.sampler.next_2d();
             let Some(bs) = scattering.sample(u_lobe, u) else {
                 continue;
             };
@@ -122,37 +102,26 @@ impl DirectIntegrator {
             if bs.terminates_secondary {
                 sample_lambda.terminate_secondary();
             }
-            let origin = BsdfSampleOrigin {
-                p: si.p,
-                n: si.shading.n,
+            let origin = ScatterOrigin {
+                receiver: Receiver::surface(si.p, si.shading.n),
                 pdf: bs.pdf,
                 specular: bs.flags.is_delta(),
             };
             let sampled_ray = si.spawn_ray(bs.wi);
-            count.rays += 1;
-            let found = world.geometry.intersect(&sampled_ray);
+            let found = ctx.intersect(&sampled_ray);
             let emitted = emission_found(
-                prepared,
+                ctx,
                 &sampled_ray,
                 found.as_ref(),
                 Some(&origin),
                 &sample_lambda,
                 strategies,
             );
-            let contribution = bs.weight * emitted;
-            bsdf += if sample_lambda.secondary_terminated() && !lambda.secondary_terminated() {
-                hero_only(contribution)
-            } else {
-                contribution
-            };
+            bsdf += path_estimate(bs.weight * emitted, &lambda, &sample_lambda);
         }
         if self.bsdf_samples > 0 {
             result += bsdf * (1.0 / self.bsdf_samples as f32);
         }
-
-        if !wavelengths.secondary_terminated() && lambda.secondary_terminated() {
-            return hero_only(result);
-        }
-        result
+        path_estimate(result, wavelengths, &lambda)
     }
 }

@@ -32,32 +32,26 @@
 //! (the hero-only estimator of the same integral), so each branch of the split decides for
 //! itself.
 //!
-//! ```xml
-//! <integrator type="distrib">
-//!     <integer name="max_depth" value="-1"/>          <!-- as for path -->
-//!     <integer name="bounce_samples" value="4"/>      <!-- N at potential 1 -->
-//!     <integer name="shadow_rays" value="4"/>         <!-- N_l at potential 1 -->
-//!     <string name="lights" value="power"/>           <!-- one light chosen ∝ "power" or "uniform"ly; or "all" -->
-//!     <float name="rr_threshold" value="0.1"/>        <!-- potential below which roulette starts -->
-//!     <boolean name="hide_emitters" value="false"/>
-//! </integrator>
-//! ```
+//! Its parameters (`bounce_samples` N and `shadow_rays` N_l at potential 1, `rr_threshold`, the
+//! choice of `lights`, `max_depth`, `hide_emitters`) and their defaults are listed in
+//! docs/plugins.md.
 
 use glam::Vec3;
 
 use crate::bsdf::{BxdfTree, Scattering};
 use crate::geometry::SurfaceInteraction;
-use crate::integrator::{PreparedIntegrator, RayCount, hero_only, unoccluded};
+use crate::integrator::SampleContext;
+use crate::integrator::mis::{emission_along, sample_point_on, unoccluded};
+use crate::integrator::vertex::{allows_next_vertex, hero_only, surface_scattering};
 use crate::light::{Light, LightSelection, Receiver};
 use crate::math::Ray;
-use crate::sampling::sampler::Sampler;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 
 /// Which lights a vertex sends shadow rays to.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum DirectLights {
-    /// One light per shading point, drawn by the integrator's light sampler (∝ power, or
-    /// uniformly) and the estimate divided by its probability.
+    /// One light per shading point, drawn by the integrator's light sampler (by importance,
+    /// ∝ power, or uniformly) and the estimate divided by its probability.
     One(LightSelection),
     /// Every light, each with its own shadow rays (the slides' loop over the lights).
     All,
@@ -127,142 +121,113 @@ impl DistributionIntegrator {
         }
     }
 
-    fn depth_allows_next_vertex(&self, depth: i32) -> bool {
-        self.max_depth < 0 || depth + 1 < self.max_depth
-    }
-
     pub(super) fn radiance(
         &self,
-        prepared: &PreparedIntegrator,
+        ctx: &mut SampleContext,
         ray: Ray,
         lambda: &SampledWavelengths,
-        sampler: &mut Sampler,
-        count: &mut RayCount,
     ) -> SampledSpectrum {
         if self.max_depth == 0 {
             return SampledSpectrum::ZERO;
         }
-        let mut estimate = Estimate {
-            integrator: self,
-            prepared,
-            sampler,
-            count,
+        let camera = Level {
+            depth: 0,
+            potential: 1.0,
         };
-        estimate.incoming(ray, 0, 1.0, !self.hide_emitters, lambda)
+        self.incoming(ctx, ray, camera, !self.hide_emitters, lambda)
     }
-}
 
-/// One camera sample's recursive estimate: the integrator, its world and light sampler, and the
-/// sample's random numbers and ray count.
-struct Estimate<'a, 's> {
-    integrator: &'a DistributionIntegrator,
-    prepared: &'a PreparedIntegrator<'a>,
-    sampler: &'s mut Sampler,
-    count: &'s mut RayCount,
-}
-
-impl Estimate<'_, '_> {
-    /// Radiance arriving along `ray` (the slides' `incoming_radiance`); emission at the hit is
-    /// counted only when `with_emission`.
+    /// Radiance arriving along `ray` at a vertex of `level` (the slides' `incoming_radiance`);
+    /// emission at the hit is counted only when `with_emission`.
     fn incoming(
-        &mut self,
+        &self,
+        ctx: &mut SampleContext,
         ray: Ray,
-        depth: i32,
-        potential: f32,
+        level: Level,
         with_emission: bool,
         lambda: &SampledWavelengths,
     ) -> SampledSpectrum {
-        let world = self.prepared.world;
-        self.count.rays += 1;
-        let Some(si) = world.geometry.intersect(&ray) else {
-            // Leaving the scene: the environment is a light like any other, counted here only
-            // where no shadow ray could have found it (camera rays, specular bounces).
-            return match world.environment {
-                Some(env) if with_emission => {
-                    world.lights[env as usize].environment_radiance(ray.d.normalize(), lambda)
-                }
-                _ => SampledSpectrum::ZERO,
-            };
-        };
-        let wo_world = -ray.d.normalize();
-        let info = world.shape_info[si.shape as usize];
+        let hit = ctx.intersect(&ray);
+        let d = ray.d.normalize();
         let mut result = SampledSpectrum::ZERO;
-        if with_emission
-            && let Some(light_index) = info.light
-            && let Light::Area(light) = &world.lights[light_index as usize]
-        {
-            result += light.emitted(si.uv, si.shading.n, wo_world, lambda);
+        // Emission (the environment's when the ray leaves the scene) is counted only where no
+        // shadow ray could have found it: camera rays and specular bounces.
+        if with_emission && let Some(found) = emission_along(ctx.world(), d, hit.as_ref(), lambda) {
+            result += found.radiance;
         }
-        if self.integrator.depth_allows_next_vertex(depth) {
-            result += self.reflected(&si, wo_world, depth, potential, lambda);
+        let Some(si) = hit else {
+            return result;
+        };
+        if allows_next_vertex(self.max_depth, level.depth) {
+            result += self.reflected(ctx, &si, -d, level, lambda);
         }
         result
     }
 
     /// Reflected radiance at `si` towards `wo_world` (the slides' `reflected_radiance`).
     fn reflected(
-        &mut self,
+        &self,
+        ctx: &mut SampleContext,
         si: &SurfaceInteraction,
         wo_world: Vec3,
-        depth: i32,
-        potential: f32,
+        level: Level,
         lambda: &SampledWavelengths,
     ) -> SampledSpectrum {
-        let world = self.prepared.world;
-        let survival = self.integrator.choose_s(potential, depth);
-        if !(self.sampler.next_1d() < survival) {
+        let survival = self.choose_s(level.potential, level.depth);
+        if !(ctx.sampler.next_1d() < survival) {
             return SampledSpectrum::ZERO;
         }
-        let material = &world.materials[world.shape_info[si.shape as usize].material as usize];
         // This level's lobes, alive while the levels below it are estimated.
         let mut lobes = BxdfTree::empty();
-        let scattering = material.scattering(si, wo_world, lambda, &mut lobes);
-        let smooth = scattering.flags().has_smooth_lobe();
-        // A dispersive BSDF that can be evaluated uses the hero's index for all its lobes
-        // (roughdielectric): the whole vertex continues with the hero alone.
-        if smooth && scattering.is_dispersive() && !lambda.secondary_terminated() {
-            let mut hero = *lambda;
-            hero.terminate_secondary();
-            let estimate = self.scatter(si, &scattering, depth, potential, survival, &hero);
-            return hero_only(estimate);
+        let mut vertex_lambda = *lambda;
+        let scattering =
+            surface_scattering(ctx.world(), si, wo_world, &mut vertex_lambda, &mut lobes);
+        let estimate = self.scatter(ctx, si, &scattering, level, survival, &vertex_lambda);
+        // A vertex whose BSDF keeps only the hero continues with it alone.
+        if vertex_lambda.secondary_terminated() && !lambda.secondary_terminated() {
+            hero_only(estimate)
+        } else {
+            estimate
         }
-        self.scatter(si, &scattering, depth, potential, survival, lambda)
     }
 
     /// The direct and split indirect estimate at a vertex that survived roulette with
     /// probability `survival`.
     fn scatter(
-        &mut self,
+        &self,
+        ctx: &mut SampleContext,
         si: &SurfaceInteraction,
         scattering: &Scattering,
-        depth: i32,
-        potential: f32,
+        level: Level,
         survival: f32,
         lambda: &SampledWavelengths,
     ) -> SampledSpectrum {
         let mut result = SampledSpectrum::ZERO;
         if scattering.flags().has_smooth_lobe() {
-            result += self.direct(si, scattering, potential, lambda);
+            result += self.direct(ctx, si, scattering, level.potential, lambda);
         }
 
-        let n = self.integrator.choose_n(potential);
+        let n = self.choose_n(level.potential);
         let mut indirect = SampledSpectrum::ZERO;
         for _ in 0..n {
-            let u_lobe = self.sampler.next_1d();
-            let u = self.sampler.next_2d();
+            let u_lobe = ctx.sampler.next_1d();
+            let u = ctx.sampler.next_2d();
             let Some(bs) = scattering.sample(u_lobe, u) else {
                 continue;
             };
             let specular = bs.flags.is_delta();
-            let next_potential = potential * bs.weight.max_value() / (n as f32 * survival);
+            let next = Level {
+                depth: level.depth + 1,
+                potential: level.potential * bs.weight.max_value() / (n as f32 * survival),
+            };
             let ray = si.spawn_ray(bs.wi);
             let arriving = if bs.terminates_secondary && !lambda.secondary_terminated() {
                 // This direction is the hero's alone: so is what arrives along it.
                 let mut hero = *lambda;
                 hero.terminate_secondary();
-                hero_only(self.incoming(ray, depth + 1, next_potential, specular, &hero))
+                hero_only(self.incoming(ctx, ray, next, specular, &hero))
             } else {
-                self.incoming(ray, depth + 1, next_potential, specular, lambda)
+                self.incoming(ctx, ray, next, specular, lambda)
             };
             indirect += bs.weight * arriving;
         }
@@ -273,54 +238,54 @@ impl Estimate<'_, '_> {
     /// Direct light by shadow rays: N_l per light, over every light or one drawn by the light
     /// sampler.
     fn direct(
-        &mut self,
+        &self,
+        ctx: &mut SampleContext,
         si: &SurfaceInteraction,
         scattering: &Scattering,
         potential: f32,
         lambda: &SampledWavelengths,
     ) -> SampledSpectrum {
-        let world = self.prepared.world;
-        let rays = self.integrator.shadow_rays_for(potential);
-        let estimate_light = |light: &Light, sampler: &mut Sampler, count: &mut RayCount| {
+        let world = ctx.world();
+        let rays = self.shadow_rays_for(potential);
+        let estimate_light = |ctx: &mut SampleContext, light: &Light| {
             let mut sum = SampledSpectrum::ZERO;
             for _ in 0..rays {
-                let u_choice = sampler.next_1d();
-                let u = sampler.next_2d();
-                let Some(ls) = light.sample_incident(
-                    &world.geometry.primitives,
-                    si.p,
-                    si.time,
-                    u_choice,
-                    u,
-                    lambda,
-                ) else {
+                let Some(ls) = sample_point_on(ctx, light, si.p, si.time, lambda) else {
                     continue;
                 };
-                if let Some(f) = unoccluded(world, si, scattering, &ls, count) {
+                if let Some(f) = unoccluded(ctx, si, scattering, &ls) {
                     sum += f.value * ls.radiance * (1.0 / ls.pdf);
                 }
             }
             sum * (1.0 / rays as f32)
         };
-        match self.integrator.lights {
+        match self.lights {
             DirectLights::All => {
                 let mut total = SampledSpectrum::ZERO;
                 for light in &world.lights {
-                    total += estimate_light(light, self.sampler, self.count);
+                    total += estimate_light(ctx, light);
                 }
                 total
             }
             DirectLights::One(_) => {
-                let Some((index, pmf)) = self.prepared.light_sampler.sample(
-                    self.sampler.next_1d(),
-                    &Receiver::surface(si.p, si.shading.n),
-                ) else {
+                let u_light = ctx.sampler.next_1d();
+                let receiver = Receiver::surface(si.p, si.shading.n);
+                let Some((index, pmf)) = ctx.light_sampler().sample(u_light, &receiver) else {
                     return SampledSpectrum::ZERO;
                 };
-                estimate_light(&world.lights[index], self.sampler, self.count) * (1.0 / pmf)
+                estimate_light(ctx, &world.lights[index]) * (1.0 / pmf)
             }
         }
     }
+}
+
+/// Where a vertex stands in the recursion: its depth, and its potential, the factor its estimate
+/// is multiplied by in the pixel (the product of the weights (f cos / p)/(N s) along the path,
+/// its largest value over the wavelengths), from which the splitting and roulette are chosen.
+#[derive(Clone, Copy, Debug)]
+struct Level {
+    depth: i32,
+    potential: f32,
 }
 
 #[cfg(test)]

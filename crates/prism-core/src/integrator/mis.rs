@@ -1,8 +1,11 @@
 //! Direct light by two strategies combined with multiple importance sampling (Veach 1997,
 //! §9.2): light samples (a light chosen by the integrator's light sampler, a point on it, a
-//! shadow ray) and BSDF samples that happen to find an emitter. The path tracer and the
-//! direct-illumination integrator share these two halves, so that both weigh each light the
-//! same way.
+//! shadow ray) and BSDF (or phase-function) samples that happen to find an emitter. Every
+//! integrator takes both halves from here, so that all of them weigh each light the same way:
+//! [`sample_light`] with a hook for what the shadow ray crosses (vacuum for the surface
+//! integrators, media and index-matched boundaries for the volumetric ones), and
+//! [`emission_along`] with [`FoundEmission::light_pdf`] for the emission a sampled direction
+//! finds.
 //!
 //! With n_l light samples and n_b BSDF samples per vertex, a sample of strategy s with density
 //! p_s gets the power heuristic with sample counts (Veach's eq. 9.13, β = 2),
@@ -13,17 +16,22 @@
 //!
 //! and the vertex's estimate is Σ_l w_l f L / (n_l p_l) + Σ_b w_b f L / (n_b p_b): the callers
 //! divide each strategy's sum by its count. Delta lights are found only by light samples and
-//! delta lobes only by BSDF samples, each then with weight 1.
+//! delta lobes only by BSDF samples, each then with weight 1. A light sample's density p_l is
+//! the light sampler's probability of choosing the light times the light's density of the
+//! point, both seen from the receiver ([`Receiver`]: the point and, on a surface, its shading
+//! normal), and the emission a BSDF sample finds is weighed with the same product seen from
+//! the vertex the sample left.
 
 use glam::Vec3;
 
-use crate::bsdf::Scattering;
+use crate::bsdf::{BsdfEval, Scattering};
 use crate::geometry::{SurfaceInteraction, SurfaceSample};
-use crate::integrator::{PreparedIntegrator, RayCount, normals_agree, unoccluded};
-use crate::light::{AreaLight, Light, Receiver};
+use crate::integrator::SampleContext;
+use crate::integrator::vertex::normals_agree;
+use crate::light::{AreaLight, Light, LightSample, Receiver};
 use crate::math::Ray;
-use crate::sampling::sampler::Sampler;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+use crate::world::World;
 
 /// The power heuristic with β = 2: w = p_a² / (p_a² + p_b²).
 #[inline]
@@ -44,7 +52,7 @@ pub struct Strategies {
 }
 
 impl Strategies {
-    /// One light sample and one BSDF sample per vertex (the path tracer).
+    /// One light sample and one BSDF sample per vertex (the path tracers).
     pub const ONE_EACH: Strategies = Strategies {
         light_samples: 1.0,
         bsdf_samples: 1.0,
@@ -53,133 +61,236 @@ impl Strategies {
 
 /// Where a BSDF sample came from, for weighing the emission it finds.
 #[derive(Clone, Copy, Debug)]
-pub struct BsdfSampleOrigin {
-    /// The vertex the sampled ray left from, and its shading normal.
-    pub p: Vec3,
-    pub n: Vec3,
+pub struct ScatterOrigin {
+    /// The vertex the sampled ray left from, as light sampling sees it.
+    pub receiver: Receiver,
     /// Solid-angle density of the BSDF sample.
     pub pdf: f32,
     /// Whether it came from a delta lobe (no light sample could have found its direction).
     pub specular: bool,
 }
 
-/// The emitted radiance that `ray` finds, weighted against the light samples that could have
-/// found it: at `hit` (an area light's shape), or in the environment when the ray escapes
-/// (`hit` None). Without an `origin` (a camera ray) or after a delta lobe the weight is 1.
+/// Emitted radiance found along a direction: at an area light's shape, or in the environment.
+pub struct FoundEmission<'w, 'h> {
+    /// The radiance arriving back along the direction.
+    pub radiance: SampledSpectrum,
+    light: u32,
+    at: EmitterPoint<'w, 'h>,
+}
+
+/// Where the emission was found, which its light-sampling density depends on.
+enum EmitterPoint<'w, 'h> {
+    /// The environment, in this direction (unit).
+    Environment(Vec3),
+    /// A point of an area light's shape.
+    Surface(&'w AreaLight, &'h SurfaceInteraction),
+}
+
+/// The emission that a ray in direction `d` (unit) finds: at `hit` (the emission of its shape's
+/// area light, if any), or in the environment when the ray escapes (`hit` None); None where
+/// it finds no emitter.
+#[inline]
+pub fn emission_along<'w, 'h>(
+    world: &'w World,
+    d: Vec3,
+    hit: Option<&'h SurfaceInteraction>,
+    lambda: &SampledWavelengths,
+) -> Option<FoundEmission<'w, 'h>> {
+    match hit {
+        None => {
+            let light = world.environment?;
+            Some(FoundEmission {
+                radiance: world.lights[light as usize].environment_radiance(d, lambda),
+                light,
+                at: EmitterPoint::Environment(d),
+            })
+        }
+        Some(si) => {
+            let light = world.shape_info[si.shape as usize].light?;
+            let Light::Area(area) = &world.lights[light as usize] else {
+                unreachable!("only area lights are attached to shapes");
+            };
+            Some(FoundEmission {
+                radiance: area.emitted(si.uv, si.shading.n, -d, lambda),
+                light,
+                at: EmitterPoint::Surface(area, si),
+            })
+        }
+    }
+}
+
+impl FoundEmission<'_, '_> {
+    /// The density with which light sampling from `from` would have found this emission per
+    /// unit solid angle: the probability of choosing its light times the light's density of
+    /// the point (or direction).
+    #[inline]
+    pub fn light_pdf(&self, ctx: &SampleContext, from: &Receiver) -> f32 {
+        let world = ctx.world();
+        let choice = ctx.light_sampler().pmf(self.light as usize, from);
+        choice
+            * match self.at {
+                EmitterPoint::Environment(d) => {
+                    world.lights[self.light as usize].environment_pdf(d)
+                }
+                EmitterPoint::Surface(light, si) => light.pdf_from(
+                    &world.geometry.primitives,
+                    from.p,
+                    si.time,
+                    &SurfaceSample::at(si),
+                ),
+            }
+    }
+}
+
+/// The emitted radiance that `ray` finds at `hit` (or in the environment, `hit` None),
+/// weighted against the light samples that could have found it. Without an `origin` (a camera
+/// ray) or after a delta lobe the weight is 1.
 #[inline]
 pub fn emission_found(
-    prepared: &PreparedIntegrator,
+    ctx: &SampleContext,
     ray: &Ray,
     hit: Option<&SurfaceInteraction>,
-    origin: Option<&BsdfSampleOrigin>,
+    origin: Option<&ScatterOrigin>,
     lambda: &SampledWavelengths,
     strategies: Strategies,
 ) -> SampledSpectrum {
-    let world = prepared.world;
-    let (emitted, light_index, light_pdf) = match hit {
-        None => {
-            let Some(env) = world.environment else {
-                return SampledSpectrum::ZERO;
-            };
-            let light = &world.lights[env as usize];
-            let d = ray.d.normalize();
-            let emitted = light.environment_radiance(d, lambda);
-            (emitted, env, LightPdf::Environment(d))
-        }
-        Some(si) => {
-            let Some(light_index) = world.shape_info[si.shape as usize].light else {
-                return SampledSpectrum::ZERO;
-            };
-            let Light::Area(light) = &world.lights[light_index as usize] else {
-                unreachable!("only area lights are attached to shapes");
-            };
-            let emitted = light.emitted(si.uv, si.shading.n, -ray.d.normalize(), lambda);
-            (emitted, light_index, LightPdf::Area(light, si))
-        }
+    let Some(found) = emission_along(ctx.world(), ray.d.normalize(), hit, lambda) else {
+        return SampledSpectrum::ZERO;
     };
     let Some(origin) = origin.filter(|o| !o.specular) else {
-        return emitted;
+        return found.radiance;
     };
-    if emitted.is_black() {
-        return emitted;
+    if found.radiance.is_black() {
+        return found.radiance;
     }
-    let choice = prepared
-        .light_sampler
-        .pmf(light_index as usize, &Receiver::surface(origin.p, origin.n));
-    let light_pdf = choice
-        * match light_pdf {
-            LightPdf::Environment(d) => world.lights[light_index as usize].environment_pdf(d),
-            LightPdf::Area(light, si) => light.pdf_from(
-                &world.geometry.primitives,
-                origin.p,
-                si.time,
-                &SurfaceSample::at(si),
-            ),
-        };
-    emitted
+    let light_pdf = found.light_pdf(ctx, &origin.receiver);
+    found.radiance
         * power_heuristic(
             strategies.bsdf_samples * origin.pdf,
             strategies.light_samples * light_pdf,
         )
 }
 
-/// What the light-sampling density of an emitter found by a BSDF sample depends on.
-enum LightPdf<'a> {
-    Environment(Vec3),
-    Area(&'a AreaLight, &'a SurfaceInteraction),
+/// The factors of one light sample at a vertex: the BSDF's or phase function's value towards
+/// the light and its solid-angle density of that direction, the light sample's density (the
+/// light's choice included), the transmittance of the shadow ray and the radiance.
+#[derive(Clone, Copy, Debug)]
+pub struct LightSampleTerms {
+    pub value: SampledSpectrum,
+    pub direction_pdf: f32,
+    pub light_pdf: f32,
+    pub is_delta: bool,
+    pub transmittance: SampledSpectrum,
+    pub radiance: SampledSpectrum,
 }
 
-/// One light sample at `si`: a light chosen by the light sampler, a point on it, the shadow
-/// ray, and the MIS-weighted contribution f·L·w / (p_light · p_choice). With `strict_normals`
-/// a light whose direction the geometric and shading normals put on different sides
-/// contributes nothing (Mitsuba 0.6's `strictNormals`).
-#[allow(clippy::too_many_arguments)]
+impl LightSampleTerms {
+    /// The sample's contribution f·Tr·L·w / p_light, w the power heuristic against the
+    /// vertex's own sampling with the strategies' counts (1 for a delta light).
+    #[inline]
+    pub fn weighted(&self, strategies: Strategies) -> SampledSpectrum {
+        let weight = if self.is_delta {
+            1.0
+        } else {
+            power_heuristic(
+                strategies.light_samples * self.light_pdf,
+                strategies.bsdf_samples * self.direction_pdf,
+            )
+        };
+        self.value * self.transmittance * self.radiance * (weight / self.light_pdf)
+    }
+}
+
+/// A point on `light` seen from `reference` at `time`, drawing its two random numbers.
 #[inline]
-pub fn sample_light(
-    prepared: &PreparedIntegrator,
-    si: &SurfaceInteraction,
-    scattering: &Scattering,
+pub fn sample_point_on(
+    ctx: &mut SampleContext,
+    light: &Light,
+    reference: Vec3,
+    time: f32,
     lambda: &SampledWavelengths,
-    sampler: &mut Sampler,
-    count: &mut RayCount,
-    strategies: Strategies,
-    strict_normals: bool,
-) -> SampledSpectrum {
-    let world = prepared.world;
-    let u_light = sampler.next_1d();
-    let u_choice = sampler.next_1d();
-    let u = sampler.next_2d();
-    let Some((light_index, choice_pmf)) = prepared
-        .light_sampler
-        .sample(u_light, &Receiver::surface(si.p, si.shading.n))
-    else {
-        return SampledSpectrum::ZERO;
-    };
-    let light = &world.lights[light_index];
-    let Some(ls) = light.sample_incident(
-        &world.geometry.primitives,
-        si.p,
-        si.time,
+) -> Option<LightSample> {
+    let u_choice = ctx.sampler.next_1d();
+    let u = ctx.sampler.next_2d();
+    light.sample_incident(
+        &ctx.world().geometry.primitives,
+        reference,
+        time,
         u_choice,
         u,
         lambda,
-    ) else {
-        return SampledSpectrum::ZERO;
-    };
-    if strict_normals && !normals_agree(si, ls.wi) {
-        return SampledSpectrum::ZERO;
+    )
+}
+
+/// One light sample at `receiver` at `time`: a light chosen by the light sampler and a point on
+/// it. `reach` is the vertex's side of it: the vertex's value and density towards the sample
+/// (its BSDF's or phase function's) and the transmittance of the shadow ray (1 or 0 through
+/// vacuum, the media's through media), or None where no light arrives; it is asked only for a
+/// sample that exists.
+#[inline]
+pub fn sample_light(
+    ctx: &mut SampleContext,
+    receiver: &Receiver,
+    time: f32,
+    lambda: &SampledWavelengths,
+    reach: impl FnOnce(&mut SampleContext, &LightSample) -> Option<(BsdfEval, SampledSpectrum)>,
+) -> Option<LightSampleTerms> {
+    let u_light = ctx.sampler.next_1d();
+    let u_choice = ctx.sampler.next_1d();
+    let u = ctx.sampler.next_2d();
+    let world = ctx.world();
+    let (light, choice_pmf) = ctx.light_sampler().sample(u_light, receiver)?;
+    let ls = world.lights[light].sample_incident(
+        &world.geometry.primitives,
+        receiver.p,
+        time,
+        u_choice,
+        u,
+        lambda,
+    )?;
+    let (f, transmittance) = reach(ctx, &ls)?;
+    Some(LightSampleTerms {
+        value: f.value,
+        direction_pdf: f.pdf,
+        light_pdf: choice_pmf * ls.pdf,
+        is_delta: ls.is_delta,
+        transmittance,
+        radiance: ls.radiance,
+    })
+}
+
+/// The BSDF's value and density towards the light sample `light`, if it reaches the surface
+/// vertex `si` through vacuum: zero values are dropped before the shadow ray is traced.
+#[inline]
+pub fn unoccluded(
+    ctx: &mut SampleContext,
+    si: &SurfaceInteraction,
+    scattering: &Scattering,
+    light: &LightSample,
+) -> Option<BsdfEval> {
+    let f = scattering.eval(light.wi);
+    if f.value.is_black() || ctx.occluded(&si.spawn_ray_to(light.p, light.n)) {
+        return None;
     }
-    let Some(f) = unoccluded(world, si, scattering, &ls, count) else {
-        return SampledSpectrum::ZERO;
-    };
-    let light_pdf = choice_pmf * ls.pdf;
-    let weight = if ls.is_delta {
-        1.0
-    } else {
-        power_heuristic(
-            strategies.light_samples * light_pdf,
-            strategies.bsdf_samples * f.pdf,
-        )
-    };
-    f.value * ls.radiance * (weight / light_pdf)
+    Some(f)
+}
+
+/// One light sample at the surface vertex `si` through vacuum (the surface integrators). With
+/// `strict_normals` a light whose direction the geometric and shading normals put on different
+/// sides contributes nothing (Mitsuba 0.6's `strictNormals`).
+#[inline]
+pub fn sample_light_at_surface(
+    ctx: &mut SampleContext,
+    si: &SurfaceInteraction,
+    scattering: &Scattering,
+    lambda: &SampledWavelengths,
+    strict_normals: bool,
+) -> Option<LightSampleTerms> {
+    let receiver = Receiver::surface(si.p, si.shading.n);
+    sample_light(ctx, &receiver, si.time, lambda, |ctx, ls| {
+        if strict_normals && !normals_agree(si, ls.wi) {
+            return None;
+        }
+        unoccluded(ctx, si, scattering, ls).map(|f| (f, SampledSpectrum::ONE))
+    })
 }

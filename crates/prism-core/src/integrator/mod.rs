@@ -1,24 +1,34 @@
 //! Integrators: estimators of the radiance arriving along a camera ray: the path tracer, direct
 //! illumination, the lecture's distribution ray tracer with splitting and the volumetric path
-//! tracers; `moment` runs nested
-//! integrators and writes their estimates and second moments as extra film channels, `aov` the
-//! albedo, normals, depth and other variables of the first hit beside nested integrators'
-//! images.
+//! tracers; `moment` runs nested integrators and writes their estimates and second moments as
+//! extra film channels, `aov` the albedo, normals, depth and other variables of the first hit
+//! beside nested integrators' images.
 //!
 //! An [`Integrator`] is what a scene asks for: an estimator and its parameters. Before a render
 //! it is prepared for the world ([`Integrator::prepare`]), which builds the light sampler it
-//! chooses lights with, so the sampler always follows the integrator's own settings.
+//! chooses lights with, so the sampler always follows the integrator's own settings. Each
+//! camera sample is estimated in a [`SampleContext`] (the prepared integrator, the sample's
+//! random numbers, its ray count).
+//!
+//! The estimators share one vertex step: [`vertex`] (the scattering at a surface with the
+//! dispersion rule, the depth limit, Russian roulette, hero-only estimates), [`mis`] (light
+//! sampling with a hook for what shadow rays cross, and the emission a sampled direction finds,
+//! weighed against it) and, for media, [`transmittance`].
 
 pub mod aov;
+pub mod context;
 pub mod direct;
 pub mod distribution;
 pub mod mis;
 pub mod moment;
 pub mod path;
+pub mod transmittance;
+pub mod vertex;
 pub mod volpath;
 pub mod volpathmis;
 
 pub use aov::AovIntegrator;
+pub use context::{RayCount, SampleContext};
 pub use direct::DirectIntegrator;
 pub use distribution::DistributionIntegrator;
 pub use moment::MomentIntegrator;
@@ -28,9 +38,7 @@ pub use volpath::{Tracking, VolPathIntegrator};
 use volpath::SpectralTracking;
 use volpathmis::SpectralMis;
 
-use crate::bsdf::{BsdfEval, Scattering};
-use crate::geometry::SurfaceInteraction;
-use crate::light::{LightSample, LightSampler, LightSelection};
+use crate::light::{LightSampler, LightSelection};
 use crate::math::Ray;
 use crate::sampling::sampler::Sampler;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
@@ -81,12 +89,6 @@ impl From<DistributionIntegrator> for Integrator {
     fn from(integrator: DistributionIntegrator) -> Integrator {
         Integrator::Distribution(integrator)
     }
-}
-
-/// Rays traced while estimating one sample, for the statistics line.
-#[derive(Clone, Copy, Debug, Default)]
-pub struct RayCount {
-    pub rays: u64,
 }
 
 /// An integrator ready to estimate radiance in a world: its settings, the world, and the light
@@ -201,73 +203,23 @@ impl PreparedIntegrator<'_> {
         aovs: &mut [f32],
     ) -> SampledSpectrum {
         debug_assert_eq!(aovs.len(), self.aov_count);
+        let ctx = &mut SampleContext {
+            prepared: self,
+            sampler,
+            count,
+        };
         match self.integrator {
-            Integrator::Path(integrator) => integrator.radiance(self, ray, lambda, sampler, count),
-            Integrator::Direct(integrator) => {
-                integrator.radiance(self, ray, lambda, sampler, count)
-            }
-            Integrator::Distribution(integrator) => {
-                integrator.radiance(self, ray, lambda, sampler, count)
-            }
-            Integrator::Moment(_) => {
-                MomentIntegrator::radiance(self, ray, lambda, sampler, count, aovs)
-            }
-            Integrator::Aov(integrator) => {
-                integrator.radiance(self, ray, lambda, sampler, count, aovs)
-            }
+            Integrator::Path(integrator) => integrator.radiance(ctx, ray, lambda),
+            Integrator::Direct(integrator) => integrator.radiance(ctx, ray, lambda),
+            Integrator::Distribution(integrator) => integrator.radiance(ctx, ray, lambda),
+            Integrator::Moment(_) => MomentIntegrator::radiance(ctx, ray, lambda, aovs),
+            Integrator::Aov(integrator) => integrator.radiance(ctx, ray, lambda, aovs),
             Integrator::VolPath(integrator) => match integrator.tracking {
-                Tracking::Spectral => {
-                    integrator.trace(SpectralTracking::new(), self, ray, lambda, sampler, count)
+                Tracking::Spectral => integrator.trace(SpectralTracking::new(), ctx, ray, lambda),
+                Tracking::HeroMis { spectral_mis } => {
+                    integrator.trace(SpectralMis::new(spectral_mis), ctx, ray, lambda)
                 }
-                Tracking::HeroMis { spectral_mis } => integrator.trace(
-                    SpectralMis::new(spectral_mis),
-                    self,
-                    ray,
-                    lambda,
-                    sampler,
-                    count,
-                ),
             },
         }
     }
-}
-
-/// The BSDF's value and density towards a light sample, if the light reaches the vertex: zero
-/// values are dropped before the shadow ray is traced (and counted).
-#[inline]
-fn unoccluded(
-    world: &World,
-    si: &SurfaceInteraction,
-    scattering: &Scattering,
-    light: &LightSample,
-    count: &mut RayCount,
-) -> Option<BsdfEval> {
-    let f = scattering.eval(light.wi);
-    if f.value.is_black() {
-        return None;
-    }
-    count.rays += 1;
-    if world.geometry.occluded(&si.spawn_ray_to(light.p, light.n)) {
-        return None;
-    }
-    Some(f)
-}
-
-/// Whether the geometric and the shading normal at `si` put direction `d` on the same side of
-/// the surface (Mitsuba 0.6's `strictNormals` test, which stops light leaking through surfaces
-/// whose shading normals bend far from the geometry).
-#[inline]
-fn normals_agree(si: &SurfaceInteraction, d: glam::Vec3) -> bool {
-    si.n.dot(d) * si.shading.n.dot(d) > 0.0
-}
-
-/// A path's estimate for the caller's wavelengths once the path has kept only its hero
-/// wavelength: the hero carries the whole estimate with a quarter of its density
-/// (`terminate_secondary`); expressed for wavelengths whose `to_xyz` divides by the full
-/// density, that is N times its radiance.
-#[inline]
-fn hero_only(estimate: SampledSpectrum) -> SampledSpectrum {
-    let mut hero = SampledSpectrum::ZERO;
-    hero[0] = estimate[0] * crate::spectrum::N_SPECTRUM_SAMPLES as f32;
-    hero
 }

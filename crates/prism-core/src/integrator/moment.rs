@@ -15,9 +15,8 @@
 //! `m2_c` is Σvᵢ²/N, so the variance of one sample is m2 − c², and of the pixel's mean
 //! (m2 − c²)/(N − 1) (the sample variance; see `film::stats`).
 
-use crate::integrator::{Integrator, PreparedIntegrator, RayCount};
+use crate::integrator::{Integrator, SampleContext};
 use crate::math::Ray;
-use crate::sampling::sampler::Sampler;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 
 #[derive(Clone, Debug)]
@@ -42,20 +41,18 @@ impl MomentIntegrator {
 
     /// The first nested integrator's radiance; every nested integrator's moments go to `aovs`.
     pub(super) fn radiance(
-        prepared: &PreparedIntegrator,
+        ctx: &mut SampleContext,
         ray: Ray,
         lambda: &SampledWavelengths,
-        sampler: &mut Sampler,
-        count: &mut RayCount,
         aovs: &mut [f32],
     ) -> SampledSpectrum {
         let (first, second) = aovs.split_at_mut(aovs.len() / 2);
         let mut image = SampledSpectrum::ZERO;
         let mut offset = 0;
-        for (i, nested) in prepared.nested.iter().enumerate() {
+        for (i, nested) in ctx.prepared.nested.iter().enumerate() {
             let k = nested.aov_count();
             let own = &mut first[offset..offset + k + 3];
-            let radiance = nested.radiance(ray, lambda, sampler, count, &mut own[..k]);
+            let radiance = nested.radiance(ray, lambda, ctx.sampler, ctx.count, &mut own[..k]);
             own[k..].copy_from_slice(&lambda.to_xyz(&radiance));
             for (m2, v) in second[offset..offset + k + 3].iter_mut().zip(own.iter()) {
                 *m2 = v * v;

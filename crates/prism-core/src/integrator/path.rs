@@ -2,18 +2,12 @@
 //! one BSDF sample per bounce, so the estimate is the product (w₁/p₁)(w₂/p₂)…L_e, with direct
 //! light sampling at every vertex ("Direct Light Sampling") and Russian roulette.
 //!
-//! ```xml
-//! <integrator type="path">
-//!     <integer name="max_depth" value="-1"/>     <!-- -1: unbounded; 1: emitters only; 2: direct -->
-//!     <integer name="rr_depth" value="5"/>       <!-- depth at which Russian roulette starts -->
-//!     <boolean name="hide_emitters" value="false"/>
-//!     <string name="emitter_sampling" value="power"/>   <!-- or "uniform" (Prism only) -->
-//!     <boolean name="strict_normals" value="false"/>    <!-- Mitsuba 0.6's strictNormals -->
-//! </integrator>
-//! ```
+//! Its parameters (`max_depth`, `rr_depth`, `hide_emitters`, `emitter_sampling`,
+//! `strict_normals`) and their defaults are listed in docs/plugins.md.
 //!
-//! * Light sampling picks one light with probability ∝ its power (or uniformly, see
-//!   [`crate::light::sampler`]) and divides by that probability (DESIGN.md §4). Light samples
+//! * Light sampling picks one light with the integrator's light sampler
+//!   ([`crate::light::sampler`]: by default by its importance at the vertex, or ∝ its power as
+//!   the lecture does, or uniformly) and divides by that probability. Light samples
 //!   and BSDF samples that hit an emitter or leave the scene towards the environment are
 //!   combined by multiple importance sampling with the power heuristic (Veach 1997, §9.2), so
 //!   no light is counted twice; delta lights (point, spot, directional) are reached only by
@@ -35,11 +29,13 @@
 //!   normals bend across the geometry, at the price of some energy.
 
 use crate::bsdf::BxdfTree;
-use crate::integrator::mis::{BsdfSampleOrigin, Strategies, emission_found, sample_light};
-use crate::integrator::{PreparedIntegrator, RayCount, hero_only, normals_agree};
-use crate::light::LightSelection;
+use crate::integrator::SampleContext;
+use crate::integrator::mis::{ScatterOrigin, Strategies, emission_found, sample_light_at_surface};
+use crate::integrator::vertex::{
+    allows_next_vertex, normals_agree, path_estimate, russian_roulette, surface_scattering,
+};
+use crate::light::{LightSelection, Receiver};
 use crate::math::Ray;
-use crate::sampling::sampler::Sampler;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 
 #[derive(Clone, Debug)]
@@ -69,27 +65,20 @@ impl Default for PathIntegrator {
 }
 
 impl PathIntegrator {
-    fn depth_allows_next_vertex(&self, depth: i32) -> bool {
-        self.max_depth < 0 || depth + 1 < self.max_depth
-    }
-
     pub(super) fn radiance(
         &self,
-        prepared: &PreparedIntegrator,
+        ctx: &mut SampleContext,
         mut ray: Ray,
         wavelengths: &SampledWavelengths,
-        sampler: &mut Sampler,
-        count: &mut RayCount,
     ) -> SampledSpectrum {
-        let world = prepared.world;
+        let world = ctx.world();
         // The path's own copy: a dispersive interface may drop the companion wavelengths.
         let mut lambda = *wavelengths;
-        let lambda_was_whole = !wavelengths.secondary_terminated();
         let mut result = SampledSpectrum::ZERO;
         let mut throughput = SampledSpectrum::ONE;
         // Product of the relative indices of refraction crossed (Mitsuba's η).
         let mut eta_scale = 1.0f32;
-        let mut previous: Option<BsdfSampleOrigin> = None;
+        let mut previous: Option<ScatterOrigin> = None;
         let mut depth = 0i32;
         // The lobes of the vertex at hand, rewritten at every bounce.
         let mut lobes = BxdfTree::empty();
@@ -97,14 +86,13 @@ impl PathIntegrator {
             return result;
         }
         loop {
-            count.rays += 1;
-            let hit = world.geometry.intersect(&ray);
+            let hit = ctx.intersect(&ray);
             // Emission found by the previous BSDF sample (or by the camera ray), weighted
             // against the light sample that could have found it.
             if !(self.hide_emitters && depth == 0) {
                 result += throughput
                     * emission_found(
-                        prepared,
+                        ctx,
                         &ray,
                         hit.as_ref(),
                         previous.as_ref(),
@@ -116,42 +104,24 @@ impl PathIntegrator {
                 break;
             };
             let wo_world = -ray.d.normalize();
-            let info = world.shape_info[si.shape as usize];
 
-            if !self.depth_allows_next_vertex(depth)
+            if !allows_next_vertex(self.max_depth, depth)
                 || (self.strict_normals && !normals_agree(&si, wo_world))
             {
                 break;
             }
 
-            // The BSDF of the side the path arrives on, with its textures evaluated here.
-            let scattering = world.materials[info.material as usize]
-                .scattering(&si, wo_world, &lambda, &mut lobes);
-            let smooth = scattering.flags().has_smooth_lobe();
-            // A dispersive BSDF that can be evaluated uses the hero wavelength's index for all
-            // its lobes (roughdielectric), so only the hero may see it.
-            if smooth && scattering.is_dispersive() {
-                lambda.terminate_secondary();
-            }
-
-            // Direct light sampling.
-            if smooth {
-                result += throughput
-                    * sample_light(
-                        prepared,
-                        &si,
-                        &scattering,
-                        &lambda,
-                        sampler,
-                        count,
-                        Strategies::ONE_EACH,
-                        self.strict_normals,
-                    );
+            let scattering = surface_scattering(world, &si, wo_world, &mut lambda, &mut lobes);
+            if scattering.flags().has_smooth_lobe()
+                && let Some(light) =
+                    sample_light_at_surface(ctx, &si, &scattering, &lambda, self.strict_normals)
+            {
+                result += throughput * light.weighted(Strategies::ONE_EACH);
             }
 
             // BSDF sampling for the next direction.
-            let u_lobe = sampler.next_1d();
-            let u = sampler.next_2d();
+            let u_lobe = ctx.sampler.next_1d();
+            let u = ctx.sampler.next_2d();
             let Some(bs) = scattering.sample(u_lobe, u) else {
                 break;
             };
@@ -167,26 +137,21 @@ impl PathIntegrator {
                 break;
             }
             ray = si.spawn_ray(bs.wi);
-            previous = Some(BsdfSampleOrigin {
-                p: si.p,
-                n: si.shading.n,
+            previous = Some(ScatterOrigin {
+                receiver: Receiver::surface(si.p, si.shading.n),
                 pdf: bs.pdf,
                 specular: bs.flags.is_delta(),
             });
             depth += 1;
 
-            // Russian roulette on the path's potential.
+            // Russian roulette on the path's potential, from depth `rr_depth` on.
             if depth >= self.rr_depth {
-                let survival = (throughput.max_value() * eta_scale * eta_scale).min(0.95);
-                if !(sampler.next_1d() < survival) {
+                let Some(factor) = russian_roulette(ctx, throughput, eta_scale) else {
                     break;
-                }
-                throughput *= 1.0 / survival;
+                };
+                throughput *= factor;
             }
         }
-        if lambda_was_whole && lambda.secondary_terminated() {
-            return hero_only(result);
-        }
-        result
+        path_estimate(result, wavelengths, &lambda)
     }
 }

@@ -1,13 +1,7 @@
 //! The volumetric path tracer (Mitsuba 3's `volpath`): the path tracer of [`super::path`] with
 //! participating media between the surfaces.
 //!
-//! ```xml
-//! <integrator type="volpath">
-//!     <integer name="max_depth" value="-1"/>
-//!     <integer name="rr_depth" value="5"/>
-//!     <boolean name="hide_emitters" value="false"/>
-//! </integrator>
-//! ```
+//! Its parameters and their defaults are listed in docs/plugins.md.
 //!
 //! Each segment of a path that runs through a medium is tracked with one majorant for the
 //! path's four wavelengths ([`crate::medium`], spectral tracking): null collisions fly on, a
@@ -37,18 +31,18 @@
 
 use glam::Vec3;
 
-use crate::bsdf::{BxdfTree, Scattering};
-use crate::geometry::interaction::SHADOW_EPSILON;
-use crate::geometry::offset::offset_ray_origin;
-use crate::geometry::{SurfaceInteraction, SurfaceSample};
-use crate::integrator::mis::power_heuristic;
-use crate::integrator::{PreparedIntegrator, RayCount, hero_only};
-use crate::light::{Light, LightSample, LightSelection, Receiver};
+use crate::bsdf::{BsdfEval, BxdfTree};
+use crate::integrator::SampleContext;
+use crate::integrator::mis::{LightSampleTerms, emission_along, power_heuristic, sample_light};
+use crate::integrator::transmittance::{medium_after, shadow_end, shadow_transmittance};
+use crate::integrator::vertex::{
+    allows_next_vertex, hero_only, russian_roulette, surface_scattering,
+};
+use crate::light::{LightSelection, Receiver};
 use crate::math::Ray;
-use crate::medium::{Collision, Medium, PhaseFunction, choose_collision, sample_free_flight};
+use crate::medium::{Collision, Medium, choose_collision, sample_free_flight};
 use crate::sampling::sampler::Sampler;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
-use crate::world::World;
 
 #[derive(Clone, Debug)]
 pub struct VolPathIntegrator {
@@ -129,18 +123,6 @@ pub(super) trait PathWeights {
     /// The path's estimate for the caller's wavelengths; `lambda_was_whole` when the path
     /// started with all four.
     fn estimate(&self, lambda: &SampledWavelengths, lambda_was_whole: bool) -> SampledSpectrum;
-}
-
-/// The factors of one light sample at a vertex: the BSDF's or phase function's value towards
-/// the light, the solid-angle densities of sampling that direction by the vertex and by the
-/// light (the light's choice included), the transmittance of the shadow ray and the radiance.
-pub(super) struct LightSampleTerms {
-    pub value: SampledSpectrum,
-    pub direction_pdf: f32,
-    pub light_pdf: f32,
-    pub is_delta: bool,
-    pub transmittance: SampledSpectrum,
-    pub radiance: SampledSpectrum,
 }
 
 /// `volpath`'s weights: the throughput of spectral tracking and the density of the last
@@ -238,22 +220,6 @@ impl PathWeights for SpectralTracking {
     }
 }
 
-/// The medium a ray leaving `si` in direction `d` travels in, when it was in `current`.
-#[inline]
-pub(super) fn medium_after(
-    world: &World,
-    si: &SurfaceInteraction,
-    d: Vec3,
-    current: Option<u32>,
-) -> Option<u32> {
-    let interface = world.medium_interface(si.shape);
-    if interface.is_transition() {
-        interface.target(si.n, d)
-    } else {
-        current
-    }
-}
-
 /// The throughput of the wavelengths that still count: the hero alone once the companions
 /// have been dropped at a dispersive interface.
 #[inline]
@@ -305,84 +271,16 @@ fn spectral_tracking(
     }
 }
 
-/// The transmittance from `origin` to `end` for a path in `medium` at `origin`: the product of
-/// the transmittances of the media crossed, through index-matched (`null`) boundaries; zero
-/// when another surface is in the way.
-#[allow(clippy::too_many_arguments)] // the segment, its medium and the path's state
-fn shadow_transmittance(
-    world: &World,
-    origin: Vec3,
-    end: Vec3,
-    time: f32,
-    mut medium: Option<u32>,
-    lambda: &SampledWavelengths,
-    sampler: &mut Sampler,
-    count: &mut RayCount,
-) -> SampledSpectrum {
-    let d = (end - origin).normalize();
-    let mut o = origin;
-    let mut transmittance = SampledSpectrum::ONE;
-    loop {
-        let remaining = (end - o).dot(d);
-        if !(remaining > 0.0) {
-            return transmittance;
-        }
-        count.rays += 1;
-        let segment = Ray::new(o, d, remaining, time);
-        let hit = world.geometry.intersect(&segment);
-        if let Some(m) = medium {
-            let t = hit.map_or(remaining, |si| si.t);
-            transmittance *=
-                world.media[m as usize].transmittance(&segment, t, lambda, || sampler.next_1d());
-            if transmittance.is_black() {
-                return transmittance;
-            }
-        }
-        let Some(si) = hit else {
-            return transmittance;
-        };
-        let info = world.shape_info[si.shape as usize];
-        if !world.materials[info.material as usize].is_null() {
-            return SampledSpectrum::ZERO;
-        }
-        medium = medium_after(world, &si, d, medium);
-        o = si.spawn_ray(d).o;
-    }
-}
-
-/// Where a shadow ray towards light sample `ls` ends: just off the light's surface, short of
-/// it by the shadow epsilon.
-#[inline]
-fn shadow_end(origin: Vec3, ls: &LightSample) -> Vec3 {
-    let target = if ls.n == Vec3::ZERO {
-        ls.p
-    } else {
-        let m = if (ls.p - origin).dot(ls.n) <= 0.0 {
-            ls.n
-        } else {
-            -ls.n
-        };
-        offset_ray_origin(ls.p, m)
-    };
-    origin + (target - origin) * (1.0 - SHADOW_EPSILON)
-}
-
 impl VolPathIntegrator {
-    fn depth_allows_next_vertex(&self, depth: i32) -> bool {
-        self.max_depth < 0 || depth + 1 < self.max_depth
-    }
-
     /// The path loop of both volumetric path tracers, keeping the path's weights in `weights`.
     pub(super) fn trace<W: PathWeights>(
         &self,
         mut weights: W,
-        prepared: &PreparedIntegrator,
+        ctx: &mut SampleContext,
         camera_ray: Ray,
         wavelengths: &SampledWavelengths,
-        sampler: &mut Sampler,
-        count: &mut RayCount,
     ) -> SampledSpectrum {
-        let world = prepared.world;
+        let world = ctx.world();
         let mut lambda = *wavelengths;
         let lambda_was_whole = !wavelengths.secondary_terminated();
         let mut eta_scale = 1.0f32;
@@ -399,31 +297,29 @@ impl VolPathIntegrator {
             return SampledSpectrum::ZERO;
         }
         loop {
-            count.rays += 1;
-            let hit = world.geometry.intersect(&ray);
+            let hit = ctx.intersect(&ray);
 
             // The medium between here and the surface: a real collision scatters.
             if let Some(m) = medium {
                 let med = &world.media[m as usize];
                 let t_surface = hit.map_or(f32::INFINITY, |si| si.t);
-                let collision = weights.free_flight(med, &ray, t_surface, &lambda, sampler);
+                let collision = weights.free_flight(med, &ray, t_surface, &lambda, ctx.sampler);
                 if weights.throughput().is_black() {
                     break;
                 }
                 if let Some(t) = collision {
-                    if !self.depth_allows_next_vertex(depth) {
+                    if !allows_next_vertex(self.max_depth, depth) {
                         break;
                     }
                     let p = ray.at(t);
                     let wo = -ray.d;
                     if med.sample_emitters
-                        && let Some(terms) = Self::sample_direct_medium(
-                            prepared, p, wo, ray.time, &med.phase, medium, &lambda, sampler, count,
-                        )
+                        && let Some(terms) =
+                            Self::light_sample_in_medium(ctx, p, wo, ray.time, med, medium, &lambda)
                     {
                         weights.add_light_sample(&terms);
                     }
-                    let ps = med.phase.sample(wo, sampler.next_2d());
+                    let ps = med.phase.sample(wo, ctx.sampler.next_2d());
                     if !(ps.pdf > 0.0) {
                         break;
                     }
@@ -431,90 +327,62 @@ impl VolPathIntegrator {
                     weights.scatter(SampledSpectrum::ONE, ps.pdf, !med.sample_emitters);
                     previous = Receiver::point(p);
                     depth += 1;
-                    if !self.survives_roulette(depth, &mut weights, eta_scale, sampler) {
+                    if !self.survives_roulette(ctx, depth, &mut weights, eta_scale) {
                         break;
                     }
                     continue;
                 }
             }
 
+            // Emission found by the previous directional sample (or by the camera ray).
+            if !(self.hide_emitters && depth == 0)
+                && let Some(found) = emission_along(world, ray.d, hit.as_ref(), &lambda)
+                && !found.radiance.is_black()
+            {
+                let light_pdf = if weights.weights_emission() {
+                    found.light_pdf(ctx, &previous)
+                } else {
+                    0.0
+                };
+                weights.add_emission(found.radiance, light_pdf);
+            }
             let Some(si) = hit else {
-                if let Some(env) = world.environment
-                    && !(self.hide_emitters && depth == 0)
-                {
-                    let light = &world.lights[env as usize];
-                    let emitted = light.environment_radiance(ray.d, &lambda);
-                    if !emitted.is_black() {
-                        let light_pdf = if weights.weights_emission() {
-                            prepared.light_sampler.pmf(env as usize, &previous)
-                                * light.environment_pdf(ray.d)
-                        } else {
-                            0.0
-                        };
-                        weights.add_emission(emitted, light_pdf);
-                    }
-                }
                 break;
             };
             let wo = -ray.d;
-            let info = world.shape_info[si.shape as usize];
 
-            // Emission found by the previous directional sample (or by the camera ray).
-            if let Some(light_index) = info.light
-                && !(self.hide_emitters && depth == 0)
-            {
-                let Light::Area(light) = &world.lights[light_index as usize] else {
-                    unreachable!("only area lights are attached to shapes");
-                };
-                let emitted = light.emitted(si.uv, si.shading.n, wo, &lambda);
-                if !emitted.is_black() {
-                    let light_pdf = if weights.weights_emission() {
-                        prepared.light_sampler.pmf(light_index as usize, &previous)
-                            * light.pdf_from(
-                                &world.geometry.primitives,
-                                previous.p,
-                                si.time,
-                                &SurfaceSample::at(&si),
-                            )
-                    } else {
-                        0.0
-                    };
-                    weights.add_emission(emitted, light_pdf);
-                }
-            }
-
-            let material = &world.materials[info.material as usize];
             // An index-matched boundary: cross it without a bounce.
-            if material.is_null() {
+            if world.material(&si).is_null() {
                 medium = medium_after(world, &si, ray.d, medium);
                 ray = si.spawn_ray(ray.d);
                 continue;
             }
-            if !self.depth_allows_next_vertex(depth) {
+            if !allows_next_vertex(self.max_depth, depth) {
                 break;
             }
 
-            let scattering = material.scattering(&si, wo, &lambda, &mut lobes);
-            let smooth = scattering.flags().has_smooth_lobe();
-            if smooth && scattering.is_dispersive() {
-                lambda.terminate_secondary();
-            }
-            if smooth
-                && let Some(terms) = Self::sample_direct_surface(
-                    prepared,
-                    &si,
-                    &scattering,
-                    medium,
-                    &lambda,
-                    sampler,
-                    count,
-                )
-            {
-                weights.add_light_sample(&terms);
+            let scattering = surface_scattering(world, &si, wo, &mut lambda, &mut lobes);
+            if scattering.flags().has_smooth_lobe() {
+                let receiver = Receiver::surface(si.p, si.shading.n);
+                let terms = sample_light(ctx, &receiver, si.time, &lambda, |ctx, ls| {
+                    let f = scattering.eval(ls.wi);
+                    if f.value.is_black() {
+                        return None;
+                    }
+                    let shadow = si.spawn_ray_to(ls.p, ls.n);
+                    let end = shadow.o + shadow.d * shadow.t_max;
+                    let shadow_medium = medium_after(world, &si, ls.wi, medium);
+                    let tr =
+                        shadow_transmittance(ctx, shadow.o, end, si.time, shadow_medium, &lambda);
+                    (!tr.is_black()).then_some((f, tr))
+                });
+                if let Some(terms) = terms {
+                    weights.add_light_sample(&terms);
+                }
             }
 
-            let u_lobe = sampler.next_1d();
-            let u = sampler.next_2d();
+            let u_lobe = ctx.sampler.next_1d();
+            let u = ctx.sampler.next_2d();
             let Some(bs) = scattering.sample(u_lobe, u) else {
                 break;
             };
@@ -531,150 +399,56 @@ impl VolPathIntegrator {
             ray = si.spawn_ray(wi);
             previous = Receiver::surface(si.p, si.shading.n);
             depth += 1;
-            if !self.survives_roulette(depth, &mut weights, eta_scale, sampler) {
+            if !self.survives_roulette(ctx, depth, &mut weights, eta_scale) {
                 break;
             }
         }
         weights.estimate(&lambda, lambda_was_whole)
     }
 
-    /// Russian roulette after `rr_depth` bounces: survival s = min(max throughput · η², 0.95),
-    /// the survivor's weight divided by s.
+    /// Russian roulette ([`russian_roulette`]) after `rr_depth` bounces (depth > rr_depth, as
+    /// Mitsuba's volpath counts them).
     #[inline]
     fn survives_roulette(
         &self,
+        ctx: &mut SampleContext,
         depth: i32,
         weights: &mut impl PathWeights,
         eta_scale: f32,
-        sampler: &mut Sampler,
     ) -> bool {
         if depth <= self.rr_depth {
             return true;
         }
-        let survival = (weights.throughput().max_value() * eta_scale * eta_scale).min(0.95);
-        if !(sampler.next_1d() < survival) {
+        let Some(factor) = russian_roulette(ctx, weights.throughput(), eta_scale) else {
             return false;
-        }
-        weights.scale(1.0 / survival);
+        };
+        weights.scale(factor);
         true
     }
 
-    /// A light chosen by the light sampler and a point on it, seen from `receiver`, with the
-    /// probability of having chosen that light.
-    #[inline]
-    fn sample_light(
-        prepared: &PreparedIntegrator,
-        receiver: &Receiver,
-        time: f32,
-        lambda: &SampledWavelengths,
-        sampler: &mut Sampler,
-    ) -> Option<(LightSample, f32)> {
-        let world = prepared.world;
-        let u_light = sampler.next_1d();
-        let u_choice = sampler.next_1d();
-        let u = sampler.next_2d();
-        let (light_index, choice_pmf) = prepared.light_sampler.sample(u_light, receiver)?;
-        let ls = world.lights[light_index].sample_incident(
-            &world.geometry.primitives,
-            receiver.p,
-            time,
-            u_choice,
-            u,
-            lambda,
-        )?;
-        Some((ls, choice_pmf))
-    }
-
-    /// One light sample at the surface point `si`, with the transmittance Tr of the media the
-    /// shadow ray crosses; `None` when it contributes nothing.
-    fn sample_direct_surface(
-        prepared: &PreparedIntegrator,
-        si: &SurfaceInteraction,
-        scattering: &Scattering,
-        medium: Option<u32>,
-        lambda: &SampledWavelengths,
-        sampler: &mut Sampler,
-        count: &mut RayCount,
-    ) -> Option<LightSampleTerms> {
-        let world = prepared.world;
-        let (ls, choice_pmf) = Self::sample_light(
-            prepared,
-            &Receiver::surface(si.p, si.shading.n),
-            si.time,
-            lambda,
-            sampler,
-        )?;
-        let f = scattering.eval(ls.wi);
-        if f.value.is_black() {
-            return None;
-        }
-        let shadow = si.spawn_ray_to(ls.p, ls.n);
-        let end = shadow.o + shadow.d * shadow.t_max;
-        let transmittance = shadow_transmittance(
-            world,
-            shadow.o,
-            end,
-            si.time,
-            medium_after(world, si, ls.wi, medium),
-            lambda,
-            sampler,
-            count,
-        );
-        if transmittance.is_black() {
-            return None;
-        }
-        Some(LightSampleTerms {
-            value: f.value,
-            direction_pdf: f.pdf,
-            light_pdf: choice_pmf * ls.pdf,
-            is_delta: ls.is_delta,
-            transmittance,
-            radiance: ls.radiance,
-        })
-    }
-
-    /// One light sample at the point `p` of `medium`, scattered towards `wo` by `phase` (the
-    /// path's weight already carries σ_s of the real collision); `None` when it contributes
-    /// nothing.
-    #[allow(clippy::too_many_arguments)] // the vertex, its medium and the path's state
-    fn sample_direct_medium(
-        prepared: &PreparedIntegrator,
+    /// One light sample at the point `p` of `med` (index `medium`), scattered towards `wo` by
+    /// its phase function (the path's weight already carries σ_s of the real collision), with
+    /// the transmittance of the media the shadow ray crosses.
+    fn light_sample_in_medium(
+        ctx: &mut SampleContext,
         p: Vec3,
         wo: Vec3,
         time: f32,
-        phase: &PhaseFunction,
+        med: &Medium,
         medium: Option<u32>,
         lambda: &SampledWavelengths,
-        sampler: &mut Sampler,
-        count: &mut RayCount,
     ) -> Option<LightSampleTerms> {
-        let world = prepared.world;
-        let (ls, choice_pmf) =
-            Self::sample_light(prepared, &Receiver::point(p), time, lambda, sampler)?;
-        let phase_value = phase.eval(wo, ls.wi);
-        if !(phase_value > 0.0) {
-            return None;
-        }
-        let transmittance = shadow_transmittance(
-            world,
-            p,
-            shadow_end(p, &ls),
-            time,
-            medium,
-            lambda,
-            sampler,
-            count,
-        );
-        if transmittance.is_black() {
-            return None;
-        }
-        Some(LightSampleTerms {
-            value: SampledSpectrum::splat(phase_value),
-            direction_pdf: phase_value,
-            light_pdf: choice_pmf * ls.pdf,
-            is_delta: ls.is_delta,
-            transmittance,
-            radiance: ls.radiance,
+        sample_light(ctx, &Receiver::point(p), time, lambda, |ctx, ls| {
+            let phase_value = med.phase.eval(wo, ls.wi);
+            if !(phase_value > 0.0) {
+                return None;
+            }
+            let tr = shadow_transmittance(ctx, p, shadow_end(p, ls), time, medium, lambda);
+            let f = BsdfEval {
+                value: SampledSpectrum::splat(phase_value),
+                pdf: phase_value,
+            };
+            (!tr.is_black()).then_some((f, tr))
         })
     }
 }

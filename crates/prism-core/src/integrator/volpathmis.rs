@@ -3,13 +3,7 @@
 //! four wavelengths by multiple importance sampling (Miller, Georgiev and Jarosz 2019, "A
 //! Null-Scattering Path Integral Formulation of Light Transport", §5–6).
 //!
-//! ```xml
-//! <integrator type="volpathmis">
-//!     <integer name="max_depth" value="-1"/>
-//!     <integer name="rr_depth" value="5"/>
-//!     <boolean name="hide_emitters" value="false"/>
-//! </integrator>
-//! ```
+//! Its parameters and their defaults are listed in docs/plugins.md.
 //!
 //! # Free flights of the hero wavelength
 //! Each wavelength λⱼ has its own majorant mⱼ ([`Medium::majorants`]: σ_t(λⱼ) itself in a
@@ -60,8 +54,9 @@
 //! also uses the hero's densities for its whole estimate, since the four techniques no longer
 //! share one path.
 
-use crate::integrator::hero_only;
-use crate::integrator::volpath::{LightSampleTerms, PathWeights};
+use crate::integrator::mis::LightSampleTerms;
+use crate::integrator::vertex::hero_only;
+use crate::integrator::volpath::PathWeights;
 use crate::math::Ray;
 use crate::medium::{Medium, sample_free_flight};
 use crate::sampling::sampler::Sampler;

@@ -1,0 +1,92 @@
+//! What a ray crosses between two points of a scene with participating media: the media it
+//! travels in (they change where it crosses a shape that bounds one), and the transmittance of
+//! a shadow ray through them and through index-matched boundaries, the hook that the volumetric
+//! path tracers give to light sampling ([`super::mis::sample_light`]).
+
+use glam::Vec3;
+
+use crate::geometry::SurfaceInteraction;
+use crate::geometry::interaction::SHADOW_EPSILON;
+use crate::geometry::offset::offset_ray_origin;
+use crate::integrator::SampleContext;
+use crate::light::LightSample;
+use crate::math::Ray;
+use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+use crate::world::World;
+
+/// The medium a ray leaving `si` in direction `d` travels in, when it was in `current`: the
+/// medium on the side it leaves to where the shape names an `interior` or `exterior` medium,
+/// `current` where it names none.
+#[inline]
+pub fn medium_after(
+    world: &World,
+    si: &SurfaceInteraction,
+    d: Vec3,
+    current: Option<u32>,
+) -> Option<u32> {
+    let interface = world.medium_interface(si.shape);
+    if interface.is_transition() {
+        interface.target(si.n, d)
+    } else {
+        current
+    }
+}
+
+/// The transmittance from `origin` to `end` at `time` for a ray starting in `medium`: the
+/// product of the transmittances of the media crossed (closed form in homogeneous media, ratio
+/// tracking in heterogeneous ones), through index-matched (`null`) boundaries; zero when
+/// another surface is in the way.
+pub fn shadow_transmittance(
+    ctx: &mut SampleContext,
+    origin: Vec3,
+    end: Vec3,
+    time: f32,
+    mut medium: Option<u32>,
+    lambda: &SampledWavelengths,
+) -> SampledSpectrum {
+    let world = ctx.world();
+    let d = (end - origin).normalize();
+    let mut o = origin;
+    let mut transmittance = SampledSpectrum::ONE;
+    loop {
+        let remaining = (end - o).dot(d);
+        if !(remaining > 0.0) {
+            return transmittance;
+        }
+        let segment = Ray::new(o, d, remaining, time);
+        let hit = ctx.intersect(&segment);
+        if let Some(m) = medium {
+            let t = hit.map_or(remaining, |si| si.t);
+            transmittance *= world.media[m as usize]
+                .transmittance(&segment, t, lambda, || ctx.sampler.next_1d());
+            if transmittance.is_black() {
+                return transmittance;
+            }
+        }
+        let Some(si) = hit else {
+            return transmittance;
+        };
+        if !world.material(&si).is_null() {
+            return SampledSpectrum::ZERO;
+        }
+        medium = medium_after(world, &si, d, medium);
+        o = si.spawn_ray(d).o;
+    }
+}
+
+/// Where a shadow ray from `origin` (a point in a medium) towards the light sample `ls` ends:
+/// just off the light's surface, short of it by the shadow epsilon.
+#[inline]
+pub fn shadow_end(origin: Vec3, ls: &LightSample) -> Vec3 {
+    let target = if ls.n == Vec3::ZERO {
+        ls.p
+    } else {
+        let m = if (ls.p - origin).dot(ls.n) <= 0.0 {
+            ls.n
+        } else {
+            -ls.n
+        };
+        offset_ray_origin(ls.p, m)
+    };
+    origin + (target - origin) * (1.0 - SHADOW_EPSILON)
+}
