@@ -23,7 +23,7 @@ use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use glam::{Vec2, Vec3};
 use prism_core::geometry::{Primitive, Shape};
 use prism_core::image::{ChannelImage, write_exr};
-use prism_core::light::{Light, Receiver};
+use prism_core::light::{Light, LightSource, Receiver};
 use prism_core::sampling::rng::Pcg32;
 use prism_core::scene::Scene;
 use prism_core::spectrum::{SampledWavelengths, WavelengthSampling};

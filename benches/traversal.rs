@@ -26,7 +26,7 @@ use std::time::Duration;
 use criterion::{BatchSize, Criterion, SamplingMode, Throughput, criterion_group, criterion_main};
 use glam::{UVec2, Vec2};
 use prism_core::geometry::Geometry;
-use prism_core::light::Receiver;
+use prism_core::light::{LightSource, Receiver};
 use prism_core::math::{Frame, Ray};
 use prism_core::sampling::rng::Pcg32;
 use prism_core::sampling::warp::sample_cosine_hemisphere;

@@ -16,8 +16,8 @@ use prism_core::geometry::{Shape, ShapeSampling};
 use prism_core::image::{Bitmap, Encoding};
 use prism_core::integrator::PathIntegrator;
 use prism_core::light::{
-    AreaLight, ConstantLight, DirectionalLight, EnvironmentMap, Light, LightSelection, PointLight,
-    Receiver, SpotLight,
+    AreaLight, ConstantLight, DirectionalLight, EnvironmentMap, Light, LightSelection, LightSource,
+    PointLight, Receiver, SpotLight,
 };
 use prism_core::math::{Frame, Transform};
 use prism_core::sampling::rng::Pcg32;
@@ -546,7 +546,14 @@ fn spot_light_points_along_its_transformed_axis() {
     let lambda = SampledWavelengths::single(550.0);
     // +z rotated by 90° about x is −y: a point 1 below the light is on the axis.
     let below = spot
-        .sample_incident(Vec3::new(0.0, -1.0, 0.0), &lambda)
+        .sample_incident(
+            &[],
+            Vec3::new(0.0, -1.0, 0.0),
+            0.0,
+            0.5,
+            Vec2::ZERO,
+            &lambda,
+        )
         .unwrap();
     assert_eq!(below.radiance[0], 1.0);
     // 15° off the axis: halfway down the ramp.
@@ -555,14 +562,16 @@ fn spot_light_points_along_its_transformed_axis() {
         0.0,
         15f32.to_radians().cos(),
     ));
-    let half = spot.sample_incident(off * 2.0, &lambda).unwrap();
+    let half = spot
+        .sample_incident(&[], off * 2.0, 0.0, 0.5, Vec2::ZERO, &lambda)
+        .unwrap();
     assert!(
         (half.radiance[0] * 4.0 - 0.5).abs() < 1e-4,
         "{}",
         half.radiance[0]
     );
     assert!(
-        spot.sample_incident(Vec3::new(0.0, 1.0, 0.0), &lambda)
+        spot.sample_incident(&[], Vec3::new(0.0, 1.0, 0.0), 0.0, 0.5, Vec2::ZERO, &lambda)
             .is_none()
     );
 }

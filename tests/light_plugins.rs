@@ -7,7 +7,7 @@ use std::path::Path;
 
 use glam::{Vec2, Vec3};
 use prism_core::bsdf::Bsdf;
-use prism_core::light::{Light, LightSampler, Receiver};
+use prism_core::light::{Light, LightSampler, LightSource, Receiver};
 use prism_core::scene::Scene;
 use prism_core::spectrum::SampledWavelengths;
 use prism_core::spectrum::cie::d65_normalized;

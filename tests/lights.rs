@@ -24,7 +24,7 @@ use prism_core::integrator::{
 };
 use prism_core::light::{
     AreaLight, BoundingSphere, ConstantLight, DirectionalLight, EnvironmentMap, Light,
-    LightSelection, PointLight, SpotLight,
+    LightSelection, LightSource, PointLight, SpotLight,
 };
 use prism_core::math::{Ray, Transform};
 use prism_core::sampling::rng::Pcg32;

@@ -7,7 +7,7 @@ use std::sync::Arc;
 
 use glam::{DMat4, DVec3, Vec2, Vec3};
 use prism_core::image::{Bitmap, Encoding};
-use prism_core::light::{Light, Projector, SpotLight};
+use prism_core::light::{Light, LightSource, Projector, SpotLight};
 use prism_core::math::Transform;
 use prism_core::spectrum::{SampledWavelengths, Spectrum};
 use prism_core::texture::{BitmapTexture, FilterType, Texture, TextureUse, UvTransform, WrapMode};
@@ -122,15 +122,16 @@ fn projector_power_is_its_flux() {
         .map(|cell| {
             let x = -t + width * ((cell % nx) as f32 + 0.5) / nx as f32;
             let y = -t / aspect + height * ((cell / nx) as f32 + 0.5) / ny as f32;
-            let ls = projector.sample_incident(Vec3::new(x, y, 1.0), &lambda);
+            let ls =
+                projector.sample_incident(&[], Vec3::new(x, y, 1.0), 0.0, 0.5, Vec2::ZERO, &lambda);
             ls.map_or(0.0, |ls| f64::from(ls.radiance[0] * ls.wi.z.abs()))
         })
         .sum::<f64>()
         * cell_area;
     assert!(
-        (f64::from(projector.power()) / flux - 1.0).abs() < 1e-3,
+        (f64::from(projector.power(&[])) / flux - 1.0).abs() < 1e-3,
         "power {} against the flux {flux}",
-        projector.power()
+        projector.power(&[])
     );
 }
 

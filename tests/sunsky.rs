@@ -23,7 +23,7 @@ use std::path::Path;
 
 use common::chi2::{assert_passes, chi2_from_counts, chi2_rectangle};
 use glam::{DVec3, Vec2, Vec3};
-use prism_core::light::{BoundingSphere, Light};
+use prism_core::light::{BoundingSphere, Light, LightSource};
 use prism_core::math::Frame;
 use prism_core::sampling::rng::Pcg32;
 use prism_core::spectrum::SampledWavelengths;

@@ -23,7 +23,7 @@ use prism_core::geometry::{
 };
 use prism_core::image::{Bitmap, Encoding};
 use prism_core::light::area::SHAPE_STRATEGY_FRACTION;
-use prism_core::light::{AreaLight, Light};
+use prism_core::light::{AreaLight, Light, LightSource};
 use prism_core::math::{Ray, Transform};
 use prism_core::sampling::rng::Pcg32;
 use prism_core::spectrum::SampledWavelengths;

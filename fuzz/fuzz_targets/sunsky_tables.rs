@@ -8,7 +8,7 @@
 use glam::{Vec2, Vec3};
 use libfuzzer_sys::fuzz_target;
 use prism_core::light::sunsky::data::{DATASETS, SAMPLING_DATA, SunskyTables, parse_tensor_file};
-use prism_core::light::{Sunsky, SunskySettings};
+use prism_core::light::{LightSource, Sunsky, SunskySettings};
 use prism_core::math::Transform;
 use prism_core::spectrum::SampledWavelengths;
 
@@ -42,7 +42,7 @@ fuzz_target!(|data: &[u8]| {
         let _ = light.pdf(d);
     }
     for u in [Vec2::new(0.1, 0.7), Vec2::new(0.99, 0.2)] {
-        let _ = light.sample_incident(Vec3::ZERO, u, &lambda);
+        let _ = light.sample_incident(&[], Vec3::ZERO, 0.0, 0.5, u, &lambda);
     }
-    let _ = light.power();
+    let _ = light.power(&[]);
 });

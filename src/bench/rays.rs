@@ -13,7 +13,7 @@
 use glam::Vec2;
 
 use prism_core::geometry::SurfaceInteraction;
-use prism_core::light::Receiver;
+use prism_core::light::{LightSource, Receiver};
 use prism_core::math::Ray;
 use prism_core::sampling::rng::Pcg32;
 use prism_core::sampling::warp::sample_uniform_sphere;

@@ -37,6 +37,7 @@
 
 pub mod bsdf;
 pub mod camera;
+pub mod dispatch;
 pub mod error;
 pub mod film;
 pub mod geometry;

@@ -3,7 +3,7 @@
 
 use crate::bsdf::Material;
 use crate::geometry::{Geometry, SurfaceInteraction};
-use crate::light::{BoundingSphere, Light, LightBounds};
+use crate::light::{BoundingSphere, Light, LightBounds, LightSource};
 use crate::medium::{Medium, MediumInterface};
 
 /// What a shape is made of and whether it emits.

@@ -28,7 +28,7 @@ use crate::bsdf::{BsdfEval, Scattering};
 use crate::geometry::{SurfaceInteraction, SurfaceSample};
 use crate::integrator::SampleContext;
 use crate::integrator::vertex::normals_agree;
-use crate::light::{AreaLight, Light, LightSample, Receiver};
+use crate::light::{AreaLight, Light, LightSample, LightSource, Receiver};
 use crate::math::Ray;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use crate::world::World;

@@ -35,7 +35,8 @@ use std::f32::consts::PI;
 
 use glam::{Vec2, Vec3};
 
-use super::LightSample;
+use super::{BoundingSphere, Environment, LightBounds, LightSample, LightSource};
+use crate::geometry::aggregate::AggregateElement;
 use crate::geometry::shape::area_to_solid_angle;
 use crate::geometry::{Primitive, Shape, ShapeSampling, SurfaceSample};
 use crate::sampling::distribution::PiecewiseConstant2D;
@@ -174,7 +175,31 @@ impl AreaLight {
         area_to_solid_angle(density.pdf(s.uv) / jacobian, reference, s.p, s.n).unwrap_or(0.0)
     }
 
-    pub fn sample_incident(
+    /// Density per unit solid angle with which [`Self::sample_incident`] from `reference` at
+    /// `time` finds the surface point `s` (its position, geometric normal, uv and triangle, as
+    /// a ray hit reports them).
+    pub fn pdf_from(
+        &self,
+        shapes: &[Primitive],
+        reference: Vec3,
+        time: f32,
+        s: &SurfaceSample,
+    ) -> f32 {
+        let primitive = &shapes[self.shape as usize];
+        let shape_pdf = primitive.pdf_from(reference, time, s.p, s.n, self.sampling);
+        match self.texture_strategy(primitive) {
+            None => shape_pdf,
+            Some((density, shape)) => {
+                SHAPE_STRATEGY_FRACTION * shape_pdf
+                    + (1.0 - SHAPE_STRATEGY_FRACTION)
+                        * Self::texture_pdf(density, shape, reference, s)
+            }
+        }
+    }
+}
+
+impl LightSource for AreaLight {
+    fn sample_incident(
         &self,
         shapes: &[Primitive],
         reference: Vec3,
@@ -237,32 +262,21 @@ impl AreaLight {
         })
     }
 
-    /// Density per unit solid angle with which [`Self::sample_incident`] from `reference` at
-    /// `time` finds the surface point `s` (its position, geometric normal, uv and triangle, as
-    /// a ray hit reports them).
-    pub fn pdf_from(
-        &self,
-        shapes: &[Primitive],
-        reference: Vec3,
-        time: f32,
-        s: &SurfaceSample,
-    ) -> f32 {
-        let primitive = &shapes[self.shape as usize];
-        let shape_pdf = primitive.pdf_from(reference, time, s.p, s.n, self.sampling);
-        match self.texture_strategy(primitive) {
-            None => shape_pdf,
-            Some((density, shape)) => {
-                SHAPE_STRATEGY_FRACTION * shape_pdf
-                    + (1.0 - SHAPE_STRATEGY_FRACTION)
-                        * Self::texture_pdf(density, shape, reference, s)
-            }
-        }
-    }
-
     /// Φ = π · A · L for a one-sided Lambertian emitter, with L the luminance of the radiance;
     /// for a texture, its mean luminance over [0, 1]² (exact when the uv map spreads [0, 1]²
     /// evenly over the surface, otherwise a weight for choosing the light).
-    pub fn power(&self, shapes: &[Primitive]) -> f32 {
+    fn power(&self, shapes: &[Primitive]) -> f32 {
         PI * shapes[self.shape as usize].area() * self.mean_luminance
+    }
+
+    fn bounds(&self, shapes: &[Primitive]) -> Option<LightBounds> {
+        let (lo, hi) = shapes[self.shape as usize].bounds();
+        Some(LightBounds::around_box(lo, hi, 0.0))
+    }
+
+    fn set_scene_bounds(&mut self, _bounds: BoundingSphere) {}
+
+    fn as_environment(&self) -> Option<Environment<'_>> {
+        None
     }
 }

@@ -13,7 +13,8 @@ use std::f32::consts::PI;
 
 use glam::{Vec2, Vec3};
 
-use super::{BoundingSphere, LightSample};
+use super::{BoundingSphere, Environment, LightBounds, LightSample, LightSource};
+use crate::geometry::Primitive;
 use crate::sampling::warp::{sample_uniform_sphere, uniform_sphere_pdf};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths, Spectrum};
 
@@ -43,10 +44,15 @@ impl ConstantLight {
     pub fn pdf(&self) -> f32 {
         uniform_sphere_pdf()
     }
+}
 
-    pub fn sample_incident(
+impl LightSource for ConstantLight {
+    fn sample_incident(
         &self,
+        _shapes: &[Primitive],
         reference: Vec3,
+        _time: f32,
+        _u_choice: f32,
         u: Vec2,
         lambda: &SampledWavelengths,
     ) -> Option<LightSample> {
@@ -63,7 +69,19 @@ impl ConstantLight {
 
     /// Φ = π R² ∫ L dω = 4π² R² L: the flux entering the scene's bounding sphere (each
     /// direction crosses a disk of area πR²; pbrt-v4's `UniformInfiniteLight::Phi`).
-    pub fn power(&self) -> f32 {
+    fn power(&self, _shapes: &[Primitive]) -> f32 {
         4.0 * PI * PI * self.scene.radius * self.scene.radius * self.radiance.luminance()
+    }
+
+    fn bounds(&self, _shapes: &[Primitive]) -> Option<LightBounds> {
+        None
+    }
+
+    fn set_scene_bounds(&mut self, bounds: BoundingSphere) {
+        self.scene = bounds;
+    }
+
+    fn as_environment(&self) -> Option<Environment<'_>> {
+        Some(Environment::Constant(self))
     }
 }

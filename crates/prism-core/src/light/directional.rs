@@ -12,9 +12,10 @@
 
 use std::f32::consts::PI;
 
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 
-use super::{BoundingSphere, LightSample};
+use super::{BoundingSphere, Environment, LightBounds, LightSample, LightSource};
+use crate::geometry::Primitive;
 use crate::spectrum::{SampledWavelengths, Spectrum};
 
 #[derive(Clone, Debug)]
@@ -34,12 +35,18 @@ impl DirectionalLight {
             scene: BoundingSphere::default(),
         }
     }
+}
 
+impl LightSource for DirectionalLight {
     /// The light arrives from −direction at every point; the shadow ray runs to a point beyond
     /// the scene. As a delta in direction, the "radiance" is the irradiance and the pdf 1.
-    pub fn sample_incident(
+    fn sample_incident(
         &self,
+        _shapes: &[Primitive],
         reference: Vec3,
+        _time: f32,
+        _u_choice: f32,
+        _u: Vec2,
         lambda: &SampledWavelengths,
     ) -> Option<LightSample> {
         let wi = -self.direction;
@@ -55,7 +62,19 @@ impl DirectionalLight {
 
     /// Φ = π R² E: the flux through the disk the scene's bounding sphere presents to the light
     /// (pbrt-v4's `DistantLight::Phi`).
-    pub fn power(&self) -> f32 {
+    fn power(&self, _shapes: &[Primitive]) -> f32 {
         PI * self.scene.radius * self.scene.radius * self.irradiance.luminance()
+    }
+
+    fn bounds(&self, _shapes: &[Primitive]) -> Option<LightBounds> {
+        None
+    }
+
+    fn set_scene_bounds(&mut self, bounds: BoundingSphere) {
+        self.scene = bounds;
+    }
+
+    fn as_environment(&self) -> Option<Environment<'_>> {
+        None
     }
 }

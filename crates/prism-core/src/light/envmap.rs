@@ -36,7 +36,8 @@ use std::f32::consts::PI;
 
 use glam::{Vec2, Vec3};
 
-use super::{BoundingSphere, LightSample};
+use super::{BoundingSphere, Environment, LightBounds, LightSample, LightSource};
+use crate::geometry::Primitive;
 use crate::image::Bitmap;
 use crate::math::Transform;
 use crate::sampling::distribution::PiecewiseConstant2D;
@@ -227,10 +228,15 @@ impl EnvironmentMap {
         let s = wrap(uv.x - self.half_texel());
         self.distribution.pdf(Vec2::new(s, uv.y)) / (2.0 * PI * PI * sin_theta)
     }
+}
 
-    pub fn sample_incident(
+impl LightSource for EnvironmentMap {
+    fn sample_incident(
         &self,
+        _shapes: &[Primitive],
         reference: Vec3,
+        _time: f32,
+        _u_choice: f32,
         u: Vec2,
         lambda: &SampledWavelengths,
     ) -> Option<LightSample> {
@@ -257,9 +263,21 @@ impl EnvironmentMap {
     /// Φ = π R² ∫ Y(L) dω, with ∫ Y(L) dω = 2π² ∫∫ Y sin θ du dv the integral of the sampling
     /// weights: the flux entering the scene's bounding sphere, as for [`super::ConstantLight`];
     /// exact for grey maps, and for colours up to the luminance of interpolated spectra.
-    pub fn power(&self) -> f32 {
+    fn power(&self, _shapes: &[Primitive]) -> f32 {
         let integral = 2.0 * PI * PI * self.distribution.integral() as f32 * self.scale;
         PI * self.scene.radius * self.scene.radius * integral
+    }
+
+    fn bounds(&self, _shapes: &[Primitive]) -> Option<LightBounds> {
+        None
+    }
+
+    fn set_scene_bounds(&mut self, bounds: BoundingSphere) {
+        self.scene = bounds;
+    }
+
+    fn as_environment(&self) -> Option<Environment<'_>> {
+        Some(Environment::Envmap(self))
     }
 }
 
@@ -329,9 +347,9 @@ mod tests {
         map.scene.radius = 2.0;
         let expected = 4.0 * PI * PI * 4.0 * 1.5;
         assert!(
-            (map.power() / expected - 1.0).abs() < 1e-4,
+            (map.power(&[]) / expected - 1.0).abs() < 1e-4,
             "{}",
-            map.power()
+            map.power(&[])
         );
     }
 }

@@ -31,6 +31,7 @@ pub mod sunsky;
 
 use glam::{Vec2, Vec3};
 
+use crate::dispatch::plugin_class;
 use crate::geometry::Primitive;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 pub use area::AreaLight;
@@ -44,17 +45,103 @@ pub use sampler::{LightSampler, LightSelection};
 pub use spot::SpotLight;
 pub use sunsky::{Sunsky, SunskySettings};
 
-/// A light source of the scene.
-#[derive(Clone, Debug)]
-pub enum Light {
-    Area(AreaLight),
-    Point(PointLight),
-    Spot(SpotLight),
-    Projector(Projector),
-    Directional(DirectionalLight),
-    Constant(ConstantLight),
-    Envmap(EnvironmentMap),
-    Sunsky(Box<Sunsky>),
+plugin_class! {
+    /// What every light answers: how it lights a point, how much it emits, where it is, and
+    /// whether rays that leave the scene see it.
+    pub trait LightSource {
+        /// Samples light arriving at `reference` at `time` from this light (`shapes`: the
+        /// world's primitives, which area lights are made of); `u_choice` and `u` are the
+        /// random numbers. None where the light sends nothing towards `reference`.
+        fn sample_incident(
+            &self,
+            shapes: &[Primitive],
+            reference: Vec3,
+            time: f32,
+            u_choice: f32,
+            u: Vec2,
+            lambda: &SampledWavelengths,
+        ) -> Option<LightSample>;
+
+        /// Emitted power Φ, summarised as a luminance-weighted scalar (watts weighted by ȳ):
+        /// the light sampler chooses lights in proportion to it. Lights at infinity count the
+        /// flux they send into the scene's bounding sphere, so [`Self::set_scene_bounds`] must
+        /// come first.
+        fn power(&self, shapes: &[Primitive]) -> f32;
+
+        /// Where the light is, for choosing it by importance ([`bounds`]): the box of its
+        /// shape, or its position; None for lights at infinity. The power is left 0 (the
+        /// sampler fills it in).
+        fn bounds(&self, shapes: &[Primitive]) -> Option<LightBounds>;
+
+        /// Tells a light at infinity the scene's extent (Mitsuba's `Emitter::set_scene`);
+        /// lights at a finite place ignore it.
+        fn set_scene_bounds(&mut self, bounds: BoundingSphere);
+
+        /// The light as rays that leave the scene see it (Mitsuba's "environment emitter", of
+        /// which a scene has at most one); None for lights that no ray can hit at infinity.
+        fn as_environment(&self) -> Option<Environment<'_>>;
+
+        /// Whether this light surrounds the scene and is seen by rays that leave it.
+        fn is_environment(&self) -> bool {
+            self.as_environment().is_some()
+        }
+
+        /// Radiance arriving along a ray that leaves the scene in direction `d` (unit): the
+        /// environment's emission; zero for other lights.
+        fn environment_radiance(&self, d: Vec3, lambda: &SampledWavelengths) -> SampledSpectrum {
+            self.as_environment()
+                .map_or(SampledSpectrum::ZERO, |e| e.radiance(d, lambda))
+        }
+
+        /// Density per unit solid angle with which [`Self::sample_incident`] picks the
+        /// direction `d` (unit) of an environment light; zero for other lights.
+        fn environment_pdf(&self, d: Vec3) -> f32 {
+            self.as_environment().map_or(0.0, |e| e.pdf(d))
+        }
+    }
+
+    /// A light source of the scene.
+    #[derive(Clone, Debug)]
+    pub enum Light {
+        Area(AreaLight),
+        Point(PointLight),
+        Spot(SpotLight),
+        Projector(Projector),
+        Directional(DirectionalLight),
+        Constant(ConstantLight),
+        Envmap(EnvironmentMap),
+        Sunsky(Box<Sunsky>),
+    }
+}
+
+/// A light at infinity as the rays that leave the scene see it.
+#[derive(Clone, Copy, Debug)]
+pub enum Environment<'a> {
+    Constant(&'a ConstantLight),
+    Envmap(&'a EnvironmentMap),
+    Sunsky(&'a Sunsky),
+}
+
+impl Environment<'_> {
+    /// The radiance arriving along a ray that leaves the scene in direction `d` (unit).
+    #[inline]
+    pub fn radiance(&self, d: Vec3, lambda: &SampledWavelengths) -> SampledSpectrum {
+        match self {
+            Environment::Constant(light) => light.radiance(lambda),
+            Environment::Envmap(light) => light.radiance(d, lambda),
+            Environment::Sunsky(light) => light.radiance(d, lambda),
+        }
+    }
+
+    /// The density per unit solid angle with which the light's `sample_incident` draws `d`.
+    #[inline]
+    pub fn pdf(&self, d: Vec3) -> f32 {
+        match self {
+            Environment::Constant(light) => light.pdf(),
+            Environment::Envmap(light) => light.pdf(d),
+            Environment::Sunsky(light) => light.pdf(d),
+        }
+    }
 }
 
 /// Incident light sampled at a point: where it comes from and how much arrives.
@@ -118,111 +205,5 @@ impl BoundingSphere {
 impl Default for BoundingSphere {
     fn default() -> Self {
         BoundingSphere::around_box(None)
-    }
-}
-
-impl Light {
-    /// Samples light arriving at `reference` at `time`. `u_choice` and `u` are the random
-    /// numbers.
-    pub fn sample_incident(
-        &self,
-        shapes: &[Primitive],
-        reference: Vec3,
-        time: f32,
-        u_choice: f32,
-        u: Vec2,
-        lambda: &SampledWavelengths,
-    ) -> Option<LightSample> {
-        match self {
-            Light::Area(light) => {
-                light.sample_incident(shapes, reference, time, u_choice, u, lambda)
-            }
-            Light::Point(light) => light.sample_incident(reference, lambda),
-            Light::Spot(light) => light.sample_incident(reference, lambda),
-            Light::Projector(light) => light.sample_incident(reference, lambda),
-            Light::Directional(light) => light.sample_incident(reference, lambda),
-            Light::Constant(light) => light.sample_incident(reference, u, lambda),
-            Light::Envmap(light) => light.sample_incident(reference, u, lambda),
-            Light::Sunsky(light) => light.sample_incident(reference, u, lambda),
-        }
-    }
-
-    /// Where the light is, for choosing it by importance ([`bounds`]): the box of its shape,
-    /// or its position; None for lights at infinity. The power is left 0 (the sampler fills
-    /// it in).
-    pub fn bounds(&self, shapes: &[Primitive]) -> Option<LightBounds> {
-        use crate::geometry::aggregate::AggregateElement;
-        match self {
-            Light::Area(light) => {
-                let (lo, hi) = shapes[light.shape as usize].bounds();
-                Some(LightBounds::around_box(lo, hi, 0.0))
-            }
-            Light::Point(light) => Some(LightBounds::at_point(light.position, 0.0)),
-            Light::Spot(light) => Some(LightBounds::at_point(light.position(), 0.0)),
-            Light::Projector(light) => Some(LightBounds::at_point(light.position(), 0.0)),
-            Light::Directional(_) | Light::Constant(_) | Light::Envmap(_) | Light::Sunsky(_) => {
-                None
-            }
-        }
-    }
-
-    /// Emitted power Φ, summarised as a luminance-weighted scalar (watts weighted by ȳ): the
-    /// light sampler chooses lights in proportion to it. Lights at infinity count the flux they
-    /// send into the scene's bounding sphere, so [`Self::set_scene_bounds`] must come first.
-    pub fn power(&self, shapes: &[Primitive]) -> f32 {
-        match self {
-            Light::Area(light) => light.power(shapes),
-            Light::Point(light) => light.power(),
-            Light::Spot(light) => light.power(),
-            Light::Projector(light) => light.power(),
-            Light::Directional(light) => light.power(),
-            Light::Constant(light) => light.power(),
-            Light::Envmap(light) => light.power(),
-            Light::Sunsky(light) => light.power(),
-        }
-    }
-
-    /// Tells lights at infinity the scene's extent (Mitsuba's `Emitter::set_scene`).
-    pub fn set_scene_bounds(&mut self, bounds: BoundingSphere) {
-        match self {
-            Light::Directional(light) => light.scene = bounds,
-            Light::Constant(light) => light.scene = bounds,
-            Light::Envmap(light) => light.scene = bounds,
-            Light::Sunsky(light) => light.scene = bounds,
-            Light::Area(_) | Light::Point(_) | Light::Spot(_) | Light::Projector(_) => {}
-        }
-    }
-
-    /// Whether this light surrounds the scene and is seen by rays that leave it (Mitsuba's
-    /// "environment emitter", of which a scene has at most one).
-    pub fn is_environment(&self) -> bool {
-        matches!(
-            self,
-            Light::Constant(_) | Light::Envmap(_) | Light::Sunsky(_)
-        )
-    }
-
-    /// Radiance arriving along a ray that leaves the scene in direction `d` (unit): the
-    /// environment's emission; zero for other lights.
-    #[inline]
-    pub fn environment_radiance(&self, d: Vec3, lambda: &SampledWavelengths) -> SampledSpectrum {
-        match self {
-            Light::Constant(light) => light.radiance(lambda),
-            Light::Envmap(light) => light.radiance(d, lambda),
-            Light::Sunsky(light) => light.radiance(d, lambda),
-            _ => SampledSpectrum::ZERO,
-        }
-    }
-
-    /// Density per unit solid angle with which [`Self::sample_incident`] picks the direction
-    /// `d` (unit) of an environment light; zero for other lights.
-    #[inline]
-    pub fn environment_pdf(&self, d: Vec3) -> f32 {
-        match self {
-            Light::Constant(light) => light.pdf(),
-            Light::Envmap(light) => light.pdf(d),
-            Light::Sunsky(light) => light.pdf(d),
-            _ => 0.0,
-        }
     }
 }

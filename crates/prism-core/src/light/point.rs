@@ -11,9 +11,10 @@
 
 use std::f32::consts::PI;
 
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 
-use super::LightSample;
+use super::{BoundingSphere, Environment, LightBounds, LightSample, LightSource};
+use crate::geometry::Primitive;
 use crate::spectrum::{SampledWavelengths, Spectrum};
 
 #[derive(Clone, Debug)]
@@ -22,10 +23,14 @@ pub struct PointLight {
     pub intensity: Spectrum,
 }
 
-impl PointLight {
-    pub fn sample_incident(
+impl LightSource for PointLight {
+    fn sample_incident(
         &self,
+        _shapes: &[Primitive],
         reference: Vec3,
+        _time: f32,
+        _u_choice: f32,
+        _u: Vec2,
         lambda: &SampledWavelengths,
     ) -> Option<LightSample> {
         let d = self.position - reference;
@@ -44,7 +49,17 @@ impl PointLight {
     }
 
     /// Φ = 4π I.
-    pub fn power(&self) -> f32 {
+    fn power(&self, _shapes: &[Primitive]) -> f32 {
         4.0 * PI * self.intensity.luminance()
+    }
+
+    fn bounds(&self, _shapes: &[Primitive]) -> Option<LightBounds> {
+        Some(LightBounds::at_point(self.position, 0.0))
+    }
+
+    fn set_scene_bounds(&mut self, _bounds: BoundingSphere) {}
+
+    fn as_environment(&self) -> Option<Environment<'_>> {
+        None
     }
 }

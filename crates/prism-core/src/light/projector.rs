@@ -34,7 +34,8 @@ use std::f32::consts::PI;
 
 use glam::{Vec2, Vec3};
 
-use super::LightSample;
+use super::{BoundingSphere, Environment, LightBounds, LightSample, LightSource};
+use crate::geometry::Primitive;
 use crate::math::Transform;
 use crate::spectrum::SampledWavelengths;
 use crate::texture::Texture;
@@ -90,9 +91,22 @@ impl Projector {
         (uv.x >= 0.0 && uv.x <= 1.0 && uv.y >= 0.0 && uv.y <= 1.0).then_some(uv)
     }
 
-    pub fn sample_incident(
+    /// Φ = π · scale · Ē · 4 t² / a: the irradiance π · scale · E on the plane z = 1 over the
+    /// image's rectangle there, [−t, t] × [−t/a, t/a] (Ē the mean of the image's values).
+    /// Where the light sits.
+    pub fn position(&self) -> Vec3 {
+        self.position
+    }
+}
+
+impl LightSource for Projector {
+    fn sample_incident(
         &self,
+        _shapes: &[Primitive],
         reference: Vec3,
+        _time: f32,
+        _u_choice: f32,
+        _u: Vec2,
         lambda: &SampledWavelengths,
     ) -> Option<LightSample> {
         let local = self.to_world.inverse_point(reference);
@@ -121,15 +135,18 @@ impl Projector {
         })
     }
 
-    /// Φ = π · scale · Ē · 4 t² / a: the irradiance π · scale · E on the plane z = 1 over the
-    /// image's rectangle there, [−t, t] × [−t/a, t/a] (Ē the mean of the image's values).
-    /// Where the light sits.
-    pub fn position(&self) -> Vec3 {
-        self.position
-    }
-
-    pub fn power(&self) -> f32 {
+    fn power(&self, _shapes: &[Primitive]) -> f32 {
         let t = self.tan_half_fov;
         PI * self.scale * self.mean_irradiance * 4.0 * t * t / self.aspect
+    }
+
+    fn bounds(&self, _shapes: &[Primitive]) -> Option<LightBounds> {
+        Some(LightBounds::at_point(self.position(), 0.0))
+    }
+
+    fn set_scene_bounds(&mut self, _bounds: BoundingSphere) {}
+
+    fn as_environment(&self) -> Option<Environment<'_>> {
+        None
     }
 }

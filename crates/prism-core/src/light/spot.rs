@@ -22,7 +22,8 @@
 
 use glam::{Vec2, Vec3};
 
-use super::LightSample;
+use super::{BoundingSphere, Environment, LightBounds, LightSample, LightSource};
+use crate::geometry::Primitive;
 use crate::math::Transform;
 use crate::spectrum::{SampledWavelengths, Spectrum};
 use crate::texture::Texture;
@@ -86,9 +87,24 @@ impl SpotLight {
         }
     }
 
-    pub fn sample_incident(
+    /// Φ = I ∫ falloff dω = 2π I [(1 − cos β) + ∫_β^c (c − θ)/(c − β) sin θ dθ]
+    ///   = 2π I [1 − (sin c − sin β)/(c − β)]   (integrating the ramp by parts),
+    /// which tends to the cone's 2π I (1 − cos c) as the ramp's width c − β goes to 0; with a
+    /// texture, times its mean value over the image (a weight for choosing the light).
+    /// Where the light sits.
+    pub fn position(&self) -> Vec3 {
+        self.position
+    }
+}
+
+impl LightSource for SpotLight {
+    fn sample_incident(
         &self,
+        _shapes: &[Primitive],
         reference: Vec3,
+        _time: f32,
+        _u_choice: f32,
+        _u: Vec2,
         lambda: &SampledWavelengths,
     ) -> Option<LightSample> {
         let d = self.position - reference;
@@ -119,16 +135,7 @@ impl SpotLight {
         })
     }
 
-    /// Φ = I ∫ falloff dω = 2π I [(1 − cos β) + ∫_β^c (c − θ)/(c − β) sin θ dθ]
-    ///   = 2π I [1 − (sin c − sin β)/(c − β)]   (integrating the ramp by parts),
-    /// which tends to the cone's 2π I (1 − cos c) as the ramp's width c − β goes to 0; with a
-    /// texture, times its mean value over the image (a weight for choosing the light).
-    /// Where the light sits.
-    pub fn position(&self) -> Vec3 {
-        self.position
-    }
-
-    pub fn power(&self) -> f32 {
+    fn power(&self, _shapes: &[Primitive]) -> f32 {
         let (c, b) = (f64::from(self.cutoff), f64::from(self.beam));
         let width = c - b;
         let fraction = if width > 1e-4 {
@@ -139,6 +146,16 @@ impl SpotLight {
         };
         let texture_mean = self.texture.as_ref().map_or(1.0, Texture::mean_value);
         (2.0 * std::f64::consts::PI * fraction) as f32 * self.intensity.luminance() * texture_mean
+    }
+
+    fn bounds(&self, _shapes: &[Primitive]) -> Option<LightBounds> {
+        Some(LightBounds::at_point(self.position(), 0.0))
+    }
+
+    fn set_scene_bounds(&mut self, _bounds: BoundingSphere) {}
+
+    fn as_environment(&self) -> Option<Environment<'_>> {
+        None
     }
 }
 
@@ -172,9 +189,9 @@ mod tests {
                 / f64::from(n);
             let expected = 2.0 * integral;
             assert!(
-                (f64::from(light.power()) / expected - 1.0).abs() < 1e-4,
+                (f64::from(light.power(&[])) / expected - 1.0).abs() < 1e-4,
                 "cutoff {cutoff}, beam {beam}: {} vs {expected}",
-                light.power()
+                light.power(&[])
             );
         }
     }

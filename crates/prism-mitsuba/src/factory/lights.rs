@@ -22,8 +22,8 @@ use prism_core::geometry::ShapeSampling;
 use prism_core::image::read_bitmap;
 use prism_core::light::sunsky::sun_position::{DateTime, Location, sun_angles};
 use prism_core::light::{
-    AreaLight, ConstantLight, DirectionalLight, EnvironmentMap, Light, PointLight, Projector,
-    SpotLight, Sunsky, SunskySettings,
+    AreaLight, ConstantLight, DirectionalLight, EnvironmentMap, Light, LightSource, PointLight,
+    Projector, SpotLight, Sunsky, SunskySettings,
 };
 use prism_core::math::Transform;
 use prism_core::spectrum::{RgbIntent, Spectrum};

@@ -34,7 +34,8 @@ use std::f32::consts::PI;
 
 use glam::{Vec2, Vec3};
 
-use super::{BoundingSphere, LightSample};
+use super::{BoundingSphere, Environment, LightBounds, LightSample, LightSource};
+use crate::geometry::Primitive;
 use crate::math::{Frame, Transform};
 use crate::sampling::distribution::PiecewiseConstant2D;
 use crate::spectrum::cie::cie_y;
@@ -307,10 +308,30 @@ impl Sunsky {
         self.sky_weight * sky + (1.0 - self.sky_weight) * sun
     }
 
+    /// The sun's unit direction in the emitter's frame.
+    pub fn sun_direction(&self) -> Vec3 {
+        self.sun
+    }
+
+    /// The probability of sampling the sky rather than the sun.
+    pub fn sky_weight(&self) -> f32 {
+        self.sky_weight
+    }
+
+    /// The band wavelengths (nm) at which a scene's albedo is evaluated.
+    pub fn band_wavelengths() -> [f32; BANDS] {
+        std::array::from_fn(band_wavelength)
+    }
+}
+
+impl LightSource for Sunsky {
     /// A direction towards the sky or the sun (see the module's documentation).
-    pub fn sample_incident(
+    fn sample_incident(
         &self,
+        _shapes: &[Primitive],
         reference: Vec3,
+        _time: f32,
+        _u_choice: f32,
         u: Vec2,
         lambda: &SampledWavelengths,
     ) -> Option<LightSample> {
@@ -353,23 +374,20 @@ impl Sunsky {
     /// Φ = π R² ∫ Y(L) dω, the luminous flux entering the scene's bounding sphere (as for
     /// [`super::EnvironmentMap::power`]): the sky's integral from the sampling table's cells
     /// and the sun's radiance times its solid angle.
-    pub fn power(&self) -> f32 {
+    fn power(&self, _shapes: &[Primitive]) -> f32 {
         let integral = self.sky_luminous + self.sun_luminous;
         (std::f64::consts::PI * f64::from(self.scene.radius).powi(2) * integral) as f32
     }
 
-    /// The sun's unit direction in the emitter's frame.
-    pub fn sun_direction(&self) -> Vec3 {
-        self.sun
+    fn bounds(&self, _shapes: &[Primitive]) -> Option<LightBounds> {
+        None
     }
 
-    /// The probability of sampling the sky rather than the sun.
-    pub fn sky_weight(&self) -> f32 {
-        self.sky_weight
+    fn set_scene_bounds(&mut self, bounds: BoundingSphere) {
+        self.scene = bounds;
     }
 
-    /// The band wavelengths (nm) at which a scene's albedo is evaluated.
-    pub fn band_wavelengths() -> [f32; BANDS] {
-        std::array::from_fn(band_wavelength)
+    fn as_environment(&self) -> Option<Environment<'_>> {
+        Some(Environment::Sunsky(self))
     }
 }
