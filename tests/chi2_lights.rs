@@ -11,6 +11,7 @@ use std::f64::consts::PI;
 use common::chi2::{assert_passes, chi2_discrete, chi2_from_counts, chi2_rectangle, simpson_2d};
 use common::scenes::{Object, build, camera};
 use glam::{DMat4, DVec3, Mat3, UVec2, Vec2, Vec3};
+use prism_core::geometry::ShapeGeometry;
 use prism_core::geometry::Sphere;
 use prism_core::geometry::{Shape, ShapeSampling};
 use prism_core::image::{Bitmap, Encoding};
@@ -55,13 +56,13 @@ fn cone_chi2(distance: f32, seed: u64, name: &str) {
         60,
         seed,
         |rng| {
-            let sample = s.sample_from(Vec3::ZERO, u2(rng))?;
+            let sample = s.sample_from(Vec3::ZERO, 0.5, u2(rng), ShapeSampling::SolidAngle)?;
             assert!(
                 (f64::from(sample.pdf) / expected_pdf - 1.0).abs() < 1e-4,
                 "{name}: pdf {} instead of {expected_pdf}",
                 sample.pdf
             );
-            let claimed = s.pdf_from(Vec3::ZERO, sample.p, sample.n);
+            let claimed = s.pdf_from(Vec3::ZERO, sample.p, sample.n, ShapeSampling::SolidAngle);
             assert_eq!(
                 claimed, sample.pdf,
                 "{name}: pdf_from disagrees with the sample"

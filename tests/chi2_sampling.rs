@@ -7,8 +7,8 @@ use std::f64::consts::PI;
 
 use common::chi2::{assert_passes, chi2_discrete, chi2_interval, chi2_rectangle, chi2_sphere};
 use glam::{Mat3, Vec2, Vec3};
-use prism_core::geometry::Sphere;
 use prism_core::geometry::TriangleMesh;
+use prism_core::geometry::{ShapeGeometry, ShapeSampling, Sphere};
 use prism_core::light::{LightBounds, LightSampler, LightSelection, Receiver};
 use prism_core::sampling::rng::Pcg32;
 use prism_core::sampling::warp;
@@ -313,8 +313,8 @@ fn sphere_cone_sampling_is_uniform_over_the_visible_cone() {
         60,
         8,
         |rng| {
-            let sample = s.sample_from(reference, u2(rng))?;
-            let claimed = s.pdf_from(reference, sample.p, sample.n);
+            let sample = s.sample_from(reference, 0.5, u2(rng), ShapeSampling::SolidAngle)?;
+            let claimed = s.pdf_from(reference, sample.p, sample.n, ShapeSampling::SolidAngle);
             assert!((claimed - sample.pdf).abs() <= 1e-4 * claimed);
             let w = frame
                 .to_local((sample.p - reference).normalize())
@@ -343,7 +343,7 @@ fn sphere_sampling_from_inside_converts_area_to_solid_angle() {
         202,
         9,
         |rng| {
-            let sample = s.sample_from(reference, u2(rng))?;
+            let sample = s.sample_from(reference, 0.5, u2(rng), ShapeSampling::SolidAngle)?;
             Some((sample.p - reference).normalize())
         },
         |w| {

@@ -11,6 +11,7 @@ use common::chi2::{assert_passes, chi2_rectangle};
 use common::scenes::{assert_mean_luminance, render_film};
 use glam::{DMat4, DVec3, Vec2, Vec3};
 use prism_core::geometry::Shape;
+use prism_core::geometry::ShapeGeometry;
 use prism_core::geometry::shape::Cylinder;
 use prism_core::math::{Ray, Transform};
 use prism_core::sampling::rng::Pcg32;
@@ -72,7 +73,7 @@ fn rays_meet_the_open_tube_where_they_should() {
     // ∂p/∂u = 2π r (−1, 0, 0), ∂p/∂v = (0, 0, l).
     let r = ray(Vec3::new(1.0, 6.0, 3.5), -Vec3::Y);
     let t = shape.intersect_analytic(&r, f32::INFINITY).unwrap();
-    let si = c.interaction(r.o, r.d, t, 7);
+    let si = c.interaction_at(r.o, r.d, t, 7);
     assert!(si.p.abs_diff_eq(Vec3::new(1.0, 2.5, 3.5), 1e-5), "{}", si.p);
     assert!(si.uv.abs_diff_eq(Vec2::new(0.25, 0.25), 1e-5), "{}", si.uv);
     assert!(si.n.abs_diff_eq(Vec3::Y, 1e-6), "{}", si.n);
@@ -82,7 +83,7 @@ fn rays_meet_the_open_tube_where_they_should() {
     let flipped = cylinder(DVec3::new(1.0, 2.0, 3.0), 0.5, 2.0, true);
     assert!(
         flipped
-            .interaction(r.o, r.d, t, 7)
+            .interaction_at(r.o, r.d, t, 7)
             .n
             .abs_diff_eq(-Vec3::Y, 1e-6)
     );
@@ -103,7 +104,9 @@ fn area_samples_are_uniform_with_the_claimed_density() {
         20,
         17,
         |rng: &mut Pcg32| {
-            let s = c.sample_area(Vec2::new(rng.next_f32(), rng.next_f32()));
+            let s = c
+                .sample_area(0.5, Vec2::new(rng.next_f32(), rng.next_f32()))
+                .unwrap();
             assert!(
                 (f64::from(s.pdf) / expected_pdf - 1.0).abs() < 1e-5,
                 "pdf {} instead of {expected_pdf}",

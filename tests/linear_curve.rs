@@ -56,7 +56,7 @@ fn a_straight_curve_of_constant_radius_is_a_capsule() {
     assert_eq!(segment, 0);
     assert!((hit.t - 2.5).abs() < 1e-6, "{hit:?}");
     assert!((hit.s - 0.5).abs() < 1e-6, "{hit:?}");
-    let si = curve.interaction(o, -Vec3::Z, hit.t, 0, 3);
+    let si = curve.segment_interaction(o, -Vec3::Z, hit.t, 0, 3);
     assert!(si.n.abs_diff_eq(Vec3::Z, 1e-6), "{}", si.n);
     assert!(si.p.abs_diff_eq(Vec3::new(1.0, 0.0, 0.5), 1e-6), "{}", si.p);
     assert!((si.uv.y - 0.5).abs() < 1e-6, "{}", si.uv);

@@ -9,8 +9,10 @@ use std::path::PathBuf;
 use common::scenes::{pixel_mean_and_variance, render_film};
 use common::serialized::{serialized_file, triangle_shape};
 use glam::Vec3;
+use prism_core::geometry::ShapeGeometry;
 use prism_core::geometry::shape::MeshAttribute;
 use prism_core::geometry::{TriangleMesh, triangle::TriangleHit};
+use prism_core::math::Ray;
 use prism_mitsuba::load_scene;
 
 #[test]
@@ -44,7 +46,8 @@ fn attributes_are_interpolated_barycentrically_and_faces_are_constant() {
         b1: 0.3,
         b2: 0.2,
     };
-    let at = mesh.interaction(1, &hit, 0).attributes.0;
+    let ray = Ray::new(Vec3::ZERO, Vec3::Z, f32::INFINITY, 0.0);
+    let at = mesh.interaction(&ray, 1, &hit, 0).attributes.0;
     let expected = vertex[1] * 0.5 + vertex[3] * 0.3 + vertex[2] * 0.2;
     assert!(at[3].abs_diff_eq(expected, 1e-6), "{} != {expected}", at[3]);
     assert_eq!(at[0], Vec3::splat(0.9));

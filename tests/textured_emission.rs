@@ -19,7 +19,7 @@ use common::chi2::{assert_passes, chi2_discrete};
 use glam::{Vec2, Vec3};
 use prism_core::geometry::triangle::{TriangleHit, WatertightRay};
 use prism_core::geometry::{
-    Disk, Primitive, Shape, Sphere, SurfaceInteraction, SurfaceSample, TriangleMesh,
+    Disk, Primitive, Shape, ShapeGeometry, Sphere, SurfaceInteraction, SurfaceSample, TriangleMesh,
 };
 use prism_core::image::{Bitmap, Encoding};
 use prism_core::light::area::SHAPE_STRATEGY_FRACTION;
@@ -299,7 +299,7 @@ fn shape_hit(shape: &Shape, o: Vec3, d: Vec3) -> SurfaceInteraction {
         .find_map(|t| {
             let [p0, p1, p2] = mesh.vertices(t);
             let hit = ray.intersect(f32::INFINITY, p0, p1, p2)?;
-            Some(mesh.interaction(t, &hit, 0))
+            Some(mesh.interaction(&Ray::new(o, d, f32::INFINITY, 0.0), t as u32, &hit, 0))
         })
         .expect("the ray meets the mesh")
 }

@@ -16,7 +16,7 @@ use glam::Vec3;
 
 use super::bvh::{BuildPrimitive, Bvh, PrimitiveKind};
 use super::interaction::SurfaceInteraction;
-use super::shape::{Shape, TriangleMesh};
+use super::shape::{Shape, ShapeGeometry, TriangleMesh};
 use super::triangle::{TriangleHit, WatertightRay};
 use crate::math::Ray;
 
@@ -238,10 +238,10 @@ impl<P: AggregateElement> Aggregate<P> {
 impl AggregateElement for Shape {
     #[inline]
     fn mesh(&self) -> Option<&TriangleMesh> {
-        match self {
-            Shape::Mesh(mesh) => Some(mesh),
-            _ => None,
-        }
+        let Shape::Mesh(mesh) = self else {
+            return None;
+        };
+        Some(mesh)
     }
 
     fn bounds(&self) -> (Vec3, Vec3) {
@@ -255,7 +255,7 @@ impl AggregateElement for Shape {
 
     #[inline]
     fn interaction(&self, ray: &Ray, hit: &Hit) -> Option<SurfaceInteraction> {
-        Some(Shape::interaction(
+        Some(ShapeGeometry::interaction(
             self,
             ray,
             hit.primitive,
@@ -265,19 +265,19 @@ impl AggregateElement for Shape {
     }
 
     fn heap_bytes(&self) -> usize {
-        Shape::heap_bytes(self)
+        ShapeGeometry::heap_bytes(self)
     }
 
     fn part_count(&self) -> Option<usize> {
-        Shape::part_count(self)
+        ShapeGeometry::part_count(self)
     }
 
     fn part_bounds(&self, part: u32) -> (Vec3, Vec3) {
-        Shape::part_bounds(self, part)
+        ShapeGeometry::part_bounds(self, part)
     }
 
     #[inline]
     fn intersect_part(&self, ray: &Ray, part: u32, t_max: f32) -> Option<f32> {
-        Shape::intersect_part(self, ray, part, t_max)
+        ShapeGeometry::intersect_part(self, ray, part, t_max)
     }
 }

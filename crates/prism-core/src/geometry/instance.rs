@@ -16,7 +16,7 @@ use glam::{Vec2, Vec3};
 
 use super::aggregate::Aggregate;
 use super::interaction::SurfaceInteraction;
-use super::shape::{Shape, ShapeSampling, SurfaceSample};
+use super::shape::{Shape, ShapeGeometry, ShapeSampling, SurfaceSample};
 use crate::math::{AnimatedTransform, Frame, Ray};
 
 /// A shape, or a group of shapes, placed by an animated transform.

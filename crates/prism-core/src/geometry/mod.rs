@@ -17,4 +17,4 @@ pub use aggregate::{Aggregate, AggregateElement, ExternalRayQueries, Hit};
 pub use instance::Instance;
 pub use interaction::SurfaceInteraction;
 pub use primitive::{Geometry, Primitive};
-pub use shape::{Disk, Shape, ShapeSampling, Sphere, SurfaceSample, TriangleMesh};
+pub use shape::{Disk, Shape, ShapeGeometry, ShapeSampling, Sphere, SurfaceSample, TriangleMesh};

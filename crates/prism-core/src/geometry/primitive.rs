@@ -6,7 +6,7 @@ use glam::{Vec2, Vec3};
 use super::aggregate::{Aggregate, AggregateElement, Hit};
 use super::instance::Instance;
 use super::interaction::SurfaceInteraction;
-use super::shape::{Shape, ShapeSampling, SurfaceSample, TriangleMesh};
+use super::shape::{Shape, ShapeGeometry, ShapeSampling, SurfaceSample, TriangleMesh};
 use crate::math::Ray;
 
 /// One primitive of the scene, dispatched by `match`.
@@ -107,14 +107,14 @@ impl AggregateElement for Primitive {
 
     fn part_count(&self) -> Option<usize> {
         match self {
-            Primitive::Shape(shape) => shape.part_count(),
+            Primitive::Shape(shape) => ShapeGeometry::part_count(shape),
             Primitive::Instance(_) => None,
         }
     }
 
     fn part_bounds(&self, part: u32) -> (Vec3, Vec3) {
         match self {
-            Primitive::Shape(shape) => shape.part_bounds(part),
+            Primitive::Shape(shape) => ShapeGeometry::part_bounds(shape, part),
             Primitive::Instance(instance) => instance.swept_bounds,
         }
     }
@@ -122,14 +122,14 @@ impl AggregateElement for Primitive {
     #[inline]
     fn intersect_part(&self, ray: &Ray, part: u32, t_max: f32) -> Option<f32> {
         match self {
-            Primitive::Shape(shape) => shape.intersect_part(ray, part, t_max),
+            Primitive::Shape(shape) => ShapeGeometry::intersect_part(shape, ray, part, t_max),
             Primitive::Instance(instance) => instance.intersect(ray, t_max),
         }
     }
 
     fn heap_bytes(&self) -> usize {
         match self {
-            Primitive::Shape(shape) => shape.heap_bytes(),
+            Primitive::Shape(shape) => ShapeGeometry::heap_bytes(shape),
             // A group's object is shared by its instances and is not counted in any of them.
             Primitive::Instance(instance) if instance.first_shape.is_some() => 0,
             Primitive::Instance(instance) => instance.object.memory_bytes(),

@@ -38,7 +38,7 @@ use glam::{Vec2, Vec3};
 use super::{BoundingSphere, Environment, LightBounds, LightSample, LightSource};
 use crate::geometry::aggregate::AggregateElement;
 use crate::geometry::shape::area_to_solid_angle;
-use crate::geometry::{Primitive, Shape, ShapeSampling, SurfaceSample};
+use crate::geometry::{Primitive, Shape, ShapeGeometry, ShapeSampling, SurfaceSample};
 use crate::sampling::distribution::PiecewiseConstant2D;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths, Spectrum};
 use crate::texture::Texture;

@@ -59,7 +59,8 @@ pub struct SphericalRectangle {
 
 /// The corner coordinates of a rectangle seen from a point (z₀ < 0 on the point's side), and
 /// the interior angles of its projection.
-struct Projection {
+#[derive(Clone, Copy, Debug)]
+pub struct Projection {
     z0: f32,
     x0: f32,
     y0: f32,
@@ -115,15 +116,15 @@ impl RectangleFrame {
     }
 
     /// The solid angle the rectangle subtends at `origin`, from the interior angles as complex
-    /// numbers (the derivation is at `project`); None in its plane.
+    /// numbers (the derivation is at [`Self::project`]); None in its plane.
     pub fn solid_angle(&self, origin: Vec3) -> Option<f32> {
         self.project(origin).map(|p| p.solid_angle)
     }
 
-    /// The projection from `origin`, ready to sample; None in the rectangle's plane.
-    pub fn spherical(&self, origin: Vec3) -> Option<SphericalRectangle> {
-        let p = self.project(origin)?;
-        Some(SphericalRectangle {
+    /// The projection `projection` (of this rectangle), ready to sample.
+    pub fn spherical(&self, projection: &Projection) -> SphericalRectangle {
+        let p = projection;
+        SphericalRectangle {
             width: self.width,
             height: self.height,
             z0: p.z0,
@@ -135,7 +136,7 @@ impl RectangleFrame {
             b1: p.y1 / (p.z0 * p.z0 + p.y1 * p.y1).sqrt(),
             k: p.last.unit_conjugate(),
             solid_angle: p.solid_angle,
-        })
+        }
     }
 
     /// The corners relative to `origin` and the solid angle S.
@@ -145,7 +146,8 @@ impl RectangleFrame {
     /// are, up to one positive factor, (y₀x₁, |z₀| r₁₀), (−x₁y₁, |z₀| r₁₁), (x₀y₁, |z₀| r₀₁) and
     /// (−x₀y₀, |z₀| r₀₀), r_ij the distance to corner v_ij. As complex numbers their product has
     /// the argument γ₀ + γ₁ + γ₂ + γ₃ = S + 2π, so S costs four square roots and one arctangent.
-    fn project(&self, origin: Vec3) -> Option<Projection> {
+    /// None in the rectangle's plane.
+    pub fn project(&self, origin: Vec3) -> Option<Projection> {
         let d = self.corner - origin;
         // In the frame with ẑ turned towards the origin, so that the plane lies at z₀ < 0.
         let z0 = -d.dot(self.z).abs();
@@ -172,6 +174,14 @@ impl RectangleFrame {
             last,
             solid_angle,
         })
+    }
+}
+
+impl Projection {
+    /// The solid angle S the rectangle subtends.
+    #[inline]
+    pub fn solid_angle(&self) -> f32 {
+        self.solid_angle
     }
 }
 
@@ -230,7 +240,7 @@ mod tests {
                 Vec3::new(0.0, 2.0 * a, 0.0),
             )
             .unwrap()
-            .spherical(Vec3::new(0.0, 0.0, h))
+            .project(Vec3::new(0.0, 0.0, h))
             .unwrap();
             let (a, h) = (f64::from(a), f64::from(h));
             let expected = 4.0 * (a * a / (a * a + h * h)).asin();
@@ -247,7 +257,7 @@ mod tests {
         let (ex, ey) = (Vec3::new(0.5, 0.0, 0.0), Vec3::new(0.0, 0.0, 0.8));
         let frame = RectangleFrame::new(corner, ex, ey).unwrap();
         for origin in [Vec3::new(-0.4, 0.7, 0.2), Vec3::new(0.5, -0.25, 1.3)] {
-            let r = frame.spherical(origin).unwrap();
+            let r = frame.spherical(&frame.project(origin).unwrap());
             let total = r.solid_angle();
             for i in 1..10 {
                 let u = i as f32 / 10.0;
@@ -263,7 +273,7 @@ mod tests {
                 }
             }
         }
-        assert!(frame.spherical(Vec3::new(0.5, -0.2, 1.3)).is_none());
+        assert!(frame.project(Vec3::new(0.5, -0.2, 1.3)).is_none());
         assert!(frame.solid_angle(Vec3::new(0.5, -0.2, 1.3)).is_none());
     }
 }

@@ -16,7 +16,7 @@ use super::shapes;
 use crate::description::PluginNode;
 use crate::params::Params;
 use prism_core::error::{Error, Result};
-use prism_core::geometry::{Aggregate, Instance, Primitive, Shape};
+use prism_core::geometry::{Aggregate, Instance, Primitive, Shape, ShapeGeometry};
 use prism_core::medium::MediumInterface;
 use prism_core::world::ShapeInfo;
 

@@ -713,6 +713,7 @@ pub fn cube() -> MeshData {
 mod tests {
     use super::*;
     use glam::DMat4;
+    use prism_core::geometry::ShapeGeometry;
 
     #[test]
     fn cube_faces_point_outwards() {

@@ -30,8 +30,11 @@ use std::f64::consts::TAU;
 use glam::{DVec3, DVec4, Vec2, Vec3, Vec4};
 
 use super::linear_curve::local_frame;
+use super::{Segments, ShapeGeometry, SolidAngleSampler, SurfaceSample};
 use crate::geometry::interaction::{AttributeValues, SurfaceInteraction};
+use crate::geometry::triangle::TriangleHit;
 use crate::math::Frame;
+use crate::math::Ray;
 
 /// Subdivision depth at which a piece is intersected whatever its flatness.
 const MAX_DEPTH: u32 = 6;
@@ -152,22 +155,6 @@ impl BSplineCurve {
         (lo - r, hi + r)
     }
 
-    /// The bounds of all segments.
-    pub fn bounds(&self) -> (Vec3, Vec3) {
-        (0..self.segments.len())
-            .map(|i| self.segment_bounds(i))
-            .fold(
-                (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
-                |(lo, hi), (l, h)| (lo.min(l), hi.max(h)),
-            )
-    }
-
-    /// Bytes of heap memory of the segments.
-    pub fn heap_bytes(&self) -> usize {
-        self.segments.capacity() * std::mem::size_of::<[Vec4; 4]>()
-            + self.ends.capacity() * std::mem::size_of::<(bool, bool)>()
-    }
-
     /// Segment `i` relative to the point `o`, in double precision.
     fn relative(&self, i: usize, o: Vec3) -> Bezier {
         let o = o.as_dvec3().extend(0.0);
@@ -215,7 +202,7 @@ impl BSplineCurve {
     /// The surface interaction of a hit at distance `t` on segment `segment` (its parameter is
     /// found again by intersecting the segment; a hit from a structure that intersects the
     /// curves as a whole and names no segment is found on all of them).
-    pub fn interaction(
+    pub fn segment_interaction(
         &self,
         o: Vec3,
         d: Vec3,
@@ -478,4 +465,62 @@ fn cone_hits(d: DVec3, a: DVec3, ra: f64, b: DVec3, rb: f64) -> [Option<(f64, f6
         let z = (t * dz - az) / length;
         (alpha + beta * t >= 0.0 && (-0.5..=1.5).contains(&z)).then_some((t, z))
     })
+}
+
+impl ShapeGeometry for BSplineCurve {
+    /// Mitsuba gives curves no area or sampling: they cannot be area lights.
+    fn area(&self) -> f32 {
+        0.0
+    }
+
+    /// The bounds of all segments.
+    fn object_bounds(&self) -> (Vec3, Vec3) {
+        (0..self.segments.len())
+            .map(|i| self.segment_bounds(i))
+            .fold(
+                (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+                |(lo, hi), (l, h)| (lo.min(l), hi.max(h)),
+            )
+    }
+
+    fn as_segments(&self) -> Option<Segments<'_>> {
+        Some(Segments::BSpline(self))
+    }
+
+    fn intersect_analytic(&self, ray: &Ray, t_max: f32) -> Option<f32> {
+        self.intersect(ray.o, ray.d, t_max).map(|(_, hit)| hit.t)
+    }
+
+    fn interaction(
+        &self,
+        ray: &Ray,
+        primitive: u32,
+        hit: &TriangleHit,
+        index: u32,
+    ) -> SurfaceInteraction {
+        // Finds its segment again itself when the named one was not hit.
+        self.segment_interaction(ray.o, ray.d, hit.t, primitive, index)
+    }
+
+    fn sample_area(&self, _u_choice: f32, _u: Vec2) -> Option<SurfaceSample> {
+        None
+    }
+
+    fn solid_angle_sampler(&self, _reference: Vec3) -> Option<SolidAngleSampler<'_>> {
+        None
+    }
+
+    fn at_uv(&self, _uv: Vec2) -> Option<(SurfaceSample, f32)> {
+        None
+    }
+
+    fn uv_jacobian_at(&self, _primitive: u32, _uv: Vec2) -> Option<f32> {
+        None
+    }
+
+    /// Bytes of heap memory of the segments.
+    fn heap_bytes(&self) -> usize {
+        self.segments.capacity() * std::mem::size_of::<[Vec4; 4]>()
+            + self.ends.capacity() * std::mem::size_of::<(bool, bool)>()
+    }
 }

@@ -12,8 +12,10 @@ use std::f32::consts::PI;
 use glam::{DVec3, Vec2, Vec3};
 
 use super::mesh::SurfaceSample;
+use super::{Segments, ShapeGeometry, SolidAngleSampler};
 use crate::geometry::interaction::{AttributeValues, SurfaceInteraction};
-use crate::math::{Frame, Transform};
+use crate::geometry::triangle::TriangleHit;
+use crate::math::{Frame, Ray, Transform};
 
 /// A circular cylinder (the scene reader allows no transform that would make it elliptic or
 /// sheared, so that its area and uniform sampling are exact).
@@ -34,11 +36,6 @@ impl Cylinder {
             flip_normals,
             area: 2.0 * PI * radius * length,
         }
-    }
-
-    /// 2π r L.
-    pub fn area(&self) -> f32 {
-        self.area
     }
 
     /// Nearest t in (0, t_max) where the ray meets the tube: the roots of
@@ -81,7 +78,7 @@ impl Cylinder {
     }
 
     /// The surface interaction at the point hit at distance `t`, projected back onto the tube.
-    pub fn interaction(&self, o: Vec3, d: Vec3, t: f32, shape: u32) -> SurfaceInteraction {
+    pub fn interaction_at(&self, o: Vec3, d: Vec3, t: f32, shape: u32) -> SurfaceInteraction {
         let local = self.to_world.inverse_point(o + d * t).as_dvec3();
         let radial = DVec3::new(local.x, local.y, 0.0).normalize_or(DVec3::X);
         let local = Vec3::new(
@@ -136,19 +133,70 @@ impl Cylinder {
             pdf,
         }
     }
+}
+
+impl ShapeGeometry for Cylinder {
+    /// 2π r L.
+    fn area(&self) -> f32 {
+        self.area
+    }
+
+    fn object_bounds(&self) -> (Vec3, Vec3) {
+        (0..8)
+            .map(|corner| {
+                let bit = |b: u32| if corner & (1 << b) != 0 { 1.0 } else { 0.0 };
+                let x = 2.0 * bit(0) - 1.0;
+                let y = 2.0 * bit(1) - 1.0;
+                self.to_world.point(Vec3::new(x, y, bit(2)))
+            })
+            .fold(
+                (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+                |(lo, hi), p| (lo.min(p), hi.max(p)),
+            )
+    }
+
+    fn as_segments(&self) -> Option<Segments<'_>> {
+        None
+    }
+
+    fn intersect_analytic(&self, ray: &Ray, t_max: f32) -> Option<f32> {
+        self.intersect(ray.o, ray.d, t_max)
+    }
+
+    fn interaction(
+        &self,
+        ray: &Ray,
+        _primitive: u32,
+        hit: &TriangleHit,
+        index: u32,
+    ) -> SurfaceInteraction {
+        self.interaction_at(ray.o, ray.d, hit.t, index)
+    }
 
     /// A uniform point: (u, v) uniform, which a similarity of the tube keeps uniform in area;
     /// pdf 1/(2π r L) per unit area.
-    pub fn sample_area(&self, u: Vec2) -> SurfaceSample {
-        self.point_at_uv(u, 1.0 / self.area)
+    fn sample_area(&self, _u_choice: f32, u: Vec2) -> Option<SurfaceSample> {
+        Some(self.point_at_uv(u, 1.0 / self.area))
+    }
+
+    fn solid_angle_sampler(&self, _reference: Vec3) -> Option<SolidAngleSampler<'_>> {
+        None
     }
 
     /// The point at `uv` in [0, 1]² and |∂p/∂u × ∂p/∂v| = 2π r L there (Mitsuba's
     /// `eval_parameterization`); None outside [0, 1]².
-    pub fn at_uv(&self, uv: Vec2) -> Option<(SurfaceSample, f32)> {
+    fn at_uv(&self, uv: Vec2) -> Option<(SurfaceSample, f32)> {
         if !(uv.x >= 0.0 && uv.x <= 1.0 && uv.y >= 0.0 && uv.y <= 1.0) {
             return None;
         }
         Some((self.point_at_uv(uv, 0.0), self.area))
+    }
+
+    fn uv_jacobian_at(&self, _primitive: u32, uv: Vec2) -> Option<f32> {
+        self.at_uv(uv).map(|(_, jacobian)| jacobian)
+    }
+
+    fn heap_bytes(&self) -> usize {
+        0
     }
 }

@@ -17,8 +17,11 @@ use std::f32::consts::PI;
 
 use glam::{DVec3, Vec2, Vec3, Vec4};
 
+use super::{Segments, ShapeGeometry, SolidAngleSampler, SurfaceSample};
 use crate::geometry::interaction::{AttributeValues, SurfaceInteraction};
+use crate::geometry::triangle::TriangleHit;
 use crate::math::Frame;
+use crate::math::Ray;
 
 /// A set of round linear curves, one primitive per segment.
 #[derive(Clone, Debug)]
@@ -73,22 +76,6 @@ impl LinearCurve {
         ((ca - a.w).min(cb - b.w), (ca + a.w).max(cb + b.w))
     }
 
-    /// The bounds of all control-point spheres.
-    pub fn bounds(&self) -> (Vec3, Vec3) {
-        (0..self.segments.len())
-            .map(|i| self.segment_bounds(i))
-            .fold(
-                (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
-                |(lo, hi), (l, h)| (lo.min(l), hi.max(h)),
-            )
-    }
-
-    /// Bytes of heap memory of the control points and segment indices.
-    pub fn heap_bytes(&self) -> usize {
-        self.points.capacity() * std::mem::size_of::<Vec4>()
-            + self.segments.capacity() * std::mem::size_of::<u32>()
-    }
-
     /// The nearest front-face hit in (0, t_max) on segment `i`.
     pub fn intersect_segment(&self, i: usize, o: Vec3, d: Vec3, t_max: f32) -> Option<SegmentHit> {
         let (a, b) = self.ends(i);
@@ -118,7 +105,7 @@ impl LinearCurve {
 
     /// The surface interaction of a hit on segment `segment` at distance `t` (its sweep
     /// parameter is found again from the point).
-    pub fn interaction(
+    pub fn segment_interaction(
         &self,
         o: Vec3,
         d: Vec3,
@@ -293,4 +280,73 @@ fn round_cone_entry(
     }
     let t = best?;
     Some((t, sweep_parameter(o + d * t, a, ra, b, rb)))
+}
+
+impl ShapeGeometry for LinearCurve {
+    /// Mitsuba gives curves no area or sampling: they cannot be area lights.
+    fn area(&self) -> f32 {
+        0.0
+    }
+
+    /// The bounds of all control-point spheres.
+    fn object_bounds(&self) -> (Vec3, Vec3) {
+        (0..self.segments.len())
+            .map(|i| self.segment_bounds(i))
+            .fold(
+                (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+                |(lo, hi), (l, h)| (lo.min(l), hi.max(h)),
+            )
+    }
+
+    fn as_segments(&self) -> Option<Segments<'_>> {
+        Some(Segments::Linear(self))
+    }
+
+    fn intersect_analytic(&self, ray: &Ray, t_max: f32) -> Option<f32> {
+        self.intersect(ray.o, ray.d, t_max).map(|(_, hit)| hit.t)
+    }
+
+    fn interaction(
+        &self,
+        ray: &Ray,
+        primitive: u32,
+        hit: &TriangleHit,
+        index: u32,
+    ) -> SurfaceInteraction {
+        // A structure that intersects the curve as a whole (Embree's, through
+        // `intersect_analytic`) does not name the segment: find it again.
+        let (o, d) = (ray.o, ray.d);
+        let named = self
+            .intersect_segment(primitive as usize, o, d, f32::INFINITY)
+            .is_some_and(|h| h.t == hit.t);
+        let segment = if named {
+            primitive
+        } else {
+            self.intersect(o, d, f32::INFINITY)
+                .map_or(primitive, |(segment, _)| segment as u32)
+        };
+        self.segment_interaction(o, d, hit.t, segment, index)
+    }
+
+    fn sample_area(&self, _u_choice: f32, _u: Vec2) -> Option<SurfaceSample> {
+        None
+    }
+
+    fn solid_angle_sampler(&self, _reference: Vec3) -> Option<SolidAngleSampler<'_>> {
+        None
+    }
+
+    fn at_uv(&self, _uv: Vec2) -> Option<(SurfaceSample, f32)> {
+        None
+    }
+
+    fn uv_jacobian_at(&self, _primitive: u32, _uv: Vec2) -> Option<f32> {
+        None
+    }
+
+    /// Bytes of heap memory of the control points and segment indices.
+    fn heap_bytes(&self) -> usize {
+        self.points.capacity() * std::mem::size_of::<Vec4>()
+            + self.segments.capacity() * std::mem::size_of::<u32>()
+    }
 }

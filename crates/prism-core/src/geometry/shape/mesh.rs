@@ -5,11 +5,12 @@ use std::sync::OnceLock;
 use glam::{Vec2, Vec3};
 
 use super::uv_grid::UvGrid;
+use super::{Segments, ShapeGeometry, SolidAngleSampler};
 use crate::geometry::interaction::{AttributeValues, MAX_MESH_ATTRIBUTES, SurfaceInteraction};
 use crate::geometry::triangle::TriangleHit;
-use crate::math::Frame;
+use crate::math::{Frame, Ray};
 use crate::sampling::distribution::AliasTable;
-use crate::sampling::spherical_rectangle::RectangleFrame;
+use crate::sampling::spherical_rectangle::{Projection, RectangleFrame};
 use crate::sampling::warp::sample_uniform_triangle;
 
 /// A rectangle is sampled by solid angle from points closer to its centre than this many times
@@ -221,36 +222,6 @@ impl TriangleMesh {
         0.5 * (p1 - p0).cross(p2 - p0).length()
     }
 
-    /// Total surface area.
-    pub fn area(&self) -> f32 {
-        self.area
-    }
-
-    /// Bytes of heap memory the mesh holds: vertex attributes, indices and the area table.
-    pub fn heap_bytes(&self) -> usize {
-        use std::mem::size_of;
-        self.positions.capacity() * size_of::<Vec3>()
-            + self
-                .normals
-                .as_ref()
-                .map_or(0, |n| n.capacity() * size_of::<Vec3>())
-            + self
-                .uvs
-                .as_ref()
-                .map_or(0, |uv| uv.capacity() * size_of::<Vec2>())
-            + self.triangles.capacity() * size_of::<[u32; 3]>()
-            + self.face_normals.capacity() * size_of::<Vec3>()
-            + self
-                .attributes
-                .iter()
-                .map(|a| a.values.capacity() * size_of::<Vec3>())
-                .sum::<usize>()
-            + self.light_sampling.get().map_or(0, |l| {
-                size_of::<LightSampling>() + l.area_table.as_ref().map_or(0, AliasTable::heap_bytes)
-            })
-            + self.uv_grid.get().map_or(0, UvGrid::heap_bytes)
-    }
-
     /// The unit geometric normal of a triangle: (p1 − p0) × (p2 − p0), counter-clockwise
     /// vertices facing the viewer (Mitsuba's convention), reversed by `flip_normals`; zero for a
     /// degenerate triangle.
@@ -283,64 +254,6 @@ impl TriangleMesh {
         }
     }
 
-    /// The surface interaction of a ray hit on a triangle.
-    pub fn interaction(
-        &self,
-        triangle: usize,
-        hit: &TriangleHit,
-        shape: u32,
-    ) -> SurfaceInteraction {
-        let [p0, p1, p2] = self.vertices(triangle);
-        let b = [hit.b0, hit.b1, hit.b2];
-        // The barycentric combination is closer to the surface than o + t·d.
-        let p = p0 * b[0] + p1 * b[1] + p2 * b[2];
-        let n = self.face_normal(triangle);
-        let shading_n = self.shading_normal(triangle, b, n);
-        // Without texture coordinates, (u, v) are the barycentrics of p1 and p2 (as Mitsuba), so
-        // ∂p/∂u and ∂p/∂v are the edges from p0.
-        let (mut dp_du, mut dp_dv) = (p1 - p0, p2 - p0);
-        let uv = match &self.uvs {
-            Some(uvs) => {
-                let [a, bb, c] = self.triangles[triangle];
-                let [uv0, uv1, uv2] = [uvs[a as usize], uvs[bb as usize], uvs[c as usize]];
-                // Solve [dp1 dp2] = [∂p/∂u ∂p/∂v] [duv1 duv2] (pbrt-v4 §6.5.3).
-                let (duv1, duv2) = (uv1 - uv0, uv2 - uv0);
-                let det = duv1.x * duv2.y - duv1.y * duv2.x;
-                if det.abs() > 1e-12 {
-                    let inv = 1.0 / det;
-                    let (dp1, dp2) = (dp_du, dp_dv);
-                    dp_du = (dp1 * duv2.y - dp2 * duv1.y) * inv;
-                    dp_dv = (dp2 * duv1.x - dp1 * duv2.x) * inv;
-                }
-                uv0 * b[0] + uv1 * b[1] + uv2 * b[2]
-            }
-            None => Vec2::new(b[1], b[2]),
-        };
-        SurfaceInteraction {
-            p,
-            t: hit.t,
-            n,
-            shading: Frame::from_normal_and_tangent(shading_n, dp_du),
-            uv,
-            dp_du,
-            dp_dv,
-            shape,
-            primitive: triangle as u32,
-            time: 0.0,
-            attributes: self.attributes_at(triangle, b),
-        }
-    }
-
-    /// A point uniformly distributed over the mesh's area: a triangle chosen in proportion to its
-    /// area by `u_choice`, then a uniform point in it. The pdf is 1/area. None for a mesh of zero
-    /// area.
-    pub fn sample_area(&self, u_choice: f32, u: Vec2) -> Option<SurfaceSample> {
-        let table = self.light_sampling().area_table.as_ref()?;
-        let (triangle, _) = table.sample(u_choice);
-        let b = sample_uniform_triangle(u);
-        Some(self.surface_sample(triangle, [b.x, b.y, 1.0 - b.x - b.y], 1.0 / self.area))
-    }
-
     /// The point at barycentric coordinates `b` of a triangle, with its normals, texture
     /// coordinates and the density `pdf`.
     fn surface_sample(&self, triangle: usize, b: [f32; 3], pdf: f32) -> SurfaceSample {
@@ -355,34 +268,6 @@ impl TriangleMesh {
             primitive: triangle as u32,
             pdf,
         }
-    }
-
-    /// A point of the rectangle the mesh is, seen from `reference` near it, uniform in the solid
-    /// angle S it subtends ([`crate::sampling::spherical_rectangle`]; density 1/S); None when
-    /// the mesh is no rectangle or `reference` is too far ([`SOLID_ANGLE_SAMPLING_DISTANCE`]) or
-    /// in its plane, where the shape samples its area instead.
-    pub fn sample_by_solid_angle(&self, reference: Vec3, u: Vec2) -> Option<SurfaceSample> {
-        let r = self.near_rectangle(reference)?;
-        let projection = r.frame.spherical(reference)?;
-        let st = projection.sample(u);
-        // p = a + s·edge_x + t·edge_y lies on triangle 0 when s + t ≤ 1, else on triangle 1.
-        let (s, t) = (st.x, st.y);
-        let (triangle, weights) = if s + t <= 1.0 {
-            (0, [1.0 - s - t, s, t])
-        } else {
-            (1, [s + t - 1.0, 1.0 - t, 1.0 - s])
-        };
-        let mut b = [0.0; 3];
-        for (slot, weight) in r.slots[triangle].into_iter().zip(weights) {
-            b[slot] = weight;
-        }
-        Some(self.surface_sample(triangle, b, 1.0 / projection.solid_angle()))
-    }
-
-    /// Density of [`Self::sample_by_solid_angle`] from `reference`, 1/S, where it samples.
-    pub fn solid_angle_pdf(&self, reference: Vec3) -> Option<f32> {
-        let r = self.near_rectangle(reference)?;
-        r.frame.solid_angle(reference).map(|s| 1.0 / s)
     }
 
     /// The mesh's light-sampling tables, built on first use.
@@ -467,10 +352,145 @@ impl TriangleMesh {
         })
     }
 
+    /// The triangle [`Self::at_uv`] maps `uv` to.
+    pub fn triangle_at_uv(&self, uv: Vec2) -> Option<usize> {
+        self.uv_grid()
+            .find(uv, |t| self.uv_triangle(t))
+            .map(|hit| hit.triangle)
+    }
+}
+
+impl ShapeGeometry for TriangleMesh {
+    /// Total surface area.
+    fn area(&self) -> f32 {
+        self.area
+    }
+
+    fn object_bounds(&self) -> (Vec3, Vec3) {
+        self.positions.iter().fold(
+            (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+            |(lo, hi), &p| (lo.min(p), hi.max(p)),
+        )
+    }
+
+    fn as_segments(&self) -> Option<Segments<'_>> {
+        None
+    }
+
+    fn intersect_analytic(&self, _ray: &Ray, _t_max: f32) -> Option<f32> {
+        None
+    }
+
+    /// Bytes of heap memory the mesh holds: vertex attributes, indices and the area table.
+    fn heap_bytes(&self) -> usize {
+        use std::mem::size_of;
+        self.positions.capacity() * size_of::<Vec3>()
+            + self
+                .normals
+                .as_ref()
+                .map_or(0, |n| n.capacity() * size_of::<Vec3>())
+            + self
+                .uvs
+                .as_ref()
+                .map_or(0, |uv| uv.capacity() * size_of::<Vec2>())
+            + self.triangles.capacity() * size_of::<[u32; 3]>()
+            + self.face_normals.capacity() * size_of::<Vec3>()
+            + self
+                .attributes
+                .iter()
+                .map(|a| a.values.capacity() * size_of::<Vec3>())
+                .sum::<usize>()
+            + self.light_sampling.get().map_or(0, |l| {
+                size_of::<LightSampling>() + l.area_table.as_ref().map_or(0, AliasTable::heap_bytes)
+            })
+            + self.uv_grid.get().map_or(0, UvGrid::heap_bytes)
+    }
+
+    /// The surface interaction of a ray hit on a triangle.
+    fn interaction(
+        &self,
+        _ray: &Ray,
+        primitive: u32,
+        hit: &TriangleHit,
+        index: u32,
+    ) -> SurfaceInteraction {
+        let (triangle, shape) = (primitive as usize, index);
+        let [p0, p1, p2] = self.vertices(triangle);
+        let b = [hit.b0, hit.b1, hit.b2];
+        // The barycentric combination is closer to the surface than o + t·d.
+        let p = p0 * b[0] + p1 * b[1] + p2 * b[2];
+        let n = self.face_normal(triangle);
+        let shading_n = self.shading_normal(triangle, b, n);
+        // Without texture coordinates, (u, v) are the barycentrics of p1 and p2 (as Mitsuba), so
+        // ∂p/∂u and ∂p/∂v are the edges from p0.
+        let (mut dp_du, mut dp_dv) = (p1 - p0, p2 - p0);
+        let uv = match &self.uvs {
+            Some(uvs) => {
+                let [a, bb, c] = self.triangles[triangle];
+                let [uv0, uv1, uv2] = [uvs[a as usize], uvs[bb as usize], uvs[c as usize]];
+                // Solve [dp1 dp2] = [∂p/∂u ∂p/∂v] [duv1 duv2] (pbrt-v4 §6.5.3).
+                let (duv1, duv2) = (uv1 - uv0, uv2 - uv0);
+                let det = duv1.x * duv2.y - duv1.y * duv2.x;
+                if det.abs() > 1e-12 {
+                    let inv = 1.0 / det;
+                    let (dp1, dp2) = (dp_du, dp_dv);
+                    dp_du = (dp1 * duv2.y - dp2 * duv1.y) * inv;
+                    dp_dv = (dp2 * duv1.x - dp1 * duv2.x) * inv;
+                }
+                uv0 * b[0] + uv1 * b[1] + uv2 * b[2]
+            }
+            None => Vec2::new(b[1], b[2]),
+        };
+        SurfaceInteraction {
+            p,
+            t: hit.t,
+            n,
+            shading: Frame::from_normal_and_tangent(shading_n, dp_du),
+            uv,
+            dp_du,
+            dp_dv,
+            shape,
+            primitive: triangle as u32,
+            time: 0.0,
+            attributes: self.attributes_at(triangle, b),
+        }
+    }
+
+    /// From a point near the rectangle the mesh is ([`SOLID_ANGLE_SAMPLING_DISTANCE`]) and out
+    /// of its plane, the spherical rectangle; None for other meshes and points, which sample
+    /// the area.
+    fn solid_angle_sampler(&self, reference: Vec3) -> Option<SolidAngleSampler<'_>> {
+        let rectangle = self.near_rectangle(reference)?;
+        let projection = rectangle.frame.project(reference)?;
+        Some(SolidAngleSampler::Rectangle(RectangleView {
+            mesh: self,
+            rectangle,
+            projection,
+        }))
+    }
+
+    /// A point uniformly distributed over the mesh's area: a triangle chosen in proportion to its
+    /// area by `u_choice`, then a uniform point in it. The pdf is 1/area. None for a mesh of zero
+    /// area.
+    fn sample_area(&self, u_choice: f32, u: Vec2) -> Option<SurfaceSample> {
+        let table = self.light_sampling().area_table.as_ref()?;
+        let (triangle, _) = table.sample(u_choice);
+        let b = sample_uniform_triangle(u);
+        Some(self.surface_sample(triangle, [b.x, b.y, 1.0 - b.x - b.y], 1.0 / self.area))
+    }
+
+    fn uv_jacobian_at(&self, primitive: u32, uv: Vec2) -> Option<f32> {
+        let triangle = self.triangle_at_uv(uv)?;
+        if triangle != primitive as usize {
+            return None;
+        }
+        self.uv_jacobian(triangle)
+    }
+
     /// The surface point with texture coordinates `uv` (Mitsuba's `eval_parameterization`), on
     /// the lowest-numbered triangle whose uv triangle contains it, with that triangle's
     /// [`Self::uv_jacobian`]; None where no triangle covers `uv`. The sample's pdf is 0.
-    pub fn at_uv(&self, uv: Vec2) -> Option<(SurfaceSample, f32)> {
+    fn at_uv(&self, uv: Vec2) -> Option<(SurfaceSample, f32)> {
         let hit = self.uv_grid().find(uv, |t| self.uv_triangle(t))?;
         let triangle = hit.triangle;
         let jacobian = self.uv_jacobian(triangle)?;
@@ -487,12 +507,38 @@ impl TriangleMesh {
         };
         Some((sample, jacobian))
     }
+}
 
-    /// The triangle [`Self::at_uv`] maps `uv` to.
-    pub fn triangle_at_uv(&self, uv: Vec2) -> Option<usize> {
-        self.uv_grid()
-            .find(uv, |t| self.uv_triangle(t))
-            .map(|hit| hit.triangle)
+/// A rectangle mesh seen from one point near it: its spherical projection, sampled uniformly
+/// in solid angle ([`crate::sampling::spherical_rectangle`], Ureña et al. 2013; density 1/S).
+#[derive(Clone, Copy, Debug)]
+pub struct RectangleView<'a> {
+    mesh: &'a TriangleMesh,
+    rectangle: &'a Rectangle,
+    projection: Projection,
+}
+
+impl RectangleView<'_> {
+    /// A point whose direction is uniform in the solid angle S the rectangle subtends.
+    pub fn sample(&self, u: Vec2) -> SurfaceSample {
+        let st = self.rectangle.frame.spherical(&self.projection).sample(u);
+        // p = a + s·edge_x + t·edge_y lies on triangle 0 when s + t ≤ 1, else on triangle 1.
+        let (s, t) = (st.x, st.y);
+        let (triangle, weights) = if s + t <= 1.0 {
+            (0, [1.0 - s - t, s, t])
+        } else {
+            (1, [s + t - 1.0, 1.0 - t, 1.0 - s])
+        };
+        let mut b = [0.0; 3];
+        for (slot, weight) in self.rectangle.slots[triangle].into_iter().zip(weights) {
+            b[slot] = weight;
+        }
+        self.mesh.surface_sample(triangle, b, self.pdf())
+    }
+
+    /// The density of [`Self::sample`] per unit solid angle, 1/S.
+    pub fn pdf(&self) -> f32 {
+        1.0 / self.projection.solid_angle()
     }
 }
 

@@ -5,8 +5,10 @@ use std::f32::consts::PI;
 use glam::{DVec3, Mat3, Vec2, Vec3};
 
 use super::mesh::SurfaceSample;
+use super::{Segments, ShapeGeometry, SolidAngleSampler};
 use crate::geometry::interaction::{AttributeValues, SurfaceInteraction};
-use crate::math::Frame;
+use crate::geometry::triangle::TriangleHit;
+use crate::math::{Frame, Ray};
 use crate::sampling::warp::sample_uniform_sphere;
 
 /// A sphere; the normal points outwards unless `flip_normals`.
@@ -25,10 +27,6 @@ pub struct Sphere {
 const OUTSIDE_MARGIN: f32 = 1e-4;
 
 impl Sphere {
-    pub fn area(&self) -> f32 {
-        4.0 * PI * self.radius * self.radius
-    }
-
     /// Nearest t in (0, t_max) where the ray meets the sphere. Solved in double precision with
     /// the discriminant written as r² − |f − (f·d/d·d) d|² (Haines et al. 2019, "Precision
     /// Improvements for Ray/Sphere Intersection", Ray Tracing Gems ch. 7), which keeps its
@@ -60,7 +58,7 @@ impl Sphere {
 
     /// The surface interaction at the point hit at distance `t`; the point is projected back
     /// onto the sphere, where it is accurate to a few ulps.
-    pub fn interaction(&self, o: Vec3, d: Vec3, t: f32, shape: u32) -> SurfaceInteraction {
+    pub fn interaction_at(&self, o: Vec3, d: Vec3, t: f32, shape: u32) -> SurfaceInteraction {
         let c = self.center.as_dvec3();
         let hit = o.as_dvec3() + d.as_dvec3() * f64::from(t);
         let outward = (hit - c).normalize_or(DVec3::Z);
@@ -127,9 +125,64 @@ impl Sphere {
         2.0 * PI * PI * self.radius * self.radius * (PI * uv.y).sin().abs()
     }
 
+    /// Whether a point at squared distance `dc2` from the centre is clearly outside the sphere.
+    fn is_outside(&self, dc2: f32) -> bool {
+        dc2 > self.radius * self.radius * (1.0 + OUTSIDE_MARGIN)
+    }
+}
+
+impl ShapeGeometry for Sphere {
+    fn area(&self) -> f32 {
+        4.0 * PI * self.radius * self.radius
+    }
+
+    fn object_bounds(&self) -> (Vec3, Vec3) {
+        (self.center - self.radius, self.center + self.radius)
+    }
+
+    fn as_segments(&self) -> Option<Segments<'_>> {
+        None
+    }
+
+    fn intersect_analytic(&self, ray: &Ray, t_max: f32) -> Option<f32> {
+        self.intersect(ray.o, ray.d, t_max)
+    }
+
+    fn interaction(
+        &self,
+        ray: &Ray,
+        _primitive: u32,
+        hit: &TriangleHit,
+        index: u32,
+    ) -> SurfaceInteraction {
+        self.interaction_at(ray.o, ray.d, hit.t, index)
+    }
+
+    /// A uniform point on the whole sphere; pdf per unit area.
+    fn sample_area(&self, _u_choice: f32, u: Vec2) -> Option<SurfaceSample> {
+        Some(SurfaceSample {
+            pdf: 1.0 / self.area(),
+            ..self.surface_point(sample_uniform_sphere(u))
+        })
+    }
+
+    /// From outside, the cone the sphere subtends (the lecture's "sample the front-facing
+    /// part", pbrt-v4 §6.2.4), so no sample is wasted on the far side; from inside (or on the
+    /// surface: a sphere lighting its own inside), None: points are uniform in area.
+    fn solid_angle_sampler(&self, reference: Vec3) -> Option<SolidAngleSampler<'_>> {
+        let to_center = self.center - reference;
+        let dc2 = to_center.length_squared();
+        self.is_outside(dc2)
+            .then_some(SolidAngleSampler::SphereCone(SphereCone {
+                sphere: self,
+                to_center,
+                dc2,
+            }))
+    }
+
     /// The surface point with texture coordinates `uv` in [0, 1]² (the inverse of
     /// [`Self::uv`]), with its [`Self::uv_jacobian`]. The sample's pdf is 0.
-    pub fn at_uv(&self, uv: Vec2) -> Option<(SurfaceSample, f32)> {
+    fn at_uv(&self, uv: Vec2) -> Option<(SurfaceSample, f32)> {
         if !(uv.x >= 0.0 && uv.x <= 1.0 && uv.y >= 0.0 && uv.y <= 1.0) {
             return None;
         }
@@ -144,31 +197,28 @@ impl Sphere {
         Some((sample, self.uv_jacobian(uv)))
     }
 
-    /// Whether a point at squared distance `dc2` from the centre is clearly outside the sphere.
-    fn is_outside(&self, dc2: f32) -> bool {
-        dc2 > self.radius * self.radius * (1.0 + OUTSIDE_MARGIN)
+    fn uv_jacobian_at(&self, _primitive: u32, uv: Vec2) -> Option<f32> {
+        self.at_uv(uv).map(|(_, jacobian)| jacobian)
     }
 
-    /// A uniform point on the whole sphere; pdf per unit area.
-    pub fn sample_area(&self, u: Vec2) -> SurfaceSample {
-        SurfaceSample {
-            pdf: 1.0 / self.area(),
-            ..self.surface_point(sample_uniform_sphere(u))
-        }
+    fn heap_bytes(&self) -> usize {
+        0
     }
+}
 
-    /// A point seen from `reference`, pdf per unit solid angle. Outside the sphere the direction
-    /// is uniform in the cone the sphere subtends (the lecture's "sample the front-facing part",
-    /// pbrt-v4 §6.2.4), so no sample is wasted on the far side; inside, points are uniform in area.
-    pub fn sample_from(&self, reference: Vec3, u: Vec2) -> Option<SurfaceSample> {
-        let to_center = self.center - reference;
-        let dc2 = to_center.length_squared();
-        let r = self.radius;
-        if !self.is_outside(dc2) {
-            let s = self.sample_area(u);
-            let pdf = area_to_solid_angle(s.pdf, reference, s.p, s.n)?;
-            return Some(SurfaceSample { pdf, ..s });
-        }
+/// The cone a sphere subtends at a point outside it, sampled uniformly in solid angle.
+#[derive(Clone, Copy, Debug)]
+pub struct SphereCone<'a> {
+    sphere: &'a Sphere,
+    /// From the reference point to the centre, and its squared length.
+    to_center: Vec3,
+    dc2: f32,
+}
+
+impl SphereCone<'_> {
+    /// A point of the sphere whose direction is uniform in the cone; pdf per unit solid angle.
+    pub fn sample(&self, u: Vec2) -> Option<SurfaceSample> {
+        let (to_center, dc2, r) = (self.to_center, self.dc2, self.sphere.radius);
         let dc = dc2.sqrt();
         let sin2_max = r * r / dc2;
         let one_minus_cos_max = one_minus_cos(sin2_max);
@@ -193,18 +243,14 @@ impl Sphere {
             .normalize();
         Some(SurfaceSample {
             pdf: 1.0 / (2.0 * PI * one_minus_cos_max),
-            ..self.surface_point(outward)
+            ..self.sphere.surface_point(outward)
         })
     }
 
-    /// Density of [`Self::sample_from`] for the point `p` (normal `n`), per unit solid angle.
-    pub fn pdf_from(&self, reference: Vec3, p: Vec3, n: Vec3) -> f32 {
-        let dc2 = (self.center - reference).length_squared();
-        let r = self.radius;
-        if !self.is_outside(dc2) {
-            return area_to_solid_angle(1.0 / self.area(), reference, p, n).unwrap_or(0.0);
-        }
-        1.0 / (2.0 * PI * one_minus_cos(r * r / dc2))
+    /// The density of [`Self::sample`], 1 / (2π (1 − cos θ_max)).
+    pub fn pdf(&self) -> f32 {
+        let r = self.sphere.radius;
+        1.0 / (2.0 * PI * one_minus_cos(r * r / self.dc2))
     }
 }
 
@@ -230,6 +276,7 @@ pub fn area_to_solid_angle(pdf_area: f32, reference: Vec3, p: Vec3, n: Vec3) -> 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::geometry::shape::ShapeSampling;
 
     fn unit_sphere() -> Sphere {
         Sphere {
@@ -245,7 +292,7 @@ mod tests {
         let s = unit_sphere();
         let t = s.intersect(Vec3::ZERO, Vec3::Z, f32::INFINITY).unwrap();
         assert!((t - 4.0).abs() < 1e-6);
-        let si = s.interaction(Vec3::ZERO, Vec3::Z, t, 0);
+        let si = s.interaction_at(Vec3::ZERO, Vec3::Z, t, 0);
         assert!((si.n + Vec3::Z).length() < 1e-6);
         // From inside, the far wall.
         let t = s
@@ -254,7 +301,7 @@ mod tests {
         assert!((t - 1.0).abs() < 1e-6);
         assert!(s.intersect(Vec3::ZERO, Vec3::X, f32::INFINITY).is_none());
         // Rays leaving the surface do not hit it again.
-        let si = s.interaction(Vec3::ZERO, Vec3::Z, 4.0, 0);
+        let si = s.interaction_at(Vec3::ZERO, Vec3::Z, 4.0, 0);
         let ray = si.spawn_ray(-Vec3::Z);
         assert!(s.intersect(ray.o, ray.d, f32::INFINITY).is_none());
     }
@@ -269,12 +316,14 @@ mod tests {
         };
         for k in 0..1000 {
             let u = Vec2::new((k % 31) as f32 / 31.0 + 0.01, (k / 31) as f32 / 33.0 + 0.01);
-            let x = s.sample_area(u);
+            let x = s.sample_area(0.5, u).unwrap();
             let v = Vec2::new(
                 ((k * 7) % 29) as f32 / 29.0 + 0.02,
                 ((k * 3) % 37) as f32 / 37.0 + 0.03,
             );
-            let y = s.sample_from(x.p, v).unwrap();
+            let y = s
+                .sample_from(x.p, 0.5, v, ShapeSampling::SolidAngle)
+                .unwrap();
             let w = (y.p - x.p).normalize();
             let estimate = w.dot(x.n).max(0.0) / y.pdf;
             assert!((estimate - PI).abs() < 1e-2 * PI, "sample {k}: {estimate}");
@@ -290,7 +339,9 @@ mod tests {
         {
             for k in 0..1000 {
                 let u = Vec2::new((k % 37) as f32 / 37.0, (k / 37) as f32 / 27.0);
-                let sample = s.sample_from(reference, u).unwrap();
+                let sample = s
+                    .sample_from(reference, 0.5, u, ShapeSampling::SolidAngle)
+                    .unwrap();
                 assert!(
                     ((sample.p - s.center).length() - 1.0).abs() < 1e-4,
                     "case {i}"
@@ -298,7 +349,9 @@ mod tests {
                 // Visible: the normal faces the reference.
                 assert!(sample.n.dot(reference - sample.p) >= -1e-3, "case {i}");
                 assert!(
-                    (s.pdf_from(reference, sample.p, sample.n) - sample.pdf).abs()
+                    (s.pdf_from(reference, sample.p, sample.n, ShapeSampling::SolidAngle)
+                        - sample.pdf)
+                        .abs()
                         <= 1e-6 * sample.pdf
                 );
             }
