@@ -11,6 +11,7 @@ use prism_core::light::{Light, LightSampler, LightSource, Receiver};
 use prism_core::scene::Scene;
 use prism_core::spectrum::SampledWavelengths;
 use prism_core::spectrum::cie::d65_normalized;
+use prism_core::texture::TextureValues;
 use prism_mitsuba::factory::build_scene;
 use prism_mitsuba::reader::read_scene_str;
 

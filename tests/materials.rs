@@ -21,6 +21,7 @@ use prism_core::bsdf::{Bsdf, BsdfFlags, BsdfModel};
 use prism_core::sampling::rng::Pcg32;
 use prism_core::spectrum::SampledWavelengths;
 use prism_core::spectrum::conductors::CONDUCTORS;
+use prism_core::texture::TextureValues;
 
 fn temp_dir(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("prism-materials-{}-{name}", std::process::id()));

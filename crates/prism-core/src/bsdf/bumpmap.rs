@@ -23,6 +23,7 @@ use super::perturbed::{Tilt, resolve_perturbed};
 use super::{Bsdf, BsdfFlags, BsdfModel, BxdfTree, NodeId, ShadingPoint};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use crate::texture::Texture;
+use crate::texture::TextureValues;
 
 #[derive(Clone, Debug)]
 pub struct BumpMap {

@@ -9,6 +9,7 @@ use std::f32::consts::PI;
 use glam::{Vec2, Vec3};
 
 use crate::spectrum::{SampledSpectrum, SampledWavelengths, cie::cie_y};
+use crate::texture::TextureValues;
 use crate::texture::{Texture, TexturePoint};
 
 /// An optional parameter's value at a point (absent: the lobe it scales is off).

@@ -18,6 +18,7 @@ use wide::f32x4;
 use super::fresnel::{fresnel_conductor4, reflect_z};
 use super::{BsdfFlags, BsdfModel, BsdfSample, Bxdf, BxdfTree, NodeId, ShadingPoint};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+use crate::texture::TextureValues;
 use crate::texture::{Texture, TexturePoint};
 
 #[derive(Clone, Debug)]

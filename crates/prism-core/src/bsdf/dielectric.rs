@@ -25,6 +25,7 @@ use super::fresnel::{fresnel_dielectric, reflect_z, refract_z};
 use super::{BsdfFlags, BsdfModel, BsdfSample, Bxdf, BxdfTree, NodeId, ShadingPoint};
 use crate::spectrum::ior::RelativeIor;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+use crate::texture::TextureValues;
 use crate::texture::{Texture, TexturePoint};
 
 #[derive(Clone, Debug)]

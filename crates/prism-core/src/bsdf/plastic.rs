@@ -34,6 +34,7 @@ use super::{
 use crate::sampling::warp::{cosine_hemisphere_pdf, sample_cosine_hemisphere};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use crate::texture::Texture;
+use crate::texture::TextureValues;
 
 #[derive(Clone, Debug)]
 pub struct Plastic {

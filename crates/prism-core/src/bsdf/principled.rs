@@ -56,6 +56,7 @@ use super::{BsdfEval, BsdfFlags, BsdfModel, BsdfSample, Bxdf, BxdfTree, NodeId, 
 use crate::sampling::warp::{cosine_hemisphere_pdf, sample_cosine_hemisphere};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use crate::texture::Texture;
+use crate::texture::TextureValues;
 
 /// The relative weights with which the lobes are sampled (Mitsuba's `*_sampling_rate`).
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -24,6 +24,7 @@ use super::microfacet::{Microfacet, MicrofacetKind};
 use super::{BsdfEval, BsdfFlags, BsdfModel, BsdfSample, Bxdf, BxdfTree, NodeId, ShadingPoint};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use crate::texture::Texture;
+use crate::texture::TextureValues;
 
 #[derive(Clone, Debug)]
 pub struct RoughConductor {

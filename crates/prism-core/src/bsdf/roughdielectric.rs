@@ -32,6 +32,7 @@ use super::{BsdfEval, BsdfFlags, BsdfModel, BsdfSample, Bxdf, BxdfTree, NodeId, 
 use crate::spectrum::ior::RelativeIor;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use crate::texture::Texture;
+use crate::texture::TextureValues;
 
 #[derive(Clone, Debug)]
 pub struct RoughDielectric {

@@ -37,6 +37,7 @@ use super::{
 use crate::sampling::warp::{cosine_hemisphere_pdf, sample_cosine_hemisphere};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use crate::texture::Texture;
+use crate::texture::TextureValues;
 
 /// Entries of the transmittance table (Mitsuba's MI_ROUGH_TRANSMITTANCE_RES).
 const TABLE_SIZE: usize = 64;

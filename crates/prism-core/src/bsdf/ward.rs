@@ -35,6 +35,7 @@ use super::{
 use crate::sampling::warp::{cosine_hemisphere_pdf, sample_cosine_hemisphere};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use crate::texture::Texture;
+use crate::texture::TextureValues;
 
 /// Which normalisation of the glossy lobe.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

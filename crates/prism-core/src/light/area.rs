@@ -42,6 +42,7 @@ use crate::geometry::{Primitive, Shape, ShapeGeometry, ShapeSampling, SurfaceSam
 use crate::sampling::distribution::PiecewiseConstant2D;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths, Spectrum};
 use crate::texture::Texture;
+use crate::texture::TextureValues;
 
 /// The probability with which a textured emitter is sampled by its shape rather than by its
 /// texture (see the module's text).

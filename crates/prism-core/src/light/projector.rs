@@ -39,6 +39,7 @@ use crate::geometry::Primitive;
 use crate::math::Transform;
 use crate::spectrum::SampledWavelengths;
 use crate::texture::Texture;
+use crate::texture::TextureValues;
 
 #[derive(Clone, Debug)]
 pub struct Projector {

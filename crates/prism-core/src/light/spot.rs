@@ -27,6 +27,7 @@ use crate::geometry::Primitive;
 use crate::math::Transform;
 use crate::spectrum::{SampledWavelengths, Spectrum};
 use crate::texture::Texture;
+use crate::texture::TextureValues;
 
 #[derive(Clone, Debug)]
 pub struct SpotLight {

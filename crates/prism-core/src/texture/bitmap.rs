@@ -22,7 +22,7 @@
 
 use glam::{Vec2, Vec3};
 
-use super::UvTransform;
+use super::{TexturePoint, TextureValues, UvTransform, mean_over_cells};
 use crate::image::Bitmap;
 use crate::spectrum::rgb::{RgbSigmoidPolynomial, RgbToSpectrumTable};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
@@ -220,7 +220,21 @@ impl BitmapTexture {
         }
     }
 
-    pub fn eval(&self, uv: Vec2, lambda: &SampledWavelengths) -> SampledSpectrum {
+    /// The luminance (or value) of texel `i`.
+    #[inline]
+    fn texel_value(&self, i: usize) -> f32 {
+        match &self.texels {
+            Texels::Scalar(t) => t[i],
+            Texels::Rgb(t) => luminance(t[i]),
+            Texels::Spectral(t) => luminance(t[i].linear_srgb()),
+            Texels::Emission(t) => luminance(t[i].linear_srgb()),
+        }
+    }
+}
+
+impl TextureValues for BitmapTexture {
+    fn eval(&self, at: impl Into<TexturePoint>, lambda: &SampledWavelengths) -> SampledSpectrum {
+        let uv = at.into().uv;
         let (index, weight, _) = self.footprint(uv);
         match &self.texels {
             Texels::Spectral(texels) => {
@@ -245,22 +259,12 @@ impl BitmapTexture {
                 }
                 result
             }
-            _ => SampledSpectrum::splat(self.eval_1(uv)),
+            Texels::Scalar(_) | Texels::Rgb(_) => SampledSpectrum::splat(self.eval_1(uv)),
         }
     }
 
-    /// The luminance (or value) of texel `i`.
-    #[inline]
-    fn texel_value(&self, i: usize) -> f32 {
-        match &self.texels {
-            Texels::Scalar(t) => t[i],
-            Texels::Rgb(t) => luminance(t[i]),
-            Texels::Spectral(t) => luminance(t[i].linear_srgb()),
-            Texels::Emission(t) => luminance(t[i].linear_srgb()),
-        }
-    }
-
-    pub fn eval_1(&self, uv: Vec2) -> f32 {
+    fn eval_1(&self, at: impl Into<TexturePoint>) -> f32 {
+        let uv = at.into().uv;
         let (index, weight, _) = self.footprint(uv);
         index
             .into_iter()
@@ -278,7 +282,8 @@ impl BitmapTexture {
     /// ∂/∂(u, v) of [`Self::eval_1`] for bilinear filtering (Mitsuba's `eval_1_grad`): the
     /// derivative of the bilinear interpolant in texel units, times the resolution, pulled back
     /// through `to_uv`. Zero for nearest filtering.
-    pub fn eval_1_grad(&self, uv: Vec2) -> Vec2 {
+    fn eval_1_grad(&self, at: impl Into<TexturePoint>) -> Vec2 {
+        let uv = at.into().uv;
         if self.filter == FilterType::Nearest {
             return Vec2::ZERO;
         }
@@ -292,7 +297,8 @@ impl BitmapTexture {
         self.to_uv.pull_back_gradient(d_uv)
     }
 
-    pub fn eval_3(&self, uv: Vec2) -> Vec3 {
+    fn eval_3(&self, at: impl Into<TexturePoint>) -> Vec3 {
+        let uv = at.into().uv;
         let (index, weight, _) = self.footprint(uv);
         let mut result = Vec3::ZERO;
         for (i, w) in index.into_iter().zip(weight) {
@@ -310,7 +316,7 @@ impl BitmapTexture {
         result
     }
 
-    pub fn max_value(&self) -> f32 {
+    fn max_value(&self) -> f32 {
         match &self.texels {
             Texels::Scalar(t) => t.iter().copied().fold(0.0, f32::max),
             Texels::Rgb(t) => t.iter().flatten().copied().fold(0.0, f32::max),
@@ -321,12 +327,16 @@ impl BitmapTexture {
         }
     }
 
-    pub fn min_value(&self) -> f32 {
+    fn min_value(&self) -> f32 {
         match &self.texels {
             Texels::Scalar(t) => t.iter().copied().fold(f32::INFINITY, f32::min),
             Texels::Rgb(t) => t.iter().flatten().copied().fold(f32::INFINITY, f32::min),
             Texels::Spectral(_) | Texels::Emission(_) => 0.0,
         }
+    }
+
+    fn mean_value(&self) -> f32 {
+        mean_over_cells(self, self.width.max(1), self.height.max(1))
     }
 }
 

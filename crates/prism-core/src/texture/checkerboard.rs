@@ -12,9 +12,9 @@
 //! Read as a number (a roughness, an opacity) the phase is the opposite one: `color0` where
 //! they differ (Mitsuba 3's `eval_1` tests inequality), so the same XML gives the same image.
 
-use glam::Vec2;
+use glam::{Vec2, Vec3};
 
-use super::{Texture, TexturePoint, UvTransform};
+use super::{Texture, TexturePoint, TextureValues, UvTransform, mean_over_cells};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 
 #[derive(Clone, Debug)]
@@ -32,33 +32,49 @@ impl Checkerboard {
         let upper = |x: f32| x - x.floor() > 0.5;
         upper(p.x) == upper(p.y)
     }
+}
 
+impl TextureValues for Checkerboard {
     /// The colour at `at`: `color0` on the even squares.
-    pub fn eval(&self, at: &TexturePoint, lambda: &SampledWavelengths) -> SampledSpectrum {
+    fn eval(&self, at: impl Into<TexturePoint>, lambda: &SampledWavelengths) -> SampledSpectrum {
+        let at = at.into();
         let texture = if self.in_even_square(at.uv) {
             &self.color0
         } else {
             &self.color1
         };
-        texture.eval(*at, lambda)
+        texture.eval(at, lambda)
     }
 
     /// The number at `at`: `color0` on the odd squares, Mitsuba 3's phase for `eval_1`.
-    pub fn eval_1(&self, at: &TexturePoint) -> f32 {
+    fn eval_1(&self, at: impl Into<TexturePoint>) -> f32 {
+        let at = at.into();
         let texture = if self.in_even_square(at.uv) {
             &self.color1
         } else {
             &self.color0
         };
-        texture.eval_1(*at)
+        texture.eval_1(at)
     }
 
-    pub fn max_value(&self) -> f32 {
+    fn eval_1_grad(&self, _at: impl Into<TexturePoint>) -> Vec2 {
+        Vec2::ZERO
+    }
+
+    fn eval_3(&self, at: impl Into<TexturePoint>) -> Vec3 {
+        Vec3::splat(self.eval_1(at))
+    }
+
+    fn max_value(&self) -> f32 {
         self.color0.max_value().max(self.color1.max_value())
     }
 
-    pub fn min_value(&self) -> f32 {
+    fn min_value(&self) -> f32 {
         self.color0.min_value().min(self.color1.min_value())
+    }
+
+    fn mean_value(&self) -> f32 {
+        mean_over_cells(self, 256, 256)
     }
 }
 
@@ -77,14 +93,14 @@ mod tests {
         };
         let lambda = SampledWavelengths::single(550.0);
         let at = |u: f32, v: f32| TexturePoint::from(Vec2::new(u, v));
-        let colour = |u: f32, v: f32| c.eval(&at(u, v), &lambda)[0];
+        let colour = |u: f32, v: f32| c.eval(at(u, v), &lambda)[0];
         assert_eq!(colour(0.25, 0.25), 0.4);
         assert_eq!(colour(0.75, 0.75), 0.4);
         assert_eq!(colour(0.75, 0.25), 0.2);
         assert_eq!(colour(1.25, -0.25), 0.2);
-        assert_eq!(c.eval_1(&at(0.25, 0.25)), 0.2);
-        assert_eq!(c.eval_1(&at(0.75, 0.75)), 0.2);
-        assert_eq!(c.eval_1(&at(0.75, 0.25)), 0.4);
-        assert_eq!(c.eval_1(&at(1.25, -0.25)), 0.4);
+        assert_eq!(c.eval_1(at(0.25, 0.25)), 0.2);
+        assert_eq!(c.eval_1(at(0.75, 0.75)), 0.2);
+        assert_eq!(c.eval_1(at(0.75, 0.25)), 0.4);
+        assert_eq!(c.eval_1(at(1.25, -0.25)), 0.4);
     }
 }

@@ -13,9 +13,10 @@
 //!
 //! [`MAX_MESH_ATTRIBUTES`]: crate::geometry::interaction::MAX_MESH_ATTRIBUTES
 
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 use wide::f32x4;
 
+use super::{TexturePoint, TextureValues};
 use crate::geometry::interaction::AttributeValues;
 use crate::spectrum::rgb::{RgbSigmoidPolynomial, RgbToSpectrumTable};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
@@ -31,9 +32,12 @@ impl MeshAttributeTexture {
     fn polynomial(&self, values: &AttributeValues) -> RgbSigmoidPolynomial {
         RgbToSpectrumTable::srgb().fetch(values.0[usize::from(self.slot)].to_array())
     }
+}
 
+impl TextureValues for MeshAttributeTexture {
     #[inline]
-    pub fn eval(&self, values: &AttributeValues, lambda: &SampledWavelengths) -> SampledSpectrum {
+    fn eval(&self, at: impl Into<TexturePoint>, lambda: &SampledWavelengths) -> SampledSpectrum {
+        let values = &at.into().attributes;
         let lambda = f32x4::from(*lambda.lambdas());
         let value = f32x4::splat(self.scale) * self.polynomial(values).eval4(lambda);
         SampledSpectrum(value.to_array())
@@ -41,14 +45,33 @@ impl MeshAttributeTexture {
 
     /// The mean of the spectrum over 360–830 nm (the scene reader reads colour attributes only
     /// as colours, as Mitsuba does; this keeps the function total).
-    pub fn eval_1(&self, values: &AttributeValues) -> f32 {
+    fn eval_1(&self, at: impl Into<TexturePoint>) -> f32 {
+        let values = &at.into().attributes;
         let rgb = self.polynomial(values).linear_srgb();
         self.scale * (rgb[0] + rgb[1] + rgb[2]) / 3.0
     }
 
+    fn eval_1_grad(&self, _at: impl Into<TexturePoint>) -> Vec2 {
+        Vec2::ZERO
+    }
+
     /// The linear sRGB colour of the spectrum.
-    pub fn eval_3(&self, values: &AttributeValues) -> Vec3 {
+    fn eval_3(&self, at: impl Into<TexturePoint>) -> Vec3 {
+        let values = &at.into().attributes;
         Vec3::from(self.polynomial(values).linear_srgb()) * self.scale
+    }
+
+    fn max_value(&self) -> f32 {
+        self.scale
+    }
+
+    fn min_value(&self) -> f32 {
+        0.0
+    }
+
+    /// No (u, v) map: its bound (the scene reader reads mesh attributes only as colours).
+    fn mean_value(&self) -> f32 {
+        self.scale
     }
 }
 
@@ -69,7 +92,11 @@ mod tests {
                 scale: 0.5,
             };
             let lambda = SampledWavelengths::sample(0.3, WavelengthSampling::default());
-            let value = texture.eval(&values, &lambda);
+            let at = TexturePoint {
+                uv: glam::Vec2::ZERO,
+                attributes: values,
+            };
+            let value = texture.eval(at, &lambda);
             for i in 0..4 {
                 let expected = 0.5 * polynomial.eval(lambda.lambda(i));
                 assert!((value[i] - expected).abs() <= 1e-6, "{rgb:?}: {value:?}");

@@ -12,6 +12,7 @@
 
 pub mod bitmap;
 pub mod checkerboard;
+pub mod constant;
 pub mod mesh_attribute;
 
 use std::sync::Arc;
@@ -22,20 +23,53 @@ pub use bitmap::{BitmapTexture, FilterType, TextureUse, WrapMode};
 pub use checkerboard::Checkerboard;
 pub use mesh_attribute::MeshAttributeTexture;
 
+use crate::dispatch::plugin_class;
 use crate::geometry::interaction::AttributeValues;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths, Spectrum};
 
-/// A texture, dispatched by `match`.
-#[derive(Clone, Debug)]
-pub enum Texture {
-    /// The same value everywhere.
-    Constant(Spectrum),
-    /// An image (shared between the materials that reference it).
-    Bitmap(Arc<BitmapTexture>),
-    /// Two textures in a checkerboard pattern.
-    Checkerboard(Box<Checkerboard>),
-    /// A colour the mesh carries per vertex or per face (Mitsuba's `mesh_attribute`).
-    MeshAttribute(MeshAttributeTexture),
+plugin_class! {
+    /// What every texture answers: its value at a point read as a spectrum, as a number or
+    /// as a raw RGB triple, and bounds of its values.
+    pub trait TextureValues {
+        /// The spectral value at `at` and the wavelengths `lambda`.
+        fn eval(&self, at: impl Into<TexturePoint>, lambda: &SampledWavelengths) -> SampledSpectrum;
+
+        /// The scalar value at `at` (a constant spectrum's value; a non-constant one's mean
+        /// over 360–830 nm).
+        fn eval_1(&self, at: impl Into<TexturePoint>) -> f32;
+
+        /// The gradient (∂/∂u, ∂/∂v) of [`Self::eval_1`] (for bump mapping); zero where the
+        /// texture is piecewise constant.
+        fn eval_1_grad(&self, at: impl Into<TexturePoint>) -> Vec2;
+
+        /// The raw RGB value at `at` (normal maps); a constant or checkerboard gives its scalar
+        /// value in all three components, a mesh attribute the linear sRGB colour of its
+        /// spectrum.
+        fn eval_3(&self, at: impl Into<TexturePoint>) -> Vec3;
+
+        /// An upper bound of the values (spectral or scalar) the texture takes.
+        fn max_value(&self) -> f32;
+
+        /// The smallest value the texture takes (for validating scalar parameters).
+        fn min_value(&self) -> f32;
+
+        /// The mean of [`Self::eval_1`] over [0, 1]²: at an image's texel centres, or on a
+        /// grid of 256 × 256 cell centres for a pattern ([`mean_over_cells`]).
+        fn mean_value(&self) -> f32;
+    }
+
+    /// A texture.
+    #[derive(Clone, Debug)]
+    pub enum Texture {
+        /// The same value everywhere.
+        Constant(Spectrum),
+        /// An image (shared between the materials that reference it).
+        Bitmap(Arc<BitmapTexture>),
+        /// Two textures in a checkerboard pattern.
+        Checkerboard(Box<Checkerboard>),
+        /// A colour the mesh carries per vertex or per face (Mitsuba's `mesh_attribute`).
+        MeshAttribute(MeshAttributeTexture),
+    }
 }
 
 /// Where a texture is looked up.
@@ -61,103 +95,21 @@ impl Texture {
     pub fn constant(v: f32) -> Texture {
         Texture::Constant(Spectrum::Constant(v))
     }
+}
 
-    /// The spectral value at `uv` and the wavelengths `lambda`.
-    #[inline]
-    pub fn eval(
-        &self,
-        at: impl Into<TexturePoint>,
-        lambda: &SampledWavelengths,
-    ) -> SampledSpectrum {
-        let at = at.into();
-        match self {
-            Texture::Constant(spectrum) => spectrum.sample(lambda),
-            Texture::Bitmap(bitmap) => bitmap.eval(at.uv, lambda),
-            Texture::Checkerboard(checkerboard) => checkerboard.eval(&at, lambda),
-            Texture::MeshAttribute(attribute) => attribute.eval(&at.attributes, lambda),
-        }
-    }
-
-    /// The scalar value at `uv` (a constant spectrum's value; a non-constant one's mean over
-    /// 360–830 nm).
-    #[inline]
-    pub fn eval_1(&self, at: impl Into<TexturePoint>) -> f32 {
-        let at = at.into();
-        match self {
-            Texture::Constant(Spectrum::Constant(v)) => *v,
-            Texture::Constant(spectrum) => spectrum.mean(),
-            Texture::Bitmap(bitmap) => bitmap.eval_1(at.uv),
-            Texture::Checkerboard(checkerboard) => checkerboard.eval_1(&at),
-            Texture::MeshAttribute(attribute) => attribute.eval_1(&at.attributes),
-        }
-    }
-
-    /// The gradient (∂/∂u, ∂/∂v) of [`Self::eval_1`] (for bump mapping); zero where the texture
-    /// is piecewise constant.
-    #[inline]
-    pub fn eval_1_grad(&self, at: impl Into<TexturePoint>) -> Vec2 {
-        match self {
-            Texture::Bitmap(bitmap) => bitmap.eval_1_grad(at.into().uv),
-            Texture::Constant(_) | Texture::Checkerboard(_) | Texture::MeshAttribute(_) => {
-                Vec2::ZERO
-            }
-        }
-    }
-
-    /// The raw RGB value at `uv` (normal maps); a constant or checkerboard gives its scalar value
-    /// in all three components, a mesh attribute the linear sRGB colour of its spectrum.
-    #[inline]
-    pub fn eval_3(&self, at: impl Into<TexturePoint>) -> Vec3 {
-        let at = at.into();
-        match self {
-            Texture::Bitmap(bitmap) => bitmap.eval_3(at.uv),
-            Texture::MeshAttribute(attribute) => attribute.eval_3(&at.attributes),
-            _ => Vec3::splat(self.eval_1(at)),
-        }
-    }
-
-    /// An upper bound of the values (spectral or scalar) the texture takes.
-    pub fn max_value(&self) -> f32 {
-        match self {
-            Texture::Constant(spectrum) => spectrum.max_value(),
-            Texture::Bitmap(bitmap) => bitmap.max_value(),
-            Texture::Checkerboard(checkerboard) => checkerboard.max_value(),
-            Texture::MeshAttribute(attribute) => attribute.scale,
-        }
-    }
-
-    /// The mean of [`Self::eval_1`] over [0, 1]²: at an image's texel centres, or on a grid of
-    /// 256 × 256 cell centres for a pattern.
-    pub fn mean_value(&self) -> f32 {
-        let (nx, ny) = match self {
-            Texture::Constant(_) => return self.eval_1(Vec2::ZERO),
-            Texture::Bitmap(bitmap) => (bitmap.width.max(1), bitmap.height.max(1)),
-            Texture::Checkerboard(_) => (256, 256),
-            // No (u, v) map: its bound (the scene reader reads mesh attributes only as colours).
-            Texture::MeshAttribute(attribute) => return attribute.scale,
-        };
-        let sum: f64 = (0..nx * ny)
-            .map(|cell| {
-                let uv = Vec2::new(
-                    ((cell % nx) as f32 + 0.5) / nx as f32,
-                    ((cell / nx) as f32 + 0.5) / ny as f32,
-                );
-                f64::from(self.eval_1(uv))
-            })
-            .sum();
-        (sum / (nx * ny) as f64) as f32
-    }
-
-    /// The smallest value the texture takes (for validating scalar parameters).
-    pub fn min_value(&self) -> f32 {
-        match self {
-            Texture::Constant(Spectrum::Constant(v)) => *v,
-            Texture::Constant(spectrum) => spectrum.min_value(),
-            Texture::Bitmap(bitmap) => bitmap.min_value(),
-            Texture::Checkerboard(checkerboard) => checkerboard.min_value(),
-            Texture::MeshAttribute(_) => 0.0,
-        }
-    }
+/// The mean of `texture`'s [`TextureValues::eval_1`] at the centres of an `nx` × `ny` grid of
+/// cells over [0, 1]².
+pub fn mean_over_cells(texture: &impl TextureValues, nx: usize, ny: usize) -> f32 {
+    let sum: f64 = (0..nx * ny)
+        .map(|cell| {
+            let uv = Vec2::new(
+                ((cell % nx) as f32 + 0.5) / nx as f32,
+                ((cell / nx) as f32 + 0.5) / ny as f32,
+            );
+            f64::from(texture.eval_1(uv))
+        })
+        .sum();
+    (sum / (nx * ny) as f64) as f32
 }
 
 /// Mitsuba's `to_uv`: an affine map of texture coordinates, (u, v) ↦ A (u, v) + b. A 4 × 4

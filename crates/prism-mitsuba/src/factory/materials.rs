@@ -23,8 +23,8 @@ use prism_core::error::{Error, Result};
 use prism_core::spectrum::conductors::{conductor_names, conductor_preset};
 use prism_core::spectrum::ior::{Ior, NAMED_IORS, RelativeIor, named_ior};
 use prism_core::spectrum::{LAMBDA_MAX, LAMBDA_MIN, PiecewiseLinear, RgbIntent, Spectrum};
-use prism_core::texture::Texture;
 use prism_core::texture::TextureUse;
+use prism_core::texture::{Texture, TextureValues};
 
 type Build = fn(&Params, &mut TextureCache) -> Result<Bsdf>;
 
