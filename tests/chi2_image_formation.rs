@@ -10,7 +10,10 @@ mod common;
 use common::chi2::{assert_passes, chi2_from_counts};
 use glam::Vec2;
 use prism_core::camera::Shutter;
-use prism_core::film::{Filter, FilterSampler};
+use prism_core::film::{
+    BoxFilter, Filter, FilterSampler, GaussianFilter, Kernel, LanczosFilter, MitchellFilter,
+    TentFilter,
+};
 use prism_core::sampling::rng::Pcg32;
 
 const SAMPLES: usize = 1_000_000;
@@ -18,15 +21,15 @@ const SAMPLES: usize = 1_000_000;
 const TESTS: usize = FILTERS.len() * 2 + 2;
 
 const FILTERS: [Filter; 6] = [
-    Filter::Box { radius: 0.5 },
-    Filter::Tent { radius: 1.0 },
-    Filter::Gaussian { stddev: 0.5 },
-    Filter::Mitchell {
+    Filter::Box(BoxFilter { radius: 0.5 }),
+    Filter::Tent(TentFilter { radius: 1.0 }),
+    Filter::Gaussian(GaussianFilter { stddev: 0.5 }),
+    Filter::Mitchell(MitchellFilter {
         b: 1.0 / 3.0,
         c: 1.0 / 3.0,
-    },
-    Filter::Mitchell { b: 0.0, c: 0.5 },
-    Filter::Lanczos { lobes: 3 },
+    }),
+    Filter::Mitchell(MitchellFilter { b: 0.0, c: 0.5 }),
+    Filter::Lanczos(LanczosFilter { lobes: 3 }),
 ];
 
 /// Probability of each of `bins` equal bins of [lo, hi) under `pdf`, by the fine midpoint rule.
@@ -123,10 +126,10 @@ fn shutter_times_follow_their_density() {
         (300u64, None),
         (
             301,
-            Some(Filter::Mitchell {
+            Some(Filter::Mitchell(MitchellFilter {
                 b: 1.0 / 3.0,
                 c: 1.0 / 3.0,
-            }),
+            })),
         ),
     ] {
         let shutter = Shutter::new(0.25, 1.75, filter);

@@ -8,7 +8,9 @@ mod common;
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicU32, Ordering};
 
-use prism_core::film::{Film, Filter, PixelSums};
+use prism_core::film::{
+    Film, Filter, GaussianFilter, Kernel, MitchellFilter, PixelSums, TentFilter,
+};
 use prism_core::math::quadrature::simpson;
 use prism_core::render::{RenderOptions, StopRule, render};
 use prism_core::scene::Scene;
@@ -76,14 +78,14 @@ fn edge_value(filter: Filter, column: u32) -> f64 {
 /// The filters of the test and their names in a scene.
 fn filters() -> [(&'static str, Filter); 3] {
     [
-        ("tent", Filter::Tent { radius: 1.0 }),
-        ("gaussian", Filter::Gaussian { stddev: 0.5 }),
+        ("tent", Filter::Tent(TentFilter { radius: 1.0 })),
+        ("gaussian", Filter::Gaussian(GaussianFilter { stddev: 0.5 })),
         (
             "mitchell",
-            Filter::Mitchell {
+            Filter::Mitchell(MitchellFilter {
                 b: 1.0 / 3.0,
                 c: 1.0 / 3.0,
-            },
+            }),
         ),
     ]
 }

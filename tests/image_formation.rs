@@ -10,7 +10,9 @@ use common::scenes::{
 };
 use glam::{DMat4, DVec2, DVec3, Mat3, UVec2, Vec2, Vec3};
 use prism_core::camera::{Camera, PerspectiveCamera, Shutter};
-use prism_core::film::{Film, Filter};
+use prism_core::film::{
+    BoxFilter, Film, Filter, GaussianFilter, LanczosFilter, MitchellFilter, TentFilter,
+};
 use prism_core::geometry::{Disk, Instance, Primitive, Shape, Sphere};
 use prism_core::integrator::PathIntegrator;
 use prism_core::math::{AnimatedTransform, Transform};
@@ -43,15 +45,15 @@ fn pixel_p_value(film: &Film, expected: impl Fn(usize) -> f64) -> f64 {
 fn a_constant_image_stays_constant_under_every_filter() {
     let size = UVec2::new(12, 12);
     for (seed, filter) in [
-        Filter::Box { radius: 0.5 },
-        Filter::Tent { radius: 1.0 },
-        Filter::Gaussian { stddev: 0.5 },
-        Filter::Mitchell {
+        Filter::Box(BoxFilter { radius: 0.5 }),
+        Filter::Tent(TentFilter { radius: 1.0 }),
+        Filter::Gaussian(GaussianFilter { stddev: 0.5 }),
+        Filter::Mitchell(MitchellFilter {
             b: 1.0 / 3.0,
             c: 1.0 / 3.0,
-        },
-        Filter::Mitchell { b: 0.0, c: 0.5 },
-        Filter::Lanczos { lobes: 3 },
+        }),
+        Filter::Mitchell(MitchellFilter { b: 0.0, c: 0.5 }),
+        Filter::Lanczos(LanczosFilter { lobes: 3 }),
     ]
     .into_iter()
     .enumerate()
@@ -75,7 +77,7 @@ fn a_constant_image_stays_constant_under_every_filter() {
         );
         scene.film.filter = filter;
         // Lanczos' lobes make its weights the noisiest: more samples keep the test sensitive.
-        let spp = if matches!(filter, Filter::Lanczos { .. }) {
+        let spp = if matches!(filter, Filter::Lanczos(_)) {
             4096
         } else {
             1024

@@ -4,7 +4,7 @@
 use glam::{DMat4, DVec3, UVec2, Vec2};
 use prism_core::bsdf::{Bsdf, Diffuse, Material};
 use prism_core::camera::{Camera, PerspectiveCamera};
-use prism_core::film::{CropWindow, Film, Filter, Reconstruction};
+use prism_core::film::{BoxFilter, CropWindow, Film, Filter, Reconstruction};
 use prism_core::geometry::{Geometry, Primitive, Shape};
 use prism_core::integrator::{Integrator, PathIntegrator};
 use prism_core::light::{AreaLight, Light};
@@ -79,7 +79,7 @@ pub fn build(
                 offset: UVec2::ZERO,
                 size,
             },
-            filter: Filter::Box { radius: 0.5 },
+            filter: Filter::Box(BoxFilter { radius: 0.5 }),
             reconstruction: Reconstruction::default(),
             wavelength_sampling: WavelengthSampling::default(),
         },

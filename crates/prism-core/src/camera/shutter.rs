@@ -15,7 +15,7 @@
 //! </sensor>
 //! ```
 
-use crate::film::{Filter, FilterSampler};
+use crate::film::{Filter, FilterSampler, Kernel};
 
 #[derive(Clone, Debug)]
 pub struct Shutter {

@@ -24,94 +24,202 @@
 
 use glam::Vec2;
 
+use crate::dispatch::plugin_class;
 use crate::math::quadrature::simpson;
 use crate::sampling::distribution::PiecewiseConstant1D;
 
-/// A separable reconstruction filter k(x)k(y).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Filter {
-    /// k = 1 on [−r, r].
-    Box { radius: f32 },
-    /// k = max(0, 1 − |x|/r).
-    Tent { radius: f32 },
-    /// Mitsuba 3's truncated Gaussian: k = max(0, exp(−x²/2σ²) − exp(−r²/2σ²)), r = 4σ.
-    Gaussian { stddev: f32 },
-    /// The cubic of Mitchell & Netravali 1988, "Reconstruction Filters in Computer Graphics",
-    /// eq. 8, on [−2, 2]; Catmull–Rom is B = 0, C = 1/2.
-    Mitchell { b: f32, c: f32 },
-    /// Lanczos' windowed sinc, sinc(x) sinc(x/a) on [−a, a] with a = `lobes`.
-    Lanczos { lobes: u32 },
-}
+plugin_class! {
+    /// What every reconstruction kernel answers: its support and its value, and whether its
+    /// density |k|/∫|k| can be sampled in closed form.
+    pub trait Kernel {
+        /// The radius r of the support [−r, r].
+        fn radius(&self) -> f32;
 
-impl Filter {
-    pub fn radius(&self) -> f32 {
-        match *self {
-            Filter::Box { radius } | Filter::Tent { radius } => radius,
-            Filter::Gaussian { stddev } => 4.0 * stddev,
-            Filter::Mitchell { .. } => 2.0,
-            Filter::Lanczos { lobes } => lobes as f32,
+        /// k(x) for |x| ≤ r.
+        fn kernel(&self, x: f32) -> f32;
+
+        /// How the density |k|/∫|k| is sampled exactly (the box and the tent, which are
+        /// non-negative); None for kernels sampled from a table of |k| ([`FilterSampler`]).
+        fn closed_form(&self) -> Option<ClosedForm>;
+
+        /// The 1-D kernel k(x), zero outside the support.
+        fn eval(&self, x: f32) -> f32 {
+            if x.abs() > self.radius() {
+                0.0
+            } else {
+                self.kernel(x)
+            }
         }
     }
 
-    /// The 1-D kernel k(x).
-    pub fn eval(&self, x: f32) -> f32 {
+    /// A separable reconstruction filter k(x)k(y).
+    #[derive(Clone, Copy, Debug, PartialEq)]
+    pub enum Filter {
+        Box(BoxFilter),
+        Tent(TentFilter),
+        Gaussian(GaussianFilter),
+        Mitchell(MitchellFilter),
+        Lanczos(LanczosFilter),
+    }
+}
+
+/// The exact sampling of a non-negative kernel: ∫k, and the inverse of the CDF of k/∫k on the
+/// support scaled to [−1, 1] (x = r · inverse_cdf(u)).
+#[derive(Clone, Copy, Debug)]
+pub struct ClosedForm {
+    pub integral: f32,
+    pub inverse_cdf: fn(f32) -> f32,
+}
+
+/// k = 1 on [−r, r].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BoxFilter {
+    pub radius: f32,
+}
+
+impl Kernel for BoxFilter {
+    fn radius(&self) -> f32 {
+        self.radius
+    }
+
+    fn kernel(&self, _x: f32) -> f32 {
+        1.0
+    }
+
+    fn closed_form(&self) -> Option<ClosedForm> {
+        Some(ClosedForm {
+            integral: 2.0 * self.radius,
+            inverse_cdf: |u| 2.0 * u - 1.0,
+        })
+    }
+}
+
+/// k = max(0, 1 − |x|/r).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TentFilter {
+    pub radius: f32,
+}
+
+impl Kernel for TentFilter {
+    fn radius(&self) -> f32 {
+        self.radius
+    }
+
+    fn kernel(&self, x: f32) -> f32 {
+        (1.0 - x.abs() / self.radius).max(0.0)
+    }
+
+    fn closed_form(&self) -> Option<ClosedForm> {
+        Some(ClosedForm {
+            integral: self.radius,
+            inverse_cdf: sample_tent,
+        })
+    }
+}
+
+/// Mitsuba 3's truncated Gaussian: k = max(0, exp(−x²/2σ²) − exp(−r²/2σ²)), r = 4σ.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GaussianFilter {
+    pub stddev: f32,
+}
+
+impl Kernel for GaussianFilter {
+    fn radius(&self) -> f32 {
+        4.0 * self.stddev
+    }
+
+    fn kernel(&self, x: f32) -> f32 {
         let r = self.radius();
-        if x.abs() > r {
-            return 0.0;
+        let alpha = -1.0 / (2.0 * self.stddev * self.stddev);
+        ((alpha * x * x).exp() - (alpha * r * r).exp()).max(0.0)
+    }
+
+    fn closed_form(&self) -> Option<ClosedForm> {
+        None
+    }
+}
+
+/// The cubic of Mitchell & Netravali 1988, "Reconstruction Filters in Computer Graphics", eq. 8,
+/// on [−2, 2]; Catmull–Rom is B = 0, C = 1/2.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MitchellFilter {
+    pub b: f32,
+    pub c: f32,
+}
+
+impl Kernel for MitchellFilter {
+    fn radius(&self) -> f32 {
+        2.0
+    }
+
+    fn kernel(&self, x: f32) -> f32 {
+        let (b, c) = (self.b, self.c);
+        let x = x.abs();
+        let (x2, x3) = (x * x, x * x * x);
+        let polynomial = if x < 1.0 {
+            (12.0 - 9.0 * b - 6.0 * c) * x3 + (-18.0 + 12.0 * b + 6.0 * c) * x2 + (6.0 - 2.0 * b)
+        } else {
+            (-b - 6.0 * c) * x3
+                + (6.0 * b + 30.0 * c) * x2
+                + (-12.0 * b - 48.0 * c) * x
+                + (8.0 * b + 24.0 * c)
+        };
+        polynomial / 6.0
+    }
+
+    fn closed_form(&self) -> Option<ClosedForm> {
+        None
+    }
+}
+
+/// Lanczos' windowed sinc, sinc(x) sinc(x/a) on [−a, a] with a = `lobes`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LanczosFilter {
+    pub lobes: u32,
+}
+
+impl Kernel for LanczosFilter {
+    fn radius(&self) -> f32 {
+        self.lobes as f32
+    }
+
+    fn kernel(&self, x: f32) -> f32 {
+        let x = x.abs();
+        if x < 1e-6 {
+            return 1.0;
         }
-        match *self {
-            Filter::Box { .. } => 1.0,
-            Filter::Tent { radius } => (1.0 - x.abs() / radius).max(0.0),
-            Filter::Gaussian { stddev } => {
-                let alpha = -1.0 / (2.0 * stddev * stddev);
-                ((alpha * x * x).exp() - (alpha * r * r).exp()).max(0.0)
-            }
-            Filter::Mitchell { b, c } => {
-                let x = x.abs();
-                let (x2, x3) = (x * x, x * x * x);
-                let polynomial = if x < 1.0 {
-                    (12.0 - 9.0 * b - 6.0 * c) * x3
-                        + (-18.0 + 12.0 * b + 6.0 * c) * x2
-                        + (6.0 - 2.0 * b)
-                } else {
-                    (-b - 6.0 * c) * x3
-                        + (6.0 * b + 30.0 * c) * x2
-                        + (-12.0 * b - 48.0 * c) * x
-                        + (8.0 * b + 24.0 * c)
-                };
-                polynomial / 6.0
-            }
-            Filter::Lanczos { .. } => {
-                let x = x.abs();
-                if x < 1e-6 {
-                    return 1.0;
-                }
-                let (px, pxa) = (std::f32::consts::PI * x, std::f32::consts::PI * x / r);
-                (px.sin() * pxa.sin()) / (px * pxa)
-            }
-        }
+        let r = self.radius();
+        let (px, pxa) = (std::f32::consts::PI * x, std::f32::consts::PI * x / r);
+        (px.sin() * pxa.sin()) / (px * pxa)
+    }
+
+    fn closed_form(&self) -> Option<ClosedForm> {
+        None
     }
 }
 
 /// Cells per unit of filter radius in the tabulated density.
 const CELLS_PER_UNIT_RADIUS: f32 = 64.0;
 
-/// Draws film offsets for a filter: the box and the tent by inverting their CDFs exactly, other
-/// kernels by inverting the CDF of |k| tabulated per axis.
+/// Draws film offsets for a filter: the box and the tent by inverting their CDFs exactly
+/// ([`Kernel::closed_form`]), other kernels by inverting the CDF of |k| tabulated per axis.
 #[derive(Clone, Debug)]
 pub struct FilterSampler {
     filter: Filter,
-    /// The table of |k| and ∫ k(x) dx over the support; None for the box and the tent.
-    table: Option<(PiecewiseConstant1D, f32)>,
+    /// How offsets are drawn: the kernel's closed form, or a table of |k| with ∫ k(x) dx.
+    sampling: OffsetSampling,
 }
 
 impl FilterSampler {
     pub fn new(filter: Filter) -> FilterSampler {
-        let table = match filter {
-            Filter::Box { .. } | Filter::Tent { .. } => None,
-            _ => Some(Self::table(filter)),
+        let sampling = match filter.closed_form() {
+            Some(closed) => OffsetSampling::Exact(closed),
+            None => {
+                let (table, integral) = Self::table(filter);
+                OffsetSampling::Table(table, integral)
+            }
         };
-        FilterSampler { filter, table }
+        FilterSampler { filter, sampling }
     }
 
     /// The tabulated density of |k| and the integral of k.
@@ -141,22 +249,21 @@ impl FilterSampler {
     /// ∫ k(x) dx over the support (tabulated by Simpson's rule for kernels other than the box
     /// and the tent).
     pub fn integral_1d(&self) -> f32 {
-        match (&self.table, self.filter) {
-            (Some((_, integral)), _) => *integral,
-            (None, Filter::Tent { radius }) => radius,
-            (None, filter) => 2.0 * filter.radius(),
+        match &self.sampling {
+            OffsetSampling::Exact(closed) => closed.integral,
+            OffsetSampling::Table(_, integral) => *integral,
         }
     }
 
     /// One coordinate of an offset, with density ∝ |k|, and its weight k(x) / (p(x) ∫k): 1 for
-    /// the box and the tent, whose densities are exactly k/∫k.
+    /// kernels sampled in closed form, whose densities are exactly k/∫k.
     #[inline]
     pub fn sample_1d(&self, u: f32) -> (f32, f32) {
-        let Some((distribution, integral)) = &self.table else {
-            return match self.filter {
-                Filter::Tent { radius } => (radius * sample_tent(u), 1.0),
-                _ => ((2.0 * u - 1.0) * self.filter.radius(), 1.0),
-            };
+        let (distribution, integral) = match &self.sampling {
+            OffsetSampling::Exact(closed) => {
+                return (self.filter.radius() * (closed.inverse_cdf)(u), 1.0);
+            }
+            OffsetSampling::Table(distribution, integral) => (distribution, integral),
         };
         let (x, _) = distribution.sample(u);
         let p = distribution.pdf(x);
@@ -184,16 +291,20 @@ impl FilterSampler {
 
     /// Density of one coordinate of an offset (both axes are sampled alike and independently).
     pub fn pdf_1d(&self, x: f32) -> f32 {
-        if let Some((distribution, _)) = &self.table {
-            return distribution.pdf(x);
-        }
-        let r = self.filter.radius();
-        match self.filter {
-            _ if x.abs() > r => 0.0,
-            Filter::Tent { .. } => (1.0 - x.abs() / r) / r,
-            _ => 0.5 / r,
+        match &self.sampling {
+            OffsetSampling::Exact(closed) => self.filter.eval(x) / closed.integral,
+            OffsetSampling::Table(distribution, _) => distribution.pdf(x),
         }
     }
+}
+
+/// How a [`FilterSampler`] draws offsets.
+#[derive(Clone, Debug)]
+enum OffsetSampling {
+    /// By the kernel's closed form.
+    Exact(ClosedForm),
+    /// From the tabulated density of |k|, with ∫ k(x) dx over the support.
+    Table(PiecewiseConstant1D, f32),
 }
 
 /// The tent on [−1, 1], density 1 − |x|, by inverting its CDF: u < ½ is the left half, where
@@ -214,7 +325,7 @@ mod tests {
 
     #[test]
     fn box_filter_samples_have_unit_weight_and_stay_in_the_pixel() {
-        let sampler = FilterSampler::new(Filter::Box { radius: 0.5 });
+        let sampler = FilterSampler::new(Filter::Box(BoxFilter { radius: 0.5 }));
         let mut rng = Pcg32::seeded(2);
         for _ in 0..10_000 {
             let (offset, weight) = sampler.sample(Vec2::new(rng.next_f32(), rng.next_f32()));
@@ -228,7 +339,7 @@ mod tests {
     #[test]
     fn mitchell_kernel_is_smooth_and_a_partition_of_unity() {
         for (b, c) in [(1.0 / 3.0, 1.0 / 3.0), (0.0, 0.5), (1.0, 0.0)] {
-            let k = Filter::Mitchell { b, c };
+            let k = Filter::Mitchell(MitchellFilter { b, c });
             assert!((k.eval(1.0 - 1e-4) - k.eval(1.0 + 1e-4)).abs() < 1e-3);
             assert!(k.eval(1.999).abs() < 1e-4);
             for x in [0.0f32, 0.1, 0.37, 0.5, 0.9] {
@@ -237,25 +348,25 @@ mod tests {
             }
         }
         assert!(
-            Filter::Mitchell { b: 0.0, c: 0.5 }.eval(1.5) < 0.0,
+            Filter::Mitchell(MitchellFilter { b: 0.0, c: 0.5 }).eval(1.5) < 0.0,
             "Catmull-Rom has negative lobes"
         );
-        assert_eq!(Filter::Lanczos { lobes: 3 }.eval(0.0), 1.0);
-        assert!(Filter::Lanczos { lobes: 3 }.eval(1.0).abs() < 1e-6);
+        assert_eq!(Filter::Lanczos(LanczosFilter { lobes: 3 }).eval(0.0), 1.0);
+        assert!(Filter::Lanczos(LanczosFilter { lobes: 3 }).eval(1.0).abs() < 1e-6);
     }
 
     /// The weights average to 1 (the filter is normalised) within 4 standard errors.
     #[test]
     fn filter_weights_have_unit_mean() {
         for filter in [
-            Filter::Tent { radius: 1.0 },
-            Filter::Gaussian { stddev: 0.5 },
-            Filter::Mitchell {
+            Filter::Tent(TentFilter { radius: 1.0 }),
+            Filter::Gaussian(GaussianFilter { stddev: 0.5 }),
+            Filter::Mitchell(MitchellFilter {
                 b: 1.0 / 3.0,
                 c: 1.0 / 3.0,
-            },
-            Filter::Mitchell { b: 0.0, c: 0.5 },
-            Filter::Lanczos { lobes: 3 },
+            }),
+            Filter::Mitchell(MitchellFilter { b: 0.0, c: 0.5 }),
+            Filter::Lanczos(LanczosFilter { lobes: 3 }),
         ] {
             let sampler = FilterSampler::new(filter);
             let mut rng = Pcg32::seeded(3);

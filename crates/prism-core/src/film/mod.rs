@@ -10,7 +10,10 @@ pub mod reconstruction;
 pub mod stats;
 
 pub use accumulation::{CropWindow, Film, PixelSums, ValueSum};
-pub use filter::{Filter, FilterSampler};
+pub use filter::{
+    BoxFilter, Filter, FilterSampler, GaussianFilter, Kernel, LanczosFilter, MitchellFilter,
+    TentFilter,
+};
 pub use ldr::{LdrFormat, LdrOutput, Tonemap, TransferCurve};
 pub use output::{FilmImages, write_images, write_images_with};
 pub use reconstruction::{FilterMis, Reconstruction};

@@ -49,7 +49,7 @@
 
 use glam::Vec2;
 
-use super::filter::{Filter, FilterSampler};
+use super::filter::{Filter, FilterSampler, Kernel};
 
 /// How camera samples are turned into pixel values (the film's `reconstruction` parameter).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -164,6 +164,7 @@ impl FilterMis {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::film::{BoxFilter, GaussianFilter, LanczosFilter, MitchellFilter, TentFilter};
     use crate::sampling::rng::Pcg32;
     use glam::UVec2;
 
@@ -173,9 +174,9 @@ mod tests {
             assert_eq!(Reconstruction::from_name(name).unwrap().name(), name);
         }
         assert_eq!(Reconstruction::default(), Reconstruction::FilterMis);
-        assert!(!Reconstruction::FilterMis.shares_samples(Filter::Box { radius: 0.5 }));
-        assert!(Reconstruction::FilterMis.shares_samples(Filter::Tent { radius: 1.0 }));
-        assert!(!Reconstruction::Pixel.shares_samples(Filter::Tent { radius: 1.0 }));
+        assert!(!Reconstruction::FilterMis.shares_samples(Filter::Box(BoxFilter { radius: 0.5 })));
+        assert!(Reconstruction::FilterMis.shares_samples(Filter::Tent(TentFilter { radius: 1.0 })));
+        assert!(!Reconstruction::Pixel.shares_samples(Filter::Tent(TentFilter { radius: 1.0 })));
         assert_eq!(FilterMis::reach_of(1.0), 1);
         assert_eq!(FilterMis::reach_of(2.0), 3);
         assert_eq!(FilterMis::reach_of(0.75), 1);
@@ -185,7 +186,7 @@ mod tests {
     /// every sample's scale is 1.
     #[test]
     fn tent_weights_are_the_tent_inside_the_film() {
-        let mis = FilterMis::new(Filter::Tent { radius: 1.0 }, 16, 16);
+        let mis = FilterMis::new(Filter::Tent(TentFilter { radius: 1.0 }), 16, 16);
         let mut rng = Pcg32::seeded(5);
         for _ in 0..1000 {
             let offset = Vec2::new(rng.next_f32() * 2.0 - 1.0, rng.next_f32() * 2.0 - 1.0);
@@ -202,13 +203,13 @@ mod tests {
     #[test]
     fn the_mixture_density_matches_the_samples_of_all_pixels() {
         for filter in [
-            Filter::Tent { radius: 1.0 },
-            Filter::Gaussian { stddev: 0.5 },
-            Filter::Mitchell {
+            Filter::Tent(TentFilter { radius: 1.0 }),
+            Filter::Gaussian(GaussianFilter { stddev: 0.5 }),
+            Filter::Mitchell(MitchellFilter {
                 b: 1.0 / 3.0,
                 c: 1.0 / 3.0,
-            },
-            Filter::Lanczos { lobes: 2 },
+            }),
+            Filter::Lanczos(LanczosFilter { lobes: 2 }),
         ] {
             let width = 6u32;
             let mis = FilterMis::new(filter, width, 1);

@@ -13,7 +13,8 @@ use crate::registry::{Default, Origin, ParamKind, ParamSpec, Plugin, Registry};
 use prism_core::camera::{Camera, OrthographicCamera, PerspectiveCamera, Shutter};
 use prism_core::error::{Error, Result};
 use prism_core::film::{
-    CropWindow, Filter, LdrFormat, LdrOutput, Reconstruction, Tonemap, TransferCurve,
+    BoxFilter, CropWindow, Filter, GaussianFilter, LanczosFilter, LdrFormat, LdrOutput,
+    MitchellFilter, Reconstruction, TentFilter, Tonemap, TransferCurve,
 };
 use prism_core::image::Channels;
 use prism_core::sampling::sampler::MAX_ORTHOGONAL_STRENGTH;
@@ -399,9 +400,9 @@ pub static RFILTERS: Registry<FilterBuild> = Registry {
             summary: "The box filter.",
             params: &[BOX_RADIUS],
             build: |params| {
-                Ok(Filter::Box {
+                Ok(Filter::Box(BoxFilter {
                     radius: filter_size(params, &BOX_RADIUS)?,
-                })
+                }))
             },
         },
         Plugin {
@@ -410,9 +411,9 @@ pub static RFILTERS: Registry<FilterBuild> = Registry {
             summary: "The tent (triangle) filter.",
             params: &[TENT_RADIUS],
             build: |params| {
-                Ok(Filter::Tent {
+                Ok(Filter::Tent(TentFilter {
                     radius: filter_size(params, &TENT_RADIUS)?,
-                })
+                }))
             },
         },
         Plugin {
@@ -421,9 +422,9 @@ pub static RFILTERS: Registry<FilterBuild> = Registry {
             summary: "A Gaussian truncated at 4 standard deviations (Mitsuba's default filter).",
             params: &[STDDEV],
             build: |params| {
-                Ok(Filter::Gaussian {
+                Ok(Filter::Gaussian(GaussianFilter {
                     stddev: filter_size(params, &STDDEV)?,
-                })
+                }))
             },
         },
         Plugin {
@@ -432,10 +433,10 @@ pub static RFILTERS: Registry<FilterBuild> = Registry {
             summary: "The Mitchell–Netravali filter, radius 2.",
             params: &[MITCHELL_B, MITCHELL_C],
             build: |params| {
-                Ok(Filter::Mitchell {
+                Ok(Filter::Mitchell(MitchellFilter {
                     b: params.float_in(&MITCHELL_B, 1.0 / 3.0, 0.0, 1.0)? as f32,
                     c: params.float_in(&MITCHELL_C, 1.0 / 3.0, 0.0, 1.0)? as f32,
-                })
+                }))
             },
         },
         Plugin {
@@ -443,7 +444,7 @@ pub static RFILTERS: Registry<FilterBuild> = Registry {
             origin: Origin::Mitsuba3,
             summary: "The Catmull–Rom filter: Mitchell–Netravali with B = 0, C = ½.",
             params: &[],
-            build: |_| Ok(Filter::Mitchell { b: 0.0, c: 0.5 }),
+            build: |_| Ok(Filter::Mitchell(MitchellFilter { b: 0.0, c: 0.5 })),
         },
         Plugin {
             name: "lanczos",
@@ -458,9 +459,9 @@ pub static RFILTERS: Registry<FilterBuild> = Registry {
                         format!("lanczos needs between 1 and 32 lobes, not {lobes}"),
                     ));
                 }
-                Ok(Filter::Lanczos {
+                Ok(Filter::Lanczos(LanczosFilter {
                     lobes: lobes as u32,
-                })
+                }))
             },
         },
     ],
@@ -840,7 +841,7 @@ fn default_film() -> FilmSettings {
             offset: UVec2::ZERO,
             size,
         },
-        filter: Filter::Gaussian { stddev: 0.5 },
+        filter: Filter::Gaussian(GaussianFilter { stddev: 0.5 }),
         reconstruction: Reconstruction::default(),
         wavelength_sampling: WavelengthSampling::default(),
     }
@@ -970,7 +971,7 @@ fn film_settings(params: &Params) -> Result<FilmSettings> {
     }
     let filter = match params.single_child(&RFILTER)? {
         Some(child) => build_filter(&child.node)?,
-        None => Filter::Gaussian { stddev: 0.5 },
+        None => Filter::Gaussian(GaussianFilter { stddev: 0.5 }),
     };
     let reconstruction = Reconstruction::from_name(params.choice(&RECONSTRUCTION)?)
         .expect("the choice is one of the names");
