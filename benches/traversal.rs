@@ -25,6 +25,7 @@ use std::time::Duration;
 
 use criterion::{BatchSize, Criterion, SamplingMode, Throughput, criterion_group, criterion_main};
 use glam::{UVec2, Vec2};
+use prism_core::camera::CameraModel;
 use prism_core::geometry::Geometry;
 use prism_core::light::{LightSource, Receiver};
 use prism_core::math::{Frame, Ray};

@@ -10,6 +10,7 @@ use common::scenes::{
     render_film,
 };
 use glam::{DMat4, DVec3, Mat3, UVec2, Vec2, Vec3};
+use prism_core::camera::CameraModel;
 use prism_core::geometry::Shape;
 use prism_core::geometry::Sphere;
 use prism_core::integrator::{DistributionIntegrator, Integrator, PathIntegrator};

@@ -11,6 +11,7 @@ use common::scenes::{
     Object, build, camera, disk_light_over_plane, pixel_mean_and_variance, render_film,
 };
 use glam::{DMat4, DVec3, UVec2, Vec2};
+use prism_core::camera::CameraModel;
 use prism_core::film::Film;
 use prism_core::geometry::Shape;
 use prism_core::integrator::DirectIntegrator;

@@ -14,7 +14,7 @@ use common::scenes::{
     Object, build, camera, image_mean_and_standard_error, pixel_mean_and_variance, render_film,
 };
 use glam::{DMat4, DVec3, Mat3, UVec2, Vec2, Vec3};
-use prism_core::camera::Camera;
+use prism_core::camera::{Camera, CameraModel};
 use prism_core::film::Film;
 use prism_core::geometry::Sphere;
 use prism_core::geometry::{Primitive, Shape, ShapeSampling};

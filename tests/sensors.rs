@@ -10,7 +10,7 @@ use std::path::Path;
 use common::scenes::{assert_mean_luminance, render_film};
 
 use glam::Vec2;
-use prism_core::camera::Camera;
+use prism_core::camera::{Camera, CameraModel};
 use prism_core::scene::Scene;
 use prism_mitsuba::factory::build_scene;
 use prism_mitsuba::reader::read_scene_str;

@@ -12,6 +12,7 @@
 
 use glam::Vec2;
 
+use prism_core::camera::CameraModel;
 use prism_core::geometry::SurfaceInteraction;
 use prism_core::light::{LightSource, Receiver};
 use prism_core::math::Ray;

@@ -3,7 +3,7 @@
 
 use glam::{DMat4, DVec3, UVec2, Vec2};
 use prism_core::bsdf::{Bsdf, Diffuse, Material};
-use prism_core::camera::{Camera, PerspectiveCamera};
+use prism_core::camera::{Camera, CameraModel, PerspectiveCamera};
 use prism_core::film::{BoxFilter, CropWindow, Film, Filter, Reconstruction};
 use prism_core::geometry::{Geometry, Primitive, Shape};
 use prism_core::integrator::{Integrator, PathIntegrator};

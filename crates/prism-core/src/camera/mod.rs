@@ -10,23 +10,22 @@ pub use shutter::Shutter;
 
 use glam::Vec2;
 
+use crate::dispatch::plugin_class;
 use crate::math::Ray;
 
-/// The scene's camera.
-#[derive(Clone, Debug)]
-pub enum Camera {
-    Perspective(PerspectiveCamera),
-    Orthographic(OrthographicCamera),
-}
+plugin_class! {
+    /// What every camera answers: the ray through a point of its film.
+    pub trait CameraModel {
+        /// The ray through the film position `film` (in pixels of the full film, origin
+        /// top-left), the lens position `lens` ∈ [0, 1)² (unused without a lens), at time
+        /// `time`.
+        fn generate_ray(&self, film: Vec2, lens: Vec2, time: f32) -> Ray;
+    }
 
-impl Camera {
-    /// The ray through the film position `film` (in pixels of the full film, origin top-left),
-    /// the lens position `lens` ∈ [0, 1)² (unused without a lens), at time `time`.
-    #[inline]
-    pub fn generate_ray(&self, film: Vec2, lens: Vec2, time: f32) -> Ray {
-        match self {
-            Camera::Perspective(camera) => camera.generate_ray(film, lens, time),
-            Camera::Orthographic(camera) => camera.generate_ray(film, time),
-        }
+    /// The scene's camera.
+    #[derive(Clone, Debug)]
+    pub enum Camera {
+        Perspective(PerspectiveCamera),
+        Orthographic(OrthographicCamera),
     }
 }

@@ -20,6 +20,7 @@
 
 use glam::{Vec2, Vec3};
 
+use super::CameraModel;
 use crate::math::{AnimatedTransform, Ray};
 
 #[derive(Clone, Debug)]
@@ -33,11 +34,11 @@ pub struct OrthographicCamera {
     pub far_clip: f32,
 }
 
-impl OrthographicCamera {
+impl CameraModel for OrthographicCamera {
     /// The ray through film position `film` (pixels, origin at the top-left of the full film)
     /// at time `time`.
     #[inline]
-    pub fn generate_ray(&self, film: Vec2, time: f32) -> Ray {
+    fn generate_ray(&self, film: Vec2, _lens: Vec2, time: f32) -> Ray {
         let ndc = film / self.film_size;
         let aspect = self.film_size.x / self.film_size.y;
         let local = Vec3::new(
@@ -79,7 +80,7 @@ mod tests {
             (Vec2::new(100.0, 50.0), Vec3::new(0.0, 0.0, 0.5)),
             (Vec2::new(50.0, 0.0), Vec3::new(1.5, 1.0, 0.5)),
         ] {
-            let ray = camera.generate_ray(film, 0.0);
+            let ray = camera.generate_ray(film, Vec2::ZERO, 0.0);
             assert!((ray.o - expected).length() < 1e-6, "{film}: {}", ray.o);
             assert!((ray.d - Vec3::Z).length() < 1e-7);
             assert!((ray.t_max - 9.5).abs() < 1e-6);

@@ -31,6 +31,7 @@
 
 use glam::{Vec2, Vec3};
 
+use super::CameraModel;
 use crate::math::{AnimatedTransform, Ray};
 use crate::sampling::warp::sample_uniform_disk_concentric;
 
@@ -98,12 +99,12 @@ pub fn focal_length_to_diagonal_fov(mm: f64) -> f64 {
     (2.0 * ((36.0f64 * 36.0 + 24.0 * 24.0).sqrt() / (2.0 * mm)).atan()).to_degrees()
 }
 
-impl PerspectiveCamera {
+impl CameraModel for PerspectiveCamera {
     /// The ray through film position `film` (pixels, origin at the top-left of the full film),
     /// through lens position `lens` ∈ [0, 1)² (unused by a pinhole) at time `time`. It starts on
     /// the near plane and ends on the far plane, as in Mitsuba.
     #[inline]
-    pub fn generate_ray(&self, film: Vec2, lens: Vec2, time: f32) -> Ray {
+    fn generate_ray(&self, film: Vec2, lens: Vec2, time: f32) -> Ray {
         let ndc = film / self.film_size;
         let aspect = self.film_size.x / self.film_size.y;
         // The pinhole direction, with z = 1.

@@ -30,6 +30,7 @@ use glam::{UVec2, Vec2, Vec4};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
 
+use crate::camera::CameraModel;
 use crate::error::{Error, Result};
 use crate::film::accumulation::{
     AOV_SUMS_PER_CHANNEL, acceptable_sample, add_aov_sample, add_shared_aov_sample,
