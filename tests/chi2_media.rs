@@ -6,8 +6,8 @@ mod common;
 
 use common::chi2::{assert_passes, chi2_interval, chi2_sphere};
 use glam::{Vec2, Vec3};
-use prism_core::medium::PhaseFunction;
 use prism_core::medium::sample_free_flight;
+use prism_core::medium::{BlendPhase, HenyeyGreenstein, Isotropic, PhaseFunction, PhaseModel};
 
 /// Number of chi-square tests in this file, for Šidák's correction.
 const TESTS: usize = 6;
@@ -40,7 +40,7 @@ fn phase_chi2(name: &str, phase: &PhaseFunction, wo: Vec3, seed: u64) {
 fn henyey_greenstein_forward_follows_its_density() {
     phase_chi2(
         "hg g = 0.7",
-        &PhaseFunction::HenyeyGreenstein { g: 0.7 },
+        &PhaseFunction::HenyeyGreenstein(HenyeyGreenstein { g: 0.7 }),
         Vec3::new(0.3, -0.2, 0.9),
         1,
     );
@@ -50,7 +50,7 @@ fn henyey_greenstein_forward_follows_its_density() {
 fn henyey_greenstein_backward_follows_its_density() {
     phase_chi2(
         "hg g = -0.4",
-        &PhaseFunction::HenyeyGreenstein { g: -0.4 },
+        &PhaseFunction::HenyeyGreenstein(HenyeyGreenstein { g: -0.4 }),
         Vec3::new(-0.5, 0.6, -0.2),
         2,
     );
@@ -58,22 +58,29 @@ fn henyey_greenstein_backward_follows_its_density() {
 
 #[test]
 fn isotropic_phase_is_uniform() {
-    phase_chi2("isotropic", &PhaseFunction::Isotropic, Vec3::Z, 3);
+    phase_chi2(
+        "isotropic",
+        &PhaseFunction::Isotropic(Isotropic),
+        Vec3::Z,
+        3,
+    );
 }
 
 #[test]
 fn blendphase_follows_the_mixture_density() {
     phase_chi2(
         "blendphase",
-        &PhaseFunction::Blend {
+        &PhaseFunction::Blend(BlendPhase {
             weight: 0.3,
-            first: Box::new(PhaseFunction::HenyeyGreenstein { g: 0.6 }),
-            second: Box::new(PhaseFunction::Blend {
+            first: Box::new(PhaseFunction::HenyeyGreenstein(HenyeyGreenstein { g: 0.6 })),
+            second: Box::new(PhaseFunction::Blend(BlendPhase {
                 weight: 0.5,
-                first: Box::new(PhaseFunction::Isotropic),
-                second: Box::new(PhaseFunction::HenyeyGreenstein { g: -0.8 }),
-            }),
-        },
+                first: Box::new(PhaseFunction::Isotropic(Isotropic)),
+                second: Box::new(PhaseFunction::HenyeyGreenstein(HenyeyGreenstein {
+                    g: -0.8,
+                })),
+            })),
+        }),
         Vec3::new(0.1, 0.9, 0.4),
         4,
     );

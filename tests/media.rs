@@ -17,7 +17,8 @@ use prism_core::integrator::{Integrator, Tracking, VolPathIntegrator};
 use prism_core::light::{DirectionalLight, Light};
 use prism_core::math::{Ray, Transform};
 use prism_core::medium::{
-    GridFilter, GridVolume, Medium, MediumInterface, MediumKind, PhaseFunction, Volume,
+    GridFilter, GridVolume, HenyeyGreenstein, Heterogeneous, Homogeneous, Isotropic, Medium,
+    MediumInterface, MediumKind, PhaseFunction, PhaseModel, Volume,
 };
 use prism_core::sampling::rng::Pcg32;
 use prism_core::scene::Scene;
@@ -36,11 +37,11 @@ fn boxed(scale: DVec3, offset: DVec3) -> Shape {
 
 fn homogeneous(sigma_t: Spectrum, albedo: f32, phase: PhaseFunction) -> Medium {
     Medium {
-        kind: MediumKind::Homogeneous {
+        kind: MediumKind::Homogeneous(Homogeneous {
             sigma_t,
             albedo: Spectrum::Constant(albedo),
             scale: 1.0,
-        },
+        }),
         phase,
         sample_emitters: true,
     }
@@ -136,7 +137,11 @@ fn slab(
         size,
         integrator,
     );
-    scene.world.media = vec![homogeneous(sigma_t, albedo, PhaseFunction::Isotropic)];
+    scene.world.media = vec![homogeneous(
+        sigma_t,
+        albedo,
+        PhaseFunction::Isotropic(Isotropic),
+    )];
     // The tests' sample counts and margins were sized with this density (under `visible`, which
     // leaves the ends of the spectrum, where this σ_t is large, to few samples, the hero-only
     // estimator's variance is heavy-tailed and its own standard error several times larger).
@@ -340,7 +345,7 @@ fn single_scattering(
 fn single_scattering_in_a_slab_isotropic() {
     for (name, integrator) in volumetric_integrators() {
         single_scattering(
-            PhaseFunction::Isotropic,
+            PhaseFunction::Isotropic(Isotropic),
             Spectrum::Constant(0.6),
             integrator,
             name,
@@ -352,7 +357,7 @@ fn single_scattering_in_a_slab_isotropic() {
 #[test]
 fn single_scattering_in_a_slab_henyey_greenstein() {
     single_scattering(
-        PhaseFunction::HenyeyGreenstein { g: -0.3 },
+        PhaseFunction::HenyeyGreenstein(HenyeyGreenstein { g: -0.3 }),
         Spectrum::Constant(0.6),
         VolPathIntegrator::default(),
         "volpath",
@@ -364,7 +369,7 @@ fn single_scattering_in_a_slab_henyey_greenstein() {
 fn single_scattering_in_a_chromatic_slab() {
     for (name, integrator) in chromatic_unbiased() {
         single_scattering(
-            PhaseFunction::HenyeyGreenstein { g: 0.4 },
+            PhaseFunction::HenyeyGreenstein(HenyeyGreenstein { g: 0.4 }),
             Spectrum::PiecewiseLinear(chromatic_sigma_t()),
             integrator,
             name,
@@ -425,7 +430,7 @@ fn closed_furnace_with_a_chromatic_non_absorbing_medium() {
             homogeneous(
                 Spectrum::PiecewiseLinear(sigma_t.clone()),
                 1.0,
-                PhaseFunction::HenyeyGreenstein { g: 0.6 },
+                PhaseFunction::HenyeyGreenstein(HenyeyGreenstein { g: 0.6 }),
             ),
             integrator,
             2048,
@@ -458,12 +463,12 @@ fn closed_furnace_with_a_heterogeneous_non_absorbing_medium() {
     for (k, integrator) in volumetric_integrators().into_iter().enumerate() {
         medium_furnace(
             Medium {
-                kind: MediumKind::Heterogeneous {
+                kind: MediumKind::Heterogeneous(Heterogeneous {
                     sigma_t: Volume::Grid(Box::new(grid.clone())),
                     albedo: Volume::Constant(Spectrum::Constant(1.0)),
                     scale: 1.5,
-                },
-                phase: PhaseFunction::Isotropic,
+                }),
+                phase: PhaseFunction::Isotropic(Isotropic),
                 sample_emitters: true,
             },
             integrator,
@@ -499,7 +504,7 @@ fn emitter_inside_an_absorbing_medium() {
     scene.world.media = vec![homogeneous(
         Spectrum::Constant(sigma_t),
         0.0,
-        PhaseFunction::Isotropic,
+        PhaseFunction::Isotropic(Isotropic),
     )];
     scene.world.camera_medium = Some(0);
     let film = render_film(&scene, 2048, 7, None);
@@ -595,12 +600,12 @@ fn ratio_tracking_is_unbiased_on_generated_grids() {
         .unwrap();
         let scale = 1.7f32;
         let medium = Medium {
-            kind: MediumKind::Heterogeneous {
+            kind: MediumKind::Heterogeneous(Heterogeneous {
                 sigma_t: Volume::Grid(Box::new(grid.clone())),
                 albedo: Volume::Constant(Spectrum::Constant(0.5)),
                 scale,
-            },
-            phase: PhaseFunction::Isotropic,
+            }),
+            phase: PhaseFunction::Isotropic(Isotropic),
             sample_emitters: true,
         };
         for (r, ray) in rays.iter().enumerate() {

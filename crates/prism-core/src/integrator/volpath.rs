@@ -40,7 +40,7 @@ use crate::integrator::vertex::{
 };
 use crate::light::{LightSelection, Receiver};
 use crate::math::Ray;
-use crate::medium::{Collision, Medium, choose_collision, sample_free_flight};
+use crate::medium::{Collision, Medium, PhaseModel, choose_collision, sample_free_flight};
 use crate::sampling::sampler::Sampler;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 

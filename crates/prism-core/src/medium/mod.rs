@@ -44,9 +44,10 @@ pub mod volume;
 
 use glam::Vec3;
 
-pub use phase::{PhaseFunction, PhaseSample};
+pub use phase::{BlendPhase, HenyeyGreenstein, Isotropic, PhaseFunction, PhaseModel, PhaseSample};
 pub use volume::{GridFilter, GridVolume, Volume};
 
+use crate::dispatch::plugin_class;
 use crate::math::Ray;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths, Spectrum};
 
@@ -61,29 +62,129 @@ pub struct Medium {
     pub sample_emitters: bool,
 }
 
-/// How a medium's coefficients vary.
+plugin_class! {
+    /// What every kind of medium answers: its coefficients at a point, a bound on them, and
+    /// where along a ray it may be non-empty.
+    pub trait MediumModel {
+        /// The coefficients at `p` for the wavelengths `lambda`.
+        fn coefficients(&self, p: Vec3, lambda: &SampledWavelengths) -> MediumCoefficients;
+
+        /// Whether the coefficients are the same everywhere.
+        fn is_homogeneous(&self) -> bool;
+
+        /// A majorant m ≥ σ_t(x, λᵢ) for every point and each of the wavelengths `lambda`.
+        fn majorant(&self, lambda: &SampledWavelengths) -> f32;
+
+        /// The parameter interval of `ray` (unit direction) in which the medium may be
+        /// non-empty, within [0, t_max].
+        fn ray_extent(&self, ray: &Ray, t_max: f32) -> Option<(f32, f32)>;
+    }
+
+    /// How a medium's coefficients vary.
+    #[derive(Clone, Debug)]
+    pub enum MediumKind {
+        Homogeneous(Homogeneous),
+        HomogeneousAbsorbingScattering(HomogeneousAbsorbingScattering),
+        Heterogeneous(Heterogeneous),
+    }
+}
+
+/// The same σ_t = scale·sigma_t and albedo everywhere.
 #[derive(Clone, Debug)]
-pub enum MediumKind {
-    /// The same σ_t = scale·sigma_t and albedo everywhere.
-    Homogeneous {
-        sigma_t: Spectrum,
-        albedo: Spectrum,
-        scale: f32,
-    },
-    /// The same σ_a = scale·sigma_a and σ_s = scale·sigma_s everywhere (Mitsuba 0.6's form),
-    /// so σ_t = σ_a + σ_s.
-    HomogeneousAbsorbingScattering {
-        sigma_a: Spectrum,
-        sigma_s: Spectrum,
-        scale: f32,
-    },
-    /// σ_t(x) = scale·sigma_t(x) and albedo(x) from volumes; outside the box of a grid
-    /// `sigma_t` the medium is empty.
-    Heterogeneous {
-        sigma_t: Volume,
-        albedo: Volume,
-        scale: f32,
-    },
+pub struct Homogeneous {
+    pub sigma_t: Spectrum,
+    pub albedo: Spectrum,
+    pub scale: f32,
+}
+
+impl MediumModel for Homogeneous {
+    #[inline]
+    fn coefficients(&self, _p: Vec3, lambda: &SampledWavelengths) -> MediumCoefficients {
+        let sigma_t = self.sigma_t.sample(lambda) * self.scale;
+        MediumCoefficients {
+            sigma_s: sigma_t * self.albedo.sample(lambda),
+            sigma_t,
+        }
+    }
+
+    fn is_homogeneous(&self) -> bool {
+        true
+    }
+
+    #[inline]
+    fn majorant(&self, lambda: &SampledWavelengths) -> f32 {
+        self.coefficients(Vec3::ZERO, lambda).sigma_t.max_value()
+    }
+
+    fn ray_extent(&self, _ray: &Ray, t_max: f32) -> Option<(f32, f32)> {
+        Some((0.0, t_max))
+    }
+}
+
+/// The same σ_a = scale·sigma_a and σ_s = scale·sigma_s everywhere (Mitsuba 0.6's form), so
+/// σ_t = σ_a + σ_s.
+#[derive(Clone, Debug)]
+pub struct HomogeneousAbsorbingScattering {
+    pub sigma_a: Spectrum,
+    pub sigma_s: Spectrum,
+    pub scale: f32,
+}
+
+impl MediumModel for HomogeneousAbsorbingScattering {
+    #[inline]
+    fn coefficients(&self, _p: Vec3, lambda: &SampledWavelengths) -> MediumCoefficients {
+        let sigma_s = self.sigma_s.sample(lambda) * self.scale;
+        MediumCoefficients {
+            sigma_t: self.sigma_a.sample(lambda) * self.scale + sigma_s,
+            sigma_s,
+        }
+    }
+
+    fn is_homogeneous(&self) -> bool {
+        true
+    }
+
+    #[inline]
+    fn majorant(&self, lambda: &SampledWavelengths) -> f32 {
+        self.coefficients(Vec3::ZERO, lambda).sigma_t.max_value()
+    }
+
+    fn ray_extent(&self, _ray: &Ray, t_max: f32) -> Option<(f32, f32)> {
+        Some((0.0, t_max))
+    }
+}
+
+/// σ_t(x) = scale·sigma_t(x) and albedo(x) from volumes; outside the box of a grid `sigma_t`
+/// the medium is empty.
+#[derive(Clone, Debug)]
+pub struct Heterogeneous {
+    pub sigma_t: Volume,
+    pub albedo: Volume,
+    pub scale: f32,
+}
+
+impl MediumModel for Heterogeneous {
+    #[inline]
+    fn coefficients(&self, p: Vec3, lambda: &SampledWavelengths) -> MediumCoefficients {
+        let sigma_t = self.sigma_t.eval(p, lambda) * self.scale;
+        MediumCoefficients {
+            sigma_s: sigma_t * self.albedo.eval(p, lambda),
+            sigma_t,
+        }
+    }
+
+    fn is_homogeneous(&self) -> bool {
+        false
+    }
+
+    #[inline]
+    fn majorant(&self, _lambda: &SampledWavelengths) -> f32 {
+        self.sigma_t.max_value() * self.scale
+    }
+
+    fn ray_extent(&self, ray: &Ray, t_max: f32) -> Option<(f32, f32)> {
+        self.sigma_t.ray_extent(ray, t_max)
+    }
 }
 
 /// The media on the two sides of a surface (Mitsuba's `interior` and `exterior`): indices into
@@ -134,58 +235,19 @@ impl Medium {
     /// The medium's coefficients at `p` for the wavelengths `lambda`.
     #[inline]
     pub fn coefficients(&self, p: Vec3, lambda: &SampledWavelengths) -> MediumCoefficients {
-        match &self.kind {
-            MediumKind::Homogeneous {
-                sigma_t,
-                albedo,
-                scale,
-            } => {
-                let sigma_t = sigma_t.sample(lambda) * *scale;
-                MediumCoefficients {
-                    sigma_s: sigma_t * albedo.sample(lambda),
-                    sigma_t,
-                }
-            }
-            MediumKind::HomogeneousAbsorbingScattering {
-                sigma_a,
-                sigma_s,
-                scale,
-            } => {
-                let sigma_s = sigma_s.sample(lambda) * *scale;
-                MediumCoefficients {
-                    sigma_t: sigma_a.sample(lambda) * *scale + sigma_s,
-                    sigma_s,
-                }
-            }
-            MediumKind::Heterogeneous {
-                sigma_t,
-                albedo,
-                scale,
-            } => {
-                let sigma_t = sigma_t.eval(p, lambda) * *scale;
-                MediumCoefficients {
-                    sigma_s: sigma_t * albedo.eval(p, lambda),
-                    sigma_t,
-                }
-            }
-        }
+        self.kind.coefficients(p, lambda)
     }
 
     /// Whether the coefficients are the same everywhere.
     #[inline]
     pub fn is_homogeneous(&self) -> bool {
-        !matches!(self.kind, MediumKind::Heterogeneous { .. })
+        self.kind.is_homogeneous()
     }
 
     /// A majorant m ≥ σ_t(x, λᵢ) for every point and each of the wavelengths `lambda`.
     #[inline]
     pub fn majorant(&self, lambda: &SampledWavelengths) -> f32 {
-        match &self.kind {
-            MediumKind::Homogeneous { .. } | MediumKind::HomogeneousAbsorbingScattering { .. } => {
-                self.coefficients(Vec3::ZERO, lambda).sigma_t.max_value()
-            }
-            MediumKind::Heterogeneous { sigma_t, scale, .. } => sigma_t.max_value() * scale,
-        }
+        self.kind.majorant(lambda)
     }
 
     /// Each wavelength's own majorant m(λᵢ) ≥ σ_t(x, λᵢ) for every point: σ_t(λᵢ) itself for a
@@ -204,12 +266,7 @@ impl Medium {
     /// within [0, t_max].
     #[inline]
     pub fn ray_extent(&self, ray: &Ray, t_max: f32) -> Option<(f32, f32)> {
-        match &self.kind {
-            MediumKind::Homogeneous { .. } | MediumKind::HomogeneousAbsorbingScattering { .. } => {
-                Some((0.0, t_max))
-            }
-            MediumKind::Heterogeneous { sigma_t, .. } => sigma_t.ray_extent(ray, t_max),
-        }
+        self.kind.ray_extent(ray, t_max)
     }
 
     /// Transmittance along `ray` (unit direction) from t = 0 to `t_max`: exact for a

@@ -10,24 +10,28 @@ use std::f32::consts::PI;
 
 use glam::{Vec2, Vec3};
 
+use crate::dispatch::plugin_class;
 use crate::math::Frame;
 use crate::sampling::warp::{sample_uniform_sphere, uniform_sphere_pdf};
 
-/// A phase function as the scene describes it.
-#[derive(Clone, Debug, PartialEq)]
-pub enum PhaseFunction {
-    /// p = 1/(4π).
-    Isotropic,
-    /// Henyey & Greenstein 1941: p(θ) = (1 − g²) / (4π (1 + g² + 2g cos θ)^{3/2}), with θ the
-    /// angle between `wo` and `wi` (pbrt-v4 §11.3.1), so that g > 0 scatters forward (`wi`
-    /// close to the direction the path came from, −`wo`); |g| < 1.
-    HenyeyGreenstein { g: f32 },
-    /// (1 − weight)·first + weight·second, Mitsuba's `blendphase`; weight in [0, 1].
-    Blend {
-        weight: f32,
-        first: Box<PhaseFunction>,
-        second: Box<PhaseFunction>,
-    },
+plugin_class! {
+    /// What every phase function answers: its value, which is also its sampling density, and
+    /// a sample.
+    pub trait PhaseModel {
+        /// p(wo, wi), which is also the density [`PhaseModel::sample`] draws `wi` with.
+        fn eval(&self, wo: Vec3, wi: Vec3) -> f32;
+
+        /// Draws `wi` given `wo` from the uniform numbers `u`.
+        fn sample(&self, wo: Vec3, u: Vec2) -> PhaseSample;
+    }
+
+    /// A phase function as the scene describes it.
+    #[derive(Clone, Debug, PartialEq)]
+    pub enum PhaseFunction {
+        Isotropic(Isotropic),
+        HenyeyGreenstein(HenyeyGreenstein),
+        Blend(BlendPhase),
+    }
 }
 
 /// A direction drawn from a phase function.
@@ -39,6 +43,33 @@ pub struct PhaseSample {
     pub pdf: f32,
 }
 
+/// p = 1/(4π).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Isotropic;
+
+impl PhaseModel for Isotropic {
+    #[inline]
+    fn eval(&self, _wo: Vec3, _wi: Vec3) -> f32 {
+        uniform_sphere_pdf()
+    }
+
+    #[inline]
+    fn sample(&self, _wo: Vec3, u: Vec2) -> PhaseSample {
+        PhaseSample {
+            wi: sample_uniform_sphere(u),
+            pdf: uniform_sphere_pdf(),
+        }
+    }
+}
+
+/// Henyey & Greenstein 1941: p(θ) = (1 − g²) / (4π (1 + g² + 2g cos θ)^{3/2}), with θ the angle
+/// between `wo` and `wi` (pbrt-v4 §11.3.1), so that g > 0 scatters forward (`wi` close to the
+/// direction the path came from, −`wo`); |g| < 1.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HenyeyGreenstein {
+    pub g: f32,
+}
+
 /// The Henyey–Greenstein density for cos θ = wo·wi.
 #[inline]
 pub fn henyey_greenstein(cos_theta: f32, g: f32) -> f32 {
@@ -46,65 +77,59 @@ pub fn henyey_greenstein(cos_theta: f32, g: f32) -> f32 {
     (1.0 - g * g) / (4.0 * PI * denom * denom.max(0.0).sqrt())
 }
 
-impl PhaseFunction {
-    /// p(wo, wi), which is also the density [`PhaseFunction::sample`] draws `wi` with.
-    pub fn eval(&self, wo: Vec3, wi: Vec3) -> f32 {
-        match self {
-            PhaseFunction::Isotropic => uniform_sphere_pdf(),
-            PhaseFunction::HenyeyGreenstein { g } => henyey_greenstein(wo.dot(wi), *g),
-            PhaseFunction::Blend {
-                weight,
-                first,
-                second,
-            } => (1.0 - weight) * first.eval(wo, wi) + weight * second.eval(wo, wi),
-        }
+impl PhaseModel for HenyeyGreenstein {
+    #[inline]
+    fn eval(&self, wo: Vec3, wi: Vec3) -> f32 {
+        henyey_greenstein(wo.dot(wi), self.g)
     }
 
-    /// Draws `wi` given `wo` from the uniform numbers `u`.
-    ///
-    /// Henyey–Greenstein is sampled by inverting the CDF of cos θ (pbrt-v4 §11.3.1):
-    /// cos θ = −(1 + g² − ((1 − g²)/(1 + g − 2g·u₀))²) / (2g), φ = 2π·u₁. A blend chooses its
-    /// first component with probability 1 − weight by u₀ (rescaled to [0, 1) for the chosen
-    /// one), so the mixture's density is the blend of the components'.
-    pub fn sample(&self, wo: Vec3, u: Vec2) -> PhaseSample {
-        match self {
-            PhaseFunction::Isotropic => PhaseSample {
-                wi: sample_uniform_sphere(u),
-                pdf: uniform_sphere_pdf(),
-            },
-            PhaseFunction::HenyeyGreenstein { g } => {
-                let g = *g;
-                let cos_theta = if g.abs() < 1e-3 {
-                    1.0 - 2.0 * u.x
-                } else {
-                    let s = (1.0 - g * g) / (1.0 + g - 2.0 * g * u.x);
-                    (-(1.0 + g * g - s * s) / (2.0 * g)).clamp(-1.0, 1.0)
-                };
-                let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
-                let phi = 2.0 * PI * u.y;
-                let local = Vec3::new(sin_theta * phi.cos(), sin_theta * phi.sin(), cos_theta);
-                let wi = Frame::from_normal(wo).to_world(local).normalize();
-                PhaseSample {
-                    wi,
-                    pdf: henyey_greenstein(cos_theta, g),
-                }
-            }
-            PhaseFunction::Blend {
-                weight,
-                first,
-                second,
-            } => {
-                let (chosen, u0) = if u.x < 1.0 - weight {
-                    (first, u.x / (1.0 - weight))
-                } else {
-                    (second, (u.x - (1.0 - weight)) / weight)
-                };
-                let sample = chosen.sample(wo, Vec2::new(u0.min(1.0 - f32::EPSILON), u.y));
-                PhaseSample {
-                    wi: sample.wi,
-                    pdf: self.eval(wo, sample.wi),
-                }
-            }
+    /// By inverting the CDF of cos θ (pbrt-v4 §11.3.1):
+    /// cos θ = −(1 + g² − ((1 − g²)/(1 + g − 2g·u₀))²) / (2g), φ = 2π·u₁.
+    fn sample(&self, wo: Vec3, u: Vec2) -> PhaseSample {
+        let g = self.g;
+        let cos_theta = if g.abs() < 1e-3 {
+            1.0 - 2.0 * u.x
+        } else {
+            let s = (1.0 - g * g) / (1.0 + g - 2.0 * g * u.x);
+            (-(1.0 + g * g - s * s) / (2.0 * g)).clamp(-1.0, 1.0)
+        };
+        let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
+        let phi = 2.0 * PI * u.y;
+        let local = Vec3::new(sin_theta * phi.cos(), sin_theta * phi.sin(), cos_theta);
+        let wi = Frame::from_normal(wo).to_world(local).normalize();
+        PhaseSample {
+            wi,
+            pdf: henyey_greenstein(cos_theta, g),
+        }
+    }
+}
+
+/// (1 − weight)·first + weight·second, Mitsuba's `blendphase`; weight in [0, 1].
+#[derive(Clone, Debug, PartialEq)]
+pub struct BlendPhase {
+    pub weight: f32,
+    pub first: Box<PhaseFunction>,
+    pub second: Box<PhaseFunction>,
+}
+
+impl PhaseModel for BlendPhase {
+    fn eval(&self, wo: Vec3, wi: Vec3) -> f32 {
+        (1.0 - self.weight) * self.first.eval(wo, wi) + self.weight * self.second.eval(wo, wi)
+    }
+
+    /// Chooses the first component with probability 1 − weight by u₀ (rescaled to [0, 1) for
+    /// the chosen one), so the mixture's density is the blend of the components'.
+    fn sample(&self, wo: Vec3, u: Vec2) -> PhaseSample {
+        let weight = self.weight;
+        let (chosen, u0) = if u.x < 1.0 - weight {
+            (&self.first, u.x / (1.0 - weight))
+        } else {
+            (&self.second, (u.x - (1.0 - weight)) / weight)
+        };
+        let sample = chosen.sample(wo, Vec2::new(u0.min(1.0 - f32::EPSILON), u.y));
+        PhaseSample {
+            wi: sample.wi,
+            pdf: self.eval(wo, sample.wi),
         }
     }
 }

@@ -11,7 +11,10 @@ use crate::registry::{Default, Origin, ParamKind, ParamSpec, Plugin, Range, Regi
 use prism_core::error::{Error, Result};
 use prism_core::math::Transform;
 use prism_core::medium::volume::parse_vol;
-use prism_core::medium::{GridFilter, GridVolume, Medium, MediumKind, PhaseFunction, Volume};
+use prism_core::medium::{
+    BlendPhase, GridFilter, GridVolume, HenyeyGreenstein, Heterogeneous, Homogeneous,
+    HomogeneousAbsorbingScattering, Isotropic, Medium, MediumKind, PhaseFunction, Volume,
+};
 use prism_core::spectrum::Spectrum;
 
 type BuildMedium = fn(&Params) -> Result<Medium>;
@@ -59,7 +62,7 @@ pub static PHASES: Registry<BuildPhase> = Registry {
             origin: Origin::Mitsuba3,
             summary: "Scattering into every direction alike, p = 1/(4π).",
             params: &[],
-            build: |_| Ok(PhaseFunction::Isotropic),
+            build: |_| Ok(PhaseFunction::Isotropic(Isotropic)),
         },
         Plugin {
             name: "hg",
@@ -238,7 +241,7 @@ fn build_phase(node: &PluginNode) -> Result<PhaseFunction> {
 fn phase(params: &Params) -> Result<PhaseFunction> {
     match params.single_child(&PHASE)? {
         Some(child) => build_phase(&child.node),
-        None => Ok(PhaseFunction::Isotropic),
+        None => Ok(PhaseFunction::Isotropic(Isotropic)),
     }
 }
 
@@ -308,19 +311,19 @@ fn build_homogeneous(params: &Params) -> Result<Medium> {
                 .with_help("give both sigma_a and sigma_s, or sigma_t and albedo"));
             }
         }
-        MediumKind::HomogeneousAbsorbingScattering {
+        MediumKind::HomogeneousAbsorbingScattering(HomogeneousAbsorbingScattering {
             sigma_a: spectrum_param(params, &SIGMA_A)?,
             sigma_s: spectrum_param(params, &SIGMA_S)?,
             scale,
-        }
+        })
     } else {
         let albedo = spectrum_param(params, &ALBEDO)?;
         check_albedo(params, &ALBEDO, given_max(params, &ALBEDO, &albedo))?;
-        MediumKind::Homogeneous {
+        MediumKind::Homogeneous(Homogeneous {
             sigma_t: spectrum_param(params, &SIGMA_T)?,
             albedo,
             scale,
-        }
+        })
     };
     Ok(Medium {
         kind,
@@ -364,11 +367,11 @@ fn build_heterogeneous(params: &Params) -> Result<Medium> {
     let sigma_t = volume_param(params, &SIGMA_T_VOLUME)?;
     let albedo = volume_param(params, &ALBEDO_VOLUME)?;
     Ok(Medium {
-        kind: MediumKind::Heterogeneous {
+        kind: MediumKind::Heterogeneous(Heterogeneous {
             sigma_t,
             albedo,
             scale: scale(params)?,
-        },
+        }),
         phase: phase(params)?,
         sample_emitters: params.boolean(&SAMPLE_EMITTERS)?,
     })
@@ -383,7 +386,9 @@ fn build_hg(params: &Params) -> Result<PhaseFunction> {
         )
         .with_help("g = 0 is isotropic; values near ±1 scatter almost straight on or back"));
     }
-    Ok(PhaseFunction::HenyeyGreenstein { g: g as f32 })
+    Ok(PhaseFunction::HenyeyGreenstein(HenyeyGreenstein {
+        g: g as f32,
+    }))
 }
 
 fn build_blendphase(params: &Params) -> Result<PhaseFunction> {
@@ -400,11 +405,11 @@ fn build_blendphase(params: &Params) -> Result<PhaseFunction> {
         )
         .with_help("nest two <phase> elements"));
     };
-    Ok(PhaseFunction::Blend {
+    Ok(PhaseFunction::Blend(BlendPhase {
         weight,
         first: Box::new(build_phase(&first.node)?),
         second: Box::new(build_phase(&second.node)?),
-    })
+    }))
 }
 
 fn build_constvolume(params: &Params, range: Range) -> Result<Volume> {
