@@ -16,6 +16,7 @@
 //! | module | concept |
 //! | --- | --- |
 //! | [`error`] | errors with source locations |
+//! | [`dispatch`] | how a plugin class is declared: its trait and the enum that dispatches it |
 //! | [`math`] | vectors, frames, transforms, rays, special functions |
 //! | [`sampling`] | random numbers, warps, tabulated distributions, the per-pixel sampler |
 //! | [`spectrum`] | wavelengths and spectral values along a path, CIE tables, RGB upsampling |
