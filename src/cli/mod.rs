@@ -5,4 +5,5 @@ pub mod compare;
 pub mod converge;
 pub mod merge;
 pub mod plugins;
+pub mod progress_bar;
 pub mod render;

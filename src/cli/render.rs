@@ -17,6 +17,7 @@ use std::time::Duration;
 use clap::Args;
 use glam::UVec2;
 
+use super::progress_bar::TerminalProgress;
 use crate::accel::Accel;
 use prism_core::error::{Error, Result};
 use prism_core::film::stats::rejected_report;
@@ -25,7 +26,7 @@ use prism_core::film::{CropWindow, PixelSums, Reconstruction};
 use prism_core::integrator::RayCount;
 use prism_core::render::state::{RenderIdentity, RenderState};
 use prism_core::render::{
-    Checkpoints, Progress, RenderOptions, SampleEstimator, Snapshot, StopReason, StopRule,
+    Checkpoints, ProgressReport, RenderOptions, SampleEstimator, Snapshot, StopReason, StopRule,
     StopRuleNames, render_with_checkpoints,
 };
 use prism_core::sampling::sampler::{Sampler, SamplerKind};
@@ -367,11 +368,9 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         interrupt: Some(interrupt),
         threads: args.threads,
         seed,
-        progress: if std::io::stderr().is_terminal() {
-            Progress::Terminal
-        } else {
-            Progress::Hidden
-        },
+        progress: std::io::stderr()
+            .is_terminal()
+            .then(|| Arc::new(TerminalProgress::new()) as Arc<dyn ProgressReport>),
     };
     let (exr_path, png_path) = output_paths(args);
     let png_path = png_path.with_extension(scene.ldr_output.format.extension());

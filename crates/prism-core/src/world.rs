@@ -97,11 +97,6 @@ impl World {
             .unwrap_or_default()
     }
 
-    /// Whether the scene has participating media.
-    pub fn has_media(&self) -> bool {
-        !self.media.is_empty()
-    }
-
     /// The world with the lights' sampling weights (one per light, each finite and at
     /// least 0) in place of the default 1.
     pub fn with_sampling_weights(mut self, weights: Vec<f32>) -> World {

@@ -16,33 +16,47 @@ use crate::scene::Scene;
 use prism_core::error::Error;
 use prism_core::film::FilmImages;
 use prism_core::render::{
-    Progress, ProgressCounter, RenderOptions, StopRule, StopRuleNames, render as render_scene,
+    ProgressCounter, RenderOptions, StopRule, StopRuleNames, render as render_scene,
 };
 
 /// How often the calling thread checks for signals and reports progress.
 const POLL: Duration = Duration::from_millis(100);
 
-/// Renders `scene` with `spp` samples per pixel (None: the sampler's `sample_count`) from the
-/// random streams of `seed` (None: the sampler's `seed`) on `threads` worker threads (None:
-/// one per core). With a `time_limit` in seconds or a `target_error` (the image's mean relative
-/// standard error) the render stops at whichever comes first, `spp` then only capping the
-/// samples. `progress`, if given, is called as `progress(samples, total, error)` about ten
-/// times a second and once at the end, with the camera samples taken, those the render will
-/// take (None when open-ended) and the image's mean relative error (infinite before the first
-/// pass). The image is the same for every number of threads.
-#[pyfunction]
-#[pyo3(signature = (scene, spp = None, seed = None, threads = None, progress = None, time_limit = None, target_error = None))]
-#[allow(clippy::too_many_arguments)]
-pub fn render(
-    py: Python<'_>,
-    scene: &Scene,
+/// How to render, read from the keyword arguments of `prism_renderer.render` (a dict): `spp`
+/// samples per pixel (None: the sampler's `sample_count`), the random streams of `seed` (None:
+/// the sampler's `seed`), `threads` worker threads (None: one per core), and with a
+/// `time_limit` in seconds or a `target_error` (the image's mean relative standard error) the
+/// render stops at whichever comes first, `spp` then only capping the samples.
+#[derive(FromPyObject)]
+#[pyo3(from_item_all)]
+pub struct RenderSettings {
     spp: Option<u32>,
     seed: Option<u64>,
     threads: Option<usize>,
-    progress: Option<Bound<'_, PyAny>>,
     time_limit: Option<f64>,
     target_error: Option<f64>,
+}
+
+/// Renders `scene` as `settings` say. `progress`, if given, is called as
+/// `progress(samples, total, error)` about ten times a second and once at the end, with the
+/// camera samples taken, those the render will take (None when open-ended) and the image's mean
+/// relative error (infinite before the first pass). The image is the same for every number of
+/// threads.
+#[pyfunction]
+#[pyo3(signature = (scene, settings, progress = None))]
+pub fn render(
+    py: Python<'_>,
+    scene: &Scene,
+    settings: RenderSettings,
+    progress: Option<Bound<'_, PyAny>>,
 ) -> PyResult<Image> {
+    let RenderSettings {
+        spp,
+        seed,
+        threads,
+        time_limit,
+        target_error,
+    } = settings;
     if threads == Some(0) {
         return Err(to_py(py, &Error::usage("threads must be at least 1")));
     }
@@ -69,7 +83,7 @@ pub fn render(
         interrupt: Some(interrupt.clone()),
         threads,
         seed: seed.unwrap_or(loaded.seed),
-        progress: Progress::Counter(counter.clone()),
+        progress: Some(counter.clone()),
     };
     let report = || -> PyResult<()> {
         match &progress {

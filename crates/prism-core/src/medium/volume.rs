@@ -267,25 +267,3 @@ pub fn parse_vol(bytes: &[u8]) -> Result<VolFile, String> {
         data,
     })
 }
-
-/// The bytes of a `.vol` file holding `data` (channel fastest, then x, y, z).
-pub fn write_vol(
-    resolution: [usize; 3],
-    channels: usize,
-    bbox: (Vec3, Vec3),
-    data: &[f32],
-) -> Vec<u8> {
-    let mut bytes = Vec::with_capacity(VOL_HEADER_BYTES + 4 * data.len());
-    bytes.extend_from_slice(b"VOL\x03");
-    bytes.extend_from_slice(&1i32.to_le_bytes());
-    for v in [resolution[0], resolution[1], resolution[2], channels] {
-        bytes.extend_from_slice(&(v as i32).to_le_bytes());
-    }
-    for v in [bbox.0.x, bbox.0.y, bbox.0.z, bbox.1.x, bbox.1.y, bbox.1.z] {
-        bytes.extend_from_slice(&v.to_le_bytes());
-    }
-    for v in data {
-        bytes.extend_from_slice(&v.to_le_bytes());
-    }
-    bytes
-}

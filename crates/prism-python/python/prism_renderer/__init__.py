@@ -104,12 +104,14 @@ def render(
     try:
         return _native.render(
             scene,
-            spp=spp,
-            seed=seed,
-            threads=threads,
-            progress=callback,
-            time_limit=time_limit,
-            target_error=target_error,
+            {
+                "spp": spp,
+                "seed": seed,
+                "threads": threads,
+                "time_limit": time_limit,
+                "target_error": target_error,
+            },
+            callback,
         )
     finally:
         if bar is not None:

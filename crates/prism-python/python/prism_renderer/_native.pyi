@@ -1,7 +1,7 @@
 """Type stubs of the native module (crates/prism-python/src); the package re-exports these."""
 
 import os
-from typing import Callable, Dict, List, Optional, Sequence, Tuple, Union
+from typing import Callable, Dict, List, Optional, Sequence, Tuple, TypedDict, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -196,17 +196,20 @@ def load_dict(scene: dict) -> Scene:
     ``{"type": "ref", "id": ...}``, and nested plugins. Plugins directly in the scene can be
     referred to by their key. Raises :class:`PrismError` with ``file`` the key path."""
 
+class _RenderSettings(TypedDict):
+    spp: Optional[int]
+    seed: Optional[int]
+    threads: Optional[int]
+    time_limit: Optional[float]
+    target_error: Optional[float]
+
 def render(
     scene: Scene,
-    spp: Optional[int] = None,
-    seed: Optional[int] = None,
-    threads: Optional[int] = None,
+    settings: _RenderSettings,
     progress: Optional[Callable[[int, Optional[int], float], object]] = None,
-    time_limit: Optional[float] = None,
-    target_error: Optional[float] = None,
 ) -> Image:
-    """Renders ``scene`` (see :func:`prism_renderer.render`); ``progress`` is a callable or
-    None."""
+    """Renders ``scene`` (see :func:`prism_renderer.render`, whose keywords ``settings``
+    holds); ``progress`` is a callable or None."""
 
 def compare(
     test: Union[Image, str, os.PathLike],

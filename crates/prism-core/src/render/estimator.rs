@@ -1,0 +1,86 @@
+//! The estimate of one camera sample: its wavelengths, film position, time and lens position
+//! drawn from the sampler, its camera ray, and the integrator's radiance along it in CIE XYZ.
+
+use glam::{UVec2, Vec2};
+
+use crate::camera::CameraModel;
+use crate::film::{FilterMis, FilterSampler};
+use crate::integrator::{PreparedIntegrator, RayCount};
+use crate::sampling::sampler::Sampler;
+use crate::scene::Scene;
+use crate::spectrum::SampledWavelengths;
+
+/// What every camera sample of a render uses: the scene, its integrator prepared for the
+/// scene's world, the sampler of the reconstruction filter, and filter MIS's weights when the
+/// samples are shared between pixels.
+pub struct SampleEstimator<'a> {
+    pub(super) scene: &'a Scene,
+    integrator: PreparedIntegrator<'a>,
+    filter: FilterSampler,
+    pub(super) shared: Option<FilterMis>,
+}
+
+impl<'a> SampleEstimator<'a> {
+    pub fn new(scene: &'a Scene) -> SampleEstimator<'a> {
+        let film = &scene.film;
+        SampleEstimator {
+            scene,
+            integrator: scene.integrator.prepare(&scene.world),
+            filter: FilterSampler::new(film.filter),
+            shared: film
+                .reconstruction
+                .shares_samples(film.filter)
+                .then(|| FilterMis::new(film.filter, film.size.x, film.size.y)),
+        }
+    }
+
+    /// How many extra channels each sample writes.
+    pub fn aov_count(&self) -> usize {
+        self.integrator.aov_count()
+    }
+
+    /// Traces sample `index` of `pixel` (full-film coordinates): its film offset from the
+    /// pixel's centre, the filter weight the one-pixel estimator gives it, and its CIE XYZ
+    /// weighted by the shutter's filter; its extra channels, weighted alike, go to `aovs`.
+    pub(super) fn trace(
+        &self,
+        sampler: &mut Sampler,
+        pixel: UVec2,
+        index: u32,
+        count: &mut RayCount,
+        aovs: &mut [f32],
+    ) -> (Vec2, f32, [f32; 3]) {
+        let scene = self.scene;
+        sampler.start_pixel_sample(pixel, index);
+        let primary = sampler.camera_sample();
+        let lambda = SampledWavelengths::sample(primary.wavelength, scene.film.wavelength_sampling);
+        let (offset, filter_weight) = self.filter.sample(primary.film);
+        let (time, time_weight) = scene.shutter.sample(primary.time);
+        let film_position = pixel.as_vec2() + Vec2::splat(0.5) + offset;
+        let ray = scene.camera.generate_ray(film_position, primary.lens, time);
+        let radiance = self.integrator.radiance(ray, &lambda, sampler, count, aovs);
+        for v in aovs.iter_mut() {
+            *v *= time_weight;
+        }
+        let xyz = lambda.to_xyz(&radiance).map(|v| v * time_weight);
+        (offset, filter_weight, xyz)
+    }
+
+    /// The one-pixel estimate of sample `index` of `pixel` (full-film coordinates): its
+    /// filter-weighted CIE XYZ; the sample's extra channels, weighted by the same filter weight,
+    /// go to `aovs`. Under filter MIS the same sample also feeds the pixels around.
+    pub fn estimate(
+        &self,
+        sampler: &mut Sampler,
+        pixel: UVec2,
+        index: u32,
+        count: &mut RayCount,
+        aovs: &mut [f32],
+    ) -> [f32; 3] {
+        let (_, weight, xyz) = self.trace(sampler, pixel, index, count, aovs);
+        for v in aovs.iter_mut() {
+            *v *= weight;
+        }
+        xyz.map(|v| v * weight)
+    }
+}

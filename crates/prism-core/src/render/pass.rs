@@ -1,0 +1,170 @@
+//! A pass of a render: the samples of a range of indices added to every pixel of the crop
+//! window, the tiles in parallel, by the one-pixel reconstruction or by filter MIS.
+
+use std::ops::Range;
+
+use glam::UVec2;
+use rayon::prelude::*;
+
+use super::RenderOptions;
+use super::estimator::SampleEstimator;
+use super::filter_mis::{SharedSamples, gather_tile};
+use super::progress::ProgressReport;
+use super::stop::Cancel;
+use super::tiles::{Tile, TileSums};
+use crate::film::FilterMis;
+use crate::film::accumulation::{AOV_SUMS_PER_CHANNEL, add_aov_sample};
+use crate::integrator::RayCount;
+use crate::sampling::sampler::Sampler;
+
+/// Under filter MIS, the samples kept for one batch of sample indices take at most about this
+/// many bytes (a batch has at least one index).
+const SHARED_SAMPLES_BYTES: usize = 64 << 20;
+
+/// Adds the samples `range` of every pixel of a tile to a copy of its sums; None when the pass
+/// was cancelled before the tile was done.
+fn render_tile(
+    estimator: &SampleEstimator,
+    tile: Tile,
+    sums: &TileSums,
+    range: Range<u32>,
+    options: &RenderOptions,
+    cancel: &Cancel,
+) -> Option<(TileSums, u64)> {
+    let scene = estimator.scene;
+    let mut sampler = Sampler::new(scene.sampler.kind, options.samples_per_pixel, options.seed);
+    let mut count = RayCount::default();
+    let mut sums = sums.clone();
+    let k = estimator.aov_count();
+    let stride = AOV_SUMS_PER_CHANNEL * k;
+    // One sample's extra channels, reused for every sample of the tile.
+    let mut aovs = vec![0.0f32; k];
+    let crop_offset = scene.film.crop.offset;
+    for y in 0..tile.size.y {
+        if cancel.raised() {
+            return None;
+        }
+        for x in 0..tile.size.x {
+            let pixel = crop_offset + tile.origin + UVec2::new(x, y);
+            let i = (y * tile.size.x + x) as usize;
+            for index in range.clone() {
+                aovs.fill(0.0);
+                let xyz = estimator.estimate(&mut sampler, pixel, index, &mut count, &mut aovs);
+                sums.pixels[i].add(xyz);
+                add_aov_sample(&mut sums.aovs[i * stride..i * stride + k], &aovs);
+            }
+        }
+    }
+    Some((sums, count.rays))
+}
+
+/// What every pass of a render works with.
+pub(super) struct Pass<'p, 's> {
+    pub(super) estimator: &'p SampleEstimator<'s>,
+    pub(super) tiles: &'p [Tile],
+    pub(super) options: &'p RenderOptions,
+    pub(super) cancel: &'p Cancel<'p>,
+    pub(super) progress: &'p dyn ProgressReport,
+}
+
+impl Pass<'_, '_> {
+    /// Adds the samples `range` of every pixel to copies of the tiles' `sums`, in parallel; None
+    /// when the pass was cancelled.
+    pub(super) fn render(
+        &self,
+        sums: &[TileSums],
+        range: Range<u32>,
+    ) -> Option<(Vec<TileSums>, u64)> {
+        match &self.estimator.shared {
+            Some(mis) => self.render_shared(mis, sums, range),
+            None => self.render_one_pixel(sums, range),
+        }
+    }
+
+    /// The one-pixel reconstruction: every tile's pixels take their own samples.
+    fn render_one_pixel(
+        &self,
+        sums: &[TileSums],
+        range: Range<u32>,
+    ) -> Option<(Vec<TileSums>, u64)> {
+        let pass = u64::from(range.end - range.start);
+        let (estimator, options, cancel) = (self.estimator, self.options, self.cancel);
+        let results: Vec<Option<(TileSums, u64)>> = self
+            .tiles
+            .par_iter()
+            .zip(sums)
+            .map(|(&tile, tile_sums)| {
+                let result =
+                    render_tile(estimator, tile, tile_sums, range.clone(), options, cancel);
+                if result.is_some() {
+                    self.progress
+                        .advance(u64::from(tile.size.x * tile.size.y) * pass);
+                }
+                result
+            })
+            .collect();
+        let mut rays = 0;
+        let mut new_sums = Vec::with_capacity(results.len());
+        for result in results {
+            let (tile_sums, tile_rays) = result?;
+            new_sums.push(tile_sums);
+            rays += tile_rays;
+        }
+        Some((new_sums, rays))
+    }
+
+    /// Filter MIS: for each batch of sample indices, the samples of every pixel within reach of
+    /// the crop window are traced, then every pixel of the crop gathers what each index brings
+    /// it from the (2·reach + 1)² pixels around, always in the same order, and adds the totals
+    /// of each index to its sums ([`PixelSums::add_shared`]).
+    fn render_shared(
+        &self,
+        mis: &FilterMis,
+        sums: &[TileSums],
+        range: Range<u32>,
+    ) -> Option<(Vec<TileSums>, u64)> {
+        let estimator = self.estimator;
+        let film = &estimator.scene.film;
+        let reach = UVec2::splat(mis.reach());
+        let origin = film.crop.offset.saturating_sub(reach);
+        let end = (film.crop.offset + film.crop.size + reach).min(film.size);
+        let size = end - origin;
+        let k = estimator.aov_count();
+        let bytes_per_index = SharedSamples::bytes_per_index(size, k, mis.reach());
+        let batch = (SHARED_SAMPLES_BYTES / bytes_per_index)
+            .clamp(1, (range.end - range.start) as usize) as u32;
+        let mut samples = SharedSamples::new(origin, size, batch, k, mis.reach());
+        let mut new_sums = sums.to_vec();
+        let mut rays = 0;
+        let mut start = range.start;
+        while start < range.end {
+            let batch_range = start..(start + batch).min(range.end);
+            rays += samples.trace(
+                estimator,
+                mis,
+                batch_range.clone(),
+                self.options,
+                self.cancel,
+            )?;
+            new_sums
+                .par_iter_mut()
+                .zip(self.tiles)
+                .for_each(|(tile_sums, &tile)| {
+                    gather_tile(
+                        estimator,
+                        mis,
+                        &samples,
+                        tile,
+                        tile_sums,
+                        batch_range.clone(),
+                        self.options,
+                    );
+                    let pixels = u64::from(tile.size.x * tile.size.y);
+                    self.progress
+                        .advance(pixels * u64::from(batch_range.end - batch_range.start));
+                });
+            start = batch_range.end;
+        }
+        Some((new_sums, rays))
+    }
+}
