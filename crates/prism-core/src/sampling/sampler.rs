@@ -176,13 +176,17 @@ impl Sampler {
             SamplerKind::Stratified { jitter }
             | SamplerKind::MultiJitter { jitter }
             | SamplerKind::Orthogonal { jitter, .. } => jitter,
-            _ => true,
+            SamplerKind::Independent | SamplerKind::NRooks | SamplerKind::LowDiscrepancy => true,
         };
         let levels = match kind {
             SamplerKind::Orthogonal { strength, .. } => {
                 orthogonal_array_base(requested.max(1), strength)
             }
-            _ => 1,
+            SamplerKind::Independent
+            | SamplerKind::Stratified { .. }
+            | SamplerKind::MultiJitter { .. }
+            | SamplerKind::NRooks
+            | SamplerKind::LowDiscrepancy => 1,
         };
         Sampler {
             kind,
@@ -269,7 +273,11 @@ impl Sampler {
                     lens: Vec2::new(lu, lv),
                 }
             }
-            _ => CameraSample {
+            SamplerKind::Independent
+            | SamplerKind::Stratified { .. }
+            | SamplerKind::MultiJitter { .. }
+            | SamplerKind::LowDiscrepancy
+            | SamplerKind::Orthogonal { .. } => CameraSample {
                 wavelength: self.next_1d(),
                 time: self.next_1d(),
                 film: self.next_2d(),

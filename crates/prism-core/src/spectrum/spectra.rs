@@ -132,34 +132,40 @@ impl Spectrum {
 
     /// The largest value over 360–830 nm (sampled at 1 nm), used to bound reflectances.
     pub fn max_value(&self) -> f32 {
-        match self {
-            Spectrum::Constant(v) => *v,
-            _ => (0..=470)
+        self.constant_value().unwrap_or_else(|| {
+            (0..=470)
                 .map(|i| self.value(LAMBDA_MIN + i as f32))
-                .fold(0.0, f32::max),
-        }
+                .fold(0.0, f32::max)
+        })
     }
 
     /// The smallest value over 360–830 nm (sampled at 1 nm).
     pub fn min_value(&self) -> f32 {
-        match self {
-            Spectrum::Constant(v) => *v,
-            _ => (0..=470)
+        self.constant_value().unwrap_or_else(|| {
+            (0..=470)
                 .map(|i| self.value(LAMBDA_MIN + i as f32))
-                .fold(f32::INFINITY, f32::min),
-        }
+                .fold(f32::INFINITY, f32::min)
+        })
     }
 
     /// The mean value over 360–830 nm (sampled at 1 nm).
     pub fn mean(&self) -> f32 {
+        self.constant_value().unwrap_or_else(|| {
+            let sum: f64 = (0..=470)
+                .map(|i| f64::from(self.value(LAMBDA_MIN + i as f32)))
+                .sum();
+            (sum / 471.0) as f32
+        })
+    }
+
+    /// The value at every wavelength, when the spectrum is constant.
+    fn constant_value(&self) -> Option<f32> {
         match self {
-            Spectrum::Constant(v) => *v,
-            _ => {
-                let sum: f64 = (0..=470)
-                    .map(|i| f64::from(self.value(LAMBDA_MIN + i as f32)))
-                    .sum();
-                (sum / 471.0) as f32
-            }
+            Spectrum::Constant(v) => Some(*v),
+            Spectrum::PiecewiseLinear(_)
+            | Spectrum::Rgb { .. }
+            | Spectrum::RgbIlluminant { .. }
+            | Spectrum::Blackbody(_) => None,
         }
     }
 
