@@ -22,7 +22,7 @@
 use crate::bsdf::BxdfTree;
 use crate::integrator::SampleContext;
 use crate::integrator::mis::{ScatterOrigin, Strategies, emission_found, sample_light_at_surface};
-use crate::integrator::vertex::{path_estimate, surface_scattering};
+use crate::integrator::vertex::{path_estimate, surface_scattering, wavelengths_after};
 use crate::light::Receiver;
 use crate::math::Ray;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
@@ -98,10 +98,7 @@ impl DirectIntegrator {
                 continue;
             }
             // This sample's own wavelengths: a dispersive refraction is the hero's alone.
-            let mut sample_lambda = lambda;
-            if bs.terminates_secondary {
-                sample_lambda.terminate_secondary();
-            }
+            let sample_lambda = wavelengths_after(&lambda, &bs);
             let origin = ScatterOrigin {
                 receiver: Receiver::surface(si.p, si.shading.n),
                 pdf: bs.pdf,

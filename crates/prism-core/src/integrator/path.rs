@@ -33,6 +33,7 @@ use crate::integrator::SampleContext;
 use crate::integrator::mis::{ScatterOrigin, Strategies, emission_found, sample_light_at_surface};
 use crate::integrator::vertex::{
     allows_next_vertex, normals_agree, path_estimate, russian_roulette, surface_scattering,
+    wavelengths_after,
 };
 use crate::light::{LightSelection, Receiver};
 use crate::math::Ray;
@@ -128,9 +129,7 @@ impl PathIntegrator {
             if self.strict_normals && !normals_agree(&si, bs.wi) {
                 break;
             }
-            if bs.terminates_secondary {
-                lambda.terminate_secondary();
-            }
+            lambda = wavelengths_after(&lambda, &bs);
             throughput *= bs.weight;
             eta_scale *= bs.eta;
             if throughput.is_black() {

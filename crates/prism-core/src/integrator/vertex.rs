@@ -5,7 +5,7 @@
 
 use glam::Vec3;
 
-use crate::bsdf::{BxdfTree, Scattering};
+use crate::bsdf::{BsdfSample, BxdfTree, Scattering};
 use crate::geometry::SurfaceInteraction;
 use crate::integrator::SampleContext;
 use crate::spectrum::{N_SPECTRUM_SAMPLES, SampledSpectrum, SampledWavelengths};
@@ -32,6 +32,18 @@ pub fn surface_scattering<'t, 'w>(
         lambda.terminate_secondary();
     }
     scattering
+}
+
+/// The wavelengths that follow the BSDF sample `bs`: those of `lambda`, or its hero alone when
+/// the sample is a dispersive delta refraction (which bends each wavelength its own way, so
+/// the sampled direction is the hero's only).
+#[inline]
+pub fn wavelengths_after(lambda: &SampledWavelengths, bs: &BsdfSample) -> SampledWavelengths {
+    let mut after = *lambda;
+    if bs.terminates_secondary {
+        after.terminate_secondary();
+    }
+    after
 }
 
 /// Whether a path whose last vertex has depth `depth` may have another: `max_depth` counts the

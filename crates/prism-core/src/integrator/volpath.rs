@@ -36,7 +36,7 @@ use crate::integrator::SampleContext;
 use crate::integrator::mis::{LightSampleTerms, emission_along, power_heuristic, sample_light};
 use crate::integrator::transmittance::{medium_after, shadow_end, shadow_transmittance};
 use crate::integrator::vertex::{
-    allows_next_vertex, hero_only, russian_roulette, surface_scattering,
+    allows_next_vertex, hero_only, russian_roulette, surface_scattering, wavelengths_after,
 };
 use crate::light::{LightSelection, Receiver};
 use crate::math::Ray;
@@ -386,9 +386,7 @@ impl VolPathIntegrator {
             let Some(bs) = scattering.sample(u_lobe, u) else {
                 break;
             };
-            if bs.terminates_secondary {
-                lambda.terminate_secondary();
-            }
+            lambda = wavelengths_after(&lambda, &bs);
             weights.scatter(bs.weight, bs.pdf, bs.flags.is_delta());
             eta_scale *= bs.eta;
             if weights.throughput().is_black() {
