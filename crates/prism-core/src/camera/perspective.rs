@@ -19,7 +19,7 @@
 //! film position leaves from a uniformly sampled point of the aperture disk (concentric map) and
 //! passes through the point of the focal plane the pinhole ray would reach. The aperture is
 //! `aperture_radius`, or, in the lecture's parametrisation, the aperture *area* a
-//! (`aperture_area`), so the radius is √(a/π) (DESIGN.md §4).
+//! (`aperture_area`), so the radius is √(a/π) (docs/architecture.md, The lecture's errata).
 //!
 //! ```xml
 //! <sensor type="thinlens">
@@ -146,7 +146,8 @@ mod tests {
         let expected = (2.0 * (2.0 * 15f64.to_radians().tan()).atan()).to_degrees();
         assert!((horizontal_fov(30.0, FovAxis::Y, 2.0) - expected).abs() < 1e-9);
         assert!((horizontal_fov(30.0, FovAxis::Smaller, 2.0) - expected).abs() < 1e-9);
-        // The default 50 mm lens on a square film (DESIGN.md §5: 34.022 degrees).
+        // The default 50 mm lens on a square film: 34.022 degrees (docs/mitsuba-compatibility.md,
+        // Semantics that decide parity).
         let fov = horizontal_fov(focal_length_to_diagonal_fov(50.0), FovAxis::Diagonal, 1.0);
         assert!((fov - 34.022).abs() < 1e-3, "{fov}");
     }

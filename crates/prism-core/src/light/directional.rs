@@ -8,7 +8,8 @@
 //! </emitter>
 //! ```
 //! Without `direction`, the light travels along the +z axis of `to_world` (default: world +z).
-//! A diffuse surface tilted by θ from the light reflects L = ρ E cos θ / π (DESIGN.md §7).
+//! A diffuse surface tilted by θ from the light reflects L = ρ E cos θ / π (docs/testing.md, Closed
+//! forms).
 
 use std::f32::consts::PI;
 

@@ -3,7 +3,7 @@
 //! receiver's cosine), or everywhere alike in proportion to its power (the lecture's "assign the
 //! probabilities proportional to the emitted spectral power", through an alias table), or
 //! uniformly (Mitsuba's default, every emitter with the same `sampling_weight`); the estimate is
-//! then divided by that probability (DESIGN.md §4).
+//! then divided by that probability (docs/architecture.md, The lecture's errata).
 //!
 //! The choice is the path integrator's `emitter_sampling` parameter (a Prism extension that
 //! Mitsuba does not know):
