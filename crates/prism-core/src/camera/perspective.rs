@@ -3,14 +3,16 @@
 //!
 //! ```xml
 //! <sensor type="perspective">
-//!     <float name="fov" value="39.3"/>          <!-- or focal_length="50mm" (the default) -->
+//!     <float name="fov" value="39.3"/>          <!-- or focal_length -->
 //!     <string name="fov_axis" value="x"/>       <!-- x, y, diagonal, smaller, larger -->
-//!     <float name="near_clip" value="0.01"/>    <!-- defaults 1e-2 and 1e4 -->
+//!     <float name="near_clip" value="0.01"/>
 //!     <float name="far_clip" value="10000"/>
 //!     <transform name="to_world"> <lookat origin="..." target="..." up="..."/> </transform>
 //!     <film .../> <sampler .../>
 //! </sensor>
 //! ```
+//! Its parameters and their defaults are listed in docs/plugins.md.
+//!
 //! The camera looks along +z of its frame, with +y up and +x to the left of the image (Mitsuba's
 //! convention: `lookat` builds the frame [left, up, forward, origin]).
 //!
@@ -24,7 +26,7 @@
 //! ```xml
 //! <sensor type="thinlens">
 //!     <float name="aperture_radius" value="0.05"/>   <!-- or aperture_area -->
-//!     <float name="focus_distance" value="4"/>       <!-- or focal_distance; default far_clip -->
+//!     <float name="focus_distance" value="4"/>       <!-- or focal_distance -->
 //!     <float name="fov" value="40"/>
 //! </sensor>
 //! ```

@@ -9,9 +9,10 @@
 //! Mitsuba does not know):
 //! ```xml
 //! <integrator type="path">
-//!     <string name="emitter_sampling" value="power"/>   <!-- "exhaustive" (default), "power" or "uniform" -->
+//!     <string name="emitter_sampling" value="power"/>   <!-- "exhaustive", "power" or "uniform" -->
 //! </integrator>
 //! ```
+//! Its parameters and their defaults are listed in docs/plugins.md.
 //!
 //! `exhaustive` is pbrt-v4's `ExhaustiveLightSampler` (Pharr, Jakob and Humphreys, pbrt-v4,
 //! §12.6.3): every light at a finite place is weighed by its importance I(p, n) at the receiver,
