@@ -1,22 +1,31 @@
 #!/usr/bin/env python3
-"""Generates crates/prism-core/src/spectrum/cie_tables.rs from the CIE data files in ../shared/data/cie/.
+"""Writes crates/prism-core/src/spectrum/cie_tables.rs from the CIE data files in data/cie/.
 
-usage: python3 tools/gen_cie_tables.py ../shared/data/cie > crates/prism-core/src/spectrum/cie_tables.rs
+usage: python3 tools/gen_cie_tables.py [--data DIR] [--out FILE]
 
 The tables are embedded at 1 nm from 360 to 830 nm (471 values each), exactly as the CIE files
-give them (D65 is cut to the same range).
+give them (D65 is cut to the same range). Arrays are laid out as `cargo fmt` lays them out (one
+value per line when a value is longer than 10 characters, else as many per line as fit in 99
+columns), so the written file is the committed one byte for byte.
 """
+import argparse
 import csv
-import sys
 from pathlib import Path
 
-folder = Path(sys.argv[1])
+ROOT = Path(__file__).resolve().parent.parent
+parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+parser.add_argument("--data", type=Path, default=ROOT / "data" / "cie", help="folder of the CIE CSV files")
+parser.add_argument(
+    "--out", type=Path, default=ROOT / "crates" / "prism-core" / "src" / "spectrum" / "cie_tables.rs"
+)
+args = parser.parse_args()
+
 cmf = {}
-with open(folder / "CIE_xyz_1931_2deg.csv") as f:
+with open(args.data / "CIE_xyz_1931_2deg.csv") as f:
     for row in csv.reader(f):
         cmf[int(row[0])] = tuple(row[1:4])
 d65 = {}
-with open(folder / "CIE_std_illum_D65.csv") as f:
+with open(args.data / "CIE_std_illum_D65.csv") as f:
     for row in csv.reader(f):
         d65[int(row[0])] = row[1]
 
@@ -24,24 +33,36 @@ lambdas = range(360, 831)
 assert all(l in cmf and l in d65 for l in lambdas)
 
 
+# rustfmt's `short_array_element_width_threshold`: arrays of values no longer than this are packed.
+SHORT_VALUE = 10
+
+
 def table(name, doc, values):
+    values = [v.strip() if any(c in v for c in ".eE") else v.strip() + ".0" for v in values]
     out = [f"/// {doc}", f"pub const {name}: [f32; {len(values)}] = ["]
-    line = "   "
-    for v in values:
-        v = v.strip()
-        if not any(c in v for c in ".eE"):
-            v += ".0"
-        item = f" {v},"
-        if len(line) + len(item) > 99:
-            out.append(line)
-            line = "   "
-        line += item
-    out.append(line)
+    if max(len(v) for v in values) > SHORT_VALUE:
+        out += [f"    {v}," for v in values]
+    else:
+        line = "   "
+        for v in values:
+            item = f" {v},"
+            if len(line) + len(item) > 99:
+                out.append(line)
+                line = "   "
+            line += item
+        out.append(line)
     out.append("];")
     return "\n".join(out)
 
 
-print("""//! CIE 1931 2-degree colour matching functions and the CIE standard illuminant D65, at 1 nm from
+lines = []
+
+
+def emit(text=""):
+    lines.append(text)
+
+
+emit("""//! CIE 1931 2-degree colour matching functions and the CIE standard illuminant D65, at 1 nm from
 //! 360 nm to 830 nm.
 //!
 //! Source: CIE (2019), "CIE 1931 colour-matching functions, 2 degree observer", dataset
@@ -49,24 +70,25 @@ print("""//! CIE 1931 2-degree colour matching functions and the CIE standard il
 //! DOI 10.25039/CIE.DS.hjfjmt59; both © CIE, licensed CC BY-SA 4.0. Generated from the official
 //! CSV files by `tools/gen_cie_tables.py`; do not edit by hand.
 """)
-print("#![allow(clippy::excessive_precision)] // the CIE's digits, kept as published")
-print()
+emit("#![allow(clippy::excessive_precision)] // the CIE's digits, kept as published")
+emit()
 sum_y = sum(float(cmf[l][1]) for l in lambdas)
 sum_d65_y = sum(float(cmf[l][1]) * float(d65[l]) for l in lambdas)
-print("/// Sum of y-bar over the 1 nm table: the integral of y-bar in nm (rectangle rule).")
-print(f"pub const CIE_Y_INTEGRAL: f64 = {sum_y!r};")
-print()
-print("/// Mean of D65 weighted by y-bar over the table: sum(D65 y-bar) / sum(y-bar). Dividing D65 by")
-print("/// it gives an illuminant of luminance Y = 1.")
-print(f"pub const D65_LUMINANCE: f64 = {sum_d65_y / sum_y!r};")
-print()
-print("/// Wavelength of the first entry of every table, in nm.")
-print("pub const TABLE_LAMBDA_MIN: f32 = 360.0;")
-print()
-print(table("CIE_X", "x-bar(lambda), 360..=830 nm at 1 nm.", [cmf[l][0] for l in lambdas]))
-print()
-print(table("CIE_Y", "y-bar(lambda), 360..=830 nm at 1 nm.", [cmf[l][1] for l in lambdas]))
-print()
-print(table("CIE_Z", "z-bar(lambda), 360..=830 nm at 1 nm.", [cmf[l][2] for l in lambdas]))
-print()
-print(table("D65", "Relative spectral power of D65 (100 at 560 nm), 360..=830 nm at 1 nm.", [d65[l] for l in lambdas]))
+emit("/// Sum of y-bar over the 1 nm table: the integral of y-bar in nm (rectangle rule).")
+emit(f"pub const CIE_Y_INTEGRAL: f64 = {sum_y!r};")
+emit()
+emit("/// Mean of D65 weighted by y-bar over the table: sum(D65 y-bar) / sum(y-bar). Dividing D65 by")
+emit("/// it gives an illuminant of luminance Y = 1.")
+emit(f"pub const D65_LUMINANCE: f64 = {sum_d65_y / sum_y!r};")
+emit()
+emit("/// Wavelength of the first entry of every table, in nm.")
+emit("pub const TABLE_LAMBDA_MIN: f32 = 360.0;")
+emit()
+emit(table("CIE_X", "x-bar(lambda), 360..=830 nm at 1 nm.", [cmf[l][0] for l in lambdas]))
+emit()
+emit(table("CIE_Y", "y-bar(lambda), 360..=830 nm at 1 nm.", [cmf[l][1] for l in lambdas]))
+emit()
+emit(table("CIE_Z", "z-bar(lambda), 360..=830 nm at 1 nm.", [cmf[l][2] for l in lambdas]))
+emit()
+emit(table("D65", "Relative spectral power of D65 (100 at 560 nm), 360..=830 nm at 1 nm.", [d65[l] for l in lambdas]))
+args.out.write_text("\n".join(lines) + "\n")

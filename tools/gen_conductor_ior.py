@@ -1,21 +1,26 @@
 #!/usr/bin/env python3
-"""Writes crates/prism-core/src/spectrum/conductors.rs: the complex indices of refraction (eta, k) of Mitsuba's
-named conductor presets, from the .spd files Mitsuba 3 ships in resources/data/ior (the
-mitsuba-data repository; the Python wheel installs them under mitsuba/data/ior). A preset whose
-data equals another's (most `*_palik` files repeat their base material) becomes an alias of it.
+"""Writes crates/prism-core/src/spectrum/conductors.rs: the complex indices of refraction (eta, k)
+of Mitsuba's named conductor presets, from the .spd files in data/ior (Mitsuba 3's
+resources/data/ior, from the mitsuba-data repository; data/README.md). A preset whose data
+equals another's (most `*_palik` files repeat their base material) becomes an alias of it.
 
-usage: tools/gen_conductor_ior.py [DIR_WITH_SPD_FILES]
-
-Default directory: the Mitsuba 3 installed by ../shared/tools/mitsuba-ref."""
+usage: python3 tools/gen_conductor_ior.py [--data DIR] [--out FILE]
+"""
+import argparse
 import glob
 import os
 import struct
 import sys
+from pathlib import Path
 
-default = os.path.expanduser(
-    "~/.cache/prism-peers/venv/lib/python3.11/site-packages/mitsuba/data/ior")
-src = sys.argv[1] if len(sys.argv) > 1 else default
-out = os.path.join(os.path.dirname(__file__), "..", "crates", "prism-core", "src", "spectrum", "conductors.rs")
+ROOT = Path(__file__).resolve().parent.parent
+parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+parser.add_argument("--data", type=Path, default=ROOT / "data" / "ior", help="folder of the .spd files")
+parser.add_argument(
+    "--out", type=Path, default=ROOT / "crates" / "prism-core" / "src" / "spectrum" / "conductors.rs"
+)
+args = parser.parse_args()
+src, out = str(args.data), args.out
 
 
 def f32(x):
@@ -42,6 +47,8 @@ def read(path):
 
 
 names = sorted(os.path.basename(p)[: -len(".eta.spd")] for p in glob.glob(os.path.join(src, "*.eta.spd")))
+if not names:
+    sys.exit(f"gen_conductor_ior.py: no .eta.spd files in {src}")
 data = {}
 for name in names:
     eta = read(os.path.join(src, name + ".eta.spd"))
@@ -112,5 +119,5 @@ for name in tables:
     lines.append("        ],")
     lines.append("    },")
 lines.append("];")
-open(out, "w").write("\n".join(lines) + "\n")
+out.write_text("\n".join(lines) + "\n")
 print(f"wrote {len(tables)} presets and {len(aliases)} aliases to {out}")

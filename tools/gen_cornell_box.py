@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
-"""Writes the bundled Cornell box (scenes/cornell-box/) from the measured data.
+"""Writes the bundled Cornell box (scenes/cornell-box/) from the measured data in data/.
 
-usage: python3 tools/gen_cornell_box.py ../shared/data/cornell_spectra.txt scenes/cornell-box
+usage: python3 tools/gen_cornell_box.py [--data data/cornell_spectra.txt] [--out scenes/cornell-box]
 
 Geometry, camera, reflectance spectra and the light's emission spectrum are those of the
 Cornell University Program of Computer Graphics, "Cornell Box Data"
@@ -10,10 +10,15 @@ OBJ mesh whose triangles face the inside of the box (the surfaces are one-sided 
 reflectors). Two choices are ours, as in Mitsuba's cbox scene: the luminaire is moved 0.5 mm
 below the ceiling so the two do not coincide, and its own reflectance is a flat 0.78.
 """
-import sys
+import argparse
 from pathlib import Path
 
-data_file, out_dir = Path(sys.argv[1]), Path(sys.argv[2])
+ROOT = Path(__file__).resolve().parent.parent
+parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+parser.add_argument("--data", type=Path, default=ROOT / "data" / "cornell_spectra.txt")
+parser.add_argument("--out", type=Path, default=ROOT / "scenes" / "cornell-box", help="the scene's folder")
+args = parser.parse_args()
+data_file, out_dir = args.data, args.out
 sections, current = {}, None
 for raw in data_file.read_text().splitlines():
     line = raw.split("#", 1)[0].rstrip()

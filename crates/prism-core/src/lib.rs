@@ -10,8 +10,8 @@
 //! the end the image is written as EXR (linear) and PNG (sRGB).
 //!
 //! # Modules, lowest layer first
-//! Each module uses only those above it in this table (a test checks it; see
-//! docs/architecture.md).
+//! Each module uses only those above it in this table, the order of the `layers` block of
+//! docs/architecture.md (one test checks the code against that block, another this table).
 //!
 //! | module | concept |
 //! | --- | --- |
@@ -25,10 +25,11 @@
 //! | [`texture`] | values that vary over a surface |
 //! | [`bsdf`] | BSDFs, their lobes at a point, materials |
 //! | [`light`] | light sources and the light sampler |
-//! | [`world`] | geometry, materials and lights together |
-//! | [`camera`] | the thin-lens perspective camera and the shutter |
+//! | [`medium`] | participating media and phase functions |
+//! | [`world`] | geometry, materials, lights and media together |
 //! | [`film`] | reconstruction filters, pixel sums and their error, the images written |
-//! | [`integrator`] | the path tracer and the lecture's distribution ray tracer |
+//! | [`camera`] | perspective, thin-lens and orthographic cameras and the shutter |
+//! | [`integrator`] | the estimators: path, direct, distrib, volpath, volpathmis, moment, aov |
 //! | [`scene`] | the world with camera, film, sampler and integrator |
 //! | [`render`] | passes, tiles, threads, progress, render states |
 

@@ -6,12 +6,14 @@
 //!     <texture type="bitmap" name="height">
 //!         <boolean name="raw" value="true"/> <string name="filename" value="bumps.png"/>
 //!     </texture>
-//!     <float name="scale" value="1"/>                        <!-- height scale, default 1 -->
+//!     <float name="scale" value="1"/>                        <!-- height scale -->
 //!     <boolean name="flip_invalid_normals" value="true"/>
 //!     <boolean name="use_shadowing_function" value="true"/>
 //!     <bsdf type="roughplastic"/>
 //! </bsdf>
 //! ```
+//! Its parameters and their defaults are listed in docs/plugins.md.
+//!
 //! As Mitsuba 3.9 (`bumpmap.cpp`, `perturbed_bsdf.h`): with the height gradient (h_u, h_v) the
 //! tangents become ∂p/∂u + n (h_u − n·∂p/∂u) and ∂p/∂v + n (h_v − n·∂p/∂v); the perturbed normal
 //! is their cross product, turned to the side of the geometric normal. The rest is shared with

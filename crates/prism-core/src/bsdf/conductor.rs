@@ -3,12 +3,14 @@
 //!
 //! ```xml
 //! <bsdf type="conductor">
-//!     <string name="material" value="Au"/>       <!-- a preset; default "none": 100 % mirror -->
+//!     <string name="material" value="Au"/>       <!-- a preset -->
 //!     <!-- or: <spectrum name="eta" value="..."/> <spectrum name="k" value="..."/> (or <rgb>, textures) -->
-//!     <rgb name="specular_reflectance" value="1"/>   <!-- optional factor, default 1 -->
-//!     <float name="ext_eta" value="1.33"/>           <!-- Mitsuba 0.6: exterior index, default 1 -->
+//!     <rgb name="specular_reflectance" value="1"/>   <!-- optional factor -->
+//!     <float name="ext_eta" value="1.33"/>           <!-- Mitsuba 0.6: exterior index -->
 //! </bsdf>
 //! ```
+//! Its parameters and their defaults are listed in docs/plugins.md.
+//!
 //! A single specular lobe: `sample` returns the mirror direction with weight
 //! F(cos θ, η(λ), k(λ)) · specular_reflectance; nothing to evaluate. One-sided.
 

@@ -3,13 +3,15 @@
 //!
 //! ```xml
 //! <bsdf type="dielectric">
-//!     <string name="int_ior" value="bk7"/>     <!-- number or name; default bk7 (1.5046) -->
-//!     <string name="ext_ior" value="air"/>     <!-- default air (1.000277) -->
+//!     <string name="int_ior" value="bk7"/>     <!-- number or name -->
+//!     <string name="ext_ior" value="air"/>
 //!     <!-- dispersive: <spectrum name="int_ior" type="sellmeier"> ... </spectrum>, see spectrum::ior -->
 //!     <rgb name="specular_reflectance" value="1"/>     <!-- optional factors -->
 //!     <rgb name="specular_transmittance" value="1"/>
 //! </bsdf>
 //! ```
+//! Its parameters and their defaults are listed in docs/plugins.md.
+//!
 //! Two specular lobes, chosen with the probabilities F and 1 − F, so the weights are 1 (times the
 //! optional factors, and (η_i/η_t)² for transmitted radiance, which is compressed into a smaller
 //! solid angle: Veach 1997, §5.2). With a dispersive index (our extension; Mitsuba's indices are

@@ -2,9 +2,11 @@
 //!
 //! ```xml
 //! <bsdf type="diffuse">
-//!     <rgb name="reflectance" value="0.2, 0.25, 0.7"/>   <!-- or a texture; default 0.5 -->
+//!     <rgb name="reflectance" value="0.2, 0.25, 0.7"/>   <!-- or a texture -->
 //! </bsdf>
 //! ```
+//! Its parameters and their defaults are listed in docs/plugins.md.
+//!
 //! Sampled by Nusselt's analogue (cosine-weighted hemisphere, the lecture's "Importance Sampling
 //! of the Reflection Integral"), so the sample weight is ρ. One-sided: black from behind.
 

@@ -355,7 +355,8 @@ impl<'a> BxdfTree<'a> {
 
 /// Declares the BSDFs: the description enum [`Bsdf`], one variant per plugin, and the lobe enum
 /// [`Node`], one variant per kind of lobes (bump and normal maps share theirs), dispatched to
-/// [`BsdfModel`] and [`Bxdf`] by `match` (no dynamic dispatch in the hot path, DESIGN.md §3.1).
+/// [`BsdfModel`] and [`Bxdf`] by `match` (no dynamic dispatch in the hot path: docs/architecture.md,
+/// Conventions).
 macro_rules! bsdfs {
     (
         descriptions { $($variant:ident($model:ty),)+ }

@@ -4,11 +4,13 @@
 //!
 //! ```xml
 //! <bsdf type="phong">
-//!     <float name="exponent" value="30"/>                 <!-- or a texture; default 30 -->
-//!     <rgb name="specular_reflectance" value="0.2"/>      <!-- or a texture; default 0.2 -->
-//!     <rgb name="diffuse_reflectance" value="0.5"/>       <!-- or a texture; default 0.5 -->
+//!     <float name="exponent" value="30"/>                 <!-- or a texture -->
+//!     <rgb name="specular_reflectance" value="0.2"/>      <!-- or a texture -->
+//!     <rgb name="diffuse_reflectance" value="0.5"/>       <!-- or a texture -->
 //! </bsdf>
 //! ```
+//! Its parameters and their defaults are listed in docs/plugins.md.
+//!
 //! f cos θi = (ρ_d/π + ρ_s (n + 2)/(2π) cos^n α) cos θi, α the angle between wi and the mirror
 //! direction of wo. When max(ρ_d + ρ_s) > 1 both are scaled down to conserve energy, as Mitsuba
 //! 0.6 does. The glossy lobe is sampled by p = (n + 1)/(2π) cos^n α around the mirror direction

@@ -3,13 +3,15 @@
 //!
 //! ```xml
 //! <bsdf type="plastic">
-//!     <rgb name="diffuse_reflectance" value="0.1, 0.27, 0.36"/>  <!-- or a texture; default 0.5 -->
-//!     <string name="int_ior" value="polypropylene"/>             <!-- default polypropylene (1.49) -->
+//!     <rgb name="diffuse_reflectance" value="0.1, 0.27, 0.36"/>  <!-- or a texture -->
+//!     <string name="int_ior" value="polypropylene"/>
 //!     <string name="ext_ior" value="air"/>
 //!     <rgb name="specular_reflectance" value="1"/>               <!-- optional factor -->
 //!     <boolean name="nonlinear" value="false"/>
 //! </bsdf>
 //! ```
+//! Its parameters and their defaults are listed in docs/plugins.md.
+//!
 //! Two lobes: the coating's mirror reflection F(cos θo) (a delta), and the base seen through it,
 //!
 //!   f cos θi = ρ (1 − F(cos θo)) (1 − F(cos θi)) cos θi / (π η² (1 − F_dr)),

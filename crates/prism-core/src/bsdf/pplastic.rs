@@ -5,14 +5,16 @@
 //!
 //! ```xml
 //! <bsdf type="pplastic">
-//!     <rgb name="diffuse_reflectance" value="0.05, 0.03, 0.1"/>  <!-- or a texture; default 0.5 -->
-//!     <float name="alpha" value="0.06"/>               <!-- or alpha_u and alpha_v; default 0.1 -->
+//!     <rgb name="diffuse_reflectance" value="0.05, 0.03, 0.1"/>  <!-- or a texture -->
+//!     <float name="alpha" value="0.06"/>               <!-- or alpha_u and alpha_v -->
 //!     <string name="distribution" value="beckmann"/>   <!-- or ggx -->
 //!     <string name="int_ior" value="polypropylene"/>
 //!     <string name="ext_ior" value="air"/>
 //!     <rgb name="specular_reflectance" value="1"/>     <!-- optional factor -->
 //! </bsdf>
 //! ```
+//! Its parameters and their defaults are listed in docs/plugins.md.
+//!
 //! f cos θi = s F(wo·h) D(h) G(wo, wi, h) / (4 cos θo)                     (rough specular)
 //!          + (1 − F(cos θo)) ρ (1 − F(cos θi)) cos θi / π                  (diffuse base)
 //!

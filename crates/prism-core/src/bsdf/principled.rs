@@ -7,7 +7,7 @@
 //! <bsdf type="principled">
 //!     <rgb name="base_color" value="0.8, 0.2, 0.1"/>   <!-- every parameter may be a texture -->
 //!     <float name="metallic" value="0.7"/>
-//!     <float name="specular" value="0.6"/>             <!-- or eta; default 0.5 (η = 1.5) -->
+//!     <float name="specular" value="0.6"/>             <!-- or eta -->
 //!     <float name="roughness" value="0.2"/>
 //!     <float name="spec_tint" value="0.4"/>
 //!     <float name="anisotropic" value="0.5"/>
@@ -19,6 +19,8 @@
 //!     <float name="flatness" value="0.1"/>
 //! </bsdf>
 //! ```
+//! Its parameters and their defaults are listed in docs/plugins.md.
+//!
 //! With c the base colour, w_brdf = (1 − metallic)(1 − spec_trans) and
 //! w_bsdf = (1 − metallic) spec_trans, seen from the front (cos θo > 0):
 //!

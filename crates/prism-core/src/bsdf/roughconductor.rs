@@ -4,14 +4,16 @@
 //!
 //! ```xml
 //! <bsdf type="roughconductor">
-//!     <string name="material" value="Al"/>           <!-- or eta and k; default "none": F = 1 -->
-//!     <string name="distribution" value="ggx"/>      <!-- or beckmann (the default) -->
-//!     <float name="alpha_u" value="0.05"/>           <!-- or alpha for both; default 0.1 -->
+//!     <string name="material" value="Al"/>           <!-- or eta and k -->
+//!     <string name="distribution" value="ggx"/>      <!-- or beckmann -->
+//!     <float name="alpha_u" value="0.05"/>           <!-- or alpha for both -->
 //!     <float name="alpha_v" value="0.3"/>            <!-- (floats or textures) -->
 //!     <rgb name="specular_reflectance" value="1"/>   <!-- optional factor -->
-//!     <float name="ext_eta" value="1.33"/>           <!-- Mitsuba 0.6: exterior index, default 1 -->
+//!     <float name="ext_eta" value="1.33"/>           <!-- Mitsuba 0.6: exterior index -->
 //! </bsdf>
 //! ```
+//! Its parameters and their defaults are listed in docs/plugins.md.
+//!
 //! f(wo, wi) cos θi = F(wo·h) D(h) G(wo, wi, h) / (4 cos θo) with h the half vector; sampled by
 //! visible normals (Heitz & d'Eon 2014), so the weight is F(wo·m) G₁(wi, m). α_u runs along
 //! ∂p/∂u. One-sided.

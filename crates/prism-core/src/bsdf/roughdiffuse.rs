@@ -5,11 +5,13 @@
 //!
 //! ```xml
 //! <bsdf type="roughdiffuse">
-//!     <rgb name="reflectance" value="0.5"/>         <!-- or a texture; default 0.5 -->
-//!     <float name="alpha" value="0.2"/>             <!-- or a texture; default 0.2 -->
+//!     <rgb name="reflectance" value="0.5"/>         <!-- or a texture -->
+//!     <float name="alpha" value="0.2"/>             <!-- or a texture -->
 //!     <boolean name="use_fast_approx" value="false"/>
 //! </bsdf>
 //! ```
+//! Its parameters and their defaults are listed in docs/plugins.md.
+//!
 //! α is a Beckmann-style RMS slope; as in Mitsuba the Oren–Nayar slope deviation is σ = α/√2.
 //! α = 0 is Lambert's law. Sampled like `diffuse` (cosine-weighted); labelled a diffuse lobe
 //! (Mitsuba 0.6 calls it glossy, which only matters to its own integrators). One-sided.

@@ -4,12 +4,14 @@
 //! ```xml
 //! <bsdf type="ward">
 //!     <string name="variant" value="balanced"/>          <!-- ward, ward-duer or balanced -->
-//!     <float name="alpha_u" value="0.1"/>                <!-- or a texture; default alpha -->
-//!     <float name="alpha_v" value="0.3"/>                <!-- or a texture; default alpha -->
-//!     <rgb name="specular_reflectance" value="0.2"/>     <!-- or a texture; default 0.2 -->
-//!     <rgb name="diffuse_reflectance" value="0.5"/>      <!-- or a texture; default 0.5 -->
+//!     <float name="alpha_u" value="0.1"/>                <!-- or a texture -->
+//!     <float name="alpha_v" value="0.3"/>                <!-- or a texture -->
+//!     <rgb name="specular_reflectance" value="0.2"/>     <!-- or a texture -->
+//!     <rgb name="diffuse_reflectance" value="0.5"/>      <!-- or a texture -->
 //! </bsdf>
 //! ```
+//! Its parameters and their defaults are listed in docs/plugins.md.
+//!
 //! With h = wo + wi (not normalised) and E = exp(−((h_x/α_u)² + (h_y/α_v)²) / h_z²),
 //!
 //!   f = ρ_d/π + ρ_s E / (4π α_u α_v √(cos θo cos θi))    (`ward`: Ward 1992, eq. 5a)

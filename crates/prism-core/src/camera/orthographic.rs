@@ -8,10 +8,12 @@
 //!         <scale x="2" y="2"/>                <!-- the film covers 4 × 4/a units -->
 //!         <lookat origin="0, 0, 5" target="0, 0, 0" up="0, 1, 0"/>
 //!     </transform>
-//!     <float name="near_clip" value="0.01"/>   <!-- defaults 1e-2 and 1e4 -->
+//!     <float name="near_clip" value="0.01"/>
 //!     <float name="far_clip" value="10000"/>
 //! </sensor>
 //! ```
+//! Its parameters and their defaults are listed in docs/plugins.md.
+//!
 //! Mitsuba 3's `orthographic.cpp` maps the film position s ∈ [0, 1]² (of the full film) to the
 //! camera point ((1 − 2 sₓ), (1 − 2 s_y) / a, near) (+x to the left of the image, +y up, as for
 //! `perspective`); the ray leaves the world image of that point along the world image of +z,

@@ -3,14 +3,16 @@
 //!
 //! ```xml
 //! <sensor type="perspective">
-//!     <float name="fov" value="39.3"/>          <!-- or focal_length="50mm" (the default) -->
+//!     <float name="fov" value="39.3"/>          <!-- or focal_length -->
 //!     <string name="fov_axis" value="x"/>       <!-- x, y, diagonal, smaller, larger -->
-//!     <float name="near_clip" value="0.01"/>    <!-- defaults 1e-2 and 1e4 -->
+//!     <float name="near_clip" value="0.01"/>
 //!     <float name="far_clip" value="10000"/>
 //!     <transform name="to_world"> <lookat origin="..." target="..." up="..."/> </transform>
 //!     <film .../> <sampler .../>
 //! </sensor>
 //! ```
+//! Its parameters and their defaults are listed in docs/plugins.md.
+//!
 //! The camera looks along +z of its frame, with +y up and +x to the left of the image (Mitsuba's
 //! convention: `lookat` builds the frame [left, up, forward, origin]).
 //!
@@ -19,12 +21,12 @@
 //! film position leaves from a uniformly sampled point of the aperture disk (concentric map) and
 //! passes through the point of the focal plane the pinhole ray would reach. The aperture is
 //! `aperture_radius`, or, in the lecture's parametrisation, the aperture *area* a
-//! (`aperture_area`), so the radius is √(a/π) (DESIGN.md §4).
+//! (`aperture_area`), so the radius is √(a/π) (docs/architecture.md, The lecture's errata).
 //!
 //! ```xml
 //! <sensor type="thinlens">
 //!     <float name="aperture_radius" value="0.05"/>   <!-- or aperture_area -->
-//!     <float name="focus_distance" value="4"/>       <!-- or focal_distance; default far_clip -->
+//!     <float name="focus_distance" value="4"/>       <!-- or focal_distance -->
 //!     <float name="fov" value="40"/>
 //! </sensor>
 //! ```
@@ -146,7 +148,8 @@ mod tests {
         let expected = (2.0 * (2.0 * 15f64.to_radians().tan()).atan()).to_degrees();
         assert!((horizontal_fov(30.0, FovAxis::Y, 2.0) - expected).abs() < 1e-9);
         assert!((horizontal_fov(30.0, FovAxis::Smaller, 2.0) - expected).abs() < 1e-9);
-        // The default 50 mm lens on a square film (DESIGN.md §5: 34.022 degrees).
+        // The default 50 mm lens on a square film: 34.022 degrees (docs/mitsuba-compatibility.md,
+        // Semantics that decide parity).
         let fov = horizontal_fov(focal_length_to_diagonal_fov(50.0), FovAxis::Diagonal, 1.0);
         assert!((fov - 34.022).abs() < 1e-3, "{fov}");
     }

@@ -11,9 +11,10 @@
 //! <sensor type="perspective">
 //!     <float name="shutter_open" value="0"/>
 //!     <float name="shutter_close" value="1"/>
-//!     <rfilter type="mitchell" name="shutter_filter"/>   <!-- optional; box when absent -->
+//!     <rfilter type="mitchell" name="shutter_filter"/>   <!-- optional -->
 //! </sensor>
 //! ```
+//! Its parameters and their defaults are listed in docs/plugins.md.
 
 use crate::film::{Filter, FilterSampler, Kernel};
 

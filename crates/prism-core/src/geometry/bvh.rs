@@ -21,8 +21,10 @@
 //! stops at its first hit. The slab test is pbrt-v4's (§6.1.2): (bound − o)·(1/d) per axis,
 //! the exit distance enlarged by 1 + 2γ(3) so that rounding never culls a box the ray touches
 //! (pbrt-v4 §6.8.2), and zero direction components replaced by tiny ones so that no 0·∞ appears.
-//! The eight boxes take one AVX instruction per step where the processor has AVX (detected at
-//! run time, so the default build runs everywhere), else two SSE or NEON instructions. Every
+//! The eight boxes take one AVX instruction per step where the processor has AVX, else two SSE
+//! or NEON instructions. AVX is detected at run time, so a binary built for any x86-64
+//! (`RUSTFLAGS="-C target-cpu=x86-64"`) still uses it where it is present; the repository's own
+//! build targets the processor that builds it (`.cargo/config.toml`), and runs there. Every
 //! child about to be visited is prefetched whole, so that its cache lines arrive together:
 //! on large scenes traversal waits mostly for memory. The triangle test of a leaf is inlined
 //! into the traversal (so that it, too, runs in AVX's three-operand instructions) with the

@@ -3,10 +3,12 @@
 //! ```xml
 //! <shape type="rectangle">
 //!     <emitter type="area">
-//!         <rgb name="radiance" value="17, 12, 4"/>   <!-- default: D65 of luminance 1 -->
+//!         <rgb name="radiance" value="17, 12, 4"/>
 //!     </emitter>
 //! </shape>
 //! ```
+//! Its parameters and their defaults are listed in docs/plugins.md.
+//!
 //! The radiance may also be a texture (`<texture type="bitmap" name="radiance">`, or a
 //! `checkerboard`), looked up at the surface's texture coordinates; as Mitsuba 3 reads it, its
 //! colours are upsampled as reflectances are, with no D65 factor (an `<rgb>` radiance has one).

@@ -2,10 +2,13 @@
 //!
 //! ```xml
 //! <emitter type="constant">
-//!     <rgb name="radiance" value="0.8, 0.9, 1.0"/>   <!-- default 1 -->
+//!     <rgb name="radiance" value="0.8, 0.9, 1.0"/>
 //! </emitter>
 //! ```
-//! A convex diffuse object of reflectance ρ in it has the radiance ρL everywhere (DESIGN.md §7).
+//! Its parameters and their defaults are listed in docs/plugins.md.
+//!
+//! A convex diffuse object of reflectance ρ in it has the radiance ρL everywhere (docs/testing.md,
+//! Closed forms).
 //! Light samples are uniform on the sphere of directions (as in Mitsuba); rays that leave the
 //! scene see L, and the two are combined by multiple importance sampling.
 

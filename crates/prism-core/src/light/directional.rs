@@ -4,11 +4,14 @@
 //! ```xml
 //! <emitter type="directional">
 //!     <vector name="direction" x="0" y="-1" z="0"/>   <!-- where the light travels; or to_world -->
-//!     <rgb name="irradiance" value="5"/>              <!-- on a surface facing it; default 1 -->
+//!     <rgb name="irradiance" value="5"/>              <!-- on a surface facing it -->
 //! </emitter>
 //! ```
+//! Its parameters and their defaults are listed in docs/plugins.md.
+//!
 //! Without `direction`, the light travels along the +z axis of `to_world` (default: world +z).
-//! A diffuse surface tilted by θ from the light reflects L = ρ E cos θ / π (DESIGN.md §7).
+//! A diffuse surface tilted by θ from the light reflects L = ρ E cos θ / π (docs/testing.md, Closed
+//! forms).
 
 use std::f32::consts::PI;
 

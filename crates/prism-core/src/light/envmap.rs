@@ -4,12 +4,13 @@
 //! ```xml
 //! <emitter type="envmap">
 //!     <string name="filename" value="sky.exr"/>    <!-- required; at least 2 × 3 pixels -->
-//!     <float name="scale" value="1"/>              <!-- multiplies the image; default 1 -->
-//!     <transform name="to_world">                  <!-- rotates the map; default identity -->
+//!     <float name="scale" value="1"/>              <!-- multiplies the image -->
+//!     <transform name="to_world">                  <!-- rotates the map -->
 //!         <rotate y="1" angle="90"/>
 //!     </transform>
 //! </emitter>
 //! ```
+//! Its parameters and their defaults are listed in docs/plugins.md.
 //!
 //! # Mitsuba's conventions, reproduced exactly
 //! * Orientation: in the map's frame +y is up. The image coordinates (u, v) ∈ [0, 1]² (u to the

@@ -3,9 +3,11 @@
 //! ```xml
 //! <emitter type="point">
 //!     <point name="position" x="0" y="2" z="0"/>   <!-- or a to_world transform -->
-//!     <rgb name="intensity" value="10"/>            <!-- default: D65 of luminance 1 -->
+//!     <rgb name="intensity" value="10"/>
 //! </emitter>
 //! ```
+//! Its parameters and their defaults are listed in docs/plugins.md.
+//!
 //! Irradiance at distance d on a surface tilted by θ is I cos θ / d² (the lecture's point-light
 //! term of "Direct Light Sampling").
 

@@ -3,16 +3,18 @@
 //!
 //! ```xml
 //! <emitter type="projector">
-//!     <texture type="bitmap" name="irradiance">     <!-- or a value; default D65 of 1 -->
+//!     <texture type="bitmap" name="irradiance">     <!-- or a value -->
 //!         <string name="filename" value="slide.png"/>
 //!     </texture>
-//!     <float name="scale" value="2"/>               <!-- default 1 -->
+//!     <float name="scale" value="2"/>
 //!     <float name="fov" value="45"/>                <!-- along fov_axis; or focal_length -->
 //!     <transform name="to_world">                   <!-- at the origin, shining along +z -->
 //!         <lookat origin="1, 1, 1" target="1, 2, 1" up="0, 0, 1"/>
 //!     </transform>
 //! </emitter>
 //! ```
+//! Its parameters and their defaults are listed in docs/plugins.md.
+//!
 //! As in Mitsuba 3 (`src/emitters/projector.cpp`): a point x of the light's frame (z > 0) sees
 //! the image at
 //!

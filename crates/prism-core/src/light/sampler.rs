@@ -3,15 +3,16 @@
 //! receiver's cosine), or everywhere alike in proportion to its power (the lecture's "assign the
 //! probabilities proportional to the emitted spectral power", through an alias table), or
 //! uniformly (Mitsuba's default, every emitter with the same `sampling_weight`); the estimate is
-//! then divided by that probability (DESIGN.md §4).
+//! then divided by that probability (docs/architecture.md, The lecture's errata).
 //!
 //! The choice is the path integrator's `emitter_sampling` parameter (a Prism extension that
 //! Mitsuba does not know):
 //! ```xml
 //! <integrator type="path">
-//!     <string name="emitter_sampling" value="power"/>   <!-- "exhaustive" (default), "power" or "uniform" -->
+//!     <string name="emitter_sampling" value="power"/>   <!-- "exhaustive", "power" or "uniform" -->
 //! </integrator>
 //! ```
+//! Its parameters and their defaults are listed in docs/plugins.md.
 //!
 //! `exhaustive` is pbrt-v4's `ExhaustiveLightSampler` (Pharr, Jakob and Humphreys, pbrt-v4,
 //! §12.6.3): every light at a finite place is weighed by its importance I(p, n) at the receiver,

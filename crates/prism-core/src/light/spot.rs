@@ -5,14 +5,16 @@
 //!     <transform name="to_world">                   <!-- at the origin, shining along +z -->
 //!         <lookat origin="1, 1, 1" target="1, 2, 1"/>
 //!     </transform>
-//!     <rgb name="intensity" value="10"/>            <!-- on the axis; default 1 -->
-//!     <float name="cutoff_angle" value="20"/>       <!-- degrees; default 20 -->
-//!     <float name="beam_width" value="15"/>         <!-- degrees; default 3/4 of cutoff_angle -->
+//!     <rgb name="intensity" value="10"/>            <!-- on the axis -->
+//!     <float name="cutoff_angle" value="20"/>       <!-- degrees -->
+//!     <float name="beam_width" value="15"/>         <!-- degrees -->
 //!     <texture type="bitmap" name="texture">        <!-- optional, projected -->
 //!         <string name="filename" value="gobo.png"/>
 //!     </texture>
 //! </emitter>
 //! ```
+//! Its parameters and their defaults are listed in docs/plugins.md.
+//!
 //! The falloff is Mitsuba's: the full intensity within `beam_width` of the axis, then linear in
 //! the angle down to zero at `cutoff_angle`. An optional `texture` multiplies the intensity,
 //! projected as in Mitsuba 3's `direction_to_uv`: the direction (x, y, z) of the light's frame

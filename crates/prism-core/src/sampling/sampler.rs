@@ -1,5 +1,5 @@
 //! The per-pixel sampler: the random numbers of one pixel sample, dimension by dimension
-//! (DESIGN.md §3.5).
+//! (docs/architecture.md, Conventions).
 //!
 //! A pixel sample first takes its *primary* dimensions, the parameters of the camera ray that
 //! the lecture samples independently ("Distribution Raytracing", "Reference Implementation:

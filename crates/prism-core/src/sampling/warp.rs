@@ -73,7 +73,8 @@ pub fn invert_uniform_disk_concentric(p: Vec2) -> Vec2 {
 
 /// Cosine-weighted hemisphere about +z by Nusselt's analogue (Malley's method): a uniform point
 /// (x, y) on the unit disk is lifted to (x, y, sqrt(1 - x² - y²)), giving density cos θ / π.
-/// (The lecture's slide writes the lift as 1 - sqrt(x² + y²); that is a slip, see DESIGN.md §4.)
+/// (The lecture's slide writes the lift as 1 - sqrt(x² + y²); that is a slip: docs/architecture.md,
+/// The lecture's errata.)
 pub fn sample_cosine_hemisphere(u: Vec2) -> Vec3 {
     let d = sample_uniform_disk_concentric(u);
     let z = (1.0 - d.length_squared()).max(0.0).sqrt();

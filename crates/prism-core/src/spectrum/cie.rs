@@ -145,7 +145,7 @@ mod tests {
         let z = integrate(|l| f64::from(d65_normalized(l) * cie_xyz(l)[2]));
         let (x, y, z) = (x / CIE_Y_INTEGRAL, y / CIE_Y_INTEGRAL, z / CIE_Y_INTEGRAL);
         assert!((y - 1.0).abs() < 1e-4, "Y = {y}");
-        // D65 white point: x = 0.31273, y = 0.32902 (../shared/data/README.md).
+        // D65 white point: x = 0.31273, y = 0.32902 (data/README.md).
         assert!((x / (x + y + z) - 0.31273).abs() < 2e-5);
         assert!((y / (x + y + z) - 0.32902).abs() < 2e-5);
         // ... which the sRGB matrix maps to (1, 1, 1) within the matrix's rounding.

@@ -2,11 +2,13 @@
 //!
 //! ```xml
 //! <texture type="checkerboard" name="reflectance">
-//!     <rgb name="color0" value="0.4"/>   <!-- default 0.4 -->
-//!     <rgb name="color1" value="0.2"/>   <!-- default 0.2 -->
+//!     <rgb name="color0" value="0.4"/>
+//!     <rgb name="color1" value="0.2"/>
 //!     <transform name="to_uv"> <scale x="8" y="8"/> </transform>
 //! </texture>
 //! ```
+//! Its parameters and their defaults are listed in docs/plugins.md.
+//!
 //! With (u, v) = to_uv(uv), a colour lookup uses `color0` where frac(u) > ½ and frac(v) > ½
 //! agree and `color1` where they differ (Mitsuba 3, `src/textures/checkerboard.cpp`, `eval`).
 //! Read as a number (a roughness, an opacity) the phase is the opposite one: `color0` where

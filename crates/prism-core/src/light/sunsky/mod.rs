@@ -3,7 +3,7 @@
 //! ```xml
 //! <emitter type="sunsky">
 //!     <vector name="sun_direction" x="0.3" y="0.2" z="0.8"/>  <!-- or a place and time -->
-//!     <float name="turbidity" value="3"/>   <!-- 1 … 10; default 3 -->
+//!     <float name="turbidity" value="3"/>   <!-- 1 … 10 -->
 //!     <float name="albedo" value="0.3"/>    <!-- ground albedo, a spectrum in [0, 1] -->
 //!     <float name="sun_scale" value="1"/>   <!-- 0 turns the sun off -->
 //!     <float name="sky_scale" value="1"/>   <!-- 0 turns the sky off -->
@@ -12,6 +12,7 @@
 //!     <transform name="to_world"> … </transform>   <!-- the frame is +z up -->
 //! </emitter>
 //! ```
+//! Its parameters and their defaults are listed in docs/plugins.md.
 //!
 //! The emitter's frame is +z up (+x north for the place-and-time form, whose sun position is
 //! [`sun_position`]); `to_world` places it. Radiance is in W m⁻² sr⁻¹ nm⁻¹, the models of
