@@ -3,7 +3,7 @@
 //! Mitsuba 3's `parse_fov` reads them, as a horizontal angle for an image of a given aspect.
 
 use crate::params::Params;
-use crate::registry::{Default, ParamKind, ParamSpec};
+use crate::registry::{Choice, Default, ParamKind, ParamSpec};
 use prism_core::camera::perspective::{FovAxis, focal_length_to_diagonal_fov, horizontal_fov};
 use prism_core::error::{Error, Result};
 
@@ -15,7 +15,28 @@ pub const FOV: ParamSpec = ParamSpec::new(
 );
 pub const FOV_AXIS: ParamSpec = ParamSpec::new(
     "fov_axis",
-    ParamKind::Choice(&["x", "y", "diagonal", "smaller", "larger"]),
+    ParamKind::Choice(&[
+        Choice {
+            name: "x",
+            value: &FovAxis::X,
+        },
+        Choice {
+            name: "y",
+            value: &FovAxis::Y,
+        },
+        Choice {
+            name: "diagonal",
+            value: &FovAxis::Diagonal,
+        },
+        Choice {
+            name: "smaller",
+            value: &FovAxis::Smaller,
+        },
+        Choice {
+            name: "larger",
+            value: &FovAxis::Larger,
+        },
+    ]),
     Default::Str("x"),
     "the film axis `fov` is measured along",
 );
@@ -35,16 +56,7 @@ pub fn horizontal_fov_param(params: &Params, aspect: f64) -> Result<f64> {
                 "give either \"fov\" or \"focal_length\", not both",
             ));
         }
-        (Some(fov), None) => {
-            let axis = match params.choice(&FOV_AXIS)? {
-                "y" => FovAxis::Y,
-                "diagonal" => FovAxis::Diagonal,
-                "smaller" => FovAxis::Smaller,
-                "larger" => FovAxis::Larger,
-                _ => FovAxis::X,
-            };
-            horizontal_fov(fov, axis, aspect)
-        }
+        (Some(fov), None) => horizontal_fov(fov, params.choice(&FOV_AXIS)?, aspect),
         (None, focal_length) => {
             let text = focal_length.unwrap_or("50mm");
             let mm: f64 = text

@@ -4,7 +4,7 @@
 
 use crate::description::{PluginClass, PluginNode};
 use crate::params::Params;
-use crate::registry::{Default, Origin, ParamKind, ParamSpec, Plugin, Registry};
+use crate::registry::{Choice, Default, Origin, ParamKind, ParamSpec, Plugin, Registry};
 use crate::suggest::closest_match;
 use prism_core::error::{Error, Result, SourceLocation};
 use prism_core::film::output::IMAGE_CHANNELS;
@@ -137,7 +137,20 @@ const HIDE_EMITTERS: ParamSpec = ParamSpec::new(
 );
 const EMITTER_SAMPLING: ParamSpec = ParamSpec::new(
     "emitter_sampling",
-    ParamKind::Choice(&LightSelection::NAMES),
+    ParamKind::Choice(&[
+        Choice {
+            name: "exhaustive",
+            value: &LightSelection::Exhaustive,
+        },
+        Choice {
+            name: "power",
+            value: &LightSelection::Power,
+        },
+        Choice {
+            name: "uniform",
+            value: &LightSelection::Uniform,
+        },
+    ]),
     Default::Str("exhaustive"),
     "Prism only (Mitsuba rejects it): one light per shading point chosen ∝ its importance \
      there (power × `sampling_weight` over squared distance, times the receiver's cosine \
@@ -206,7 +219,24 @@ const SHADOW_RAYS: ParamSpec = ParamSpec::new(
 );
 const LIGHTS: ParamSpec = ParamSpec::new(
     "lights",
-    ParamKind::Choice(&["exhaustive", "power", "uniform", "all"]),
+    ParamKind::Choice(&[
+        Choice {
+            name: "exhaustive",
+            value: &DirectLights::One(LightSelection::Exhaustive),
+        },
+        Choice {
+            name: "power",
+            value: &DirectLights::One(LightSelection::Power),
+        },
+        Choice {
+            name: "uniform",
+            value: &DirectLights::One(LightSelection::Uniform),
+        },
+        Choice {
+            name: "all",
+            value: &DirectLights::All,
+        },
+    ]),
     Default::Str("exhaustive"),
     "one light per vertex chosen ∝ its importance there, ∝ power or uniformly (as the path \
      integrator's `emitter_sampling`), or every light",
@@ -287,8 +317,7 @@ fn path_settings(params: &Params) -> Result<PathIntegrator> {
             format!("rr_depth must be at least 1, not {rr_depth}"),
         ));
     }
-    let light_selection = LightSelection::from_name(params.choice(&EMITTER_SAMPLING)?)
-        .expect("the parameter's choices are the selections' names");
+    let light_selection = params.choice(&EMITTER_SAMPLING)?;
     Ok(PathIntegrator {
         max_depth,
         rr_depth: rr_depth as i32,
@@ -488,12 +517,7 @@ fn build_volpathmis(params: &Params) -> Result<Integrator> {
 }
 
 fn build_distrib(params: &Params) -> Result<Integrator> {
-    let lights = match params.choice(&LIGHTS)? {
-        "all" => DirectLights::All,
-        name => DirectLights::One(
-            LightSelection::from_name(name).expect("the parameter's choices name selections"),
-        ),
-    };
+    let lights = params.choice(&LIGHTS)?;
     let rr_threshold = params.float(&RR_THRESHOLD)?;
     if !(rr_threshold > 0.0 && rr_threshold.is_finite()) {
         return Err(Error::input(

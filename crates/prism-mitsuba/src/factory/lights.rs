@@ -15,7 +15,7 @@ use super::textures::{TextureCache, build_texture};
 use crate::description::{NestedPlugin, PluginClass, PluginNode};
 use crate::params::Params;
 use crate::registry::Range;
-use crate::registry::{Default, Origin, ParamKind, ParamSpec, Plugin, Registry};
+use crate::registry::{Bounds, Choice, Default, Origin, ParamKind, ParamSpec, Plugin, Registry};
 use prism_core::bsdf::{Diffuse, Material};
 use prism_core::error::{Error, Result, SourceLocation};
 use prism_core::geometry::ShapeSampling;
@@ -147,14 +147,23 @@ pub static EMITTERS: Registry<Build> = Registry {
 
 const SAMPLING_WEIGHT: ParamSpec = ParamSpec::new(
     "sampling_weight",
-    ParamKind::Float,
+    ParamKind::FloatIn(Bounds::FINITE_NON_NEGATIVE),
     Default::Float(1.0),
     "relative weight of choosing this emitter for direct light: P ∝ weight (uniform \
      `emitter_sampling`, Mitsuba's rule) or ∝ power × weight (by power); 0 never chooses it",
 );
 const AREA_SAMPLING: ParamSpec = ParamSpec::new(
     "sampling",
-    ParamKind::Choice(&["solid_angle", "area"]),
+    ParamKind::Choice(&[
+        Choice {
+            name: "solid_angle",
+            value: &ShapeSampling::SolidAngle,
+        },
+        Choice {
+            name: "area",
+            value: &ShapeSampling::Area,
+        },
+    ]),
     Default::Str("solid_angle"),
     "(Prism) how light samples find the shape: `solid_angle` (spheres by their cone, rectangles \
      by the spherical rectangle from within two diagonals, other shapes by area) or `area` (every \
@@ -217,7 +226,7 @@ const PROJECTOR_IRRADIANCE: ParamSpec = ParamSpec::new(
 );
 const PROJECTOR_SCALE: ParamSpec = ParamSpec::new(
     "scale",
-    ParamKind::Float,
+    ParamKind::FloatIn(Bounds::FINITE_NON_NEGATIVE),
     Default::Float(1.0),
     "factor on the irradiance",
 );
@@ -241,7 +250,7 @@ const TO_WORLD: ParamSpec = ParamSpec::new(
 );
 const CUTOFF_ANGLE: ParamSpec = ParamSpec::new(
     "cutoff_angle",
-    ParamKind::Float,
+    ParamKind::FloatIn(Bounds::between(0.0, 180.0)),
     Default::Float(20.0),
     "angle from the axis, in degrees, beyond which there is no light",
 );
@@ -297,9 +306,9 @@ const MINUTE: ParamSpec = ParamSpec::new("minute", ParamKind::Float, Default::Fl
 const SECOND: ParamSpec = ParamSpec::new("second", ParamKind::Float, Default::Float(0.0), "second");
 const TURBIDITY: ParamSpec = ParamSpec::new(
     "turbidity",
-    ParamKind::Float,
+    ParamKind::FloatIn(Bounds::between(1.0, 10.0)),
     Default::Float(3.0),
-    "haziness of the atmosphere, in [1, 10]",
+    "haziness of the atmosphere",
 );
 const SKY_ALBEDO: ParamSpec = ParamSpec::new(
     "albedo",
@@ -312,19 +321,19 @@ const SKY_ALBEDO: ParamSpec = ParamSpec::new(
 );
 const SUN_SCALE: ParamSpec = ParamSpec::new(
     "sun_scale",
-    ParamKind::Float,
+    ParamKind::FloatIn(Bounds::FINITE_NON_NEGATIVE),
     Default::Float(1.0),
     "factor on the sun's radiance (0 turns the sun off)",
 );
 const SKY_SCALE: ParamSpec = ParamSpec::new(
     "sky_scale",
-    ParamKind::Float,
+    ParamKind::FloatIn(Bounds::FINITE_NON_NEGATIVE),
     Default::Float(1.0),
     "factor on the sky's radiance (0 turns the sky off)",
 );
 const SUN_APERTURE: ParamSpec = ParamSpec::new(
     "sun_aperture",
-    ParamKind::Float,
+    ParamKind::FloatIn(Bounds::between(0.0, 180.0)),
     Default::Float(0.5358),
     "the sun disc's full angle in degrees, in (0, 180); its irradiance stays that of the real sun",
 );
@@ -387,17 +396,14 @@ pub fn build_scene_light(node: &PluginNode, textures: &mut TextureCache) -> Resu
 
 /// The emitter's `sampling_weight`: finite and at least 0.
 fn sampling_weight(params: &Params) -> Result<f32> {
-    let weight = params.float_in(&SAMPLING_WEIGHT, 1.0, 0.0, f64::from(f32::MAX))?;
+    let weight = params.float_in(&SAMPLING_WEIGHT)?;
     Ok(weight as f32)
 }
 
 /// Mitsuba's `area`: a value, a nested spectrum, or a texture read as emission.
 fn build_area(params: &Params, shape: Option<u32>, textures: &mut TextureCache) -> Result<Light> {
     let shape = shape.unwrap_or(0);
-    let sampling = match params.string(&AREA_SAMPLING)? {
-        "area" => ShapeSampling::Area,
-        _ => ShapeSampling::SolidAngle,
-    };
+    let sampling = params.choice(&AREA_SAMPLING)?;
     let light = match params.named_child(&AREA_RADIANCE) {
         Some(child) if child.node.class == PluginClass::Texture => {
             let texture = build_texture(&child.node, TextureUse::Emission, textures)?;
@@ -430,14 +436,14 @@ fn build_point(params: &Params) -> Result<Light> {
 
 fn build_spot(params: &Params, textures: &mut TextureCache) -> Result<Light> {
     let intensity = emission_param(params, &INTENSITY)?;
-    let cutoff = params.float_in(&CUTOFF_ANGLE, 20.0, 0.0, 180.0)?;
+    let cutoff = params.float_in(&CUTOFF_ANGLE)?;
     if cutoff == 0.0 {
         return Err(Error::input(
             params.location_of(&CUTOFF_ANGLE),
             "the spot emitter's cutoff_angle must be greater than 0",
         ));
     }
-    let beam = params.float_in(&BEAM_WIDTH, 0.75 * cutoff, 0.0, cutoff)?;
+    let beam = params.float_between(&BEAM_WIDTH, 0.75 * cutoff, 0.0, cutoff)?;
     let to_world = invertible(params, &TO_WORLD)?;
     let light = SpotLight::new(
         to_world,
@@ -501,7 +507,7 @@ fn build_projector(params: &Params, textures: &mut TextureCache) -> Result<Light
             1.0,
         ),
     };
-    let scale = params.float_in(&PROJECTOR_SCALE, 1.0, 0.0, f64::from(f32::MAX))?;
+    let scale = params.float_in(&PROJECTOR_SCALE)?;
     let fov_x = horizontal_fov_param(params, aspect)?;
     let to_world = invertible(params, &TO_WORLD)?;
     Ok(Light::Projector(Projector::new(
@@ -756,12 +762,10 @@ fn build_sunsky(params: &Params) -> Result<Light> {
             "the sunsky emitter's sun direction is degenerate in its to_world frame",
         ));
     }
-    let turbidity = params.float_in(&TURBIDITY, 3.0, 1.0, 10.0)?;
-    let scale = |spec: &ParamSpec| -> Result<f32> {
-        Ok(params.float_in(spec, 1.0, 0.0, f64::from(f32::MAX))? as f32)
-    };
+    let turbidity = params.float_in(&TURBIDITY)?;
+    let scale = |spec: &ParamSpec| -> Result<f32> { Ok(params.float_in(spec)? as f32) };
     let (sun_scale, sky_scale) = (scale(&SUN_SCALE)?, scale(&SKY_SCALE)?);
-    let aperture = params.float_in(&SUN_APERTURE, 0.5358, 0.0, 180.0)?;
+    let aperture = params.float_in(&SUN_APERTURE)?;
     if !(aperture > 0.0 && aperture < 180.0) {
         return Err(Error::input(
             params.location_of(&SUN_APERTURE),

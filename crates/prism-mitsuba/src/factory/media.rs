@@ -7,7 +7,9 @@ use glam::DMat4;
 use super::spectra::spectrum_param;
 use crate::description::{PluginClass, PluginNode, PropertyValue};
 use crate::params::Params;
-use crate::registry::{Default, Origin, ParamKind, ParamSpec, Plugin, Range, Registry};
+use crate::registry::{
+    Bounds, Choice, Default, Origin, ParamKind, ParamSpec, Plugin, Range, Registry,
+};
 use prism_core::error::{Error, Result};
 use prism_core::math::Transform;
 use prism_core::medium::volume::parse_vol;
@@ -177,9 +179,9 @@ const G: ParamSpec = ParamSpec::new(
 );
 const PHASE_WEIGHT: ParamSpec = ParamSpec::new(
     "weight",
-    ParamKind::Float,
+    ParamKind::FloatIn(Bounds::UNIT),
     Default::Float(0.5),
-    "weight of the second phase function, in [0, 1]",
+    "weight of the second phase function",
 );
 const BLENDED_PHASES: ParamSpec = ParamSpec::nested(
     PluginClass::Phase,
@@ -203,7 +205,16 @@ const FILENAME: ParamSpec = ParamSpec::new(
 );
 const FILTER_TYPE: ParamSpec = ParamSpec::new(
     "filter_type",
-    ParamKind::Choice(&["bilinear", "nearest"]),
+    ParamKind::Choice(&[
+        Choice {
+            name: "bilinear",
+            value: &GridFilter::Trilinear,
+        },
+        Choice {
+            name: "nearest",
+            value: &GridFilter::Nearest,
+        },
+    ]),
     Default::Str("bilinear"),
     "interpolation between voxels: `bilinear` (trilinear in 3D, Mitsuba's name) or `nearest`",
 );
@@ -392,7 +403,7 @@ fn build_hg(params: &Params) -> Result<PhaseFunction> {
 }
 
 fn build_blendphase(params: &Params) -> Result<PhaseFunction> {
-    let weight = params.float_in(&PHASE_WEIGHT, 0.5, 0.0, 1.0)? as f32;
+    let weight = params.float_in(&PHASE_WEIGHT)? as f32;
     let children = params.children(&BLENDED_PHASES);
     let [first, second] = children.as_slice() else {
         return Err(Error::input(
@@ -481,10 +492,7 @@ fn build_gridvolume(params: &Params, range: Range) -> Result<Volume> {
         .with_help("check to_world (and the grid's bounding box with use_grid_bbox)")
     };
     let to_world = Transform::new(to_world).ok_or_else(singular)?;
-    let filter = match params.choice(&FILTER_TYPE)? {
-        "nearest" => GridFilter::Nearest,
-        _ => GridFilter::Trilinear,
-    };
+    let filter = params.choice(&FILTER_TYPE)?;
     let grid = GridVolume::new(file.resolution, file.data, to_world, filter)
         .expect("a parsed grid holds its voxels");
     if range == Range::Albedo && grid.max_value() > 1.0 {

@@ -9,7 +9,7 @@ use glam::{UVec2, Vec2};
 use super::fov::{FOCAL_LENGTH, FOV, FOV_AXIS, horizontal_fov_param};
 use crate::description::{PluginClass, PluginNode};
 use crate::params::{Params, Warning};
-use crate::registry::{Default, Origin, ParamKind, ParamSpec, Plugin, Registry};
+use crate::registry::{Bounds, Choice, Default, Origin, ParamKind, ParamSpec, Plugin, Registry};
 use prism_core::camera::{Camera, OrthographicCamera, PerspectiveCamera, Shutter};
 use prism_core::error::{Error, Result};
 use prism_core::film::{
@@ -283,19 +283,62 @@ const CROP_HEIGHT: ParamSpec = ParamSpec::new(
 );
 const FILE_FORMAT: ParamSpec = ParamSpec::new(
     "file_format",
-    ParamKind::Choice(&["openexr", "exr"]),
+    ParamKind::Choice(&[
+        Choice {
+            name: "openexr",
+            value: &(),
+        },
+        Choice {
+            name: "exr",
+            value: &(),
+        },
+    ]),
     Default::Str("openexr"),
     "accepted; the output is always OpenEXR",
 );
 const PIXEL_FORMAT: ParamSpec = ParamSpec::new(
     "pixel_format",
-    ParamKind::Choice(&["rgb", "rgba", "xyz", "xyza", "luminance", "luminance_alpha"]),
+    ParamKind::Choice(&[
+        Choice {
+            name: "rgb",
+            value: &(),
+        },
+        Choice {
+            name: "rgba",
+            value: &(),
+        },
+        Choice {
+            name: "xyz",
+            value: &(),
+        },
+        Choice {
+            name: "xyza",
+            value: &(),
+        },
+        Choice {
+            name: "luminance",
+            value: &(),
+        },
+        Choice {
+            name: "luminance_alpha",
+            value: &(),
+        },
+    ]),
     Default::Str("rgb"),
     "accepted; the output always holds RGB and XYZ",
 );
 const RECONSTRUCTION: ParamSpec = ParamSpec::new(
     "reconstruction",
-    ParamKind::Choice(&Reconstruction::NAMES),
+    ParamKind::Choice(&[
+        Choice {
+            name: "filter_mis",
+            value: &Reconstruction::FilterMis,
+        },
+        Choice {
+            name: "pixel",
+            value: &Reconstruction::Pixel,
+        },
+    ]),
     Default::Str("filter_mis"),
     "Prism only (Mitsuba rejects it): how samples become pixels: `filter_mis` (every sample \
      feeds every pixel its filter covers, unbiased, with less noise than Mitsuba's splatting) or \
@@ -304,7 +347,24 @@ const RECONSTRUCTION: ParamSpec = ParamSpec::new(
 );
 const WAVELENGTH_SAMPLING: ParamSpec = ParamSpec::new(
     "wavelength_sampling",
-    ParamKind::Choice(&WavelengthSampling::NAMES),
+    ParamKind::Choice(&[
+        Choice {
+            name: "balanced",
+            value: &WavelengthSampling::Balanced,
+        },
+        Choice {
+            name: "cie_sum",
+            value: &WavelengthSampling::CieSum,
+        },
+        Choice {
+            name: "visible",
+            value: &WavelengthSampling::Visible,
+        },
+        Choice {
+            name: "uniform",
+            value: &WavelengthSampling::Uniform,
+        },
+    ]),
     Default::Str("visible"),
     "Prism only (Mitsuba rejects it): the density wavelengths are drawn from: `visible` \
      (Mitsuba's and pbrt's, the quietest on the Cornell boxes), `balanced` (least error of \
@@ -313,7 +373,20 @@ const WAVELENGTH_SAMPLING: ParamSpec = ParamSpec::new(
 );
 const COMPONENT_FORMAT: ParamSpec = ParamSpec::new(
     "component_format",
-    ParamKind::Choice(&["float16", "float32", "uint32"]),
+    ParamKind::Choice(&[
+        Choice {
+            name: "float16",
+            value: &(),
+        },
+        Choice {
+            name: "float32",
+            value: &(),
+        },
+        Choice {
+            name: "uint32",
+            value: &(),
+        },
+    ]),
     Default::Str("float32"),
     "accepted; the output is always 32-bit float",
 );
@@ -343,19 +416,66 @@ const HDR_GAMMA: ParamSpec = ParamSpec::new(
 );
 const LDR_FILE_FORMAT: ParamSpec = ParamSpec::new(
     "file_format",
-    ParamKind::Choice(&["png", "jpeg", "jpg"]),
+    ParamKind::Choice(&[
+        Choice {
+            name: "png",
+            value: &LdrFormat::Png,
+        },
+        Choice {
+            name: "jpeg",
+            value: &LdrFormat::Jpeg,
+        },
+        Choice {
+            name: "jpg",
+            value: &LdrFormat::Jpeg,
+        },
+    ]),
     Default::Str("png"),
     "the 8-bit file: PNG, or JPEG of quality 100 (extension `.jpg`)",
 );
 const LDR_PIXEL_FORMAT: ParamSpec = ParamSpec::new(
     "pixel_format",
-    ParamKind::Choice(&["rgb", "rgba", "luminance", "luminanceAlpha"]),
+    ParamKind::Choice(&[
+        Choice {
+            name: "rgb",
+            value: &Channels::Rgb,
+        },
+        Choice {
+            name: "rgba",
+            value: &Channels::Rgba,
+        },
+        Choice {
+            name: "luminance",
+            value: &Channels::Luminance,
+        },
+        Choice {
+            name: "luminanceAlpha",
+            value: &Channels::LuminanceAlpha,
+        },
+    ]),
     Default::Str("rgb"),
     "the 8-bit image's channels; Prism's alpha is opaque (its film records no coverage), and a JPEG drops it, as Mitsuba 0.6 does",
 );
+/// How `ldrfilm` maps radiance to 8-bit values.
+#[derive(Clone, Copy)]
+enum TonemapMethod {
+    /// Scale by 2^`exposure`, then the transfer curve.
+    Gamma,
+    /// Reinhard et al. 2002's global operator.
+    Reinhard,
+}
 const TONEMAP_METHOD: ParamSpec = ParamSpec::new(
     "tonemap_method",
-    ParamKind::Choice(&["gamma", "reinhard"]),
+    ParamKind::Choice(&[
+        Choice {
+            name: "gamma",
+            value: &TonemapMethod::Gamma,
+        },
+        Choice {
+            name: "reinhard",
+            value: &TonemapMethod::Reinhard,
+        },
+    ]),
     Default::Str("gamma"),
     "`gamma`: scale by 2^`exposure`; `reinhard`: Reinhard et al. 2002's global operator with `key` and `burn`",
 );
@@ -434,8 +554,8 @@ pub static RFILTERS: Registry<FilterBuild> = Registry {
             params: &[MITCHELL_B, MITCHELL_C],
             build: |params| {
                 Ok(Filter::Mitchell(MitchellFilter {
-                    b: params.float_in(&MITCHELL_B, 1.0 / 3.0, 0.0, 1.0)? as f32,
-                    c: params.float_in(&MITCHELL_C, 1.0 / 3.0, 0.0, 1.0)? as f32,
+                    b: params.float_in(&MITCHELL_B)? as f32,
+                    c: params.float_in(&MITCHELL_C)? as f32,
                 }))
             },
         },
@@ -487,15 +607,15 @@ const STDDEV: ParamSpec = ParamSpec::new(
 );
 const MITCHELL_B: ParamSpec = ParamSpec::new(
     "B",
-    ParamKind::Float,
+    ParamKind::FloatIn(Bounds::UNIT),
     Default::Float(1.0 / 3.0),
-    "B, in [0, 1]",
+    "the blur parameter B",
 );
 const MITCHELL_C: ParamSpec = ParamSpec::new(
     "C",
-    ParamKind::Float,
+    ParamKind::FloatIn(Bounds::UNIT),
     Default::Float(1.0 / 3.0),
-    "C, in [0, 1]",
+    "the ringing parameter C",
 );
 const LOBES: ParamSpec = ParamSpec::new(
     "lobes",
@@ -863,7 +983,7 @@ fn build_film(node: &PluginNode) -> Result<(FilmSettings, LdrOutput, Vec<Warning
 fn build_hdrfilm(params: &Params) -> Result<(FilmSettings, LdrOutput)> {
     let film = film_settings(params)?;
     for spec in [&FILE_FORMAT, &PIXEL_FORMAT, &COMPONENT_FORMAT] {
-        params.choice(spec)?;
+        params.choice::<()>(spec)?;
     }
     Ok((film, LdrOutput::default()))
 }
@@ -872,15 +992,12 @@ fn build_hdrfilm(params: &Params) -> Result<(FilmSettings, LdrOutput)> {
 /// image is tonemapped ([`prism_core::film::ldr`]).
 fn build_ldrfilm(params: &Params) -> Result<(FilmSettings, LdrOutput)> {
     let film = film_settings(params)?;
-    let format = match params.choice(&LDR_FILE_FORMAT)? {
-        "png" => LdrFormat::Png,
-        _ => LdrFormat::Jpeg,
-    };
+    let format = params.choice(&LDR_FILE_FORMAT)?;
+    // A JPEG has no alpha channel.
     let channels = match (params.choice(&LDR_PIXEL_FORMAT)?, format) {
-        ("rgba", LdrFormat::Png) => Channels::Rgba,
-        ("luminanceAlpha", LdrFormat::Png) => Channels::LuminanceAlpha,
-        ("luminance" | "luminanceAlpha", _) => Channels::Luminance,
-        _ => Channels::Rgb,
+        (Channels::Rgba, LdrFormat::Jpeg) => Channels::Rgb,
+        (Channels::LuminanceAlpha, LdrFormat::Jpeg) => Channels::Luminance,
+        (channels, _) => channels,
     };
     let gamma = params.float(&LDR_GAMMA)?;
     let curve = if gamma == -1.0 {
@@ -916,11 +1033,11 @@ fn build_ldrfilm(params: &Params) -> Result<(FilmSettings, LdrOutput)> {
         return Err(out_of_range(&BURN, "[0, 1]", burn));
     }
     let tonemap = match params.choice(&TONEMAP_METHOD)? {
-        "reinhard" => Tonemap::Reinhard {
+        TonemapMethod::Reinhard => Tonemap::Reinhard {
             key: key as f32,
             burn: burn as f32,
         },
-        _ => Tonemap::Exposure {
+        TonemapMethod::Gamma => Tonemap::Exposure {
             exposure: exposure as f32,
         },
     };
@@ -973,10 +1090,8 @@ fn film_settings(params: &Params) -> Result<FilmSettings> {
         Some(child) => build_filter(&child.node)?,
         None => Filter::Gaussian(GaussianFilter { stddev: 0.5 }),
     };
-    let reconstruction = Reconstruction::from_name(params.choice(&RECONSTRUCTION)?)
-        .expect("the choice is one of the names");
-    let wavelength_sampling = WavelengthSampling::from_name(params.choice(&WAVELENGTH_SAMPLING)?)
-        .expect("the choice is one of the names");
+    let reconstruction = params.choice(&RECONSTRUCTION)?;
+    let wavelength_sampling = params.choice(&WAVELENGTH_SAMPLING)?;
     let size = UVec2::new(width as u32, height as u32);
     Ok(FilmSettings {
         size,

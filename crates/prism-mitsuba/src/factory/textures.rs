@@ -13,7 +13,7 @@ use super::spectra::spectrum_param;
 use crate::description::{PluginClass, PluginNode, PropertyValue, SpectrumValue};
 use crate::params::Params;
 use crate::registry::Range;
-use crate::registry::{Bounds, Default, Origin, ParamKind, ParamSpec, Plugin, Registry};
+use crate::registry::{Bounds, Choice, Default, Origin, ParamKind, ParamSpec, Plugin, Registry};
 use prism_core::error::{Error, Result};
 use prism_core::geometry::interaction::MAX_MESH_ATTRIBUTES;
 use prism_core::image::{Bitmap, Encoding, read_bitmap};
@@ -92,14 +92,45 @@ const FILENAME: ParamSpec = ParamSpec::new(
 );
 const FILTER_TYPE: ParamSpec = ParamSpec::new(
     "filter_type",
-    ParamKind::Choice(&["bilinear", "nearest", "trilinear", "ewa"]),
+    ParamKind::Choice(&[
+        Choice {
+            name: "bilinear",
+            value: &FilterType::Bilinear,
+        },
+        Choice {
+            name: "nearest",
+            value: &FilterType::Nearest,
+        },
+        // Mitsuba 0.6's mip-mapped filters, at full resolution the limit of their pyramids.
+        Choice {
+            name: "trilinear",
+            value: &FilterType::Bilinear,
+        },
+        Choice {
+            name: "ewa",
+            value: &FilterType::Bilinear,
+        },
+    ]),
     Default::Str("bilinear"),
     "interpolate the four nearest texels, or take the one containing the point; Mitsuba 0.6's \
      mip-mapped `trilinear` and `ewa` are read as `bilinear` (docs/mitsuba-compatibility.md)",
 );
 const WRAP_MODE: ParamSpec = ParamSpec::new(
     "wrap_mode",
-    ParamKind::Choice(&["repeat", "mirror", "clamp"]),
+    ParamKind::Choice(&[
+        Choice {
+            name: "repeat",
+            value: &WrapMode::Repeat,
+        },
+        Choice {
+            name: "mirror",
+            value: &WrapMode::Mirror,
+        },
+        Choice {
+            name: "clamp",
+            value: &WrapMode::Clamp,
+        },
+    ]),
     Default::Str("repeat"),
     "how coordinates outside [0, 1] map into the image",
 );
@@ -117,7 +148,20 @@ const TO_UV: ParamSpec = ParamSpec::new(
 );
 const FORMAT: ParamSpec = ParamSpec::new(
     "format",
-    ParamKind::Choice(&["auto", "variant", "fp16"]),
+    ParamKind::Choice(&[
+        Choice {
+            name: "auto",
+            value: &(),
+        },
+        Choice {
+            name: "variant",
+            value: &(),
+        },
+        Choice {
+            name: "fp16",
+            value: &(),
+        },
+    ]),
     Default::Str("auto"),
     "accepted; texels are always stored in full precision",
 );
@@ -559,17 +603,9 @@ fn build_bitmap(params: &Params, usage: TextureUse) -> Result<Texture> {
         .with_help("add <string name=\"filename\" value=\"image.png\"/>")
     })?;
     let location = params.location_of(&FILENAME);
-    let filter = match params.choice(&FILTER_TYPE)? {
-        "nearest" => FilterType::Nearest,
-        // "trilinear" and "ewa": at full resolution, the limit of their mip-map pyramids.
-        _ => FilterType::Bilinear,
-    };
-    let wrap = match params.choice(&WRAP_MODE)? {
-        "mirror" => WrapMode::Mirror,
-        "clamp" => WrapMode::Clamp,
-        _ => WrapMode::Repeat,
-    };
-    params.choice(&FORMAT)?;
+    let filter = params.choice(&FILTER_TYPE)?;
+    let wrap = params.choice(&WRAP_MODE)?;
+    params.choice::<()>(&FORMAT)?;
     params.boolean(&ACCEL)?;
     let raw = params.boolean(&RAW)?;
     let to_uv = UvTransform::from_matrix(&params.transform(&TO_UV)?);
