@@ -132,6 +132,22 @@ pub struct Choice {
 }
 
 impl Choice {
+    /// The option called `name`, which selects `value`.
+    pub const fn new<T: Any + Send + Sync>(name: &'static str, value: &'static T) -> Choice {
+        Choice { name, value }
+    }
+
+    /// Options that Prism accepts and ignores (each selects `()`).
+    pub const fn accepted<const N: usize>(names: [&'static str; N]) -> [Choice; N] {
+        let mut choices = [Choice::new("", &()); N];
+        let mut i = 0;
+        while i < N {
+            choices[i] = Choice::new(names[i], &());
+            i += 1;
+        }
+        choices
+    }
+
     /// The options' names, in their order.
     pub fn names(choices: &[Choice]) -> Vec<&'static str> {
         choices.iter().map(|c| c.name).collect()

@@ -16,26 +16,11 @@ pub const FOV: ParamSpec = ParamSpec::new(
 pub const FOV_AXIS: ParamSpec = ParamSpec::new(
     "fov_axis",
     ParamKind::Choice(&[
-        Choice {
-            name: "x",
-            value: &FovAxis::X,
-        },
-        Choice {
-            name: "y",
-            value: &FovAxis::Y,
-        },
-        Choice {
-            name: "diagonal",
-            value: &FovAxis::Diagonal,
-        },
-        Choice {
-            name: "smaller",
-            value: &FovAxis::Smaller,
-        },
-        Choice {
-            name: "larger",
-            value: &FovAxis::Larger,
-        },
+        Choice::new("x", &FovAxis::X),
+        Choice::new("y", &FovAxis::Y),
+        Choice::new("diagonal", &FovAxis::Diagonal),
+        Choice::new("smaller", &FovAxis::Smaller),
+        Choice::new("larger", &FovAxis::Larger),
     ]),
     Default::Str("x"),
     "the film axis `fov` is measured along",

@@ -138,18 +138,9 @@ const HIDE_EMITTERS: ParamSpec = ParamSpec::new(
 const EMITTER_SAMPLING: ParamSpec = ParamSpec::new(
     "emitter_sampling",
     ParamKind::Choice(&[
-        Choice {
-            name: "exhaustive",
-            value: &LightSelection::Exhaustive,
-        },
-        Choice {
-            name: "power",
-            value: &LightSelection::Power,
-        },
-        Choice {
-            name: "uniform",
-            value: &LightSelection::Uniform,
-        },
+        Choice::new("exhaustive", &LightSelection::Exhaustive),
+        Choice::new("power", &LightSelection::Power),
+        Choice::new("uniform", &LightSelection::Uniform),
     ]),
     Default::Str("exhaustive"),
     "Prism only (Mitsuba rejects it): one light per shading point chosen ∝ its importance \
@@ -220,22 +211,10 @@ const SHADOW_RAYS: ParamSpec = ParamSpec::new(
 const LIGHTS: ParamSpec = ParamSpec::new(
     "lights",
     ParamKind::Choice(&[
-        Choice {
-            name: "exhaustive",
-            value: &DirectLights::One(LightSelection::Exhaustive),
-        },
-        Choice {
-            name: "power",
-            value: &DirectLights::One(LightSelection::Power),
-        },
-        Choice {
-            name: "uniform",
-            value: &DirectLights::One(LightSelection::Uniform),
-        },
-        Choice {
-            name: "all",
-            value: &DirectLights::All,
-        },
+        Choice::new("exhaustive", &DirectLights::One(LightSelection::Exhaustive)),
+        Choice::new("power", &DirectLights::One(LightSelection::Power)),
+        Choice::new("uniform", &DirectLights::One(LightSelection::Uniform)),
+        Choice::new("all", &DirectLights::All),
     ]),
     Default::Str("exhaustive"),
     "one light per vertex chosen ∝ its importance there, ∝ power or uniformly (as the path \

@@ -206,14 +206,8 @@ const FILENAME: ParamSpec = ParamSpec::new(
 const FILTER_TYPE: ParamSpec = ParamSpec::new(
     "filter_type",
     ParamKind::Choice(&[
-        Choice {
-            name: "bilinear",
-            value: &GridFilter::Trilinear,
-        },
-        Choice {
-            name: "nearest",
-            value: &GridFilter::Nearest,
-        },
+        Choice::new("bilinear", &GridFilter::Trilinear),
+        Choice::new("nearest", &GridFilter::Nearest),
     ]),
     Default::Str("bilinear"),
     "interpolation between voxels: `bilinear` (trilinear in 3D, Mitsuba's name) or `nearest`",

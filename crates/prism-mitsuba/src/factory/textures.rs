@@ -93,23 +93,11 @@ const FILENAME: ParamSpec = ParamSpec::new(
 const FILTER_TYPE: ParamSpec = ParamSpec::new(
     "filter_type",
     ParamKind::Choice(&[
-        Choice {
-            name: "bilinear",
-            value: &FilterType::Bilinear,
-        },
-        Choice {
-            name: "nearest",
-            value: &FilterType::Nearest,
-        },
+        Choice::new("bilinear", &FilterType::Bilinear),
+        Choice::new("nearest", &FilterType::Nearest),
         // Mitsuba 0.6's mip-mapped filters, at full resolution the limit of their pyramids.
-        Choice {
-            name: "trilinear",
-            value: &FilterType::Bilinear,
-        },
-        Choice {
-            name: "ewa",
-            value: &FilterType::Bilinear,
-        },
+        Choice::new("trilinear", &FilterType::Bilinear),
+        Choice::new("ewa", &FilterType::Bilinear),
     ]),
     Default::Str("bilinear"),
     "interpolate the four nearest texels, or take the one containing the point; Mitsuba 0.6's \
@@ -118,18 +106,9 @@ const FILTER_TYPE: ParamSpec = ParamSpec::new(
 const WRAP_MODE: ParamSpec = ParamSpec::new(
     "wrap_mode",
     ParamKind::Choice(&[
-        Choice {
-            name: "repeat",
-            value: &WrapMode::Repeat,
-        },
-        Choice {
-            name: "mirror",
-            value: &WrapMode::Mirror,
-        },
-        Choice {
-            name: "clamp",
-            value: &WrapMode::Clamp,
-        },
+        Choice::new("repeat", &WrapMode::Repeat),
+        Choice::new("mirror", &WrapMode::Mirror),
+        Choice::new("clamp", &WrapMode::Clamp),
     ]),
     Default::Str("repeat"),
     "how coordinates outside [0, 1] map into the image",
@@ -148,20 +127,7 @@ const TO_UV: ParamSpec = ParamSpec::new(
 );
 const FORMAT: ParamSpec = ParamSpec::new(
     "format",
-    ParamKind::Choice(&[
-        Choice {
-            name: "auto",
-            value: &(),
-        },
-        Choice {
-            name: "variant",
-            value: &(),
-        },
-        Choice {
-            name: "fp16",
-            value: &(),
-        },
-    ]),
+    ParamKind::Choice(&Choice::accepted(["auto", "variant", "fp16"])),
     Default::Str("auto"),
     "accepted; texels are always stored in full precision",
 );

@@ -1,0 +1,128 @@
+//! Shape plugins: `obj`, `ply`, `serialized`, `rectangle`, `cube`, `sphere`, `disk`,
+//! `cylinder`, `linearcurve` and `bsplinecurve`, and the instancing plugins `shapegroup` and `instance` (built by the scene,
+//! [`super::instancing`]). Any shape whose
+//! `to_world` is an `<animation>` moves while the shutter is open: it is built in object space
+//! and placed by an [`Instance`].
+
+/// The parameters of a shape: its own, then those every shape takes (`to_world`, `bsdf`,
+/// `emitter`, `interior` and `exterior`).
+macro_rules! shape_params {
+    [$($own:expr),* $(,)?] => {
+        &[
+            $($own,)*
+            $crate::factory::shapes::TO_WORLD,
+            $crate::factory::shapes::BSDF,
+            $crate::factory::shapes::EMITTER,
+            $crate::factory::shapes::INTERIOR,
+            $crate::factory::shapes::EXTERIOR,
+        ]
+    };
+}
+
+mod curves;
+mod groups;
+mod meshes;
+mod quadrics;
+
+use crate::description::{PluginClass, PluginNode};
+use crate::params::Params;
+use crate::registry::{Default, ParamKind, ParamSpec, Plugin, Registry};
+pub use groups::{GROUP_SHAPES, INSTANCE_GROUP, INSTANCE_TO_WORLD};
+pub use meshes::{cube, rectangle, transform_mesh};
+use prism_core::error::Result;
+use prism_core::geometry::{Instance, Primitive, Shape};
+use prism_core::math::Transform;
+
+/// Builds a shape placed by a fixed transform.
+type Build = fn(&Params, &Transform) -> Result<Shape>;
+
+/// Every shape, each declared in the module of its kind.
+pub static SHAPES: Registry<Build> = Registry {
+    class: PluginClass::Shape,
+    plugins: &[
+        meshes::OBJ,
+        meshes::PLY,
+        meshes::SERIALIZED,
+        meshes::RECTANGLE,
+        meshes::CUBE,
+        quadrics::SPHERE,
+        quadrics::DISK,
+        quadrics::CYLINDER,
+        curves::LINEARCURVE,
+        curves::BSPLINECURVE,
+        groups::SHAPEGROUP,
+        groups::INSTANCE,
+    ],
+};
+
+/// The orientation of meshes and quadrics.
+const FLIP_NORMALS: ParamSpec = ParamSpec::new(
+    "flip_normals",
+    ParamKind::Boolean,
+    Default::Boolean(false),
+    "turn the normals (and the side an area light emits from) inside out",
+);
+
+/// The transform of every shape, whatever its type.
+pub const TO_WORLD: ParamSpec = ParamSpec::new(
+    "to_world",
+    ParamKind::AnimatedTransform,
+    Default::Text("identity"),
+    "object to world; an `<animation>` of `<transform time=\"t\">` keys (Mitsuba 0.6's syntax) \
+     moves the shape during the exposure, interpolated as translation, rotation (slerp) and scale",
+);
+
+/// The BSDF of every shape.
+pub const BSDF: ParamSpec = ParamSpec::nested(
+    PluginClass::Bsdf,
+    Default::Text("diffuse 0.5 (black when emitting)"),
+    "what the shape is made of",
+);
+
+/// The emitter of every shape.
+pub const EMITTER: ParamSpec =
+    ParamSpec::nested(PluginClass::Emitter, Default::None, "an `area` emitter");
+
+/// The medium inside a shape (the side its normals point away from).
+pub const INTERIOR: ParamSpec = ParamSpec::new(
+    "interior",
+    ParamKind::Nested(PluginClass::Medium),
+    Default::None,
+    "a `<medium name=\"interior\">` (or `<ref name=\"interior\" id=\"...\"/>`) inside the shape",
+);
+
+/// The medium outside a shape.
+pub const EXTERIOR: ParamSpec = ParamSpec::new(
+    "exterior",
+    ParamKind::Nested(PluginClass::Medium),
+    Default::None,
+    "a `<medium name=\"exterior\">` outside the shape",
+);
+
+/// Whether `plugin` makes curves: shapes that are hit but have no area (nor area sampling).
+pub fn is_curve(plugin: &Plugin<Build>) -> bool {
+    matches!(plugin.name, "linearcurve" | "bsplinecurve")
+}
+
+/// The plugin a `<shape>` names, and its parameters.
+pub fn shape_params(node: &PluginNode) -> Result<(&'static Plugin<Build>, Params<'_>)> {
+    let plugin = SHAPES.find(node)?;
+    Ok((plugin, Params::new(node, plugin.params)))
+}
+
+/// Builds a shape (its BSDF and emitter are the caller's business: it marks them used). A shape
+/// whose `to_world` is an `<animation>` is built in object space and placed by an [`Instance`];
+/// a fixed `to_world` is applied to the shape once.
+pub fn build_shape(plugin: &Plugin<Build>, params: &Params) -> Result<Primitive> {
+    // A `shapegroup` has no transform: the scene builds it, so it only gets here nested, where
+    // its builder refuses it.
+    if plugin.params.iter().all(|p| p.name != TO_WORLD.name) {
+        return (plugin.build)(params, &Transform::IDENTITY).map(Primitive::Shape);
+    }
+    let to_world = params.animated_transform(&TO_WORLD)?;
+    if to_world.is_animated() {
+        let shape = (plugin.build)(params, &Transform::IDENTITY)?;
+        return Ok(Primitive::Instance(Instance::new(shape, to_world)));
+    }
+    (plugin.build)(params, to_world.first()).map(Primitive::Shape)
+}
