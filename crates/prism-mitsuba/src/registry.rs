@@ -298,6 +298,16 @@ impl ParamSpec {
     }
 }
 
+/// Declares parameters one a line, `NAME = spec;` each a `const` [`ParamSpec`], so that a
+/// plugin's parameters read as a table: name, kind (with its bounds or options), default and
+/// meaning.
+macro_rules! params {
+    ($($(#[$attr:meta])* $vis:vis $name:ident = $spec:expr;)*) => {
+        $($(#[$attr])* $vis const $name: $crate::registry::ParamSpec = $spec;)*
+    };
+}
+pub(crate) use params;
+
 /// A plugin: its name in scene files, where it comes from, what it is, its parameters and the
 /// function that builds it (whose type depends on the class).
 pub struct Plugin<B: 'static> {

@@ -12,7 +12,7 @@ use super::textures::TextureCache;
 use super::{integrators, lights, materials, media, sensor, shapes, textures};
 use crate::description::{NestedPlugin, PluginClass, PluginNode};
 use crate::params::{Params, Warning};
-use crate::registry::{Default, ParamSpec};
+use crate::registry::{Default, ParamSpec, params};
 use prism_core::bsdf::Material;
 use prism_core::error::{Error, Result, SourceLocation};
 use prism_core::geometry::{Geometry, Primitive, Shape};
@@ -33,38 +33,16 @@ pub struct LoadedScene {
     pub warnings: Vec<Warning>,
 }
 
-const INTEGRATOR: ParamSpec = ParamSpec::nested(
-    PluginClass::Integrator,
-    Default::Text("`path`"),
-    "the integrator",
-);
-const SENSOR: ParamSpec = ParamSpec::nested(PluginClass::Sensor, Default::Required, "the camera");
-const SHAPES: ParamSpec = ParamSpec::nested(PluginClass::Shape, Default::None, "the shapes");
-const EMITTERS: ParamSpec = ParamSpec::nested(
-    PluginClass::Emitter,
-    Default::None,
-    "lights; an `area` emitter here is attached to the shape that references its id",
-);
-const BSDFS: ParamSpec = ParamSpec::nested(
-    PluginClass::Bsdf,
-    Default::None,
-    "BSDFs declared to be referenced by id",
-);
-const TEXTURES: ParamSpec = ParamSpec::nested(
-    PluginClass::Texture,
-    Default::None,
-    "textures declared to be referenced by id",
-);
-const SAMPLERS: ParamSpec = ParamSpec::nested(
-    PluginClass::Sampler,
-    Default::None,
-    "samplers declared to be referenced by id from the sensor",
-);
-const MEDIA: ParamSpec = ParamSpec::nested(
-    PluginClass::Medium,
-    Default::None,
-    "media declared to be referenced by id",
-);
+params! {
+    INTEGRATOR = ParamSpec::nested(PluginClass::Integrator, Default::Text("`path`"), "the integrator");
+    SENSOR = ParamSpec::nested(PluginClass::Sensor, Default::Required, "the camera");
+    SHAPES = ParamSpec::nested(PluginClass::Shape, Default::None, "the shapes");
+    EMITTERS = ParamSpec::nested(PluginClass::Emitter, Default::None, "lights; an `area` emitter here is attached to the shape that references its id");
+    BSDFS = ParamSpec::nested(PluginClass::Bsdf, Default::None, "BSDFs declared to be referenced by id");
+    TEXTURES = ParamSpec::nested(PluginClass::Texture, Default::None, "textures declared to be referenced by id");
+    SAMPLERS = ParamSpec::nested(PluginClass::Sampler, Default::None, "samplers declared to be referenced by id from the sensor");
+    MEDIA = ParamSpec::nested(PluginClass::Medium, Default::None, "media declared to be referenced by id");
+}
 /// What the `<scene>` element holds.
 const SCENE: &[ParamSpec] = &[
     INTEGRATOR, SENSOR, SHAPES, EMITTERS, BSDFS, TEXTURES, SAMPLERS, MEDIA,

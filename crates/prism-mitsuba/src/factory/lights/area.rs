@@ -4,7 +4,7 @@ use super::{Build, D65, SAMPLING_WEIGHT, emission_param};
 use crate::description::PluginClass;
 use crate::factory::textures::{TextureCache, build_texture};
 use crate::params::Params;
-use crate::registry::{Choice, Default, Origin, ParamKind, ParamSpec, Plugin, Range};
+use crate::registry::{Choice, Default, Origin, ParamKind, ParamSpec, Plugin, Range, params};
 use prism_core::error::Result;
 use prism_core::geometry::ShapeSampling;
 use prism_core::light::{AreaLight, Light};
@@ -24,28 +24,10 @@ pub(super) const AREA: Plugin<Build> = Plugin {
     build: build_area,
 };
 
-const AREA_SAMPLING: ParamSpec = ParamSpec::new(
-    "sampling",
-    ParamKind::Choice(&[
-        Choice::new("solid_angle", &ShapeSampling::SolidAngle),
-        Choice::new("area", &ShapeSampling::Area),
-    ]),
-    Default::Str("solid_angle"),
-    "(Prism) how light samples find the shape: `solid_angle` (spheres by their cone, rectangles \
-     by the spherical rectangle from within two diagonals, other shapes by area) or `area` (every \
-     shape uniformly by area, the lecture's direct light sampling)",
-);
-
-const AREA_RADIANCE: ParamSpec = ParamSpec::new(
-    "radiance",
-    ParamKind::Spectrum {
-        range: Range::Emission,
-        textured: true,
-    },
-    D65,
-    "emitted radiance; or a nested `<spectrum type=\"blackbody\">`, or a `<texture>` (its \
-     colours upsampled as reflectances, without D65, as Mitsuba 3 reads them)",
-);
+params! {
+    AREA_SAMPLING = ParamSpec::new("sampling", ParamKind::Choice(&[Choice::new("solid_angle", &ShapeSampling::SolidAngle), Choice::new("area", &ShapeSampling::Area)]), Default::Str("solid_angle"), "(Prism) how light samples find the shape: `solid_angle` (spheres by their cone, rectangles by the spherical rectangle from within two diagonals, other shapes by area) or `area` (every shape uniformly by area, the lecture's direct light sampling)");
+    AREA_RADIANCE = ParamSpec::new("radiance", ParamKind::Spectrum { range: Range::Emission, textured: true, }, D65, "emitted radiance; or a nested `<spectrum type=\"blackbody\">`, or a `<texture>` (its colours upsampled as reflectances, without D65, as Mitsuba 3 reads them)");
+}
 
 /// Mitsuba's `area`: a value, a nested spectrum, or a texture read as emission.
 fn build_area(params: &Params, shape: Option<u32>, textures: &mut TextureCache) -> Result<Light> {

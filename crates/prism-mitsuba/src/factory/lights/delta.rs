@@ -8,7 +8,7 @@ use crate::description::{NestedPlugin, PluginClass};
 use crate::factory::fov::{FOCAL_LENGTH, FOV, FOV_AXIS, horizontal_fov_param};
 use crate::factory::textures::{TextureCache, build_texture};
 use crate::params::Params;
-use crate::registry::{Bounds, Default, Origin, ParamKind, ParamSpec, Plugin, Range};
+use crate::registry::{Bounds, Default, Origin, ParamKind, ParamSpec, Plugin, Range, params};
 use glam::{DVec3, Vec3};
 use prism_core::error::{Error, Result};
 use prism_core::light::{DirectionalLight, Light, PointLight, Projector, SpotLight};
@@ -64,79 +64,17 @@ pub(super) const DIRECTIONAL: Plugin<Build> = Plugin {
     build: |params, _, _| build_directional(params),
 };
 
-const INTENSITY: ParamSpec = ParamSpec::new(
-    "intensity",
-    ParamKind::Spectrum {
-        range: Range::Emission,
-        textured: false,
-    },
-    D65,
-    "radiant intensity (on the axis, for a spot); or a nested blackbody",
-);
-
-const IRRADIANCE: ParamSpec = ParamSpec::new(
-    "irradiance",
-    ParamKind::Spectrum {
-        range: Range::Emission,
-        textured: false,
-    },
-    D65,
-    "irradiance on a surface facing the light; or a nested blackbody",
-);
-
-const SPOT_TEXTURE: ParamSpec = ParamSpec::new(
-    "texture",
-    ParamKind::Nested(PluginClass::Texture),
-    Default::Text("none"),
-    "a texture projected along the light, spanning the square around the cone at z = 1 (its \
-     colours read as for textured emission); needs `cutoff_angle` below 90",
-);
-
-const PROJECTOR_IRRADIANCE: ParamSpec = ParamSpec::new(
-    "irradiance",
-    ParamKind::Spectrum {
-        range: Range::Emission,
-        textured: true,
-    },
-    D65,
-    "the image on the plane z = 1 (a `<texture>`, its colours read as for textured emission, \
-     which sets the aspect ratio), or a value",
-);
-
-const PROJECTOR_SCALE: ParamSpec = ParamSpec::new(
-    "scale",
-    ParamKind::FloatIn(Bounds::FINITE_NON_NEGATIVE),
-    Default::Float(1.0),
-    "factor on the irradiance",
-);
-
-const POSITION: ParamSpec = ParamSpec::new(
-    "position",
-    ParamKind::Point,
-    Default::Text("the origin"),
-    "where the light is (or give `to_world`)",
-);
-
-const DIRECTION: ParamSpec = ParamSpec::new(
-    "direction",
-    ParamKind::Vector,
-    Default::Text("+z"),
-    "where the light travels (or give `to_world`: its +z)",
-);
-
-const CUTOFF_ANGLE: ParamSpec = ParamSpec::new(
-    "cutoff_angle",
-    ParamKind::FloatIn(Bounds::between(0.0, 180.0)),
-    Default::Float(20.0),
-    "angle from the axis, in degrees, beyond which there is no light",
-);
-
-const BEAM_WIDTH: ParamSpec = ParamSpec::new(
-    "beam_width",
-    ParamKind::Float,
-    Default::Text("¾ `cutoff_angle`"),
-    "angle, in degrees, within which the intensity is full",
-);
+params! {
+    INTENSITY = ParamSpec::new("intensity", ParamKind::Spectrum { range: Range::Emission, textured: false, }, D65, "radiant intensity (on the axis, for a spot); or a nested blackbody");
+    IRRADIANCE = ParamSpec::new("irradiance", ParamKind::Spectrum { range: Range::Emission, textured: false, }, D65, "irradiance on a surface facing the light; or a nested blackbody");
+    SPOT_TEXTURE = ParamSpec::new("texture", ParamKind::Nested(PluginClass::Texture), Default::Text("none"), "a texture projected along the light, spanning the square around the cone at z = 1 (its colours read as for textured emission); needs `cutoff_angle` below 90");
+    PROJECTOR_IRRADIANCE = ParamSpec::new("irradiance", ParamKind::Spectrum { range: Range::Emission, textured: true, }, D65, "the image on the plane z = 1 (a `<texture>`, its colours read as for textured emission, which sets the aspect ratio), or a value");
+    PROJECTOR_SCALE = ParamSpec::new("scale", ParamKind::FloatIn(Bounds::FINITE_NON_NEGATIVE), Default::Float(1.0), "factor on the irradiance");
+    POSITION = ParamSpec::new("position", ParamKind::Point, Default::Text("the origin"), "where the light is (or give `to_world`)");
+    DIRECTION = ParamSpec::new("direction", ParamKind::Vector, Default::Text("+z"), "where the light travels (or give `to_world`: its +z)");
+    CUTOFF_ANGLE = ParamSpec::new("cutoff_angle", ParamKind::FloatIn(Bounds::between(0.0, 180.0)), Default::Float(20.0), "angle from the axis, in degrees, beyond which there is no light");
+    BEAM_WIDTH = ParamSpec::new("beam_width", ParamKind::Float, Default::Text("¾ `cutoff_angle`"), "angle, in degrees, within which the intensity is full");
+}
 
 fn build_point(params: &Params) -> Result<Light> {
     let intensity = emission_param(params, &INTENSITY)?;

@@ -3,7 +3,7 @@
 use super::{Build, D65, SAMPLING_WEIGHT, TO_WORLD, emission_param, invertible};
 use crate::factory::spectra::spectrum_param;
 use crate::params::Params;
-use crate::registry::{Bounds, Default, Origin, ParamKind, ParamSpec, Plugin, Range};
+use crate::registry::{Bounds, Default, Origin, ParamKind, ParamSpec, Plugin, Range, params};
 use glam::Vec3;
 use prism_core::error::{Error, Result};
 use prism_core::image::read_bitmap;
@@ -60,115 +60,27 @@ pub(super) const SUNSKY: Plugin<Build> = Plugin {
     build: |params, _, _| build_sunsky(params),
 };
 
-const RADIANCE: ParamSpec = ParamSpec::new(
-    "radiance",
-    ParamKind::Spectrum {
-        range: Range::Emission,
-        textured: false,
-    },
-    D65,
-    "emitted radiance; or a nested `<spectrum type=\"blackbody\">`",
-);
-
-const ENVMAP_FILENAME: ParamSpec = ParamSpec::new(
-    "filename",
-    ParamKind::String,
-    Default::Required,
-    "the image: OpenEXR, Radiance HDR, PNG or JPEG, at least 2 × 3 pixels",
-);
-
-const ENVMAP_SCALE: ParamSpec = ParamSpec::new(
-    "scale",
-    ParamKind::Float,
-    Default::Float(1.0),
-    "factor on the image's values",
-);
-
-const SUN_DIRECTION: ParamSpec = ParamSpec::new(
-    "sun_direction",
-    ParamKind::Vector,
-    Default::Text("from the place and time"),
-    "the sun's direction (world space); not together with the place and time",
-);
-
-const LATITUDE: ParamSpec = ParamSpec::new(
-    "latitude",
-    ParamKind::Float,
-    Default::Float(35.6894),
-    "degrees north (Tokyo by default)",
-);
-
-const LONGITUDE: ParamSpec = ParamSpec::new(
-    "longitude",
-    ParamKind::Float,
-    Default::Float(139.6917),
-    "degrees east",
-);
-
-const TIMEZONE: ParamSpec = ParamSpec::new(
-    "timezone",
-    ParamKind::Float,
-    Default::Float(9.0),
-    "hours ahead of UTC",
-);
-
-const YEAR: ParamSpec = ParamSpec::new("year", ParamKind::Integer, Default::Integer(2010), "year");
-
-const MONTH: ParamSpec = ParamSpec::new("month", ParamKind::Integer, Default::Integer(7), "month");
-
-const DAY: ParamSpec = ParamSpec::new("day", ParamKind::Integer, Default::Integer(10), "day");
-
-const HOUR: ParamSpec =
-    ParamSpec::new("hour", ParamKind::Float, Default::Float(15.0), "local hour");
-
-const MINUTE: ParamSpec = ParamSpec::new("minute", ParamKind::Float, Default::Float(0.0), "minute");
-
-const SECOND: ParamSpec = ParamSpec::new("second", ParamKind::Float, Default::Float(0.0), "second");
-
-const TURBIDITY: ParamSpec = ParamSpec::new(
-    "turbidity",
-    ParamKind::FloatIn(Bounds::between(1.0, 10.0)),
-    Default::Float(3.0),
-    "haziness of the atmosphere",
-);
-
-const SKY_ALBEDO: ParamSpec = ParamSpec::new(
-    "albedo",
-    ParamKind::Spectrum {
-        range: Range::Albedo,
-        textured: false,
-    },
-    Default::Float(0.3),
-    "the ground's albedo, in [0, 1] at every wavelength",
-);
-
-const SUN_SCALE: ParamSpec = ParamSpec::new(
-    "sun_scale",
-    ParamKind::FloatIn(Bounds::FINITE_NON_NEGATIVE),
-    Default::Float(1.0),
-    "factor on the sun's radiance (0 turns the sun off)",
-);
-
-const SKY_SCALE: ParamSpec = ParamSpec::new(
-    "sky_scale",
-    ParamKind::FloatIn(Bounds::FINITE_NON_NEGATIVE),
-    Default::Float(1.0),
-    "factor on the sky's radiance (0 turns the sky off)",
-);
-
-const SUN_APERTURE: ParamSpec = ParamSpec::new(
-    "sun_aperture",
-    ParamKind::FloatIn(Bounds::between(0.0, 180.0)),
-    Default::Float(0.5358),
-    "the sun disc's full angle in degrees, in (0, 180); its irradiance stays that of the real sun",
-);
-
-const COMPLEX_SUN: ParamSpec = ParamSpec::new(
-    "complex_sun",
-    ParamKind::Boolean,
-    Default::Boolean(false),
-    "the solar radiance function with limb darkening instead of a uniform disc",
-);
+params! {
+    RADIANCE = ParamSpec::new("radiance", ParamKind::Spectrum { range: Range::Emission, textured: false, }, D65, "emitted radiance; or a nested `<spectrum type=\"blackbody\">`");
+    ENVMAP_FILENAME = ParamSpec::new("filename", ParamKind::String, Default::Required, "the image: OpenEXR, Radiance HDR, PNG or JPEG, at least 2 × 3 pixels");
+    ENVMAP_SCALE = ParamSpec::new("scale", ParamKind::Float, Default::Float(1.0), "factor on the image's values");
+    SUN_DIRECTION = ParamSpec::new("sun_direction", ParamKind::Vector, Default::Text("from the place and time"), "the sun's direction (world space); not together with the place and time");
+    LATITUDE = ParamSpec::new("latitude", ParamKind::Float, Default::Float(35.6894), "degrees north (Tokyo by default)");
+    LONGITUDE = ParamSpec::new("longitude", ParamKind::Float, Default::Float(139.6917), "degrees east");
+    TIMEZONE = ParamSpec::new("timezone", ParamKind::Float, Default::Float(9.0), "hours ahead of UTC");
+    YEAR = ParamSpec::new("year", ParamKind::Integer, Default::Integer(2010), "year");
+    MONTH = ParamSpec::new("month", ParamKind::Integer, Default::Integer(7), "month");
+    DAY = ParamSpec::new("day", ParamKind::Integer, Default::Integer(10), "day");
+    HOUR = ParamSpec::new("hour", ParamKind::Float, Default::Float(15.0), "local hour");
+    MINUTE = ParamSpec::new("minute", ParamKind::Float, Default::Float(0.0), "minute");
+    SECOND = ParamSpec::new("second", ParamKind::Float, Default::Float(0.0), "second");
+    TURBIDITY = ParamSpec::new("turbidity", ParamKind::FloatIn(Bounds::between(1.0, 10.0)), Default::Float(3.0), "haziness of the atmosphere");
+    SKY_ALBEDO = ParamSpec::new("albedo", ParamKind::Spectrum { range: Range::Albedo, textured: false, }, Default::Float(0.3), "the ground's albedo, in [0, 1] at every wavelength");
+    SUN_SCALE = ParamSpec::new("sun_scale", ParamKind::FloatIn(Bounds::FINITE_NON_NEGATIVE), Default::Float(1.0), "factor on the sun's radiance (0 turns the sun off)");
+    SKY_SCALE = ParamSpec::new("sky_scale", ParamKind::FloatIn(Bounds::FINITE_NON_NEGATIVE), Default::Float(1.0), "factor on the sky's radiance (0 turns the sky off)");
+    SUN_APERTURE = ParamSpec::new("sun_aperture", ParamKind::FloatIn(Bounds::between(0.0, 180.0)), Default::Float(0.5358), "the sun disc's full angle in degrees, in (0, 180); its irradiance stays that of the real sun");
+    COMPLEX_SUN = ParamSpec::new("complex_sun", ParamKind::Boolean, Default::Boolean(false), "the solar radiance function with limb darkening instead of a uniform disc");
+}
 
 /// Mitsuba's `envmap`.
 fn build_envmap(params: &Params) -> Result<Light> {

@@ -15,7 +15,7 @@ use crate::description::{PluginClass, PluginNode};
 use crate::factory::spectra::{NestedSpectrum, build_nested_spectrum, spectrum_param};
 use crate::factory::textures::TextureCache;
 use crate::params::Params;
-use crate::registry::{Bounds, Default, ParamKind, ParamSpec, Registry};
+use crate::registry::{Bounds, Default, ParamKind, ParamSpec, Registry, params};
 use glam::DMat4;
 use prism_core::bsdf::{Diffuse, Material};
 use prism_core::error::{Error, Result, SourceLocation};
@@ -42,25 +42,18 @@ pub static EMITTERS: Registry<Build> = Registry {
     ],
 };
 
-/// The weight of every emitter in the choice of a light to sample.
-const SAMPLING_WEIGHT: ParamSpec = ParamSpec::new(
-    "sampling_weight",
-    ParamKind::FloatIn(Bounds::FINITE_NON_NEGATIVE),
-    Default::Float(1.0),
-    "relative weight of choosing this emitter for direct light: P ∝ weight (uniform \
-     `emitter_sampling`, Mitsuba's rule) or ∝ power × weight (by power); 0 never chooses it",
-);
+params! {
+    /// The weight of every emitter in the choice of a light to sample.
+    SAMPLING_WEIGHT = ParamSpec::new("sampling_weight", ParamKind::FloatIn(Bounds::FINITE_NON_NEGATIVE), Default::Float(1.0), "relative weight of choosing this emitter for direct light: P ∝ weight (uniform `emitter_sampling`, Mitsuba's rule) or ∝ power × weight (by power); 0 never chooses it");
+}
 
 /// The default emission: the illuminant D65 of luminance 1.
 const D65: Default = Default::Text("D65 of luminance 1");
 
-/// The placement of the emitters that have one.
-const TO_WORLD: ParamSpec = ParamSpec::new(
-    "to_world",
-    ParamKind::Transform,
-    Default::Text("identity"),
-    "the emitter's placement",
-);
+params! {
+    /// The placement of the emitters that have one.
+    TO_WORLD = ParamSpec::new("to_world", ParamKind::Transform, Default::Text("identity"), "the emitter's placement");
+}
 
 /// Builds the area light nested in the shape with index `shape`, with its sampling weight.
 pub fn build_area_light(

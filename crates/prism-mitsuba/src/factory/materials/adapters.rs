@@ -5,7 +5,7 @@ use super::{Build, build_bsdf};
 use crate::description::{PluginClass, PluginNode};
 use crate::factory::textures::{TextureCache, build_texture, float_texture};
 use crate::params::Params;
-use crate::registry::{Bounds, Default, Origin, ParamKind, ParamSpec, Plugin};
+use crate::registry::{Bounds, Default, Origin, ParamKind, ParamSpec, Plugin, params};
 use prism_core::bsdf::{
     Blend, Bsdf, BsdfFlags, BsdfModel, BumpMap, Mask, NormalMap, Null, TwoSided,
 };
@@ -89,68 +89,18 @@ pub(super) const NORMALMAP: Plugin<Build> = Plugin {
     build: build_normalmap,
 };
 
-pub(super) const TWOSIDED_BSDFS: ParamSpec = ParamSpec::nested(
-    PluginClass::Bsdf,
-    Default::Required,
-    "one reflecting BSDF for both sides, or two: front, then back",
-);
-
-const NESTED_BSDF: ParamSpec =
-    ParamSpec::nested(PluginClass::Bsdf, Default::Required, "the BSDF adapted");
-
-const OPACITY: ParamSpec = ParamSpec::new(
-    "opacity",
-    ParamKind::FloatTexture(Bounds::UNIT),
-    Default::Float(0.5),
-    "the opacity α",
-);
-
-const WEIGHT: ParamSpec = ParamSpec::new(
-    "weight",
-    ParamKind::FloatTexture(Bounds::UNIT),
-    Default::Required,
-    "the share w of the second BSDF",
-);
-
-const BLENDED_BSDFS: ParamSpec = ParamSpec::nested(
-    PluginClass::Bsdf,
-    Default::Required,
-    "two BSDFs: f₀, then f₁",
-);
-
-const HEIGHTS: ParamSpec = ParamSpec::nested(
-    PluginClass::Texture,
-    Default::Required,
-    "the height texture (read as numbers; give `raw` for 8-bit images)",
-);
-
-const BUMP_SCALE: ParamSpec = ParamSpec::new(
-    "scale",
-    ParamKind::Float,
-    Default::Float(1.0),
-    "factor on the heights",
-);
-
-const FLIP_INVALID_NORMALS: ParamSpec = ParamSpec::new(
-    "flip_invalid_normals",
-    ParamKind::Boolean,
-    Default::Boolean(true),
-    "mirror a normal that the outgoing direction sees from behind",
-);
-
-const USE_SHADOWING_FUNCTION: ParamSpec = ParamSpec::new(
-    "use_shadowing_function",
-    ParamKind::Boolean,
-    Default::Boolean(true),
-    "attenuate by Conty Estevez et al.'s shadowing term (the bump terminator)",
-);
-
-const NORMAL_TEXTURE: ParamSpec = ParamSpec::new(
-    "normalmap",
-    ParamKind::Nested(PluginClass::Texture),
-    Default::Required,
-    "a texture named `normalmap`, read raw: the normals in the shading frame",
-);
+params! {
+    pub(super) TWOSIDED_BSDFS = ParamSpec::nested(PluginClass::Bsdf, Default::Required, "one reflecting BSDF for both sides, or two: front, then back");
+    NESTED_BSDF = ParamSpec::nested(PluginClass::Bsdf, Default::Required, "the BSDF adapted");
+    OPACITY = ParamSpec::new("opacity", ParamKind::FloatTexture(Bounds::UNIT), Default::Float(0.5), "the opacity α");
+    WEIGHT = ParamSpec::new("weight", ParamKind::FloatTexture(Bounds::UNIT), Default::Required, "the share w of the second BSDF");
+    BLENDED_BSDFS = ParamSpec::nested(PluginClass::Bsdf, Default::Required, "two BSDFs: f₀, then f₁");
+    HEIGHTS = ParamSpec::nested(PluginClass::Texture, Default::Required, "the height texture (read as numbers; give `raw` for 8-bit images)");
+    BUMP_SCALE = ParamSpec::new("scale", ParamKind::Float, Default::Float(1.0), "factor on the heights");
+    FLIP_INVALID_NORMALS = ParamSpec::new("flip_invalid_normals", ParamKind::Boolean, Default::Boolean(true), "mirror a normal that the outgoing direction sees from behind");
+    USE_SHADOWING_FUNCTION = ParamSpec::new("use_shadowing_function", ParamKind::Boolean, Default::Boolean(true), "attenuate by Conty Estevez et al.'s shadowing term (the bump terminator)");
+    NORMAL_TEXTURE = ParamSpec::new("normalmap", ParamKind::Nested(PluginClass::Texture), Default::Required, "a texture named `normalmap`, read raw: the normals in the shading frame");
+}
 
 /// The front and back BSDFs of a `twosided` element.
 pub(super) fn twosided_pair(params: &Params, textures: &mut TextureCache) -> Result<(Bsdf, Bsdf)> {

@@ -4,7 +4,7 @@ use super::ior::{EXT_IOR, INT_IOR, relative_ior};
 use super::microfacet::roughness;
 use super::{Build, SPECULAR_REFLECTANCE, colour};
 use crate::factory::textures::optional_spectrum_texture;
-use crate::registry::{Origin, ParamSpec, Plugin, Range};
+use crate::registry::{Origin, Plugin, Range, params};
 use prism_core::bsdf::{Bsdf, Dielectric, RoughDielectric, ThinDielectric};
 
 pub(super) const DIELECTRIC: Plugin<Build> = Plugin {
@@ -71,9 +71,6 @@ pub(super) const THINDIELECTRIC: Plugin<Build> = Plugin {
     },
 };
 
-const SPECULAR_TRANSMITTANCE: ParamSpec = colour(
-    "specular_transmittance",
-    Range::Albedo,
-    1.0,
-    "a factor on the transmitted light",
-);
+params! {
+    SPECULAR_TRANSMITTANCE = colour("specular_transmittance", Range::Albedo, 1.0, "a factor on the transmitted light");
+}

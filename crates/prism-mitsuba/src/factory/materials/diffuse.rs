@@ -2,7 +2,7 @@
 
 use super::{Build, colour};
 use crate::factory::textures::{float_texture, spectrum_texture};
-use crate::registry::{Bounds, Default, Origin, ParamKind, ParamSpec, Plugin, Range};
+use crate::registry::{Bounds, Default, Origin, ParamKind, ParamSpec, Plugin, Range, params};
 use prism_core::bsdf::{Bsdf, Diffuse, RoughDiffuse};
 
 pub(super) const DIFFUSE: Plugin<Build> = Plugin {
@@ -32,18 +32,8 @@ pub(super) const ROUGHDIFFUSE: Plugin<Build> = Plugin {
     },
 };
 
-const REFLECTANCE: ParamSpec = colour("reflectance", Range::Albedo, 0.5, "the reflectance ρ");
-
-const OREN_NAYAR_ALPHA: ParamSpec = ParamSpec::new(
-    "alpha",
-    ParamKind::FloatTexture(Bounds::NON_NEGATIVE),
-    Default::Float(0.2),
-    "RMS slope of the surface; 0 is Lambert's law",
-);
-
-const USE_FAST_APPROX: ParamSpec = ParamSpec::new(
-    "use_fast_approx",
-    ParamKind::Boolean,
-    Default::Boolean(false),
-    "use the qualitative model of the paper's eq. 30",
-);
+params! {
+    REFLECTANCE = colour("reflectance", Range::Albedo, 0.5, "the reflectance ρ");
+    OREN_NAYAR_ALPHA = ParamSpec::new("alpha", ParamKind::FloatTexture(Bounds::NON_NEGATIVE), Default::Float(0.2), "RMS slope of the surface; 0 is Lambert's law");
+    USE_FAST_APPROX = ParamSpec::new("use_fast_approx", ParamKind::Boolean, Default::Boolean(false), "use the qualitative model of the paper's eq. 30");
+}

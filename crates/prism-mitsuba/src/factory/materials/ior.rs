@@ -4,32 +4,16 @@
 use crate::description::{PluginClass, PluginNode, PropertyValue, SpectrumValue};
 use crate::factory::spectra::{NestedSpectrum, build_nested_spectrum};
 use crate::params::Params;
-use crate::registry::{Default, ParamKind, ParamSpec};
+use crate::registry::{Default, ParamKind, ParamSpec, params};
 use prism_core::error::{Error, Result};
 use prism_core::spectrum::ior::{Ior, NAMED_IORS, RelativeIor, named_ior};
 use prism_core::spectrum::{LAMBDA_MAX, LAMBDA_MIN, PiecewiseLinear, RgbIntent, Spectrum};
 
-pub(super) const INT_IOR: ParamSpec = ParamSpec::new(
-    "int_ior",
-    ParamKind::Ior,
-    Default::Str("bk7"),
-    "index of refraction inside: a number, a name (`bk7`, `water`, …), a `<spectrum>`, or \
-     (Prism) a dispersive `<spectrum type=\"sellmeier\">` or `cauchy`",
-);
-
-pub(super) const COATING_INT_IOR: ParamSpec = ParamSpec::new(
-    "int_ior",
-    ParamKind::Ior,
-    Default::Str("polypropylene"),
-    "index of refraction of the coating: a number or a name",
-);
-
-pub(super) const EXT_IOR: ParamSpec = ParamSpec::new(
-    "ext_ior",
-    ParamKind::Ior,
-    Default::Str("air"),
-    "index of refraction outside",
-);
+params! {
+    pub(super) INT_IOR = ParamSpec::new("int_ior", ParamKind::Ior, Default::Str("bk7"), "index of refraction inside: a number, a name (`bk7`, `water`, …), a `<spectrum>`, or (Prism) a dispersive `<spectrum type=\"sellmeier\">` or `cauchy`");
+    pub(super) COATING_INT_IOR = ParamSpec::new("int_ior", ParamKind::Ior, Default::Str("polypropylene"), "index of refraction of the coating: a number or a name");
+    pub(super) EXT_IOR = ParamSpec::new("ext_ior", ParamKind::Ior, Default::Str("air"), "index of refraction outside");
+}
 
 /// `int_ior` (as `interior` declares it) and `ext_ior`. With `must_differ`, equal constant
 /// indices are refused (Mitsuba's rule for rough interfaces).

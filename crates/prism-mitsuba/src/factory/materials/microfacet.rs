@@ -3,48 +3,18 @@
 
 use crate::factory::textures::{TextureCache, float_texture};
 use crate::params::Params;
-use crate::registry::{Bounds, Choice, Default, ParamKind, ParamSpec};
+use crate::registry::{Bounds, Choice, Default, ParamKind, ParamSpec, params};
 use prism_core::bsdf::microfacet::MicrofacetKind;
 use prism_core::error::{Error, Result};
 use prism_core::texture::Texture;
 
-pub(super) const DISTRIBUTION: ParamSpec = ParamSpec::new(
-    "distribution",
-    ParamKind::Choice(&[
-        Choice::new("beckmann", &MicrofacetKind::Beckmann),
-        Choice::new("ggx", &MicrofacetKind::Ggx),
-    ]),
-    Default::Str("beckmann"),
-    "the microfacet distribution",
-);
-
-pub(super) const ALPHA: ParamSpec = ParamSpec::new(
-    "alpha",
-    ParamKind::FloatTexture(Bounds::POSITIVE),
-    Default::Float(0.1),
-    "roughness α (RMS slope for Beckmann)",
-);
-
-pub(super) const ALPHA_U: ParamSpec = ParamSpec::new(
-    "alpha_u",
-    ParamKind::FloatTexture(Bounds::POSITIVE),
-    Default::Text("`alpha`"),
-    "roughness along ∂p/∂u (with `alpha_v`, instead of `alpha`)",
-);
-
-pub(super) const ALPHA_V: ParamSpec = ParamSpec::new(
-    "alpha_v",
-    ParamKind::FloatTexture(Bounds::POSITIVE),
-    Default::Text("`alpha`"),
-    "roughness along ∂p/∂v",
-);
-
-pub(super) const SAMPLE_VISIBLE: ParamSpec = ParamSpec::new(
-    "sample_visible",
-    ParamKind::Boolean,
-    Default::Boolean(true),
-    "accepted; visible normals are always sampled",
-);
+params! {
+    pub(super) DISTRIBUTION = ParamSpec::new("distribution", ParamKind::Choice(&[Choice::new("beckmann", &MicrofacetKind::Beckmann), Choice::new("ggx", &MicrofacetKind::Ggx)]), Default::Str("beckmann"), "the microfacet distribution");
+    pub(super) ALPHA = ParamSpec::new("alpha", ParamKind::FloatTexture(Bounds::POSITIVE), Default::Float(0.1), "roughness α (RMS slope for Beckmann)");
+    pub(super) ALPHA_U = ParamSpec::new("alpha_u", ParamKind::FloatTexture(Bounds::POSITIVE), Default::Text("`alpha`"), "roughness along ∂p/∂u (with `alpha_v`, instead of `alpha`)");
+    pub(super) ALPHA_V = ParamSpec::new("alpha_v", ParamKind::FloatTexture(Bounds::POSITIVE), Default::Text("`alpha`"), "roughness along ∂p/∂v");
+    pub(super) SAMPLE_VISIBLE = ParamSpec::new("sample_visible", ParamKind::Boolean, Default::Boolean(true), "accepted; visible normals are always sampled");
+}
 
 /// The microfacet distribution and its roughness along ∂p/∂u and ∂p/∂v: `alpha`, or `alpha_u`
 /// and `alpha_v` (both, and not with `alpha`), numbers above 0 or textures; default 0.1.

@@ -33,7 +33,7 @@ mod principled;
 use crate::description::{PluginClass, PluginNode};
 use crate::factory::textures::TextureCache;
 use crate::params::Params;
-use crate::registry::{Default, ParamKind, ParamSpec, Range, Registry};
+use crate::registry::{Default, ParamKind, ParamSpec, Range, Registry, params};
 use adapters::{TWOSIDED_BSDFS, twosided_pair};
 use prism_core::bsdf::{Bsdf, Diffuse, MAX_NODES, Material};
 use prism_core::error::{Error, Result};
@@ -81,21 +81,12 @@ const fn colour(name: &'static str, range: Range, default: f64, doc: &'static st
     )
 }
 
-/// The factor on the specular reflection of dielectrics and coatings.
-const SPECULAR_REFLECTANCE: ParamSpec = colour(
-    "specular_reflectance",
-    Range::Albedo,
-    1.0,
-    "a factor on the reflected light",
-);
-
-/// The reflectance of a diffuse base under a coating or a glossy lobe.
-const DIFFUSE_REFLECTANCE: ParamSpec = colour(
-    "diffuse_reflectance",
-    Range::Albedo,
-    0.5,
-    "reflectance of the diffuse base",
-);
+params! {
+    /// The factor on the specular reflection of dielectrics and coatings.
+    SPECULAR_REFLECTANCE = colour("specular_reflectance", Range::Albedo, 1.0, "a factor on the reflected light");
+    /// The reflectance of a diffuse base under a coating or a glossy lobe.
+    DIFFUSE_REFLECTANCE = colour("diffuse_reflectance", Range::Albedo, 0.5, "reflectance of the diffuse base");
+}
 
 /// Mitsuba's default material for a shape without a BSDF: one-sided diffuse, reflectance 0.5.
 pub fn default_material() -> Material {

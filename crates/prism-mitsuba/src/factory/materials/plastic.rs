@@ -8,7 +8,7 @@ use crate::factory::textures::{
     TextureCache, float_value, optional_spectrum_texture, spectrum_texture,
 };
 use crate::params::Params;
-use crate::registry::{Bounds, Default, Origin, ParamKind, ParamSpec, Plugin};
+use crate::registry::{Bounds, Default, Origin, ParamKind, ParamSpec, Plugin, params};
 use prism_core::bsdf::{Bsdf, Plastic, PolarizedPlastic, RoughPlastic};
 use prism_core::error::{Error, Result};
 
@@ -81,20 +81,10 @@ pub(super) const PPLASTIC: Plugin<Build> = Plugin {
     },
 };
 
-const NONLINEAR: ParamSpec = ParamSpec::new(
-    "nonlinear",
-    ParamKind::Boolean,
-    Default::Boolean(false),
-    "let the bounces between base and coating be modulated by the base colour (darker, more \
-     saturated colours)",
-);
-
-const PLASTIC_ALPHA: ParamSpec = ParamSpec::new(
-    "alpha",
-    ParamKind::Float,
-    Default::Float(0.1),
-    "roughness α of the coating: a number greater than 0 (isotropic only, no texture, as Mitsuba)",
-);
+params! {
+    NONLINEAR = ParamSpec::new("nonlinear", ParamKind::Boolean, Default::Boolean(false), "let the bounces between base and coating be modulated by the base colour (darker, more saturated colours)");
+    PLASTIC_ALPHA = ParamSpec::new("alpha", ParamKind::Float, Default::Float(0.1), "roughness α of the coating: a number greater than 0 (isotropic only, no texture, as Mitsuba)");
+}
 
 fn build_roughplastic(params: &Params, t: &mut TextureCache) -> Result<Bsdf> {
     let eta = constant_relative_ior(params, true)?;

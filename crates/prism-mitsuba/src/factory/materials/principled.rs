@@ -4,7 +4,7 @@
 use super::{Build, colour};
 use crate::factory::textures::{TextureCache, float_texture, float_value, spectrum_texture};
 use crate::params::Params;
-use crate::registry::{Bounds, Default, Origin, ParamKind, ParamSpec, Plugin, Range};
+use crate::registry::{Bounds, Default, Origin, ParamKind, ParamSpec, Plugin, Range, params};
 use prism_core::bsdf::{Bsdf, Principled, PrincipledThin, principled, principledthin};
 use prism_core::error::{Error, Result};
 use prism_core::spectrum::Spectrum;
@@ -61,7 +61,9 @@ pub(super) const PRINCIPLEDTHIN: Plugin<Build> = Plugin {
     build: build_principledthin,
 };
 
-const BASE_COLOR: ParamSpec = colour("base_color", Range::Albedo, 0.5, "the colour c");
+params! {
+    BASE_COLOR = colour("base_color", Range::Albedo, 0.5, "the colour c");
+}
 
 pub(super) const fn weight(name: &'static str, default: f64, doc: &'static str) -> ParamSpec {
     ParamSpec::new(
@@ -72,121 +74,36 @@ pub(super) const fn weight(name: &'static str, default: f64, doc: &'static str) 
     )
 }
 
-const ROUGHNESS: ParamSpec = weight(
-    "roughness",
-    0.5,
-    "roughness of the main specular lobes (α = roughness²)",
-);
-
-const ANISOTROPIC: ParamSpec = weight(
-    "anisotropic",
-    0.0,
-    "degree of anisotropy: α_u/α_v = 1/(1 − 0.9·anisotropic)",
-);
-
-const METALLIC: ParamSpec = weight("metallic", 0.0, "blend from dielectric (0) to metal (1)");
-
-const SPEC_TRANS: ParamSpec = weight(
-    "spec_trans",
-    0.0,
-    "share of the dielectric part that transmits (rough glass at 1)",
-);
-
-const PRINCIPLED_ETA: ParamSpec = ParamSpec::new(
-    "eta",
-    ParamKind::Float,
-    Default::Text("from `specular`"),
-    "relative index of refraction (instead of `specular`)",
-);
-
-const SPECULAR: ParamSpec = ParamSpec::new(
-    "specular",
-    ParamKind::Float,
-    Default::Float(0.5),
-    "Fresnel reflectance at normal incidence ÷ 0.08: η = 2/(1 − √(0.08·specular)) − 1",
-);
-
-const SPEC_TINT: ParamSpec = weight(
-    "spec_tint",
-    0.0,
-    "share of the dielectric reflection tinted by the base colour",
-);
-
-const SHEEN: ParamSpec = weight("sheen", 0.0, "weight of the sheen lobe");
-
-const SHEEN_TINT: ParamSpec = weight("sheen_tint", 0.0, "tint of the sheen by the base colour");
-
-const FLATNESS: ParamSpec = weight(
-    "flatness",
-    0.0,
-    "blend from the diffuse lobe to Hanrahan–Krueger's fake subsurface",
-);
-
-const CLEARCOAT: ParamSpec = weight("clearcoat", 0.0, "weight of the clearcoat lobe");
-
-const CLEARCOAT_GLOSS: ParamSpec = weight(
-    "clearcoat_gloss",
-    0.0,
-    "gloss of the clearcoat: α from 0.1 (0) to 0.001 (1)",
-);
+params! {
+    ROUGHNESS = weight("roughness", 0.5, "roughness of the main specular lobes (α = roughness²)");
+    ANISOTROPIC = weight("anisotropic", 0.0, "degree of anisotropy: α_u/α_v = 1/(1 − 0.9·anisotropic)");
+    METALLIC = weight("metallic", 0.0, "blend from dielectric (0) to metal (1)");
+    SPEC_TRANS = weight("spec_trans", 0.0, "share of the dielectric part that transmits (rough glass at 1)");
+    PRINCIPLED_ETA = ParamSpec::new("eta", ParamKind::Float, Default::Text("from `specular`"), "relative index of refraction (instead of `specular`)");
+    SPECULAR = ParamSpec::new("specular", ParamKind::Float, Default::Float(0.5), "Fresnel reflectance at normal incidence ÷ 0.08: η = 2/(1 − √(0.08·specular)) − 1");
+    SPEC_TINT = weight("spec_tint", 0.0, "share of the dielectric reflection tinted by the base colour");
+    SHEEN = weight("sheen", 0.0, "weight of the sheen lobe");
+    SHEEN_TINT = weight("sheen_tint", 0.0, "tint of the sheen by the base colour");
+    FLATNESS = weight("flatness", 0.0, "blend from the diffuse lobe to Hanrahan–Krueger's fake subsurface");
+    CLEARCOAT = weight("clearcoat", 0.0, "weight of the clearcoat lobe");
+    CLEARCOAT_GLOSS = weight("clearcoat_gloss", 0.0, "gloss of the clearcoat: α from 0.1 (0) to 0.001 (1)");
+}
 
 const fn sampling_rate(name: &'static str, doc: &'static str) -> ParamSpec {
     ParamSpec::new(name, ParamKind::Float, Default::Float(1.0), doc)
 }
 
-const DIFFUSE_SAMPLING_RATE: ParamSpec = sampling_rate(
-    "diffuse_reflectance_sampling_rate",
-    "relative rate of sampling the diffuse lobe",
-);
-
-const MAIN_SPECULAR_SAMPLING_RATE: ParamSpec = sampling_rate(
-    "main_specular_sampling_rate",
-    "relative rate of sampling the main specular lobes",
-);
-
-const CLEARCOAT_SAMPLING_RATE: ParamSpec = sampling_rate(
-    "clearcoat_sampling_rate",
-    "relative rate of sampling the clearcoat",
-);
-
-const THIN_SPEC_TRANS: ParamSpec = weight(
-    "spec_trans",
-    0.0,
-    "blend from the diffuse (0) to the specular (1) response",
-);
-
-const THIN_ETA: ParamSpec = ParamSpec::new(
-    "eta",
-    ParamKind::FloatTexture(Bounds::POSITIVE),
-    Default::Float(1.5),
-    "relative index of refraction of the sheet (its Fresnel term and transmitted roughness)",
-);
-
-const DIFF_TRANS: ParamSpec = ParamSpec::new(
-    "diff_trans",
-    ParamKind::FloatTexture(Bounds {
-        min: 0.0,
-        min_exclusive: false,
-        max: 2.0,
-    }),
-    Default::Float(0.0),
-    "share of the diffuse response transmitted, from 0 (none) to 2 (all)",
-);
-
-const SPECULAR_REFLECTANCE_SAMPLING_RATE: ParamSpec = sampling_rate(
-    "specular_reflectance_sampling_rate",
-    "relative rate of sampling the specular reflection",
-);
-
-const SPECULAR_TRANSMITTANCE_SAMPLING_RATE: ParamSpec = sampling_rate(
-    "specular_transmittance_sampling_rate",
-    "relative rate of sampling the specular transmission",
-);
-
-const DIFFUSE_TRANSMITTANCE_SAMPLING_RATE: ParamSpec = sampling_rate(
-    "diffuse_transmittance_sampling_rate",
-    "relative rate of sampling the diffuse transmission",
-);
+params! {
+    DIFFUSE_SAMPLING_RATE = sampling_rate("diffuse_reflectance_sampling_rate", "relative rate of sampling the diffuse lobe");
+    MAIN_SPECULAR_SAMPLING_RATE = sampling_rate("main_specular_sampling_rate", "relative rate of sampling the main specular lobes");
+    CLEARCOAT_SAMPLING_RATE = sampling_rate("clearcoat_sampling_rate", "relative rate of sampling the clearcoat");
+    THIN_SPEC_TRANS = weight("spec_trans", 0.0, "blend from the diffuse (0) to the specular (1) response");
+    THIN_ETA = ParamSpec::new("eta", ParamKind::FloatTexture(Bounds::POSITIVE), Default::Float(1.5), "relative index of refraction of the sheet (its Fresnel term and transmitted roughness)");
+    DIFF_TRANS = ParamSpec::new("diff_trans", ParamKind::FloatTexture(Bounds { min: 0.0, min_exclusive: false, max: 2.0, }), Default::Float(0.0), "share of the diffuse response transmitted, from 0 (none) to 2 (all)");
+    SPECULAR_REFLECTANCE_SAMPLING_RATE = sampling_rate("specular_reflectance_sampling_rate", "relative rate of sampling the specular reflection");
+    SPECULAR_TRANSMITTANCE_SAMPLING_RATE = sampling_rate("specular_transmittance_sampling_rate", "relative rate of sampling the specular transmission");
+    DIFFUSE_TRANSMITTANCE_SAMPLING_RATE = sampling_rate("diffuse_transmittance_sampling_rate", "relative rate of sampling the diffuse transmission");
+}
 
 /// A lobe weight of `principled` or `principledthin`: `None` (the lobe is off) when the scene
 /// leaves it out or gives the number 0, as Mitsuba's `get_flag`.

@@ -4,7 +4,7 @@
 use super::rfilter::build_filter;
 use crate::description::{PluginClass, PluginNode};
 use crate::params::{Params, Warning};
-use crate::registry::{Choice, Default, Origin, ParamKind, ParamSpec, Plugin, Registry};
+use crate::registry::{Choice, Default, Origin, ParamKind, ParamSpec, Plugin, Registry, params};
 use glam::UVec2;
 use prism_core::error::{Error, Result};
 use prism_core::film::{
@@ -75,154 +75,25 @@ pub static FILMS: Registry<FilmBuild> = Registry {
     ],
 };
 
-const WIDTH: ParamSpec = ParamSpec::new(
-    "width",
-    ParamKind::Integer,
-    Default::Integer(768),
-    "pixels across",
-);
-
-const HEIGHT: ParamSpec = ParamSpec::new(
-    "height",
-    ParamKind::Integer,
-    Default::Integer(576),
-    "pixels down",
-);
-
-const CROP_OFFSET_X: ParamSpec = ParamSpec::new(
-    "crop_offset_x",
-    ParamKind::Integer,
-    Default::Integer(0),
-    "first column rendered",
-);
-
-const CROP_OFFSET_Y: ParamSpec = ParamSpec::new(
-    "crop_offset_y",
-    ParamKind::Integer,
-    Default::Integer(0),
-    "first row rendered",
-);
-
-const CROP_WIDTH: ParamSpec = ParamSpec::new(
-    "crop_width",
-    ParamKind::Integer,
-    Default::Text("`width` − `crop_offset_x`"),
-    "columns rendered",
-);
-
-const CROP_HEIGHT: ParamSpec = ParamSpec::new(
-    "crop_height",
-    ParamKind::Integer,
-    Default::Text("`height` − `crop_offset_y`"),
-    "rows rendered",
-);
-
-const FILE_FORMAT: ParamSpec = ParamSpec::new(
-    "file_format",
-    ParamKind::Choice(&Choice::accepted(["openexr", "exr"])),
-    Default::Str("openexr"),
-    "accepted; the output is always OpenEXR",
-);
-
-const PIXEL_FORMAT: ParamSpec = ParamSpec::new(
-    "pixel_format",
-    ParamKind::Choice(&Choice::accepted([
-        "rgb",
-        "rgba",
-        "xyz",
-        "xyza",
-        "luminance",
-        "luminance_alpha",
-    ])),
-    Default::Str("rgb"),
-    "accepted; the output always holds RGB and XYZ",
-);
-
-const RECONSTRUCTION: ParamSpec = ParamSpec::new(
-    "reconstruction",
-    ParamKind::Choice(&[
-        Choice::new("filter_mis", &Reconstruction::FilterMis),
-        Choice::new("pixel", &Reconstruction::Pixel),
-    ]),
-    Default::Str("filter_mis"),
-    "Prism only (Mitsuba rejects it): how samples become pixels: `filter_mis` (every sample \
-     feeds every pixel its filter covers, unbiased, with less noise than Mitsuba's splatting) or \
-     `pixel` (each sample counts for its own pixel, the lecture's estimator); the same for a \
-     `box` filter; see docs/reconstruction.md",
-);
-
-const WAVELENGTH_SAMPLING: ParamSpec = ParamSpec::new(
-    "wavelength_sampling",
-    ParamKind::Choice(&[
-        Choice::new("balanced", &WavelengthSampling::Balanced),
-        Choice::new("cie_sum", &WavelengthSampling::CieSum),
-        Choice::new("visible", &WavelengthSampling::Visible),
-        Choice::new("uniform", &WavelengthSampling::Uniform),
-    ]),
-    Default::Str("visible"),
-    "Prism only (Mitsuba rejects it): the density wavelengths are drawn from: `visible` \
-     (Mitsuba's and pbrt's, the quietest on the Cornell boxes), `balanced` (least error of \
-     luminance and linear sRGB under white light), `cie_sum` (∝ x̄+ȳ+z̄, the lecture's), \
-     `uniform`; see docs/wavelengths.md",
-);
-
-const COMPONENT_FORMAT: ParamSpec = ParamSpec::new(
-    "component_format",
-    ParamKind::Choice(&Choice::accepted(["float16", "float32", "uint32"])),
-    Default::Str("float32"),
-    "accepted; the output is always 32-bit float",
-);
-
-const BANNER: ParamSpec = ParamSpec::new(
-    "banner",
-    ParamKind::Boolean,
-    Default::Ignored,
-    "Mitsuba 0.6's \"rendered by Mitsuba\" banner; Prism writes none",
-);
-
-const ATTACH_LOG: ParamSpec = ParamSpec::new(
-    "attach_log",
-    ParamKind::Boolean,
-    Default::Ignored,
-    "Mitsuba 0.6's render log in the image's metadata; Prism attaches none",
-);
-
-const HIGH_QUALITY_EDGES: ParamSpec = ParamSpec::new(
-    "high_quality_edges",
-    ParamKind::Boolean,
-    Default::Ignored,
-    "Mitsuba 0.6's sampling of a margin outside the film; Prism samples the film's pixels only",
-);
-
-const HDR_GAMMA: ParamSpec = ParamSpec::new(
-    "gamma",
-    ParamKind::Float,
-    Default::Ignored,
-    "a gamma on an HDR film, as Mitsuba 0.6 scenes give it; the EXR is linear",
-);
-
-const LDR_FILE_FORMAT: ParamSpec = ParamSpec::new(
-    "file_format",
-    ParamKind::Choice(&[
-        Choice::new("png", &LdrFormat::Png),
-        Choice::new("jpeg", &LdrFormat::Jpeg),
-        Choice::new("jpg", &LdrFormat::Jpeg),
-    ]),
-    Default::Str("png"),
-    "the 8-bit file: PNG, or JPEG of quality 100 (extension `.jpg`)",
-);
-
-const LDR_PIXEL_FORMAT: ParamSpec = ParamSpec::new(
-    "pixel_format",
-    ParamKind::Choice(&[
-        Choice::new("rgb", &Channels::Rgb),
-        Choice::new("rgba", &Channels::Rgba),
-        Choice::new("luminance", &Channels::Luminance),
-        Choice::new("luminanceAlpha", &Channels::LuminanceAlpha),
-    ]),
-    Default::Str("rgb"),
-    "the 8-bit image's channels; Prism's alpha is opaque (its film records no coverage), and a JPEG drops it, as Mitsuba 0.6 does",
-);
+params! {
+    WIDTH = ParamSpec::new("width", ParamKind::Integer, Default::Integer(768), "pixels across");
+    HEIGHT = ParamSpec::new("height", ParamKind::Integer, Default::Integer(576), "pixels down");
+    CROP_OFFSET_X = ParamSpec::new("crop_offset_x", ParamKind::Integer, Default::Integer(0), "first column rendered");
+    CROP_OFFSET_Y = ParamSpec::new("crop_offset_y", ParamKind::Integer, Default::Integer(0), "first row rendered");
+    CROP_WIDTH = ParamSpec::new("crop_width", ParamKind::Integer, Default::Text("`width` − `crop_offset_x`"), "columns rendered");
+    CROP_HEIGHT = ParamSpec::new("crop_height", ParamKind::Integer, Default::Text("`height` − `crop_offset_y`"), "rows rendered");
+    FILE_FORMAT = ParamSpec::new("file_format", ParamKind::Choice(&Choice::accepted(["openexr", "exr"])), Default::Str("openexr"), "accepted; the output is always OpenEXR");
+    PIXEL_FORMAT = ParamSpec::new("pixel_format", ParamKind::Choice(&Choice::accepted(["rgb", "rgba", "xyz", "xyza", "luminance", "luminance_alpha"])), Default::Str("rgb"), "accepted; the output always holds RGB and XYZ");
+    RECONSTRUCTION = ParamSpec::new("reconstruction", ParamKind::Choice(&[Choice::new("filter_mis", &Reconstruction::FilterMis), Choice::new("pixel", &Reconstruction::Pixel)]), Default::Str("filter_mis"), "Prism only (Mitsuba rejects it): how samples become pixels: `filter_mis` (every sample feeds every pixel its filter covers, unbiased, with less noise than Mitsuba's splatting) or `pixel` (each sample counts for its own pixel, the lecture's estimator); the same for a `box` filter; see docs/reconstruction.md");
+    WAVELENGTH_SAMPLING = ParamSpec::new("wavelength_sampling", ParamKind::Choice(&[Choice::new("balanced", &WavelengthSampling::Balanced), Choice::new("cie_sum", &WavelengthSampling::CieSum), Choice::new("visible", &WavelengthSampling::Visible), Choice::new("uniform", &WavelengthSampling::Uniform)]), Default::Str("visible"), "Prism only (Mitsuba rejects it): the density wavelengths are drawn from: `visible` (Mitsuba's and pbrt's, the quietest on the Cornell boxes), `balanced` (least error of luminance and linear sRGB under white light), `cie_sum` (∝ x̄+ȳ+z̄, the lecture's), `uniform`; see docs/wavelengths.md");
+    COMPONENT_FORMAT = ParamSpec::new("component_format", ParamKind::Choice(&Choice::accepted(["float16", "float32", "uint32"])), Default::Str("float32"), "accepted; the output is always 32-bit float");
+    BANNER = ParamSpec::new("banner", ParamKind::Boolean, Default::Ignored, "Mitsuba 0.6's \"rendered by Mitsuba\" banner; Prism writes none");
+    ATTACH_LOG = ParamSpec::new("attach_log", ParamKind::Boolean, Default::Ignored, "Mitsuba 0.6's render log in the image's metadata; Prism attaches none");
+    HIGH_QUALITY_EDGES = ParamSpec::new("high_quality_edges", ParamKind::Boolean, Default::Ignored, "Mitsuba 0.6's sampling of a margin outside the film; Prism samples the film's pixels only");
+    HDR_GAMMA = ParamSpec::new("gamma", ParamKind::Float, Default::Ignored, "a gamma on an HDR film, as Mitsuba 0.6 scenes give it; the EXR is linear");
+    LDR_FILE_FORMAT = ParamSpec::new("file_format", ParamKind::Choice(&[Choice::new("png", &LdrFormat::Png), Choice::new("jpeg", &LdrFormat::Jpeg), Choice::new("jpg", &LdrFormat::Jpeg)]), Default::Str("png"), "the 8-bit file: PNG, or JPEG of quality 100 (extension `.jpg`)");
+    LDR_PIXEL_FORMAT = ParamSpec::new("pixel_format", ParamKind::Choice(&[Choice::new("rgb", &Channels::Rgb), Choice::new("rgba", &Channels::Rgba), Choice::new("luminance", &Channels::Luminance), Choice::new("luminanceAlpha", &Channels::LuminanceAlpha)]), Default::Str("rgb"), "the 8-bit image's channels; Prism's alpha is opaque (its film records no coverage), and a JPEG drops it, as Mitsuba 0.6 does");
+}
 
 /// How `ldrfilm` maps radiance to 8-bit values.
 #[derive(Clone, Copy)]
@@ -233,49 +104,14 @@ enum TonemapMethod {
     Reinhard,
 }
 
-const TONEMAP_METHOD: ParamSpec = ParamSpec::new(
-    "tonemap_method",
-    ParamKind::Choice(&[
-        Choice::new("gamma", &TonemapMethod::Gamma),
-        Choice::new("reinhard", &TonemapMethod::Reinhard),
-    ]),
-    Default::Str("gamma"),
-    "`gamma`: scale by 2^`exposure`; `reinhard`: Reinhard et al. 2002's global operator with `key` and `burn`",
-);
-
-const LDR_GAMMA: ParamSpec = ParamSpec::new(
-    "gamma",
-    ParamKind::Float,
-    Default::Float(-1.0),
-    "the transfer curve v^(1/γ) of the 8-bit values; −1 is the sRGB curve",
-);
-
-const EXPOSURE: ParamSpec = ParamSpec::new(
-    "exposure",
-    ParamKind::Float,
-    Default::Float(0.0),
-    "with `gamma` tonemapping, the exposure in f-stops: values are scaled by 2^exposure",
-);
-
-const KEY: ParamSpec = ParamSpec::new(
-    "key",
-    ParamKind::Float,
-    Default::Float(0.18),
-    "with `reinhard`, the value the log-average luminance maps to, in (0, 1]",
-);
-
-const BURN: ParamSpec = ParamSpec::new(
-    "burn",
-    ParamKind::Float,
-    Default::Float(0.0),
-    "with `reinhard`, how much highlights may burn out, in [0, 1]",
-);
-
-const RFILTER: ParamSpec = ParamSpec::nested(
-    PluginClass::Rfilter,
-    Default::Text("`gaussian`"),
-    "the reconstruction filter",
-);
+params! {
+    TONEMAP_METHOD = ParamSpec::new("tonemap_method", ParamKind::Choice(&[Choice::new("gamma", &TonemapMethod::Gamma), Choice::new("reinhard", &TonemapMethod::Reinhard)]), Default::Str("gamma"), "`gamma`: scale by 2^`exposure`; `reinhard`: Reinhard et al. 2002's global operator with `key` and `burn`");
+    LDR_GAMMA = ParamSpec::new("gamma", ParamKind::Float, Default::Float(-1.0), "the transfer curve v^(1/γ) of the 8-bit values; −1 is the sRGB curve");
+    EXPOSURE = ParamSpec::new("exposure", ParamKind::Float, Default::Float(0.0), "with `gamma` tonemapping, the exposure in f-stops: values are scaled by 2^exposure");
+    KEY = ParamSpec::new("key", ParamKind::Float, Default::Float(0.18), "with `reinhard`, the value the log-average luminance maps to, in (0, 1]");
+    BURN = ParamSpec::new("burn", ParamKind::Float, Default::Float(0.0), "with `reinhard`, how much highlights may burn out, in [0, 1]");
+    RFILTER = ParamSpec::nested(PluginClass::Rfilter, Default::Text("`gaussian`"), "the reconstruction filter");
+}
 
 /// Largest film side, and largest pixel count, accepted (each pixel keeps 112 bytes of sums,
 /// twice while a pass is rendered).

@@ -8,7 +8,7 @@ pub mod sampler;
 use crate::description::{PluginClass, PluginNode};
 use crate::factory::fov::{FOCAL_LENGTH, FOV, FOV_AXIS, horizontal_fov_param};
 use crate::params::{Params, Warning};
-use crate::registry::{Default, Origin, ParamKind, ParamSpec, Plugin, Registry};
+use crate::registry::{Default, Origin, ParamKind, ParamSpec, Plugin, Registry, params};
 use film::{build_film, default_film};
 use glam::Vec2;
 use prism_core::camera::{Camera, OrthographicCamera, PerspectiveCamera, Shutter};
@@ -87,107 +87,23 @@ pub static SENSORS: Registry<SensorBuild> = Registry {
     ],
 };
 
-const NEAR_CLIP: ParamSpec = ParamSpec::new(
-    "near_clip",
-    ParamKind::Float,
-    Default::Float(1e-2),
-    "distance before which nothing is seen",
-);
-
-const FAR_CLIP: ParamSpec = ParamSpec::new(
-    "far_clip",
-    ParamKind::Float,
-    Default::Float(1e4),
-    "distance beyond which nothing is seen",
-);
-
-const SENSOR_TO_WORLD: ParamSpec = ParamSpec::new(
-    "to_world",
-    ParamKind::AnimatedTransform,
-    Default::Text("identity"),
-    "camera to world: rotations and translations (a `lookat`), or an `<animation>` of them",
-);
-
-const SHUTTER_OPEN: ParamSpec = ParamSpec::new(
-    "shutter_open",
-    ParamKind::Float,
-    Default::Float(0.0),
-    "time the shutter opens",
-);
-
-const SHUTTER_CLOSE: ParamSpec = ParamSpec::new(
-    "shutter_close",
-    ParamKind::Float,
-    Default::Text("`shutter_open`"),
-    "time the shutter closes",
-);
-
-const SHUTTER_FILTER: ParamSpec = ParamSpec::new(
-    "shutter_filter",
-    ParamKind::Nested(PluginClass::Rfilter),
-    Default::Text("box"),
-    "Prism only: a nested `<rfilter name=\"shutter_filter\">` weighting time within the shutter interval",
-);
-
-const FILM: ParamSpec = ParamSpec::nested(
-    PluginClass::Film,
-    Default::Text("`hdrfilm`, 768 × 576, gaussian"),
-    "the film",
-);
-
-const SAMPLER: ParamSpec = ParamSpec::nested(
-    PluginClass::Sampler,
-    Default::Text("`independent`, 4 samples"),
-    "the sampler",
-);
-
-const SENSOR_MEDIUM: ParamSpec = ParamSpec::nested(
-    PluginClass::Medium,
-    Default::None,
-    "the medium the camera sits in (for `volpath`)",
-);
-
-const APERTURE_RADIUS: ParamSpec = ParamSpec::new(
-    "aperture_radius",
-    ParamKind::Float,
-    Default::Required,
-    "radius of the lens (or give `aperture_area`)",
-);
-
-const APERTURE_AREA: ParamSpec = ParamSpec::new(
-    "aperture_area",
-    ParamKind::Float,
-    Default::None,
-    "Prism only, the lecture's form: the lens's area a, radius √(a/π)",
-);
-
-const FOCUS_DISTANCE: ParamSpec = ParamSpec::new(
-    "focus_distance",
-    ParamKind::Float,
-    Default::Text("`far_clip`"),
-    "distance of the plane in focus",
-);
-
-const PINHOLE_FOCUS_DISTANCE: ParamSpec = ParamSpec::new(
-    "focus_distance",
-    ParamKind::Float,
-    Default::Text("`far_clip`"),
-    "read as Mitsuba 3 reads it on every projective camera; a pinhole has everything in focus",
-);
-
-const FOCAL_DISTANCE: ParamSpec = ParamSpec::new(
-    "focal_distance",
-    ParamKind::Float,
-    Default::None,
-    "Prism only, the lecture's name for `focus_distance`",
-);
-
-const ORTHOGRAPHIC_TO_WORLD: ParamSpec = ParamSpec::new(
-    "to_world",
-    ParamKind::AnimatedTransform,
-    Default::Text("identity"),
-    "camera to world, scales included (they set the film's extent in the scene), or an `<animation>` of them",
-);
+params! {
+    NEAR_CLIP = ParamSpec::new("near_clip", ParamKind::Float, Default::Float(1e-2), "distance before which nothing is seen");
+    FAR_CLIP = ParamSpec::new("far_clip", ParamKind::Float, Default::Float(1e4), "distance beyond which nothing is seen");
+    SENSOR_TO_WORLD = ParamSpec::new("to_world", ParamKind::AnimatedTransform, Default::Text("identity"), "camera to world: rotations and translations (a `lookat`), or an `<animation>` of them");
+    SHUTTER_OPEN = ParamSpec::new("shutter_open", ParamKind::Float, Default::Float(0.0), "time the shutter opens");
+    SHUTTER_CLOSE = ParamSpec::new("shutter_close", ParamKind::Float, Default::Text("`shutter_open`"), "time the shutter closes");
+    SHUTTER_FILTER = ParamSpec::new("shutter_filter", ParamKind::Nested(PluginClass::Rfilter), Default::Text("box"), "Prism only: a nested `<rfilter name=\"shutter_filter\">` weighting time within the shutter interval");
+    FILM = ParamSpec::nested(PluginClass::Film, Default::Text("`hdrfilm`, 768 × 576, gaussian"), "the film");
+    SAMPLER = ParamSpec::nested(PluginClass::Sampler, Default::Text("`independent`, 4 samples"), "the sampler");
+    SENSOR_MEDIUM = ParamSpec::nested(PluginClass::Medium, Default::None, "the medium the camera sits in (for `volpath`)");
+    APERTURE_RADIUS = ParamSpec::new("aperture_radius", ParamKind::Float, Default::Required, "radius of the lens (or give `aperture_area`)");
+    APERTURE_AREA = ParamSpec::new("aperture_area", ParamKind::Float, Default::None, "Prism only, the lecture's form: the lens's area a, radius √(a/π)");
+    FOCUS_DISTANCE = ParamSpec::new("focus_distance", ParamKind::Float, Default::Text("`far_clip`"), "distance of the plane in focus");
+    PINHOLE_FOCUS_DISTANCE = ParamSpec::new("focus_distance", ParamKind::Float, Default::Text("`far_clip`"), "read as Mitsuba 3 reads it on every projective camera; a pinhole has everything in focus");
+    FOCAL_DISTANCE = ParamSpec::new("focal_distance", ParamKind::Float, Default::None, "Prism only, the lecture's name for `focus_distance`");
+    ORTHOGRAPHIC_TO_WORLD = ParamSpec::new("to_world", ParamKind::AnimatedTransform, Default::Text("identity"), "camera to world, scales included (they set the film's extent in the scene), or an `<animation>` of them");
+}
 
 /// The camera, shutter, film settings, sampler settings and sampler seed of a `<sensor>`.
 pub struct SensorSettings {

@@ -2,7 +2,7 @@
 
 use crate::description::{PluginClass, PluginNode};
 use crate::params::Params;
-use crate::registry::{Bounds, Default, Origin, ParamKind, ParamSpec, Plugin, Registry};
+use crate::registry::{Bounds, Default, Origin, ParamKind, ParamSpec, Plugin, Registry, params};
 use prism_core::error::{Error, Result};
 use prism_core::film::{
     BoxFilter, Filter, GaussianFilter, LanczosFilter, MitchellFilter, TentFilter,
@@ -86,47 +86,14 @@ pub static RFILTERS: Registry<FilterBuild> = Registry {
     ],
 };
 
-const BOX_RADIUS: ParamSpec = ParamSpec::new(
-    "radius",
-    ParamKind::Float,
-    Default::Float(0.5),
-    "half width in pixels",
-);
-
-const TENT_RADIUS: ParamSpec = ParamSpec::new(
-    "radius",
-    ParamKind::Float,
-    Default::Float(1.0),
-    "half width in pixels",
-);
-
-const STDDEV: ParamSpec = ParamSpec::new(
-    "stddev",
-    ParamKind::Float,
-    Default::Float(0.5),
-    "standard deviation in pixels",
-);
-
-const MITCHELL_B: ParamSpec = ParamSpec::new(
-    "B",
-    ParamKind::FloatIn(Bounds::UNIT),
-    Default::Float(1.0 / 3.0),
-    "the blur parameter B",
-);
-
-const MITCHELL_C: ParamSpec = ParamSpec::new(
-    "C",
-    ParamKind::FloatIn(Bounds::UNIT),
-    Default::Float(1.0 / 3.0),
-    "the ringing parameter C",
-);
-
-const LOBES: ParamSpec = ParamSpec::new(
-    "lobes",
-    ParamKind::Integer,
-    Default::Integer(3),
-    "lobes of the sinc (1 to 32)",
-);
+params! {
+    BOX_RADIUS = ParamSpec::new("radius", ParamKind::Float, Default::Float(0.5), "half width in pixels");
+    TENT_RADIUS = ParamSpec::new("radius", ParamKind::Float, Default::Float(1.0), "half width in pixels");
+    STDDEV = ParamSpec::new("stddev", ParamKind::Float, Default::Float(0.5), "standard deviation in pixels");
+    MITCHELL_B = ParamSpec::new("B", ParamKind::FloatIn(Bounds::UNIT), Default::Float(1.0 / 3.0), "the blur parameter B");
+    MITCHELL_C = ParamSpec::new("C", ParamKind::FloatIn(Bounds::UNIT), Default::Float(1.0 / 3.0), "the ringing parameter C");
+    LOBES = ParamSpec::new("lobes", ParamKind::Integer, Default::Integer(3), "lobes of the sinc (1 to 32)");
+}
 
 pub(super) fn build_filter(node: &PluginNode) -> Result<Filter> {
     let plugin = RFILTERS.find(node)?;

@@ -3,7 +3,7 @@
 
 use crate::description::{PluginClass, PluginNode};
 use crate::params::Params;
-use crate::registry::{Default, Origin, ParamKind, ParamSpec, Plugin, Registry};
+use crate::registry::{Default, Origin, ParamKind, ParamSpec, Plugin, Registry, params};
 use prism_core::error::{Error, Result};
 use prism_core::sampling::sampler::MAX_ORTHOGONAL_STRENGTH;
 use prism_core::scene::{SamplerKind, SamplerSettings};
@@ -80,33 +80,12 @@ pub static SAMPLERS: Registry<SamplerBuild> = Registry {
     ],
 };
 
-const STRENGTH: ParamSpec = ParamSpec::new(
-    "strength",
-    ParamKind::Integer,
-    Default::Integer(2),
-    "the orthogonal array's strength t: every t dimensions together are stratified (1 to 4)",
-);
-
-const SAMPLE_COUNT: ParamSpec = ParamSpec::new(
-    "sample_count",
-    ParamKind::Integer,
-    Default::Integer(4),
-    "samples per pixel (1 to 2²⁴)",
-);
-
-const SEED: ParamSpec = ParamSpec::new(
-    "seed",
-    ParamKind::Integer,
-    Default::Integer(0),
-    "seed of every random number (`--seed` overrides it)",
-);
-
-const JITTER: ParamSpec = ParamSpec::new(
-    "jitter",
-    ParamKind::Boolean,
-    Default::Boolean(true),
-    "jitter samples within their strata",
-);
+params! {
+    STRENGTH = ParamSpec::new("strength", ParamKind::Integer, Default::Integer(2), "the orthogonal array's strength t: every t dimensions together are stratified (1 to 4)");
+    SAMPLE_COUNT = ParamSpec::new("sample_count", ParamKind::Integer, Default::Integer(4), "samples per pixel (1 to 2²⁴)");
+    SEED = ParamSpec::new("seed", ParamKind::Integer, Default::Integer(0), "seed of every random number (`--seed` overrides it)");
+    JITTER = ParamSpec::new("jitter", ParamKind::Boolean, Default::Boolean(true), "jitter samples within their strata");
+}
 
 /// The sampler a node describes, with its seed.
 pub(crate) fn build_sampler(node: &PluginNode) -> Result<(SamplerSettings, u64)> {

@@ -4,7 +4,7 @@ use super::meshes::mesh_error;
 use super::{Build, TO_WORLD};
 use crate::mesh::curves::{CurveData, load_curves};
 use crate::params::Params;
-use crate::registry::{Default, Origin, ParamKind, ParamSpec, Plugin};
+use crate::registry::{Default, Origin, ParamKind, ParamSpec, Plugin, params};
 use prism_core::error::{Error, Result};
 use prism_core::geometry::Shape;
 use prism_core::geometry::shape::{BSplineCurve, LinearCurve};
@@ -36,12 +36,9 @@ pub(super) const BSPLINECURVE: Plugin<Build> = Plugin {
     build: build_bspline_curve,
 };
 
-const CURVE_FILENAME: ParamSpec = ParamSpec::new(
-    "filename",
-    ParamKind::String,
-    Default::Required,
-    "the curve file",
-);
+params! {
+    CURVE_FILENAME = ParamSpec::new("filename", ParamKind::String, Default::Required, "the curve file");
+}
 
 /// Round linear curves read from a file, their points placed by `to_world` (radii unchanged).
 fn build_linear_curve(params: &Params, to_world: &Transform) -> Result<Shape> {

@@ -4,7 +4,7 @@
 use super::Build;
 use crate::description::PluginClass;
 use crate::params::Params;
-use crate::registry::{Default, Origin, ParamKind, ParamSpec, Plugin};
+use crate::registry::{Default, Origin, ParamKind, ParamSpec, Plugin, params};
 use prism_core::error::Error;
 
 pub(super) const SHAPEGROUP: Plugin<Build> = Plugin {
@@ -26,28 +26,14 @@ pub(super) const INSTANCE: Plugin<Build> = Plugin {
     build: |params, _| Err(nested_instancing(params, "an instance")),
 };
 
-/// The shapes of a `shapegroup`.
-pub const GROUP_SHAPES: ParamSpec = ParamSpec::nested(
-    PluginClass::Shape,
-    Default::None,
-    "the group's shapes, each with its BSDF and media",
-);
-
-/// The group an `instance` places.
-pub const INSTANCE_GROUP: ParamSpec = ParamSpec::nested(
-    PluginClass::Shape,
-    Default::Required,
-    "the `shapegroup` placed, usually `<ref id=\"...\"/>`",
-);
-
-/// The transform of an `instance`.
-pub const INSTANCE_TO_WORLD: ParamSpec = ParamSpec::new(
-    "to_world",
-    ParamKind::AnimatedTransform,
-    Default::Text("identity"),
-    "group to world; an `<animation>` moves the instance during the exposure (Prism; Mitsuba 3 \
-     takes a fixed transform)",
-);
+params! {
+    /// The shapes of a `shapegroup`.
+    pub GROUP_SHAPES = ParamSpec::nested(PluginClass::Shape, Default::None, "the group's shapes, each with its BSDF and media");
+    /// The group an `instance` places.
+    pub INSTANCE_GROUP = ParamSpec::nested(PluginClass::Shape, Default::Required, "the `shapegroup` placed, usually `<ref id=\"...\"/>`");
+    /// The transform of an `instance`.
+    pub INSTANCE_TO_WORLD = ParamSpec::new("to_world", ParamKind::AnimatedTransform, Default::Text("identity"), "group to world; an `<animation>` moves the instance during the exposure (Prism; Mitsuba 3 takes a fixed transform)");
+}
 
 /// The error for a `shapegroup` or `instance` inside a `shapegroup` (a shape built as a
 /// group's member; the scene builds top-level groups and instances itself).

@@ -5,7 +5,7 @@ use super::{Build, FLIP_NORMALS};
 use crate::description::PluginNode;
 use crate::mesh::{MeshData, load_obj, load_ply, load_serialized};
 use crate::params::Params;
-use crate::registry::{Default, Origin, ParamKind, ParamSpec, Plugin};
+use crate::registry::{Default, Origin, ParamKind, ParamSpec, Plugin, params};
 use glam::{Vec2, Vec3};
 use prism_core::error::{Error, Result};
 use prism_core::geometry::shape::MeshAttribute;
@@ -69,33 +69,12 @@ pub(super) const CUBE: Plugin<Build> = Plugin {
     },
 };
 
-const FILENAME: ParamSpec = ParamSpec::new(
-    "filename",
-    ParamKind::String,
-    Default::Required,
-    "the mesh file",
-);
-
-const SHAPE_INDEX: ParamSpec = ParamSpec::new(
-    "shape_index",
-    ParamKind::Integer,
-    Default::Integer(0),
-    "which of the file's shapes to load, counted from 0",
-);
-
-const FACE_NORMALS: ParamSpec = ParamSpec::new(
-    "face_normals",
-    ParamKind::Boolean,
-    Default::Boolean(false),
-    "ignore vertex normals and shade flat",
-);
-
-const FLIP_TEX_COORDS: ParamSpec = ParamSpec::new(
-    "flip_tex_coords",
-    ParamKind::Boolean,
-    Default::Boolean(true),
-    "flip texture coordinates, v → 1 − v, as Mitsuba's OBJ reader does",
-);
+params! {
+    FILENAME = ParamSpec::new("filename", ParamKind::String, Default::Required, "the mesh file");
+    SHAPE_INDEX = ParamSpec::new("shape_index", ParamKind::Integer, Default::Integer(0), "which of the file's shapes to load, counted from 0");
+    FACE_NORMALS = ParamSpec::new("face_normals", ParamKind::Boolean, Default::Boolean(false), "ignore vertex normals and shade flat");
+    FLIP_TEX_COORDS = ParamSpec::new("flip_tex_coords", ParamKind::Boolean, Default::Boolean(true), "flip texture coordinates, v → 1 − v, as Mitsuba's OBJ reader does");
+}
 
 /// The mesh file formats.
 #[derive(Clone, Copy, PartialEq, Eq)]

@@ -26,7 +26,7 @@ mod quadrics;
 
 use crate::description::{PluginClass, PluginNode};
 use crate::params::Params;
-use crate::registry::{Default, ParamKind, ParamSpec, Plugin, Registry};
+use crate::registry::{Default, ParamKind, ParamSpec, Plugin, Registry, params};
 pub use groups::{GROUP_SHAPES, INSTANCE_GROUP, INSTANCE_TO_WORLD};
 pub use meshes::{cube, rectangle, transform_mesh};
 use prism_core::error::Result;
@@ -55,49 +55,20 @@ pub static SHAPES: Registry<Build> = Registry {
     ],
 };
 
-/// The orientation of meshes and quadrics.
-const FLIP_NORMALS: ParamSpec = ParamSpec::new(
-    "flip_normals",
-    ParamKind::Boolean,
-    Default::Boolean(false),
-    "turn the normals (and the side an area light emits from) inside out",
-);
-
-/// The transform of every shape, whatever its type.
-pub const TO_WORLD: ParamSpec = ParamSpec::new(
-    "to_world",
-    ParamKind::AnimatedTransform,
-    Default::Text("identity"),
-    "object to world; an `<animation>` of `<transform time=\"t\">` keys (Mitsuba 0.6's syntax) \
-     moves the shape during the exposure, interpolated as translation, rotation (slerp) and scale",
-);
-
-/// The BSDF of every shape.
-pub const BSDF: ParamSpec = ParamSpec::nested(
-    PluginClass::Bsdf,
-    Default::Text("diffuse 0.5 (black when emitting)"),
-    "what the shape is made of",
-);
-
-/// The emitter of every shape.
-pub const EMITTER: ParamSpec =
-    ParamSpec::nested(PluginClass::Emitter, Default::None, "an `area` emitter");
-
-/// The medium inside a shape (the side its normals point away from).
-pub const INTERIOR: ParamSpec = ParamSpec::new(
-    "interior",
-    ParamKind::Nested(PluginClass::Medium),
-    Default::None,
-    "a `<medium name=\"interior\">` (or `<ref name=\"interior\" id=\"...\"/>`) inside the shape",
-);
-
-/// The medium outside a shape.
-pub const EXTERIOR: ParamSpec = ParamSpec::new(
-    "exterior",
-    ParamKind::Nested(PluginClass::Medium),
-    Default::None,
-    "a `<medium name=\"exterior\">` outside the shape",
-);
+params! {
+    /// The orientation of meshes and quadrics.
+    FLIP_NORMALS = ParamSpec::new("flip_normals", ParamKind::Boolean, Default::Boolean(false), "turn the normals (and the side an area light emits from) inside out");
+    /// The transform of every shape, whatever its type.
+    pub TO_WORLD = ParamSpec::new("to_world", ParamKind::AnimatedTransform, Default::Text("identity"), "object to world; an `<animation>` of `<transform time=\"t\">` keys (Mitsuba 0.6's syntax) moves the shape during the exposure, interpolated as translation, rotation (slerp) and scale");
+    /// The BSDF of every shape.
+    pub BSDF = ParamSpec::nested(PluginClass::Bsdf, Default::Text("diffuse 0.5 (black when emitting)"), "what the shape is made of");
+    /// The emitter of every shape.
+    pub EMITTER = ParamSpec::nested(PluginClass::Emitter, Default::None, "an `area` emitter");
+    /// The medium inside a shape (the side its normals point away from).
+    pub INTERIOR = ParamSpec::new("interior", ParamKind::Nested(PluginClass::Medium), Default::None, "a `<medium name=\"interior\">` (or `<ref name=\"interior\" id=\"...\"/>`) inside the shape");
+    /// The medium outside a shape.
+    pub EXTERIOR = ParamSpec::new("exterior", ParamKind::Nested(PluginClass::Medium), Default::None, "a `<medium name=\"exterior\">` outside the shape");
+}
 
 /// Whether `plugin` makes curves: shapes that are hit but have no area (nor area sampling).
 pub fn is_curve(plugin: &Plugin<Build>) -> bool {

@@ -2,7 +2,7 @@
 
 use super::{Build, FLIP_NORMALS, TO_WORLD};
 use crate::params::Params;
-use crate::registry::{Default, Origin, ParamKind, ParamSpec, Plugin};
+use crate::registry::{Default, Origin, ParamKind, ParamSpec, Plugin, params};
 use glam::{DMat4, DVec3, Mat3};
 use prism_core::error::{Error, Result};
 use prism_core::geometry::shape::Cylinder;
@@ -41,40 +41,13 @@ pub(super) const CYLINDER: Plugin<Build> = Plugin {
     build: build_cylinder,
 };
 
-const CENTER: ParamSpec = ParamSpec::new(
-    "center",
-    ParamKind::Point,
-    Default::Text("the origin"),
-    "centre of the sphere",
-);
-
-const RADIUS: ParamSpec = ParamSpec::new(
-    "radius",
-    ParamKind::Float,
-    Default::Float(1.0),
-    "radius of the sphere",
-);
-
-const P0: ParamSpec = ParamSpec::new(
-    "p0",
-    ParamKind::Point,
-    Default::Text("(0, 0, 0)"),
-    "centre of the cylinder's start",
-);
-
-const P1: ParamSpec = ParamSpec::new(
-    "p1",
-    ParamKind::Point,
-    Default::Text("(0, 0, 1)"),
-    "centre of the cylinder's end",
-);
-
-const CYLINDER_RADIUS: ParamSpec = ParamSpec::new(
-    "radius",
-    ParamKind::Float,
-    Default::Float(1.0),
-    "radius of the cylinder",
-);
+params! {
+    CENTER = ParamSpec::new("center", ParamKind::Point, Default::Text("the origin"), "centre of the sphere");
+    RADIUS = ParamSpec::new("radius", ParamKind::Float, Default::Float(1.0), "radius of the sphere");
+    P0 = ParamSpec::new("p0", ParamKind::Point, Default::Text("(0, 0, 0)"), "centre of the cylinder's start");
+    P1 = ParamSpec::new("p1", ParamKind::Point, Default::Text("(0, 0, 1)"), "centre of the cylinder's end");
+    CYLINDER_RADIUS = ParamSpec::new("radius", ParamKind::Float, Default::Float(1.0), "radius of the cylinder");
+}
 
 /// A sphere placed by `to_world`, which may only rotate, translate and scale uniformly.
 fn build_sphere(params: &Params, to_world: &Transform) -> Result<Shape> {
