@@ -176,16 +176,7 @@ impl SceneBuilder {
         let (plugin, shape_params) = shapes::shape_params(&child.node)?;
         let mut shape = shapes::build_shape(plugin, &shape_params)?;
         let area = shape.area();
-        if !area.is_finite() {
-            return Err(Error::input(
-                &child.location,
-                format!(
-                    "the area of {} is not a finite number",
-                    child.node.describe()
-                ),
-            )
-            .with_help("fix the shape's transform or its vertices"));
-        }
+        shapes::check_area(area, child)?;
         let shape_index = self.shapes.len() as u32;
         let emitter = shape_params.single_child(&shapes::EMITTER)?;
         // Curves are hit but have no area sampling in Mitsuba, which refuses to make them

@@ -3,26 +3,26 @@
 use super::ior::{EXT_IOR, INT_IOR, relative_ior};
 use super::microfacet::roughness;
 use super::{Build, SPECULAR_REFLECTANCE, colour};
-use crate::factory::textures::optional_spectrum_texture;
-use crate::registry::{Origin, Plugin, Range, params};
+use crate::factory::textures::{TextureCache, optional_spectrum_texture};
+use crate::params::Params;
+use crate::registry::{Origin, ParamSpec, Plugin, Range, params};
 use prism_core::bsdf::{Bsdf, Dielectric, RoughDielectric, ThinDielectric};
+use prism_core::error::Result;
+use prism_core::spectrum::ior::RelativeIor;
+use prism_core::texture::Texture;
 
 pub(super) const DIELECTRIC: Plugin<Build> = Plugin {
     name: "dielectric",
     origin: Origin::Mitsuba3,
     summary: "A smooth interface between two dielectrics (glass, water), from both sides. \
               Behind a dispersive index each wavelength refracts its own way.",
-    params: &[
-        INT_IOR,
-        EXT_IOR,
-        SPECULAR_REFLECTANCE,
-        SPECULAR_TRANSMITTANCE,
-    ],
+    params: SMOOTH_INTERFACE,
     build: |params, t| {
+        let (eta, specular_reflectance, specular_transmittance) = smooth_interface(params, t)?;
         Ok(Bsdf::Dielectric(Dielectric {
-            eta: relative_ior(params, &INT_IOR, false)?,
-            specular_reflectance: optional_spectrum_texture(params, &SPECULAR_REFLECTANCE, t)?,
-            specular_transmittance: optional_spectrum_texture(params, &SPECULAR_TRANSMITTANCE, t)?,
+            eta,
+            specular_reflectance,
+            specular_transmittance,
         }))
     },
 };
@@ -56,21 +56,37 @@ pub(super) const THINDIELECTRIC: Plugin<Build> = Plugin {
     origin: Origin::Mitsuba3,
     summary: "A thin pane of glass: reflects R' = 2R/(1 + R) and lets the rest through \
               undeflected.",
-    params: &[
-        INT_IOR,
-        EXT_IOR,
-        SPECULAR_REFLECTANCE,
-        SPECULAR_TRANSMITTANCE,
-    ],
+    params: SMOOTH_INTERFACE,
     build: |params, t| {
+        let (eta, specular_reflectance, specular_transmittance) = smooth_interface(params, t)?;
         Ok(Bsdf::ThinDielectric(ThinDielectric {
-            eta: relative_ior(params, &INT_IOR, false)?,
-            specular_reflectance: optional_spectrum_texture(params, &SPECULAR_REFLECTANCE, t)?,
-            specular_transmittance: optional_spectrum_texture(params, &SPECULAR_TRANSMITTANCE, t)?,
+            eta,
+            specular_reflectance,
+            specular_transmittance,
         }))
     },
 };
 
 params! {
     SPECULAR_TRANSMITTANCE = colour("specular_transmittance", Range::Albedo, 1.0, "a factor on the transmitted light");
+}
+
+/// The parameters of a smooth interface (`dielectric`, `thindielectric`).
+const SMOOTH_INTERFACE: &[ParamSpec] = &[
+    INT_IOR,
+    EXT_IOR,
+    SPECULAR_REFLECTANCE,
+    SPECULAR_TRANSMITTANCE,
+];
+
+/// The relative index and the specular factors of a smooth interface.
+fn smooth_interface(
+    params: &Params,
+    t: &mut TextureCache,
+) -> Result<(RelativeIor, Option<Texture>, Option<Texture>)> {
+    Ok((
+        relative_ior(params, &INT_IOR, false)?,
+        optional_spectrum_texture(params, &SPECULAR_REFLECTANCE, t)?,
+        optional_spectrum_texture(params, &SPECULAR_TRANSMITTANCE, t)?,
+    ))
 }

@@ -12,18 +12,29 @@ use crate::registry::{Bounds, Default, Origin, ParamKind, ParamSpec, Plugin, par
 use prism_core::bsdf::{Bsdf, Plastic, PolarizedPlastic, RoughPlastic};
 use prism_core::error::{Error, Result};
 
+/// The parameters of a coated BSDF: the base, the coating's indices and its specular factor,
+/// then its own.
+macro_rules! coating_params {
+    [$($own:expr),* $(,)?] => {
+        &[
+            DIFFUSE_REFLECTANCE,
+            COATING_INT_IOR,
+            EXT_IOR,
+            SPECULAR_REFLECTANCE,
+            $($own,)*
+        ]
+    };
+}
+
+/// The parameters of `plastic`.
+const PLASTIC_PARAMS: &[ParamSpec] = coating_params![NONLINEAR];
+
 pub(super) const PLASTIC: Plugin<Build> = Plugin {
     name: "plastic",
     origin: Origin::Mitsuba3,
     summary: "A diffuse base under a smooth dielectric coating (Weidlich & Wilkie 2007). \
               One-sided.",
-    params: &[
-        DIFFUSE_REFLECTANCE,
-        COATING_INT_IOR,
-        EXT_IOR,
-        SPECULAR_REFLECTANCE,
-        NONLINEAR,
-    ],
+    params: PLASTIC_PARAMS,
     build: |params, t| {
         let eta = constant_relative_ior(params, false)?;
         Ok(Bsdf::Plastic(Plastic::new(
@@ -40,17 +51,13 @@ pub(super) const ROUGHPLASTIC: Plugin<Build> = Plugin {
     origin: Origin::Mitsuba3,
     summary: "A diffuse base under a rough dielectric coating, with Mitsuba 3's tabulated \
               coating transmittance. One-sided.",
-    params: &[
-        DIFFUSE_REFLECTANCE,
-        COATING_INT_IOR,
-        EXT_IOR,
-        SPECULAR_REFLECTANCE,
+    params: coating_params![
         NONLINEAR,
         DISTRIBUTION,
         PLASTIC_ALPHA,
         ALPHA_U,
         ALPHA_V,
-        SAMPLE_VISIBLE,
+        SAMPLE_VISIBLE
     ],
     build: build_roughplastic,
 };

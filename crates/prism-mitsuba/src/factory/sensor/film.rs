@@ -15,6 +15,27 @@ use prism_core::image::Channels;
 use prism_core::scene::FilmSettings;
 use prism_core::spectrum::WavelengthSampling;
 
+/// The parameters of a film: the size and crop window every film takes, its own `[format]`
+/// parameters, the filter and reconstruction every film takes, and its own `[after]`.
+macro_rules! film_params {
+    ([$($format:expr),*], [$($after:expr),*]) => {
+        &[
+            WIDTH,
+            HEIGHT,
+            CROP_OFFSET_X,
+            CROP_OFFSET_Y,
+            CROP_WIDTH,
+            CROP_HEIGHT,
+            $($format,)*
+            RFILTER,
+            RECONSTRUCTION,
+            WAVELENGTH_SAMPLING,
+            BANNER,
+            $($after,)*
+        ]
+    };
+}
+
 type FilmBuild = fn(&Params) -> Result<(FilmSettings, LdrOutput)>;
 
 pub static FILMS: Registry<FilmBuild> = Registry {
@@ -25,24 +46,10 @@ pub static FILMS: Registry<FilmBuild> = Registry {
             origin: Origin::Mitsuba3,
             summary: "A high dynamic range film; Prism writes it as 32-bit OpenEXR (RGB, XYZ, per-pixel \
                       variance and relative error) and an sRGB PNG.",
-            params: &[
-                WIDTH,
-                HEIGHT,
-                CROP_OFFSET_X,
-                CROP_OFFSET_Y,
-                CROP_WIDTH,
-                CROP_HEIGHT,
-                FILE_FORMAT,
-                PIXEL_FORMAT,
-                COMPONENT_FORMAT,
-                RFILTER,
-                RECONSTRUCTION,
-                WAVELENGTH_SAMPLING,
-                BANNER,
-                ATTACH_LOG,
-                HIGH_QUALITY_EDGES,
-                HDR_GAMMA,
-            ],
+            params: film_params!(
+                [FILE_FORMAT, PIXEL_FORMAT, COMPONENT_FORMAT],
+                [ATTACH_LOG, HIGH_QUALITY_EDGES, HDR_GAMMA]
+            ),
             build: build_hdrfilm,
         },
         Plugin {
@@ -50,26 +57,18 @@ pub static FILMS: Registry<FilmBuild> = Registry {
             origin: Origin::Mitsuba06,
             summary: "Mitsuba 0.6's low dynamic range film: Prism writes its usual OpenEXR and, in \
                       place of the sRGB PNG, the 8-bit PNG or JPEG tonemapped as the film asks.",
-            params: &[
-                WIDTH,
-                HEIGHT,
-                CROP_OFFSET_X,
-                CROP_OFFSET_Y,
-                CROP_WIDTH,
-                CROP_HEIGHT,
-                LDR_FILE_FORMAT,
-                LDR_PIXEL_FORMAT,
-                TONEMAP_METHOD,
-                LDR_GAMMA,
-                EXPOSURE,
-                KEY,
-                BURN,
-                RFILTER,
-                RECONSTRUCTION,
-                WAVELENGTH_SAMPLING,
-                BANNER,
-                HIGH_QUALITY_EDGES,
-            ],
+            params: film_params!(
+                [
+                    LDR_FILE_FORMAT,
+                    LDR_PIXEL_FORMAT,
+                    TONEMAP_METHOD,
+                    LDR_GAMMA,
+                    EXPOSURE,
+                    KEY,
+                    BURN
+                ],
+                [HIGH_QUALITY_EDGES]
+            ),
             build: build_ldrfilm,
         },
     ],

@@ -24,12 +24,12 @@ mod groups;
 mod meshes;
 mod quadrics;
 
-use crate::description::{PluginClass, PluginNode};
+use crate::description::{NestedPlugin, PluginClass, PluginNode};
 use crate::params::Params;
 use crate::registry::{Default, ParamKind, ParamSpec, Plugin, Registry, params};
 pub use groups::{GROUP_SHAPES, INSTANCE_GROUP, INSTANCE_TO_WORLD};
 pub use meshes::{cube, rectangle, transform_mesh};
-use prism_core::error::Result;
+use prism_core::error::{Error, Result};
 use prism_core::geometry::{Instance, Primitive, Shape};
 use prism_core::math::Transform;
 
@@ -96,4 +96,20 @@ pub fn build_shape(plugin: &Plugin<Build>, params: &Params) -> Result<Primitive>
         return Ok(Primitive::Instance(Instance::new(shape, to_world)));
     }
     (plugin.build)(params, to_world.first()).map(Primitive::Shape)
+}
+
+/// Checks that a built shape's area is a finite number (a degenerate transform or vertices
+/// make it infinite or NaN).
+pub fn check_area(area: f32, shape: &NestedPlugin) -> Result<()> {
+    if area.is_finite() {
+        return Ok(());
+    }
+    Err(Error::input(
+        &shape.location,
+        format!(
+            "the area of {} is not a finite number",
+            shape.node.describe()
+        ),
+    )
+    .with_help("fix the shape's transform or its vertices"))
 }
