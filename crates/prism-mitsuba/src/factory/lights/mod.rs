@@ -1,11 +1,12 @@
 //! Emitter plugins: `area` (nested in a shape, or declared with an id and referenced from one),
-//! and at the top level of the scene `point`, `spot`, `projector`, `directional`, `constant`,
-//! `envmap` and `sunsky` (see each light's module in [`prism_core::light`] for its parameters). Emission may be given as `<rgb>` (an illuminant: the upsampled colour
-//! times D65), `<float>` (D65 scaled), `<spectrum>` (as written) or a nested
-//! `<spectrum type="blackbody">` with a `temperature` in kelvin; an area emitter's radiance may
-//! also be a `<texture>` (as a projector's `irradiance` and a spot's `texture`), whose colours
-//! are upsampled as reflectances are, without the D65 factor of an `<rgb>` radiance (as
-//! Mitsuba 3 reads them).
+//! and at the top level of the scene `point`, `spot`, `projector` and `directional` (module
+//! `delta`), and `constant`, `envmap` and `sunsky` (module `environment`); see each light's
+//! module in [`prism_core::light`] for its parameters. Emission may be given as `<rgb>` (an
+//! illuminant: the upsampled colour times D65), `<float>` (D65 scaled), `<spectrum>` (as
+//! written) or a nested `<spectrum type="blackbody">` with a `temperature` in kelvin; an area
+//! emitter's radiance may also be a `<texture>` (as a projector's `irradiance` and a spot's
+//! `texture`), whose colours are upsampled as reflectances are, without the D65 factor of an
+//! `<rgb>` radiance (as Mitsuba 3 reads them).
 
 mod area;
 mod delta;

@@ -61,11 +61,8 @@ pub(super) const PRINCIPLEDTHIN: Plugin<Build> = Plugin {
     build: build_principledthin,
 };
 
-params! {
-    BASE_COLOR = colour("base_color", Range::Albedo, 0.5, "the colour c");
-}
-
-pub(super) const fn weight(name: &'static str, default: f64, doc: &'static str) -> ParamSpec {
+/// A weight in [0, 1], or a texture of them.
+const fn weight(name: &'static str, default: f64, doc: &'static str) -> ParamSpec {
     ParamSpec::new(
         name,
         ParamKind::FloatTexture(Bounds::UNIT),
@@ -74,7 +71,13 @@ pub(super) const fn weight(name: &'static str, default: f64, doc: &'static str) 
     )
 }
 
+/// A relative sampling rate, 1 by default.
+const fn sampling_rate(name: &'static str, doc: &'static str) -> ParamSpec {
+    ParamSpec::new(name, ParamKind::Float, Default::Float(1.0), doc)
+}
+
 params! {
+    BASE_COLOR = colour("base_color", Range::Albedo, 0.5, "the colour c");
     ROUGHNESS = weight("roughness", 0.5, "roughness of the main specular lobes (α = roughness²)");
     ANISOTROPIC = weight("anisotropic", 0.0, "degree of anisotropy: α_u/α_v = 1/(1 − 0.9·anisotropic)");
     METALLIC = weight("metallic", 0.0, "blend from dielectric (0) to metal (1)");
@@ -87,13 +90,6 @@ params! {
     FLATNESS = weight("flatness", 0.0, "blend from the diffuse lobe to Hanrahan–Krueger's fake subsurface");
     CLEARCOAT = weight("clearcoat", 0.0, "weight of the clearcoat lobe");
     CLEARCOAT_GLOSS = weight("clearcoat_gloss", 0.0, "gloss of the clearcoat: α from 0.1 (0) to 0.001 (1)");
-}
-
-const fn sampling_rate(name: &'static str, doc: &'static str) -> ParamSpec {
-    ParamSpec::new(name, ParamKind::Float, Default::Float(1.0), doc)
-}
-
-params! {
     DIFFUSE_SAMPLING_RATE = sampling_rate("diffuse_reflectance_sampling_rate", "relative rate of sampling the diffuse lobe");
     MAIN_SPECULAR_SAMPLING_RATE = sampling_rate("main_specular_sampling_rate", "relative rate of sampling the main specular lobes");
     CLEARCOAT_SAMPLING_RATE = sampling_rate("clearcoat_sampling_rate", "relative rate of sampling the clearcoat");

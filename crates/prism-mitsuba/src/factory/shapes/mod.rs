@@ -1,8 +1,8 @@
-//! Shape plugins: `obj`, `ply`, `serialized`, `rectangle`, `cube`, `sphere`, `disk`,
-//! `cylinder`, `linearcurve` and `bsplinecurve`, and the instancing plugins `shapegroup` and `instance` (built by the scene,
-//! [`super::instancing`]). Any shape whose
-//! `to_world` is an `<animation>` moves while the shutter is open: it is built in object space
-//! and placed by an [`Instance`].
+//! Shape plugins: triangle meshes (`obj`, `ply`, `serialized`, `rectangle`, `cube`), quadrics
+//! (`sphere`, `disk`, `cylinder`), curves (`linearcurve`, `bsplinecurve`), and the entries of the
+//! instancing plugins `shapegroup` and `instance`, which the scene builds
+//! ([`super::instancing`]). Any shape whose `to_world` is an `<animation>` moves while the
+//! shutter is open: it is built in object space and placed by an [`Instance`].
 
 /// The parameters of a shape: its own, then those every shape takes (`to_world`, `bsdf`,
 /// `emitter`, `interior` and `exterior`).
