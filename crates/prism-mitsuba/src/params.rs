@@ -13,7 +13,7 @@ use std::fmt;
 use glam::{DMat4, DVec3};
 
 use crate::description::{NestedPlugin, PluginNode, Property, PropertyValue};
-use crate::registry::{Default, ParamKind, ParamSpec};
+use crate::registry::{Choice, Default, ParamKind, ParamSpec};
 use crate::suggest::closest_match;
 use prism_core::error::{Error, Result, SourceLocation};
 use prism_core::math::{AnimatedTransform, Transform};
@@ -189,25 +189,28 @@ impl<'a> Params<'a> {
         Ok(self.string_opt(spec)?.unwrap_or(default))
     }
 
-    /// One of the strings `spec` declares (compared ignoring ASCII case), or its default; the
-    /// declared spelling.
-    pub fn choice(&self, spec: &ParamSpec) -> Result<&'static str> {
+    /// The value of the option `spec` declares that the scene names (compared ignoring ASCII
+    /// case), or of its default.
+    pub fn choice<T: Copy + 'static>(&self, spec: &ParamSpec) -> Result<T> {
         let ParamKind::Choice(choices) = spec.kind else {
             panic!("\"{}\" is not a choice", spec.name);
         };
         let value = self.string(spec)?;
-        if let Some(choice) = choices.iter().find(|c| c.eq_ignore_ascii_case(value)) {
-            return Ok(choice);
-        }
-        Err(Error::input(
-            self.location_of(spec),
-            format!(
-                "unknown value \"{value}\" for parameter \"{}\" of {}",
-                spec.name,
-                self.node.describe()
-            ),
-        )
-        .with_help(format!("use one of: {}", choices.join(", "))))
+        let Some(choice) = choices.iter().find(|c| c.name.eq_ignore_ascii_case(value)) else {
+            return Err(Error::input(
+                self.location_of(spec),
+                format!(
+                    "unknown value \"{value}\" for parameter \"{}\" of {}",
+                    spec.name,
+                    self.node.describe()
+                ),
+            )
+            .with_help(format!("use one of: {}", Choice::names(choices).join(", "))));
+        };
+        let Some(selected) = choice.value.downcast_ref::<T>() else {
+            panic!("the options of \"{}\" select another type", spec.name);
+        };
+        Ok(*selected)
     }
 
     /// A transform, if present.
@@ -276,9 +279,19 @@ impl<'a> Params<'a> {
         }
     }
 
-    /// A float that must lie in `[min, max]` (inclusive), or its default; an error names the
-    /// range otherwise.
-    pub fn float_in(&self, spec: &ParamSpec, default: f64, min: f64, max: f64) -> Result<f64> {
+    /// A float within the bounds `spec` declares (inclusive), or its declared default.
+    pub fn float_in(&self, spec: &ParamSpec) -> Result<f64> {
+        let (ParamKind::FloatIn(bounds), Default::Float(default)) = (spec.kind, spec.default)
+        else {
+            panic!("\"{}\" is not a bounded float with a default", spec.name);
+        };
+        assert!(!bounds.min_exclusive, "\"{}\" has an open bound", spec.name);
+        self.float_between(spec, default, f64::from(bounds.min), f64::from(bounds.max))
+    }
+
+    /// A float in `[min, max]`, or `default` when absent (for a parameter whose default and
+    /// range depend on another's value); an error names the range otherwise.
+    pub fn float_between(&self, spec: &ParamSpec, default: f64, min: f64, max: f64) -> Result<f64> {
         let value = self.float_opt(spec)?.unwrap_or(default);
         if !(value >= min && value <= max) {
             return Err(Error::input(

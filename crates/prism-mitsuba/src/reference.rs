@@ -51,19 +51,19 @@ pub fn reference() -> Vec<ClassReference> {
         (
             PluginClass::Film,
             "Where the image forms; a film nests its `rfilter`.",
-            entries(&crate::factory::sensor::FILMS),
+            entries(&crate::factory::sensor::film::FILMS),
         ),
         (
             PluginClass::Rfilter,
             "Reconstruction filters (of the film, and of the shutter's time). Offsets are drawn with \
              p ∝ |k(x)k(y)| and weighted k/p with its sign, so negative lobes are kept; pixels \
              divide by the sample count.",
-            entries(&crate::factory::sensor::RFILTERS),
+            entries(&crate::factory::sensor::rfilter::RFILTERS),
         ),
         (
             PluginClass::Sampler,
             "Per-pixel samplers of the primary dimensions (wavelength, time, film position, lens).",
-            entries(&crate::factory::sensor::SAMPLERS),
+            entries(&crate::factory::sensor::sampler::SAMPLERS),
         ),
         (
             PluginClass::Shape,

@@ -7,6 +7,8 @@
 //! plugin reference `docs/plugins.md` is generated from the same tables ([`plugins_markdown`];
 //! a test fails when the file is stale).
 
+use std::any::Any;
+
 use crate::description::{PluginClass, PluginNode};
 use crate::suggest::closest_match;
 use prism_core::error::{Error, Result};
@@ -55,8 +57,10 @@ pub enum ParamKind {
     Integer,
     Boolean,
     String,
-    /// One of these strings.
-    Choice(&'static [&'static str]),
+    /// A float within `Bounds`.
+    FloatIn(Bounds),
+    /// One of these strings, each selecting its value.
+    Choice(&'static [Choice]),
     /// A `<transform>`.
     Transform,
     /// A `<transform>` or, for motion, an `<animation>` of them.
@@ -88,7 +92,8 @@ impl ParamKind {
             ParamKind::Integer => "integer".into(),
             ParamKind::Boolean => "boolean".into(),
             ParamKind::String => "string".into(),
-            ParamKind::Choice(choices) => format!("string: {}", choices.join(", ")),
+            ParamKind::FloatIn(bounds) => format!("float, {}", bounds.describe()),
+            ParamKind::Choice(choices) => format!("string: {}", Choice::names(choices).join(", ")),
             ParamKind::Transform => "transform".into(),
             ParamKind::AnimatedTransform => "transform or animation".into(),
             ParamKind::Point => "point".into(),
@@ -118,7 +123,45 @@ impl ParamKind {
     }
 }
 
-/// The values a number may take: at least (or, `min_exclusive`, above) `min`, at most `max`.
+/// One option of a choice parameter: the name a scene gives and the value it selects (`()`
+/// for an option that is accepted and means nothing to Prism).
+#[derive(Clone, Copy, Debug)]
+pub struct Choice {
+    pub name: &'static str,
+    pub value: &'static (dyn Any + Send + Sync),
+}
+
+impl Choice {
+    /// The option called `name`, which selects `value`.
+    pub const fn new<T: Any + Send + Sync>(name: &'static str, value: &'static T) -> Choice {
+        Choice { name, value }
+    }
+
+    /// Options that Prism accepts and ignores (each selects `()`).
+    pub const fn accepted<const N: usize>(names: [&'static str; N]) -> [Choice; N] {
+        let mut choices = [Choice::new("", &()); N];
+        let mut i = 0;
+        while i < N {
+            choices[i] = Choice::new(names[i], &());
+            i += 1;
+        }
+        choices
+    }
+
+    /// The options' names, in their order.
+    pub fn names(choices: &[Choice]) -> Vec<&'static str> {
+        choices.iter().map(|c| c.name).collect()
+    }
+}
+
+impl PartialEq for Choice {
+    fn eq(&self, other: &Choice) -> bool {
+        self.name == other.name
+    }
+}
+
+/// The values a number may take: at least (or, `min_exclusive`, above) `min`, at most `max`
+/// (`f32::MAX`: any finite number).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Bounds {
     pub min: f32,
@@ -145,11 +188,22 @@ impl Bounds {
         min_exclusive: false,
         max: 1.0,
     };
+    /// At least 0 and finite.
+    pub const FINITE_NON_NEGATIVE: Bounds = Bounds::between(0.0, f32::MAX);
+
+    /// In [min, max].
+    pub const fn between(min: f32, max: f32) -> Bounds {
+        Bounds {
+            min,
+            min_exclusive: false,
+            max,
+        }
+    }
 
     /// "in [0, 1]", "greater than 0", ...
     pub fn describe(&self) -> String {
         let (min, max) = (self.min, self.max);
-        match (self.min_exclusive, max.is_finite()) {
+        match (self.min_exclusive, max < f32::MAX) {
             (true, true) => format!("in ({min}, {max}]"),
             (true, false) => format!("greater than {min}"),
             (false, true) => format!("in [{min}, {max}]"),
@@ -243,6 +297,16 @@ impl ParamSpec {
         }
     }
 }
+
+/// Declares parameters one a line, `NAME = spec;` each a `const` [`ParamSpec`], so that a
+/// plugin's parameters read as a table: name, kind (with its bounds or options), default and
+/// meaning.
+macro_rules! params {
+    ($($(#[$attr:meta])* $vis:vis $name:ident = $spec:expr;)*) => {
+        $($(#[$attr])* $vis const $name: $crate::registry::ParamSpec = $spec;)*
+    };
+}
+pub(crate) use params;
 
 /// A plugin: its name in scene files, where it comes from, what it is, its parameters and the
 /// function that builds it (whose type depends on the class).

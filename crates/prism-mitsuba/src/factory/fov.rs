@@ -3,28 +3,15 @@
 //! Mitsuba 3's `parse_fov` reads them, as a horizontal angle for an image of a given aspect.
 
 use crate::params::Params;
-use crate::registry::{Default, ParamKind, ParamSpec};
+use crate::registry::{Choice, Default, ParamKind, ParamSpec, params};
 use prism_core::camera::perspective::{FovAxis, focal_length_to_diagonal_fov, horizontal_fov};
 use prism_core::error::{Error, Result};
 
-pub const FOV: ParamSpec = ParamSpec::new(
-    "fov",
-    ParamKind::Float,
-    Default::Text("from `focal_length`"),
-    "field of view in degrees, along `fov_axis`",
-);
-pub const FOV_AXIS: ParamSpec = ParamSpec::new(
-    "fov_axis",
-    ParamKind::Choice(&["x", "y", "diagonal", "smaller", "larger"]),
-    Default::Str("x"),
-    "the film axis `fov` is measured along",
-);
-pub const FOCAL_LENGTH: ParamSpec = ParamSpec::new(
-    "focal_length",
-    ParamKind::String,
-    Default::Str("50mm"),
-    "the field of view as the focal length of a lens on 35 mm film (diagonal); instead of `fov`",
-);
+params! {
+    pub FOV = ParamSpec::new("fov", ParamKind::Float, Default::Text("from `focal_length`"), "field of view in degrees, along `fov_axis`");
+    pub FOV_AXIS = ParamSpec::new("fov_axis", ParamKind::Choice(&[Choice::new("x", &FovAxis::X), Choice::new("y", &FovAxis::Y), Choice::new("diagonal", &FovAxis::Diagonal), Choice::new("smaller", &FovAxis::Smaller), Choice::new("larger", &FovAxis::Larger)]), Default::Str("x"), "the film axis `fov` is measured along");
+    pub FOCAL_LENGTH = ParamSpec::new("focal_length", ParamKind::String, Default::Str("50mm"), "the field of view as the focal length of a lens on 35 mm film (diagonal); instead of `fov`");
+}
 /// The horizontal field of view in degrees, strictly between 0 and 180, of an image of
 /// `aspect` = width / height.
 pub fn horizontal_fov_param(params: &Params, aspect: f64) -> Result<f64> {
@@ -35,16 +22,7 @@ pub fn horizontal_fov_param(params: &Params, aspect: f64) -> Result<f64> {
                 "give either \"fov\" or \"focal_length\", not both",
             ));
         }
-        (Some(fov), None) => {
-            let axis = match params.choice(&FOV_AXIS)? {
-                "y" => FovAxis::Y,
-                "diagonal" => FovAxis::Diagonal,
-                "smaller" => FovAxis::Smaller,
-                "larger" => FovAxis::Larger,
-                _ => FovAxis::X,
-            };
-            horizontal_fov(fov, axis, aspect)
-        }
+        (Some(fov), None) => horizontal_fov(fov, params.choice(&FOV_AXIS)?, aspect),
         (None, focal_length) => {
             let text = focal_length.unwrap_or("50mm");
             let mm: f64 = text

@@ -70,16 +70,7 @@ impl ShapeGroups {
                     .with_help("animate the instances' to_world instead"));
                 }
             };
-            if !shape.area().is_finite() {
-                return Err(Error::input(
-                    &child.location,
-                    format!(
-                        "the area of {} is not a finite number",
-                        child.node.describe()
-                    ),
-                )
-                .with_help("fix the shape's transform or its vertices"));
-            }
+            shapes::check_area(shape.area(), child)?;
             if let Some(emitter) = shape_params.single_child(&shapes::EMITTER)? {
                 return Err(Error::input(
                     &emitter.location,

@@ -4,7 +4,7 @@
 
 use crate::description::{PluginClass, PluginNode};
 use crate::params::Params;
-use crate::registry::{Default, Origin, ParamKind, ParamSpec, Plugin, Registry};
+use crate::registry::{Choice, Default, Origin, ParamKind, ParamSpec, Plugin, Registry, params};
 use crate::suggest::closest_match;
 use prism_core::error::{Error, Result, SourceLocation};
 use prism_core::film::output::IMAGE_CHANNELS;
@@ -117,106 +117,24 @@ pub static INTEGRATORS: Registry<Build> = Registry {
     ],
 };
 
-const MAX_DEPTH: ParamSpec = ParamSpec::new(
-    "max_depth",
-    ParamKind::Integer,
-    Default::Integer(-1),
-    "longest path: −1 unbounded, 1 emitters only, 2 direct light",
-);
-const RR_DEPTH: ParamSpec = ParamSpec::new(
-    "rr_depth",
-    ParamKind::Integer,
-    Default::Integer(5),
-    "depth from which Russian roulette may end paths",
-);
-const HIDE_EMITTERS: ParamSpec = ParamSpec::new(
-    "hide_emitters",
-    ParamKind::Boolean,
-    Default::Boolean(false),
-    "leave emitters seen directly by the camera black",
-);
-const EMITTER_SAMPLING: ParamSpec = ParamSpec::new(
-    "emitter_sampling",
-    ParamKind::Choice(&LightSelection::NAMES),
-    Default::Str("exhaustive"),
-    "Prism only (Mitsuba rejects it): one light per shading point chosen ∝ its importance \
-     there (power × `sampling_weight` over squared distance, times the receiver's cosine \
-     bound; pbrt-v4's `exhaustive`), ∝ its power × `sampling_weight` everywhere alike (the \
-     lecture's), or ∝ `sampling_weight` alone (Mitsuba's rule; uniform by default)",
-);
-const USE_SPECTRAL_MIS: ParamSpec = ParamSpec::new(
-    "use_spectral_mis",
-    ParamKind::Boolean,
-    Default::Boolean(true),
-    "combine the four wavelengths' free-flight densities by MIS; false weights every \
-     wavelength by the hero's densities alone",
-);
-const STRICT_NORMALS: ParamSpec = ParamSpec::new(
-    "strict_normals",
-    ParamKind::Boolean,
-    Default::Boolean(false),
-    "Mitsuba 0.6 (`strictNormals`; Mitsuba 3 has none): end paths at directions the geometric \
-     and shading normals put on different sides",
-);
-const SHADING_SAMPLES: ParamSpec = ParamSpec::new(
-    "shading_samples",
-    ParamKind::Integer,
-    Default::Integer(1),
-    "sets both emitter_samples and bsdf_samples (not with either of them)",
-);
-const EMITTER_SAMPLES: ParamSpec = ParamSpec::new(
-    "emitter_samples",
-    ParamKind::Integer,
-    Default::Text("shading_samples"),
-    "light samples per camera ray",
-);
-const BSDF_SAMPLES: ParamSpec = ParamSpec::new(
-    "bsdf_samples",
-    ParamKind::Integer,
-    Default::Text("shading_samples"),
-    "BSDF samples per camera ray",
-);
-const NESTED_INTEGRATORS: ParamSpec = ParamSpec::nested(
-    PluginClass::Integrator,
-    Default::Required,
-    "the integrators whose moments are recorded (at least one), in order",
-);
-const NESTED_IMAGE_INTEGRATORS: ParamSpec = ParamSpec::nested(
-    PluginClass::Integrator,
-    Default::Text("none (a black image)"),
-    "the integrators whose images are written beside the variables, in order",
-);
-const AOVS: ParamSpec = ParamSpec::new(
-    "aovs",
-    ParamKind::String,
-    Default::Required,
-    "comma-separated name:type pairs, e.g. \"dd.y:depth,nn:sh_normal,alb:albedo\"",
-);
-const BOUNCE_SAMPLES: ParamSpec = ParamSpec::new(
-    "bounce_samples",
-    ParamKind::Integer,
-    Default::Integer(4),
-    "bounce samples at potential 1 (1 to 1024)",
-);
-const SHADOW_RAYS: ParamSpec = ParamSpec::new(
-    "shadow_rays",
-    ParamKind::Integer,
-    Default::Integer(4),
-    "shadow rays per light at potential 1 (1 to 1024)",
-);
-const LIGHTS: ParamSpec = ParamSpec::new(
-    "lights",
-    ParamKind::Choice(&["exhaustive", "power", "uniform", "all"]),
-    Default::Str("exhaustive"),
-    "one light per vertex chosen ∝ its importance there, ∝ power or uniformly (as the path \
-     integrator's `emitter_sampling`), or every light",
-);
-const RR_THRESHOLD: ParamSpec = ParamSpec::new(
-    "rr_threshold",
-    ParamKind::Float,
-    Default::Float(0.1),
-    "potential below which Russian roulette starts",
-);
+params! {
+    MAX_DEPTH = ParamSpec::new("max_depth", ParamKind::Integer, Default::Integer(-1), "longest path: −1 unbounded, 1 emitters only, 2 direct light");
+    RR_DEPTH = ParamSpec::new("rr_depth", ParamKind::Integer, Default::Integer(5), "depth from which Russian roulette may end paths");
+    HIDE_EMITTERS = ParamSpec::new("hide_emitters", ParamKind::Boolean, Default::Boolean(false), "leave emitters seen directly by the camera black");
+    EMITTER_SAMPLING = ParamSpec::new("emitter_sampling", ParamKind::Choice(&[Choice::new("exhaustive", &LightSelection::Exhaustive), Choice::new("power", &LightSelection::Power), Choice::new("uniform", &LightSelection::Uniform)]), Default::Str("exhaustive"), "Prism only (Mitsuba rejects it): one light per shading point chosen ∝ its importance there (power × `sampling_weight` over squared distance, times the receiver's cosine bound; pbrt-v4's `exhaustive`), ∝ its power × `sampling_weight` everywhere alike (the lecture's), or ∝ `sampling_weight` alone (Mitsuba's rule; uniform by default)");
+    USE_SPECTRAL_MIS = ParamSpec::new("use_spectral_mis", ParamKind::Boolean, Default::Boolean(true), "combine the four wavelengths' free-flight densities by MIS; false weights every wavelength by the hero's densities alone");
+    STRICT_NORMALS = ParamSpec::new("strict_normals", ParamKind::Boolean, Default::Boolean(false), "Mitsuba 0.6 (`strictNormals`; Mitsuba 3 has none): end paths at directions the geometric and shading normals put on different sides");
+    SHADING_SAMPLES = ParamSpec::new("shading_samples", ParamKind::Integer, Default::Integer(1), "sets both emitter_samples and bsdf_samples (not with either of them)");
+    EMITTER_SAMPLES = ParamSpec::new("emitter_samples", ParamKind::Integer, Default::Text("shading_samples"), "light samples per camera ray");
+    BSDF_SAMPLES = ParamSpec::new("bsdf_samples", ParamKind::Integer, Default::Text("shading_samples"), "BSDF samples per camera ray");
+    NESTED_INTEGRATORS = ParamSpec::nested(PluginClass::Integrator, Default::Required, "the integrators whose moments are recorded (at least one), in order");
+    NESTED_IMAGE_INTEGRATORS = ParamSpec::nested(PluginClass::Integrator, Default::Text("none (a black image)"), "the integrators whose images are written beside the variables, in order");
+    AOVS = ParamSpec::new("aovs", ParamKind::String, Default::Required, "comma-separated name:type pairs, e.g. \"dd.y:depth,nn:sh_normal,alb:albedo\"");
+    BOUNCE_SAMPLES = ParamSpec::new("bounce_samples", ParamKind::Integer, Default::Integer(4), "bounce samples at potential 1 (1 to 1024)");
+    SHADOW_RAYS = ParamSpec::new("shadow_rays", ParamKind::Integer, Default::Integer(4), "shadow rays per light at potential 1 (1 to 1024)");
+    LIGHTS = ParamSpec::new("lights", ParamKind::Choice(&[Choice::new("exhaustive", &DirectLights::One(LightSelection::Exhaustive)), Choice::new("power", &DirectLights::One(LightSelection::Power)), Choice::new("uniform", &DirectLights::One(LightSelection::Uniform)), Choice::new("all", &DirectLights::All)]), Default::Str("exhaustive"), "one light per vertex chosen ∝ its importance there, ∝ power or uniformly (as the path integrator's `emitter_sampling`), or every light");
+    RR_THRESHOLD = ParamSpec::new("rr_threshold", ParamKind::Float, Default::Float(0.1), "potential below which Russian roulette starts");
+}
 
 /// Builds the integrator a node describes.
 pub fn build_integrator(node: &PluginNode) -> Result<Integrator> {
@@ -287,8 +205,7 @@ fn path_settings(params: &Params) -> Result<PathIntegrator> {
             format!("rr_depth must be at least 1, not {rr_depth}"),
         ));
     }
-    let light_selection = LightSelection::from_name(params.choice(&EMITTER_SAMPLING)?)
-        .expect("the parameter's choices are the selections' names");
+    let light_selection = params.choice(&EMITTER_SAMPLING)?;
     Ok(PathIntegrator {
         max_depth,
         rr_depth: rr_depth as i32,
@@ -488,12 +405,7 @@ fn build_volpathmis(params: &Params) -> Result<Integrator> {
 }
 
 fn build_distrib(params: &Params) -> Result<Integrator> {
-    let lights = match params.choice(&LIGHTS)? {
-        "all" => DirectLights::All,
-        name => DirectLights::One(
-            LightSelection::from_name(name).expect("the parameter's choices name selections"),
-        ),
-    };
+    let lights = params.choice(&LIGHTS)?;
     let rr_threshold = params.float(&RR_THRESHOLD)?;
     if !(rr_threshold > 0.0 && rr_threshold.is_finite()) {
         return Err(Error::input(

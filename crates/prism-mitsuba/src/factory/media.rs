@@ -7,7 +7,9 @@ use glam::DMat4;
 use super::spectra::spectrum_param;
 use crate::description::{PluginClass, PluginNode, PropertyValue};
 use crate::params::Params;
-use crate::registry::{Default, Origin, ParamKind, ParamSpec, Plugin, Range, Registry};
+use crate::registry::{
+    Bounds, Choice, Default, Origin, ParamKind, ParamSpec, Plugin, Range, Registry, params,
+};
 use prism_core::error::{Error, Result};
 use prism_core::math::Transform;
 use prism_core::medium::volume::parse_vol;
@@ -104,121 +106,25 @@ pub static VOLUMES: Registry<BuildVolume> = Registry {
     ],
 };
 
-const SIGMA_T: ParamSpec = ParamSpec::new(
-    "sigma_t",
-    ParamKind::Spectrum {
-        range: Range::Coefficient,
-        textured: false,
-    },
-    Default::Float(1.0),
-    "extinction coefficient per scene unit",
-);
-const ALBEDO: ParamSpec = ParamSpec::new(
-    "albedo",
-    ParamKind::Spectrum {
-        range: Range::Albedo,
-        textured: false,
-    },
-    Default::Float(0.75),
-    "single-scattering albedo σ_s/σ_t, in [0, 1]",
-);
-const SIGMA_A: ParamSpec = ParamSpec::new(
-    "sigma_a",
-    ParamKind::Spectrum {
-        range: Range::Coefficient,
-        textured: false,
-    },
-    Default::None,
-    "Mitsuba 0.6: absorption coefficient, with `sigma_s` in place of `sigma_t` and `albedo`",
-);
-const SIGMA_S: ParamSpec = ParamSpec::new(
-    "sigma_s",
-    ParamKind::Spectrum {
-        range: Range::Coefficient,
-        textured: false,
-    },
-    Default::None,
-    "Mitsuba 0.6: scattering coefficient, with `sigma_a`",
-);
-const SIGMA_T_VOLUME: ParamSpec = ParamSpec::new(
-    "sigma_t",
-    ParamKind::Volume(Range::Coefficient),
-    Default::Float(1.0),
-    "extinction coefficient per scene unit",
-);
-const ALBEDO_VOLUME: ParamSpec = ParamSpec::new(
-    "albedo",
-    ParamKind::Volume(Range::Albedo),
-    Default::Float(0.75),
-    "single-scattering albedo σ_s/σ_t, in [0, 1]",
-);
-const SCALE: ParamSpec = ParamSpec::new(
-    "scale",
-    ParamKind::Float,
-    Default::Float(1.0),
-    "factor on the coefficients (a change of units)",
-);
-const SAMPLE_EMITTERS: ParamSpec = ParamSpec::new(
-    "sample_emitters",
-    ParamKind::Boolean,
-    Default::Boolean(true),
-    "sample lights at scattering points in the medium (next-event estimation)",
-);
-const PHASE: ParamSpec = ParamSpec::nested(
-    PluginClass::Phase,
-    Default::Text("`isotropic`"),
-    "the phase function",
-);
-const G: ParamSpec = ParamSpec::new(
-    "g",
-    ParamKind::Float,
-    Default::Float(0.8),
-    "mean cosine of the deflection, in (−1, 1): > 0 forward, < 0 backward",
-);
-const PHASE_WEIGHT: ParamSpec = ParamSpec::new(
-    "weight",
-    ParamKind::Float,
-    Default::Float(0.5),
-    "weight of the second phase function, in [0, 1]",
-);
-const BLENDED_PHASES: ParamSpec = ParamSpec::nested(
-    PluginClass::Phase,
-    Default::Required,
-    "the two phase functions",
-);
-const VALUE: ParamSpec = ParamSpec::new(
-    "value",
-    ParamKind::Spectrum {
-        range: Range::Coefficient,
-        textured: false,
-    },
-    Default::Float(1.0),
-    "the value",
-);
-const FILENAME: ParamSpec = ParamSpec::new(
-    "filename",
-    ParamKind::String,
-    Default::Required,
-    "the `.vol` file",
-);
-const FILTER_TYPE: ParamSpec = ParamSpec::new(
-    "filter_type",
-    ParamKind::Choice(&["bilinear", "nearest"]),
-    Default::Str("bilinear"),
-    "interpolation between voxels: `bilinear` (trilinear in 3D, Mitsuba's name) or `nearest`",
-);
-const VOLUME_TO_WORLD: ParamSpec = ParamSpec::new(
-    "to_world",
-    ParamKind::Transform,
-    Default::Text("identity"),
-    "from the unit cube [0, 1]³ to the world",
-);
-const USE_GRID_BBOX: ParamSpec = ParamSpec::new(
-    "use_grid_bbox",
-    ParamKind::Boolean,
-    Default::Boolean(false),
-    "place the grid in the box its file gives (then transformed by `to_world`)",
-);
+params! {
+    SIGMA_T = ParamSpec::new("sigma_t", ParamKind::Spectrum { range: Range::Coefficient, textured: false, }, Default::Float(1.0), "extinction coefficient per scene unit");
+    ALBEDO = ParamSpec::new("albedo", ParamKind::Spectrum { range: Range::Albedo, textured: false, }, Default::Float(0.75), "single-scattering albedo σ_s/σ_t, in [0, 1]");
+    SIGMA_A = ParamSpec::new("sigma_a", ParamKind::Spectrum { range: Range::Coefficient, textured: false, }, Default::None, "Mitsuba 0.6: absorption coefficient, with `sigma_s` in place of `sigma_t` and `albedo`");
+    SIGMA_S = ParamSpec::new("sigma_s", ParamKind::Spectrum { range: Range::Coefficient, textured: false, }, Default::None, "Mitsuba 0.6: scattering coefficient, with `sigma_a`");
+    SIGMA_T_VOLUME = ParamSpec::new("sigma_t", ParamKind::Volume(Range::Coefficient), Default::Float(1.0), "extinction coefficient per scene unit");
+    ALBEDO_VOLUME = ParamSpec::new("albedo", ParamKind::Volume(Range::Albedo), Default::Float(0.75), "single-scattering albedo σ_s/σ_t, in [0, 1]");
+    SCALE = ParamSpec::new("scale", ParamKind::Float, Default::Float(1.0), "factor on the coefficients (a change of units)");
+    SAMPLE_EMITTERS = ParamSpec::new("sample_emitters", ParamKind::Boolean, Default::Boolean(true), "sample lights at scattering points in the medium (next-event estimation)");
+    PHASE = ParamSpec::nested(PluginClass::Phase, Default::Text("`isotropic`"), "the phase function");
+    G = ParamSpec::new("g", ParamKind::Float, Default::Float(0.8), "mean cosine of the deflection, in (−1, 1): > 0 forward, < 0 backward");
+    PHASE_WEIGHT = ParamSpec::new("weight", ParamKind::FloatIn(Bounds::UNIT), Default::Float(0.5), "weight of the second phase function");
+    BLENDED_PHASES = ParamSpec::nested(PluginClass::Phase, Default::Required, "the two phase functions");
+    VALUE = ParamSpec::new("value", ParamKind::Spectrum { range: Range::Coefficient, textured: false, }, Default::Float(1.0), "the value");
+    FILENAME = ParamSpec::new("filename", ParamKind::String, Default::Required, "the `.vol` file");
+    FILTER_TYPE = ParamSpec::new("filter_type", ParamKind::Choice(&[Choice::new("bilinear", &GridFilter::Trilinear), Choice::new("nearest", &GridFilter::Nearest)]), Default::Str("bilinear"), "interpolation between voxels: `bilinear` (trilinear in 3D, Mitsuba's name) or `nearest`");
+    VOLUME_TO_WORLD = ParamSpec::new("to_world", ParamKind::Transform, Default::Text("identity"), "from the unit cube [0, 1]³ to the world");
+    USE_GRID_BBOX = ParamSpec::new("use_grid_bbox", ParamKind::Boolean, Default::Boolean(false), "place the grid in the box its file gives (then transformed by `to_world`)");
+}
 
 /// Builds the medium a `<medium>` node describes.
 pub fn build_medium(node: &PluginNode) -> Result<Medium> {
@@ -392,7 +298,7 @@ fn build_hg(params: &Params) -> Result<PhaseFunction> {
 }
 
 fn build_blendphase(params: &Params) -> Result<PhaseFunction> {
-    let weight = params.float_in(&PHASE_WEIGHT, 0.5, 0.0, 1.0)? as f32;
+    let weight = params.float_in(&PHASE_WEIGHT)? as f32;
     let children = params.children(&BLENDED_PHASES);
     let [first, second] = children.as_slice() else {
         return Err(Error::input(
@@ -481,10 +387,7 @@ fn build_gridvolume(params: &Params, range: Range) -> Result<Volume> {
         .with_help("check to_world (and the grid's bounding box with use_grid_bbox)")
     };
     let to_world = Transform::new(to_world).ok_or_else(singular)?;
-    let filter = match params.choice(&FILTER_TYPE)? {
-        "nearest" => GridFilter::Nearest,
-        _ => GridFilter::Trilinear,
-    };
+    let filter = params.choice(&FILTER_TYPE)?;
     let grid = GridVolume::new(file.resolution, file.data, to_world, filter)
         .expect("a parsed grid holds its voxels");
     if range == Range::Albedo && grid.max_value() > 1.0 {

@@ -10,7 +10,7 @@
 
 use crate::description::{PluginClass, PropertyValue, SpectrumValue};
 use crate::params::Params;
-use crate::registry::{Default, Origin, ParamKind, ParamSpec, Plugin, Range, Registry};
+use crate::registry::{Default, Origin, ParamKind, ParamSpec, Plugin, Range, Registry, params};
 use prism_core::error::{Error, Result};
 use prism_core::spectrum::ior::{Ior, SELLMEIER_GLASSES, sellmeier_glass};
 use prism_core::spectrum::{PiecewiseLinear, RgbIntent, Spectrum};
@@ -50,27 +50,19 @@ pub static SPECTRA: Registry<Build> = Registry {
     ],
 };
 
-pub const BLACKBODY_TEMPERATURE: ParamSpec = ParamSpec::new(
-    "temperature",
-    ParamKind::Float,
-    Default::Required,
-    "temperature in kelvin",
-);
-const GLASS: ParamSpec = ParamSpec::new(
-    "glass",
-    ParamKind::String,
-    Default::None,
-    "a catalogue glass: N-BK7, N-SF11, N-F2, fused silica, diamond",
-);
-const B1: ParamSpec = ParamSpec::new("b1", ParamKind::Float, Default::Float(0.0), "B₁");
-const B2: ParamSpec = ParamSpec::new("b2", ParamKind::Float, Default::Float(0.0), "B₂");
-const B3: ParamSpec = ParamSpec::new("b3", ParamKind::Float, Default::Float(0.0), "B₃");
-const C1: ParamSpec = ParamSpec::new("c1", ParamKind::Float, Default::Float(0.0), "C₁ in µm²");
-const C2: ParamSpec = ParamSpec::new("c2", ParamKind::Float, Default::Float(0.0), "C₂ in µm²");
-const C3: ParamSpec = ParamSpec::new("c3", ParamKind::Float, Default::Float(0.0), "C₃ in µm²");
-const CAUCHY_A: ParamSpec = ParamSpec::new("a", ParamKind::Float, Default::Float(1.5), "A");
-const CAUCHY_B: ParamSpec = ParamSpec::new("b", ParamKind::Float, Default::Float(0.0), "B in µm²");
-const CAUCHY_C: ParamSpec = ParamSpec::new("c", ParamKind::Float, Default::Float(0.0), "C in µm⁴");
+params! {
+    pub BLACKBODY_TEMPERATURE = ParamSpec::new("temperature", ParamKind::Float, Default::Required, "temperature in kelvin");
+    GLASS = ParamSpec::new("glass", ParamKind::String, Default::None, "a catalogue glass: N-BK7, N-SF11, N-F2, fused silica, diamond");
+    B1 = ParamSpec::new("b1", ParamKind::Float, Default::Float(0.0), "B₁");
+    B2 = ParamSpec::new("b2", ParamKind::Float, Default::Float(0.0), "B₂");
+    B3 = ParamSpec::new("b3", ParamKind::Float, Default::Float(0.0), "B₃");
+    C1 = ParamSpec::new("c1", ParamKind::Float, Default::Float(0.0), "C₁ in µm²");
+    C2 = ParamSpec::new("c2", ParamKind::Float, Default::Float(0.0), "C₂ in µm²");
+    C3 = ParamSpec::new("c3", ParamKind::Float, Default::Float(0.0), "C₃ in µm²");
+    CAUCHY_A = ParamSpec::new("a", ParamKind::Float, Default::Float(1.5), "A");
+    CAUCHY_B = ParamSpec::new("b", ParamKind::Float, Default::Float(0.0), "B in µm²");
+    CAUCHY_C = ParamSpec::new("c", ParamKind::Float, Default::Float(0.0), "C in µm⁴");
+}
 
 fn build_blackbody(params: &Params) -> Result<NestedSpectrum> {
     let Some(temperature) = params.float_opt(&BLACKBODY_TEMPERATURE)? else {

@@ -13,7 +13,9 @@ use super::spectra::spectrum_param;
 use crate::description::{PluginClass, PluginNode, PropertyValue, SpectrumValue};
 use crate::params::Params;
 use crate::registry::Range;
-use crate::registry::{Bounds, Default, Origin, ParamKind, ParamSpec, Plugin, Registry};
+use crate::registry::{
+    Bounds, Choice, Default, Origin, ParamKind, ParamSpec, Plugin, Registry, params,
+};
 use prism_core::error::{Error, Result};
 use prism_core::geometry::interaction::MAX_MESH_ATTRIBUTES;
 use prism_core::image::{Bitmap, Encoding, read_bitmap};
@@ -71,87 +73,20 @@ pub static TEXTURES: Registry<Build> = Registry {
     ],
 };
 
-const ATTRIBUTE_NAME: ParamSpec = ParamSpec::new(
-    "name",
-    ParamKind::String,
-    Default::Required,
-    "the attribute, starting with `vertex_` or `face_`",
-);
-const ATTRIBUTE_SCALE: ParamSpec = ParamSpec::new(
-    "scale",
-    ParamKind::Float,
-    Default::Float(1.0),
-    "a factor applied to the attribute's value",
-);
-
-const FILENAME: ParamSpec = ParamSpec::new(
-    "filename",
-    ParamKind::String,
-    Default::Required,
-    "the image: PNG, JPEG, OpenEXR or Radiance HDR",
-);
-const FILTER_TYPE: ParamSpec = ParamSpec::new(
-    "filter_type",
-    ParamKind::Choice(&["bilinear", "nearest", "trilinear", "ewa"]),
-    Default::Str("bilinear"),
-    "interpolate the four nearest texels, or take the one containing the point; Mitsuba 0.6's \
-     mip-mapped `trilinear` and `ewa` are read as `bilinear` (docs/mitsuba-compatibility.md)",
-);
-const WRAP_MODE: ParamSpec = ParamSpec::new(
-    "wrap_mode",
-    ParamKind::Choice(&["repeat", "mirror", "clamp"]),
-    Default::Str("repeat"),
-    "how coordinates outside [0, 1] map into the image",
-);
-const RAW: ParamSpec = ParamSpec::new(
-    "raw",
-    ParamKind::Boolean,
-    Default::Boolean(false),
-    "read 8- and 16-bit values as they are, without sRGB decoding (normal maps need it)",
-);
-const TO_UV: ParamSpec = ParamSpec::new(
-    "to_uv",
-    ParamKind::Transform,
-    Default::Text("identity"),
-    "an affine map of the texture coordinates",
-);
-const FORMAT: ParamSpec = ParamSpec::new(
-    "format",
-    ParamKind::Choice(&["auto", "variant", "fp16"]),
-    Default::Str("auto"),
-    "accepted; texels are always stored in full precision",
-);
-const ACCEL: ParamSpec = ParamSpec::new(
-    "accel",
-    ParamKind::Boolean,
-    Default::Boolean(true),
-    "accepted; Mitsuba's GPU texture acceleration does not apply",
-);
-const COLOR0: ParamSpec = ParamSpec::new(
-    "color0",
-    ParamKind::Spectrum {
-        range: Range::Albedo,
-        textured: true,
-    },
-    Default::Float(0.4),
-    "the first colour (a number when the texture is read as one)",
-);
-const COLOR1: ParamSpec = ParamSpec::new(
-    "color1",
-    ParamKind::Spectrum {
-        range: Range::Albedo,
-        textured: true,
-    },
-    Default::Float(0.2),
-    "the second colour",
-);
-
-const RAW_VALUE: ParamSpec = ParamSpec::new(
-    "value",
-    ParamKind::FloatOrVector,
-    Default::Required,
-    "the value: one number, or three",
-);
+params! {
+    ATTRIBUTE_NAME = ParamSpec::new("name", ParamKind::String, Default::Required, "the attribute, starting with `vertex_` or `face_`");
+    ATTRIBUTE_SCALE = ParamSpec::new("scale", ParamKind::Float, Default::Float(1.0), "a factor applied to the attribute's value");
+    FILENAME = ParamSpec::new("filename", ParamKind::String, Default::Required, "the image: PNG, JPEG, OpenEXR or Radiance HDR");
+    FILTER_TYPE = ParamSpec::new("filter_type", ParamKind::Choice(&[Choice::new("bilinear", &FilterType::Bilinear), Choice::new("nearest", &FilterType::Nearest), Choice::new("trilinear", &FilterType::Bilinear), Choice::new("ewa", &FilterType::Bilinear)]), Default::Str("bilinear"), "interpolate the four nearest texels, or take the one containing the point; Mitsuba 0.6's mip-mapped `trilinear` and `ewa` are read as `bilinear` (docs/mitsuba-compatibility.md)");
+    WRAP_MODE = ParamSpec::new("wrap_mode", ParamKind::Choice(&[Choice::new("repeat", &WrapMode::Repeat), Choice::new("mirror", &WrapMode::Mirror), Choice::new("clamp", &WrapMode::Clamp)]), Default::Str("repeat"), "how coordinates outside [0, 1] map into the image");
+    RAW = ParamSpec::new("raw", ParamKind::Boolean, Default::Boolean(false), "read 8- and 16-bit values as they are, without sRGB decoding (normal maps need it)");
+    TO_UV = ParamSpec::new("to_uv", ParamKind::Transform, Default::Text("identity"), "an affine map of the texture coordinates");
+    FORMAT = ParamSpec::new("format", ParamKind::Choice(&Choice::accepted(["auto", "variant", "fp16"])), Default::Str("auto"), "accepted; texels are always stored in full precision");
+    ACCEL = ParamSpec::new("accel", ParamKind::Boolean, Default::Boolean(true), "accepted; Mitsuba's GPU texture acceleration does not apply");
+    COLOR0 = ParamSpec::new("color0", ParamKind::Spectrum { range: Range::Albedo, textured: true, }, Default::Float(0.4), "the first colour (a number when the texture is read as one)");
+    COLOR1 = ParamSpec::new("color1", ParamKind::Spectrum { range: Range::Albedo, textured: true, }, Default::Float(0.2), "the second colour");
+    RAW_VALUE = ParamSpec::new("value", ParamKind::FloatOrVector, Default::Required, "the value: one number, or three");
+}
 
 /// Textures built so far, by element and use.
 #[derive(Default)]
@@ -438,19 +373,11 @@ fn emission_texture(
     Ok(Texture::Constant(spectrum_param(params, spec)?))
 }
 
-/// Read as a number, a checkerboard's colours are numbers too.
-const SCALAR_COLOR0: ParamSpec = ParamSpec::new(
-    "color0",
-    ParamKind::FloatTexture(Bounds::NON_NEGATIVE),
-    Default::Float(0.4),
-    "",
-);
-const SCALAR_COLOR1: ParamSpec = ParamSpec::new(
-    "color1",
-    ParamKind::FloatTexture(Bounds::NON_NEGATIVE),
-    Default::Float(0.2),
-    "",
-);
+params! {
+    /// Read as a number, a checkerboard's colours are numbers too.
+    SCALAR_COLOR0 = ParamSpec::new("color0", ParamKind::FloatTexture(Bounds::NON_NEGATIVE), Default::Float(0.4), "");
+    SCALAR_COLOR1 = ParamSpec::new("color1", ParamKind::FloatTexture(Bounds::NON_NEGATIVE), Default::Float(0.2), "");
+}
 
 fn build_checkerboard(
     params: &Params,
@@ -559,17 +486,9 @@ fn build_bitmap(params: &Params, usage: TextureUse) -> Result<Texture> {
         .with_help("add <string name=\"filename\" value=\"image.png\"/>")
     })?;
     let location = params.location_of(&FILENAME);
-    let filter = match params.choice(&FILTER_TYPE)? {
-        "nearest" => FilterType::Nearest,
-        // "trilinear" and "ewa": at full resolution, the limit of their mip-map pyramids.
-        _ => FilterType::Bilinear,
-    };
-    let wrap = match params.choice(&WRAP_MODE)? {
-        "mirror" => WrapMode::Mirror,
-        "clamp" => WrapMode::Clamp,
-        _ => WrapMode::Repeat,
-    };
-    params.choice(&FORMAT)?;
+    let filter = params.choice(&FILTER_TYPE)?;
+    let wrap = params.choice(&WRAP_MODE)?;
+    params.choice::<()>(&FORMAT)?;
     params.boolean(&ACCEL)?;
     let raw = params.boolean(&RAW)?;
     let to_uv = UvTransform::from_matrix(&params.transform(&TO_UV)?);

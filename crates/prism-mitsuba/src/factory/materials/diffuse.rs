@@ -1,0 +1,39 @@
+//! The Lambertian reflector and Oren–Nayar's rough diffuse reflector.
+
+use super::{Build, colour};
+use crate::factory::textures::{float_texture, spectrum_texture};
+use crate::registry::{Bounds, Default, Origin, ParamKind, ParamSpec, Plugin, Range, params};
+use prism_core::bsdf::{Bsdf, Diffuse, RoughDiffuse};
+
+pub(super) const DIFFUSE: Plugin<Build> = Plugin {
+    name: "diffuse",
+    origin: Origin::Mitsuba3,
+    summary: "The ideal Lambertian reflector, f = ρ/π, sampled by the cosine. One-sided.",
+    params: &[REFLECTANCE],
+    build: |params, t| {
+        Ok(Bsdf::Diffuse(Diffuse {
+            reflectance: spectrum_texture(params, &REFLECTANCE, t)?,
+        }))
+    },
+};
+
+pub(super) const ROUGHDIFFUSE: Plugin<Build> = Plugin {
+    name: "roughdiffuse",
+    origin: Origin::Mitsuba06,
+    summary: "Oren–Nayar's rough diffuse reflector (σ = α/√2), with its interreflection \
+              term. One-sided.",
+    params: &[REFLECTANCE, OREN_NAYAR_ALPHA, USE_FAST_APPROX],
+    build: |params, t| {
+        Ok(Bsdf::RoughDiffuse(RoughDiffuse {
+            reflectance: spectrum_texture(params, &REFLECTANCE, t)?,
+            alpha: float_texture(params, &OREN_NAYAR_ALPHA, t)?,
+            use_fast_approx: params.boolean(&USE_FAST_APPROX)?,
+        }))
+    },
+};
+
+params! {
+    REFLECTANCE = colour("reflectance", Range::Albedo, 0.5, "the reflectance ρ");
+    OREN_NAYAR_ALPHA = ParamSpec::new("alpha", ParamKind::FloatTexture(Bounds::NON_NEGATIVE), Default::Float(0.2), "RMS slope of the surface; 0 is Lambert's law");
+    USE_FAST_APPROX = ParamSpec::new("use_fast_approx", ParamKind::Boolean, Default::Boolean(false), "use the qualitative model of the paper's eq. 30");
+}

@@ -1,0 +1,532 @@
+//! The scene builder: reads the sections of the root `<scene>` (integrator, sensor, shapes,
+//! emitters, and the BSDFs, textures, samplers and media declared to be referenced by id) into
+//! a renderable [`Scene`], each object built once however often it is referenced.
+
+use std::collections::HashMap;
+use std::collections::hash_map::Entry;
+use std::sync::Arc;
+
+use super::instancing::ShapeGroups;
+use super::sensor::SensorSettings;
+use super::textures::TextureCache;
+use super::{integrators, lights, materials, media, sensor, shapes, textures};
+use crate::description::{NestedPlugin, PluginClass, PluginNode};
+use crate::params::{Params, Warning};
+use crate::registry::{Default, ParamSpec, params};
+use prism_core::bsdf::Material;
+use prism_core::error::{Error, Result, SourceLocation};
+use prism_core::geometry::{Geometry, Primitive, Shape};
+use prism_core::integrator::{Integrator, PathIntegrator};
+use prism_core::light::Light;
+use prism_core::medium::{Medium, MediumInterface};
+use prism_core::scene::Scene;
+use prism_core::texture::TextureUse;
+use prism_core::world::{ShapeInfo, World};
+
+/// A renderable scene and the settings its file gives for rendering it.
+pub struct LoadedScene {
+    pub scene: Scene,
+    /// The sampler's `seed` parameter.
+    pub seed: u64,
+    /// Parameters of the file that Prism reads but ignores (Mitsuba 0.6 forms), one warning
+    /// each, in the order they were read.
+    pub warnings: Vec<Warning>,
+}
+
+params! {
+    INTEGRATOR = ParamSpec::nested(PluginClass::Integrator, Default::Text("`path`"), "the integrator");
+    SENSOR = ParamSpec::nested(PluginClass::Sensor, Default::Required, "the camera");
+    SHAPES = ParamSpec::nested(PluginClass::Shape, Default::None, "the shapes");
+    EMITTERS = ParamSpec::nested(PluginClass::Emitter, Default::None, "lights; an `area` emitter here is attached to the shape that references its id");
+    BSDFS = ParamSpec::nested(PluginClass::Bsdf, Default::None, "BSDFs declared to be referenced by id");
+    TEXTURES = ParamSpec::nested(PluginClass::Texture, Default::None, "textures declared to be referenced by id");
+    SAMPLERS = ParamSpec::nested(PluginClass::Sampler, Default::None, "samplers declared to be referenced by id from the sensor");
+    MEDIA = ParamSpec::nested(PluginClass::Medium, Default::None, "media declared to be referenced by id");
+}
+/// What the `<scene>` element holds.
+const SCENE: &[ParamSpec] = &[
+    INTEGRATOR, SENSOR, SHAPES, EMITTERS, BSDFS, TEXTURES, SAMPLERS, MEDIA,
+];
+
+/// Builds the scene described by the root `<scene>` node, section by section; each section
+/// reports its errors in the order Mitsuba would.
+pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
+    let params = Params::new(root, SCENE);
+    let integrator = integrator(&params)?;
+    let sensor = single_sensor(root, &params)?;
+    let mut builder = SceneBuilder::default();
+    builder.shapes(&params)?;
+    builder.emitters(&params)?;
+    builder.declared_bsdfs(&params)?;
+    builder.declared_textures(&params)?;
+    for child in params.children(&SAMPLERS) {
+        // Checked even when no sensor references it.
+        sensor::sampler::build_sampler(&child.node)?;
+    }
+    let camera_medium = match &sensor.medium {
+        Some(node) => Some(builder.media.index(&NestedPlugin {
+            name: None,
+            node: node.clone(),
+            location: node.location.clone(),
+        })?),
+        None => None,
+    };
+    builder.declared_media(&params)?;
+    params.finish()?;
+    check_renders_media(&integrator, &builder.media)?;
+    Ok(builder.finish(root, integrator, sensor, camera_medium))
+}
+
+/// The scene's integrator, `path` by default.
+fn integrator(params: &Params) -> Result<Integrator> {
+    match params.single_child(&INTEGRATOR)? {
+        Some(child) => {
+            let integrator = integrators::build_integrator(&child.node)?;
+            integrators::check_channel_names(&integrator, &child.location)?;
+            Ok(integrator)
+        }
+        None => Ok(Integrator::Path(PathIntegrator::default())),
+    }
+}
+
+/// The scene's one sensor.
+fn single_sensor(root: &PluginNode, params: &Params) -> Result<SensorSettings> {
+    let sensors = params.children(&SENSOR);
+    let Some(sensor) = sensors.first() else {
+        return Err(Error::input(&root.location, "the scene has no <sensor>")
+            .with_help("add a <sensor type=\"perspective\"> with a film and a sampler"));
+    };
+    if let Some(second) = sensors.get(1) {
+        return Err(
+            Error::input(&second.location, "the scene has more than one <sensor>")
+                .with_help("Prism renders one sensor per scene: remove the others"),
+        );
+    }
+    sensor::build_sensor(&sensor.node)
+}
+
+/// The distrib integrator estimates no participating media: a scene with media and distrib is
+/// an error at the first medium.
+fn check_renders_media(integrator: &Integrator, media: &MediaCache) -> Result<()> {
+    if let (Integrator::Distribution(_), Some(location)) = (integrator, &media.first) {
+        return Err(Error::input(
+            location,
+            "the distrib integrator does not render participating media",
+        )
+        .with_help(
+            "render scenes with media with <integrator type=\"volpath\"> or \"volpathmis\"",
+        ));
+    }
+    Ok(())
+}
+
+/// The parts of the world read so far.
+#[derive(Default)]
+struct SceneBuilder {
+    materials: MaterialCache,
+    textures: TextureCache,
+    media: MediaCache,
+    shapes: Vec<Primitive>,
+    shape_info: Vec<ShapeInfo>,
+    medium_interfaces: Vec<MediumInterface>,
+    lights: Vec<Light>,
+    sampling_weights: Vec<f32>,
+    /// The area emitters attached to shapes, with where each was attached (an emitter declared
+    /// at the top level with an id reaches its shape by a `<ref>`).
+    attached_emitters: HashMap<*const PluginNode, SourceLocation>,
+}
+
+impl SceneBuilder {
+    /// The `<shape>` section: shape groups, instances and shapes, in document order.
+    fn shapes(&mut self, params: &Params) -> Result<()> {
+        let mut groups = ShapeGroups::default();
+        for child in params.children(&SHAPES) {
+            let Self {
+                materials,
+                textures,
+                media,
+                ..
+            } = self;
+            let mut member = |member: &Params| materials.group_member(member, textures, media);
+            match child.node.plugin_type.as_str() {
+                "shapegroup" => {
+                    groups.group(&child.node, &mut member)?;
+                }
+                "instance" => {
+                    let index = self.shapes.len();
+                    if let Some(instance) = groups.instance(&child.node, index, &mut member)? {
+                        self.shapes.push(instance.primitive);
+                        self.shape_info.push(instance.info);
+                        self.medium_interfaces.push(MediumInterface::default());
+                    }
+                }
+                _ => self.shape(child)?,
+            }
+        }
+        groups.assign_shape_ids(
+            &mut self.shapes,
+            &mut self.shape_info,
+            &mut self.medium_interfaces,
+        );
+        Ok(())
+    }
+
+    /// One shape, with its material, its area light and its media.
+    fn shape(&mut self, child: &NestedPlugin) -> Result<()> {
+        let (plugin, shape_params) = shapes::shape_params(&child.node)?;
+        let mut shape = shapes::build_shape(plugin, &shape_params)?;
+        let area = shape.area();
+        shapes::check_area(area, child)?;
+        let shape_index = self.shapes.len() as u32;
+        let emitter = shape_params.single_child(&shapes::EMITTER)?;
+        // Curves are hit but have no area sampling in Mitsuba, which refuses to make them
+        // emit; so does Prism.
+        let curve = shapes::is_curve(plugin);
+        if curve && let Some(emitter) = &emitter {
+            return Err(Error::input(
+                &emitter.location,
+                format!(
+                    "{} cannot emit: curves have no area sampling (as in Mitsuba 3)",
+                    child.node.describe()
+                ),
+            )
+            .with_help("remove the emitter, or light the curves with another shape"));
+        }
+        // A shape of zero area is never hit, so it contributes nothing; like Mitsuba, Prism
+        // reads it (its BSDF included) and renders without it, but an emitter needs an area
+        // to send its power from (Mitsuba refuses it too).
+        if area == 0.0
+            && let Some(emitter) = &emitter
+        {
+            return Err(Error::input(
+                &emitter.location,
+                format!("{} has no area, so it cannot emit", child.node.describe()),
+            )
+            .with_help("remove the emitter, or fix the shape's transform or its vertices"));
+        }
+        let material = self.materials.shape_material(
+            shape_params.single_child(&shapes::BSDF)?,
+            emitter.is_some(),
+            &mut self.textures,
+        )?;
+        let light = match emitter {
+            Some(emitter) => Some(self.attach_emitter(&shape, shape_index, emitter)?),
+            None => None,
+        };
+        bind_mesh_attributes(
+            &mut shape,
+            self.textures.material_attributes(material),
+            &child.node,
+        )?;
+        let interface = shape_media(&shape_params, &mut self.media)?;
+        shape_params.finish()?;
+        if area == 0.0 && !curve {
+            return Ok(());
+        }
+        self.shapes.push(shape);
+        self.shape_info.push(ShapeInfo { material, light });
+        self.medium_interfaces.push(interface);
+        Ok(())
+    }
+
+    /// The area light of the shape with index `shape_index`; the index of the light.
+    fn attach_emitter(
+        &mut self,
+        shape: &Primitive,
+        shape_index: u32,
+        emitter: &NestedPlugin,
+    ) -> Result<u32> {
+        if let Primitive::Instance(instance) = shape
+            && !instance.to_world.is_similarity()
+        {
+            return Err(Error::input(
+                &emitter.location,
+                "an emitting shape may move, turn and scale uniformly, but not stretch",
+            )
+            .with_help(
+                "animate the emitter with rotations, translations and uniform scales only",
+            ));
+        }
+        if let Some(first) = self
+            .attached_emitters
+            .insert(Arc::as_ptr(&emitter.node), emitter.location.clone())
+        {
+            return Err(Error::input(
+                &emitter.location,
+                format!(
+                    "{} is already attached to the shape at {first}",
+                    emitter.node.describe()
+                ),
+            )
+            .with_help(
+                "an area emitter can be attached to a single shape (as in Mitsuba): \
+                 give each shape its own <emitter type=\"area\">",
+            ));
+        }
+        let (light, weight) =
+            lights::build_area_light(&emitter.node, shape_index, &mut self.textures)?;
+        self.lights.push(light);
+        self.sampling_weights.push(weight);
+        Ok((self.lights.len() - 1) as u32)
+    }
+
+    /// The `<emitter>` section: the lights other than area lights, and the area emitters
+    /// declared to be referenced by a shape.
+    fn emitters(&mut self, params: &Params) -> Result<()> {
+        let mut scene_lights = Vec::new();
+        for child in params.children(&EMITTERS) {
+            if lights::is_area(&child.node) {
+                // An area emitter declared at the top level belongs to the shape that
+                // references it; one that no shape references emits nothing (Mitsuba ignores
+                // it), but its parameters are still checked.
+                if !self
+                    .attached_emitters
+                    .contains_key(&Arc::as_ptr(&child.node))
+                {
+                    lights::build_area_light(&child.node, 0, &mut self.textures)?;
+                }
+                continue;
+            }
+            let (light, weight) = lights::build_scene_light(&child.node, &mut self.textures)?;
+            scene_lights.push((light, weight, child.location.clone()));
+        }
+        lights::check_single_environment(&scene_lights)?;
+        for (light, weight, _) in scene_lights {
+            self.lights.push(light);
+            self.sampling_weights.push(weight);
+        }
+        Ok(())
+    }
+
+    /// BSDFs declared at the top level (to be referenced by id) are built even when unused, so
+    /// that their errors are reported as Mitsuba would.
+    fn declared_bsdfs(&mut self, params: &Params) -> Result<()> {
+        for child in params.children(&BSDFS) {
+            self.materials.declared(&child.node, &mut self.textures)?;
+        }
+        Ok(())
+    }
+
+    /// Textures declared at the top level (referenced by id from BSDFs) are read even when no
+    /// BSDF uses them, so that a missing or corrupt image is reported.
+    fn declared_textures(&mut self, params: &Params) -> Result<()> {
+        for child in params.children(&TEXTURES) {
+            if !self.textures.contains(&child.node) {
+                textures::build_texture(&child.node, TextureUse::Scalar, &mut self.textures)?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Media declared at the top level are built even when unused, so that their errors are
+    /// reported.
+    fn declared_media(&mut self, params: &Params) -> Result<()> {
+        for child in params.children(&MEDIA) {
+            self.media.index(child)?;
+        }
+        Ok(())
+    }
+
+    /// The scene, from the parts read.
+    fn finish(
+        self,
+        root: &PluginNode,
+        integrator: Integrator,
+        sensor: SensorSettings,
+        camera_medium: Option<u32>,
+    ) -> LoadedScene {
+        let mut world = World::new(
+            Geometry::new(self.shapes),
+            self.shape_info,
+            self.materials.materials,
+            self.lights,
+        )
+        .with_sampling_weights(self.sampling_weights);
+        if self.medium_interfaces.iter().any(|m| m.is_transition()) {
+            world.medium_interfaces = self.medium_interfaces;
+        }
+        world.media = self.media.media;
+        world.camera_medium = camera_medium;
+        let mut scene = Scene::new(
+            world,
+            sensor.camera,
+            sensor.film,
+            sensor.sampler,
+            integrator,
+        );
+        scene.shutter = sensor.shutter;
+        scene.ldr_output = sensor.ldr_output;
+        scene.fingerprint = crate::fingerprint::scene_fingerprint(root);
+        LoadedScene {
+            scene,
+            seed: sensor.seed,
+            warnings: sensor.warnings,
+        }
+    }
+}
+
+/// The scene's materials, each BSDF built once however often it is referenced.
+#[derive(Default)]
+struct MaterialCache {
+    materials: Vec<Material>,
+    ids: HashMap<*const PluginNode, u32>,
+}
+
+impl MaterialCache {
+    /// The index of a shape's material: its BSDF, or the default (black for an emitter, as
+    /// Mitsuba's, else diffuse 0.5).
+    fn shape_material(
+        &mut self,
+        bsdf: Option<&NestedPlugin>,
+        emits: bool,
+        textures: &mut TextureCache,
+    ) -> Result<u32> {
+        if let Some(bsdf) = bsdf {
+            let key = Arc::as_ptr(&bsdf.node);
+            if let Some(&index) = self.ids.get(&key) {
+                return Ok(index);
+            }
+            textures.take_used_slots();
+            self.materials
+                .push(materials::build_material(&bsdf.node, textures)?);
+            let index = (self.materials.len() - 1) as u32;
+            self.ids.insert(key, index);
+            let attributes = textures.take_used_slots();
+            textures.set_material_attributes(index, attributes);
+            return Ok(index);
+        }
+        self.materials.push(if emits {
+            lights::default_emitter_material()
+        } else {
+            materials::default_material()
+        });
+        Ok((self.materials.len() - 1) as u32)
+    }
+
+    /// Builds a BSDF declared at the top level, unless a shape has built it already.
+    fn declared(&mut self, node: &Arc<PluginNode>, textures: &mut TextureCache) -> Result<()> {
+        if let Entry::Vacant(entry) = self.ids.entry(Arc::as_ptr(node)) {
+            self.materials
+                .push(materials::build_material(node, textures)?);
+            entry.insert((self.materials.len() - 1) as u32);
+        }
+        Ok(())
+    }
+
+    /// The material and media of a shape in a `shapegroup`.
+    fn group_member(
+        &mut self,
+        member: &Params,
+        textures: &mut TextureCache,
+        media: &mut MediaCache,
+    ) -> Result<(u32, MediumInterface)> {
+        let material = self.shape_material(member.single_child(&shapes::BSDF)?, false, textures)?;
+        if let Some((_, name)) = textures.material_attributes(material).first() {
+            let node = member.node();
+            return Err(Error::input(
+                &node.location,
+                format!(
+                    "{} in a shapegroup has a BSDF that reads the mesh attribute \"{name}\"; \
+                     Prism's instanced shapes carry no attributes",
+                    node.describe()
+                ),
+            )
+            .with_help("place the mesh directly in the scene instead of through an instance"));
+        }
+        Ok((material, shape_media(member, media)?))
+    }
+}
+
+/// The scene's media, each built once however often it is referenced.
+#[derive(Default)]
+struct MediaCache {
+    media: Vec<Medium>,
+    ids: HashMap<*const PluginNode, u32>,
+    /// Where the first medium is given, for the integrators that refuse media.
+    first: Option<SourceLocation>,
+}
+
+impl MediaCache {
+    /// The index of the medium `child` describes (a `<medium>` or a reference to one).
+    fn index(&mut self, child: &NestedPlugin) -> Result<u32> {
+        if child.node.class != PluginClass::Medium {
+            return Err(Error::input(
+                &child.location,
+                format!("expected a <medium> here, not a {}", child.node.describe()),
+            )
+            .with_help("interior, exterior and the sensor's medium are <medium> elements"));
+        }
+        let key = Arc::as_ptr(&child.node);
+        if let Some(&index) = self.ids.get(&key) {
+            return Ok(index);
+        }
+        self.media.push(media::build_medium(&child.node)?);
+        self.first.get_or_insert_with(|| child.location.clone());
+        let index = (self.media.len() - 1) as u32;
+        self.ids.insert(key, index);
+        Ok(index)
+    }
+}
+
+/// The media on the two sides of a shape (its `interior` and `exterior`).
+fn shape_media(shape_params: &Params, media: &mut MediaCache) -> Result<MediumInterface> {
+    let mut interface = MediumInterface::default();
+    if let Some(child) = shape_params.named_child(&shapes::INTERIOR) {
+        interface.interior = Some(media.index(child)?);
+    }
+    if let Some(child) = shape_params.named_child(&shapes::EXTERIOR) {
+        interface.exterior = Some(media.index(child)?);
+    }
+    Ok(interface)
+}
+
+/// Makes the shape's mesh fill the attribute slots its BSDF's `mesh_attribute` textures read;
+/// a shape without one of those attributes is an error (Mitsuba's "invalid attribute
+/// requested", which it reports while rendering).
+fn bind_mesh_attributes(
+    shape: &mut Primitive,
+    attributes: &[(u8, String)],
+    node: &PluginNode,
+) -> Result<()> {
+    let Some((_, first)) = attributes.first() else {
+        return Ok(());
+    };
+    let Primitive::Shape(Shape::Mesh(mesh)) = shape else {
+        let what = if matches!(shape, Primitive::Instance(_)) {
+            "a moving shape"
+        } else {
+            "a shape that is not a mesh"
+        };
+        return Err(Error::input(
+            &node.location,
+            format!(
+                "{} has no attribute \"{first}\" (Mitsuba: invalid attribute requested): its \
+                 BSDF reads mesh attributes, which {what} does not carry",
+                node.describe()
+            ),
+        )
+        .with_help("give the attribute to a ply or serialized mesh that has it"));
+    };
+    for (slot, name) in attributes {
+        if !mesh.bind_attribute(name, *slot) {
+            let names: Vec<&str> = mesh.attribute_names().collect();
+            let has = if names.is_empty() {
+                "it has none".to_string()
+            } else {
+                format!("it has {}", names.join(", "))
+            };
+            return Err(Error::input(
+                &node.location,
+                format!(
+                    "{} has no attribute \"{name}\" (Mitsuba: invalid attribute requested); \
+                     {has}",
+                    node.describe()
+                ),
+            )
+            .with_help(
+                "use a mesh with per-vertex colours (PLY red green blue, or serialized colours)",
+            ));
+        }
+    }
+    Ok(())
+}
