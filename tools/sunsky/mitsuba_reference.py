@@ -1,5 +1,5 @@
 """Reference radiance of Mitsuba 3's `sunsky` emitter (scalar_spectral), printed as Rust
-arrays for tests/sunsky.rs. Run once with Mitsuba 3.9.1's Python:
+arrays for tests/integration/lights/sunsky.rs. Run once with Mitsuba 3.9.1's Python:
 
     ~/.cache/prism/mitsuba-3.9.1/bin/python tools/sunsky/mitsuba_reference.py
 """

@@ -18,7 +18,7 @@
 //! | [`error`] | errors with source locations |
 //! | [`dispatch`] | how a plugin class is declared: its trait and the enum that dispatches it |
 //! | [`math`] | vectors, frames, transforms, rays, special functions |
-//! | [`sampling`] | random numbers, warps, tabulated distributions, the per-pixel sampler |
+//! | [`sampling`] | random numbers, warps, tabulated distributions, the per-pixel sampler, chi-square tests of densities |
 //! | [`spectrum`] | wavelengths and spectral values along a path, CIE tables, RGB upsampling |
 //! | [`image`] | image files: decoding, EXR and PNG output, the sRGB curve, comparison |
 //! | [`geometry`] | shapes, intersection, the BVH, instances, the scene's primitives |

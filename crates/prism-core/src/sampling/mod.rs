@@ -1,5 +1,6 @@
-//! Sampling: random numbers, warps from the unit square, tabulated distributions and the
-//! per-pixel sampler.
+//! Sampling: random numbers, warps from the unit square, tabulated distributions, the
+//! per-pixel sampler, and the chi-square test of a sampling routine against its density.
+pub mod chi2;
 pub mod distribution;
 pub mod rng;
 pub mod sampler;

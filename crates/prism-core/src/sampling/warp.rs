@@ -159,7 +159,10 @@ pub fn invert_uniform_triangle(b: Vec2) -> Vec2 {
 
 #[cfg(test)]
 mod tests {
+    use std::f64::consts::TAU;
+
     use super::*;
+    use crate::sampling::chi2::{Suite, chi2_rectangle};
     use crate::sampling::rng::Pcg32;
 
     /// The polynomial cosine and sine agree with the exact values over the whole range they
@@ -234,6 +237,44 @@ mod tests {
             let sin = (c.x * c.x + c.y * c.y).sqrt();
             assert!(sin <= (2.0 * (1.0 - cos_max)).sqrt() * 1.01);
         }
+    }
+
+    /// The cone's directions follow the density the warp claims: a chi-square test in the
+    /// coordinates (1 − cos θ, φ), whose measure is solid angle, with the density evaluated by
+    /// [`uniform_cone_pdf`] at each point.
+    #[test]
+    fn uniform_cone_follows_its_density() {
+        const SUITE: Suite = Suite::new(&["uniform cone"]);
+        let cos_max = 0.5;
+        let sample = |rng: &mut Pcg32| {
+            let w = sample_uniform_cone(Vec2::new(rng.next_f32(), rng.next_f32()), cos_max);
+            let phi = f64::from(w.y).atan2(f64::from(w.x)).rem_euclid(TAU);
+            Some((1.0 - f64::from(w.z), phi))
+        };
+        let pdf = |one_minus_cos: f64, phi: f64| {
+            let (cos, sin) = (
+                1.0 - one_minus_cos,
+                (one_minus_cos * (2.0 - one_minus_cos)).sqrt(),
+            );
+            let w = Vec3::new(
+                (sin * phi.cos()) as f32,
+                (sin * phi.sin()) as f32,
+                cos as f32,
+            );
+            f64::from(uniform_cone_pdf(w, cos_max))
+        };
+        let one_minus_cos_max = f64::from(1.0 - cos_max);
+        let outcome = chi2_rectangle(
+            1_000_000,
+            (0.0, one_minus_cos_max),
+            (0.0, TAU),
+            40,
+            80,
+            12,
+            sample,
+            pdf,
+        );
+        SUITE.assert_passes("uniform cone", &outcome.unwrap());
     }
 
     #[test]

@@ -1,0 +1,9 @@
+//! The integrators' estimators against closed forms and against each other, their error, and
+//! the `aov` and `moment` integrators.
+
+mod aov;
+mod closed_form;
+mod convergence;
+mod direct;
+mod moment;
+mod strict_normals;

@@ -1,0 +1,416 @@
+//! The sensor plugins as the scene reader builds them from Mitsuba XML: the field of view
+//! from `fov`, `fov_axis` and `focal_length` (Mitsuba 3's `parse_fov`), `focus_distance`,
+//! which Mitsuba 3 reads on every projective camera, the orthographic camera against closed
+//! forms, Mitsuba 0.6's ignored film parameters and its `ldrfilm`.
+
+use std::path::Path;
+
+use glam::Vec2;
+use prism_core::camera::{Camera, CameraModel};
+use prism_core::scene::Scene;
+use prism_mitsuba::factory::build_scene;
+use prism_mitsuba::reader::read_scene_str;
+
+use crate::common::scenes::{assert_mean_luminance, render_film};
+
+/// Builds a scene holding one sensor, whose inner XML is `sensor` and film `width` × `height`.
+fn load_sensor(
+    kind: &str,
+    sensor: &str,
+    width: u32,
+    height: u32,
+) -> prism_core::error::Result<Scene> {
+    let text = format!(
+        r#"<scene version="3.0.0">
+    <sensor type="{kind}">
+        {sensor}
+        <film type="hdrfilm"><integer name="width" value="{width}"/><integer name="height" value="{height}"/></film>
+    </sensor>
+</scene>"#
+    );
+    let root = read_scene_str(&text, &Path::new(".").join("scene.xml"), &[])?;
+    Ok(build_scene(&root)?.scene)
+}
+
+fn tan_half_fov_x(scene: &Scene) -> f64 {
+    match &scene.camera {
+        Camera::Perspective(camera) => f64::from(camera.tan_half_fov_x),
+        Camera::Orthographic(_) => panic!("not a perspective camera"),
+    }
+}
+
+/// tan(x/2) for x in degrees.
+fn tan_half(degrees: f64) -> f64 {
+    (0.5 * degrees).to_radians().tan()
+}
+
+/// Mitsuba 3's `parse_fov`: the horizontal half-angle's tangent from each axis, on a landscape
+/// (64 × 48) and a portrait (48 × 64) film.
+#[test]
+fn field_of_view_axes_are_read_as_mitsuba_reads_them() {
+    for (width, height) in [(64u32, 48u32), (48, 64)] {
+        let aspect = f64::from(width) / f64::from(height);
+        let t = tan_half(50.0);
+        let diagonal = t / (1.0 + 1.0 / (aspect * aspect)).sqrt();
+        let (smaller, larger) = if aspect > 1.0 {
+            (t * aspect, t)
+        } else {
+            (t, t * aspect)
+        };
+        for (axis, expected) in [
+            ("x", t),
+            ("y", t * aspect),
+            ("diagonal", diagonal),
+            ("smaller", smaller),
+            ("larger", larger),
+            ("Diagonal", diagonal),
+        ] {
+            let sensor = format!(
+                r#"<float name="fov" value="50"/><string name="fov_axis" value="{axis}"/>"#
+            );
+            let scene = load_sensor("perspective", &sensor, width, height).unwrap();
+            let got = tan_half_fov_x(&scene);
+            assert!(
+                (got / expected - 1.0).abs() < 1e-6,
+                "{axis} on {width} × {height}: {got}, expected {expected}"
+            );
+        }
+    }
+}
+
+/// `focal_length` is the diagonal field of view of a lens on 36 × 24 mm film, with or without
+/// the "mm" suffix; 50 mm is the default.
+#[test]
+fn focal_lengths_give_diagonal_fields_of_view() {
+    let (width, height) = (64u32, 48u32);
+    let aspect = f64::from(width) / f64::from(height);
+    for (text, mm) in [(None, 50.0), (Some("35mm"), 35.0), (Some("85"), 85.0)] {
+        let sensor = text.map_or(String::new(), |t| {
+            format!(r#"<string name="focal_length" value="{t}"/>"#)
+        });
+        let scene = load_sensor("perspective", &sensor, width, height).unwrap();
+        let half_diagonal = (36.0f64 * 36.0 + 24.0 * 24.0).sqrt() / (2.0 * mm);
+        let expected = half_diagonal / (1.0 + 1.0 / (aspect * aspect)).sqrt();
+        let got = tan_half_fov_x(&scene);
+        assert!(
+            (got / expected - 1.0).abs() < 1e-6,
+            "{text:?}: {got} vs {expected}"
+        );
+    }
+    // Mitsuba 3 reads `fov_axis` only with `fov`: beside `focal_length` it is unused.
+    let err = load_sensor(
+        "perspective",
+        r#"<string name="focal_length" value="35mm"/><string name="fov_axis" value="y"/>"#,
+        width,
+        height,
+    )
+    .err()
+    .expect("fov_axis beside focal_length is an error");
+    assert!(err.to_string().contains("fov_axis"), "{err}");
+}
+
+/// Mitsuba 3 reads `focus_distance` on every projective camera; on a pinhole it changes no
+/// ray.
+#[test]
+fn focus_distance_on_a_pinhole_changes_nothing() {
+    let plain = load_sensor("perspective", r#"<float name="fov" value="40"/>"#, 32, 32).unwrap();
+    let focused = load_sensor(
+        "perspective",
+        r#"<float name="fov" value="40"/><float name="focus_distance" value="3"/>"#,
+        32,
+        32,
+    )
+    .unwrap();
+    for (film, lens) in [
+        (Vec2::new(0.0, 0.0), Vec2::new(0.1, 0.9)),
+        (Vec2::new(16.5, 7.25), Vec2::new(0.7, 0.3)),
+        (Vec2::new(32.0, 32.0), Vec2::new(0.5, 0.5)),
+    ] {
+        let a = plain.camera.generate_ray(film, lens, 0.0);
+        let b = focused.camera.generate_ray(film, lens, 0.0);
+        assert_eq!((a.o, a.d, a.t_max), (b.o, b.d, b.t_max));
+    }
+    let err = load_sensor(
+        "perspective",
+        r#"<string name="focus_distance" value="near"/>"#,
+        32,
+        32,
+    )
+    .err()
+    .expect("a string focus_distance is an error");
+    assert!(err.to_string().contains("focus_distance"), "{err}");
+}
+
+/// A Mitsuba 0.6 film's `banner`, `attachLog`, `highQualityEdges` and an HDR film's `gamma`
+/// are read and ignored, each with one warning naming its place; the scene loads.
+#[test]
+fn mitsuba_06_film_parameters_are_ignored_with_one_warning_each() {
+    let text = r#"<scene version="0.6.0">
+    <sensor type="perspective">
+        <film type="hdrfilm">
+            <integer name="width" value="4"/><integer name="height" value="4"/>
+            <boolean name="banner" value="false"/>
+            <boolean name="attachLog" value="false"/>
+            <boolean name="highQualityEdges" value="true"/>
+            <float name="gamma" value="2.2"/>
+        </film>
+    </sensor>
+</scene>"#;
+    let path = Path::new("old").join("scene.xml");
+    let root = read_scene_str(text, &path, &[]).unwrap();
+    let loaded = build_scene(&root).unwrap();
+    let got: Vec<String> = loaded.warnings.iter().map(|w| w.to_string()).collect();
+    let file = path.display();
+    let expected_starts = [
+        format!("{file}:5:13: warning: film \"hdrfilm\" ignores \"banner\""),
+        format!("{file}:6:13: warning: film \"hdrfilm\" ignores \"attach_log\""),
+        format!("{file}:7:13: warning: film \"hdrfilm\" ignores \"high_quality_edges\""),
+        format!("{file}:8:13: warning: film \"hdrfilm\" ignores \"gamma\""),
+    ];
+    assert_eq!(got.len(), expected_starts.len(), "{got:#?}");
+    for (warning, start) in got.iter().zip(&expected_starts) {
+        assert!(
+            warning.starts_with(start.as_str()),
+            "{warning}\nexpected {start}"
+        );
+    }
+    // A scene without them has no warnings.
+    let plain = load_sensor("perspective", "", 4, 4);
+    assert!(plain.is_ok());
+}
+
+/// `prism render` prints each warning once, on stderr, and renders.
+#[test]
+fn the_command_line_prints_each_warning_once() {
+    let dir = std::env::temp_dir().join(format!("prism-sensors-warnings-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(
+        dir.join("scene.xml"),
+        r#"<scene version="0.6.0">
+    <sensor type="perspective">
+        <film type="hdrfilm">
+            <integer name="width" value="4"/><integer name="height" value="4"/>
+            <boolean name="banner" value="false"/>
+        </film>
+    </sensor>
+</scene>"#,
+    )
+    .unwrap();
+    let output = std::process::Command::new(env!("CARGO_BIN_EXE_prism"))
+        .arg("render")
+        .arg(dir.join("scene.xml"))
+        .arg("-o")
+        .arg(dir.join("out.exr"))
+        .args(["--spp", "1"])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(0), "{stderr}");
+    assert_eq!(stderr.matches("warning:").count(), 1, "{stderr}");
+    assert!(
+        stderr.contains("scene.xml:5:13: warning: film \"hdrfilm\" ignores \"banner\""),
+        "{stderr}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// Renders `film` (the inner XML of an `ldrfilm` of 8 × 6 pixels) with `prism render` into a
+/// fresh folder; returns the folder.
+fn render_ldrfilm(name: &str, film: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("prism-sensors-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(
+        dir.join("scene.xml"),
+        format!(
+            r#"<scene version="0.6.0">
+    <sensor type="perspective">
+        <float name="fov" value="60"/>
+        <transform name="toWorld"><lookAt origin="0, 0, -3" target="0, 0, 0" up="0, 1, 0"/></transform>
+        <film type="ldrfilm">
+            <integer name="width" value="8"/><integer name="height" value="6"/>
+            {film}
+            <rfilter type="box"/>
+        </film>
+    </sensor>
+    <emitter type="constant"><rgb name="radiance" value="0.3, 0.6, 1.5"/></emitter>
+    <shape type="sphere"><bsdf type="diffuse"><rgb name="reflectance" value="0.9, 0.5, 0.1"/></bsdf></shape>
+</scene>"#
+        ),
+    )
+    .unwrap();
+    let output = std::process::Command::new(env!("CARGO_BIN_EXE_prism"))
+        .arg("render")
+        .arg(dir.join("scene.xml"))
+        .arg("-o")
+        .arg(dir.join("out.exr"))
+        .args(["--spp", "4"])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(0), "{stderr}");
+    dir
+}
+
+/// The linear sRGB pixels of the EXR Prism wrote.
+fn exr_rgb(dir: &Path) -> Vec<[f64; 3]> {
+    let image = prism_core::image::read_exr(&dir.join("out.exr")).unwrap();
+    let (r, g, b) = (
+        image.channel("R").unwrap(),
+        image.channel("G").unwrap(),
+        image.channel("B").unwrap(),
+    );
+    (0..r.len())
+        .map(|i| [f64::from(r[i]), f64::from(g[i]), f64::from(b[i])])
+        .collect()
+}
+
+/// The 8-bit values of an image file, `channels` per pixel.
+fn image_bytes(path: &Path) -> (usize, Vec<i32>) {
+    let bitmap = prism_core::image::read_bitmap(path).unwrap();
+    assert_eq!((bitmap.width, bitmap.height), (8, 6));
+    let bytes = bitmap
+        .data
+        .iter()
+        .map(|v| (v * 255.0).round() as i32)
+        .collect();
+    (bitmap.channels, bytes)
+}
+
+/// Asserts 8-bit values equal the exact ones rounded: within half a step, and 10⁻² more for
+/// the difference between Prism's f32 arithmetic and the test's f64.
+fn assert_bytes(got: &[i32], expected: &[f64]) {
+    assert_eq!(got.len(), expected.len());
+    for (i, (&g, &e)) in got.iter().zip(expected).enumerate() {
+        assert!(
+            (f64::from(g) - e).abs() <= 0.5 + 1e-2,
+            "value {i}: {g}, expected {e}"
+        );
+    }
+}
+
+/// `ldrfilm` with `gamma` tonemapping: the PNG holds 255 · clamp(2^exposure · v)^(1/γ) of the
+/// EXR's linear values.
+#[test]
+fn ldrfilm_writes_exposure_and_gamma() {
+    let dir = render_ldrfilm(
+        "ldr-gamma",
+        r#"<float name="exposure" value="-1"/><float name="gamma" value="2.2"/>"#,
+    );
+    let rgb = exr_rgb(&dir);
+    let expected: Vec<f64> = rgb
+        .iter()
+        .flatten()
+        .map(|&v| 255.0 * (0.5 * v).clamp(0.0, 1.0).powf(1.0 / 2.2))
+        .collect();
+    let (channels, bytes) = image_bytes(&dir.join("out.png"));
+    assert_eq!(channels, 3);
+    assert_bytes(&bytes, &expected);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// `ldrfilm` with Reinhard's operator, as luminance: each pixel's luminance L becomes
+/// Lp (1 + Lp / L_white²) / (1 + Lp) with Lp = L · key / exp(mean ln(10⁻³ + L)) and
+/// b = 1 − burn entering as L_white² b⁴, then the sRGB curve.
+#[test]
+fn ldrfilm_writes_reinhard_luminance() {
+    let dir = render_ldrfilm(
+        "ldr-reinhard",
+        r#"<string name="tonemapMethod" value="reinhard"/><float name="key" value="0.3"/>
+            <float name="burn" value="0.2"/><string name="pixelFormat" value="luminance"/>"#,
+    );
+    let luminance: Vec<f64> = exr_rgb(&dir)
+        .iter()
+        .map(|p| 0.212_671 * p[0] + 0.715_160 * p[1] + 0.072_169 * p[2])
+        .collect();
+    let log_average =
+        (luminance.iter().map(|l| (1e-3 + l).ln()).sum::<f64>() / luminance.len() as f64).exp();
+    let scale = 0.3 / log_average;
+    let white = luminance.iter().copied().fold(0.0, f64::max) * scale;
+    let inv_white2 = 1.0 / (white * white * 0.8f64.powi(4));
+    let srgb = |v: f64| {
+        if v <= 0.003_130_8 {
+            12.92 * v
+        } else {
+            1.055 * v.powf(1.0 / 2.4) - 0.055
+        }
+    };
+    let expected: Vec<f64> = luminance
+        .iter()
+        .map(|&l| {
+            let lp = l * scale;
+            255.0 * srgb((lp * (1.0 + lp * inv_white2) / (1.0 + lp)).clamp(0.0, 1.0))
+        })
+        .collect();
+    let (channels, bytes) = image_bytes(&dir.join("out.png"));
+    assert_eq!(channels, 1);
+    assert_bytes(&bytes, &expected);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// `fileFormat="jpeg"` writes `out.jpg` (and no PNG); an RGBA PNG has an opaque alpha.
+#[test]
+fn ldrfilm_writes_jpeg_and_rgba() {
+    let dir = render_ldrfilm("ldr-jpeg", r#"<string name="fileFormat" value="jpeg"/>"#);
+    let jpeg = std::fs::read(dir.join("out.jpg")).unwrap();
+    assert_eq!(&jpeg[..2], &[0xFF, 0xD8]);
+    assert!(!dir.join("out.png").exists());
+    let (channels, _) = image_bytes(&dir.join("out.jpg"));
+    assert_eq!(channels, 3);
+    std::fs::remove_dir_all(&dir).unwrap();
+
+    let dir = render_ldrfilm("ldr-rgba", r#"<string name="pixelFormat" value="rgba"/>"#);
+    let (channels, bytes) = image_bytes(&dir.join("out.png"));
+    assert_eq!(channels, 4);
+    assert!(bytes.chunks(4).all(|p| p[3] == 255));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// An orthographic scene of 64 × 48 pixels with a box filter: the camera 3 above the origin
+/// looking down, its film scaled by `scale` (covering [−s, s] × [−0.75 s, 0.75 s]), over `body`.
+fn orthographic_scene(scale: f64, body: &str) -> Scene {
+    let text = format!(
+        r#"<scene version="3.0.0">
+    <sensor type="orthographic">
+        <transform name="to_world">
+            <scale x="{scale}" y="{scale}"/>
+            <lookat origin="0, 0, 3" target="0, 0, 0" up="0, 1, 0"/>
+        </transform>
+        <film type="hdrfilm"><integer name="width" value="64"/><integer name="height" value="48"/>
+            <rfilter type="box"/></film>
+    </sensor>
+    {body}
+</scene>"#
+    );
+    let root = read_scene_str(&text, &Path::new(".").join("scene.xml"), &[]).unwrap();
+    build_scene(&root).unwrap().scene
+}
+
+/// Over an emitting plane that fills the film, every pixel of an orthographic camera measures
+/// the plane's radiance: `<rgb value="2"/>` emission is D65 of luminance 2, so Y = 2.
+#[test]
+fn an_orthographic_camera_over_an_emitting_plane_sees_its_radiance() {
+    let scene = orthographic_scene(
+        2.0,
+        r#"<shape type="rectangle"><transform name="to_world"><scale value="5"/></transform>
+        <emitter type="area"><rgb name="radiance" value="2"/></emitter></shape>"#,
+    );
+    let film = render_film(&scene, 64, 1, None);
+    assert_mean_luminance("orthographic over a plane", &film, 2.0);
+}
+
+/// The image of an emitting disk of radius 0.6 (Y = 1) on black covers its area's share of
+/// the film's 2s × 1.5s: the image's mean luminance is π 0.6² / (2s · 1.5s).
+#[test]
+fn the_orthographic_image_of_a_disk_has_the_disks_area() {
+    let s = 1.5;
+    let scene = orthographic_scene(
+        s,
+        r#"<shape type="disk"><transform name="to_world"><scale value="0.6"/></transform>
+        <emitter type="area"><rgb name="radiance" value="1"/></emitter></shape>"#,
+    );
+    let film = render_film(&scene, 256, 2, None);
+    let expected = std::f64::consts::PI * 0.36 / (2.0 * s * 1.5 * s);
+    assert_mean_luminance("orthographic image of a disk", &film, expected);
+}

@@ -1,0 +1,21 @@
+//! Prism's integration tests, one crate of topic modules: the renderer through its library and
+//! through the `prism` program (docs/testing.md says what each topic tests).
+
+mod bench;
+mod chi2;
+mod common;
+mod determinism;
+#[cfg(feature = "embree")]
+mod embree;
+mod errors;
+mod estimators;
+mod image_formation;
+mod layers;
+mod leniency;
+mod lights;
+mod materials;
+mod media;
+mod references;
+mod reliability;
+mod shapes;
+mod signposts;

@@ -1,0 +1,186 @@
+//! `mesh_attribute` textures: a mesh's attribute is interpolated barycentrically at a hit (and
+//! a face attribute is constant over its triangle); a PLY or serialized mesh whose vertices (or
+//! a PLY whose faces) all have one colour renders as the same colour given as `<rgb>`.
+
+use std::path::PathBuf;
+
+use glam::Vec3;
+use prism_core::geometry::ShapeGeometry;
+use prism_core::geometry::shape::MeshAttribute;
+use prism_core::geometry::{TriangleMesh, triangle::TriangleHit};
+use prism_core::math::Ray;
+use prism_mitsuba::load_scene;
+
+use crate::common::scenes::{pixel_mean_and_variance, render_film};
+use crate::common::serialized::{serialized_file, triangle_shape};
+
+#[test]
+fn attributes_are_interpolated_barycentrically_and_faces_are_constant() {
+    let positions = vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::new(1.0, 1.0, 0.0)];
+    let mut mesh = TriangleMesh::new(positions, None, None, vec![[0, 1, 2], [1, 3, 2]], false);
+    let vertex = [
+        Vec3::new(1.0, 2.0, 3.0),
+        Vec3::new(-4.0, 0.5, 8.0),
+        Vec3::new(0.25, -1.0, 2.0),
+        Vec3::new(7.0, 7.0, 7.0),
+    ];
+    mesh.set_attributes(vec![
+        MeshAttribute {
+            name: "vertex_color".into(),
+            per_face: false,
+            values: vertex.to_vec(),
+        },
+        MeshAttribute {
+            name: "face_color".into(),
+            per_face: true,
+            values: vec![Vec3::splat(0.1), Vec3::splat(0.9)],
+        },
+    ]);
+    assert!(mesh.bind_attribute("vertex_color", 3));
+    assert!(mesh.bind_attribute("face_color", 0));
+    assert!(!mesh.bind_attribute("vertex_normal", 1));
+    let hit = TriangleHit {
+        t: 1.0,
+        b0: 0.5,
+        b1: 0.3,
+        b2: 0.2,
+    };
+    let ray = Ray::new(Vec3::ZERO, Vec3::Z, f32::INFINITY, 0.0);
+    let at = mesh.interaction(&ray, 1, &hit, 0).attributes.0;
+    let expected = vertex[1] * 0.5 + vertex[3] * 0.3 + vertex[2] * 0.2;
+    assert!(at[3].abs_diff_eq(expected, 1e-6), "{} != {expected}", at[3]);
+    assert_eq!(at[0], Vec3::splat(0.9));
+    assert_eq!((at[1], at[2]), (Vec3::ZERO, Vec3::ZERO));
+}
+
+/// A scratch folder removed on drop.
+struct Folder(PathBuf);
+
+impl Drop for Folder {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+/// A quad under a constant white sky seen from above with direct lighting only (no Russian
+/// roulette), its diffuse reflectance `reflectance` (an `<rgb>` or a `<texture>`), read from
+/// `mesh` (the shape's type and file name).
+fn quad_scene(mesh: (&str, &str), reflectance: &str) -> String {
+    format!(
+        r#"<scene version="3.0.0">
+    <integrator type="path"><integer name="max_depth" value="2"/></integrator>
+    <sensor type="perspective">
+        <transform name="to_world"><lookat origin="0, 0, 3" target="0, 0, 0" up="0, 1, 0"/></transform>
+        <film type="hdrfilm"><integer name="width" value="8"/><integer name="height" value="8"/></film>
+    </sensor>
+    <emitter type="constant"/>
+    <shape type="{}"><string name="filename" value="{}"/>
+        <bsdf type="diffuse">{reflectance}</bsdf>
+    </shape>
+</scene>
+"#,
+        mesh.0, mesh.1
+    )
+}
+
+/// Renders the scene with the mesh attribute `attribute` as reflectance and with the same colour
+/// as `<rgb>`, from the same random numbers: the images agree to rounding (the interpolated
+/// coefficients of equal corners equal the corners' up to a few ulps).
+fn assert_renders_as_rgb(
+    name: &str,
+    files: &[(&str, Vec<u8>)],
+    mesh: (&str, &str),
+    attribute: &str,
+    rgb: &str,
+) {
+    let dir = std::env::temp_dir().join(format!(
+        "prism-mesh-attribute-{name}-{}",
+        std::process::id()
+    ));
+    std::fs::create_dir_all(&dir).unwrap();
+    let folder = Folder(dir);
+    for (file, contents) in files {
+        std::fs::write(folder.0.join(file), contents).unwrap();
+    }
+    let attribute = format!(
+        r#"<texture type="mesh_attribute" name="reflectance"><string name="name" value="{attribute}"/></texture>"#
+    );
+    let constant = format!(r#"<rgb name="reflectance" value="{rgb}"/>"#);
+    let films: Vec<_> = [attribute.as_str(), constant.as_str()]
+        .iter()
+        .map(|reflectance| {
+            let path = folder.0.join("scene.xml");
+            std::fs::write(&path, quad_scene(mesh, reflectance)).unwrap();
+            let loaded = load_scene(&path, &[]).unwrap_or_else(|e| panic!("{e}"));
+            render_film(&loaded.scene, 16, 5, Some(1))
+        })
+        .collect();
+    let mut lit = 0;
+    for i in 0..films[0].pixels.len() {
+        for c in 0..3 {
+            let (a, _) = pixel_mean_and_variance(&films[0], i, c);
+            let (b, _) = pixel_mean_and_variance(&films[1], i, c);
+            assert!(
+                (a - b).abs() <= 1e-5 * b.abs().max(1e-3),
+                "{name}: pixel {i}, channel {c}: {a} with the attribute, {b} with <rgb>"
+            );
+            lit += usize::from(b > 0.0);
+        }
+    }
+    assert!(lit > 0, "{name}: the quad was not seen");
+}
+
+#[test]
+fn a_uniform_ply_colour_renders_as_that_rgb() {
+    let mut ply = b"ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n\
+        property float z\nproperty float red\nproperty float green\nproperty float blue\n\
+        element face 2\nproperty list uchar int vertex_indices\nend_header\n"
+        .to_vec();
+    for (x, y) in [(-1, -1), (1, -1), (1, 1), (-1, 1)] {
+        ply.extend_from_slice(format!("{x} {y} 0 0.2 0.5 0.8\n").as_bytes());
+    }
+    ply.extend_from_slice(b"3 0 1 2\n3 0 2 3\n");
+    assert_renders_as_rgb(
+        "ply",
+        &[("quad.ply", ply)],
+        ("ply", "quad.ply"),
+        "vertex_color",
+        "0.2, 0.5, 0.8",
+    );
+}
+
+#[test]
+fn serialized_colours_are_the_vertex_color_attribute() {
+    let mut shape = triangle_shape();
+    shape.positions = vec![[-2.0, -2.0, 0.0], [2.0, -2.0, 0.0], [0.0, 2.0, 0.0]];
+    shape.colors = Some(vec![[0.7, 0.3, 0.1]; 3]);
+    let file = serialized_file(&[shape], 4);
+    assert_renders_as_rgb(
+        "serialized",
+        &[("tri.serialized", file)],
+        ("serialized", "tri.serialized"),
+        "vertex_color",
+        "0.7, 0.3, 0.1",
+    );
+}
+
+/// PLY face colours (`r g b` on the face element) are the `face_color` attribute, one colour
+/// for every triangle of a polygon's fan.
+#[test]
+fn a_uniform_ply_face_colour_renders_as_that_rgb() {
+    let mut ply = b"ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n\
+        property float z\nelement face 1\nproperty list uchar int vertex_indices\n\
+        property float r\nproperty float g\nproperty float b\nend_header\n"
+        .to_vec();
+    for (x, y) in [(-1, -1), (1, -1), (1, 1), (-1, 1)] {
+        ply.extend_from_slice(format!("{x} {y} 0\n").as_bytes());
+    }
+    ply.extend_from_slice(b"4 0 1 2 3 0.6 0.1 0.3\n");
+    assert_renders_as_rgb(
+        "ply-face",
+        &[("quad.ply", ply)],
+        ("ply", "quad.ply"),
+        "face_color",
+        "0.6, 0.1, 0.3",
+    );
+}
