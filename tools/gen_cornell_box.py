@@ -108,6 +108,13 @@ white, green, red = (spectrum(f"reflectance.{c}") for c in ("white", "green", "r
 emission = spectrum("emission.light")
 
 
+def diffuse(bsdf_id, kind, reflectance):
+    return f"""    <bsdf type="diffuse" id="{bsdf_id}">
+        <{kind} name="reflectance" value="{reflectance}"/>
+    </bsdf>
+"""
+
+
 def shape(name, reflectance_id, emitter=""):
     return f"""    <shape type="obj">
         <string name="filename" value="meshes/{name}.obj"/>
@@ -150,19 +157,7 @@ xml = f"""<?xml version="1.0" encoding="utf-8"?>
         </film>
     </sensor>
 
-    <bsdf type="diffuse" id="white">
-        <spectrum name="reflectance" value="{white}"/>
-    </bsdf>
-    <bsdf type="diffuse" id="green">
-        <spectrum name="reflectance" value="{green}"/>
-    </bsdf>
-    <bsdf type="diffuse" id="red">
-        <spectrum name="reflectance" value="{red}"/>
-    </bsdf>
-    <bsdf type="diffuse" id="luminaire">
-        <float name="reflectance" value="0.78"/>
-    </bsdf>
-
+{diffuse("white", "spectrum", white)}{diffuse("green", "spectrum", green)}{diffuse("red", "spectrum", red)}{diffuse("luminaire", "float", "0.78")}
 {shape("floor", "white")}{shape("ceiling", "white")}{shape("back_wall", "white")}{shape("right_wall", "green")}{shape("left_wall", "red")}{shape("short_block", "white")}{shape("tall_block", "white")}{shape("light", "luminaire", f'''
         <emitter type="area">
             <spectrum name="radiance" value="{emission}"/>

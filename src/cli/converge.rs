@@ -167,17 +167,6 @@ fn integrator_label(integrator: &Integrator) -> &'static str {
     }
 }
 
-fn sampler_label(kind: SamplerKind) -> &'static str {
-    match kind {
-        SamplerKind::Independent => "independent",
-        SamplerKind::Stratified { .. } => "stratified",
-        SamplerKind::MultiJitter { .. } => "multijitter",
-        SamplerKind::NRooks => "nrooks",
-        SamplerKind::LowDiscrepancy => "ldsampler",
-        SamplerKind::Orthogonal { .. } => "orthogonal",
-    }
-}
-
 pub fn run(args: &ConvergeArgs) -> Result<()> {
     if !(1..=1 << 20).contains(&args.max_spp) {
         return Err(Error::usage("--max-spp must be between 1 and 2^20"));
@@ -223,7 +212,7 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
         for &kind in &samplers {
             scene.integrator = integrator.clone();
             scene.sampler.kind = kind;
-            let label = format!("{} / {}", integrator_label(integrator), sampler_label(kind));
+            let label = format!("{} / {}", integrator_label(integrator), kind.name());
             let mut series = Series {
                 label,
                 points: Vec::new(),
