@@ -10,14 +10,9 @@ OBJ mesh whose triangles face the inside of the box (the surfaces are one-sided 
 reflectors). Two choices are ours, as in Mitsuba's cbox scene: the luminaire is moved 0.5 mm
 below the ceiling so the two do not coincide, and its own reflectance is a flat 0.78.
 """
-import argparse
-from pathlib import Path
+import generator_args
 
-ROOT = Path(__file__).resolve().parent.parent
-parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-parser.add_argument("--data", type=Path, default=ROOT / "data" / "cornell_spectra.txt")
-parser.add_argument("--out", type=Path, default=ROOT / "scenes" / "cornell-box", help="the scene's folder")
-args = parser.parse_args()
+args = generator_args.parse(__doc__, "data/cornell_spectra.txt", "scenes/cornell-box", out_help="the scene's folder")
 data_file, out_dir = args.data, args.out
 sections, current = {}, None
 for raw in data_file.read_text().splitlines():
