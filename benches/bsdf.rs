@@ -12,9 +12,10 @@
 //! see it; `wi` for `eval` uniform over the sphere for transmitting BSDFs and over the upper
 //! hemisphere for reflecting ones). Criterion reports queries (elements) per second.
 
+mod common;
+
 use std::hint::black_box;
 use std::path::Path;
-use std::time::Duration;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use glam::{Vec2, Vec3};
@@ -140,9 +141,7 @@ fn bsdfs(c: &mut Criterion) {
 
 criterion_group! {
     name = benches;
-    config = Criterion::default()
-        .warm_up_time(Duration::from_secs(1))
-        .measurement_time(Duration::from_secs(3))
+    config = common::criterion()
         .sample_size(50);
     targets = bsdfs
 }

@@ -15,9 +15,10 @@
 //! Each benchmark runs over a fixed, seeded set of 4,096 shading points on the floor below the
 //! lights, with wavelengths and random numbers; Criterion reports samples (elements) per second.
 
+mod common;
+
 use std::hint::black_box;
 use std::path::Path;
-use std::time::Duration;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use glam::{Vec2, Vec3};
@@ -164,9 +165,7 @@ fn lights(c: &mut Criterion) {
 
 criterion_group! {
     name = benches;
-    config = Criterion::default()
-        .warm_up_time(Duration::from_secs(1))
-        .measurement_time(Duration::from_secs(3))
+    config = common::criterion()
         .sample_size(50);
     targets = lights
 }

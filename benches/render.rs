@@ -5,8 +5,9 @@
 //! samples (elements) per second, once on one thread (the cost of a sample) and once on all
 //! cores (the scaling of the tile scheduler).
 
+mod common;
+
 use std::path::Path;
-use std::time::Duration;
 
 use criterion::{Criterion, SamplingMode, Throughput, criterion_group, criterion_main};
 use prism_core::render::{RenderOptions, render};
@@ -42,9 +43,7 @@ fn cornell_box(c: &mut Criterion) {
 
 criterion_group! {
     name = benches;
-    config = Criterion::default()
-        .warm_up_time(Duration::from_secs(1))
-        .measurement_time(Duration::from_secs(3));
+    config = common::criterion();
     targets = cornell_box
 }
 criterion_main!(benches);

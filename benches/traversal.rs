@@ -18,6 +18,8 @@
 //! (once; it is kept in `target/bench-scenes`) and loaded only when one of its benchmarks runs,
 //! so `cargo bench --bench traversal -- cornell` is quick.
 
+mod common;
+
 use std::hint::black_box;
 use std::path::{Path, PathBuf};
 use std::sync::LazyLock;
@@ -193,9 +195,7 @@ fn bvh_build(c: &mut Criterion) {
 
 criterion_group! {
     name = benches;
-    config = Criterion::default()
-        .warm_up_time(Duration::from_secs(1))
-        .measurement_time(Duration::from_secs(3));
+    config = common::criterion();
     targets = traversal, bvh_build
 }
 criterion_main!(benches);

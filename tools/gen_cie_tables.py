@@ -8,17 +8,13 @@ give them (D65 is cut to the same range). Arrays are laid out as `cargo fmt` lay
 value per line when a value is longer than 10 characters, else as many per line as fit in 99
 columns), so the written file is the committed one byte for byte.
 """
-import argparse
 import csv
-from pathlib import Path
 
-ROOT = Path(__file__).resolve().parent.parent
-parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-parser.add_argument("--data", type=Path, default=ROOT / "data" / "cie", help="folder of the CIE CSV files")
-parser.add_argument(
-    "--out", type=Path, default=ROOT / "crates" / "prism-core" / "src" / "spectrum" / "cie_tables.rs"
+import generator_args
+
+args = generator_args.parse(
+    __doc__, "data/cie", "crates/prism-core/src/spectrum/cie_tables.rs", data_help="folder of the CIE CSV files"
 )
-args = parser.parse_args()
 
 cmf = {}
 with open(args.data / "CIE_xyz_1931_2deg.csv") as f:

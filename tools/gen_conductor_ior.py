@@ -6,20 +6,16 @@ equals another's (most `*_palik` files repeat their base material) becomes an al
 
 usage: python3 tools/gen_conductor_ior.py [--data DIR] [--out FILE]
 """
-import argparse
 import glob
 import os
 import struct
 import sys
-from pathlib import Path
 
-ROOT = Path(__file__).resolve().parent.parent
-parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-parser.add_argument("--data", type=Path, default=ROOT / "data" / "ior", help="folder of the .spd files")
-parser.add_argument(
-    "--out", type=Path, default=ROOT / "crates" / "prism-core" / "src" / "spectrum" / "conductors.rs"
+import generator_args
+
+args = generator_args.parse(
+    __doc__, "data/ior", "crates/prism-core/src/spectrum/conductors.rs", data_help="folder of the .spd files"
 )
-args = parser.parse_args()
 src, out = str(args.data), args.out
 
 

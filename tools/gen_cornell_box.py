@@ -10,14 +10,9 @@ OBJ mesh whose triangles face the inside of the box (the surfaces are one-sided 
 reflectors). Two choices are ours, as in Mitsuba's cbox scene: the luminaire is moved 0.5 mm
 below the ceiling so the two do not coincide, and its own reflectance is a flat 0.78.
 """
-import argparse
-from pathlib import Path
+import generator_args
 
-ROOT = Path(__file__).resolve().parent.parent
-parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-parser.add_argument("--data", type=Path, default=ROOT / "data" / "cornell_spectra.txt")
-parser.add_argument("--out", type=Path, default=ROOT / "scenes" / "cornell-box", help="the scene's folder")
-args = parser.parse_args()
+args = generator_args.parse(__doc__, "data/cornell_spectra.txt", "scenes/cornell-box", out_help="the scene's folder")
 data_file, out_dir = args.data, args.out
 sections, current = {}, None
 for raw in data_file.read_text().splitlines():
@@ -108,6 +103,13 @@ white, green, red = (spectrum(f"reflectance.{c}") for c in ("white", "green", "r
 emission = spectrum("emission.light")
 
 
+def diffuse(bsdf_id, kind, reflectance):
+    return f"""    <bsdf type="diffuse" id="{bsdf_id}">
+        <{kind} name="reflectance" value="{reflectance}"/>
+    </bsdf>
+"""
+
+
 def shape(name, reflectance_id, emitter=""):
     return f"""    <shape type="obj">
         <string name="filename" value="meshes/{name}.obj"/>
@@ -150,19 +152,7 @@ xml = f"""<?xml version="1.0" encoding="utf-8"?>
         </film>
     </sensor>
 
-    <bsdf type="diffuse" id="white">
-        <spectrum name="reflectance" value="{white}"/>
-    </bsdf>
-    <bsdf type="diffuse" id="green">
-        <spectrum name="reflectance" value="{green}"/>
-    </bsdf>
-    <bsdf type="diffuse" id="red">
-        <spectrum name="reflectance" value="{red}"/>
-    </bsdf>
-    <bsdf type="diffuse" id="luminaire">
-        <float name="reflectance" value="0.78"/>
-    </bsdf>
-
+{diffuse("white", "spectrum", white)}{diffuse("green", "spectrum", green)}{diffuse("red", "spectrum", red)}{diffuse("luminaire", "float", "0.78")}
 {shape("floor", "white")}{shape("ceiling", "white")}{shape("back_wall", "white")}{shape("right_wall", "green")}{shape("left_wall", "red")}{shape("short_block", "white")}{shape("tall_block", "white")}{shape("light", "luminaire", f'''
         <emitter type="area">
             <spectrum name="radiance" value="{emission}"/>

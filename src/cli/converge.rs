@@ -79,6 +79,8 @@ impl Series {
     }
 }
 
+/// The integrator `name`: the scene's own when it is that one, else that integrator's defaults
+/// with the scene's depth limit.
 fn integrator_named(name: &str, scene: &Scene) -> Result<Integrator> {
     let image = scene.integrator.image_integrator();
     let max_depth = match image {
@@ -89,51 +91,39 @@ fn integrator_named(name: &str, scene: &Scene) -> Result<Integrator> {
         Integrator::VolPath(v) => v.max_depth,
         Integrator::Moment(_) | Integrator::Aov(_) => -1,
     };
-    match name {
-        "path" => Ok(match image {
-            Integrator::Path(p) => Integrator::Path(p.clone()),
-            _ => PathIntegrator {
-                max_depth,
-                ..PathIntegrator::default()
-            }
-            .into(),
-        }),
-        "direct" => Ok(match image {
-            Integrator::Direct(d) => Integrator::Direct(d.clone()),
-            _ => DirectIntegrator::default().into(),
-        }),
-        "distrib" => Ok(match image {
-            Integrator::Distribution(d) => Integrator::Distribution(d.clone()),
-            _ => DistributionIntegrator {
-                max_depth,
-                ..DistributionIntegrator::default()
-            }
-            .into(),
-        }),
-        "volpath" => Ok(match image {
-            Integrator::VolPath(v) if v.tracking == Tracking::Spectral => {
-                Integrator::VolPath(v.clone())
-            }
-            _ => VolPathIntegrator {
-                max_depth,
-                ..VolPathIntegrator::default()
-            }
-            .into(),
-        }),
-        "volpathmis" => Ok(match image {
-            Integrator::VolPath(v) if v.tracking != Tracking::Spectral => {
-                Integrator::VolPath(v.clone())
-            }
-            _ => VolPathIntegrator {
-                max_depth,
-                tracking: Tracking::HeroMis { spectral_mis: true },
-                ..VolPathIntegrator::default()
-            }
-            .into(),
-        }),
-        other => Err(Error::usage(format!("unknown integrator \"{other}\""))
-            .with_help("use path, direct, distrib, volpath or volpathmis")),
-    }
+    let defaults: Integrator = match name {
+        "path" => PathIntegrator {
+            max_depth,
+            ..PathIntegrator::default()
+        }
+        .into(),
+        "direct" => DirectIntegrator::default().into(),
+        "distrib" => DistributionIntegrator {
+            max_depth,
+            ..DistributionIntegrator::default()
+        }
+        .into(),
+        "volpath" => VolPathIntegrator {
+            max_depth,
+            ..VolPathIntegrator::default()
+        }
+        .into(),
+        "volpathmis" => VolPathIntegrator {
+            max_depth,
+            tracking: Tracking::HeroMis { spectral_mis: true },
+            ..VolPathIntegrator::default()
+        }
+        .into(),
+        other => {
+            return Err(Error::usage(format!("unknown integrator \"{other}\""))
+                .with_help("use path, direct, distrib, volpath or volpathmis"));
+        }
+    };
+    Ok(if integrator_label(image) == name {
+        image.clone()
+    } else {
+        defaults
+    })
 }
 
 fn sampler_named(name: &str) -> Result<SamplerKind> {
@@ -164,17 +154,6 @@ fn integrator_label(integrator: &Integrator) -> &'static str {
         Integrator::VolPath(_) => "volpathmis",
         Integrator::Moment(_) => "moment",
         Integrator::Aov(_) => "aov",
-    }
-}
-
-fn sampler_label(kind: SamplerKind) -> &'static str {
-    match kind {
-        SamplerKind::Independent => "independent",
-        SamplerKind::Stratified { .. } => "stratified",
-        SamplerKind::MultiJitter { .. } => "multijitter",
-        SamplerKind::NRooks => "nrooks",
-        SamplerKind::LowDiscrepancy => "ldsampler",
-        SamplerKind::Orthogonal { .. } => "orthogonal",
     }
 }
 
@@ -223,7 +202,7 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
         for &kind in &samplers {
             scene.integrator = integrator.clone();
             scene.sampler.kind = kind;
-            let label = format!("{} / {}", integrator_label(integrator), sampler_label(kind));
+            let label = format!("{} / {}", integrator_label(integrator), kind.name());
             let mut series = Series {
                 label,
                 points: Vec::new(),

@@ -10,8 +10,8 @@ pub struct TerminalProgress {
     bar: ProgressBar,
 }
 
-impl TerminalProgress {
-    pub fn new() -> TerminalProgress {
+impl Default for TerminalProgress {
+    fn default() -> TerminalProgress {
         TerminalProgress {
             bar: ProgressBar::with_draw_target(None, ProgressDrawTarget::stderr()),
         }

@@ -29,7 +29,7 @@ use prism_core::render::{
     Checkpoints, ProgressReport, RenderOptions, SampleEstimator, Snapshot, StopReason, StopRule,
     StopRuleNames, render_with_checkpoints,
 };
-use prism_core::sampling::sampler::{Sampler, SamplerKind};
+use prism_core::sampling::sampler::Sampler;
 use prism_core::scene::Scene;
 use prism_core::spectrum::WavelengthSampling;
 use prism_mitsuba::fingerprint::{override_reconstruction, override_wavelengths};
@@ -120,21 +120,24 @@ fn parse_numbers(
 }
 
 pub(crate) fn parse_reconstruction(text: &str) -> Result<Reconstruction, String> {
-    Reconstruction::from_name(text).ok_or_else(|| {
-        format!(
-            "expected one of {}, got \"{text}\"",
-            Reconstruction::NAMES.join(", ")
-        )
-    })
+    parse_name(text, Reconstruction::from_name, &Reconstruction::NAMES)
 }
 
 pub(crate) fn parse_wavelengths(text: &str) -> Result<WavelengthSampling, String> {
-    WavelengthSampling::from_name(text).ok_or_else(|| {
-        format!(
-            "expected one of {}, got \"{text}\"",
-            WavelengthSampling::NAMES.join(", ")
-        )
-    })
+    parse_name(
+        text,
+        WavelengthSampling::from_name,
+        &WavelengthSampling::NAMES,
+    )
+}
+
+/// The value called `text`, read by `from_name`, one of `names`.
+fn parse_name<T>(
+    text: &str,
+    from_name: fn(&str) -> Option<T>,
+    names: &[&str],
+) -> Result<T, String> {
+    from_name(text).ok_or_else(|| format!("expected one of {}, got \"{text}\"", names.join(", ")))
 }
 
 fn parse_crop(text: &str) -> Result<[u32; 4], String> {
@@ -220,18 +223,6 @@ fn stop_rule(args: &RenderArgs, scene_spp: u32) -> Result<StopRule> {
     Ok(rule)
 }
 
-/// The sampler's name in render states and messages.
-fn sampler_name(kind: SamplerKind) -> &'static str {
-    match kind {
-        SamplerKind::Independent => "independent",
-        SamplerKind::Stratified { .. } => "stratified",
-        SamplerKind::MultiJitter { .. } => "multijitter",
-        SamplerKind::NRooks => "nrooks",
-        SamplerKind::LowDiscrepancy => "ldsampler",
-        SamplerKind::Orthogonal { .. } => "orthogonal",
-    }
-}
-
 /// Signals that stop a render: the first raises `interrupt` (and records its number), a second
 /// exits at once with the conventional status.
 fn install_signal_handlers(interrupt: Arc<AtomicBool>, signal: Arc<AtomicI32>) -> Result<()> {
@@ -307,7 +298,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let identity = RenderIdentity {
         scene: scene.fingerprint,
         seed,
-        sampler: sampler_name(scene.sampler.kind).to_string(),
+        sampler: scene.sampler.kind.name().to_string(),
         samples_per_pixel: strata,
         film_size: scene.film.size,
         crop: scene.film.crop,
@@ -370,7 +361,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         seed,
         progress: std::io::stderr()
             .is_terminal()
-            .then(|| Arc::new(TerminalProgress::new()) as Arc<dyn ProgressReport>),
+            .then(|| Arc::new(TerminalProgress::default()) as Arc<dyn ProgressReport>),
     };
     let (exr_path, png_path) = output_paths(args);
     let png_path = png_path.with_extension(scene.ldr_output.format.extension());

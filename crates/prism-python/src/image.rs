@@ -3,9 +3,10 @@
 
 use std::path::{Path, PathBuf};
 
-use numpy::ndarray::{Array2, Array3};
+use numpy::ndarray::{Array2, Array3, Dimension};
 use numpy::{
-    IntoPyArray, PyArray2, PyArray3, PyArrayMethods, PyReadonlyArray2, PyUntypedArrayMethods,
+    IntoPyArray, PyArray, PyArray2, PyArray3, PyArrayMethods, PyReadonlyArray2,
+    PyUntypedArrayMethods,
 };
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict};
@@ -113,31 +114,14 @@ impl Image {
 
     /// The arrays' current values.
     fn images(&self, py: Python<'_>) -> FilmImages {
-        let rgb = self.rgb.bind(py).readonly();
-        let values = |array: &Py<PyArray3<f32>>| -> Vec<f32> {
-            array
-                .bind(py)
-                .readonly()
-                .as_array()
-                .iter()
-                .copied()
-                .collect()
-        };
-        let shape = rgb.shape();
+        let shape = self.rgb.bind(py).shape();
         FilmImages {
             width: shape[1],
             height: shape[0],
-            rgb: values(&self.rgb),
-            xyz: values(&self.xyz),
-            variance: values(&self.variance),
-            relative_error: self
-                .relative_error
-                .bind(py)
-                .readonly()
-                .as_array()
-                .iter()
-                .copied()
-                .collect(),
+            rgb: values(self.rgb.bind(py)),
+            xyz: values(self.xyz.bind(py)),
+            variance: values(self.variance.bind(py)),
+            relative_error: values(self.relative_error.bind(py)),
         }
     }
 }
@@ -217,6 +201,11 @@ impl Image {
             self.spp
         )
     }
+}
+
+/// The values of `array`, in row-major order.
+fn values<D: Dimension>(array: &Bound<'_, PyArray<f32, D>>) -> Vec<f32> {
+    array.readonly().as_array().iter().copied().collect()
 }
 
 /// An EXR file given to read, whose failures are the input's fault.

@@ -56,14 +56,13 @@ impl Scene {
 
     #[setter]
     fn set_wavelengths(&mut self, py: Python<'_>, name: &str) -> PyResult<()> {
-        let density = WavelengthSampling::from_name(name).ok_or_else(|| {
-            to_py(
-                py,
-                &Error::usage(format!("no wavelength density is called \"{name}\"")).with_help(
-                    format!("choose one of {}", WavelengthSampling::NAMES.join(", ")),
-                ),
-            )
-        })?;
+        let density = named(
+            py,
+            "wavelength density",
+            name,
+            WavelengthSampling::from_name,
+            &WavelengthSampling::NAMES,
+        )?;
         override_wavelengths(&mut self.loaded.scene, density);
         Ok(())
     }
@@ -77,14 +76,13 @@ impl Scene {
 
     #[setter]
     fn set_reconstruction(&mut self, py: Python<'_>, name: &str) -> PyResult<()> {
-        let reconstruction = Reconstruction::from_name(name).ok_or_else(|| {
-            to_py(
-                py,
-                &Error::usage(format!("no reconstruction is called \"{name}\"")).with_help(
-                    format!("choose one of {}", Reconstruction::NAMES.join(", ")),
-                ),
-            )
-        })?;
+        let reconstruction = named(
+            py,
+            "reconstruction",
+            name,
+            Reconstruction::from_name,
+            &Reconstruction::NAMES,
+        )?;
         override_reconstruction(&mut self.loaded.scene, reconstruction);
         Ok(())
     }
@@ -116,4 +114,22 @@ pub fn load_dict(py: Python<'_>, scene: &Bound<'_, PyDict>) -> PyResult<Scene> {
     let root = dict_of(scene, "scene")?;
     let loaded = py.detach(|| load_scene_dict(&root)).into_py_result(py)?;
     Ok(Scene { loaded })
+}
+
+/// The setting called `name`, read by `from_name`; else a usage error that names the `what` and
+/// lists the `names` there are.
+fn named<T>(
+    py: Python<'_>,
+    what: &str,
+    name: &str,
+    from_name: fn(&str) -> Option<T>,
+    names: &[&str],
+) -> PyResult<T> {
+    from_name(name).ok_or_else(|| {
+        to_py(
+            py,
+            &Error::usage(format!("no {what} is called \"{name}\""))
+                .with_help(format!("choose one of {}", names.join(", "))),
+        )
+    })
 }

@@ -44,50 +44,38 @@ use crate::sampling::sampler::Sampler;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use crate::world::World;
 
-/// The scene's integrator.
-#[derive(Clone, Debug)]
-pub enum Integrator {
-    Path(PathIntegrator),
-    Direct(DirectIntegrator),
-    Distribution(DistributionIntegrator),
-    Moment(MomentIntegrator),
-    Aov(AovIntegrator),
-    VolPath(VolPathIntegrator),
+/// Declares the [`Integrator`] enum with a `From` conversion per variant, so that an
+/// integrator's settings become the scene's integrator with `.into()`.
+macro_rules! integrator_enum {
+    (
+        $(#[$meta:meta])*
+        pub enum Integrator {
+            $($variant:ident($integrator:ty),)+
+        }
+    ) => {
+        $(#[$meta])*
+        pub enum Integrator {
+            $($variant($integrator),)+
+        }
+
+        $(impl From<$integrator> for Integrator {
+            fn from(integrator: $integrator) -> Integrator {
+                Integrator::$variant(integrator)
+            }
+        })+
+    };
 }
 
-impl From<AovIntegrator> for Integrator {
-    fn from(integrator: AovIntegrator) -> Integrator {
-        Integrator::Aov(integrator)
-    }
-}
-
-impl From<DirectIntegrator> for Integrator {
-    fn from(integrator: DirectIntegrator) -> Integrator {
-        Integrator::Direct(integrator)
-    }
-}
-
-impl From<MomentIntegrator> for Integrator {
-    fn from(integrator: MomentIntegrator) -> Integrator {
-        Integrator::Moment(integrator)
-    }
-}
-
-impl From<VolPathIntegrator> for Integrator {
-    fn from(integrator: VolPathIntegrator) -> Integrator {
-        Integrator::VolPath(integrator)
-    }
-}
-
-impl From<PathIntegrator> for Integrator {
-    fn from(integrator: PathIntegrator) -> Integrator {
-        Integrator::Path(integrator)
-    }
-}
-
-impl From<DistributionIntegrator> for Integrator {
-    fn from(integrator: DistributionIntegrator) -> Integrator {
-        Integrator::Distribution(integrator)
+integrator_enum! {
+    /// The scene's integrator.
+    #[derive(Clone, Debug)]
+    pub enum Integrator {
+        Path(PathIntegrator),
+        Direct(DirectIntegrator),
+        Distribution(DistributionIntegrator),
+        Moment(MomentIntegrator),
+        Aov(AovIntegrator),
+        VolPath(VolPathIntegrator),
     }
 }
 

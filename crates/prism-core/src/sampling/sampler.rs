@@ -67,6 +67,18 @@ pub enum SamplerKind {
 pub const MAX_ORTHOGONAL_STRENGTH: u32 = 4;
 
 impl SamplerKind {
+    /// The sampler's plugin name, as scenes, render states and messages write it.
+    pub fn name(self) -> &'static str {
+        match self {
+            SamplerKind::Independent => "independent",
+            SamplerKind::Stratified { .. } => "stratified",
+            SamplerKind::MultiJitter { .. } => "multijitter",
+            SamplerKind::NRooks => "nrooks",
+            SamplerKind::LowDiscrepancy => "ldsampler",
+            SamplerKind::Orthogonal { .. } => "orthogonal",
+        }
+    }
+
     /// The sample count the sampler really takes for a requested one: `stratified` rounds up to
     /// a square (its 2-D grids are √N × √N) and `multijitter` to a product m·n with m ≥ n close to
     /// √N, as Mitsuba does; the others take any count.
@@ -293,20 +305,11 @@ impl Sampler {
             SamplerKind::Independent | SamplerKind::NRooks => self.rng.next_f32(),
             SamplerKind::Stratified { .. } | SamplerKind::MultiJitter { .. } => {
                 let dimension = self.next_dimension();
-                let stratum = permute(
-                    self.index,
-                    self.sample_count,
-                    self.permutation_seed(dimension, 0),
-                );
-                (stratum as f32 + self.jitter_value()) / self.sample_count as f32
+                self.latin_hypercube(dimension)
             }
             SamplerKind::LowDiscrepancy => {
                 let dimension = self.next_dimension();
-                let i = permute(
-                    self.index,
-                    self.sample_count,
-                    self.permutation_seed(dimension, 0),
-                );
+                let i = self.stratum(dimension);
                 let scramble = self.permutation_seed(dimension, 1);
                 unit_from_bits(radical_inverse_2(i, scramble))
             }
@@ -328,11 +331,7 @@ impl Sampler {
             }
             SamplerKind::Stratified { .. } => {
                 let dimension = self.next_dimension();
-                let cell = permute(
-                    self.index,
-                    self.sample_count,
-                    self.permutation_seed(dimension, 0),
-                );
+                let cell = self.stratum(dimension);
                 let (jx, jy) = (self.jitter_value(), self.jitter_value());
                 Vec2::new(
                     ((cell % self.columns) as f32 + jx) / self.columns as f32,
@@ -345,11 +344,7 @@ impl Sampler {
             }
             SamplerKind::LowDiscrepancy => {
                 let dimension = self.next_dimension();
-                let i = permute(
-                    self.index,
-                    self.sample_count,
-                    self.permutation_seed(dimension, 0),
-                );
+                let i = self.stratum(dimension);
                 let (scramble_x, scramble_y) = (
                     self.permutation_seed(dimension, 1),
                     self.permutation_seed(dimension, 2),
@@ -386,14 +381,20 @@ impl Sampler {
         hash_u64s(&[self.pixel_seed, u64::from(dimension), u64::from(part)]) as u32
     }
 
-    /// Coordinate `dimension` of the current sample in a Latin hypercube over the pixel's N
-    /// samples: stratum π_d(i) of N, jittered.
-    fn latin_hypercube(&mut self, dimension: u32) -> f32 {
-        let stratum = permute(
+    /// The current sample's place π_d(i) in dimension `dimension`'s permutation of the pixel's
+    /// N samples: its stratum of N in that dimension.
+    fn stratum(&self, dimension: u32) -> u32 {
+        permute(
             self.index,
             self.sample_count,
             self.permutation_seed(dimension, 0),
-        );
+        )
+    }
+
+    /// Coordinate `dimension` of the current sample in a Latin hypercube over the pixel's N
+    /// samples: stratum π_d(i) of N, jittered.
+    fn latin_hypercube(&mut self, dimension: u32) -> f32 {
+        let stratum = self.stratum(dimension);
         (stratum as f32 + self.jitter_value()) / self.sample_count as f32
     }
 
@@ -402,11 +403,7 @@ impl Sampler {
     /// with the columns' and rows' shuffles correlated; the sample index itself is permuted first.
     fn correlated_multi_jittered(&mut self, dimension: u32) -> Vec2 {
         let (m, n) = (self.columns, self.rows);
-        let s = permute(
-            self.index,
-            self.sample_count,
-            self.permutation_seed(dimension, 0),
-        );
+        let s = self.stratum(dimension);
         let (x, y) = (s % m, s / m);
         let sx = permute(x, m, self.permutation_seed(dimension, 1));
         let sy = permute(y, n, self.permutation_seed(dimension, 2));

@@ -106,18 +106,7 @@ impl RgbSigmoidPolynomial {
         if rgb[0] == rgb[1] && rgb[1] == rgb[2] {
             return Self::constant(rgb[0]);
         }
-        let target = rgb.map(f64::from);
-        // Continuation from grey: solve for colours on the segment from the grey of the same
-        // mean to the target, each solution starting the next iteration.
-        let mean = (target[0] + target[1] + target[2]) / 3.0;
-        let mut coefficients = [0.0f64, 0.0, logit_of_constant(mean)];
-        const STEPS: usize = 8;
-        for step in 1..=STEPS {
-            let t = step as f64 / STEPS as f64;
-            let partial = std::array::from_fn(|c| mean + t * (target[c] - mean));
-            coefficients = gauss_newton(partial, coefficients);
-        }
-        to_nanometre_coefficients(coefficients)
+        to_nanometre_coefficients(fit_from_grey(rgb.map(f64::from)))
     }
 }
 
@@ -273,14 +262,7 @@ impl RgbToSpectrumTable {
                 };
                 let mut c = gauss_newton(rgb, start);
                 if lab_error(rgb, &c) > 1e-6 {
-                    let mean = (rgb[0] + rgb[1] + rgb[2]) / 3.0;
-                    let mut restart = [0.0, 0.0, logit_of_constant(mean)];
-                    const STEPS: usize = 8;
-                    for step in 1..=STEPS {
-                        let t = step as f64 / STEPS as f64;
-                        let partial = std::array::from_fn(|c| mean + t * (rgb[c] - mean));
-                        restart = gauss_newton(partial, restart);
-                    }
+                    let restart = fit_from_grey(rgb);
                     if lab_error(rgb, &restart) < lab_error(rgb, &c) {
                         c = restart;
                     }
@@ -343,6 +325,21 @@ fn lab_error(rgb: [f64; 3], coefficients: &[f64; 3]) -> f64 {
     let target = lab(mul3(&LINEAR_SRGB_TO_XYZ, rgb.map(|c| c as f32)).map(f64::from));
     let model = lab(xyz_of(coefficients));
     (0..3).map(|j| (target[j] - model[j]).powi(2)).sum()
+}
+
+/// The normalised coefficients of `target` by continuation from grey: solves for the colours on
+/// the segment from the grey of the same mean to the target in eight steps, each solution
+/// starting the next.
+fn fit_from_grey(target: [f64; 3]) -> [f64; 3] {
+    let mean = (target[0] + target[1] + target[2]) / 3.0;
+    let mut coefficients = [0.0f64, 0.0, logit_of_constant(mean)];
+    const STEPS: usize = 8;
+    for step in 1..=STEPS {
+        let t = step as f64 / STEPS as f64;
+        let partial = std::array::from_fn(|c| mean + t * (target[c] - mean));
+        coefficients = gauss_newton(partial, coefficients);
+    }
+    coefficients
 }
 
 /// s⁻¹(v) for the model's sigmoid, finite for v strictly inside (0, 1).

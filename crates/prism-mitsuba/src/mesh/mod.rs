@@ -73,6 +73,46 @@ fn file_error(path: &Path, message: impl Display) -> Error {
     Error::usage(format!("{}: {message}", path.display()))
 }
 
+/// The vertices or the triangles of the mesh read from `path`, for checking an attribute that
+/// has one value per element.
+struct Elements<'a> {
+    path: &'a Path,
+    /// The element's name, singular and plural.
+    singular: &'static str,
+    plural: &'static str,
+    count: usize,
+}
+
+impl Elements<'_> {
+    /// Checks that `values`, when present, hold one value per element and that all their
+    /// numbers are finite; `name` names one value and `names` the attribute in the errors.
+    fn check<T: Copy + Into<[f32; N]>, const N: usize>(
+        &self,
+        name: &str,
+        names: &str,
+        values: Option<&[T]>,
+    ) -> Result<()> {
+        let Some(values) = values else {
+            return Ok(());
+        };
+        let (element, elements, count) = (self.singular, self.plural, self.count);
+        if values.len() != count {
+            return Err(file_error(
+                self.path,
+                format!("{} {names} for {count} {elements}", values.len()),
+            ));
+        }
+        let finite = |v: T| v.into().iter().all(|c| c.is_finite());
+        match values.iter().position(|&v| !finite(v)) {
+            Some(i) => Err(file_error(
+                self.path,
+                format!("the {name} of {element} {i} is not a finite number"),
+            )),
+            None => Ok(()),
+        }
+    }
+}
+
 impl MeshData {
     /// Checks that every index is in range, that normals and texture coordinates come one per
     /// vertex, and that all numbers are finite. The readers report these problems with a line
@@ -93,75 +133,24 @@ impl MeshData {
                 ));
             }
         }
-        if let Some(i) = self.positions.iter().position(|p| !p.is_finite()) {
-            return Err(file_error(
-                path,
-                format!("the position of vertex {i} is not a finite number"),
-            ));
-        }
-        if let Some(normals) = &self.normals {
-            if normals.len() != vertex_count {
-                return Err(file_error(
-                    path,
-                    format!("{} normals for {vertex_count} vertices", normals.len()),
-                ));
-            }
-            if let Some(i) = normals.iter().position(|n| !n.is_finite()) {
-                return Err(file_error(
-                    path,
-                    format!("the normal of vertex {i} is not a finite number"),
-                ));
-            }
-        }
-        if let Some(uvs) = &self.uvs {
-            if uvs.len() != vertex_count {
-                return Err(file_error(
-                    path,
-                    format!(
-                        "{} texture coordinates for {vertex_count} vertices",
-                        uvs.len()
-                    ),
-                ));
-            }
-            if let Some(i) = uvs.iter().position(|uv| !uv.is_finite()) {
-                return Err(file_error(
-                    path,
-                    format!("the texture coordinate of vertex {i} is not a finite number"),
-                ));
-            }
-        }
-        if let Some(colors) = &self.colors {
-            if colors.len() != vertex_count {
-                return Err(file_error(
-                    path,
-                    format!("{} colours for {vertex_count} vertices", colors.len()),
-                ));
-            }
-            if let Some(i) = colors.iter().position(|c| !c.is_finite()) {
-                return Err(file_error(
-                    path,
-                    format!("the colour of vertex {i} is not a finite number"),
-                ));
-            }
-        }
-        if let Some(colors) = &self.face_colors {
-            let triangle_count = self.triangles.len();
-            if colors.len() != triangle_count {
-                return Err(file_error(
-                    path,
-                    format!(
-                        "{} face colours for {triangle_count} triangles",
-                        colors.len()
-                    ),
-                ));
-            }
-            if let Some(i) = colors.iter().position(|c| !c.is_finite()) {
-                return Err(file_error(
-                    path,
-                    format!("the colour of triangle {i} is not a finite number"),
-                ));
-            }
-        }
+        let vertices = Elements {
+            path,
+            singular: "vertex",
+            plural: "vertices",
+            count: vertex_count,
+        };
+        let triangles = Elements {
+            path,
+            singular: "triangle",
+            plural: "triangles",
+            count: self.triangles.len(),
+        };
+        vertices.check("position", "positions", Some(&self.positions))?;
+        vertices.check("normal", "normals", self.normals.as_deref())?;
+        let uvs = self.uvs.as_deref();
+        vertices.check("texture coordinate", "texture coordinates", uvs)?;
+        vertices.check("colour", "colours", self.colors.as_deref())?;
+        triangles.check("colour", "face colours", self.face_colors.as_deref())?;
         Ok(())
     }
 
