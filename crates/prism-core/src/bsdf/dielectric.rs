@@ -22,7 +22,7 @@
 use glam::{Vec2, Vec3};
 
 use super::fresnel::{fresnel_dielectric, reflect_z, refract_z};
-use super::{BsdfFlags, BsdfModel, BsdfSample, Bxdf, BxdfTree, NodeId, ShadingPoint};
+use super::{BsdfFlags, BsdfSample, Bxdf, BxdfTree, LeafBsdf};
 use crate::spectrum::ior::RelativeIor;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use crate::texture::TextureValues;
@@ -82,7 +82,9 @@ const FLAGS: BsdfFlags = BsdfFlags::SPECULAR
     .union(BsdfFlags::REFLECTION)
     .union(BsdfFlags::TRANSMISSION);
 
-impl BsdfModel for Dielectric {
+impl LeafBsdf for Dielectric {
+    type Lobes<'a> = DielectricLobes;
+
     fn flags(&self) -> BsdfFlags {
         FLAGS
     }
@@ -91,37 +93,13 @@ impl BsdfModel for Dielectric {
         self.eta.is_dispersive()
     }
 
-    fn node_count(&self) -> usize {
-        1
-    }
-
-    /// None: only specular lobes.
-    fn diffuse_reflectance(
-        &self,
-        _point: &ShadingPoint,
-        _wo: Vec3,
-        _lambda: &SampledWavelengths,
-    ) -> SampledSpectrum {
-        SampledSpectrum::ZERO
-    }
-
     #[inline]
-    fn resolve<'a>(
-        &'a self,
-        point: &ShadingPoint,
-        _wo: Vec3,
-        lambda: &SampledWavelengths,
-        tree: &mut BxdfTree<'a>,
-    ) -> NodeId {
-        tree.push(DielectricLobes {
+    fn lobes(&self, at: TexturePoint, lambda: &SampledWavelengths) -> DielectricLobes {
+        DielectricLobes {
             eta: SampledIor::at(&self.eta, lambda),
-            specular_reflectance: optional_factor(&self.specular_reflectance, point.at(), lambda),
-            specular_transmittance: optional_factor(
-                &self.specular_transmittance,
-                point.at(),
-                lambda,
-            ),
-        })
+            specular_reflectance: optional_factor(&self.specular_reflectance, at, lambda),
+            specular_transmittance: optional_factor(&self.specular_transmittance, at, lambda),
+        }
     }
 }
 

@@ -13,8 +13,9 @@
 
 use glam::{Vec2, Vec3};
 
-use super::{BsdfFlags, BsdfModel, BsdfSample, Bxdf, BxdfTree, NodeId, ShadingPoint};
+use super::{BsdfFlags, BsdfSample, Bxdf, BxdfTree, LeafBsdf};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+use crate::texture::TexturePoint;
 
 /// The `null` BSDF (no parameters).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -22,38 +23,16 @@ pub struct Null;
 
 const FLAGS: BsdfFlags = BsdfFlags::NULL;
 
-impl BsdfModel for Null {
+impl LeafBsdf for Null {
+    type Lobes<'a> = NullLobes;
+
     fn flags(&self) -> BsdfFlags {
         FLAGS
     }
 
-    fn is_dispersive(&self) -> bool {
-        false
-    }
-
-    fn node_count(&self) -> usize {
-        1
-    }
-
-    /// None: light passes straight through.
-    fn diffuse_reflectance(
-        &self,
-        _point: &ShadingPoint,
-        _wo: Vec3,
-        _lambda: &SampledWavelengths,
-    ) -> SampledSpectrum {
-        SampledSpectrum::ZERO
-    }
-
     #[inline]
-    fn resolve<'a>(
-        &'a self,
-        _point: &ShadingPoint,
-        _wo: Vec3,
-        _lambda: &SampledWavelengths,
-        tree: &mut BxdfTree<'a>,
-    ) -> NodeId {
-        tree.push(NullLobes)
+    fn lobes(&self, _at: TexturePoint, _lambda: &SampledWavelengths) -> NullLobes {
+        NullLobes
     }
 }
 

@@ -20,14 +20,12 @@ use std::f32::consts::{FRAC_1_PI, PI};
 use glam::{Vec2, Vec3};
 
 use super::fresnel::reflect_z;
-use super::{
-    BsdfEval, BsdfFlags, BsdfModel, BsdfSample, Bxdf, BxdfTree, NodeId, ShadingPoint,
-    mixture_sample,
-};
+use super::{BsdfEval, BsdfFlags, BsdfSample, Bxdf, BxdfTree, LeafBsdf, mixture_sample};
 use crate::math::Frame;
 use crate::sampling::warp::{cosine_hemisphere_pdf, sample_cosine_hemisphere};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use crate::texture::Texture;
+use crate::texture::TexturePoint;
 use crate::texture::TextureValues;
 
 #[derive(Clone, Debug)]
@@ -43,46 +41,29 @@ const FLAGS: BsdfFlags = BsdfFlags::GLOSSY
     .union(BsdfFlags::DIFFUSE)
     .union(BsdfFlags::REFLECTION);
 
-impl BsdfModel for Phong {
+impl LeafBsdf for Phong {
+    type Lobes<'a> = PhongLobes;
+
     fn flags(&self) -> BsdfFlags {
         FLAGS
     }
 
-    fn is_dispersive(&self) -> bool {
-        false
-    }
-
-    fn node_count(&self) -> usize {
-        1
-    }
-
     /// The diffuse reflectance, scaled as the lobes are.
-    fn diffuse_reflectance(
-        &self,
-        point: &ShadingPoint,
-        _wo: Vec3,
-        lambda: &SampledWavelengths,
-    ) -> SampledSpectrum {
-        self.scale * self.diffuse_reflectance.eval(point.at(), lambda)
+    fn albedo(&self, at: TexturePoint, lambda: &SampledWavelengths) -> SampledSpectrum {
+        self.scale * self.diffuse_reflectance.eval(at, lambda)
     }
 
     #[inline]
-    fn resolve<'a>(
-        &'a self,
-        point: &ShadingPoint,
-        _wo: Vec3,
-        lambda: &SampledWavelengths,
-        tree: &mut BxdfTree<'a>,
-    ) -> NodeId {
-        let specular = self.specular_reflectance.eval(point.at(), lambda) * self.scale;
-        let diffuse = self.diffuse_reflectance.eval(point.at(), lambda) * self.scale;
+    fn lobes(&self, at: TexturePoint, lambda: &SampledWavelengths) -> PhongLobes {
+        let specular = self.specular_reflectance.eval(at, lambda) * self.scale;
+        let diffuse = self.diffuse_reflectance.eval(at, lambda) * self.scale;
         let (s, d) = (specular.average(), diffuse.average());
-        tree.push(PhongLobes {
-            exponent: self.exponent.eval_1(point.at()),
+        PhongLobes {
+            exponent: self.exponent.eval_1(at),
             specular,
             diffuse,
             p_glossy: if s + d > 0.0 { s / (s + d) } else { 1.0 },
-        })
+        }
     }
 }
 

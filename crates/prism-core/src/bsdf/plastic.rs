@@ -27,13 +27,11 @@ use glam::{Vec2, Vec3};
 
 use super::dielectric::optional_factor;
 use super::fresnel::{fresnel_dielectric, fresnel_diffuse_reflectance, reflect_z};
-use super::{
-    BsdfEval, BsdfFlags, BsdfModel, BsdfSample, Bxdf, BxdfTree, NodeId, ShadingPoint,
-    mixture_sample,
-};
+use super::{BsdfEval, BsdfFlags, BsdfSample, Bxdf, BxdfTree, LeafBsdf, mixture_sample};
 use crate::sampling::warp::{cosine_hemisphere_pdf, sample_cosine_hemisphere};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use crate::texture::Texture;
+use crate::texture::TexturePoint;
 use crate::texture::TextureValues;
 
 #[derive(Clone, Debug)]
@@ -71,39 +69,22 @@ const FLAGS: BsdfFlags = BsdfFlags::SPECULAR
     .union(BsdfFlags::DIFFUSE)
     .union(BsdfFlags::REFLECTION);
 
-impl BsdfModel for Plastic {
+impl LeafBsdf for Plastic {
+    type Lobes<'a> = PlasticLobes<'a>;
+
     fn flags(&self) -> BsdfFlags {
         FLAGS
     }
 
-    fn is_dispersive(&self) -> bool {
-        false
-    }
-
-    fn node_count(&self) -> usize {
-        1
-    }
-
     /// The diffuse reflectance under the coating.
-    fn diffuse_reflectance(
-        &self,
-        point: &ShadingPoint,
-        _wo: Vec3,
-        lambda: &SampledWavelengths,
-    ) -> SampledSpectrum {
-        self.diffuse_reflectance.eval(point.at(), lambda)
+    fn albedo(&self, at: TexturePoint, lambda: &SampledWavelengths) -> SampledSpectrum {
+        self.diffuse_reflectance.eval(at, lambda)
     }
 
     #[inline]
-    fn resolve<'a>(
-        &'a self,
-        point: &ShadingPoint,
-        _wo: Vec3,
-        lambda: &SampledWavelengths,
-        tree: &mut BxdfTree<'a>,
-    ) -> NodeId {
+    fn lobes<'a>(&'a self, at: TexturePoint, lambda: &SampledWavelengths) -> PlasticLobes<'a> {
         // ρ / (1 − F_dr) or, nonlinear, ρ / (1 − ρ F_dr).
-        let rho = self.diffuse_reflectance.eval(point.at(), lambda);
+        let rho = self.diffuse_reflectance.eval(at, lambda);
         let diffuse = SampledSpectrum::from_fn(|i| {
             let bounce = if self.nonlinear {
                 rho[i] * self.fdr_internal
@@ -112,11 +93,11 @@ impl BsdfModel for Plastic {
             };
             rho[i] / (1.0 - bounce)
         });
-        tree.push(PlasticLobes {
+        PlasticLobes {
             plastic: self,
             diffuse,
-            specular_reflectance: optional_factor(&self.specular_reflectance, point.at(), lambda),
-        })
+            specular_reflectance: optional_factor(&self.specular_reflectance, at, lambda),
+        }
     }
 }
 

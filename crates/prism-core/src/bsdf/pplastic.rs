@@ -30,13 +30,11 @@ use glam::{Vec2, Vec3};
 use super::dielectric::optional_factor;
 use super::fresnel::{fresnel_dielectric, reflect};
 use super::microfacet::{Microfacet, MicrofacetKind};
-use super::{
-    BsdfEval, BsdfFlags, BsdfModel, BsdfSample, Bxdf, BxdfTree, NodeId, ShadingPoint,
-    mixture_sample,
-};
+use super::{BsdfEval, BsdfFlags, BsdfSample, Bxdf, BxdfTree, LeafBsdf, mixture_sample};
 use crate::sampling::warp::{cosine_hemisphere_pdf, sample_cosine_hemisphere};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use crate::texture::Texture;
+use crate::texture::TexturePoint;
 use crate::texture::TextureValues;
 
 #[derive(Clone, Debug)]
@@ -54,51 +52,34 @@ const FLAGS: BsdfFlags = BsdfFlags::GLOSSY
     .union(BsdfFlags::DIFFUSE)
     .union(BsdfFlags::REFLECTION);
 
-impl BsdfModel for PolarizedPlastic {
+impl LeafBsdf for PolarizedPlastic {
+    type Lobes<'a> = PolarizedPlasticLobes;
+
     fn flags(&self) -> BsdfFlags {
         FLAGS
     }
 
-    fn is_dispersive(&self) -> bool {
-        false
-    }
-
-    fn node_count(&self) -> usize {
-        1
-    }
-
     /// The diffuse reflectance of the base.
-    fn diffuse_reflectance(
-        &self,
-        point: &ShadingPoint,
-        _wo: Vec3,
-        lambda: &SampledWavelengths,
-    ) -> SampledSpectrum {
-        self.diffuse_reflectance.eval(point.at(), lambda)
+    fn albedo(&self, at: TexturePoint, lambda: &SampledWavelengths) -> SampledSpectrum {
+        self.diffuse_reflectance.eval(at, lambda)
     }
 
     #[inline]
-    fn resolve<'a>(
-        &'a self,
-        point: &ShadingPoint,
-        _wo: Vec3,
-        lambda: &SampledWavelengths,
-        tree: &mut BxdfTree<'a>,
-    ) -> NodeId {
-        let diffuse = self.diffuse_reflectance.eval(point.at(), lambda);
-        let specular = optional_factor(&self.specular_reflectance, point.at(), lambda);
+    fn lobes(&self, at: TexturePoint, lambda: &SampledWavelengths) -> PolarizedPlasticLobes {
+        let diffuse = self.diffuse_reflectance.eval(at, lambda);
+        let specular = optional_factor(&self.specular_reflectance, at, lambda);
         let (s, d) = (specular.average(), diffuse.average());
-        tree.push(PolarizedPlasticLobes {
+        PolarizedPlasticLobes {
             eta: self.eta,
             distribution: Microfacet::new(
                 self.distribution,
-                self.alpha_u.eval_1(point.at()),
-                self.alpha_v.eval_1(point.at()),
+                self.alpha_u.eval_1(at),
+                self.alpha_v.eval_1(at),
             ),
             diffuse,
             specular,
             p_specular: if s + d > 0.0 { s / (s + d) } else { 1.0 },
-        })
+        }
     }
 }
 

@@ -52,10 +52,11 @@ use super::burley::{
 };
 use super::fresnel::{fresnel_dielectric, reflect, refract};
 use super::microfacet::{Microfacet, MicrofacetKind};
-use super::{BsdfEval, BsdfFlags, BsdfModel, BsdfSample, Bxdf, BxdfTree, NodeId, ShadingPoint};
+use super::{BsdfEval, BsdfFlags, BsdfSample, Bxdf, BxdfTree, LeafBsdf};
 use crate::sampling::warp::{cosine_hemisphere_pdf, sample_cosine_hemisphere};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use crate::texture::Texture;
+use crate::texture::TexturePoint;
 use crate::texture::TextureValues;
 
 /// The relative weights with which the lobes are sampled (Mitsuba's `*_sampling_rate`).
@@ -86,7 +87,9 @@ pub struct Principled {
     pub rates: SamplingRates,
 }
 
-impl BsdfModel for Principled {
+impl LeafBsdf for Principled {
+    type Lobes<'a> = PrincipledLobes;
+
     fn flags(&self) -> BsdfFlags {
         let reflection = BsdfFlags::DIFFUSE
             .union(BsdfFlags::GLOSSY)
@@ -98,33 +101,13 @@ impl BsdfModel for Principled {
         }
     }
 
-    fn is_dispersive(&self) -> bool {
-        false
-    }
-
-    fn node_count(&self) -> usize {
-        1
-    }
-
     /// The base colour, as Mitsuba's `eval_diffuse_reflectance`.
-    fn diffuse_reflectance(
-        &self,
-        point: &ShadingPoint,
-        _wo: Vec3,
-        lambda: &SampledWavelengths,
-    ) -> SampledSpectrum {
-        self.base_color.eval(point.at(), lambda)
+    fn albedo(&self, at: TexturePoint, lambda: &SampledWavelengths) -> SampledSpectrum {
+        self.base_color.eval(at, lambda)
     }
 
     #[inline]
-    fn resolve<'a>(
-        &'a self,
-        point: &ShadingPoint,
-        _wo: Vec3,
-        lambda: &SampledWavelengths,
-        tree: &mut BxdfTree<'a>,
-    ) -> NodeId {
-        let at = point.at();
+    fn lobes(&self, at: TexturePoint, lambda: &SampledWavelengths) -> PrincipledLobes {
         let base_color = self.base_color.eval(at, lambda);
         let roughness = self.roughness.eval_1(at);
         let (alpha_u, alpha_v) = specular_alphas(roughness, optional_value(&self.anisotropic, at));
@@ -136,7 +119,7 @@ impl BsdfModel for Principled {
             1.0
         };
         let clearcoat = optional_value(&self.clearcoat, at);
-        tree.push(PrincipledLobes {
+        PrincipledLobes {
             distribution: Microfacet::new(MicrofacetKind::Ggx, alpha_u, alpha_v),
             base_color,
             tint: tint(&base_color, luminance),
@@ -157,7 +140,7 @@ impl BsdfModel for Principled {
                 )
             }),
             rates: self.rates,
-        })
+        }
     }
 }
 

@@ -40,10 +40,11 @@ use super::burley::{
 };
 use super::fresnel::{fresnel_dielectric, reflect};
 use super::microfacet::{Microfacet, MicrofacetKind};
-use super::{BsdfEval, BsdfFlags, BsdfModel, BsdfSample, Bxdf, BxdfTree, NodeId, ShadingPoint};
+use super::{BsdfEval, BsdfFlags, BsdfSample, Bxdf, BxdfTree, LeafBsdf};
 use crate::sampling::warp::{cosine_hemisphere_pdf, sample_cosine_hemisphere};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use crate::texture::Texture;
+use crate::texture::TexturePoint;
 use crate::texture::TextureValues;
 
 /// The relative weights with which the lobes are sampled (Mitsuba's `*_sampling_rate`).
@@ -73,7 +74,9 @@ pub struct PrincipledThin {
     pub rates: ThinSamplingRates,
 }
 
-impl BsdfModel for PrincipledThin {
+impl LeafBsdf for PrincipledThin {
+    type Lobes<'a> = PrincipledThinLobes;
+
     /// Always transmitting, as Mitsuba declares it (so it cannot be nested in `twosided`).
     fn flags(&self) -> BsdfFlags {
         BsdfFlags::DIFFUSE
@@ -82,33 +85,13 @@ impl BsdfModel for PrincipledThin {
             .union(BsdfFlags::TRANSMISSION)
     }
 
-    fn is_dispersive(&self) -> bool {
-        false
-    }
-
-    fn node_count(&self) -> usize {
-        1
-    }
-
     /// The base colour, as Mitsuba's `eval_diffuse_reflectance`.
-    fn diffuse_reflectance(
-        &self,
-        point: &ShadingPoint,
-        _wo: Vec3,
-        lambda: &SampledWavelengths,
-    ) -> SampledSpectrum {
-        self.base_color.eval(point.at(), lambda)
+    fn albedo(&self, at: TexturePoint, lambda: &SampledWavelengths) -> SampledSpectrum {
+        self.base_color.eval(at, lambda)
     }
 
     #[inline]
-    fn resolve<'a>(
-        &'a self,
-        point: &ShadingPoint,
-        _wo: Vec3,
-        lambda: &SampledWavelengths,
-        tree: &mut BxdfTree<'a>,
-    ) -> NodeId {
-        let at = point.at();
+    fn lobes(&self, at: TexturePoint, lambda: &SampledWavelengths) -> PrincipledThinLobes {
         let base_color = self.base_color.eval(at, lambda);
         let roughness = self.roughness.eval_1(at);
         let anisotropic = optional_value(&self.anisotropic, at);
@@ -122,7 +105,7 @@ impl BsdfModel for PrincipledThin {
         } else {
             1.0
         };
-        tree.push(PrincipledThinLobes {
+        PrincipledThinLobes {
             reflection: Microfacet::new(MicrofacetKind::Ggx, alpha_u, alpha_v),
             transmission: Microfacet::new(MicrofacetKind::Ggx, scaled_u, scaled_v),
             base_color,
@@ -136,7 +119,7 @@ impl BsdfModel for PrincipledThin {
             flatness: optional_value(&self.flatness, at),
             diff_trans: optional_value(&self.diff_trans, at).map(|t| 0.5 * t),
             rates: self.rates,
-        })
+        }
     }
 }
 

@@ -28,10 +28,11 @@ use glam::{Vec2, Vec3};
 use super::dielectric::optional_factor;
 use super::fresnel::{fresnel_dielectric, reflect, refract};
 use super::microfacet::{Microfacet, MicrofacetKind};
-use super::{BsdfEval, BsdfFlags, BsdfModel, BsdfSample, Bxdf, BxdfTree, NodeId, ShadingPoint};
+use super::{BsdfEval, BsdfFlags, BsdfSample, Bxdf, BxdfTree, LeafBsdf};
 use crate::spectrum::ior::RelativeIor;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use crate::texture::Texture;
+use crate::texture::TexturePoint;
 use crate::texture::TextureValues;
 
 #[derive(Clone, Debug)]
@@ -48,7 +49,11 @@ const FLAGS: BsdfFlags = BsdfFlags::GLOSSY
     .union(BsdfFlags::REFLECTION)
     .union(BsdfFlags::TRANSMISSION);
 
-impl BsdfModel for RoughDielectric {
+/// No diffuse reflectance: only glossy lobes (Mitsuba 3 evaluates the BSDF towards the normal
+/// instead, see docs/mitsuba-compatibility.md).
+impl LeafBsdf for RoughDielectric {
+    type Lobes<'a> = RoughDielectricLobes;
+
     fn flags(&self) -> BsdfFlags {
         FLAGS
     }
@@ -57,43 +62,19 @@ impl BsdfModel for RoughDielectric {
         self.eta.is_dispersive()
     }
 
-    fn node_count(&self) -> usize {
-        1
-    }
-
-    /// None: only glossy lobes (Mitsuba 3 evaluates the BSDF towards the normal instead, see docs/mitsuba-compatibility.md).
-    fn diffuse_reflectance(
-        &self,
-        _point: &ShadingPoint,
-        _wo: Vec3,
-        _lambda: &SampledWavelengths,
-    ) -> SampledSpectrum {
-        SampledSpectrum::ZERO
-    }
-
     #[inline]
-    fn resolve<'a>(
-        &'a self,
-        point: &ShadingPoint,
-        _wo: Vec3,
-        lambda: &SampledWavelengths,
-        tree: &mut BxdfTree<'a>,
-    ) -> NodeId {
-        tree.push(RoughDielectricLobes {
+    fn lobes(&self, at: TexturePoint, lambda: &SampledWavelengths) -> RoughDielectricLobes {
+        RoughDielectricLobes {
             eta_hero: self.eta.at(lambda.lambda(0)),
             dispersive: self.eta.is_dispersive(),
             distribution: Microfacet::new(
                 self.distribution,
-                self.alpha_u.eval_1(point.at()),
-                self.alpha_v.eval_1(point.at()),
+                self.alpha_u.eval_1(at),
+                self.alpha_v.eval_1(at),
             ),
-            specular_reflectance: optional_factor(&self.specular_reflectance, point.at(), lambda),
-            specular_transmittance: optional_factor(
-                &self.specular_transmittance,
-                point.at(),
-                lambda,
-            ),
-        })
+            specular_reflectance: optional_factor(&self.specular_reflectance, at, lambda),
+            specular_transmittance: optional_factor(&self.specular_transmittance, at, lambda),
+        }
     }
 }
 

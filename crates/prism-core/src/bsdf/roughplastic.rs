@@ -30,13 +30,11 @@ use rayon::prelude::*;
 use super::dielectric::optional_factor;
 use super::fresnel::{fresnel_dielectric, reflect, refract};
 use super::microfacet::{GaussLegendre, Microfacet, MicrofacetKind};
-use super::{
-    BsdfEval, BsdfFlags, BsdfModel, BsdfSample, Bxdf, BxdfTree, NodeId, ShadingPoint,
-    mixture_sample,
-};
+use super::{BsdfEval, BsdfFlags, BsdfSample, Bxdf, BxdfTree, LeafBsdf, mixture_sample};
 use crate::sampling::warp::{cosine_hemisphere_pdf, sample_cosine_hemisphere};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use crate::texture::Texture;
+use crate::texture::TexturePoint;
 use crate::texture::TextureValues;
 
 /// Entries of the transmittance table (Mitsuba's MI_ROUGH_TRANSMITTANCE_RES).
@@ -153,39 +151,22 @@ const FLAGS: BsdfFlags = BsdfFlags::GLOSSY
     .union(BsdfFlags::DIFFUSE)
     .union(BsdfFlags::REFLECTION);
 
-impl BsdfModel for RoughPlastic {
+impl LeafBsdf for RoughPlastic {
+    type Lobes<'a> = RoughPlasticLobes<'a>;
+
     fn flags(&self) -> BsdfFlags {
         FLAGS
     }
 
-    fn is_dispersive(&self) -> bool {
-        false
-    }
-
-    fn node_count(&self) -> usize {
-        1
-    }
-
     /// The diffuse reflectance under the coating.
-    fn diffuse_reflectance(
-        &self,
-        point: &ShadingPoint,
-        _wo: Vec3,
-        lambda: &SampledWavelengths,
-    ) -> SampledSpectrum {
-        self.diffuse_reflectance.eval(point.at(), lambda)
+    fn albedo(&self, at: TexturePoint, lambda: &SampledWavelengths) -> SampledSpectrum {
+        self.diffuse_reflectance.eval(at, lambda)
     }
 
     #[inline]
-    fn resolve<'a>(
-        &'a self,
-        point: &ShadingPoint,
-        _wo: Vec3,
-        lambda: &SampledWavelengths,
-        tree: &mut BxdfTree<'a>,
-    ) -> NodeId {
+    fn lobes<'a>(&'a self, at: TexturePoint, lambda: &SampledWavelengths) -> RoughPlasticLobes<'a> {
         // ρ / (1 − R_i) or, nonlinear, ρ / (1 − ρ R_i).
-        let rho = self.diffuse_reflectance.eval(point.at(), lambda);
+        let rho = self.diffuse_reflectance.eval(at, lambda);
         let diffuse = SampledSpectrum::from_fn(|i| {
             let bounce = if self.nonlinear {
                 rho[i] * self.internal_reflectance
@@ -194,11 +175,11 @@ impl BsdfModel for RoughPlastic {
             };
             rho[i] / (1.0 - bounce)
         });
-        tree.push(RoughPlasticLobes {
+        RoughPlasticLobes {
             plastic: self,
             diffuse,
-            specular_reflectance: optional_factor(&self.specular_reflectance, point.at(), lambda),
-        })
+            specular_reflectance: optional_factor(&self.specular_reflectance, at, lambda),
+        }
     }
 }
 

@@ -19,10 +19,11 @@ use glam::{Vec2, Vec3};
 
 use super::dielectric::{SampledIor, optional_factor};
 use super::fresnel::{fresnel_dielectric, reflect_z};
-use super::{BsdfFlags, BsdfModel, BsdfSample, Bxdf, BxdfTree, NodeId, ShadingPoint};
+use super::{BsdfFlags, BsdfSample, Bxdf, BxdfTree, LeafBsdf};
 use crate::spectrum::ior::RelativeIor;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use crate::texture::Texture;
+use crate::texture::TexturePoint;
 
 #[derive(Clone, Debug)]
 pub struct ThinDielectric {
@@ -35,48 +36,22 @@ const FLAGS: BsdfFlags = BsdfFlags::SPECULAR
     .union(BsdfFlags::REFLECTION)
     .union(BsdfFlags::NULL);
 
-impl BsdfModel for ThinDielectric {
+/// Not dispersive: the pane does not bend light, so a dispersive index changes only how much
+/// each wavelength reflects, never its direction.
+impl LeafBsdf for ThinDielectric {
+    type Lobes<'a> = ThinDielectricLobes;
+
     fn flags(&self) -> BsdfFlags {
         FLAGS
     }
 
-    /// The pane does not bend light, so a dispersive index changes only how much each
-    /// wavelength reflects, never its direction.
-    fn is_dispersive(&self) -> bool {
-        false
-    }
-
-    fn node_count(&self) -> usize {
-        1
-    }
-
-    /// None: only specular and null lobes.
-    fn diffuse_reflectance(
-        &self,
-        _point: &ShadingPoint,
-        _wo: Vec3,
-        _lambda: &SampledWavelengths,
-    ) -> SampledSpectrum {
-        SampledSpectrum::ZERO
-    }
-
     #[inline]
-    fn resolve<'a>(
-        &'a self,
-        point: &ShadingPoint,
-        _wo: Vec3,
-        lambda: &SampledWavelengths,
-        tree: &mut BxdfTree<'a>,
-    ) -> NodeId {
-        tree.push(ThinDielectricLobes {
+    fn lobes(&self, at: TexturePoint, lambda: &SampledWavelengths) -> ThinDielectricLobes {
+        ThinDielectricLobes {
             eta: SampledIor::at(&self.eta, lambda),
-            specular_reflectance: optional_factor(&self.specular_reflectance, point.at(), lambda),
-            specular_transmittance: optional_factor(
-                &self.specular_transmittance,
-                point.at(),
-                lambda,
-            ),
-        })
+            specular_reflectance: optional_factor(&self.specular_reflectance, at, lambda),
+            specular_transmittance: optional_factor(&self.specular_transmittance, at, lambda),
+        }
     }
 }
 

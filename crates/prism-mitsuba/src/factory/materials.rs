@@ -363,8 +363,7 @@ pub static BSDFS: Registry<Build> = Registry {
             build: |params, t| {
                 let (front, back) = twosided_pair(params, t)?;
                 Ok(Bsdf::TwoSided(TwoSided {
-                    front: Box::new(front),
-                    back: Box::new(back),
+                    sides: [Box::new(front), Box::new(back)],
                 }))
             },
         },
