@@ -49,6 +49,29 @@ pub(crate) fn optional_factor(
     }
 }
 
+/// The optional factors of a dielectric's reflection and transmission (Mitsuba's
+/// `specular_reflectance` and `specular_transmittance`) at a point: 1 where absent.
+#[derive(Clone, Copy, Debug)]
+pub struct SpecularFactors {
+    pub reflectance: SampledSpectrum,
+    pub transmittance: SampledSpectrum,
+}
+
+impl SpecularFactors {
+    #[inline]
+    pub fn at(
+        reflectance: &Option<Texture>,
+        transmittance: &Option<Texture>,
+        at: TexturePoint,
+        lambda: &SampledWavelengths,
+    ) -> SpecularFactors {
+        SpecularFactors {
+            reflectance: optional_factor(reflectance, at, lambda),
+            transmittance: optional_factor(transmittance, at, lambda),
+        }
+    }
+}
+
 /// A relative index of refraction at a path's wavelengths: η(λᵢ) for each when it is
 /// dispersive, else the one value everywhere.
 #[derive(Clone, Copy, Debug)]
@@ -97,8 +120,12 @@ impl LeafBsdf for Dielectric {
     fn lobes(&self, at: TexturePoint, lambda: &SampledWavelengths) -> DielectricLobes {
         DielectricLobes {
             eta: SampledIor::at(&self.eta, lambda),
-            specular_reflectance: optional_factor(&self.specular_reflectance, at, lambda),
-            specular_transmittance: optional_factor(&self.specular_transmittance, at, lambda),
+            specular: SpecularFactors::at(
+                &self.specular_reflectance,
+                &self.specular_transmittance,
+                at,
+                lambda,
+            ),
         }
     }
 }
@@ -107,8 +134,7 @@ impl LeafBsdf for Dielectric {
 #[derive(Clone, Copy, Debug)]
 pub struct DielectricLobes {
     pub eta: SampledIor,
-    pub specular_reflectance: SampledSpectrum,
-    pub specular_transmittance: SampledSpectrum,
+    pub specular: SpecularFactors,
 }
 
 impl Bxdf for DielectricLobes {
@@ -130,7 +156,7 @@ impl Bxdf for DielectricLobes {
             hero.reflectance
         };
         if u_lobe < p_reflect {
-            let weight = reflectance * (1.0 / p_reflect) * self.specular_reflectance;
+            let weight = reflectance * (1.0 / p_reflect) * self.specular.reflectance;
             return Some(BsdfSample::new(
                 reflect_z(wo),
                 weight,
@@ -145,7 +171,7 @@ impl Bxdf for DielectricLobes {
         let p_transmit = 1.0 - p_reflect;
         let transmittance = (SampledSpectrum::ONE - reflectance) * (1.0 / p_transmit);
         let radiance_scale = hero.eta_ti * hero.eta_ti;
-        let weight = transmittance * radiance_scale * self.specular_transmittance;
+        let weight = transmittance * radiance_scale * self.specular.transmittance;
         Some(BsdfSample {
             wi: refract_z(wo, hero.cos_theta_t, hero.eta_ti),
             weight,

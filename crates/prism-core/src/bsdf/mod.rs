@@ -63,6 +63,7 @@ pub mod conductor;
 pub mod dielectric;
 pub mod diffuse;
 pub mod fresnel;
+pub mod glossydiffuse;
 pub mod mask;
 pub mod material;
 pub mod microfacet;

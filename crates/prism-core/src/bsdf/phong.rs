@@ -20,9 +20,9 @@ use std::f32::consts::{FRAC_1_PI, PI};
 use glam::{Vec2, Vec3};
 
 use super::fresnel::reflect_z;
-use super::{BsdfEval, BsdfFlags, BsdfSample, Bxdf, BxdfTree, LeafBsdf, mixture_sample};
+use super::glossydiffuse::GlossyDiffuseLobes;
+use super::{BsdfFlags, LeafBsdf};
 use crate::math::Frame;
-use crate::sampling::warp::{cosine_hemisphere_pdf, sample_cosine_hemisphere};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use crate::texture::Texture;
 use crate::texture::TexturePoint;
@@ -77,7 +77,7 @@ pub struct PhongLobes {
     pub p_glossy: f32,
 }
 
-impl PhongLobes {
+impl GlossyDiffuseLobes for PhongLobes {
     #[inline]
     fn value(&self, wo: Vec3, wi: Vec3) -> SampledSpectrum {
         let cos_alpha = reflect_z(wo).dot(wi);
@@ -90,51 +90,27 @@ impl PhongLobes {
     }
 
     #[inline]
-    fn mixture_pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+    fn glossy_probability(&self, _wo: Vec3) -> f32 {
+        self.p_glossy
+    }
+
+    /// cos α = u^(1/(n+1)) around the mirror direction.
+    #[inline]
+    fn sample_glossy(&self, wo: Vec3, u: Vec2) -> Vec3 {
+        let cos_alpha = u.y.powf(1.0 / (self.exponent + 1.0));
+        let sin_alpha = (1.0 - cos_alpha * cos_alpha).max(0.0).sqrt();
+        let phi = 2.0 * PI * u.x;
+        let local = Vec3::new(sin_alpha * phi.cos(), sin_alpha * phi.sin(), cos_alpha);
+        Frame::from_normal(reflect_z(wo)).to_world(local)
+    }
+
+    #[inline]
+    fn glossy_pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         let cos_alpha = reflect_z(wo).dot(wi);
-        let glossy = if cos_alpha > 0.0 {
+        if cos_alpha > 0.0 {
             (self.exponent + 1.0) / (2.0 * PI) * cos_alpha.powf(self.exponent)
         } else {
             0.0
-        };
-        self.p_glossy * glossy + (1.0 - self.p_glossy) * cosine_hemisphere_pdf(wi)
-    }
-}
-
-impl Bxdf for PhongLobes {
-    fn eval(&self, _tree: &BxdfTree, wo: Vec3, wi: Vec3) -> BsdfEval {
-        if !(wo.z > 0.0 && wi.z > 0.0) {
-            return BsdfEval::ZERO;
         }
-        BsdfEval {
-            value: self.value(wo, wi),
-            pdf: self.mixture_pdf(wo, wi),
-        }
-    }
-
-    fn sample(&self, _tree: &BxdfTree, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<BsdfSample> {
-        if !(wo.z > 0.0) {
-            return None;
-        }
-        let (wi, flags) = if u_lobe < self.p_glossy {
-            // cos α = u^(1/(n+1)) around the mirror direction.
-            let cos_alpha = u.y.powf(1.0 / (self.exponent + 1.0));
-            let sin_alpha = (1.0 - cos_alpha * cos_alpha).max(0.0).sqrt();
-            let phi = 2.0 * PI * u.x;
-            let local = Vec3::new(sin_alpha * phi.cos(), sin_alpha * phi.sin(), cos_alpha);
-            (
-                Frame::from_normal(reflect_z(wo)).to_world(local),
-                BsdfFlags::GLOSSY.union(BsdfFlags::REFLECTION),
-            )
-        } else {
-            (
-                sample_cosine_hemisphere(u),
-                BsdfFlags::DIFFUSE.union(BsdfFlags::REFLECTION),
-            )
-        };
-        if !(wi.z > 0.0) {
-            return None;
-        }
-        mixture_sample(wi, self.value(wo, wi), self.mixture_pdf(wo, wi), flags)
     }
 }

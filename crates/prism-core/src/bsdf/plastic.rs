@@ -65,6 +65,25 @@ impl Plastic {
     }
 }
 
+/// The effective diffuse reflectance of a base of reflectance ρ under a coating that reflects
+/// the fraction R of the light from below back down: ρ / (1 − R) or, with `nonlinear`,
+/// ρ / (1 − ρ R), which darkens and saturates colours (shared with `roughplastic`).
+#[inline]
+pub(crate) fn effective_diffuse(
+    rho: SampledSpectrum,
+    internal_reflectance: f32,
+    nonlinear: bool,
+) -> SampledSpectrum {
+    SampledSpectrum::from_fn(|i| {
+        let bounce = if nonlinear {
+            rho[i] * internal_reflectance
+        } else {
+            internal_reflectance
+        };
+        rho[i] / (1.0 - bounce)
+    })
+}
+
 const FLAGS: BsdfFlags = BsdfFlags::SPECULAR
     .union(BsdfFlags::DIFFUSE)
     .union(BsdfFlags::REFLECTION);
@@ -83,19 +102,10 @@ impl LeafBsdf for Plastic {
 
     #[inline]
     fn lobes<'a>(&'a self, at: TexturePoint, lambda: &SampledWavelengths) -> PlasticLobes<'a> {
-        // ρ / (1 − F_dr) or, nonlinear, ρ / (1 − ρ F_dr).
         let rho = self.diffuse_reflectance.eval(at, lambda);
-        let diffuse = SampledSpectrum::from_fn(|i| {
-            let bounce = if self.nonlinear {
-                rho[i] * self.fdr_internal
-            } else {
-                self.fdr_internal
-            };
-            rho[i] / (1.0 - bounce)
-        });
         PlasticLobes {
             plastic: self,
-            diffuse,
+            diffuse: effective_diffuse(rho, self.fdr_internal, self.nonlinear),
             specular_reflectance: optional_factor(&self.specular_reflectance, at, lambda),
         }
     }

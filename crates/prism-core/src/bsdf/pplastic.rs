@@ -29,9 +29,9 @@ use glam::{Vec2, Vec3};
 
 use super::dielectric::optional_factor;
 use super::fresnel::{fresnel_dielectric, reflect};
+use super::glossydiffuse::GlossyDiffuseLobes;
 use super::microfacet::{Microfacet, MicrofacetKind};
-use super::{BsdfEval, BsdfFlags, BsdfSample, Bxdf, BxdfTree, LeafBsdf, mixture_sample};
-use crate::sampling::warp::{cosine_hemisphere_pdf, sample_cosine_hemisphere};
+use super::{BsdfFlags, LeafBsdf};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use crate::texture::Texture;
 use crate::texture::TexturePoint;
@@ -94,7 +94,7 @@ pub struct PolarizedPlasticLobes {
     pub p_specular: f32,
 }
 
-impl PolarizedPlasticLobes {
+impl GlossyDiffuseLobes for PolarizedPlasticLobes {
     #[inline]
     fn value(&self, wo: Vec3, wi: Vec3) -> SampledSpectrum {
         let h = (wo + wi).normalize();
@@ -111,47 +111,23 @@ impl PolarizedPlasticLobes {
     }
 
     #[inline]
-    fn mixture_pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+    fn glossy_probability(&self, _wo: Vec3) -> f32 {
+        self.p_specular
+    }
+
+    #[inline]
+    fn sample_glossy(&self, wo: Vec3, u: Vec2) -> Vec3 {
+        reflect(wo, self.distribution.sample_visible(wo, u))
+    }
+
+    #[inline]
+    fn glossy_pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         let h = (wo + wi).normalize();
         let (cos_oh, cos_ih) = (wo.dot(h), wi.dot(h));
-        let specular = if cos_oh > 0.0 && cos_ih > 0.0 {
+        if cos_oh > 0.0 && cos_ih > 0.0 {
             self.distribution.pdf_visible(wo, h) / (4.0 * cos_oh)
         } else {
             0.0
-        };
-        self.p_specular * specular + (1.0 - self.p_specular) * cosine_hemisphere_pdf(wi)
-    }
-}
-
-impl Bxdf for PolarizedPlasticLobes {
-    fn eval(&self, _tree: &BxdfTree, wo: Vec3, wi: Vec3) -> BsdfEval {
-        if !(wo.z > 0.0 && wi.z > 0.0) {
-            return BsdfEval::ZERO;
         }
-        BsdfEval {
-            value: self.value(wo, wi),
-            pdf: self.mixture_pdf(wo, wi),
-        }
-    }
-
-    fn sample(&self, _tree: &BxdfTree, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<BsdfSample> {
-        if !(wo.z > 0.0) {
-            return None;
-        }
-        let (wi, flags) = if u_lobe < self.p_specular {
-            (
-                reflect(wo, self.distribution.sample_visible(wo, u)),
-                BsdfFlags::GLOSSY.union(BsdfFlags::REFLECTION),
-            )
-        } else {
-            (
-                sample_cosine_hemisphere(u),
-                BsdfFlags::DIFFUSE.union(BsdfFlags::REFLECTION),
-            )
-        };
-        if !(wi.z > 0.0) {
-            return None;
-        }
-        mixture_sample(wi, self.value(wo, wi), self.mixture_pdf(wo, wi), flags)
     }
 }

@@ -25,7 +25,7 @@
 
 use glam::{Vec2, Vec3};
 
-use super::dielectric::optional_factor;
+use super::dielectric::SpecularFactors;
 use super::fresnel::{fresnel_dielectric, reflect, refract};
 use super::microfacet::{Microfacet, MicrofacetKind};
 use super::{BsdfEval, BsdfFlags, BsdfSample, Bxdf, BxdfTree, LeafBsdf};
@@ -72,8 +72,12 @@ impl LeafBsdf for RoughDielectric {
                 self.alpha_u.eval_1(at),
                 self.alpha_v.eval_1(at),
             ),
-            specular_reflectance: optional_factor(&self.specular_reflectance, at, lambda),
-            specular_transmittance: optional_factor(&self.specular_transmittance, at, lambda),
+            specular: SpecularFactors::at(
+                &self.specular_reflectance,
+                &self.specular_transmittance,
+                at,
+                lambda,
+            ),
         }
     }
 }
@@ -85,8 +89,7 @@ pub struct RoughDielectricLobes {
     pub eta_hero: f32,
     pub dispersive: bool,
     pub distribution: Microfacet,
-    pub specular_reflectance: SampledSpectrum,
-    pub specular_transmittance: SampledSpectrum,
+    pub specular: SpecularFactors,
 }
 
 /// The half vector of a pair of directions and what goes with it.
@@ -132,12 +135,12 @@ impl RoughDielectricLobes {
         }
         let f = fresnel_dielectric(wo.dot(m), self.eta_hero).reflectance;
         if reflect {
-            self.specular_reflectance * (f * d * g / (4.0 * wo.z.abs()))
+            self.specular.reflectance * (f * d * g / (4.0 * wo.z.abs()))
         } else {
             let (om, im) = (wo.dot(m), wi.dot(m));
             let denominator = om + eta * im;
             let value = ((1.0 - f) * d * g * om * im / (wo.z * denominator * denominator)).abs();
-            self.specular_transmittance * value
+            self.specular.transmittance * value
         }
     }
 
@@ -192,7 +195,7 @@ impl Bxdf for RoughDielectricLobes {
             let pdf = pdf_m * f / (4.0 * wi.dot(m)).abs();
             BsdfSample::new(
                 wi,
-                self.specular_reflectance,
+                self.specular.reflectance,
                 pdf,
                 BsdfFlags::GLOSSY.union(BsdfFlags::REFLECTION),
             )
@@ -204,7 +207,7 @@ impl Bxdf for RoughDielectricLobes {
             let im = wi.dot(m);
             let denominator = om + fresnel.eta_it * im;
             let jacobian = fresnel.eta_it * fresnel.eta_it * im / (denominator * denominator);
-            let weight = self.specular_transmittance * (fresnel.eta_ti * fresnel.eta_ti);
+            let weight = self.specular.transmittance * (fresnel.eta_ti * fresnel.eta_ti);
             BsdfSample {
                 wi,
                 weight,

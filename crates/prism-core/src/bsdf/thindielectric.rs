@@ -17,7 +17,7 @@
 
 use glam::{Vec2, Vec3};
 
-use super::dielectric::{SampledIor, optional_factor};
+use super::dielectric::{SampledIor, SpecularFactors};
 use super::fresnel::{fresnel_dielectric, reflect_z};
 use super::{BsdfFlags, BsdfSample, Bxdf, BxdfTree, LeafBsdf};
 use crate::spectrum::ior::RelativeIor;
@@ -49,8 +49,12 @@ impl LeafBsdf for ThinDielectric {
     fn lobes(&self, at: TexturePoint, lambda: &SampledWavelengths) -> ThinDielectricLobes {
         ThinDielectricLobes {
             eta: SampledIor::at(&self.eta, lambda),
-            specular_reflectance: optional_factor(&self.specular_reflectance, at, lambda),
-            specular_transmittance: optional_factor(&self.specular_transmittance, at, lambda),
+            specular: SpecularFactors::at(
+                &self.specular_reflectance,
+                &self.specular_transmittance,
+                at,
+                lambda,
+            ),
         }
     }
 }
@@ -59,8 +63,7 @@ impl LeafBsdf for ThinDielectric {
 #[derive(Clone, Copy, Debug)]
 pub struct ThinDielectricLobes {
     pub eta: SampledIor,
-    pub specular_reflectance: SampledSpectrum,
-    pub specular_transmittance: SampledSpectrum,
+    pub specular: SpecularFactors,
 }
 
 impl Bxdf for ThinDielectricLobes {
@@ -80,7 +83,7 @@ impl Bxdf for ThinDielectricLobes {
         };
         let p_reflect = r.average();
         if u_lobe < p_reflect {
-            let weight = r * (1.0 / p_reflect) * self.specular_reflectance;
+            let weight = r * (1.0 / p_reflect) * self.specular.reflectance;
             Some(BsdfSample::new(
                 reflect_z(wo),
                 weight,
@@ -90,7 +93,7 @@ impl Bxdf for ThinDielectricLobes {
         } else {
             let p_transmit = 1.0 - p_reflect;
             let weight =
-                (SampledSpectrum::ONE - r) * (1.0 / p_transmit) * self.specular_transmittance;
+                (SampledSpectrum::ONE - r) * (1.0 / p_transmit) * self.specular.transmittance;
             Some(BsdfSample::new(-wo, weight, p_transmit, BsdfFlags::NULL))
         }
     }
