@@ -57,14 +57,15 @@ impl LightSource for ConstantLight {
         lambda: &SampledWavelengths,
     ) -> Option<LightSample> {
         let wi = sample_uniform_sphere(u);
-        Some(LightSample {
-            p: self.scene.point_beyond(reference, wi),
-            n: Vec3::ZERO,
+        let radiance = self.radiance(lambda);
+        Some(LightSample::from_infinity(
+            &self.scene,
+            reference,
             wi,
-            radiance: self.radiance(lambda),
-            pdf: self.pdf(),
-            is_delta: false,
-        })
+            radiance,
+            self.pdf(),
+            false,
+        ))
     }
 
     /// Φ = π R² ∫ L dω = 4π² R² L: the flux entering the scene's bounding sphere (each

@@ -50,14 +50,15 @@ impl LightSource for DirectionalLight {
         lambda: &SampledWavelengths,
     ) -> Option<LightSample> {
         let wi = -self.direction;
-        Some(LightSample {
-            p: self.scene.point_beyond(reference, wi),
-            n: Vec3::ZERO,
+        let irradiance = self.irradiance.sample(lambda);
+        Some(LightSample::from_infinity(
+            &self.scene,
+            reference,
             wi,
-            radiance: self.irradiance.sample(lambda),
-            pdf: 1.0,
-            is_delta: true,
-        })
+            irradiance,
+            1.0,
+            true,
+        ))
     }
 
     /// Φ = π R² E: the flux through the disk the scene's bounding sphere presents to the light

@@ -250,14 +250,15 @@ impl LightSource for EnvironmentMap {
         if !(pdf > 0.0 && pdf.is_finite()) {
             return None;
         }
-        Some(LightSample {
-            p: self.scene.point_beyond(reference, wi),
-            n: Vec3::ZERO,
+        let radiance = self.lookup(uv, lambda);
+        Some(LightSample::from_infinity(
+            &self.scene,
+            reference,
             wi,
-            radiance: self.lookup(uv, lambda),
+            radiance,
             pdf,
-            is_delta: false,
-        })
+            false,
+        ))
     }
 
     /// Φ = π R² ∫ Y(L) dω, with ∫ Y(L) dω = 2π² ∫∫ Y sin θ du dv the integral of the sampling

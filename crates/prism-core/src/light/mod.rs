@@ -165,6 +165,52 @@ pub struct LightSample {
     pub is_delta: bool,
 }
 
+impl LightSample {
+    /// Light from the point `p` of a point, spot or projector light, arriving along `wi`: a
+    /// delta, whose shadow ray ends at `p`.
+    #[inline]
+    pub fn from_point(p: Vec3, wi: Vec3, radiance: SampledSpectrum) -> LightSample {
+        LightSample {
+            p,
+            n: Vec3::ZERO,
+            wi,
+            radiance,
+            pdf: 1.0,
+            is_delta: true,
+        }
+    }
+
+    /// Light from a light at infinity arriving at `reference` along `wi`: the shadow ray ends
+    /// beyond the scene's bounding sphere `scene`.
+    #[inline]
+    pub fn from_infinity(
+        scene: &BoundingSphere,
+        reference: Vec3,
+        wi: Vec3,
+        radiance: SampledSpectrum,
+        pdf: f32,
+        is_delta: bool,
+    ) -> LightSample {
+        LightSample {
+            p: scene.point_beyond(reference, wi),
+            n: Vec3::ZERO,
+            wi,
+            radiance,
+            pdf,
+            is_delta,
+        }
+    }
+}
+
+/// The direction from `reference` towards the point `p` and the squared distance between them,
+/// for lights at a point; None where they coincide.
+#[inline]
+pub(crate) fn towards_point(p: Vec3, reference: Vec3) -> Option<(Vec3, f32)> {
+    let d = p - reference;
+    let dist2 = d.length_squared();
+    (dist2 > 0.0).then(|| (d / dist2.sqrt(), dist2))
+}
+
 /// The sphere that bounds the scene's geometry. Lights at infinity use it, as Mitsuba's
 /// `set_scene` does, to place shadow-ray end points beyond the scene and to define their power
 /// (the flux they send into it).

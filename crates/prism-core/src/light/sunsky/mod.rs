@@ -361,14 +361,15 @@ impl LightSource for Sunsky {
         if !(pdf > 0.0 && pdf.is_finite()) {
             return None;
         }
-        Some(LightSample {
-            p: self.scene.point_beyond(reference, wi),
-            n: Vec3::ZERO,
+        let radiance = self.local_radiance(local, lambda);
+        Some(LightSample::from_infinity(
+            &self.scene,
+            reference,
             wi,
-            radiance: self.local_radiance(local, lambda),
+            radiance,
             pdf,
-            is_delta: false,
-        })
+            false,
+        ))
     }
 
     /// Φ = π R² ∫ Y(L) dω, the luminous flux entering the scene's bounding sphere (as for
