@@ -66,14 +66,9 @@ impl ConductorIor {
     }
 }
 
-const FLAGS: BsdfFlags = BsdfFlags::SPECULAR.union(BsdfFlags::REFLECTION);
-
 impl LeafBsdf for Conductor {
     type Lobes<'a> = ConductorLobes;
-
-    fn flags(&self) -> BsdfFlags {
-        FLAGS
-    }
+    const FLAGS: BsdfFlags = BsdfFlags::SPECULAR.union(BsdfFlags::REFLECTION);
 
     #[inline]
     fn lobes(&self, at: TexturePoint, lambda: &SampledWavelengths) -> ConductorLobes {
@@ -97,6 +92,11 @@ impl Bxdf for ConductorLobes {
             return None;
         }
         let weight = self.ior.reflectance(wo.z) * self.specular_reflectance;
-        Some(BsdfSample::new(reflect_z(wo), weight, 1.0, FLAGS))
+        Some(BsdfSample::new(
+            reflect_z(wo),
+            weight,
+            1.0,
+            Conductor::FLAGS,
+        ))
     }
 }

@@ -101,16 +101,11 @@ impl SampledIor {
     }
 }
 
-const FLAGS: BsdfFlags = BsdfFlags::SPECULAR
-    .union(BsdfFlags::REFLECTION)
-    .union(BsdfFlags::TRANSMISSION);
-
 impl LeafBsdf for Dielectric {
     type Lobes<'a> = DielectricLobes;
-
-    fn flags(&self) -> BsdfFlags {
-        FLAGS
-    }
+    const FLAGS: BsdfFlags = BsdfFlags::SPECULAR
+        .union(BsdfFlags::REFLECTION)
+        .union(BsdfFlags::TRANSMISSION);
 
     fn is_dispersive(&self) -> bool {
         self.eta.is_dispersive()

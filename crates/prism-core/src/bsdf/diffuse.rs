@@ -24,14 +24,9 @@ pub struct Diffuse {
     pub reflectance: Texture,
 }
 
-const FLAGS: BsdfFlags = BsdfFlags::DIFFUSE.union(BsdfFlags::REFLECTION);
-
 impl LeafBsdf for Diffuse {
     type Lobes<'a> = DiffuseLobes;
-
-    fn flags(&self) -> BsdfFlags {
-        FLAGS
-    }
+    const FLAGS: BsdfFlags = BsdfFlags::DIFFUSE.union(BsdfFlags::REFLECTION);
 
     /// The reflectance.
     fn albedo(&self, at: TexturePoint, lambda: &SampledWavelengths) -> SampledSpectrum {
@@ -74,6 +69,6 @@ impl Bxdf for DiffuseLobes {
         if !(pdf > 0.0) {
             return None;
         }
-        Some(BsdfSample::new(wi, self.reflectance, pdf, FLAGS))
+        Some(BsdfSample::new(wi, self.reflectance, pdf, Diffuse::FLAGS))
     }
 }

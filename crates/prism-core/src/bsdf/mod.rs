@@ -204,6 +204,17 @@ impl BsdfEval {
     };
 }
 
+/// The probability of choosing a lobe in proportion to an estimate of its albedo, `lobe`,
+/// against the estimate for the other lobes, `rest`: 1 where both are zero.
+#[inline]
+pub(crate) fn choice_probability(lobe: f32, rest: f32) -> f32 {
+    if lobe + rest > 0.0 {
+        lobe / (lobe + rest)
+    } else {
+        1.0
+    }
+}
+
 /// For a BSDF that is a mixture of lobes: the sample of one smooth lobe turned into a sample of
 /// the whole mixture, whose density at `wi` is `pdf` and whose value there is `value`.
 #[inline]
@@ -304,8 +315,15 @@ pub trait LeafBsdf {
     where
         Self: 'a;
 
-    /// The union of the lobes' flags ([`BsdfModel::flags`]).
-    fn flags(&self) -> BsdfFlags;
+    /// The union of the lobes' flags; for a BSDF whose lobes depend on its parameters, the
+    /// flags of those it always has.
+    const FLAGS: BsdfFlags;
+
+    /// [`BsdfModel::flags`]: [`Self::FLAGS`], to which `principled` adds its transmission where
+    /// it has one.
+    fn flags(&self) -> BsdfFlags {
+        Self::FLAGS
+    }
 
     /// [`BsdfModel::is_dispersive`]. Only a BSDF that refracts through an index of refraction
     /// that may vary with wavelength answers otherwise than this `false`.

@@ -21,14 +21,9 @@ use crate::texture::TexturePoint;
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Null;
 
-const FLAGS: BsdfFlags = BsdfFlags::NULL;
-
 impl LeafBsdf for Null {
     type Lobes<'a> = NullLobes;
-
-    fn flags(&self) -> BsdfFlags {
-        FLAGS
-    }
+    const FLAGS: BsdfFlags = BsdfFlags::NULL;
 
     #[inline]
     fn lobes(&self, _at: TexturePoint, _lambda: &SampledWavelengths) -> NullLobes {
@@ -42,6 +37,6 @@ pub struct NullLobes;
 
 impl Bxdf for NullLobes {
     fn sample(&self, _tree: &BxdfTree, wo: Vec3, _u_lobe: f32, _u: Vec2) -> Option<BsdfSample> {
-        Some(BsdfSample::new(-wo, SampledSpectrum::ONE, 1.0, FLAGS))
+        Some(BsdfSample::new(-wo, SampledSpectrum::ONE, 1.0, Null::FLAGS))
     }
 }

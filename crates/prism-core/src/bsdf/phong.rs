@@ -21,7 +21,7 @@ use glam::{Vec2, Vec3};
 
 use super::fresnel::reflect_z;
 use super::glossydiffuse::GlossyDiffuseLobes;
-use super::{BsdfFlags, LeafBsdf};
+use super::{BsdfFlags, LeafBsdf, choice_probability};
 use crate::math::Frame;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use crate::texture::Texture;
@@ -37,16 +37,11 @@ pub struct Phong {
     pub scale: f32,
 }
 
-const FLAGS: BsdfFlags = BsdfFlags::GLOSSY
-    .union(BsdfFlags::DIFFUSE)
-    .union(BsdfFlags::REFLECTION);
-
 impl LeafBsdf for Phong {
     type Lobes<'a> = PhongLobes;
-
-    fn flags(&self) -> BsdfFlags {
-        FLAGS
-    }
+    const FLAGS: BsdfFlags = BsdfFlags::GLOSSY
+        .union(BsdfFlags::DIFFUSE)
+        .union(BsdfFlags::REFLECTION);
 
     /// The diffuse reflectance, scaled as the lobes are.
     fn albedo(&self, at: TexturePoint, lambda: &SampledWavelengths) -> SampledSpectrum {
@@ -62,7 +57,7 @@ impl LeafBsdf for Phong {
             exponent: self.exponent.eval_1(at),
             specular,
             diffuse,
-            p_glossy: if s + d > 0.0 { s / (s + d) } else { 1.0 },
+            p_glossy: choice_probability(s, d),
         }
     }
 }

@@ -27,7 +27,9 @@ use glam::{Vec2, Vec3};
 
 use super::dielectric::optional_factor;
 use super::fresnel::{fresnel_dielectric, fresnel_diffuse_reflectance, reflect_z};
-use super::{BsdfEval, BsdfFlags, BsdfSample, Bxdf, BxdfTree, LeafBsdf, mixture_sample};
+use super::{
+    BsdfEval, BsdfFlags, BsdfSample, Bxdf, BxdfTree, LeafBsdf, choice_probability, mixture_sample,
+};
 use crate::sampling::warp::{cosine_hemisphere_pdf, sample_cosine_hemisphere};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use crate::texture::Texture;
@@ -84,16 +86,11 @@ pub(crate) fn effective_diffuse(
     })
 }
 
-const FLAGS: BsdfFlags = BsdfFlags::SPECULAR
-    .union(BsdfFlags::DIFFUSE)
-    .union(BsdfFlags::REFLECTION);
-
 impl LeafBsdf for Plastic {
     type Lobes<'a> = PlasticLobes<'a>;
-
-    fn flags(&self) -> BsdfFlags {
-        FLAGS
-    }
+    const FLAGS: BsdfFlags = BsdfFlags::SPECULAR
+        .union(BsdfFlags::DIFFUSE)
+        .union(BsdfFlags::REFLECTION);
 
     /// The diffuse reflectance under the coating.
     fn albedo(&self, at: TexturePoint, lambda: &SampledWavelengths) -> SampledSpectrum {
@@ -127,11 +124,7 @@ impl PlasticLobes<'_> {
         let p = self.plastic;
         let specular = f_o * self.specular_reflectance.average();
         let base = (1.0 - f_o) * self.diffuse.average() * (1.0 - p.fdr_external) * p.inv_eta2;
-        if specular + base > 0.0 {
-            specular / (specular + base)
-        } else {
-            1.0
-        }
+        choice_probability(specular, base)
     }
 
     /// The base's f cos θi given F(cos θo) and the sampled direction.

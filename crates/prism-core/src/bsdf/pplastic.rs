@@ -31,7 +31,7 @@ use super::dielectric::optional_factor;
 use super::fresnel::{fresnel_dielectric, reflect};
 use super::glossydiffuse::GlossyDiffuseLobes;
 use super::microfacet::{Microfacet, MicrofacetKind};
-use super::{BsdfFlags, LeafBsdf};
+use super::{BsdfFlags, LeafBsdf, choice_probability};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use crate::texture::Texture;
 use crate::texture::TexturePoint;
@@ -48,16 +48,11 @@ pub struct PolarizedPlastic {
     pub specular_reflectance: Option<Texture>,
 }
 
-const FLAGS: BsdfFlags = BsdfFlags::GLOSSY
-    .union(BsdfFlags::DIFFUSE)
-    .union(BsdfFlags::REFLECTION);
-
 impl LeafBsdf for PolarizedPlastic {
     type Lobes<'a> = PolarizedPlasticLobes;
-
-    fn flags(&self) -> BsdfFlags {
-        FLAGS
-    }
+    const FLAGS: BsdfFlags = BsdfFlags::GLOSSY
+        .union(BsdfFlags::DIFFUSE)
+        .union(BsdfFlags::REFLECTION);
 
     /// The diffuse reflectance of the base.
     fn albedo(&self, at: TexturePoint, lambda: &SampledWavelengths) -> SampledSpectrum {
@@ -78,7 +73,7 @@ impl LeafBsdf for PolarizedPlastic {
             ),
             diffuse,
             specular,
-            p_specular: if s + d > 0.0 { s / (s + d) } else { 1.0 },
+            p_specular: choice_probability(s, d),
         }
     }
 }

@@ -39,16 +39,11 @@ pub struct RoughConductor {
     pub ext_eta: f32,
 }
 
-const FLAGS: BsdfFlags = BsdfFlags::GLOSSY.union(BsdfFlags::REFLECTION);
-
 /// No diffuse reflectance: only a glossy lobe (Mitsuba 3 evaluates the BSDF towards the normal
 /// instead, see docs/mitsuba-compatibility.md).
 impl LeafBsdf for RoughConductor {
     type Lobes<'a> = RoughConductorLobes;
-
-    fn flags(&self) -> BsdfFlags {
-        FLAGS
-    }
+    const FLAGS: BsdfFlags = BsdfFlags::GLOSSY.union(BsdfFlags::REFLECTION);
 
     #[inline]
     fn lobes(&self, at: TexturePoint, lambda: &SampledWavelengths) -> RoughConductorLobes {
@@ -111,6 +106,6 @@ impl Bxdf for RoughConductorLobes {
         }
         let f = self.ior.reflectance(cos_om);
         let weight = f * self.specular_reflectance * self.distribution.g1(wi, m);
-        Some(BsdfSample::new(wi, weight, pdf, FLAGS))
+        Some(BsdfSample::new(wi, weight, pdf, RoughConductor::FLAGS))
     }
 }

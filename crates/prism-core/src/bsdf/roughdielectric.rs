@@ -45,18 +45,13 @@ pub struct RoughDielectric {
     pub specular_transmittance: Option<Texture>,
 }
 
-const FLAGS: BsdfFlags = BsdfFlags::GLOSSY
-    .union(BsdfFlags::REFLECTION)
-    .union(BsdfFlags::TRANSMISSION);
-
 /// No diffuse reflectance: only glossy lobes (Mitsuba 3 evaluates the BSDF towards the normal
 /// instead, see docs/mitsuba-compatibility.md).
 impl LeafBsdf for RoughDielectric {
     type Lobes<'a> = RoughDielectricLobes;
-
-    fn flags(&self) -> BsdfFlags {
-        FLAGS
-    }
+    const FLAGS: BsdfFlags = BsdfFlags::GLOSSY
+        .union(BsdfFlags::REFLECTION)
+        .union(BsdfFlags::TRANSMISSION);
 
     fn is_dispersive(&self) -> bool {
         self.eta.is_dispersive()

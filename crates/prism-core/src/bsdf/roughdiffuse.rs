@@ -32,14 +32,9 @@ pub struct RoughDiffuse {
     pub use_fast_approx: bool,
 }
 
-const FLAGS: BsdfFlags = BsdfFlags::DIFFUSE.union(BsdfFlags::REFLECTION);
-
 impl LeafBsdf for RoughDiffuse {
     type Lobes<'a> = RoughDiffuseLobes;
-
-    fn flags(&self) -> BsdfFlags {
-        FLAGS
-    }
+    const FLAGS: BsdfFlags = BsdfFlags::DIFFUSE.union(BsdfFlags::REFLECTION);
 
     /// The reflectance (Oren–Nayar's ρ).
     fn albedo(&self, at: TexturePoint, lambda: &SampledWavelengths) -> SampledSpectrum {
@@ -140,6 +135,6 @@ impl Bxdf for RoughDiffuseLobes {
         } else {
             self.value(wo, wi)
         };
-        mixture_sample(wi, value, cosine_hemisphere_pdf(wi), FLAGS)
+        mixture_sample(wi, value, cosine_hemisphere_pdf(wi), RoughDiffuse::FLAGS)
     }
 }

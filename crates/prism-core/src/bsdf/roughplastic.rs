@@ -32,7 +32,7 @@ use super::fresnel::{fresnel_dielectric, reflect, refract};
 use super::glossydiffuse::GlossyDiffuseLobes;
 use super::microfacet::{GaussLegendre, Microfacet, MicrofacetKind};
 use super::plastic::effective_diffuse;
-use super::{BsdfFlags, LeafBsdf};
+use super::{BsdfFlags, LeafBsdf, choice_probability};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use crate::texture::Texture;
 use crate::texture::TexturePoint;
@@ -148,16 +148,11 @@ impl RoughPlastic {
     }
 }
 
-const FLAGS: BsdfFlags = BsdfFlags::GLOSSY
-    .union(BsdfFlags::DIFFUSE)
-    .union(BsdfFlags::REFLECTION);
-
 impl LeafBsdf for RoughPlastic {
     type Lobes<'a> = RoughPlasticLobes<'a>;
-
-    fn flags(&self) -> BsdfFlags {
-        FLAGS
-    }
+    const FLAGS: BsdfFlags = BsdfFlags::GLOSSY
+        .union(BsdfFlags::DIFFUSE)
+        .union(BsdfFlags::REFLECTION);
 
     /// The diffuse reflectance under the coating.
     fn albedo(&self, at: TexturePoint, lambda: &SampledWavelengths) -> SampledSpectrum {
@@ -208,11 +203,7 @@ impl GlossyDiffuseLobes for RoughPlasticLobes<'_> {
         let t_o = p.transmittance(wo.z);
         let glossy = (1.0 - t_o) * self.specular_reflectance.average();
         let base = t_o * self.diffuse.average() * p.mean_transmittance * p.inv_eta2;
-        if glossy + base > 0.0 {
-            glossy / (glossy + base)
-        } else {
-            1.0
-        }
+        choice_probability(glossy, base)
     }
 
     #[inline]

@@ -32,18 +32,13 @@ pub struct ThinDielectric {
     pub specular_transmittance: Option<Texture>,
 }
 
-const FLAGS: BsdfFlags = BsdfFlags::SPECULAR
-    .union(BsdfFlags::REFLECTION)
-    .union(BsdfFlags::NULL);
-
 /// Not dispersive: the pane does not bend light, so a dispersive index changes only how much
 /// each wavelength reflects, never its direction.
 impl LeafBsdf for ThinDielectric {
     type Lobes<'a> = ThinDielectricLobes;
-
-    fn flags(&self) -> BsdfFlags {
-        FLAGS
-    }
+    const FLAGS: BsdfFlags = BsdfFlags::SPECULAR
+        .union(BsdfFlags::REFLECTION)
+        .union(BsdfFlags::NULL);
 
     #[inline]
     fn lobes(&self, at: TexturePoint, lambda: &SampledWavelengths) -> ThinDielectricLobes {

@@ -29,7 +29,7 @@ use glam::{Vec2, Vec3};
 
 use super::fresnel::reflect;
 use super::glossydiffuse::GlossyDiffuseLobes;
-use super::{BsdfFlags, LeafBsdf};
+use super::{BsdfFlags, LeafBsdf, choice_probability};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use crate::texture::Texture;
 use crate::texture::TexturePoint;
@@ -57,16 +57,11 @@ pub struct Ward {
     pub scale: f32,
 }
 
-const FLAGS: BsdfFlags = BsdfFlags::GLOSSY
-    .union(BsdfFlags::DIFFUSE)
-    .union(BsdfFlags::REFLECTION);
-
 impl LeafBsdf for Ward {
     type Lobes<'a> = WardLobes;
-
-    fn flags(&self) -> BsdfFlags {
-        FLAGS
-    }
+    const FLAGS: BsdfFlags = BsdfFlags::GLOSSY
+        .union(BsdfFlags::DIFFUSE)
+        .union(BsdfFlags::REFLECTION);
 
     /// The diffuse reflectance, scaled as the lobes are.
     fn albedo(&self, at: TexturePoint, lambda: &SampledWavelengths) -> SampledSpectrum {
@@ -84,7 +79,7 @@ impl LeafBsdf for Ward {
             alpha_v: self.alpha_v.eval_1(at),
             specular,
             diffuse,
-            p_glossy: if s + d > 0.0 { s / (s + d) } else { 1.0 },
+            p_glossy: choice_probability(s, d),
         }
     }
 }
