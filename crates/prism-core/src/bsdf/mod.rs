@@ -308,7 +308,8 @@ pub struct ResolveContext<'p> {
 }
 
 /// A BSDF that nests no other: its lobes take one node of a [`BxdfTree`] and depend on the
-/// textures' point and the wavelengths only. Its [`BsdfModel`] follows: one node, which `resolve` adds.
+/// textures' point and the wavelengths only. Its [`BsdfModel`] follows: one node, which
+/// `resolve` adds.
 pub trait LeafBsdf {
     /// The lobes at a point.
     type Lobes<'a>: Into<Node<'a>>
