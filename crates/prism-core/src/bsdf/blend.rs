@@ -14,9 +14,10 @@
 use glam::{Vec2, Vec3};
 
 use super::{
-    Bsdf, BsdfEval, BsdfFlags, BsdfModel, BsdfSample, Bxdf, BxdfTree, NodeId, ShadingPoint,
+    Adapter, Bsdf, BsdfEval, BsdfFlags, BsdfModel, BsdfSample, Bxdf, BxdfTree, NodeId,
+    ResolveContext,
 };
-use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+use crate::spectrum::SampledSpectrum;
 use crate::texture::Texture;
 use crate::texture::TextureValues;
 
@@ -26,43 +27,27 @@ pub struct Blend {
     pub nested: [Box<Bsdf>; 2],
 }
 
-impl BsdfModel for Blend {
-    fn flags(&self) -> BsdfFlags {
-        self.nested[0].flags().union(self.nested[1].flags())
-    }
+impl Adapter for Blend {
+    const OWN_FLAGS: BsdfFlags = BsdfFlags::NONE;
 
-    fn is_dispersive(&self) -> bool {
-        self.nested[0].is_dispersive() || self.nested[1].is_dispersive()
-    }
-
-    fn node_count(&self) -> usize {
-        1 + self.nested[0].node_count() + self.nested[1].node_count()
+    fn nested(&self) -> &[Box<Bsdf>] {
+        &self.nested
     }
 
     /// The nested BSDFs' blended by the weight.
-    fn diffuse_reflectance(
-        &self,
-        point: &ShadingPoint,
-        wo: Vec3,
-        lambda: &SampledWavelengths,
-    ) -> SampledSpectrum {
+    fn diffuse_reflectance(&self, context: &ResolveContext) -> SampledSpectrum {
+        let ResolveContext { point, wo, lambda } = *context;
         let weight = self.weight.eval_1(point.at()).clamp(0.0, 1.0);
         (1.0 - weight) * self.nested[0].diffuse_reflectance(point, wo, lambda)
             + weight * self.nested[1].diffuse_reflectance(point, wo, lambda)
     }
 
     #[inline]
-    fn resolve<'a>(
-        &'a self,
-        point: &ShadingPoint,
-        wo: Vec3,
-        lambda: &SampledWavelengths,
-        tree: &mut BxdfTree<'a>,
-    ) -> NodeId {
-        let first = self.nested[0].resolve(point, wo, lambda, tree);
-        let second = self.nested[1].resolve(point, wo, lambda, tree);
+    fn resolve<'a>(&'a self, context: &ResolveContext, tree: &mut BxdfTree<'a>) -> NodeId {
+        let first = self.nested[0].resolve(context, tree);
+        let second = self.nested[1].resolve(context, tree);
         tree.push(BlendLobes {
-            weight: self.weight.eval_1(point.at()).clamp(0.0, 1.0),
+            weight: self.weight.eval_1(context.point.at()).clamp(0.0, 1.0),
             nested: [first, second],
         })
     }

@@ -74,17 +74,57 @@ pub fn clearcoat_alpha(clearcoat_gloss: f32) -> f32 {
 /// ȳ(λᵢ) c(λᵢ) over the path's wavelengths (not divided by the mean of ȳ, so that a white base
 /// is tinted by 1/mean ȳ(λᵢ), as in Mitsuba).
 #[inline]
-pub fn tint_luminance(color: &SampledSpectrum, lambda: &SampledWavelengths) -> f32 {
+fn tint_luminance(color: &SampledSpectrum, lambda: &SampledWavelengths) -> f32 {
     SampledSpectrum::from_fn(|i| cie_y(lambda.lambda(i)) * color[i]).average()
 }
 
-/// The colour normalised to luminance 1 (white where it is black), Burley's C_tint.
+/// Burley's C_tint, for lobes that are tinted (`spec_tint`, `sheen_tint`; `tinted`): the colour
+/// normalised to luminance 1 (white where it is black); the colour itself where none is.
 #[inline]
-pub fn tint(color: &SampledSpectrum, luminance: f32) -> SampledSpectrum {
+pub fn tint(color: &SampledSpectrum, tinted: bool, lambda: &SampledWavelengths) -> SampledSpectrum {
+    let luminance = if tinted {
+        tint_luminance(color, lambda)
+    } else {
+        1.0
+    };
     if luminance > 0.0 {
         *color * (1.0 / luminance)
     } else {
         SampledSpectrum::ONE
+    }
+}
+
+/// The diffuse lobe's factor of c/π cos θi (Burley 2012, §5.3; Burley 2015, §5.3):
+/// (1 − ½F_o)(1 − ½F_i) + R_r (F_o + F_i + F_o F_i (R_r − 1)), F_x = (1 − cos θx)⁵ and
+/// R_r = 2 roughness cos²θ_d (`cos_d` = h·wi), blended towards the fake subsurface
+/// 1.25 (F_ss (1/(cos θo + cos θi) − ½) + ½) by `flatness`.
+#[inline]
+pub fn diffuse_factor(
+    roughness: f32,
+    flatness: Option<f32>,
+    cos_o: f32,
+    cos_i: f32,
+    cos_d: f32,
+) -> f32 {
+    let (f_o, f_i) = (schlick_weight(cos_i), schlick_weight(cos_o));
+    let retro = 2.0 * roughness * cos_d * cos_d;
+    let lambert = (1.0 - 0.5 * f_i) * (1.0 - 0.5 * f_o);
+    let mut diffuse = lambert + retro * (f_o + f_i + f_o * f_i * (retro - 1.0));
+    if let Some(flatness) = flatness {
+        let f_ss90 = 0.5 * retro;
+        let f_ss = (1.0 + f_o * (f_ss90 - 1.0)) * (1.0 + f_i * (f_ss90 - 1.0));
+        let subsurface = 1.25 * (f_ss * (1.0 / (cos_o + cos_i) - 0.5) + 0.5);
+        diffuse += flatness * (subsurface - diffuse);
+    }
+    diffuse
+}
+
+/// The sheen's colour lerp(1, C_tint, `sheen_tint`).
+#[inline]
+pub fn sheen_colour(sheen_tint: Option<f32>, tint: &SampledSpectrum) -> SampledSpectrum {
+    match sheen_tint {
+        Some(t) => SampledSpectrum::from_fn(|i| 1.0 + t * (tint[i] - 1.0)),
+        None => SampledSpectrum::ONE,
     }
 }
 

@@ -18,7 +18,7 @@ use glam::{Vec2, Vec3};
 use wide::f32x4;
 
 use super::fresnel::{fresnel_conductor4, reflect_z};
-use super::{BsdfFlags, BsdfModel, BsdfSample, Bxdf, BxdfTree, NodeId, ShadingPoint};
+use super::{BsdfFlags, BsdfSample, Bxdf, BxdfTree, LeafBsdf};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use crate::texture::TextureValues;
 use crate::texture::{Texture, TexturePoint};
@@ -68,43 +68,16 @@ impl ConductorIor {
     }
 }
 
-const FLAGS: BsdfFlags = BsdfFlags::SPECULAR.union(BsdfFlags::REFLECTION);
-
-impl BsdfModel for Conductor {
-    fn flags(&self) -> BsdfFlags {
-        FLAGS
-    }
-
-    fn is_dispersive(&self) -> bool {
-        false
-    }
-
-    fn node_count(&self) -> usize {
-        1
-    }
-
-    /// None: a mirror has only a specular lobe.
-    fn diffuse_reflectance(
-        &self,
-        _point: &ShadingPoint,
-        _wo: Vec3,
-        _lambda: &SampledWavelengths,
-    ) -> SampledSpectrum {
-        SampledSpectrum::ZERO
-    }
+impl LeafBsdf for Conductor {
+    type Lobes<'a> = ConductorLobes;
+    const FLAGS: BsdfFlags = BsdfFlags::SPECULAR.union(BsdfFlags::REFLECTION);
 
     #[inline]
-    fn resolve<'a>(
-        &'a self,
-        point: &ShadingPoint,
-        _wo: Vec3,
-        lambda: &SampledWavelengths,
-        tree: &mut BxdfTree<'a>,
-    ) -> NodeId {
-        tree.push(ConductorLobes {
-            ior: ConductorIor::at(&self.eta, &self.k, self.ext_eta, point.at(), lambda),
-            specular_reflectance: self.specular_reflectance.eval(point.at(), lambda),
-        })
+    fn lobes(&self, at: TexturePoint, lambda: &SampledWavelengths) -> ConductorLobes {
+        ConductorLobes {
+            ior: ConductorIor::at(&self.eta, &self.k, self.ext_eta, at, lambda),
+            specular_reflectance: self.specular_reflectance.eval(at, lambda),
+        }
     }
 }
 
@@ -121,6 +94,11 @@ impl Bxdf for ConductorLobes {
             return None;
         }
         let weight = self.ior.reflectance(wo.z) * self.specular_reflectance;
-        Some(BsdfSample::new(reflect_z(wo), weight, 1.0, FLAGS))
+        Some(BsdfSample::new(
+            reflect_z(wo),
+            weight,
+            1.0,
+            Conductor::FLAGS,
+        ))
     }
 }

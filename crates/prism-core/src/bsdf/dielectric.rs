@@ -24,7 +24,7 @@
 use glam::{Vec2, Vec3};
 
 use super::fresnel::{fresnel_dielectric, reflect_z, refract_z};
-use super::{BsdfFlags, BsdfModel, BsdfSample, Bxdf, BxdfTree, NodeId, ShadingPoint};
+use super::{BsdfFlags, BsdfSample, Bxdf, BxdfTree, LeafBsdf};
 use crate::spectrum::ior::RelativeIor;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use crate::texture::TextureValues;
@@ -48,6 +48,29 @@ pub(crate) fn optional_factor(
     match texture {
         Some(t) => t.eval(at, lambda),
         None => SampledSpectrum::ONE,
+    }
+}
+
+/// The optional factors of a dielectric's reflection and transmission (Mitsuba's
+/// `specular_reflectance` and `specular_transmittance`) at a point: 1 where absent.
+#[derive(Clone, Copy, Debug)]
+pub struct SpecularFactors {
+    pub reflectance: SampledSpectrum,
+    pub transmittance: SampledSpectrum,
+}
+
+impl SpecularFactors {
+    #[inline]
+    pub fn at(
+        reflectance: &Option<Texture>,
+        transmittance: &Option<Texture>,
+        at: TexturePoint,
+        lambda: &SampledWavelengths,
+    ) -> SpecularFactors {
+        SpecularFactors {
+            reflectance: optional_factor(reflectance, at, lambda),
+            transmittance: optional_factor(transmittance, at, lambda),
+        }
     }
 }
 
@@ -80,50 +103,27 @@ impl SampledIor {
     }
 }
 
-const FLAGS: BsdfFlags = BsdfFlags::SPECULAR
-    .union(BsdfFlags::REFLECTION)
-    .union(BsdfFlags::TRANSMISSION);
-
-impl BsdfModel for Dielectric {
-    fn flags(&self) -> BsdfFlags {
-        FLAGS
-    }
+impl LeafBsdf for Dielectric {
+    type Lobes<'a> = DielectricLobes;
+    const FLAGS: BsdfFlags = BsdfFlags::SPECULAR
+        .union(BsdfFlags::REFLECTION)
+        .union(BsdfFlags::TRANSMISSION);
 
     fn is_dispersive(&self) -> bool {
         self.eta.is_dispersive()
     }
 
-    fn node_count(&self) -> usize {
-        1
-    }
-
-    /// None: only specular lobes.
-    fn diffuse_reflectance(
-        &self,
-        _point: &ShadingPoint,
-        _wo: Vec3,
-        _lambda: &SampledWavelengths,
-    ) -> SampledSpectrum {
-        SampledSpectrum::ZERO
-    }
-
     #[inline]
-    fn resolve<'a>(
-        &'a self,
-        point: &ShadingPoint,
-        _wo: Vec3,
-        lambda: &SampledWavelengths,
-        tree: &mut BxdfTree<'a>,
-    ) -> NodeId {
-        tree.push(DielectricLobes {
+    fn lobes(&self, at: TexturePoint, lambda: &SampledWavelengths) -> DielectricLobes {
+        DielectricLobes {
             eta: SampledIor::at(&self.eta, lambda),
-            specular_reflectance: optional_factor(&self.specular_reflectance, point.at(), lambda),
-            specular_transmittance: optional_factor(
+            specular: SpecularFactors::at(
+                &self.specular_reflectance,
                 &self.specular_transmittance,
-                point.at(),
+                at,
                 lambda,
             ),
-        })
+        }
     }
 }
 
@@ -131,8 +131,7 @@ impl BsdfModel for Dielectric {
 #[derive(Clone, Copy, Debug)]
 pub struct DielectricLobes {
     pub eta: SampledIor,
-    pub specular_reflectance: SampledSpectrum,
-    pub specular_transmittance: SampledSpectrum,
+    pub specular: SpecularFactors,
 }
 
 impl Bxdf for DielectricLobes {
@@ -154,7 +153,7 @@ impl Bxdf for DielectricLobes {
             hero.reflectance
         };
         if u_lobe < p_reflect {
-            let weight = reflectance * (1.0 / p_reflect) * self.specular_reflectance;
+            let weight = reflectance * (1.0 / p_reflect) * self.specular.reflectance;
             return Some(BsdfSample::new(
                 reflect_z(wo),
                 weight,
@@ -169,7 +168,7 @@ impl Bxdf for DielectricLobes {
         let p_transmit = 1.0 - p_reflect;
         let transmittance = (SampledSpectrum::ONE - reflectance) * (1.0 / p_transmit);
         let radiance_scale = hero.eta_ti * hero.eta_ti;
-        let weight = transmittance * radiance_scale * self.specular_transmittance;
+        let weight = transmittance * radiance_scale * self.specular.transmittance;
         Some(BsdfSample {
             wi: refract_z(wo, hero.cos_theta_t, hero.eta_ti),
             weight,

@@ -14,10 +14,11 @@ use std::f32::consts::FRAC_1_PI;
 
 use glam::{Vec2, Vec3};
 
-use super::{BsdfEval, BsdfFlags, BsdfModel, BsdfSample, Bxdf, BxdfTree, NodeId, ShadingPoint};
+use super::{BsdfEval, BsdfFlags, BsdfSample, Bxdf, BxdfTree, LeafBsdf};
 use crate::sampling::warp::{cosine_hemisphere_pdf, sample_cosine_hemisphere};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use crate::texture::Texture;
+use crate::texture::TexturePoint;
 use crate::texture::TextureValues;
 
 #[derive(Clone, Debug)]
@@ -25,42 +26,20 @@ pub struct Diffuse {
     pub reflectance: Texture,
 }
 
-const FLAGS: BsdfFlags = BsdfFlags::DIFFUSE.union(BsdfFlags::REFLECTION);
-
-impl BsdfModel for Diffuse {
-    fn flags(&self) -> BsdfFlags {
-        FLAGS
-    }
-
-    fn is_dispersive(&self) -> bool {
-        false
-    }
-
-    fn node_count(&self) -> usize {
-        1
-    }
+impl LeafBsdf for Diffuse {
+    type Lobes<'a> = DiffuseLobes;
+    const FLAGS: BsdfFlags = BsdfFlags::DIFFUSE.union(BsdfFlags::REFLECTION);
 
     /// The reflectance.
-    fn diffuse_reflectance(
-        &self,
-        point: &ShadingPoint,
-        _wo: Vec3,
-        lambda: &SampledWavelengths,
-    ) -> SampledSpectrum {
-        self.reflectance.eval(point.at(), lambda)
+    fn albedo(&self, at: TexturePoint, lambda: &SampledWavelengths) -> SampledSpectrum {
+        self.reflectance.eval(at, lambda)
     }
 
     #[inline]
-    fn resolve<'a>(
-        &'a self,
-        point: &ShadingPoint,
-        _wo: Vec3,
-        lambda: &SampledWavelengths,
-        tree: &mut BxdfTree<'a>,
-    ) -> NodeId {
-        tree.push(DiffuseLobes {
-            reflectance: self.reflectance.eval(point.at(), lambda),
-        })
+    fn lobes(&self, at: TexturePoint, lambda: &SampledWavelengths) -> DiffuseLobes {
+        DiffuseLobes {
+            reflectance: self.reflectance.eval(at, lambda),
+        }
     }
 }
 
@@ -92,6 +71,6 @@ impl Bxdf for DiffuseLobes {
         if !(pdf > 0.0) {
             return None;
         }
-        Some(BsdfSample::new(wi, self.reflectance, pdf, FLAGS))
+        Some(BsdfSample::new(wi, self.reflectance, pdf, Diffuse::FLAGS))
     }
 }

@@ -15,9 +15,10 @@
 use glam::{Vec2, Vec3};
 
 use super::{
-    Bsdf, BsdfEval, BsdfFlags, BsdfModel, BsdfSample, Bxdf, BxdfTree, NodeId, ShadingPoint,
+    Adapter, Bsdf, BsdfEval, BsdfFlags, BsdfModel, BsdfSample, Bxdf, BxdfTree, NodeId,
+    ResolveContext,
 };
-use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+use crate::spectrum::SampledSpectrum;
 use crate::texture::Texture;
 use crate::texture::TextureValues;
 
@@ -27,40 +28,19 @@ pub struct Mask {
     pub nested: Box<Bsdf>,
 }
 
-impl BsdfModel for Mask {
-    fn flags(&self) -> BsdfFlags {
-        self.nested.flags().union(BsdfFlags::NULL)
-    }
+/// Its diffuse reflectance is the nested BSDF's (the opacity aside, as in Mitsuba).
+impl Adapter for Mask {
+    const OWN_FLAGS: BsdfFlags = BsdfFlags::NULL;
 
-    fn is_dispersive(&self) -> bool {
-        self.nested.is_dispersive()
-    }
-
-    fn node_count(&self) -> usize {
-        1 + self.nested.node_count()
-    }
-
-    /// The nested BSDF's (the opacity aside, as in Mitsuba).
-    fn diffuse_reflectance(
-        &self,
-        point: &ShadingPoint,
-        wo: Vec3,
-        lambda: &SampledWavelengths,
-    ) -> SampledSpectrum {
-        self.nested.diffuse_reflectance(point, wo, lambda)
+    fn nested(&self) -> &[Box<Bsdf>] {
+        std::slice::from_ref(&self.nested)
     }
 
     #[inline]
-    fn resolve<'a>(
-        &'a self,
-        point: &ShadingPoint,
-        wo: Vec3,
-        lambda: &SampledWavelengths,
-        tree: &mut BxdfTree<'a>,
-    ) -> NodeId {
-        let nested = self.nested.resolve(point, wo, lambda, tree);
+    fn resolve<'a>(&'a self, context: &ResolveContext, tree: &mut BxdfTree<'a>) -> NodeId {
+        let nested = self.nested.resolve(context, tree);
         tree.push(MaskLobes {
-            opacity: self.opacity.eval_1(point.at()).clamp(0.0, 1.0),
+            opacity: self.opacity.eval_1(context.point.at()).clamp(0.0, 1.0),
             nested,
         })
     }

@@ -2,7 +2,10 @@
 
 use glam::{Vec2, Vec3};
 
-use super::{Bsdf, BsdfEval, BsdfFlags, BsdfModel, BsdfSample, BxdfTree, NodeId, ShadingPoint};
+use super::{
+    Bsdf, BsdfEval, BsdfFlags, BsdfModel, BsdfSample, BxdfTree, NodeId, ResolveContext,
+    ShadingPoint,
+};
 use crate::geometry::SurfaceInteraction;
 use crate::math::Frame;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
@@ -123,7 +126,7 @@ impl<'t, 'm> Scattering<'t, 'm> {
         tree: &'t mut BxdfTree<'m>,
     ) -> Scattering<'t, 'm> {
         tree.clear();
-        let root = bsdf.resolve(point, wo, lambda, tree);
+        let root = bsdf.resolve(&ResolveContext { point, wo, lambda }, tree);
         Scattering {
             frame: point.frame,
             wo,

@@ -29,9 +29,10 @@
 //! densities summed), so that MIS sees the density the direction was really drawn with.
 //!
 //! # Adding a BSDF
-//! Write one file with the description (implementing [`BsdfModel`]) and its lobes
-//! (implementing [`Bxdf`]), add its two types to the `bsdfs!` lists below, and register its
-//! plugin and parameters with the scene reader (docs/architecture.md).
+//! Write one file with the description and its lobes (implementing [`Bxdf`]). A description
+//! that nests no other BSDF implements [`LeafBsdf`], one built around nested BSDFs [`Adapter`];
+//! [`BsdfModel`] follows from either. Add its two types to the `bsdfs!` lists below, and
+//! register its plugin and parameters with the scene reader (docs/architecture.md).
 //!
 //! | plugin | file | lobes |
 //! | --- | --- | --- |
@@ -53,7 +54,6 @@
 //! | `mask` | [`mask`] | the nested BSDF's, and null transmission |
 //! | `null` | [`null`] | null transmission only (a medium's boundary) |
 //! | `blendbsdf` | [`blend`] | both nested BSDFs' |
-//! | `null` | [`null`] | null transmission |
 //! | `bumpmap`, `normalmap` | [`bumpmap`], [`normalmap`] | the nested BSDF's, in a perturbed frame |
 
 pub mod blend;
@@ -63,6 +63,7 @@ pub mod conductor;
 pub mod dielectric;
 pub mod diffuse;
 pub mod fresnel;
+pub mod glossydiffuse;
 pub mod mask;
 pub mod material;
 pub mod microfacet;
@@ -118,6 +119,8 @@ use crate::texture::TexturePoint;
 pub struct BsdfFlags(u8);
 
 impl BsdfFlags {
+    /// No lobe.
+    pub const NONE: BsdfFlags = BsdfFlags(0);
     pub const DIFFUSE: BsdfFlags = BsdfFlags(1);
     pub const GLOSSY: BsdfFlags = BsdfFlags(2);
     /// A Dirac delta lobe (mirror or clear glass): cannot be evaluated, only sampled.
@@ -201,6 +204,17 @@ impl BsdfEval {
     };
 }
 
+/// The probability of choosing a lobe in proportion to an estimate of its albedo, `lobe`,
+/// against the estimate for the other lobes, `rest`: 1 where both are zero.
+#[inline]
+pub(crate) fn choice_probability(lobe: f32, rest: f32) -> f32 {
+    if lobe + rest > 0.0 {
+        lobe / (lobe + rest)
+    } else {
+        1.0
+    }
+}
+
 /// For a BSDF that is a mixture of lobes: the sample of one smooth lobe turned into a sample of
 /// the whole mixture, whose density at `wi` is `pdf` and whose value there is `value`.
 #[inline]
@@ -278,16 +292,83 @@ pub trait BsdfModel {
         wo: Vec3,
         lambda: &SampledWavelengths,
     ) -> SampledSpectrum;
-    /// Evaluates the textures at `point` for the wavelengths `lambda` and adds the lobes there
-    /// to `tree`, for the outgoing direction `wo` (local to `point.frame`), which adapters need
-    /// to choose a side or tilt a frame. Returns the index of the node added last, its root.
-    fn resolve<'a>(
-        &'a self,
-        point: &ShadingPoint,
-        wo: Vec3,
-        lambda: &SampledWavelengths,
-        tree: &mut BxdfTree<'a>,
-    ) -> NodeId;
+    /// Evaluates the textures at the context's point for its wavelengths and adds the lobes
+    /// there to `tree`. Returns the index of the node added last, its root.
+    fn resolve<'a>(&'a self, context: &ResolveContext, tree: &mut BxdfTree<'a>) -> NodeId;
+}
+
+/// Where a BSDF's lobes are resolved: the point, the outgoing direction `wo` (local to the
+/// point's frame), which adapters need to choose a side or tilt a frame, and the path's
+/// wavelengths `lambda`.
+#[derive(Clone, Copy, Debug)]
+pub struct ResolveContext<'p> {
+    pub point: &'p ShadingPoint,
+    pub wo: Vec3,
+    pub lambda: &'p SampledWavelengths,
+}
+
+/// A BSDF that nests no other: its lobes take one node of a [`BxdfTree`] and depend on the
+/// textures' point and the wavelengths only. Its [`BsdfModel`] follows: one node, which
+/// `resolve` adds.
+pub trait LeafBsdf {
+    /// The lobes at a point.
+    type Lobes<'a>: Into<Node<'a>>
+    where
+        Self: 'a;
+
+    /// The union of the lobes' flags; for a BSDF whose lobes depend on its parameters, the
+    /// flags of those it always has.
+    const FLAGS: BsdfFlags;
+
+    /// [`BsdfModel::flags`]: [`Self::FLAGS`], to which `principled` adds its transmission where
+    /// it has one.
+    fn flags(&self) -> BsdfFlags {
+        Self::FLAGS
+    }
+
+    /// [`BsdfModel::is_dispersive`]. Only a BSDF that refracts through an index of refraction
+    /// that may vary with wavelength answers otherwise than this `false`.
+    fn is_dispersive(&self) -> bool {
+        false
+    }
+
+    /// [`BsdfModel::diffuse_reflectance`], the reflectance of the diffuse part at `at`, which
+    /// for a leaf does not depend on `wo`. Only a BSDF with a diffuse part answers otherwise
+    /// than this zero.
+    fn albedo(&self, at: TexturePoint, lambda: &SampledWavelengths) -> SampledSpectrum {
+        let _ = (at, lambda);
+        SampledSpectrum::ZERO
+    }
+
+    /// Evaluates the textures at `at` for the wavelengths `lambda`: the lobes there.
+    fn lobes<'a>(&'a self, at: TexturePoint, lambda: &SampledWavelengths) -> Self::Lobes<'a>;
+}
+
+/// A BSDF built around nested ones (`twosided`, `mask`, `blendbsdf`, `bumpmap`, `normalmap`).
+/// Its [`BsdfModel`] follows from theirs: its flags are theirs and its own, it is dispersive
+/// where one of them is, and its lobes take one node beside theirs.
+pub trait Adapter {
+    /// The flags of the lobes the adapter adds to the nested ones' (`mask`'s null lobe).
+    const OWN_FLAGS: BsdfFlags;
+
+    /// The nested BSDFs.
+    fn nested(&self) -> &[Box<Bsdf>];
+
+    /// The most nodes the nested BSDFs' lobes take at a point: the sum of their counts, as all
+    /// of them are resolved. `twosided`, which resolves one side, answers the larger count.
+    fn nested_node_count(&self) -> usize {
+        self.nested().iter().map(|b| b.node_count()).sum()
+    }
+
+    /// [`BsdfModel::diffuse_reflectance`]: the nested BSDF's, for an adapter that nests one;
+    /// `blendbsdf` blends its two, `twosided` takes the side `wo` sees.
+    fn diffuse_reflectance(&self, context: &ResolveContext) -> SampledSpectrum {
+        let ResolveContext { point, wo, lambda } = *context;
+        self.nested()[0].diffuse_reflectance(point, wo, lambda)
+    }
+
+    /// [`BsdfModel::resolve`]: the nested BSDFs' lobes, then the adapter's node.
+    fn resolve<'a>(&'a self, context: &ResolveContext, tree: &mut BxdfTree<'a>) -> NodeId;
 }
 
 /// A BSDF's lobes at one point for one path's wavelengths, in the local frame. Adapters reach
@@ -356,38 +437,61 @@ impl<'a> BxdfTree<'a> {
 /// Declares the BSDFs: the description enum [`Bsdf`], one variant per plugin, and the lobe enum
 /// [`Node`], one variant per kind of lobes (bump and normal maps share theirs), dispatched to
 /// [`BsdfModel`] and [`Bxdf`] by `match` (no dynamic dispatch in the hot path: docs/architecture.md,
-/// Conventions).
+/// Conventions). The descriptions are listed as leaves and adapters; the [`BsdfModel`] of each
+/// follows from its [`LeafBsdf`] or [`Adapter`].
 macro_rules! bsdfs {
     (
-        descriptions { $($variant:ident($model:ty),)+ }
+        leaves { $($leaf:ident($leaf_model:ty),)+ }
+        adapters { $($adapter:ident($adapter_model:ty),)+ }
         lobes { $($node:ident($lobes:ty),)+ }
     ) => {
-        /// A BSDF as the scene describes it (one side of a surface, unless it is two-sided by
-        /// nature, as dielectrics are).
-        #[derive(Clone, Debug)]
-        pub enum Bsdf {
-            $($variant($model),)+
-        }
+        bsdfs!(@descriptions $($leaf($leaf_model),)+ $($adapter($adapter_model),)+);
 
-        impl BsdfModel for Bsdf {
+        $(impl BsdfModel for $leaf_model {
             #[inline]
             fn flags(&self) -> BsdfFlags {
-                match self {
-                    $(Bsdf::$variant(b) => b.flags(),)+
-                }
+                LeafBsdf::flags(self)
             }
 
             #[inline]
             fn is_dispersive(&self) -> bool {
-                match self {
-                    $(Bsdf::$variant(b) => b.is_dispersive(),)+
-                }
+                LeafBsdf::is_dispersive(self)
             }
 
             fn node_count(&self) -> usize {
-                match self {
-                    $(Bsdf::$variant(b) => b.node_count(),)+
-                }
+                1
+            }
+
+            fn diffuse_reflectance(
+                &self,
+                point: &ShadingPoint,
+                _wo: Vec3,
+                lambda: &SampledWavelengths,
+            ) -> SampledSpectrum {
+                self.albedo(point.at(), lambda)
+            }
+
+            #[inline]
+            fn resolve<'a>(&'a self, context: &ResolveContext, tree: &mut BxdfTree<'a>) -> NodeId {
+                tree.push(self.lobes(context.point.at(), context.lambda))
+            }
+        })+
+
+        $(impl BsdfModel for $adapter_model {
+            #[inline]
+            fn flags(&self) -> BsdfFlags {
+                self.nested()
+                    .iter()
+                    .fold(Self::OWN_FLAGS, |flags, b| flags.union(b.flags()))
+            }
+
+            #[inline]
+            fn is_dispersive(&self) -> bool {
+                self.nested().iter().any(|b| b.is_dispersive())
+            }
+
+            fn node_count(&self) -> usize {
+                1 + self.nested_node_count()
             }
 
             fn diffuse_reflectance(
@@ -396,28 +500,12 @@ macro_rules! bsdfs {
                 wo: Vec3,
                 lambda: &SampledWavelengths,
             ) -> SampledSpectrum {
-                match self {
-                    $(Bsdf::$variant(b) => b.diffuse_reflectance(point, wo, lambda),)+
-                }
+                Adapter::diffuse_reflectance(self, &ResolveContext { point, wo, lambda })
             }
 
             #[inline]
-            fn resolve<'a>(
-                &'a self,
-                point: &ShadingPoint,
-                wo: Vec3,
-                lambda: &SampledWavelengths,
-                tree: &mut BxdfTree<'a>,
-            ) -> NodeId {
-                match self {
-                    $(Bsdf::$variant(b) => b.resolve(point, wo, lambda, tree),)+
-                }
-            }
-        }
-
-        $(impl From<$model> for Bsdf {
-            fn from(bsdf: $model) -> Bsdf {
-                Bsdf::$variant(bsdf)
+            fn resolve<'a>(&'a self, context: &ResolveContext, tree: &mut BxdfTree<'a>) -> NodeId {
+                Adapter::resolve(self, context, tree)
             }
         })+
 
@@ -449,10 +537,65 @@ macro_rules! bsdfs {
             }
         })+
     };
+
+    (@descriptions $($variant:ident($model:ty),)+) => {
+        /// A BSDF as the scene describes it (one side of a surface, unless it is two-sided by
+        /// nature, as dielectrics are).
+        #[derive(Clone, Debug)]
+        pub enum Bsdf {
+            $($variant($model),)+
+        }
+
+        impl BsdfModel for Bsdf {
+            #[inline]
+            fn flags(&self) -> BsdfFlags {
+                match self {
+                    $(Bsdf::$variant(b) => BsdfModel::flags(b),)+
+                }
+            }
+
+            #[inline]
+            fn is_dispersive(&self) -> bool {
+                match self {
+                    $(Bsdf::$variant(b) => BsdfModel::is_dispersive(b),)+
+                }
+            }
+
+            fn node_count(&self) -> usize {
+                match self {
+                    $(Bsdf::$variant(b) => b.node_count(),)+
+                }
+            }
+
+            fn diffuse_reflectance(
+                &self,
+                point: &ShadingPoint,
+                wo: Vec3,
+                lambda: &SampledWavelengths,
+            ) -> SampledSpectrum {
+                match self {
+                    $(Bsdf::$variant(b) => BsdfModel::diffuse_reflectance(b, point, wo, lambda),)+
+                }
+            }
+
+            #[inline]
+            fn resolve<'a>(&'a self, context: &ResolveContext, tree: &mut BxdfTree<'a>) -> NodeId {
+                match self {
+                    $(Bsdf::$variant(b) => BsdfModel::resolve(b, context, tree),)+
+                }
+            }
+        }
+
+        $(impl From<$model> for Bsdf {
+            fn from(bsdf: $model) -> Bsdf {
+                Bsdf::$variant(bsdf)
+            }
+        })+
+    };
 }
 
 bsdfs! {
-    descriptions {
+    leaves {
         Diffuse(Diffuse),
         RoughDiffuse(RoughDiffuse),
         Conductor(Conductor),
@@ -467,12 +610,14 @@ bsdfs! {
         Ward(Ward),
         Principled(Principled),
         PrincipledThin(PrincipledThin),
+        Null(Null),
+    }
+    adapters {
         TwoSided(TwoSided),
         Mask(Mask),
         Blend(Blend),
         BumpMap(BumpMap),
         NormalMap(NormalMap),
-        Null(Null),
     }
     lobes {
         Diffuse(diffuse::DiffuseLobes),

@@ -18,8 +18,7 @@
 use glam::Vec3;
 
 use super::perturbed::{Tilt, resolve_perturbed};
-use super::{Bsdf, BsdfFlags, BsdfModel, BxdfTree, NodeId, ShadingPoint};
-use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+use super::{Adapter, Bsdf, BsdfFlags, BxdfTree, NodeId, ResolveContext};
 use crate::texture::Texture;
 use crate::texture::TextureValues;
 
@@ -31,42 +30,20 @@ pub struct NormalMap {
     pub use_shadowing_function: bool,
 }
 
-impl BsdfModel for NormalMap {
-    fn flags(&self) -> BsdfFlags {
-        self.nested.flags()
-    }
+impl Adapter for NormalMap {
+    const OWN_FLAGS: BsdfFlags = BsdfFlags::NONE;
 
-    fn is_dispersive(&self) -> bool {
-        self.nested.is_dispersive()
-    }
-
-    fn node_count(&self) -> usize {
-        1 + self.nested.node_count()
-    }
-
-    /// The nested BSDF's.
-    fn diffuse_reflectance(
-        &self,
-        point: &ShadingPoint,
-        wo: Vec3,
-        lambda: &SampledWavelengths,
-    ) -> SampledSpectrum {
-        self.nested.diffuse_reflectance(point, wo, lambda)
+    fn nested(&self) -> &[Box<Bsdf>] {
+        std::slice::from_ref(&self.nested)
     }
 
     #[inline]
-    fn resolve<'a>(
-        &'a self,
-        point: &ShadingPoint,
-        wo: Vec3,
-        lambda: &SampledWavelengths,
-        tree: &mut BxdfTree<'a>,
-    ) -> NodeId {
+    fn resolve<'a>(&'a self, context: &ResolveContext, tree: &mut BxdfTree<'a>) -> NodeId {
         let tilt = Tilt {
-            normal: self.normals.eval_3(point.at()) * 2.0 - Vec3::ONE,
+            normal: self.normals.eval_3(context.point.at()) * 2.0 - Vec3::ONE,
             flip_invalid_normals: self.flip_invalid_normals,
             use_shadowing_function: self.use_shadowing_function,
         };
-        resolve_perturbed(&self.nested, tilt, point, wo, lambda, tree)
+        resolve_perturbed(&self.nested, tilt, context, tree)
     }
 }

@@ -13,47 +13,21 @@
 
 use glam::{Vec2, Vec3};
 
-use super::{BsdfFlags, BsdfModel, BsdfSample, Bxdf, BxdfTree, NodeId, ShadingPoint};
+use super::{BsdfFlags, BsdfSample, Bxdf, BxdfTree, LeafBsdf};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+use crate::texture::TexturePoint;
 
 /// The `null` BSDF (no parameters).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Null;
 
-const FLAGS: BsdfFlags = BsdfFlags::NULL;
-
-impl BsdfModel for Null {
-    fn flags(&self) -> BsdfFlags {
-        FLAGS
-    }
-
-    fn is_dispersive(&self) -> bool {
-        false
-    }
-
-    fn node_count(&self) -> usize {
-        1
-    }
-
-    /// None: light passes straight through.
-    fn diffuse_reflectance(
-        &self,
-        _point: &ShadingPoint,
-        _wo: Vec3,
-        _lambda: &SampledWavelengths,
-    ) -> SampledSpectrum {
-        SampledSpectrum::ZERO
-    }
+impl LeafBsdf for Null {
+    type Lobes<'a> = NullLobes;
+    const FLAGS: BsdfFlags = BsdfFlags::NULL;
 
     #[inline]
-    fn resolve<'a>(
-        &'a self,
-        _point: &ShadingPoint,
-        _wo: Vec3,
-        _lambda: &SampledWavelengths,
-        tree: &mut BxdfTree<'a>,
-    ) -> NodeId {
-        tree.push(NullLobes)
+    fn lobes(&self, _at: TexturePoint, _lambda: &SampledWavelengths) -> NullLobes {
+        NullLobes
     }
 }
 
@@ -63,6 +37,6 @@ pub struct NullLobes;
 
 impl Bxdf for NullLobes {
     fn sample(&self, _tree: &BxdfTree, wo: Vec3, _u_lobe: f32, _u: Vec2) -> Option<BsdfSample> {
-        Some(BsdfSample::new(-wo, SampledSpectrum::ONE, 1.0, FLAGS))
+        Some(BsdfSample::new(-wo, SampledSpectrum::ONE, 1.0, Null::FLAGS))
     }
 }

@@ -12,9 +12,10 @@
 
 use glam::{Vec2, Vec3};
 
-use super::{Bsdf, BsdfEval, BsdfModel, BsdfSample, Bxdf, BxdfTree, NodeId, ShadingPoint};
+use super::{
+    Bsdf, BsdfEval, BsdfModel, BsdfSample, Bxdf, BxdfTree, NodeId, ResolveContext, ShadingPoint,
+};
 use crate::math::Frame;
-use crate::spectrum::SampledWavelengths;
 
 /// How a bump or normal map tilts the frame at a point.
 #[derive(Clone, Copy, Debug)]
@@ -30,11 +31,10 @@ pub struct Tilt {
 pub(crate) fn resolve_perturbed<'a>(
     nested: &'a Bsdf,
     tilt: Tilt,
-    point: &ShadingPoint,
-    wo: Vec3,
-    lambda: &SampledWavelengths,
+    context: &ResolveContext,
     tree: &mut BxdfTree<'a>,
 ) -> NodeId {
+    let ResolveContext { point, wo, lambda } = *context;
     let mut n = tilt.normal;
     if tilt.flip_invalid_normals && wo.z * wo.dot(n) <= 0.0 {
         n = Vec3::new(-n.x, -n.y, n.z);
@@ -54,7 +54,12 @@ pub(crate) fn resolve_perturbed<'a>(
         },
         ..*point
     };
-    let nested = nested.resolve(&tilted, local.to_local(wo), lambda, tree);
+    let tilted = ResolveContext {
+        point: &tilted,
+        wo: local.to_local(wo),
+        lambda,
+    };
+    let nested = nested.resolve(&tilted, tree);
     tree.push(PerturbedLobes {
         local,
         shadowing: tilt.use_shadowing_function,

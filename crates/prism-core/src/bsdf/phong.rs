@@ -22,14 +22,12 @@ use std::f32::consts::{FRAC_1_PI, PI};
 use glam::{Vec2, Vec3};
 
 use super::fresnel::reflect_z;
-use super::{
-    BsdfEval, BsdfFlags, BsdfModel, BsdfSample, Bxdf, BxdfTree, NodeId, ShadingPoint,
-    mixture_sample,
-};
+use super::glossydiffuse::GlossyDiffuseLobes;
+use super::{BsdfFlags, LeafBsdf, choice_probability};
 use crate::math::Frame;
-use crate::sampling::warp::{cosine_hemisphere_pdf, sample_cosine_hemisphere};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use crate::texture::Texture;
+use crate::texture::TexturePoint;
 use crate::texture::TextureValues;
 
 #[derive(Clone, Debug)]
@@ -41,50 +39,28 @@ pub struct Phong {
     pub scale: f32,
 }
 
-const FLAGS: BsdfFlags = BsdfFlags::GLOSSY
-    .union(BsdfFlags::DIFFUSE)
-    .union(BsdfFlags::REFLECTION);
-
-impl BsdfModel for Phong {
-    fn flags(&self) -> BsdfFlags {
-        FLAGS
-    }
-
-    fn is_dispersive(&self) -> bool {
-        false
-    }
-
-    fn node_count(&self) -> usize {
-        1
-    }
+impl LeafBsdf for Phong {
+    type Lobes<'a> = PhongLobes;
+    const FLAGS: BsdfFlags = BsdfFlags::GLOSSY
+        .union(BsdfFlags::DIFFUSE)
+        .union(BsdfFlags::REFLECTION);
 
     /// The diffuse reflectance, scaled as the lobes are.
-    fn diffuse_reflectance(
-        &self,
-        point: &ShadingPoint,
-        _wo: Vec3,
-        lambda: &SampledWavelengths,
-    ) -> SampledSpectrum {
-        self.scale * self.diffuse_reflectance.eval(point.at(), lambda)
+    fn albedo(&self, at: TexturePoint, lambda: &SampledWavelengths) -> SampledSpectrum {
+        self.scale * self.diffuse_reflectance.eval(at, lambda)
     }
 
     #[inline]
-    fn resolve<'a>(
-        &'a self,
-        point: &ShadingPoint,
-        _wo: Vec3,
-        lambda: &SampledWavelengths,
-        tree: &mut BxdfTree<'a>,
-    ) -> NodeId {
-        let specular = self.specular_reflectance.eval(point.at(), lambda) * self.scale;
-        let diffuse = self.diffuse_reflectance.eval(point.at(), lambda) * self.scale;
+    fn lobes(&self, at: TexturePoint, lambda: &SampledWavelengths) -> PhongLobes {
+        let specular = self.specular_reflectance.eval(at, lambda) * self.scale;
+        let diffuse = self.diffuse_reflectance.eval(at, lambda) * self.scale;
         let (s, d) = (specular.average(), diffuse.average());
-        tree.push(PhongLobes {
-            exponent: self.exponent.eval_1(point.at()),
+        PhongLobes {
+            exponent: self.exponent.eval_1(at),
             specular,
             diffuse,
-            p_glossy: if s + d > 0.0 { s / (s + d) } else { 1.0 },
-        })
+            p_glossy: choice_probability(s, d),
+        }
     }
 }
 
@@ -98,7 +74,7 @@ pub struct PhongLobes {
     pub p_glossy: f32,
 }
 
-impl PhongLobes {
+impl GlossyDiffuseLobes for PhongLobes {
     #[inline]
     fn value(&self, wo: Vec3, wi: Vec3) -> SampledSpectrum {
         let cos_alpha = reflect_z(wo).dot(wi);
@@ -111,51 +87,27 @@ impl PhongLobes {
     }
 
     #[inline]
-    fn mixture_pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+    fn glossy_probability(&self, _wo: Vec3) -> f32 {
+        self.p_glossy
+    }
+
+    /// cos α = u^(1/(n+1)) around the mirror direction.
+    #[inline]
+    fn sample_glossy(&self, wo: Vec3, u: Vec2) -> Vec3 {
+        let cos_alpha = u.y.powf(1.0 / (self.exponent + 1.0));
+        let sin_alpha = (1.0 - cos_alpha * cos_alpha).max(0.0).sqrt();
+        let phi = 2.0 * PI * u.x;
+        let local = Vec3::new(sin_alpha * phi.cos(), sin_alpha * phi.sin(), cos_alpha);
+        Frame::from_normal(reflect_z(wo)).to_world(local)
+    }
+
+    #[inline]
+    fn glossy_pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         let cos_alpha = reflect_z(wo).dot(wi);
-        let glossy = if cos_alpha > 0.0 {
+        if cos_alpha > 0.0 {
             (self.exponent + 1.0) / (2.0 * PI) * cos_alpha.powf(self.exponent)
         } else {
             0.0
-        };
-        self.p_glossy * glossy + (1.0 - self.p_glossy) * cosine_hemisphere_pdf(wi)
-    }
-}
-
-impl Bxdf for PhongLobes {
-    fn eval(&self, _tree: &BxdfTree, wo: Vec3, wi: Vec3) -> BsdfEval {
-        if !(wo.z > 0.0 && wi.z > 0.0) {
-            return BsdfEval::ZERO;
         }
-        BsdfEval {
-            value: self.value(wo, wi),
-            pdf: self.mixture_pdf(wo, wi),
-        }
-    }
-
-    fn sample(&self, _tree: &BxdfTree, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<BsdfSample> {
-        if !(wo.z > 0.0) {
-            return None;
-        }
-        let (wi, flags) = if u_lobe < self.p_glossy {
-            // cos α = u^(1/(n+1)) around the mirror direction.
-            let cos_alpha = u.y.powf(1.0 / (self.exponent + 1.0));
-            let sin_alpha = (1.0 - cos_alpha * cos_alpha).max(0.0).sqrt();
-            let phi = 2.0 * PI * u.x;
-            let local = Vec3::new(sin_alpha * phi.cos(), sin_alpha * phi.sin(), cos_alpha);
-            (
-                Frame::from_normal(reflect_z(wo)).to_world(local),
-                BsdfFlags::GLOSSY.union(BsdfFlags::REFLECTION),
-            )
-        } else {
-            (
-                sample_cosine_hemisphere(u),
-                BsdfFlags::DIFFUSE.union(BsdfFlags::REFLECTION),
-            )
-        };
-        if !(wi.z > 0.0) {
-            return None;
-        }
-        mixture_sample(wi, self.value(wo, wi), self.mixture_pdf(wo, wi), flags)
     }
 }

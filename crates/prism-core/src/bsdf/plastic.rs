@@ -30,12 +30,12 @@ use glam::{Vec2, Vec3};
 use super::dielectric::optional_factor;
 use super::fresnel::{fresnel_dielectric, fresnel_diffuse_reflectance, reflect_z};
 use super::{
-    BsdfEval, BsdfFlags, BsdfModel, BsdfSample, Bxdf, BxdfTree, NodeId, ShadingPoint,
-    mixture_sample,
+    BsdfEval, BsdfFlags, BsdfSample, Bxdf, BxdfTree, LeafBsdf, choice_probability, mixture_sample,
 };
 use crate::sampling::warp::{cosine_hemisphere_pdf, sample_cosine_hemisphere};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use crate::texture::Texture;
+use crate::texture::TexturePoint;
 use crate::texture::TextureValues;
 
 #[derive(Clone, Debug)]
@@ -69,56 +69,44 @@ impl Plastic {
     }
 }
 
-const FLAGS: BsdfFlags = BsdfFlags::SPECULAR
-    .union(BsdfFlags::DIFFUSE)
-    .union(BsdfFlags::REFLECTION);
+/// The effective diffuse reflectance of a base of reflectance ρ under a coating that reflects
+/// the fraction R of the light from below back down: ρ / (1 − R) or, with `nonlinear`,
+/// ρ / (1 − ρ R), which darkens and saturates colours (shared with `roughplastic`).
+#[inline]
+pub(crate) fn effective_diffuse(
+    rho: SampledSpectrum,
+    internal_reflectance: f32,
+    nonlinear: bool,
+) -> SampledSpectrum {
+    SampledSpectrum::from_fn(|i| {
+        let bounce = if nonlinear {
+            rho[i] * internal_reflectance
+        } else {
+            internal_reflectance
+        };
+        rho[i] / (1.0 - bounce)
+    })
+}
 
-impl BsdfModel for Plastic {
-    fn flags(&self) -> BsdfFlags {
-        FLAGS
-    }
-
-    fn is_dispersive(&self) -> bool {
-        false
-    }
-
-    fn node_count(&self) -> usize {
-        1
-    }
+impl LeafBsdf for Plastic {
+    type Lobes<'a> = PlasticLobes<'a>;
+    const FLAGS: BsdfFlags = BsdfFlags::SPECULAR
+        .union(BsdfFlags::DIFFUSE)
+        .union(BsdfFlags::REFLECTION);
 
     /// The diffuse reflectance under the coating.
-    fn diffuse_reflectance(
-        &self,
-        point: &ShadingPoint,
-        _wo: Vec3,
-        lambda: &SampledWavelengths,
-    ) -> SampledSpectrum {
-        self.diffuse_reflectance.eval(point.at(), lambda)
+    fn albedo(&self, at: TexturePoint, lambda: &SampledWavelengths) -> SampledSpectrum {
+        self.diffuse_reflectance.eval(at, lambda)
     }
 
     #[inline]
-    fn resolve<'a>(
-        &'a self,
-        point: &ShadingPoint,
-        _wo: Vec3,
-        lambda: &SampledWavelengths,
-        tree: &mut BxdfTree<'a>,
-    ) -> NodeId {
-        // ρ / (1 − F_dr) or, nonlinear, ρ / (1 − ρ F_dr).
-        let rho = self.diffuse_reflectance.eval(point.at(), lambda);
-        let diffuse = SampledSpectrum::from_fn(|i| {
-            let bounce = if self.nonlinear {
-                rho[i] * self.fdr_internal
-            } else {
-                self.fdr_internal
-            };
-            rho[i] / (1.0 - bounce)
-        });
-        tree.push(PlasticLobes {
+    fn lobes<'a>(&'a self, at: TexturePoint, lambda: &SampledWavelengths) -> PlasticLobes<'a> {
+        let rho = self.diffuse_reflectance.eval(at, lambda);
+        PlasticLobes {
             plastic: self,
-            diffuse,
-            specular_reflectance: optional_factor(&self.specular_reflectance, point.at(), lambda),
-        })
+            diffuse: effective_diffuse(rho, self.fdr_internal, self.nonlinear),
+            specular_reflectance: optional_factor(&self.specular_reflectance, at, lambda),
+        }
     }
 }
 
@@ -138,11 +126,7 @@ impl PlasticLobes<'_> {
         let p = self.plastic;
         let specular = f_o * self.specular_reflectance.average();
         let base = (1.0 - f_o) * self.diffuse.average() * (1.0 - p.fdr_external) * p.inv_eta2;
-        if specular + base > 0.0 {
-            specular / (specular + base)
-        } else {
-            1.0
-        }
+        choice_probability(specular, base)
     }
 
     /// The base's f cos θi given F(cos θo) and the sampled direction.

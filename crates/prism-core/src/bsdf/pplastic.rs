@@ -31,14 +31,12 @@ use glam::{Vec2, Vec3};
 
 use super::dielectric::optional_factor;
 use super::fresnel::{fresnel_dielectric, reflect};
+use super::glossydiffuse::GlossyDiffuseLobes;
 use super::microfacet::{Microfacet, MicrofacetKind};
-use super::{
-    BsdfEval, BsdfFlags, BsdfModel, BsdfSample, Bxdf, BxdfTree, NodeId, ShadingPoint,
-    mixture_sample,
-};
-use crate::sampling::warp::{cosine_hemisphere_pdf, sample_cosine_hemisphere};
+use super::{BsdfFlags, LeafBsdf, choice_probability};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use crate::texture::Texture;
+use crate::texture::TexturePoint;
 use crate::texture::TextureValues;
 
 #[derive(Clone, Debug)]
@@ -52,55 +50,33 @@ pub struct PolarizedPlastic {
     pub specular_reflectance: Option<Texture>,
 }
 
-const FLAGS: BsdfFlags = BsdfFlags::GLOSSY
-    .union(BsdfFlags::DIFFUSE)
-    .union(BsdfFlags::REFLECTION);
-
-impl BsdfModel for PolarizedPlastic {
-    fn flags(&self) -> BsdfFlags {
-        FLAGS
-    }
-
-    fn is_dispersive(&self) -> bool {
-        false
-    }
-
-    fn node_count(&self) -> usize {
-        1
-    }
+impl LeafBsdf for PolarizedPlastic {
+    type Lobes<'a> = PolarizedPlasticLobes;
+    const FLAGS: BsdfFlags = BsdfFlags::GLOSSY
+        .union(BsdfFlags::DIFFUSE)
+        .union(BsdfFlags::REFLECTION);
 
     /// The diffuse reflectance of the base.
-    fn diffuse_reflectance(
-        &self,
-        point: &ShadingPoint,
-        _wo: Vec3,
-        lambda: &SampledWavelengths,
-    ) -> SampledSpectrum {
-        self.diffuse_reflectance.eval(point.at(), lambda)
+    fn albedo(&self, at: TexturePoint, lambda: &SampledWavelengths) -> SampledSpectrum {
+        self.diffuse_reflectance.eval(at, lambda)
     }
 
     #[inline]
-    fn resolve<'a>(
-        &'a self,
-        point: &ShadingPoint,
-        _wo: Vec3,
-        lambda: &SampledWavelengths,
-        tree: &mut BxdfTree<'a>,
-    ) -> NodeId {
-        let diffuse = self.diffuse_reflectance.eval(point.at(), lambda);
-        let specular = optional_factor(&self.specular_reflectance, point.at(), lambda);
+    fn lobes(&self, at: TexturePoint, lambda: &SampledWavelengths) -> PolarizedPlasticLobes {
+        let diffuse = self.diffuse_reflectance.eval(at, lambda);
+        let specular = optional_factor(&self.specular_reflectance, at, lambda);
         let (s, d) = (specular.average(), diffuse.average());
-        tree.push(PolarizedPlasticLobes {
+        PolarizedPlasticLobes {
             eta: self.eta,
             distribution: Microfacet::new(
                 self.distribution,
-                self.alpha_u.eval_1(point.at()),
-                self.alpha_v.eval_1(point.at()),
+                self.alpha_u.eval_1(at),
+                self.alpha_v.eval_1(at),
             ),
             diffuse,
             specular,
-            p_specular: if s + d > 0.0 { s / (s + d) } else { 1.0 },
-        })
+            p_specular: choice_probability(s, d),
+        }
     }
 }
 
@@ -115,7 +91,7 @@ pub struct PolarizedPlasticLobes {
     pub p_specular: f32,
 }
 
-impl PolarizedPlasticLobes {
+impl GlossyDiffuseLobes for PolarizedPlasticLobes {
     #[inline]
     fn value(&self, wo: Vec3, wi: Vec3) -> SampledSpectrum {
         let h = (wo + wi).normalize();
@@ -132,47 +108,23 @@ impl PolarizedPlasticLobes {
     }
 
     #[inline]
-    fn mixture_pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+    fn glossy_probability(&self, _wo: Vec3) -> f32 {
+        self.p_specular
+    }
+
+    #[inline]
+    fn sample_glossy(&self, wo: Vec3, u: Vec2) -> Vec3 {
+        reflect(wo, self.distribution.sample_visible(wo, u))
+    }
+
+    #[inline]
+    fn glossy_pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         let h = (wo + wi).normalize();
         let (cos_oh, cos_ih) = (wo.dot(h), wi.dot(h));
-        let specular = if cos_oh > 0.0 && cos_ih > 0.0 {
+        if cos_oh > 0.0 && cos_ih > 0.0 {
             self.distribution.pdf_visible(wo, h) / (4.0 * cos_oh)
         } else {
             0.0
-        };
-        self.p_specular * specular + (1.0 - self.p_specular) * cosine_hemisphere_pdf(wi)
-    }
-}
-
-impl Bxdf for PolarizedPlasticLobes {
-    fn eval(&self, _tree: &BxdfTree, wo: Vec3, wi: Vec3) -> BsdfEval {
-        if !(wo.z > 0.0 && wi.z > 0.0) {
-            return BsdfEval::ZERO;
         }
-        BsdfEval {
-            value: self.value(wo, wi),
-            pdf: self.mixture_pdf(wo, wi),
-        }
-    }
-
-    fn sample(&self, _tree: &BxdfTree, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<BsdfSample> {
-        if !(wo.z > 0.0) {
-            return None;
-        }
-        let (wi, flags) = if u_lobe < self.p_specular {
-            (
-                reflect(wo, self.distribution.sample_visible(wo, u)),
-                BsdfFlags::GLOSSY.union(BsdfFlags::REFLECTION),
-            )
-        } else {
-            (
-                sample_cosine_hemisphere(u),
-                BsdfFlags::DIFFUSE.union(BsdfFlags::REFLECTION),
-            )
-        };
-        if !(wi.z > 0.0) {
-            return None;
-        }
-        mixture_sample(wi, self.value(wo, wi), self.mixture_pdf(wo, wi), flags)
     }
 }

@@ -49,15 +49,16 @@ use std::f32::consts::FRAC_1_PI;
 use glam::{Vec2, Vec3};
 
 use super::burley::{
-    Gtr1, clearcoat_alpha, optional_value, schlick_fresnel, schlick_r0, schlick_weight, smith_ggx1,
-    specular_alphas, tint, tint_luminance,
+    Gtr1, clearcoat_alpha, diffuse_factor, optional_value, schlick_fresnel, schlick_r0,
+    schlick_weight, sheen_colour, smith_ggx1, specular_alphas, tint,
 };
 use super::fresnel::{fresnel_dielectric, reflect, refract};
 use super::microfacet::{Microfacet, MicrofacetKind};
-use super::{BsdfEval, BsdfFlags, BsdfModel, BsdfSample, Bxdf, BxdfTree, NodeId, ShadingPoint};
+use super::{BsdfEval, BsdfFlags, BsdfSample, Bxdf, BxdfTree, LeafBsdf};
 use crate::sampling::warp::{cosine_hemisphere_pdf, sample_cosine_hemisphere};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use crate::texture::Texture;
+use crate::texture::TexturePoint;
 use crate::texture::TextureValues;
 
 /// The relative weights with which the lobes are sampled (Mitsuba's `*_sampling_rate`).
@@ -88,60 +89,43 @@ pub struct Principled {
     pub rates: SamplingRates,
 }
 
-impl BsdfModel for Principled {
+impl LeafBsdf for Principled {
+    type Lobes<'a> = PrincipledLobes;
+
+    /// The lobes it always has; `flags` adds the transmission where `spec_trans` is given.
+    const FLAGS: BsdfFlags = BsdfFlags::DIFFUSE
+        .union(BsdfFlags::GLOSSY)
+        .union(BsdfFlags::REFLECTION);
+
     fn flags(&self) -> BsdfFlags {
-        let reflection = BsdfFlags::DIFFUSE
-            .union(BsdfFlags::GLOSSY)
-            .union(BsdfFlags::REFLECTION);
         if self.spec_trans.is_some() {
-            reflection.union(BsdfFlags::TRANSMISSION)
+            Self::FLAGS.union(BsdfFlags::TRANSMISSION)
         } else {
-            reflection
+            Self::FLAGS
         }
     }
 
-    fn is_dispersive(&self) -> bool {
-        false
-    }
-
-    fn node_count(&self) -> usize {
-        1
-    }
-
     /// The base colour, as Mitsuba's `eval_diffuse_reflectance`.
-    fn diffuse_reflectance(
-        &self,
-        point: &ShadingPoint,
-        _wo: Vec3,
-        lambda: &SampledWavelengths,
-    ) -> SampledSpectrum {
-        self.base_color.eval(point.at(), lambda)
+    fn albedo(&self, at: TexturePoint, lambda: &SampledWavelengths) -> SampledSpectrum {
+        self.base_color.eval(at, lambda)
     }
 
     #[inline]
-    fn resolve<'a>(
-        &'a self,
-        point: &ShadingPoint,
-        _wo: Vec3,
-        lambda: &SampledWavelengths,
-        tree: &mut BxdfTree<'a>,
-    ) -> NodeId {
-        let at = point.at();
+    fn lobes(&self, at: TexturePoint, lambda: &SampledWavelengths) -> PrincipledLobes {
         let base_color = self.base_color.eval(at, lambda);
         let roughness = self.roughness.eval_1(at);
         let (alpha_u, alpha_v) = specular_alphas(roughness, optional_value(&self.anisotropic, at));
         let spec_tint = optional_value(&self.spec_tint, at);
         let sheen_tint = optional_value(&self.sheen_tint, at);
-        let luminance = if spec_tint.is_some() || sheen_tint.is_some() {
-            tint_luminance(&base_color, lambda)
-        } else {
-            1.0
-        };
         let clearcoat = optional_value(&self.clearcoat, at);
-        tree.push(PrincipledLobes {
+        PrincipledLobes {
             distribution: Microfacet::new(MicrofacetKind::Ggx, alpha_u, alpha_v),
             base_color,
-            tint: tint(&base_color, luminance),
+            tint: tint(
+                &base_color,
+                spec_tint.is_some() || sheen_tint.is_some(),
+                lambda,
+            ),
             eta: self.eta,
             roughness,
             metallic: optional_value(&self.metallic, at),
@@ -159,7 +143,7 @@ impl BsdfModel for Principled {
                 )
             }),
             rates: self.rates,
-        })
+        }
     }
 }
 
@@ -341,17 +325,8 @@ impl PrincipledLobes {
                 SampledSpectrum::splat(0.25 * clearcoat * fresnel * gtr1.d(h) * masking * cos_i);
         }
         if brdf > 0.0 {
-            let (f_o, f_i) = (schlick_weight(cos_i), schlick_weight(cos_o));
             let cos_d = h.dot(wi);
-            let retro = 2.0 * self.roughness * cos_d * cos_d;
-            let lambert = (1.0 - 0.5 * f_i) * (1.0 - 0.5 * f_o);
-            let mut diffuse = lambert + retro * (f_o + f_i + f_o * f_i * (retro - 1.0));
-            if let Some(flatness) = self.flatness {
-                let f_ss90 = 0.5 * retro;
-                let f_ss = (1.0 + f_o * (f_ss90 - 1.0)) * (1.0 + f_i * (f_ss90 - 1.0));
-                let subsurface = 1.25 * (f_ss * (1.0 / (cos_o + cos_i) - 0.5) + 0.5);
-                diffuse += flatness * (subsurface - diffuse);
-            }
+            let diffuse = diffuse_factor(self.roughness, self.flatness, cos_o, cos_i, cos_d);
             value += self.base_color * (brdf * cos_i * FRAC_1_PI * diffuse);
             let metallic = self.metallic.unwrap_or(0.0);
             if let Some(sheen) = self.sheen
@@ -359,11 +334,7 @@ impl PrincipledLobes {
                 && 1.0 - metallic > 0.0
             {
                 let weight = sheen * (1.0 - metallic) * schlick_weight(cos_d.abs()) * cos_i;
-                let colour = match self.sheen_tint {
-                    Some(t) => SampledSpectrum::from_fn(|i| 1.0 + t * (self.tint[i] - 1.0)),
-                    None => SampledSpectrum::ONE,
-                };
-                value += colour * weight;
+                value += sheen_colour(self.sheen_tint, &self.tint) * weight;
             }
         }
         value

@@ -35,15 +35,16 @@ use std::f32::consts::FRAC_1_PI;
 use glam::{Vec2, Vec3};
 
 use super::burley::{
-    optional_value, schlick_fresnel, schlick_r0, schlick_weight, specular_alphas, tint,
-    tint_luminance,
+    diffuse_factor, optional_value, schlick_fresnel, schlick_r0, schlick_weight, sheen_colour,
+    specular_alphas, tint,
 };
 use super::fresnel::{fresnel_dielectric, reflect};
 use super::microfacet::{Microfacet, MicrofacetKind};
-use super::{BsdfEval, BsdfFlags, BsdfModel, BsdfSample, Bxdf, BxdfTree, NodeId, ShadingPoint};
+use super::{BsdfEval, BsdfFlags, BsdfSample, Bxdf, BxdfTree, LeafBsdf};
 use crate::sampling::warp::{cosine_hemisphere_pdf, sample_cosine_hemisphere};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use crate::texture::Texture;
+use crate::texture::TexturePoint;
 use crate::texture::TextureValues;
 
 /// The relative weights with which the lobes are sampled (Mitsuba's `*_sampling_rate`).
@@ -73,42 +74,22 @@ pub struct PrincipledThin {
     pub rates: ThinSamplingRates,
 }
 
-impl BsdfModel for PrincipledThin {
+impl LeafBsdf for PrincipledThin {
+    type Lobes<'a> = PrincipledThinLobes;
+
     /// Always transmitting, as Mitsuba declares it (so it cannot be nested in `twosided`).
-    fn flags(&self) -> BsdfFlags {
-        BsdfFlags::DIFFUSE
-            .union(BsdfFlags::GLOSSY)
-            .union(BsdfFlags::REFLECTION)
-            .union(BsdfFlags::TRANSMISSION)
-    }
-
-    fn is_dispersive(&self) -> bool {
-        false
-    }
-
-    fn node_count(&self) -> usize {
-        1
-    }
+    const FLAGS: BsdfFlags = BsdfFlags::DIFFUSE
+        .union(BsdfFlags::GLOSSY)
+        .union(BsdfFlags::REFLECTION)
+        .union(BsdfFlags::TRANSMISSION);
 
     /// The base colour, as Mitsuba's `eval_diffuse_reflectance`.
-    fn diffuse_reflectance(
-        &self,
-        point: &ShadingPoint,
-        _wo: Vec3,
-        lambda: &SampledWavelengths,
-    ) -> SampledSpectrum {
-        self.base_color.eval(point.at(), lambda)
+    fn albedo(&self, at: TexturePoint, lambda: &SampledWavelengths) -> SampledSpectrum {
+        self.base_color.eval(at, lambda)
     }
 
     #[inline]
-    fn resolve<'a>(
-        &'a self,
-        point: &ShadingPoint,
-        _wo: Vec3,
-        lambda: &SampledWavelengths,
-        tree: &mut BxdfTree<'a>,
-    ) -> NodeId {
-        let at = point.at();
+    fn lobes(&self, at: TexturePoint, lambda: &SampledWavelengths) -> PrincipledThinLobes {
         let base_color = self.base_color.eval(at, lambda);
         let roughness = self.roughness.eval_1(at);
         let anisotropic = optional_value(&self.anisotropic, at);
@@ -117,16 +98,15 @@ impl BsdfModel for PrincipledThin {
         let (scaled_u, scaled_v) = specular_alphas((0.65 * eta - 0.35) * roughness, anisotropic);
         let spec_tint = optional_value(&self.spec_tint, at);
         let sheen_tint = optional_value(&self.sheen_tint, at);
-        let luminance = if spec_tint.is_some() || sheen_tint.is_some() {
-            tint_luminance(&base_color, lambda)
-        } else {
-            1.0
-        };
-        tree.push(PrincipledThinLobes {
+        PrincipledThinLobes {
             reflection: Microfacet::new(MicrofacetKind::Ggx, alpha_u, alpha_v),
             transmission: Microfacet::new(MicrofacetKind::Ggx, scaled_u, scaled_v),
             base_color,
-            tint: tint(&base_color, luminance),
+            tint: tint(
+                &base_color,
+                spec_tint.is_some() || sheen_tint.is_some(),
+                lambda,
+            ),
             eta,
             roughness,
             spec_trans: optional_value(&self.spec_trans, at),
@@ -136,7 +116,7 @@ impl BsdfModel for PrincipledThin {
             flatness: optional_value(&self.flatness, at),
             diff_trans: optional_value(&self.diff_trans, at).map(|t| 0.5 * t),
             rates: self.rates,
-        })
+        }
     }
 }
 
@@ -261,27 +241,15 @@ impl PrincipledThinLobes {
             }
         }
         if wi.z > 0.0 && s < 1.0 && t < 1.0 {
-            let (f_o, f_i) = (schlick_weight(cos_i), schlick_weight(cos_o));
             let cos_d = h.dot(wi);
-            let retro = 2.0 * self.roughness * cos_d * cos_d;
-            let lambert = (1.0 - 0.5 * f_i) * (1.0 - 0.5 * f_o);
-            let mut diffuse = lambert + retro * (f_o + f_i + f_o * f_i * (retro - 1.0));
-            if let Some(flatness) = self.flatness {
-                let f_ss90 = 0.5 * retro;
-                let f_ss = (1.0 + f_o * (f_ss90 - 1.0)) * (1.0 + f_i * (f_ss90 - 1.0));
-                let subsurface = 1.25 * (f_ss * (1.0 / (cos_o + cos_i) - 0.5) + 0.5);
-                diffuse += flatness * (subsurface - diffuse);
-            }
+            let diffuse = diffuse_factor(self.roughness, self.flatness, cos_o, cos_i, cos_d);
             let weight = (1.0 - s) * (1.0 - t) * cos_i;
             value += self.base_color * (weight * FRAC_1_PI * diffuse);
             if let Some(sheen) = self.sheen
                 && sheen > 0.0
             {
-                let colour = match self.sheen_tint {
-                    Some(tint) => SampledSpectrum::from_fn(|i| 1.0 + tint * (self.tint[i] - 1.0)),
-                    None => SampledSpectrum::ONE,
-                };
-                value += colour * (sheen * schlick_weight(cos_d.abs()) * weight);
+                let sheen = sheen * schlick_weight(cos_d.abs()) * weight;
+                value += sheen_colour(self.sheen_tint, &self.tint) * sheen;
             }
         }
         if self.diff_trans.is_some() && wi.z < 0.0 && s < 1.0 && t > 0.0 {

@@ -23,9 +23,10 @@ use glam::{Vec2, Vec3};
 use super::conductor::ConductorIor;
 use super::fresnel::reflect;
 use super::microfacet::{Microfacet, MicrofacetKind};
-use super::{BsdfEval, BsdfFlags, BsdfModel, BsdfSample, Bxdf, BxdfTree, NodeId, ShadingPoint};
+use super::{BsdfEval, BsdfFlags, BsdfSample, Bxdf, BxdfTree, LeafBsdf};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use crate::texture::Texture;
+use crate::texture::TexturePoint;
 use crate::texture::TextureValues;
 
 #[derive(Clone, Debug)]
@@ -40,48 +41,23 @@ pub struct RoughConductor {
     pub ext_eta: f32,
 }
 
-const FLAGS: BsdfFlags = BsdfFlags::GLOSSY.union(BsdfFlags::REFLECTION);
-
-impl BsdfModel for RoughConductor {
-    fn flags(&self) -> BsdfFlags {
-        FLAGS
-    }
-
-    fn is_dispersive(&self) -> bool {
-        false
-    }
-
-    fn node_count(&self) -> usize {
-        1
-    }
-
-    /// None: only a glossy lobe (Mitsuba 3 evaluates the BSDF towards the normal instead, see docs/mitsuba-compatibility.md).
-    fn diffuse_reflectance(
-        &self,
-        _point: &ShadingPoint,
-        _wo: Vec3,
-        _lambda: &SampledWavelengths,
-    ) -> SampledSpectrum {
-        SampledSpectrum::ZERO
-    }
+/// No diffuse reflectance: only a glossy lobe (Mitsuba 3 evaluates the BSDF towards the normal
+/// instead, see docs/mitsuba-compatibility.md).
+impl LeafBsdf for RoughConductor {
+    type Lobes<'a> = RoughConductorLobes;
+    const FLAGS: BsdfFlags = BsdfFlags::GLOSSY.union(BsdfFlags::REFLECTION);
 
     #[inline]
-    fn resolve<'a>(
-        &'a self,
-        point: &ShadingPoint,
-        _wo: Vec3,
-        lambda: &SampledWavelengths,
-        tree: &mut BxdfTree<'a>,
-    ) -> NodeId {
-        tree.push(RoughConductorLobes {
+    fn lobes(&self, at: TexturePoint, lambda: &SampledWavelengths) -> RoughConductorLobes {
+        RoughConductorLobes {
             distribution: Microfacet::new(
                 self.distribution,
-                self.alpha_u.eval_1(point.at()),
-                self.alpha_v.eval_1(point.at()),
+                self.alpha_u.eval_1(at),
+                self.alpha_v.eval_1(at),
             ),
-            ior: ConductorIor::at(&self.eta, &self.k, self.ext_eta, point.at(), lambda),
-            specular_reflectance: self.specular_reflectance.eval(point.at(), lambda),
-        })
+            ior: ConductorIor::at(&self.eta, &self.k, self.ext_eta, at, lambda),
+            specular_reflectance: self.specular_reflectance.eval(at, lambda),
+        }
     }
 }
 
@@ -132,6 +108,6 @@ impl Bxdf for RoughConductorLobes {
         }
         let f = self.ior.reflectance(cos_om);
         let weight = f * self.specular_reflectance * self.distribution.g1(wi, m);
-        Some(BsdfSample::new(wi, weight, pdf, FLAGS))
+        Some(BsdfSample::new(wi, weight, pdf, RoughConductor::FLAGS))
     }
 }

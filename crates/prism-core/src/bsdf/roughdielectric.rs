@@ -25,13 +25,14 @@
 
 use glam::{Vec2, Vec3};
 
-use super::dielectric::optional_factor;
+use super::dielectric::SpecularFactors;
 use super::fresnel::{fresnel_dielectric, reflect, refract};
 use super::microfacet::{Microfacet, MicrofacetKind};
-use super::{BsdfEval, BsdfFlags, BsdfModel, BsdfSample, Bxdf, BxdfTree, NodeId, ShadingPoint};
+use super::{BsdfEval, BsdfFlags, BsdfSample, Bxdf, BxdfTree, LeafBsdf};
 use crate::spectrum::ior::RelativeIor;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use crate::texture::Texture;
+use crate::texture::TexturePoint;
 use crate::texture::TextureValues;
 
 #[derive(Clone, Debug)]
@@ -44,56 +45,35 @@ pub struct RoughDielectric {
     pub specular_transmittance: Option<Texture>,
 }
 
-const FLAGS: BsdfFlags = BsdfFlags::GLOSSY
-    .union(BsdfFlags::REFLECTION)
-    .union(BsdfFlags::TRANSMISSION);
-
-impl BsdfModel for RoughDielectric {
-    fn flags(&self) -> BsdfFlags {
-        FLAGS
-    }
+/// No diffuse reflectance: only glossy lobes (Mitsuba 3 evaluates the BSDF towards the normal
+/// instead, see docs/mitsuba-compatibility.md).
+impl LeafBsdf for RoughDielectric {
+    type Lobes<'a> = RoughDielectricLobes;
+    const FLAGS: BsdfFlags = BsdfFlags::GLOSSY
+        .union(BsdfFlags::REFLECTION)
+        .union(BsdfFlags::TRANSMISSION);
 
     fn is_dispersive(&self) -> bool {
         self.eta.is_dispersive()
     }
 
-    fn node_count(&self) -> usize {
-        1
-    }
-
-    /// None: only glossy lobes (Mitsuba 3 evaluates the BSDF towards the normal instead, see docs/mitsuba-compatibility.md).
-    fn diffuse_reflectance(
-        &self,
-        _point: &ShadingPoint,
-        _wo: Vec3,
-        _lambda: &SampledWavelengths,
-    ) -> SampledSpectrum {
-        SampledSpectrum::ZERO
-    }
-
     #[inline]
-    fn resolve<'a>(
-        &'a self,
-        point: &ShadingPoint,
-        _wo: Vec3,
-        lambda: &SampledWavelengths,
-        tree: &mut BxdfTree<'a>,
-    ) -> NodeId {
-        tree.push(RoughDielectricLobes {
+    fn lobes(&self, at: TexturePoint, lambda: &SampledWavelengths) -> RoughDielectricLobes {
+        RoughDielectricLobes {
             eta_hero: self.eta.at(lambda.lambda(0)),
             dispersive: self.eta.is_dispersive(),
             distribution: Microfacet::new(
                 self.distribution,
-                self.alpha_u.eval_1(point.at()),
-                self.alpha_v.eval_1(point.at()),
+                self.alpha_u.eval_1(at),
+                self.alpha_v.eval_1(at),
             ),
-            specular_reflectance: optional_factor(&self.specular_reflectance, point.at(), lambda),
-            specular_transmittance: optional_factor(
+            specular: SpecularFactors::at(
+                &self.specular_reflectance,
                 &self.specular_transmittance,
-                point.at(),
+                at,
                 lambda,
             ),
-        })
+        }
     }
 }
 
@@ -104,8 +84,7 @@ pub struct RoughDielectricLobes {
     pub eta_hero: f32,
     pub dispersive: bool,
     pub distribution: Microfacet,
-    pub specular_reflectance: SampledSpectrum,
-    pub specular_transmittance: SampledSpectrum,
+    pub specular: SpecularFactors,
 }
 
 /// The half vector of a pair of directions and what goes with it.
@@ -151,12 +130,12 @@ impl RoughDielectricLobes {
         }
         let f = fresnel_dielectric(wo.dot(m), self.eta_hero).reflectance;
         if reflect {
-            self.specular_reflectance * (f * d * g / (4.0 * wo.z.abs()))
+            self.specular.reflectance * (f * d * g / (4.0 * wo.z.abs()))
         } else {
             let (om, im) = (wo.dot(m), wi.dot(m));
             let denominator = om + eta * im;
             let value = ((1.0 - f) * d * g * om * im / (wo.z * denominator * denominator)).abs();
-            self.specular_transmittance * value
+            self.specular.transmittance * value
         }
     }
 
@@ -211,7 +190,7 @@ impl Bxdf for RoughDielectricLobes {
             let pdf = pdf_m * f / (4.0 * wi.dot(m)).abs();
             BsdfSample::new(
                 wi,
-                self.specular_reflectance,
+                self.specular.reflectance,
                 pdf,
                 BsdfFlags::GLOSSY.union(BsdfFlags::REFLECTION),
             )
@@ -223,7 +202,7 @@ impl Bxdf for RoughDielectricLobes {
             let im = wi.dot(m);
             let denominator = om + fresnel.eta_it * im;
             let jacobian = fresnel.eta_it * fresnel.eta_it * im / (denominator * denominator);
-            let weight = self.specular_transmittance * (fresnel.eta_ti * fresnel.eta_ti);
+            let weight = self.specular.transmittance * (fresnel.eta_ti * fresnel.eta_ti);
             BsdfSample {
                 wi,
                 weight,

@@ -20,13 +20,11 @@ use std::f32::consts::{FRAC_1_PI, FRAC_1_SQRT_2};
 
 use glam::{Vec2, Vec3};
 
-use super::{
-    BsdfEval, BsdfFlags, BsdfModel, BsdfSample, Bxdf, BxdfTree, NodeId, ShadingPoint,
-    mixture_sample,
-};
+use super::{BsdfEval, BsdfFlags, BsdfSample, Bxdf, BxdfTree, LeafBsdf, mixture_sample};
 use crate::sampling::warp::{cosine_hemisphere_pdf, sample_cosine_hemisphere};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use crate::texture::Texture;
+use crate::texture::TexturePoint;
 use crate::texture::TextureValues;
 
 #[derive(Clone, Debug)]
@@ -36,44 +34,22 @@ pub struct RoughDiffuse {
     pub use_fast_approx: bool,
 }
 
-const FLAGS: BsdfFlags = BsdfFlags::DIFFUSE.union(BsdfFlags::REFLECTION);
-
-impl BsdfModel for RoughDiffuse {
-    fn flags(&self) -> BsdfFlags {
-        FLAGS
-    }
-
-    fn is_dispersive(&self) -> bool {
-        false
-    }
-
-    fn node_count(&self) -> usize {
-        1
-    }
+impl LeafBsdf for RoughDiffuse {
+    type Lobes<'a> = RoughDiffuseLobes;
+    const FLAGS: BsdfFlags = BsdfFlags::DIFFUSE.union(BsdfFlags::REFLECTION);
 
     /// The reflectance (Oren–Nayar's ρ).
-    fn diffuse_reflectance(
-        &self,
-        point: &ShadingPoint,
-        _wo: Vec3,
-        lambda: &SampledWavelengths,
-    ) -> SampledSpectrum {
-        self.reflectance.eval(point.at(), lambda)
+    fn albedo(&self, at: TexturePoint, lambda: &SampledWavelengths) -> SampledSpectrum {
+        self.reflectance.eval(at, lambda)
     }
 
     #[inline]
-    fn resolve<'a>(
-        &'a self,
-        point: &ShadingPoint,
-        _wo: Vec3,
-        lambda: &SampledWavelengths,
-        tree: &mut BxdfTree<'a>,
-    ) -> NodeId {
-        tree.push(RoughDiffuseLobes {
-            reflectance: self.reflectance.eval(point.at(), lambda),
-            sigma: self.alpha.eval_1(point.at()) * FRAC_1_SQRT_2,
+    fn lobes(&self, at: TexturePoint, lambda: &SampledWavelengths) -> RoughDiffuseLobes {
+        RoughDiffuseLobes {
+            reflectance: self.reflectance.eval(at, lambda),
+            sigma: self.alpha.eval_1(at) * FRAC_1_SQRT_2,
             use_fast_approx: self.use_fast_approx,
-        })
+        }
     }
 }
 
@@ -161,6 +137,6 @@ impl Bxdf for RoughDiffuseLobes {
         } else {
             self.value(wo, wi)
         };
-        mixture_sample(wi, value, cosine_hemisphere_pdf(wi), FLAGS)
+        mixture_sample(wi, value, cosine_hemisphere_pdf(wi), RoughDiffuse::FLAGS)
     }
 }

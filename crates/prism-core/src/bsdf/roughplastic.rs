@@ -29,14 +29,13 @@ use rayon::prelude::*;
 
 use super::dielectric::optional_factor;
 use super::fresnel::{fresnel_dielectric, reflect, refract};
+use super::glossydiffuse::GlossyDiffuseLobes;
 use super::microfacet::{GaussLegendre, Microfacet, MicrofacetKind};
-use super::{
-    BsdfEval, BsdfFlags, BsdfModel, BsdfSample, Bxdf, BxdfTree, NodeId, ShadingPoint,
-    mixture_sample,
-};
-use crate::sampling::warp::{cosine_hemisphere_pdf, sample_cosine_hemisphere};
+use super::plastic::effective_diffuse;
+use super::{BsdfFlags, LeafBsdf, choice_probability};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use crate::texture::Texture;
+use crate::texture::TexturePoint;
 use crate::texture::TextureValues;
 
 /// Entries of the transmittance table (Mitsuba's MI_ROUGH_TRANSMITTANCE_RES).
@@ -149,56 +148,25 @@ impl RoughPlastic {
     }
 }
 
-const FLAGS: BsdfFlags = BsdfFlags::GLOSSY
-    .union(BsdfFlags::DIFFUSE)
-    .union(BsdfFlags::REFLECTION);
-
-impl BsdfModel for RoughPlastic {
-    fn flags(&self) -> BsdfFlags {
-        FLAGS
-    }
-
-    fn is_dispersive(&self) -> bool {
-        false
-    }
-
-    fn node_count(&self) -> usize {
-        1
-    }
+impl LeafBsdf for RoughPlastic {
+    type Lobes<'a> = RoughPlasticLobes<'a>;
+    const FLAGS: BsdfFlags = BsdfFlags::GLOSSY
+        .union(BsdfFlags::DIFFUSE)
+        .union(BsdfFlags::REFLECTION);
 
     /// The diffuse reflectance under the coating.
-    fn diffuse_reflectance(
-        &self,
-        point: &ShadingPoint,
-        _wo: Vec3,
-        lambda: &SampledWavelengths,
-    ) -> SampledSpectrum {
-        self.diffuse_reflectance.eval(point.at(), lambda)
+    fn albedo(&self, at: TexturePoint, lambda: &SampledWavelengths) -> SampledSpectrum {
+        self.diffuse_reflectance.eval(at, lambda)
     }
 
     #[inline]
-    fn resolve<'a>(
-        &'a self,
-        point: &ShadingPoint,
-        _wo: Vec3,
-        lambda: &SampledWavelengths,
-        tree: &mut BxdfTree<'a>,
-    ) -> NodeId {
-        // ρ / (1 − R_i) or, nonlinear, ρ / (1 − ρ R_i).
-        let rho = self.diffuse_reflectance.eval(point.at(), lambda);
-        let diffuse = SampledSpectrum::from_fn(|i| {
-            let bounce = if self.nonlinear {
-                rho[i] * self.internal_reflectance
-            } else {
-                self.internal_reflectance
-            };
-            rho[i] / (1.0 - bounce)
-        });
-        tree.push(RoughPlasticLobes {
+    fn lobes<'a>(&'a self, at: TexturePoint, lambda: &SampledWavelengths) -> RoughPlasticLobes<'a> {
+        let rho = self.diffuse_reflectance.eval(at, lambda);
+        RoughPlasticLobes {
             plastic: self,
-            diffuse,
-            specular_reflectance: optional_factor(&self.specular_reflectance, point.at(), lambda),
-        })
+            diffuse: effective_diffuse(rho, self.internal_reflectance, self.nonlinear),
+            specular_reflectance: optional_factor(&self.specular_reflectance, at, lambda),
+        }
     }
 }
 
@@ -211,21 +179,7 @@ pub struct RoughPlasticLobes<'a> {
     specular_reflectance: SampledSpectrum,
 }
 
-impl RoughPlasticLobes<'_> {
-    /// The probability of sampling the glossy lobe at wo.
-    #[inline]
-    fn glossy_probability(&self, t_o: f32) -> f32 {
-        let p = self.plastic;
-        let glossy = (1.0 - t_o) * self.specular_reflectance.average();
-        let base = t_o * self.diffuse.average() * p.mean_transmittance * p.inv_eta2;
-        if glossy + base > 0.0 {
-            glossy / (glossy + base)
-        } else {
-            1.0
-        }
-    }
-
-    /// The value of both lobes.
+impl GlossyDiffuseLobes for RoughPlasticLobes<'_> {
     #[inline]
     fn value(&self, wo: Vec3, wi: Vec3) -> SampledSpectrum {
         let p = self.plastic;
@@ -242,51 +196,25 @@ impl RoughPlasticLobes<'_> {
         glossy + base
     }
 
+    /// In proportion to the albedo estimates of the two lobes at wo.
     #[inline]
-    fn mixture_pdf(&self, wo: Vec3, wi: Vec3, p_glossy: f32) -> f32 {
+    fn glossy_probability(&self, wo: Vec3) -> f32 {
+        let p = self.plastic;
+        let t_o = p.transmittance(wo.z);
+        let glossy = (1.0 - t_o) * self.specular_reflectance.average();
+        let base = t_o * self.diffuse.average() * p.mean_transmittance * p.inv_eta2;
+        choice_probability(glossy, base)
+    }
+
+    #[inline]
+    fn sample_glossy(&self, wo: Vec3, u: Vec2) -> Vec3 {
+        reflect(wo, self.plastic.distribution.sample_visible(wo, u))
+    }
+
+    #[inline]
+    fn glossy_pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         let h = (wo + wi).normalize();
         let glossy = self.plastic.distribution.pdf_visible(wo, h) / (4.0 * wo.dot(h));
-        p_glossy * glossy.max(0.0) + (1.0 - p_glossy) * cosine_hemisphere_pdf(wi)
-    }
-}
-
-impl Bxdf for RoughPlasticLobes<'_> {
-    fn eval(&self, _tree: &BxdfTree, wo: Vec3, wi: Vec3) -> BsdfEval {
-        if !(wo.z > 0.0 && wi.z > 0.0) {
-            return BsdfEval::ZERO;
-        }
-        let p_glossy = self.glossy_probability(self.plastic.transmittance(wo.z));
-        BsdfEval {
-            value: self.value(wo, wi),
-            pdf: self.mixture_pdf(wo, wi, p_glossy),
-        }
-    }
-
-    fn sample(&self, _tree: &BxdfTree, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<BsdfSample> {
-        if !(wo.z > 0.0) {
-            return None;
-        }
-        let p_glossy = self.glossy_probability(self.plastic.transmittance(wo.z));
-        let (wi, flags) = if u_lobe < p_glossy {
-            let m = self.plastic.distribution.sample_visible(wo, u);
-            (
-                reflect(wo, m),
-                BsdfFlags::GLOSSY.union(BsdfFlags::REFLECTION),
-            )
-        } else {
-            (
-                sample_cosine_hemisphere(u),
-                BsdfFlags::DIFFUSE.union(BsdfFlags::REFLECTION),
-            )
-        };
-        if !(wi.z > 0.0) {
-            return None;
-        }
-        mixture_sample(
-            wi,
-            self.value(wo, wi),
-            self.mixture_pdf(wo, wi, p_glossy),
-            flags,
-        )
+        glossy.max(0.0)
     }
 }

@@ -17,12 +17,13 @@
 
 use glam::{Vec2, Vec3};
 
-use super::dielectric::{SampledIor, optional_factor};
+use super::dielectric::{SampledIor, SpecularFactors};
 use super::fresnel::{fresnel_dielectric, reflect_z};
-use super::{BsdfFlags, BsdfModel, BsdfSample, Bxdf, BxdfTree, NodeId, ShadingPoint};
+use super::{BsdfFlags, BsdfSample, Bxdf, BxdfTree, LeafBsdf};
 use crate::spectrum::ior::RelativeIor;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use crate::texture::Texture;
+use crate::texture::TexturePoint;
 
 #[derive(Clone, Debug)]
 pub struct ThinDielectric {
@@ -31,52 +32,25 @@ pub struct ThinDielectric {
     pub specular_transmittance: Option<Texture>,
 }
 
-const FLAGS: BsdfFlags = BsdfFlags::SPECULAR
-    .union(BsdfFlags::REFLECTION)
-    .union(BsdfFlags::NULL);
-
-impl BsdfModel for ThinDielectric {
-    fn flags(&self) -> BsdfFlags {
-        FLAGS
-    }
-
-    /// The pane does not bend light, so a dispersive index changes only how much each
-    /// wavelength reflects, never its direction.
-    fn is_dispersive(&self) -> bool {
-        false
-    }
-
-    fn node_count(&self) -> usize {
-        1
-    }
-
-    /// None: only specular and null lobes.
-    fn diffuse_reflectance(
-        &self,
-        _point: &ShadingPoint,
-        _wo: Vec3,
-        _lambda: &SampledWavelengths,
-    ) -> SampledSpectrum {
-        SampledSpectrum::ZERO
-    }
+/// Not dispersive: the pane does not bend light, so a dispersive index changes only how much
+/// each wavelength reflects, never its direction.
+impl LeafBsdf for ThinDielectric {
+    type Lobes<'a> = ThinDielectricLobes;
+    const FLAGS: BsdfFlags = BsdfFlags::SPECULAR
+        .union(BsdfFlags::REFLECTION)
+        .union(BsdfFlags::NULL);
 
     #[inline]
-    fn resolve<'a>(
-        &'a self,
-        point: &ShadingPoint,
-        _wo: Vec3,
-        lambda: &SampledWavelengths,
-        tree: &mut BxdfTree<'a>,
-    ) -> NodeId {
-        tree.push(ThinDielectricLobes {
+    fn lobes(&self, at: TexturePoint, lambda: &SampledWavelengths) -> ThinDielectricLobes {
+        ThinDielectricLobes {
             eta: SampledIor::at(&self.eta, lambda),
-            specular_reflectance: optional_factor(&self.specular_reflectance, point.at(), lambda),
-            specular_transmittance: optional_factor(
+            specular: SpecularFactors::at(
+                &self.specular_reflectance,
                 &self.specular_transmittance,
-                point.at(),
+                at,
                 lambda,
             ),
-        })
+        }
     }
 }
 
@@ -84,8 +58,7 @@ impl BsdfModel for ThinDielectric {
 #[derive(Clone, Copy, Debug)]
 pub struct ThinDielectricLobes {
     pub eta: SampledIor,
-    pub specular_reflectance: SampledSpectrum,
-    pub specular_transmittance: SampledSpectrum,
+    pub specular: SpecularFactors,
 }
 
 impl Bxdf for ThinDielectricLobes {
@@ -105,7 +78,7 @@ impl Bxdf for ThinDielectricLobes {
         };
         let p_reflect = r.average();
         if u_lobe < p_reflect {
-            let weight = r * (1.0 / p_reflect) * self.specular_reflectance;
+            let weight = r * (1.0 / p_reflect) * self.specular.reflectance;
             Some(BsdfSample::new(
                 reflect_z(wo),
                 weight,
@@ -115,7 +88,7 @@ impl Bxdf for ThinDielectricLobes {
         } else {
             let p_transmit = 1.0 - p_reflect;
             let weight =
-                (SampledSpectrum::ONE - r) * (1.0 / p_transmit) * self.specular_transmittance;
+                (SampledSpectrum::ONE - r) * (1.0 / p_transmit) * self.specular.transmittance;
             Some(BsdfSample::new(-wo, weight, p_transmit, BsdfFlags::NULL))
         }
     }

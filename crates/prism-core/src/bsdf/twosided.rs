@@ -12,15 +12,16 @@
 use glam::{Vec2, Vec3};
 
 use super::{
-    Bsdf, BsdfEval, BsdfFlags, BsdfModel, BsdfSample, Bxdf, BxdfTree, NodeId, ShadingPoint,
+    Adapter, Bsdf, BsdfEval, BsdfFlags, BsdfModel, BsdfSample, Bxdf, BxdfTree, NodeId,
+    ResolveContext, ShadingPoint,
 };
 use crate::math::Frame;
-use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+use crate::spectrum::SampledSpectrum;
 
 #[derive(Clone, Debug)]
 pub struct TwoSided {
-    pub front: Box<Bsdf>,
-    pub back: Box<Bsdf>,
+    /// The BSDF of the front and that of the back.
+    pub sides: [Box<Bsdf>; 2],
 }
 
 /// The direction mirrored through the tangent plane.
@@ -43,30 +44,37 @@ fn back_side(sp: &ShadingPoint) -> ShadingPoint {
     }
 }
 
-impl BsdfModel for TwoSided {
-    fn flags(&self) -> BsdfFlags {
-        self.front.flags().union(self.back.flags())
+impl TwoSided {
+    #[inline]
+    fn front(&self) -> &Bsdf {
+        &self.sides[0]
     }
 
-    fn is_dispersive(&self) -> bool {
-        self.front.is_dispersive() || self.back.is_dispersive()
+    #[inline]
+    fn back(&self) -> &Bsdf {
+        &self.sides[1]
+    }
+}
+
+impl Adapter for TwoSided {
+    const OWN_FLAGS: BsdfFlags = BsdfFlags::NONE;
+
+    fn nested(&self) -> &[Box<Bsdf>] {
+        &self.sides
     }
 
-    fn node_count(&self) -> usize {
-        1 + self.front.node_count().max(self.back.node_count())
+    /// One side's: the larger count.
+    fn nested_node_count(&self) -> usize {
+        self.front().node_count().max(self.back().node_count())
     }
 
     /// That of the side `wo` sees.
-    fn diffuse_reflectance(
-        &self,
-        point: &ShadingPoint,
-        wo: Vec3,
-        lambda: &SampledWavelengths,
-    ) -> SampledSpectrum {
+    fn diffuse_reflectance(&self, context: &ResolveContext) -> SampledSpectrum {
+        let ResolveContext { point, wo, lambda } = *context;
         if wo.z >= 0.0 {
-            self.front.diffuse_reflectance(point, wo, lambda)
+            self.front().diffuse_reflectance(point, wo, lambda)
         } else {
-            self.back
+            self.back()
                 .diffuse_reflectance(&back_side(point), flip(wo), lambda)
         }
     }
@@ -74,17 +82,16 @@ impl BsdfModel for TwoSided {
     /// The side that `wo` sees: the front BSDF's lobes as they are, or the back BSDF's with
     /// mirrored directions.
     #[inline]
-    fn resolve<'a>(
-        &'a self,
-        point: &ShadingPoint,
-        wo: Vec3,
-        lambda: &SampledWavelengths,
-        tree: &mut BxdfTree<'a>,
-    ) -> NodeId {
-        if wo.z >= 0.0 {
-            return self.front.resolve(point, wo, lambda, tree);
+    fn resolve<'a>(&'a self, context: &ResolveContext, tree: &mut BxdfTree<'a>) -> NodeId {
+        if context.wo.z >= 0.0 {
+            return self.front().resolve(context, tree);
         }
-        let nested = self.back.resolve(&back_side(point), flip(wo), lambda, tree);
+        let back = ResolveContext {
+            point: &back_side(context.point),
+            wo: flip(context.wo),
+            lambda: context.lambda,
+        };
+        let nested = self.back().resolve(&back, tree);
         tree.push(BackSideLobes { nested })
     }
 }

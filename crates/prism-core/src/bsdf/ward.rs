@@ -30,13 +30,11 @@ use std::f32::consts::{FRAC_1_PI, PI};
 use glam::{Vec2, Vec3};
 
 use super::fresnel::reflect;
-use super::{
-    BsdfEval, BsdfFlags, BsdfModel, BsdfSample, Bxdf, BxdfTree, NodeId, ShadingPoint,
-    mixture_sample,
-};
-use crate::sampling::warp::{cosine_hemisphere_pdf, sample_cosine_hemisphere};
+use super::glossydiffuse::GlossyDiffuseLobes;
+use super::{BsdfFlags, LeafBsdf, choice_probability};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use crate::texture::Texture;
+use crate::texture::TexturePoint;
 use crate::texture::TextureValues;
 
 /// Which normalisation of the glossy lobe.
@@ -61,52 +59,30 @@ pub struct Ward {
     pub scale: f32,
 }
 
-const FLAGS: BsdfFlags = BsdfFlags::GLOSSY
-    .union(BsdfFlags::DIFFUSE)
-    .union(BsdfFlags::REFLECTION);
-
-impl BsdfModel for Ward {
-    fn flags(&self) -> BsdfFlags {
-        FLAGS
-    }
-
-    fn is_dispersive(&self) -> bool {
-        false
-    }
-
-    fn node_count(&self) -> usize {
-        1
-    }
+impl LeafBsdf for Ward {
+    type Lobes<'a> = WardLobes;
+    const FLAGS: BsdfFlags = BsdfFlags::GLOSSY
+        .union(BsdfFlags::DIFFUSE)
+        .union(BsdfFlags::REFLECTION);
 
     /// The diffuse reflectance, scaled as the lobes are.
-    fn diffuse_reflectance(
-        &self,
-        point: &ShadingPoint,
-        _wo: Vec3,
-        lambda: &SampledWavelengths,
-    ) -> SampledSpectrum {
-        self.scale * self.diffuse_reflectance.eval(point.at(), lambda)
+    fn albedo(&self, at: TexturePoint, lambda: &SampledWavelengths) -> SampledSpectrum {
+        self.scale * self.diffuse_reflectance.eval(at, lambda)
     }
 
     #[inline]
-    fn resolve<'a>(
-        &'a self,
-        point: &ShadingPoint,
-        _wo: Vec3,
-        lambda: &SampledWavelengths,
-        tree: &mut BxdfTree<'a>,
-    ) -> NodeId {
-        let specular = self.specular_reflectance.eval(point.at(), lambda) * self.scale;
-        let diffuse = self.diffuse_reflectance.eval(point.at(), lambda) * self.scale;
+    fn lobes(&self, at: TexturePoint, lambda: &SampledWavelengths) -> WardLobes {
+        let specular = self.specular_reflectance.eval(at, lambda) * self.scale;
+        let diffuse = self.diffuse_reflectance.eval(at, lambda) * self.scale;
         let (s, d) = (specular.average(), diffuse.average());
-        tree.push(WardLobes {
+        WardLobes {
             variant: self.variant,
-            alpha_u: self.alpha_u.eval_1(point.at()),
-            alpha_v: self.alpha_v.eval_1(point.at()),
+            alpha_u: self.alpha_u.eval_1(at),
+            alpha_v: self.alpha_v.eval_1(at),
             specular,
             diffuse,
-            p_glossy: if s + d > 0.0 { s / (s + d) } else { 1.0 },
-        })
+            p_glossy: choice_probability(s, d),
+        }
     }
 }
 
@@ -130,27 +106,6 @@ impl WardLobes {
         (-(x * x + y * y) / (h.z * h.z)).exp()
     }
 
-    #[inline]
-    fn value(&self, wo: Vec3, wi: Vec3) -> SampledSpectrum {
-        let h = wo + wi;
-        let area = PI * self.alpha_u * self.alpha_v;
-        let normalisation = match self.variant {
-            WardVariant::Ward => 1.0 / (4.0 * area * (wo.z * wi.z).sqrt()),
-            WardVariant::WardDuer => 1.0 / (4.0 * area * wo.z * wi.z),
-            WardVariant::Balanced => h.dot(h) / (area * h.z.powi(4)),
-        };
-        let glossy = normalisation * self.gaussian(h);
-        (self.specular * glossy + self.diffuse * FRAC_1_PI) * wi.z
-    }
-
-    #[inline]
-    fn mixture_pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        let h = (wo + wi).normalize();
-        let glossy =
-            self.gaussian(h) / (4.0 * PI * self.alpha_u * self.alpha_v * wo.dot(h) * h.z.powi(3));
-        self.p_glossy * glossy + (1.0 - self.p_glossy) * cosine_hemisphere_pdf(wi)
-    }
-
     /// Walter 2005, eqs. 6–9: φ_h = atan((α_v/α_u) tan 2πu_y) in the quadrant of 2πu_y, and
     /// tan²θ_h = −ln(1 − u_x) / (cos²φ_h/α_u² + sin²φ_h/α_v²).
     #[inline]
@@ -169,35 +124,33 @@ impl WardLobes {
     }
 }
 
-impl Bxdf for WardLobes {
-    fn eval(&self, _tree: &BxdfTree, wo: Vec3, wi: Vec3) -> BsdfEval {
-        if !(wo.z > 0.0 && wi.z > 0.0) {
-            return BsdfEval::ZERO;
-        }
-        BsdfEval {
-            value: self.value(wo, wi),
-            pdf: self.mixture_pdf(wo, wi),
-        }
+impl GlossyDiffuseLobes for WardLobes {
+    #[inline]
+    fn value(&self, wo: Vec3, wi: Vec3) -> SampledSpectrum {
+        let h = wo + wi;
+        let area = PI * self.alpha_u * self.alpha_v;
+        let normalisation = match self.variant {
+            WardVariant::Ward => 1.0 / (4.0 * area * (wo.z * wi.z).sqrt()),
+            WardVariant::WardDuer => 1.0 / (4.0 * area * wo.z * wi.z),
+            WardVariant::Balanced => h.dot(h) / (area * h.z.powi(4)),
+        };
+        let glossy = normalisation * self.gaussian(h);
+        (self.specular * glossy + self.diffuse * FRAC_1_PI) * wi.z
     }
 
-    fn sample(&self, _tree: &BxdfTree, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<BsdfSample> {
-        if !(wo.z > 0.0) {
-            return None;
-        }
-        let (wi, flags) = if u_lobe < self.p_glossy {
-            (
-                reflect(wo, self.sample_half_vector(u)),
-                BsdfFlags::GLOSSY.union(BsdfFlags::REFLECTION),
-            )
-        } else {
-            (
-                sample_cosine_hemisphere(u),
-                BsdfFlags::DIFFUSE.union(BsdfFlags::REFLECTION),
-            )
-        };
-        if !(wi.z > 0.0) {
-            return None;
-        }
-        mixture_sample(wi, self.value(wo, wi), self.mixture_pdf(wo, wi), flags)
+    #[inline]
+    fn glossy_probability(&self, _wo: Vec3) -> f32 {
+        self.p_glossy
+    }
+
+    #[inline]
+    fn sample_glossy(&self, wo: Vec3, u: Vec2) -> Vec3 {
+        reflect(wo, self.sample_half_vector(u))
+    }
+
+    #[inline]
+    fn glossy_pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        let h = (wo + wi).normalize();
+        self.gaussian(h) / (4.0 * PI * self.alpha_u * self.alpha_v * wo.dot(h) * h.z.powi(3))
     }
 }

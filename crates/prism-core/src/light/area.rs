@@ -76,7 +76,9 @@ fn luminance_density(texture: &Texture) -> (PiecewiseConstant2D, f32) {
             bitmap.width.clamp(1, MAX_RESOLUTION),
             bitmap.height.clamp(1, MAX_RESOLUTION),
         ),
-        _ => (PATTERN_RESOLUTION, PATTERN_RESOLUTION),
+        Texture::Constant(_) | Texture::Checkerboard(_) | Texture::MeshAttribute(_) => {
+            (PATTERN_RESOLUTION, PATTERN_RESOLUTION)
+        }
     };
     let weights: Vec<f32> = (0..nx * ny)
         .map(|cell| {
@@ -156,7 +158,7 @@ impl AreaLight {
     ) -> Option<(&'a PiecewiseConstant2D, &'a Shape)> {
         match (&self.texture_density, primitive) {
             (Some(density), Primitive::Shape(shape)) => Some((density, shape)),
-            _ => None,
+            (None, _) | (Some(_), Primitive::Instance(_)) => None,
         }
     }
 

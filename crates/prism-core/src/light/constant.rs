@@ -14,10 +14,9 @@
 
 use std::f32::consts::PI;
 
-use glam::{Vec2, Vec3};
+use glam::Vec2;
 
-use super::{BoundingSphere, Environment, LightBounds, LightSample, LightSource};
-use crate::geometry::Primitive;
+use super::{BoundingSphere, DirectionSample, Environment, LightAtInfinity};
 use crate::sampling::warp::{sample_uniform_sphere, uniform_sphere_pdf};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths, Spectrum};
 
@@ -49,42 +48,34 @@ impl ConstantLight {
     }
 }
 
-impl LightSource for ConstantLight {
-    fn sample_incident(
-        &self,
-        _shapes: &[Primitive],
-        reference: Vec3,
-        _time: f32,
-        _u_choice: f32,
-        u: Vec2,
-        lambda: &SampledWavelengths,
-    ) -> Option<LightSample> {
+impl LightAtInfinity for ConstantLight {
+    const IS_DELTA: bool = false;
+
+    fn sample_direction(&self, u: Vec2, lambda: &SampledWavelengths) -> Option<DirectionSample> {
         let wi = sample_uniform_sphere(u);
-        Some(LightSample {
-            p: self.scene.point_beyond(reference, wi),
-            n: Vec3::ZERO,
+        let radiance = self.radiance(lambda);
+        Some(DirectionSample {
             wi,
-            radiance: self.radiance(lambda),
+            radiance,
             pdf: self.pdf(),
-            is_delta: false,
         })
+    }
+
+    fn environment(&self) -> Option<Environment<'_>> {
+        Some(Environment::Constant(self))
     }
 
     /// Φ = π R² ∫ L dω = 4π² R² L: the flux entering the scene's bounding sphere (each
     /// direction crosses a disk of area πR²; pbrt-v4's `UniformInfiniteLight::Phi`).
-    fn power(&self, _shapes: &[Primitive]) -> f32 {
+    fn flux(&self) -> f32 {
         4.0 * PI * PI * self.scene.radius * self.scene.radius * self.radiance.luminance()
     }
 
-    fn bounds(&self, _shapes: &[Primitive]) -> Option<LightBounds> {
-        None
+    fn scene(&self) -> &BoundingSphere {
+        &self.scene
     }
 
-    fn set_scene_bounds(&mut self, bounds: BoundingSphere) {
-        self.scene = bounds;
-    }
-
-    fn as_environment(&self) -> Option<Environment<'_>> {
-        Some(Environment::Constant(self))
+    fn scene_mut(&mut self) -> &mut BoundingSphere {
+        &mut self.scene
     }
 }

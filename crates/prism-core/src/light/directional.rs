@@ -17,8 +17,7 @@ use std::f32::consts::PI;
 
 use glam::{Vec2, Vec3};
 
-use super::{BoundingSphere, Environment, LightBounds, LightSample, LightSource};
-use crate::geometry::Primitive;
+use super::{BoundingSphere, DirectionSample, Environment, LightAtInfinity};
 use crate::spectrum::{SampledWavelengths, Spectrum};
 
 #[derive(Clone, Debug)]
@@ -40,44 +39,36 @@ impl DirectionalLight {
     }
 }
 
-impl LightSource for DirectionalLight {
+impl LightAtInfinity for DirectionalLight {
+    const IS_DELTA: bool = true;
+
     /// The light arrives from −direction at every point; the shadow ray runs to a point beyond
     /// the scene. As a delta in direction, the "radiance" is the irradiance and the pdf 1.
-    fn sample_incident(
-        &self,
-        _shapes: &[Primitive],
-        reference: Vec3,
-        _time: f32,
-        _u_choice: f32,
-        _u: Vec2,
-        lambda: &SampledWavelengths,
-    ) -> Option<LightSample> {
+    fn sample_direction(&self, _u: Vec2, lambda: &SampledWavelengths) -> Option<DirectionSample> {
         let wi = -self.direction;
-        Some(LightSample {
-            p: self.scene.point_beyond(reference, wi),
-            n: Vec3::ZERO,
+        let irradiance = self.irradiance.sample(lambda);
+        Some(DirectionSample {
             wi,
-            radiance: self.irradiance.sample(lambda),
+            radiance: irradiance,
             pdf: 1.0,
-            is_delta: true,
         })
+    }
+
+    fn environment(&self) -> Option<Environment<'_>> {
+        None
     }
 
     /// Φ = π R² E: the flux through the disk the scene's bounding sphere presents to the light
     /// (pbrt-v4's `DistantLight::Phi`).
-    fn power(&self, _shapes: &[Primitive]) -> f32 {
+    fn flux(&self) -> f32 {
         PI * self.scene.radius * self.scene.radius * self.irradiance.luminance()
     }
 
-    fn bounds(&self, _shapes: &[Primitive]) -> Option<LightBounds> {
-        None
+    fn scene(&self) -> &BoundingSphere {
+        &self.scene
     }
 
-    fn set_scene_bounds(&mut self, bounds: BoundingSphere) {
-        self.scene = bounds;
-    }
-
-    fn as_environment(&self) -> Option<Environment<'_>> {
-        None
+    fn scene_mut(&mut self) -> &mut BoundingSphere {
+        &mut self.scene
     }
 }

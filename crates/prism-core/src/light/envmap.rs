@@ -37,8 +37,7 @@ use std::f32::consts::PI;
 
 use glam::{Vec2, Vec3};
 
-use super::{BoundingSphere, Environment, LightBounds, LightSample, LightSource};
-use crate::geometry::Primitive;
+use super::{BoundingSphere, DirectionSample, Environment, LightAtInfinity};
 use crate::image::Bitmap;
 use crate::math::Transform;
 use crate::sampling::distribution::PiecewiseConstant2D;
@@ -231,16 +230,10 @@ impl EnvironmentMap {
     }
 }
 
-impl LightSource for EnvironmentMap {
-    fn sample_incident(
-        &self,
-        _shapes: &[Primitive],
-        reference: Vec3,
-        _time: f32,
-        _u_choice: f32,
-        u: Vec2,
-        lambda: &SampledWavelengths,
-    ) -> Option<LightSample> {
+impl LightAtInfinity for EnvironmentMap {
+    const IS_DELTA: bool = false;
+
+    fn sample_direction(&self, u: Vec2, lambda: &SampledWavelengths) -> Option<DirectionSample> {
         let p = self.distribution.sample(u);
         let uv = Vec2::new(wrap(p.x + self.half_texel()), p.y);
         let local = Self::uv_to_direction(uv);
@@ -251,34 +244,28 @@ impl LightSource for EnvironmentMap {
         if !(pdf > 0.0 && pdf.is_finite()) {
             return None;
         }
-        Some(LightSample {
-            p: self.scene.point_beyond(reference, wi),
-            n: Vec3::ZERO,
-            wi,
-            radiance: self.lookup(uv, lambda),
-            pdf,
-            is_delta: false,
-        })
+        let radiance = self.lookup(uv, lambda);
+        Some(DirectionSample { wi, radiance, pdf })
+    }
+
+    fn environment(&self) -> Option<Environment<'_>> {
+        Some(Environment::Envmap(self))
     }
 
     /// Φ = π R² ∫ Y(L) dω, with ∫ Y(L) dω = 2π² ∫∫ Y sin θ du dv the integral of the sampling
     /// weights: the flux entering the scene's bounding sphere, as for [`super::ConstantLight`];
     /// exact for grey maps, and for colours up to the luminance of interpolated spectra.
-    fn power(&self, _shapes: &[Primitive]) -> f32 {
+    fn flux(&self) -> f32 {
         let integral = 2.0 * PI * PI * self.distribution.integral() as f32 * self.scale;
         PI * self.scene.radius * self.scene.radius * integral
     }
 
-    fn bounds(&self, _shapes: &[Primitive]) -> Option<LightBounds> {
-        None
+    fn scene(&self) -> &BoundingSphere {
+        &self.scene
     }
 
-    fn set_scene_bounds(&mut self, bounds: BoundingSphere) {
-        self.scene = bounds;
-    }
-
-    fn as_environment(&self) -> Option<Environment<'_>> {
-        Some(Environment::Envmap(self))
+    fn scene_mut(&mut self) -> &mut BoundingSphere {
+        &mut self.scene
     }
 }
 
@@ -286,6 +273,7 @@ impl LightSource for EnvironmentMap {
 mod tests {
     use super::*;
     use crate::image::Encoding;
+    use crate::light::LightSource;
 
     fn bitmap(width: usize, height: usize, f: impl Fn(usize, usize) -> [f32; 3]) -> Bitmap {
         let data = (0..height)

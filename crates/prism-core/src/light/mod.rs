@@ -114,6 +114,79 @@ plugin_class! {
     }
 }
 
+/// A light at infinity (`directional`, `constant`, `envmap`, `sunsky`): it lights every point
+/// from directions alone, has no place for the light sampler to bound, and is told the scene's
+/// bounding sphere (Mitsuba's `Emitter::set_scene`), beyond which its shadow rays end and
+/// through which its power is counted. Its [`LightSource`] follows.
+pub trait LightAtInfinity {
+    /// Whether the light arrives from a single direction (a Dirac delta: `directional`).
+    const IS_DELTA: bool;
+
+    /// Draws the direction light arrives from with the random numbers `u`.
+    fn sample_direction(&self, u: Vec2, lambda: &SampledWavelengths) -> Option<DirectionSample>;
+
+    /// [`LightSource::as_environment`].
+    fn environment(&self) -> Option<Environment<'_>>;
+
+    /// [`LightSource::power`]: the flux entering the scene's bounding sphere.
+    fn flux(&self) -> f32;
+
+    /// The scene's bounding sphere, as [`LightSource::set_scene_bounds`] gave it.
+    fn scene(&self) -> &BoundingSphere;
+
+    fn scene_mut(&mut self) -> &mut BoundingSphere;
+}
+
+/// Light arriving from a direction at infinity.
+#[derive(Clone, Copy, Debug)]
+pub struct DirectionSample {
+    /// The unit direction towards the light.
+    pub wi: Vec3,
+    /// The radiance along `wi` (for a delta: the irradiance).
+    pub radiance: SampledSpectrum,
+    /// The density per unit solid angle (1 for a delta).
+    pub pdf: f32,
+}
+
+impl<L: LightAtInfinity> LightSource for L {
+    #[inline]
+    fn sample_incident(
+        &self,
+        _shapes: &[Primitive],
+        reference: Vec3,
+        _time: f32,
+        _u_choice: f32,
+        u: Vec2,
+        lambda: &SampledWavelengths,
+    ) -> Option<LightSample> {
+        let s = self.sample_direction(u, lambda)?;
+        Some(LightSample::from_infinity(
+            self.scene(),
+            reference,
+            s.wi,
+            s.radiance,
+            s.pdf,
+            L::IS_DELTA,
+        ))
+    }
+
+    fn power(&self, _shapes: &[Primitive]) -> f32 {
+        self.flux()
+    }
+
+    fn bounds(&self, _shapes: &[Primitive]) -> Option<LightBounds> {
+        None
+    }
+
+    fn set_scene_bounds(&mut self, bounds: BoundingSphere) {
+        *self.scene_mut() = bounds;
+    }
+
+    fn as_environment(&self) -> Option<Environment<'_>> {
+        self.environment()
+    }
+}
+
 /// A light at infinity as the rays that leave the scene see it.
 #[derive(Clone, Copy, Debug)]
 pub enum Environment<'a> {
@@ -163,6 +236,52 @@ pub struct LightSample {
     /// Whether the light is a Dirac delta (a point or a direction): no other strategy can find
     /// it.
     pub is_delta: bool,
+}
+
+impl LightSample {
+    /// Light from the point `p` of a point, spot or projector light, arriving along `wi`: a
+    /// delta, whose shadow ray ends at `p`.
+    #[inline]
+    pub fn from_point(p: Vec3, wi: Vec3, radiance: SampledSpectrum) -> LightSample {
+        LightSample {
+            p,
+            n: Vec3::ZERO,
+            wi,
+            radiance,
+            pdf: 1.0,
+            is_delta: true,
+        }
+    }
+
+    /// Light from a light at infinity arriving at `reference` along `wi`: the shadow ray ends
+    /// beyond the scene's bounding sphere `scene`.
+    #[inline]
+    pub fn from_infinity(
+        scene: &BoundingSphere,
+        reference: Vec3,
+        wi: Vec3,
+        radiance: SampledSpectrum,
+        pdf: f32,
+        is_delta: bool,
+    ) -> LightSample {
+        LightSample {
+            p: scene.point_beyond(reference, wi),
+            n: Vec3::ZERO,
+            wi,
+            radiance,
+            pdf,
+            is_delta,
+        }
+    }
+}
+
+/// The direction from `reference` towards the point `p` and the squared distance between them,
+/// for lights at a point; None where they coincide.
+#[inline]
+pub(crate) fn towards_point(p: Vec3, reference: Vec3) -> Option<(Vec3, f32)> {
+    let d = p - reference;
+    let dist2 = d.length_squared();
+    (dist2 > 0.0).then(|| (d / dist2.sqrt(), dist2))
 }
 
 /// The sphere that bounds the scene's geometry. Lights at infinity use it, as Mitsuba's

@@ -15,7 +15,7 @@ use std::f32::consts::PI;
 
 use glam::{Vec2, Vec3};
 
-use super::{BoundingSphere, Environment, LightBounds, LightSample, LightSource};
+use super::{BoundingSphere, Environment, LightBounds, LightSample, LightSource, towards_point};
 use crate::geometry::Primitive;
 use crate::spectrum::{SampledWavelengths, Spectrum};
 
@@ -35,19 +35,9 @@ impl LightSource for PointLight {
         _u: Vec2,
         lambda: &SampledWavelengths,
     ) -> Option<LightSample> {
-        let d = self.position - reference;
-        let dist2 = d.length_squared();
-        if !(dist2 > 0.0) {
-            return None;
-        }
-        Some(LightSample {
-            p: self.position,
-            n: Vec3::ZERO,
-            wi: d / dist2.sqrt(),
-            radiance: self.intensity.sample(lambda) * (1.0 / dist2),
-            pdf: 1.0,
-            is_delta: true,
-        })
+        let (wi, dist2) = towards_point(self.position, reference)?;
+        let radiance = self.intensity.sample(lambda) * (1.0 / dist2);
+        Some(LightSample::from_point(self.position, wi, radiance))
     }
 
     /// Φ = 4π I.

@@ -94,8 +94,6 @@ impl Projector {
         (uv.x >= 0.0 && uv.x <= 1.0 && uv.y >= 0.0 && uv.y <= 1.0).then_some(uv)
     }
 
-    /// Φ = π · scale · Ē · 4 t² / a: the irradiance π · scale · E on the plane z = 1 over the
-    /// image's rectangle there, [−t, t] × [−t/a, t/a] (Ē the mean of the image's values).
     /// Where the light sits.
     pub fn position(&self) -> Vec3 {
         self.position
@@ -128,16 +126,12 @@ impl LightSource for Projector {
         if irradiance.is_black() {
             return None;
         }
-        Some(LightSample {
-            p: self.position,
-            n: Vec3::ZERO,
-            wi,
-            radiance: irradiance * (PI * self.scale / (local.z * local.z * cos_theta)),
-            pdf: 1.0,
-            is_delta: true,
-        })
+        let radiance = irradiance * (PI * self.scale / (local.z * local.z * cos_theta));
+        Some(LightSample::from_point(self.position, wi, radiance))
     }
 
+    /// Φ = π · scale · Ē · 4 t² / a: the irradiance π · scale · E on the plane z = 1 over the
+    /// image's rectangle there, [−t, t] × [−t/a, t/a] (Ē the mean of the image's values).
     fn power(&self, _shapes: &[Primitive]) -> f32 {
         let t = self.tan_half_fov;
         PI * self.scale * self.mean_irradiance * 4.0 * t * t / self.aspect

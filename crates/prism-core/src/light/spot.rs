@@ -24,7 +24,7 @@
 
 use glam::{Vec2, Vec3};
 
-use super::{BoundingSphere, Environment, LightBounds, LightSample, LightSource};
+use super::{BoundingSphere, Environment, LightBounds, LightSample, LightSource, towards_point};
 use crate::geometry::Primitive;
 use crate::math::Transform;
 use crate::spectrum::{SampledWavelengths, Spectrum};
@@ -90,10 +90,6 @@ impl SpotLight {
         }
     }
 
-    /// Φ = I ∫ falloff dω = 2π I [(1 − cos β) + ∫_β^c (c − θ)/(c − β) sin θ dθ]
-    ///   = 2π I [1 − (sin c − sin β)/(c − β)]   (integrating the ramp by parts),
-    /// which tends to the cone's 2π I (1 − cos c) as the ramp's width c − β goes to 0; with a
-    /// texture, times its mean value over the image (a weight for choosing the light).
     /// Where the light sits.
     pub fn position(&self) -> Vec3 {
         self.position
@@ -110,12 +106,7 @@ impl LightSource for SpotLight {
         _u: Vec2,
         lambda: &SampledWavelengths,
     ) -> Option<LightSample> {
-        let d = self.position - reference;
-        let dist2 = d.length_squared();
-        if !(dist2 > 0.0) {
-            return None;
-        }
-        let wi = d / dist2.sqrt();
+        let (wi, dist2) = towards_point(self.position, reference)?;
         let local = self.to_world.inverse_vector(-wi);
         let falloff = self.falloff(local);
         if falloff == 0.0 {
@@ -128,16 +119,13 @@ impl LightSource for SpotLight {
                 return None;
             }
         }
-        Some(LightSample {
-            p: self.position,
-            n: Vec3::ZERO,
-            wi,
-            radiance,
-            pdf: 1.0,
-            is_delta: true,
-        })
+        Some(LightSample::from_point(self.position, wi, radiance))
     }
 
+    /// Φ = I ∫ falloff dω = 2π I [(1 − cos β) + ∫_β^c (c − θ)/(c − β) sin θ dθ]
+    ///   = 2π I [1 − (sin c − sin β)/(c − β)]   (integrating the ramp by parts),
+    /// which tends to the cone's 2π I (1 − cos c) as the ramp's width c − β goes to 0; with a
+    /// texture, times its mean value over the image (a weight for choosing the light).
     fn power(&self, _shapes: &[Primitive]) -> f32 {
         let (c, b) = (f64::from(self.cutoff), f64::from(self.beam));
         let width = c - b;

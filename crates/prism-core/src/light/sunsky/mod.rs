@@ -35,8 +35,7 @@ use std::f32::consts::PI;
 
 use glam::{Vec2, Vec3};
 
-use super::{BoundingSphere, Environment, LightBounds, LightSample, LightSource};
-use crate::geometry::Primitive;
+use super::{BoundingSphere, DirectionSample, Environment, LightAtInfinity};
 use crate::math::{Frame, Transform};
 use crate::sampling::distribution::PiecewiseConstant2D;
 use crate::spectrum::cie::cie_y;
@@ -325,17 +324,11 @@ impl Sunsky {
     }
 }
 
-impl LightSource for Sunsky {
+impl LightAtInfinity for Sunsky {
+    const IS_DELTA: bool = false;
+
     /// A direction towards the sky or the sun (see the module's documentation).
-    fn sample_incident(
-        &self,
-        _shapes: &[Primitive],
-        reference: Vec3,
-        _time: f32,
-        _u_choice: f32,
-        u: Vec2,
-        lambda: &SampledWavelengths,
-    ) -> Option<LightSample> {
+    fn sample_direction(&self, u: Vec2, lambda: &SampledWavelengths) -> Option<DirectionSample> {
         if !(self.sky_luminous + self.sun_luminous > 0.0) {
             return None;
         }
@@ -362,33 +355,27 @@ impl LightSource for Sunsky {
         if !(pdf > 0.0 && pdf.is_finite()) {
             return None;
         }
-        Some(LightSample {
-            p: self.scene.point_beyond(reference, wi),
-            n: Vec3::ZERO,
-            wi,
-            radiance: self.local_radiance(local, lambda),
-            pdf,
-            is_delta: false,
-        })
+        let radiance = self.local_radiance(local, lambda);
+        Some(DirectionSample { wi, radiance, pdf })
+    }
+
+    fn environment(&self) -> Option<Environment<'_>> {
+        Some(Environment::Sunsky(self))
     }
 
     /// Φ = π R² ∫ Y(L) dω, the luminous flux entering the scene's bounding sphere (as for
     /// [`super::EnvironmentMap::power`]): the sky's integral from the sampling table's cells
     /// and the sun's radiance times its solid angle.
-    fn power(&self, _shapes: &[Primitive]) -> f32 {
+    fn flux(&self) -> f32 {
         let integral = self.sky_luminous + self.sun_luminous;
         (std::f64::consts::PI * f64::from(self.scene.radius).powi(2) * integral) as f32
     }
 
-    fn bounds(&self, _shapes: &[Primitive]) -> Option<LightBounds> {
-        None
+    fn scene(&self) -> &BoundingSphere {
+        &self.scene
     }
 
-    fn set_scene_bounds(&mut self, bounds: BoundingSphere) {
-        self.scene = bounds;
-    }
-
-    fn as_environment(&self) -> Option<Environment<'_>> {
-        Some(Environment::Sunsky(self))
+    fn scene_mut(&mut self) -> &mut BoundingSphere {
+        &mut self.scene
     }
 }

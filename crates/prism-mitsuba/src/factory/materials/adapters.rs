@@ -21,8 +21,7 @@ pub(super) const TWOSIDED: Plugin<Build> = Plugin {
     build: |params, t| {
         let (front, back) = twosided_pair(params, t)?;
         Ok(Bsdf::TwoSided(TwoSided {
-            front: Box::new(front),
-            back: Box::new(back),
+            sides: [Box::new(front), Box::new(back)],
         }))
     },
 };
