@@ -120,6 +120,7 @@ pub struct LightQuery<'a> {
     pub u_choice: f32,
     /// The random numbers that draw the point or direction.
     pub u: Vec2,
+    /// The wavelengths the radiance is sampled at.
     pub lambda: &'a SampledWavelengths,
 }
 
