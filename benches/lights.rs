@@ -24,7 +24,7 @@ use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use glam::{Vec2, Vec3};
 use prism_core::geometry::{Primitive, Shape};
 use prism_core::image::{ChannelImage, write_exr};
-use prism_core::light::{Light, LightSource, Receiver};
+use prism_core::light::{Light, LightQuery, LightSource, Receiver};
 use prism_core::sampling::rng::Pcg32;
 use prism_core::scene::Scene;
 use prism_core::spectrum::{SampledWavelengths, WavelengthSampling};
@@ -119,6 +119,20 @@ struct Query {
     u: Vec2,
 }
 
+impl Query {
+    /// What a light is asked for this sample, at time 0 among the scene's `shapes`.
+    fn light_query<'a>(&'a self, shapes: &'a [Primitive]) -> LightQuery<'a> {
+        LightQuery {
+            shapes,
+            reference: self.p,
+            time: 0.0,
+            u_choice: self.u_choice,
+            u: self.u,
+            lambda: &self.lambda,
+        }
+    }
+}
+
 fn queries() -> Vec<Query> {
     let mut rng = Pcg32::seeded(5);
     (0..POINTS)
@@ -144,7 +158,7 @@ fn lights(c: &mut Criterion) {
         group.bench_function(kind(&scene, light), |b| {
             b.iter(|| {
                 for q in &queries {
-                    black_box(light.sample_incident(shapes, q.p, 0.0, q.u_choice, q.u, &q.lambda));
+                    black_box(light.sample_incident(q.light_query(shapes)));
                 }
             });
         });
@@ -155,7 +169,7 @@ fn lights(c: &mut Criterion) {
                 if let Some((index, pmf)) = light_sampler.sample(q.u_light, &Receiver::point(q.p)) {
                     let light = &scene.world.lights[index];
                     black_box(pmf);
-                    black_box(light.sample_incident(shapes, q.p, 0.0, q.u_choice, q.u, &q.lambda));
+                    black_box(light.sample_incident(q.light_query(shapes)));
                 }
             }
         });

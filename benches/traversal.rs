@@ -29,7 +29,7 @@ use criterion::{BatchSize, Criterion, SamplingMode, Throughput, criterion_group,
 use glam::{UVec2, Vec2};
 use prism_core::camera::CameraModel;
 use prism_core::geometry::Geometry;
-use prism_core::light::{LightSource, Receiver};
+use prism_core::light::{LightQuery, LightSource, Receiver};
 use prism_core::math::{Frame, Ray};
 use prism_core::sampling::rng::Pcg32;
 use prism_core::sampling::warp::sample_cosine_hemisphere;
@@ -91,14 +91,14 @@ impl Fixture {
             if shadow.len() < wanted
                 && let Some((light, _)) =
                     light_sampler.sample(u_light, &Receiver::surface(si.p, si.shading.n))
-                && let Some(ls) = scene.world.lights[light].sample_incident(
-                    &scene.world.geometry.primitives,
-                    si.p,
-                    si.time,
+                && let Some(ls) = scene.world.lights[light].sample_incident(LightQuery {
+                    shapes: &scene.world.geometry.primitives,
+                    reference: si.p,
+                    time: si.time,
                     u_choice,
-                    u2(&mut rng),
-                    &lambda,
-                )
+                    u: u2(&mut rng),
+                    lambda: &lambda,
+                })
             {
                 shadow.push(si.spawn_ray_to(ls.p, ls.n));
             }

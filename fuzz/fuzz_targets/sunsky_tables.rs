@@ -8,7 +8,7 @@
 use glam::{Vec2, Vec3};
 use libfuzzer_sys::fuzz_target;
 use prism_core::light::sunsky::data::{DATASETS, SAMPLING_DATA, SunskyTables, parse_tensor_file};
-use prism_core::light::{LightSource, Sunsky, SunskySettings};
+use prism_core::light::{LightQuery, LightSource, Sunsky, SunskySettings};
 use prism_core::math::Transform;
 use prism_core::spectrum::SampledWavelengths;
 
@@ -37,12 +37,23 @@ fuzz_target!(|data: &[u8]| {
     };
     let light = Sunsky::with_tables(&settings, &tables);
     let lambda = SampledWavelengths::single(550.0);
-    for d in [Vec3::Z, Vec3::new(0.3, 0.2, 0.8).normalize(), Vec3::new(1.0, 0.0, 0.01).normalize()] {
+    for d in [
+        Vec3::Z,
+        Vec3::new(0.3, 0.2, 0.8).normalize(),
+        Vec3::new(1.0, 0.0, 0.01).normalize(),
+    ] {
         let _ = light.radiance(d, &lambda);
         let _ = light.pdf(d);
     }
     for u in [Vec2::new(0.1, 0.7), Vec2::new(0.99, 0.2)] {
-        let _ = light.sample_incident(&[], Vec3::ZERO, 0.0, 0.5, u, &lambda);
+        let _ = light.sample_incident(LightQuery {
+            shapes: &[],
+            reference: Vec3::ZERO,
+            time: 0.0,
+            u_choice: 0.5,
+            u,
+            lambda: &lambda,
+        });
     }
     let _ = light.power(&[]);
 });

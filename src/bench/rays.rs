@@ -14,7 +14,7 @@ use glam::Vec2;
 
 use prism_core::camera::CameraModel;
 use prism_core::geometry::SurfaceInteraction;
-use prism_core::light::{LightSource, Receiver};
+use prism_core::light::{LightQuery, LightSource, Receiver};
 use prism_core::math::Ray;
 use prism_core::sampling::rng::Pcg32;
 use prism_core::sampling::warp::sample_uniform_sphere;
@@ -40,14 +40,14 @@ pub fn shadow_rays(scene: &Scene, count: usize, seed: u64) -> Vec<Ray> {
             .light_sampler()
             .sample(rng.next_f32(), &receiver)?;
         let (u_choice, u) = (rng.next_f32(), Vec2::new(rng.next_f32(), rng.next_f32()));
-        let sample = scene.world.lights[light].sample_incident(
-            &scene.world.geometry.primitives,
-            hit.p,
-            hit.time,
+        let sample = scene.world.lights[light].sample_incident(LightQuery {
+            shapes: &scene.world.geometry.primitives,
+            reference: hit.p,
+            time: hit.time,
             u_choice,
             u,
-            &wavelengths,
-        )?;
+            lambda: &wavelengths,
+        })?;
         Some(hit.spawn_ray_to(sample.p, sample.n))
     })
 }

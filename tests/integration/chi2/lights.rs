@@ -13,8 +13,8 @@ use prism_core::geometry::{Shape, ShapeSampling};
 use prism_core::image::{Bitmap, Encoding};
 use prism_core::integrator::PathIntegrator;
 use prism_core::light::{
-    AreaLight, ConstantLight, DirectionalLight, EnvironmentMap, Light, LightSelection, LightSource,
-    PointLight, Receiver, SpotLight,
+    AreaLight, ConstantLight, DirectionalLight, EnvironmentMap, Light, LightQuery, LightSelection,
+    LightSource, PointLight, Receiver, SpotLight,
 };
 use prism_core::math::{Frame, Transform};
 use prism_core::sampling::chi2::{
@@ -144,8 +144,14 @@ fn rectangle_light_chi2(reference: Vec3, seed: u64, name: &str) {
         24,
         seed,
         |rng| {
-            let ls =
-                light.sample_incident(&shapes, reference, 0.0, rng.next_f32(), u2(rng), &lambda)?;
+            let ls = light.sample_incident(LightQuery {
+                shapes: &shapes,
+                reference,
+                time: 0.0,
+                u_choice: rng.next_f32(),
+                u: u2(rng),
+                lambda: &lambda,
+            })?;
             let claimed = f64::from(ls.pdf) * solid_angle;
             assert!((claimed - 1.0).abs() < 1e-4, "{name}: pdf × S = {claimed}");
             assert!((f64::from(ls.p.z) - 2.0).abs() < 1e-5, "{name}: {}", ls.p);
@@ -204,8 +210,14 @@ fn by_area_chi2(shear: f64, sampling: ShapeSampling, seed: u64, name: &str) {
         20,
         seed,
         |rng| {
-            let ls =
-                light.sample_incident(&shapes, reference, 0.0, rng.next_f32(), u2(rng), &lambda)?;
+            let ls = light.sample_incident(LightQuery {
+                shapes: &shapes,
+                reference,
+                time: 0.0,
+                u_choice: rng.next_f32(),
+                u: u2(rng),
+                lambda: &lambda,
+            })?;
             let d = ls.p - reference;
             let cos = d.normalize().dot(Vec3::Z).abs();
             let area_pdf = f64::from(ls.pdf * cos / d.length_squared());
@@ -300,7 +312,14 @@ fn environment_map_sampling_follows_luminance_times_sin_theta() {
     let mut rng = Pcg32::seeded(24);
     for _ in 0..SAMPLES {
         let ls = light
-            .sample_incident(&[], Vec3::ZERO, 0.0, 0.5, u2(&mut rng), &lambda)
+            .sample_incident(LightQuery {
+                shapes: &[],
+                reference: Vec3::ZERO,
+                time: 0.0,
+                u_choice: 0.5,
+                u: u2(&mut rng),
+                lambda: &lambda,
+            })
             .expect("an environment sample failed");
         assert!(
             (ls.pdf / light.environment_pdf(ls.wi) - 1.0).abs() < 1e-3,
@@ -508,14 +527,14 @@ fn exhaustive_selection_keeps_every_light_that_can_give_light() {
         let n = prism_core::sampling::warp::sample_uniform_sphere(u2(&mut rng));
         let receiver = Receiver::surface(p, n);
         for (i, light) in scene.world.lights.iter().enumerate() {
-            let Some(ls) = light.sample_incident(
-                &scene.world.geometry.primitives,
-                p,
-                0.0,
-                rng.next_f32(),
-                u2(&mut rng),
-                &lambda,
-            ) else {
+            let Some(ls) = light.sample_incident(LightQuery {
+                shapes: &scene.world.geometry.primitives,
+                reference: p,
+                time: 0.0,
+                u_choice: rng.next_f32(),
+                u: u2(&mut rng),
+                lambda: &lambda,
+            }) else {
                 continue;
             };
             if ls.radiance.is_black() || ls.wi.dot(n) == 0.0 {
@@ -558,14 +577,14 @@ fn spot_light_points_along_its_transformed_axis() {
     let lambda = SampledWavelengths::single(550.0);
     // +z rotated by 90° about x is −y: a point 1 below the light is on the axis.
     let below = spot
-        .sample_incident(
-            &[],
-            Vec3::new(0.0, -1.0, 0.0),
-            0.0,
-            0.5,
-            Vec2::ZERO,
-            &lambda,
-        )
+        .sample_incident(LightQuery {
+            shapes: &[],
+            reference: Vec3::new(0.0, -1.0, 0.0),
+            time: 0.0,
+            u_choice: 0.5,
+            u: Vec2::ZERO,
+            lambda: &lambda,
+        })
         .unwrap();
     assert_eq!(below.radiance[0], 1.0);
     // 15° off the axis: halfway down the ramp.
@@ -575,7 +594,14 @@ fn spot_light_points_along_its_transformed_axis() {
         15f32.to_radians().cos(),
     ));
     let half = spot
-        .sample_incident(&[], off * 2.0, 0.0, 0.5, Vec2::ZERO, &lambda)
+        .sample_incident(LightQuery {
+            shapes: &[],
+            reference: off * 2.0,
+            time: 0.0,
+            u_choice: 0.5,
+            u: Vec2::ZERO,
+            lambda: &lambda,
+        })
         .unwrap();
     assert!(
         (half.radiance[0] * 4.0 - 0.5).abs() < 1e-4,
@@ -583,7 +609,14 @@ fn spot_light_points_along_its_transformed_axis() {
         half.radiance[0]
     );
     assert!(
-        spot.sample_incident(&[], Vec3::new(0.0, 1.0, 0.0), 0.0, 0.5, Vec2::ZERO, &lambda)
-            .is_none()
+        spot.sample_incident(LightQuery {
+            shapes: &[],
+            reference: Vec3::new(0.0, 1.0, 0.0),
+            time: 0.0,
+            u_choice: 0.5,
+            u: Vec2::ZERO,
+            lambda: &lambda
+        })
+        .is_none()
     );
 }

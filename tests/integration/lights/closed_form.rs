@@ -17,7 +17,7 @@ use prism_core::integrator::{
     DistributionIntegrator, Integrator, PathIntegrator, VolPathIntegrator,
 };
 use prism_core::light::{
-    AreaLight, BoundingSphere, ConstantLight, DirectionalLight, EnvironmentMap, Light,
+    AreaLight, BoundingSphere, ConstantLight, DirectionalLight, EnvironmentMap, Light, LightQuery,
     LightSelection, LightSource, PointLight, SpotLight,
 };
 use prism_core::math::special::regularized_gamma_q;
@@ -534,7 +534,14 @@ fn flux_through_sphere(
         let normal = sample_uniform_sphere(Vec2::new(rng.next_f32(), rng.next_f32()));
         let x = s.center + normal * s.radius;
         let u = Vec2::new(rng.next_f32(), rng.next_f32());
-        let value = match light.sample_incident(shapes, x, 0.0, rng.next_f32(), u, &lambda) {
+        let value = match light.sample_incident(LightQuery {
+            shapes,
+            reference: x,
+            time: 0.0,
+            u_choice: rng.next_f32(),
+            u,
+            lambda: &lambda,
+        }) {
             Some(ls) => {
                 let cos = f64::from(ls.wi.dot(normal));
                 let crosses = if outward { cos < 0.0 } else { cos > 0.0 };

@@ -7,7 +7,7 @@ use std::path::Path;
 
 use glam::{Vec2, Vec3};
 use prism_core::bsdf::Bsdf;
-use prism_core::light::{Light, LightSampler, LightSource, Receiver};
+use prism_core::light::{Light, LightQuery, LightSampler, LightSource, Receiver};
 use prism_core::scene::Scene;
 use prism_core::spectrum::SampledWavelengths;
 use prism_core::spectrum::cie::d65_normalized;
@@ -31,14 +31,14 @@ fn load(folder: &Path, body: &str) -> Scene {
 /// `reference`, undoing the distance falloff of point and spot lights.
 fn emission_at(scene: &Scene, light: usize, reference: Vec3, lambda: f32) -> f32 {
     let ls = scene.world.lights[light]
-        .sample_incident(
-            &scene.world.geometry.primitives,
+        .sample_incident(LightQuery {
+            shapes: &scene.world.geometry.primitives,
             reference,
-            0.0,
-            0.5,
-            Vec2::splat(0.5),
-            &SampledWavelengths::single(lambda),
-        )
+            time: 0.0,
+            u_choice: 0.5,
+            u: Vec2::splat(0.5),
+            lambda: &SampledWavelengths::single(lambda),
+        })
         .unwrap();
     match scene.world.lights[light] {
         Light::Point(_) | Light::Spot(_) => ls.radiance[0] * (ls.p - reference).length_squared(),
@@ -158,14 +158,14 @@ fn directional_light_placement() {
     );
     let wi = |light: usize| {
         scene.world.lights[light]
-            .sample_incident(
-                &[],
-                Vec3::ZERO,
-                0.0,
-                0.5,
-                Vec2::splat(0.5),
-                &SampledWavelengths::single(550.0),
-            )
+            .sample_incident(LightQuery {
+                shapes: &[],
+                reference: Vec3::ZERO,
+                time: 0.0,
+                u_choice: 0.5,
+                u: Vec2::splat(0.5),
+                lambda: &SampledWavelengths::single(550.0),
+            })
             .unwrap()
             .wi
     };

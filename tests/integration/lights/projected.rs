@@ -7,7 +7,7 @@ use std::sync::Arc;
 
 use glam::{DMat4, DVec3, Vec2, Vec3};
 use prism_core::image::{Bitmap, Encoding};
-use prism_core::light::{Light, LightSource, Projector, SpotLight};
+use prism_core::light::{Light, LightQuery, LightSource, Projector, SpotLight};
 use prism_core::math::Transform;
 use prism_core::spectrum::{SampledWavelengths, Spectrum};
 use prism_core::texture::{BitmapTexture, FilterType, Texture, TextureUse, UvTransform, WrapMode};
@@ -82,7 +82,14 @@ fn projector_irradiance_on_a_plane_matches_the_closed_form() {
                 );
                 let expected = PI * scale * TEXELS[j * WIDTH + i] / (z0 * z0);
                 let received = projector
-                    .sample_incident(&[], p, 0.0, 0.5, Vec2::splat(0.5), &lambda)
+                    .sample_incident(LightQuery {
+                        shapes: &[],
+                        reference: p,
+                        time: 0.0,
+                        u_choice: 0.5,
+                        u: Vec2::splat(0.5),
+                        lambda: &lambda,
+                    })
                     .map_or(0.0, |ls| {
                         assert!(ls.is_delta && ls.p == Vec3::ZERO);
                         // The plane's normal is −z.
@@ -99,7 +106,14 @@ fn projector_irradiance_on_a_plane_matches_the_closed_form() {
     ] {
         assert!(
             projector
-                .sample_incident(&[], p, 0.0, 0.5, Vec2::splat(0.5), &lambda)
+                .sample_incident(LightQuery {
+                    shapes: &[],
+                    reference: p,
+                    time: 0.0,
+                    u_choice: 0.5,
+                    u: Vec2::splat(0.5),
+                    lambda: &lambda
+                })
                 .is_none(),
             "{p} lies outside the projected image"
         );
@@ -122,8 +136,14 @@ fn projector_power_is_its_flux() {
         .map(|cell| {
             let x = -t + width * ((cell % nx) as f32 + 0.5) / nx as f32;
             let y = -t / aspect + height * ((cell / nx) as f32 + 0.5) / ny as f32;
-            let ls =
-                projector.sample_incident(&[], Vec3::new(x, y, 1.0), 0.0, 0.5, Vec2::ZERO, &lambda);
+            let ls = projector.sample_incident(LightQuery {
+                shapes: &[],
+                reference: Vec3::new(x, y, 1.0),
+                time: 0.0,
+                u_choice: 0.5,
+                u: Vec2::ZERO,
+                lambda: &lambda,
+            });
             ls.map_or(0.0, |ls| f64::from(ls.radiance[0] * ls.wi.z.abs()))
         })
         .sum::<f64>()
@@ -167,7 +187,14 @@ fn spot_light_projects_its_texture() {
                 to_world.point(Vec3::ZERO) + to_world.vector(local).normalize() * distance;
             let expected = 2.0 * falloff * TEXELS[j * WIDTH + i];
             let intensity = light
-                .sample_incident(&[], reference, 0.0, 0.5, Vec2::splat(0.5), &lambda)
+                .sample_incident(LightQuery {
+                    shapes: &[],
+                    reference,
+                    time: 0.0,
+                    u_choice: 0.5,
+                    u: Vec2::splat(0.5),
+                    lambda: &lambda,
+                })
                 .map_or(0.0, |ls| ls.radiance[0] * distance * distance);
             assert_close(intensity, expected, &format!("texel ({i}, {j})"));
             checked += 1;

@@ -20,7 +20,7 @@ use std::f64::consts::PI;
 use std::path::Path;
 
 use glam::{DVec3, Vec2, Vec3};
-use prism_core::light::{BoundingSphere, Light, LightSource};
+use prism_core::light::{BoundingSphere, Light, LightQuery, LightSource};
 use prism_core::math::Frame;
 use prism_core::sampling::chi2::{Suite, chi2_from_counts, chi2_rectangle};
 use prism_core::sampling::rng::Pcg32;
@@ -615,7 +615,14 @@ fn u2(rng: &mut Pcg32) -> Vec2 {
 /// A light sample's direction, checking that its pdf is the light's density of that direction.
 fn sample_direction(light: &Light, rng: &mut Pcg32) -> Option<Vec3> {
     let lambda = SampledWavelengths::single(550.0);
-    let ls = light.sample_incident(&[], Vec3::ZERO, 0.0, 0.5, u2(rng), &lambda)?;
+    let ls = light.sample_incident(LightQuery {
+        shapes: &[],
+        reference: Vec3::ZERO,
+        time: 0.0,
+        u_choice: 0.5,
+        u: u2(rng),
+        lambda: &lambda,
+    })?;
     assert_eq!(ls.pdf, light.environment_pdf(ls.wi), "pdf of {}", ls.wi);
     Some(ls.wi)
 }
@@ -773,8 +780,14 @@ fn light_samples_estimate_the_irradiance() {
     let (mut sum, mut sum2) = (0.0, 0.0);
     let mut rng = Pcg32::seeded(73);
     for _ in 0..SAMPLES {
-        let Some(ls) = both.sample_incident(&[], Vec3::ZERO, 0.0, 0.5, u2(&mut rng), &lambda)
-        else {
+        let Some(ls) = both.sample_incident(LightQuery {
+            shapes: &[],
+            reference: Vec3::ZERO,
+            time: 0.0,
+            u_choice: 0.5,
+            u: u2(&mut rng),
+            lambda: &lambda,
+        }) else {
             continue;
         };
         let x = f64::from(ls.radiance[0]) * f64::from(ls.wi.z.max(0.0)) / f64::from(ls.pdf);

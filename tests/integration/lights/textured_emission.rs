@@ -20,7 +20,7 @@ use prism_core::geometry::{
 };
 use prism_core::image::{Bitmap, Encoding};
 use prism_core::light::area::SHAPE_STRATEGY_FRACTION;
-use prism_core::light::{AreaLight, Light, LightSource};
+use prism_core::light::{AreaLight, Light, LightQuery, LightSource};
 use prism_core::math::{Ray, Transform};
 use prism_core::sampling::chi2::{Suite, chi2_discrete};
 use prism_core::sampling::rng::Pcg32;
@@ -167,9 +167,14 @@ fn textured_area_light_samples_follow_the_texture_through_the_uv_map() {
         .collect();
     probabilities.push(1.0 - probabilities.iter().sum::<f64>());
     let outcome = chi2_discrete(SAMPLES, &probabilities, 7, |rng| {
-        let Some(ls) =
-            light.sample_incident(&shapes, REFERENCE, 0.0, rng.next_f32(), u2(rng), &lambda)
-        else {
+        let Some(ls) = light.sample_incident(LightQuery {
+            shapes: &shapes,
+            reference: REFERENCE,
+            time: 0.0,
+            u_choice: rng.next_f32(),
+            u: u2(rng),
+            lambda: &lambda,
+        }) else {
             return N * N;
         };
         let (quad, uv) = locate(ls.p);
@@ -227,9 +232,14 @@ fn textured_sphere_light_samples_follow_the_texture() {
         .collect();
     probabilities.push(1.0 - probabilities.iter().sum::<f64>());
     let outcome = chi2_discrete(SAMPLES, &probabilities, 9, |rng| {
-        let Some(ls) =
-            light.sample_incident(&shapes, reference, 0.0, rng.next_f32(), u2(rng), &lambda)
-        else {
+        let Some(ls) = light.sample_incident(LightQuery {
+            shapes: &shapes,
+            reference,
+            time: 0.0,
+            u_choice: rng.next_f32(),
+            u: u2(rng),
+            lambda: &lambda,
+        }) else {
             return N * N;
         };
         // θ from atan2(√(x² + y²), z), which keeps its precision at the poles (acos z loses it).
@@ -316,14 +326,14 @@ fn assert_flux(quads: &[Quad], wrap: WrapMode, name: &str) {
     let (mut sum, mut sum2) = (0.0f64, 0.0f64);
     for _ in 0..n {
         let value = light
-            .sample_incident(
-                &shapes,
-                REFERENCE,
-                0.0,
-                rng.next_f32(),
-                u2(&mut rng),
-                &lambda,
-            )
+            .sample_incident(LightQuery {
+                shapes: &shapes,
+                reference: REFERENCE,
+                time: 0.0,
+                u_choice: rng.next_f32(),
+                u: u2(&mut rng),
+                lambda: &lambda,
+            })
             .map_or(0.0, |ls| {
                 let d = ls.p - REFERENCE;
                 let area_pdf = f64::from(ls.pdf) * f64::from(d.normalize().z.abs())

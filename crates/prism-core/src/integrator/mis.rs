@@ -28,7 +28,7 @@ use crate::bsdf::{BsdfEval, Scattering};
 use crate::geometry::{SurfaceInteraction, SurfaceSample};
 use crate::integrator::SampleContext;
 use crate::integrator::vertex::normals_agree;
-use crate::light::{AreaLight, Light, LightSample, LightSource, Receiver};
+use crate::light::{AreaLight, Light, LightQuery, LightSample, LightSource, Receiver};
 use crate::math::Ray;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use crate::world::World;
@@ -212,14 +212,14 @@ pub fn sample_point_on(
 ) -> Option<LightSample> {
     let u_choice = ctx.sampler.next_1d();
     let u = ctx.sampler.next_2d();
-    light.sample_incident(
-        &ctx.world().geometry.primitives,
+    light.sample_incident(LightQuery {
+        shapes: &ctx.world().geometry.primitives,
         reference,
         time,
         u_choice,
         u,
         lambda,
-    )
+    })
 }
 
 /// One light sample at `receiver` at `time`: a light chosen by the light sampler and a point on
@@ -240,14 +240,14 @@ pub fn sample_light(
     let u = ctx.sampler.next_2d();
     let world = ctx.world();
     let (light, choice_pmf) = ctx.light_sampler().sample(u_light, receiver)?;
-    let ls = world.lights[light].sample_incident(
-        &world.geometry.primitives,
-        receiver.p,
+    let ls = world.lights[light].sample_incident(LightQuery {
+        shapes: &world.geometry.primitives,
+        reference: receiver.p,
         time,
         u_choice,
         u,
         lambda,
-    )?;
+    })?;
     let (f, transmittance) = reach(ctx, &ls)?;
     Some(LightSampleTerms {
         value: f.value,

@@ -37,7 +37,7 @@ use std::f32::consts::PI;
 
 use glam::{Vec2, Vec3};
 
-use super::{BoundingSphere, Environment, LightBounds, LightSample, LightSource};
+use super::{BoundingSphere, Environment, LightBounds, LightQuery, LightSample, LightSource};
 use crate::geometry::aggregate::AggregateElement;
 use crate::geometry::shape::area_to_solid_angle;
 use crate::geometry::{Primitive, Shape, ShapeGeometry, ShapeSampling, SurfaceSample};
@@ -204,15 +204,15 @@ impl AreaLight {
 }
 
 impl LightSource for AreaLight {
-    fn sample_incident(
-        &self,
-        shapes: &[Primitive],
-        reference: Vec3,
-        time: f32,
-        u_choice: f32,
-        u: Vec2,
-        lambda: &SampledWavelengths,
-    ) -> Option<LightSample> {
+    fn sample_incident(&self, query: LightQuery<'_>) -> Option<LightSample> {
+        let LightQuery {
+            shapes,
+            reference,
+            time,
+            u_choice,
+            u,
+            lambda,
+        } = query;
         let primitive = &shapes[self.shape as usize];
         let s = match self.texture_strategy(primitive) {
             None => primitive.sample_from(reference, time, u_choice, u, self.sampling)?,

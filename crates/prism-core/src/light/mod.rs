@@ -49,18 +49,9 @@ plugin_class! {
     /// What every light answers: how it lights a point, how much it emits, where it is, and
     /// whether rays that leave the scene see it.
     pub trait LightSource {
-        /// Samples light arriving at `reference` at `time` from this light (`shapes`: the
-        /// world's primitives, which area lights are made of); `u_choice` and `u` are the
-        /// random numbers. None where the light sends nothing towards `reference`.
-        fn sample_incident(
-            &self,
-            shapes: &[Primitive],
-            reference: Vec3,
-            time: f32,
-            u_choice: f32,
-            u: Vec2,
-            lambda: &SampledWavelengths,
-        ) -> Option<LightSample>;
+        /// Samples light arriving at the query's point from this light. None where the light
+        /// sends nothing towards it.
+        fn sample_incident(&self, query: LightQuery<'_>) -> Option<LightSample>;
 
         /// Emitted power Φ, summarised as a luminance-weighted scalar (watts weighted by ȳ):
         /// the light sampler chooses lights in proportion to it. Lights at infinity count the
@@ -114,6 +105,25 @@ plugin_class! {
     }
 }
 
+/// What [`LightSource::sample_incident`] is asked, as pbrt-v4's `LightSampleContext` with the
+/// random numbers: the receiving point and the instant, what the light may be made of, and the
+/// numbers to draw the sample with.
+#[derive(Clone, Copy, Debug)]
+pub struct LightQuery<'a> {
+    /// The world's primitives, which area lights are made of.
+    pub shapes: &'a [Primitive],
+    /// The receiving point.
+    pub reference: Vec3,
+    /// The instant, for shapes that move.
+    pub time: f32,
+    /// The random number that chooses among a light's sampling strategies or parts.
+    pub u_choice: f32,
+    /// The random numbers that draw the point or direction.
+    pub u: Vec2,
+    /// The wavelengths the radiance is sampled at.
+    pub lambda: &'a SampledWavelengths,
+}
+
 /// A light at infinity (`directional`, `constant`, `envmap`, `sunsky`): it lights every point
 /// from directions alone, has no place for the light sampler to bound, and is told the scene's
 /// bounding sphere (Mitsuba's `Emitter::set_scene`), beyond which its shadow rays end and
@@ -150,19 +160,11 @@ pub struct DirectionSample {
 
 impl<L: LightAtInfinity> LightSource for L {
     #[inline]
-    fn sample_incident(
-        &self,
-        _shapes: &[Primitive],
-        reference: Vec3,
-        _time: f32,
-        _u_choice: f32,
-        u: Vec2,
-        lambda: &SampledWavelengths,
-    ) -> Option<LightSample> {
-        let s = self.sample_direction(u, lambda)?;
+    fn sample_incident(&self, query: LightQuery<'_>) -> Option<LightSample> {
+        let s = self.sample_direction(query.u, query.lambda)?;
         Some(LightSample::from_infinity(
             self.scene(),
-            reference,
+            query.reference,
             s.wi,
             s.radiance,
             s.pdf,

@@ -13,11 +13,13 @@
 
 use std::f32::consts::PI;
 
-use glam::{Vec2, Vec3};
+use glam::Vec3;
 
-use super::{BoundingSphere, Environment, LightBounds, LightSample, LightSource, towards_point};
+use super::{
+    BoundingSphere, Environment, LightBounds, LightQuery, LightSample, LightSource, towards_point,
+};
 use crate::geometry::Primitive;
-use crate::spectrum::{SampledWavelengths, Spectrum};
+use crate::spectrum::Spectrum;
 
 #[derive(Clone, Debug)]
 pub struct PointLight {
@@ -26,17 +28,9 @@ pub struct PointLight {
 }
 
 impl LightSource for PointLight {
-    fn sample_incident(
-        &self,
-        _shapes: &[Primitive],
-        reference: Vec3,
-        _time: f32,
-        _u_choice: f32,
-        _u: Vec2,
-        lambda: &SampledWavelengths,
-    ) -> Option<LightSample> {
-        let (wi, dist2) = towards_point(self.position, reference)?;
-        let radiance = self.intensity.sample(lambda) * (1.0 / dist2);
+    fn sample_incident(&self, query: LightQuery<'_>) -> Option<LightSample> {
+        let (wi, dist2) = towards_point(self.position, query.reference)?;
+        let radiance = self.intensity.sample(query.lambda) * (1.0 / dist2);
         Some(LightSample::from_point(self.position, wi, radiance))
     }
 

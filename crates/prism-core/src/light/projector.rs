@@ -36,10 +36,9 @@ use std::f32::consts::PI;
 
 use glam::{Vec2, Vec3};
 
-use super::{BoundingSphere, Environment, LightBounds, LightSample, LightSource};
+use super::{BoundingSphere, Environment, LightBounds, LightQuery, LightSample, LightSource};
 use crate::geometry::Primitive;
 use crate::math::Transform;
-use crate::spectrum::SampledWavelengths;
 use crate::texture::Texture;
 use crate::texture::TextureValues;
 
@@ -101,18 +100,10 @@ impl Projector {
 }
 
 impl LightSource for Projector {
-    fn sample_incident(
-        &self,
-        _shapes: &[Primitive],
-        reference: Vec3,
-        _time: f32,
-        _u_choice: f32,
-        _u: Vec2,
-        lambda: &SampledWavelengths,
-    ) -> Option<LightSample> {
-        let local = self.to_world.inverse_point(reference);
+    fn sample_incident(&self, query: LightQuery<'_>) -> Option<LightSample> {
+        let local = self.to_world.inverse_point(query.reference);
         let uv = self.image_uv(local)?;
-        let d = self.position - reference;
+        let d = self.position - query.reference;
         let dist = d.length();
         if !(dist > 0.0) {
             return None;
@@ -122,7 +113,7 @@ impl LightSource for Projector {
         if !(cos_theta > 0.0) {
             return None;
         }
-        let irradiance = self.irradiance.eval(uv, lambda);
+        let irradiance = self.irradiance.eval(uv, query.lambda);
         if irradiance.is_black() {
             return None;
         }

@@ -24,10 +24,12 @@
 
 use glam::{Vec2, Vec3};
 
-use super::{BoundingSphere, Environment, LightBounds, LightSample, LightSource, towards_point};
+use super::{
+    BoundingSphere, Environment, LightBounds, LightQuery, LightSample, LightSource, towards_point,
+};
 use crate::geometry::Primitive;
 use crate::math::Transform;
-use crate::spectrum::{SampledWavelengths, Spectrum};
+use crate::spectrum::Spectrum;
 use crate::texture::Texture;
 use crate::texture::TextureValues;
 
@@ -97,24 +99,16 @@ impl SpotLight {
 }
 
 impl LightSource for SpotLight {
-    fn sample_incident(
-        &self,
-        _shapes: &[Primitive],
-        reference: Vec3,
-        _time: f32,
-        _u_choice: f32,
-        _u: Vec2,
-        lambda: &SampledWavelengths,
-    ) -> Option<LightSample> {
-        let (wi, dist2) = towards_point(self.position, reference)?;
+    fn sample_incident(&self, query: LightQuery<'_>) -> Option<LightSample> {
+        let (wi, dist2) = towards_point(self.position, query.reference)?;
         let local = self.to_world.inverse_vector(-wi);
         let falloff = self.falloff(local);
         if falloff == 0.0 {
             return None;
         }
-        let mut radiance = self.intensity.sample(lambda) * (falloff / dist2);
+        let mut radiance = self.intensity.sample(query.lambda) * (falloff / dist2);
         if let Some(texture) = &self.texture {
-            radiance *= texture.eval(self.texture_uv(local), lambda);
+            radiance *= texture.eval(self.texture_uv(local), query.lambda);
             if radiance.is_black() {
                 return None;
             }
