@@ -36,14 +36,16 @@ pub static SPECTRA: Registry<Build> = Registry {
         Plugin {
             name: "sellmeier",
             origin: Origin::Prism,
-            summary: "A dispersive index of refraction by Sellmeier's formula                       n² = 1 + Σ Bᵢλ²/(λ² − Cᵢ) (λ in µm): a catalogue `glass`, or the coefficients.",
+            summary: "A dispersive index of refraction by Sellmeier's formula \
+                      n² = 1 + Σ Bᵢλ²/(λ² − Cᵢ) (λ in µm): a catalogue `glass`, or the coefficients.",
             params: &[GLASS, B1, B2, B3, C1, C2, C3],
             build: build_sellmeier,
         },
         Plugin {
             name: "cauchy",
             origin: Origin::Prism,
-            summary: "A dispersive index of refraction by Cauchy's formula n = A + B/λ² + C/λ⁴                       (λ in µm).",
+            summary: "A dispersive index of refraction by Cauchy's formula n = A + B/λ² + C/λ⁴ \
+                      (λ in µm).",
             params: &[CAUCHY_A, CAUCHY_B, CAUCHY_C],
             build: build_cauchy,
         },

@@ -25,7 +25,9 @@ pub(super) const CONSTANT: Plugin<Build> = Plugin {
 pub(super) const ENVMAP: Plugin<Build> = Plugin {
     name: "envmap",
     origin: Origin::Mitsuba3,
-    summary: "An environment map: a latitude–longitude image with Mitsuba's orientation                       (+y up, u = 0 looks along −z), pixel-node bilinear lookup and spectral                       upsampling; importance sampled ∝ luminance · sin θ.",
+    summary: "An environment map: a latitude–longitude image with Mitsuba's orientation \
+              (+y up, u = 0 looks along −z), pixel-node bilinear lookup and spectral \
+              upsampling; importance sampled ∝ luminance · sin θ.",
     params: &[ENVMAP_FILENAME, ENVMAP_SCALE, TO_WORLD, SAMPLING_WEIGHT],
     build: |params, _, _| build_envmap(params),
 };

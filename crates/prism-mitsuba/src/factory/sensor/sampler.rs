@@ -45,7 +45,9 @@ pub static SAMPLERS: Registry<SamplerBuild> = Registry {
         Plugin {
             name: "nrooks",
             origin: Origin::Prism,
-            summary: "The lecture's N-rooks sampling: each of the six primary dimensions (wavelength,                       time, film x and y, lens u and v) stratified into N strata, shuffled                       independently.",
+            summary: "The lecture's N-rooks sampling: each of the six primary dimensions (wavelength, \
+                      time, film x and y, lens u and v) stratified into N strata, shuffled \
+                      independently.",
             params: &[SAMPLE_COUNT, SEED],
             build: |_| Ok(SamplerKind::NRooks),
         },
