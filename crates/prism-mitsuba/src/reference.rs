@@ -224,4 +224,24 @@ mod tests {
             }
         }
     }
+
+    /// Summaries and parameter docs are prose on one line: a run of spaces is a broken line
+    /// continuation in a string literal.
+    #[test]
+    fn texts_have_no_runs_of_spaces() {
+        for class in reference() {
+            for plugin in &class.plugins {
+                let texts =
+                    std::iter::once(plugin.summary).chain(plugin.params.iter().map(|p| p.doc));
+                for text in texts {
+                    assert!(
+                        !text.contains("  "),
+                        "{} {}: {text:?}",
+                        class.class.tag(),
+                        plugin.name
+                    );
+                }
+            }
+        }
+    }
 }
