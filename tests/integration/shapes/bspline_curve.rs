@@ -9,7 +9,7 @@ use std::f32::consts::PI;
 use glam::{DVec3, Vec3, Vec4};
 use prism_core::geometry::Shape;
 use prism_core::geometry::aggregate::Aggregate;
-use prism_core::geometry::shape::{BSplineCurve, TriangleMesh};
+use prism_core::geometry::shape::{BSplineCurve, Curve, TriangleMesh};
 use prism_core::math::Ray;
 use prism_core::sampling::rng::Pcg32;
 
@@ -49,7 +49,7 @@ fn a_straight_curve_of_constant_radius_is_an_open_cylinder() {
     assert_eq!(segment, 0);
     assert!((hit.t - 4.5).abs() < 1e-6, "{hit:?}");
     assert!((hit.s - 0.5).abs() < 1e-6, "{hit:?}");
-    let si = curve.segment_interaction(o, -Vec3::X, hit.t, 0, 7);
+    let si = curve.hit_interaction(&ray(o, -Vec3::X), 0, hit.t, 7);
     assert!(si.n.abs_diff_eq(Vec3::X, 1e-6), "{}", si.n);
     assert!(si.p.abs_diff_eq(Vec3::new(0.5, 0.0, 0.5), 1e-6), "{}", si.p);
     assert!(
@@ -73,7 +73,7 @@ fn a_straight_curve_of_constant_radius_is_an_open_cylinder() {
     let (segment, hit) = curve.intersect(o, -Vec3::Y, f32::INFINITY).unwrap();
     assert_eq!(segment, 1);
     assert!((hit.t - 4.5).abs() < 1e-6, "{hit:?}");
-    let si = curve.segment_interaction(o, -Vec3::Y, hit.t, 1, 0);
+    let si = curve.hit_interaction(&ray(o, -Vec3::Y), 1, hit.t, 0);
     assert!(si.n.abs_diff_eq(Vec3::Y, 1e-6), "{}", si.n);
     assert!(
         si.uv.abs_diff_eq(glam::Vec2::new(0.25, 0.6), 1e-6),
@@ -88,7 +88,7 @@ fn a_straight_curve_of_constant_radius_is_an_open_cylinder() {
     // From −y: u = 3/4.
     let o = Vec3::new(0.0, -5.0, 1.2);
     let (_, hit) = curve.intersect(o, Vec3::Y, f32::INFINITY).unwrap();
-    let si = curve.segment_interaction(o, Vec3::Y, hit.t, 1, 0);
+    let si = curve.hit_interaction(&ray(o, Vec3::Y), 1, hit.t, 0);
     assert!((si.uv.x - 0.75).abs() < 1e-6, "{}", si.uv);
     // Oblique: the exact entry into the cylinder x² + y² = 1/4.
     let o = Vec3::new(2.0, 1.0, -0.5);
@@ -177,7 +177,7 @@ fn a_straight_curve_of_linear_radius_is_a_cone_as_in_mitsuba() {
         // The closed form: x = 6 + r(z).
         assert!((hit.t - (10.0 - (0.3 + 0.05 * z))).abs() < 1e-5, "{hit:?}");
         assert!((hit.t - t).abs() < 1e-5, "{hit:?}");
-        let si = curve.segment_interaction(o, -Vec3::X, hit.t, segment as u32, 0);
+        let si = curve.hit_interaction(&ray(o, -Vec3::X), segment as u32, hit.t, 0);
         // The cone's normal: (1, 0, −r′) normalised with r′ = dr/dz = 0.05.
         let n = Vec3::new(1.0, 0.0, -0.05).normalize();
         assert!(si.n.abs_diff_eq(n, 1e-5), "{}", si.n);
@@ -452,7 +452,7 @@ fn the_hierarchy_finds_the_segment_a_brute_force_loop_finds() {
                 assert_eq!(si.primitive, hit.primitive);
                 // A hit named without its segment (as Embree's whole-shape path gives it)
                 // finds the same one.
-                let again = curve.segment_interaction(o, d, h.t, u32::MAX / 2, 0);
+                let again = curve.hit_interaction(&ray(o, d), u32::MAX / 2, h.t, 0);
                 assert_eq!(again.uv, si.uv);
                 hits += 1;
             }

@@ -29,3 +29,13 @@ plugin_class! {
         Orthographic(OrthographicCamera),
     }
 }
+
+/// The film position `film` (pixels of the full film of `film_size`, origin top-left) on the
+/// screen: (1 − 2x/W, 1 − 2y/H), from 1 at the left and top edges to −1 at the right and bottom
+/// (Mitsuba's cameras look along +z with +x to the left), and the film's aspect ratio W/H.
+#[inline]
+pub(crate) fn screen_position(film: Vec2, film_size: Vec2) -> (Vec2, f32) {
+    let ndc = film / film_size;
+    let aspect = film_size.x / film_size.y;
+    (Vec2::new(1.0 - 2.0 * ndc.x, 1.0 - 2.0 * ndc.y), aspect)
+}

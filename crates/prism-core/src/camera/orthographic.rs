@@ -22,7 +22,7 @@
 
 use glam::{Vec2, Vec3};
 
-use super::CameraModel;
+use super::{CameraModel, screen_position};
 use crate::math::{AnimatedTransform, Ray};
 
 #[derive(Clone, Debug)]
@@ -41,13 +41,8 @@ impl CameraModel for OrthographicCamera {
     /// at time `time`.
     #[inline]
     fn generate_ray(&self, film: Vec2, _lens: Vec2, time: f32) -> Ray {
-        let ndc = film / self.film_size;
-        let aspect = self.film_size.x / self.film_size.y;
-        let local = Vec3::new(
-            1.0 - 2.0 * ndc.x,
-            (1.0 - 2.0 * ndc.y) / aspect,
-            self.near_clip,
-        );
+        let (screen, aspect) = screen_position(film, self.film_size);
+        let local = Vec3::new(screen.x, screen.y / aspect, self.near_clip);
         let to_world = self.to_world.at(time);
         let d = to_world.vector(Vec3::Z).normalize();
         Ray::new(

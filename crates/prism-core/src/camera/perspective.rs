@@ -33,7 +33,7 @@
 
 use glam::{Vec2, Vec3};
 
-use super::CameraModel;
+use super::{CameraModel, screen_position};
 use crate::math::{AnimatedTransform, Ray};
 use crate::sampling::warp::sample_uniform_disk_concentric;
 
@@ -107,12 +107,11 @@ impl CameraModel for PerspectiveCamera {
     /// the near plane and ends on the far plane, as in Mitsuba.
     #[inline]
     fn generate_ray(&self, film: Vec2, lens: Vec2, time: f32) -> Ray {
-        let ndc = film / self.film_size;
-        let aspect = self.film_size.x / self.film_size.y;
+        let (screen, aspect) = screen_position(film, self.film_size);
         // The pinhole direction, with z = 1.
         let pinhole = Vec3::new(
-            (1.0 - 2.0 * ndc.x) * self.tan_half_fov_x,
-            (1.0 - 2.0 * ndc.y) * self.tan_half_fov_x / aspect,
+            screen.x * self.tan_half_fov_x,
+            screen.y * self.tan_half_fov_x / aspect,
             1.0,
         );
         let (origin, local) = if self.lens_radius > 0.0 {

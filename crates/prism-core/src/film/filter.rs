@@ -318,6 +318,23 @@ fn sample_tent(u: f32) -> f32 {
     }
 }
 
+/// The filters the tests of filtering and of its importance sampling run over: one of each
+/// smooth kind, with Mitchell–Netravali's recommended (1/3, 1/3), Catmull-Rom's negative lobes
+/// and Lanczos's oscillating ones.
+#[cfg(test)]
+pub(crate) fn filters_under_test() -> [Filter; 5] {
+    [
+        Filter::Tent(TentFilter { radius: 1.0 }),
+        Filter::Gaussian(GaussianFilter { stddev: 0.5 }),
+        Filter::Mitchell(MitchellFilter {
+            b: 1.0 / 3.0,
+            c: 1.0 / 3.0,
+        }),
+        Filter::Mitchell(MitchellFilter { b: 0.0, c: 0.5 }),
+        Filter::Lanczos(LanczosFilter { lobes: 3 }),
+    ]
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -358,16 +375,7 @@ mod tests {
     /// The weights average to 1 (the filter is normalised) within 4 standard errors.
     #[test]
     fn filter_weights_have_unit_mean() {
-        for filter in [
-            Filter::Tent(TentFilter { radius: 1.0 }),
-            Filter::Gaussian(GaussianFilter { stddev: 0.5 }),
-            Filter::Mitchell(MitchellFilter {
-                b: 1.0 / 3.0,
-                c: 1.0 / 3.0,
-            }),
-            Filter::Mitchell(MitchellFilter { b: 0.0, c: 0.5 }),
-            Filter::Lanczos(LanczosFilter { lobes: 3 }),
-        ] {
+        for filter in filters_under_test() {
             let sampler = FilterSampler::new(filter);
             let mut rng = Pcg32::seeded(3);
             let n = 200_000;

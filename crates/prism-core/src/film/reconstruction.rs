@@ -164,7 +164,8 @@ impl FilterMis {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::film::{BoxFilter, GaussianFilter, LanczosFilter, MitchellFilter, TentFilter};
+    use crate::film::filter::filters_under_test;
+    use crate::film::{BoxFilter, TentFilter};
     use crate::sampling::rng::Pcg32;
     use glam::UVec2;
 
@@ -202,15 +203,7 @@ mod tests {
     /// its density are distributed as Dₓ / W (the mixture of the columns' densities).
     #[test]
     fn the_mixture_density_matches_the_samples_of_all_pixels() {
-        for filter in [
-            Filter::Tent(TentFilter { radius: 1.0 }),
-            Filter::Gaussian(GaussianFilter { stddev: 0.5 }),
-            Filter::Mitchell(MitchellFilter {
-                b: 1.0 / 3.0,
-                c: 1.0 / 3.0,
-            }),
-            Filter::Lanczos(LanczosFilter { lobes: 2 }),
-        ] {
+        for filter in filters_under_test() {
             let width = 6u32;
             let mis = FilterMis::new(filter, width, 1);
             let r = filter.radius();

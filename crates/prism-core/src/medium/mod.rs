@@ -89,22 +89,18 @@ plugin_class! {
     }
 }
 
-/// The same σ_t = scale·sigma_t and albedo everywhere.
-#[derive(Clone, Debug)]
-pub struct Homogeneous {
-    pub sigma_t: Spectrum,
-    pub albedo: Spectrum,
-    pub scale: f32,
+/// A medium whose coefficients are the same everywhere: it answers [`MediumModel`] from them,
+/// with its largest σ_t over the wavelengths as the majorant (a tight one, so delta tracking
+/// meets no null collision) and the whole ray as its extent.
+pub trait HomogeneousModel {
+    /// The coefficients, at every point, for the wavelengths `lambda`.
+    fn uniform_coefficients(&self, lambda: &SampledWavelengths) -> MediumCoefficients;
 }
 
-impl MediumModel for Homogeneous {
+impl<M: HomogeneousModel> MediumModel for M {
     #[inline]
     fn coefficients(&self, _p: Vec3, lambda: &SampledWavelengths) -> MediumCoefficients {
-        let sigma_t = self.sigma_t.sample(lambda) * self.scale;
-        MediumCoefficients {
-            sigma_s: sigma_t * self.albedo.sample(lambda),
-            sigma_t,
-        }
+        self.uniform_coefficients(lambda)
     }
 
     fn is_homogeneous(&self) -> bool {
@@ -113,11 +109,30 @@ impl MediumModel for Homogeneous {
 
     #[inline]
     fn majorant(&self, lambda: &SampledWavelengths) -> f32 {
-        self.coefficients(Vec3::ZERO, lambda).sigma_t.max_value()
+        self.uniform_coefficients(lambda).sigma_t.max_value()
     }
 
     fn ray_extent(&self, _ray: &Ray, t_max: f32) -> Option<(f32, f32)> {
         Some((0.0, t_max))
+    }
+}
+
+/// The same σ_t = scale·sigma_t and albedo everywhere.
+#[derive(Clone, Debug)]
+pub struct Homogeneous {
+    pub sigma_t: Spectrum,
+    pub albedo: Spectrum,
+    pub scale: f32,
+}
+
+impl HomogeneousModel for Homogeneous {
+    #[inline]
+    fn uniform_coefficients(&self, lambda: &SampledWavelengths) -> MediumCoefficients {
+        let sigma_t = self.sigma_t.sample(lambda) * self.scale;
+        MediumCoefficients {
+            sigma_s: sigma_t * self.albedo.sample(lambda),
+            sigma_t,
+        }
     }
 }
 
@@ -130,27 +145,14 @@ pub struct HomogeneousAbsorbingScattering {
     pub scale: f32,
 }
 
-impl MediumModel for HomogeneousAbsorbingScattering {
+impl HomogeneousModel for HomogeneousAbsorbingScattering {
     #[inline]
-    fn coefficients(&self, _p: Vec3, lambda: &SampledWavelengths) -> MediumCoefficients {
+    fn uniform_coefficients(&self, lambda: &SampledWavelengths) -> MediumCoefficients {
         let sigma_s = self.sigma_s.sample(lambda) * self.scale;
         MediumCoefficients {
             sigma_t: self.sigma_a.sample(lambda) * self.scale + sigma_s,
             sigma_s,
         }
-    }
-
-    fn is_homogeneous(&self) -> bool {
-        true
-    }
-
-    #[inline]
-    fn majorant(&self, lambda: &SampledWavelengths) -> f32 {
-        self.coefficients(Vec3::ZERO, lambda).sigma_t.max_value()
-    }
-
-    fn ray_extent(&self, _ray: &Ray, t_max: f32) -> Option<(f32, f32)> {
-        Some((0.0, t_max))
     }
 }
 

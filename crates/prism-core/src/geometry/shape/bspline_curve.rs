@@ -29,10 +29,11 @@ use std::f64::consts::TAU;
 
 use glam::{DVec3, DVec4, Vec2, Vec3, Vec4};
 
+pub use super::curve::SegmentHit;
+use super::curve::nearest_hit;
 use super::linear_curve::local_frame;
-use super::{Segments, ShapeGeometry, SolidAngleSampler, SurfaceSample};
+use super::{Curve, Segments};
 use crate::geometry::interaction::{AttributeValues, SurfaceInteraction};
-use crate::geometry::triangle::TriangleHit;
 use crate::math::Frame;
 use crate::math::Ray;
 
@@ -51,14 +52,6 @@ pub struct BSplineCurve {
     segments: Vec<[Vec4; 4]>,
     /// Per segment: whether it starts a curve and whether it ends one (open ends).
     ends: Vec<(bool, bool)>,
-}
-
-/// A segment hit: the distance along the ray and the parameter s in [0, 1] of its cross
-/// section.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct SegmentHit {
-    pub t: f32,
-    pub s: f32,
 }
 
 /// The centre-line of a segment and its derivatives at a parameter, in double precision.
@@ -189,75 +182,9 @@ impl BSplineCurve {
 
     /// The nearest hit in (0, t_max) over all segments, with its segment.
     pub fn intersect(&self, o: Vec3, d: Vec3, t_max: f32) -> Option<(usize, SegmentHit)> {
-        let mut best: Option<(usize, SegmentHit)> = None;
-        for i in 0..self.segments.len() {
-            let limit = best.map_or(t_max, |(_, h)| h.t);
-            if let Some(hit) = self.intersect_segment(i, o, d, limit) {
-                best = Some((i, hit));
-            }
-        }
-        best
-    }
-
-    /// The surface interaction of a hit at distance `t` on segment `segment` (its parameter is
-    /// found again by intersecting the segment; a hit from a structure that intersects the
-    /// curves as a whole and names no segment is found on all of them).
-    pub fn segment_interaction(
-        &self,
-        o: Vec3,
-        d: Vec3,
-        t: f32,
-        segment: u32,
-        shape: u32,
-    ) -> SurfaceInteraction {
-        let near = |h: &SegmentHit| (h.t - t).abs() <= 1e-4 * t.abs().max(1e-3);
-        let named = ((segment as usize) < self.segments.len())
-            .then(|| self.intersect_segment(segment as usize, o, d, f32::INFINITY))
-            .flatten()
-            .filter(near);
-        let (i, s) = match named {
-            Some(hit) => (segment as usize, hit.s),
-            None => (0..self.segments.len())
-                .filter_map(|i| {
-                    let hit = self.intersect_segment(i, o, d, f32::INFINITY)?;
-                    Some((i, hit))
-                })
-                .min_by(|a, b| (a.1.t - t).abs().total_cmp(&(b.1.t - t).abs()))
-                .map_or((0, 0.5), |(i, hit)| (i, hit.s)),
-        };
-        let curve = self.relative(i, Vec3::ZERO);
-        let at = curve.eval(f64::from(s));
-        let tangent = at.dc.normalize_or(DVec3::Z);
-        let p = (o + d * t).as_dvec3();
-        let offset = p - at.c;
-        let radial =
-            (offset - tangent * offset.dot(tangent)).normalize_or(tangent.any_orthonormal_vector());
-        let n = normal(&at, offset).normalize_or(radial);
-        let (u_rot, u_rad) = local_frame(tangent);
-        let mut phi = radial.dot(u_rot).atan2(radial.dot(u_rad));
-        if phi < 0.0 {
-            phi += TAU;
-        }
-        let count = self.segments.len() as f64;
-        let dp_du = (TAU * at.r * tangent.cross(radial)).as_vec3();
-        let dp_dv = (count * (at.dc + at.dr * radial)).as_vec3();
-        let n = n.as_vec3();
-        SurfaceInteraction {
-            p: (at.c + radial * at.r).as_vec3(),
-            t,
-            n,
-            shading: Frame::from_normal_and_tangent(n, dp_du),
-            uv: Vec2::new(
-                (phi / TAU) as f32,
-                ((f64::from(s) + i as f64) / count) as f32,
-            ),
-            dp_du,
-            dp_dv,
-            shape,
-            primitive: i as u32,
-            time: 0.0,
-            attributes: AttributeValues::default(),
-        }
+        nearest_hit(self.segments.len(), t_max, |i, limit| {
+            self.intersect_segment(i, o, d, limit)
+        })
     }
 }
 
@@ -467,59 +394,67 @@ fn cone_hits(d: DVec3, a: DVec3, ra: f64, b: DVec3, rb: f64) -> [Option<(f64, f6
     })
 }
 
-impl ShapeGeometry for BSplineCurve {
-    /// Mitsuba gives curves no area or sampling: they cannot be area lights.
-    fn area(&self) -> f32 {
-        0.0
+impl Curve for BSplineCurve {
+    fn segments(&self) -> Segments<'_> {
+        Segments::BSpline(self)
     }
 
-    /// The bounds of all segments.
-    fn object_bounds(&self) -> (Vec3, Vec3) {
-        (0..self.segments.len())
-            .map(|i| self.segment_bounds(i))
-            .fold(
-                (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
-                |(lo, hi), (l, h)| (lo.min(l), hi.max(h)),
-            )
-    }
-
-    fn as_segments(&self) -> Option<Segments<'_>> {
-        Some(Segments::BSpline(self))
-    }
-
-    fn intersect_analytic(&self, ray: &Ray, t_max: f32) -> Option<f32> {
-        self.intersect(ray.o, ray.d, t_max).map(|(_, hit)| hit.t)
-    }
-
-    fn interaction(
-        &self,
-        ray: &Ray,
-        primitive: u32,
-        hit: &TriangleHit,
-        index: u32,
-    ) -> SurfaceInteraction {
-        // Finds its segment again itself when the named one was not hit.
-        self.segment_interaction(ray.o, ray.d, hit.t, primitive, index)
-    }
-
-    fn sample_area(&self, _u_choice: f32, _u: Vec2) -> Option<SurfaceSample> {
-        None
-    }
-
-    fn solid_angle_sampler(&self, _reference: Vec3) -> Option<SolidAngleSampler<'_>> {
-        None
-    }
-
-    fn at_uv(&self, _uv: Vec2) -> Option<(SurfaceSample, f32)> {
-        None
-    }
-
-    fn uv_jacobian_at(&self, _primitive: u32, _uv: Vec2) -> Option<f32> {
-        None
+    /// The segment's parameter is found again by intersecting the segment; a hit that names no
+    /// segment the ray meets at `t` is found on all of them.
+    fn hit_interaction(&self, ray: &Ray, segment: u32, t: f32, index: u32) -> SurfaceInteraction {
+        let (o, d) = (ray.o, ray.d);
+        let near = |h: &SegmentHit| (h.t - t).abs() <= 1e-4 * t.abs().max(1e-3);
+        let named = ((segment as usize) < self.segments.len())
+            .then(|| self.intersect_segment(segment as usize, o, d, f32::INFINITY))
+            .flatten()
+            .filter(near);
+        let (i, s) = match named {
+            Some(hit) => (segment as usize, hit.s),
+            None => (0..self.segments.len())
+                .filter_map(|i| {
+                    let hit = self.intersect_segment(i, o, d, f32::INFINITY)?;
+                    Some((i, hit))
+                })
+                .min_by(|a, b| (a.1.t - t).abs().total_cmp(&(b.1.t - t).abs()))
+                .map_or((0, 0.5), |(i, hit)| (i, hit.s)),
+        };
+        let curve = self.relative(i, Vec3::ZERO);
+        let at = curve.eval(f64::from(s));
+        let tangent = at.dc.normalize_or(DVec3::Z);
+        let p = (o + d * t).as_dvec3();
+        let offset = p - at.c;
+        let radial =
+            (offset - tangent * offset.dot(tangent)).normalize_or(tangent.any_orthonormal_vector());
+        let n = normal(&at, offset).normalize_or(radial);
+        let (u_rot, u_rad) = local_frame(tangent);
+        let mut phi = radial.dot(u_rot).atan2(radial.dot(u_rad));
+        if phi < 0.0 {
+            phi += TAU;
+        }
+        let count = self.segments.len() as f64;
+        let dp_du = (TAU * at.r * tangent.cross(radial)).as_vec3();
+        let dp_dv = (count * (at.dc + at.dr * radial)).as_vec3();
+        let n = n.as_vec3();
+        SurfaceInteraction {
+            p: (at.c + radial * at.r).as_vec3(),
+            t,
+            n,
+            shading: Frame::from_normal_and_tangent(n, dp_du),
+            uv: Vec2::new(
+                (phi / TAU) as f32,
+                ((f64::from(s) + i as f64) / count) as f32,
+            ),
+            dp_du,
+            dp_dv,
+            shape: index,
+            primitive: i as u32,
+            time: 0.0,
+            attributes: AttributeValues::default(),
+        }
     }
 
     /// Bytes of heap memory of the segments.
-    fn heap_bytes(&self) -> usize {
+    fn storage_bytes(&self) -> usize {
         self.segments.capacity() * std::mem::size_of::<[Vec4; 4]>()
             + self.ends.capacity() * std::mem::size_of::<(bool, bool)>()
     }

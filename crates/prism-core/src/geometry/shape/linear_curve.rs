@@ -17,9 +17,10 @@ use std::f32::consts::PI;
 
 use glam::{DVec3, Vec2, Vec3, Vec4};
 
-use super::{Segments, ShapeGeometry, SolidAngleSampler, SurfaceSample};
+pub use super::curve::SegmentHit;
+use super::curve::nearest_hit;
+use super::{Curve, Segments};
 use crate::geometry::interaction::{AttributeValues, SurfaceInteraction};
-use crate::geometry::triangle::TriangleHit;
 use crate::math::Frame;
 use crate::math::Ray;
 
@@ -30,13 +31,6 @@ pub struct LinearCurve {
     points: Vec<Vec4>,
     /// The first control point of each segment (the segment runs to the next point).
     segments: Vec<u32>,
-}
-
-/// A segment hit: the distance along the ray and the sweep parameter s in [0, 1] of the point.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct SegmentHit {
-    pub t: f32,
-    pub s: f32,
 }
 
 impl LinearCurve {
@@ -93,14 +87,9 @@ impl LinearCurve {
 
     /// The nearest hit in (0, t_max) over all segments, with its segment.
     pub fn intersect(&self, o: Vec3, d: Vec3, t_max: f32) -> Option<(usize, SegmentHit)> {
-        let mut best: Option<(usize, SegmentHit)> = None;
-        for i in 0..self.segments.len() {
-            let limit = best.map_or(t_max, |(_, h)| h.t);
-            if let Some(hit) = self.intersect_segment(i, o, d, limit) {
-                best = Some((i, hit));
-            }
-        }
-        best
+        nearest_hit(self.segments.len(), t_max, |i, limit| {
+            self.intersect_segment(i, o, d, limit)
+        })
     }
 
     /// The surface interaction of a hit on segment `segment` at distance `t` (its sweep
@@ -282,70 +271,28 @@ fn round_cone_entry(
     Some((t, sweep_parameter(o + d * t, a, ra, b, rb)))
 }
 
-impl ShapeGeometry for LinearCurve {
-    /// Mitsuba gives curves no area or sampling: they cannot be area lights.
-    fn area(&self) -> f32 {
-        0.0
+impl Curve for LinearCurve {
+    fn segments(&self) -> Segments<'_> {
+        Segments::Linear(self)
     }
 
-    /// The bounds of all control-point spheres.
-    fn object_bounds(&self) -> (Vec3, Vec3) {
-        (0..self.segments.len())
-            .map(|i| self.segment_bounds(i))
-            .fold(
-                (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
-                |(lo, hi), (l, h)| (lo.min(l), hi.max(h)),
-            )
-    }
-
-    fn as_segments(&self) -> Option<Segments<'_>> {
-        Some(Segments::Linear(self))
-    }
-
-    fn intersect_analytic(&self, ray: &Ray, t_max: f32) -> Option<f32> {
-        self.intersect(ray.o, ray.d, t_max).map(|(_, hit)| hit.t)
-    }
-
-    fn interaction(
-        &self,
-        ray: &Ray,
-        primitive: u32,
-        hit: &TriangleHit,
-        index: u32,
-    ) -> SurfaceInteraction {
-        // A structure that intersects the curve as a whole (Embree's, through
-        // `intersect_analytic`) does not name the segment: find it again.
+    /// The segment named, if the ray hits it at `t`; else the one the ray hits first.
+    fn hit_interaction(&self, ray: &Ray, segment: u32, t: f32, index: u32) -> SurfaceInteraction {
         let (o, d) = (ray.o, ray.d);
         let named = self
-            .intersect_segment(primitive as usize, o, d, f32::INFINITY)
-            .is_some_and(|h| h.t == hit.t);
+            .intersect_segment(segment as usize, o, d, f32::INFINITY)
+            .is_some_and(|h| h.t == t);
         let segment = if named {
-            primitive
+            segment
         } else {
             self.intersect(o, d, f32::INFINITY)
-                .map_or(primitive, |(segment, _)| segment as u32)
+                .map_or(segment, |(found, _)| found as u32)
         };
-        self.segment_interaction(o, d, hit.t, segment, index)
-    }
-
-    fn sample_area(&self, _u_choice: f32, _u: Vec2) -> Option<SurfaceSample> {
-        None
-    }
-
-    fn solid_angle_sampler(&self, _reference: Vec3) -> Option<SolidAngleSampler<'_>> {
-        None
-    }
-
-    fn at_uv(&self, _uv: Vec2) -> Option<(SurfaceSample, f32)> {
-        None
-    }
-
-    fn uv_jacobian_at(&self, _primitive: u32, _uv: Vec2) -> Option<f32> {
-        None
+        self.segment_interaction(o, d, t, segment, index)
     }
 
     /// Bytes of heap memory of the control points and segment indices.
-    fn heap_bytes(&self) -> usize {
+    fn storage_bytes(&self) -> usize {
         self.points.capacity() * std::mem::size_of::<Vec4>()
             + self.segments.capacity() * std::mem::size_of::<u32>()
     }

@@ -6,6 +6,7 @@
 //! ([`super::aggregate`]) and the shapes placed by transforms ([`super::primitive`]) sit above.
 
 pub mod bspline_curve;
+pub mod curve;
 pub mod cylinder;
 pub mod disk;
 pub mod linear_curve;
@@ -16,6 +17,7 @@ pub mod uv_grid;
 use glam::{Vec2, Vec3};
 
 pub use bspline_curve::BSplineCurve;
+pub use curve::Curve;
 pub use cylinder::Cylinder;
 pub use disk::Disk;
 pub use linear_curve::LinearCurve;
