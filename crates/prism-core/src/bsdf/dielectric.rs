@@ -34,8 +34,7 @@ use crate::texture::{Texture, TexturePoint};
 pub struct Dielectric {
     /// η = n_interior / n_exterior.
     pub eta: RelativeIor,
-    pub specular_reflectance: Option<Texture>,
-    pub specular_transmittance: Option<Texture>,
+    pub specular: SpecularFactorTextures,
 }
 
 /// An optional factor evaluated at a point: 1 when absent.
@@ -59,17 +58,19 @@ pub struct SpecularFactors {
     pub transmittance: SampledSpectrum,
 }
 
-impl SpecularFactors {
+/// The textures of a dielectric's [`SpecularFactors`], each optional.
+#[derive(Clone, Debug)]
+pub struct SpecularFactorTextures {
+    pub reflectance: Option<Texture>,
+    pub transmittance: Option<Texture>,
+}
+
+impl SpecularFactorTextures {
     #[inline]
-    pub fn at(
-        reflectance: &Option<Texture>,
-        transmittance: &Option<Texture>,
-        at: TexturePoint,
-        lambda: &SampledWavelengths,
-    ) -> SpecularFactors {
+    pub fn at(&self, at: TexturePoint, lambda: &SampledWavelengths) -> SpecularFactors {
         SpecularFactors {
-            reflectance: optional_factor(reflectance, at, lambda),
-            transmittance: optional_factor(transmittance, at, lambda),
+            reflectance: optional_factor(&self.reflectance, at, lambda),
+            transmittance: optional_factor(&self.transmittance, at, lambda),
         }
     }
 }
@@ -117,12 +118,7 @@ impl LeafBsdf for Dielectric {
     fn lobes(&self, at: TexturePoint, lambda: &SampledWavelengths) -> DielectricLobes {
         DielectricLobes {
             eta: SampledIor::at(&self.eta, lambda),
-            specular: SpecularFactors::at(
-                &self.specular_reflectance,
-                &self.specular_transmittance,
-                at,
-                lambda,
-            ),
+            specular: self.specular.at(at, lambda),
         }
     }
 }

@@ -31,7 +31,7 @@ use glam::{Vec2, Vec3};
 
 use super::dielectric::optional_factor;
 use super::fresnel::{fresnel_dielectric, reflect};
-use super::glossydiffuse::GlossyDiffuseLobes;
+use super::glossydiffuse::{GLOSSY_OVER_DIFFUSE, GlossyDiffuseLobes};
 use super::microfacet::{Microfacet, MicrofacetKind};
 use super::{BsdfFlags, LeafBsdf, choice_probability};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
@@ -52,9 +52,7 @@ pub struct PolarizedPlastic {
 
 impl LeafBsdf for PolarizedPlastic {
     type Lobes<'a> = PolarizedPlasticLobes;
-    const FLAGS: BsdfFlags = BsdfFlags::GLOSSY
-        .union(BsdfFlags::DIFFUSE)
-        .union(BsdfFlags::REFLECTION);
+    const FLAGS: BsdfFlags = GLOSSY_OVER_DIFFUSE;
 
     /// The diffuse reflectance of the base.
     fn albedo(&self, at: TexturePoint, lambda: &SampledWavelengths) -> SampledSpectrum {

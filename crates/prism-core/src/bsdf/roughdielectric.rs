@@ -25,7 +25,7 @@
 
 use glam::{Vec2, Vec3};
 
-use super::dielectric::SpecularFactors;
+use super::dielectric::{SpecularFactorTextures, SpecularFactors};
 use super::fresnel::{fresnel_dielectric, reflect, refract};
 use super::microfacet::{Microfacet, MicrofacetKind};
 use super::{BsdfEval, BsdfFlags, BsdfSample, Bxdf, BxdfTree, LeafBsdf};
@@ -41,8 +41,7 @@ pub struct RoughDielectric {
     pub distribution: MicrofacetKind,
     pub alpha_u: Texture,
     pub alpha_v: Texture,
-    pub specular_reflectance: Option<Texture>,
-    pub specular_transmittance: Option<Texture>,
+    pub specular: SpecularFactorTextures,
 }
 
 /// No diffuse reflectance: only glossy lobes (Mitsuba 3 evaluates the BSDF towards the normal
@@ -67,12 +66,7 @@ impl LeafBsdf for RoughDielectric {
                 self.alpha_u.eval_1(at),
                 self.alpha_v.eval_1(at),
             ),
-            specular: SpecularFactors::at(
-                &self.specular_reflectance,
-                &self.specular_transmittance,
-                at,
-                lambda,
-            ),
+            specular: self.specular.at(at, lambda),
         }
     }
 }

@@ -17,19 +17,17 @@
 
 use glam::{Vec2, Vec3};
 
-use super::dielectric::{SampledIor, SpecularFactors};
+use super::dielectric::{SampledIor, SpecularFactorTextures, SpecularFactors};
 use super::fresnel::{fresnel_dielectric, reflect_z};
 use super::{BsdfFlags, BsdfSample, Bxdf, BxdfTree, LeafBsdf};
 use crate::spectrum::ior::RelativeIor;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
-use crate::texture::Texture;
 use crate::texture::TexturePoint;
 
 #[derive(Clone, Debug)]
 pub struct ThinDielectric {
     pub eta: RelativeIor,
-    pub specular_reflectance: Option<Texture>,
-    pub specular_transmittance: Option<Texture>,
+    pub specular: SpecularFactorTextures,
 }
 
 /// Not dispersive: the pane does not bend light, so a dispersive index changes only how much
@@ -44,12 +42,7 @@ impl LeafBsdf for ThinDielectric {
     fn lobes(&self, at: TexturePoint, lambda: &SampledWavelengths) -> ThinDielectricLobes {
         ThinDielectricLobes {
             eta: SampledIor::at(&self.eta, lambda),
-            specular: SpecularFactors::at(
-                &self.specular_reflectance,
-                &self.specular_transmittance,
-                at,
-                lambda,
-            ),
+            specular: self.specular.at(at, lambda),
         }
     }
 }
