@@ -32,7 +32,7 @@ use glam::{Vec2, Vec3};
 use super::dielectric::optional_factor;
 use super::fresnel::{fresnel_dielectric, reflect};
 use super::glossydiffuse::{GLOSSY_OVER_DIFFUSE, GlossyDiffuseLobes};
-use super::microfacet::{Microfacet, MicrofacetKind};
+use super::microfacet::{Microfacet, MicrofacetRoughness};
 use super::{BsdfFlags, LeafBsdf, choice_probability};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use crate::texture::Texture;
@@ -43,9 +43,7 @@ use crate::texture::TextureValues;
 pub struct PolarizedPlastic {
     /// The relative index η = int_ior / ext_ior.
     pub eta: f32,
-    pub distribution: MicrofacetKind,
-    pub alpha_u: Texture,
-    pub alpha_v: Texture,
+    pub roughness: MicrofacetRoughness,
     pub diffuse_reflectance: Texture,
     pub specular_reflectance: Option<Texture>,
 }
@@ -66,11 +64,7 @@ impl LeafBsdf for PolarizedPlastic {
         let (s, d) = (specular.average(), diffuse.average());
         PolarizedPlasticLobes {
             eta: self.eta,
-            distribution: Microfacet::new(
-                self.distribution,
-                self.alpha_u.eval_1(at),
-                self.alpha_v.eval_1(at),
-            ),
+            distribution: self.roughness.at(at),
             diffuse,
             specular,
             p_specular: choice_probability(s, d),

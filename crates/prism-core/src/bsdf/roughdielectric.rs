@@ -27,20 +27,16 @@ use glam::{Vec2, Vec3};
 
 use super::dielectric::{SpecularFactorTextures, SpecularFactors};
 use super::fresnel::{fresnel_dielectric, reflect, refract};
-use super::microfacet::{Microfacet, MicrofacetKind};
+use super::microfacet::{Microfacet, MicrofacetRoughness};
 use super::{BsdfEval, BsdfFlags, BsdfSample, Bxdf, BxdfTree, LeafBsdf};
 use crate::spectrum::ior::RelativeIor;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
-use crate::texture::Texture;
 use crate::texture::TexturePoint;
-use crate::texture::TextureValues;
 
 #[derive(Clone, Debug)]
 pub struct RoughDielectric {
     pub eta: RelativeIor,
-    pub distribution: MicrofacetKind,
-    pub alpha_u: Texture,
-    pub alpha_v: Texture,
+    pub roughness: MicrofacetRoughness,
     pub specular: SpecularFactorTextures,
 }
 
@@ -61,11 +57,7 @@ impl LeafBsdf for RoughDielectric {
         RoughDielectricLobes {
             eta_hero: self.eta.at(lambda.lambda(0)),
             dispersive: self.eta.is_dispersive(),
-            distribution: Microfacet::new(
-                self.distribution,
-                self.alpha_u.eval_1(at),
-                self.alpha_v.eval_1(at),
-            ),
+            distribution: self.roughness.at(at),
             specular: self.specular.at(at, lambda),
         }
     }

@@ -36,12 +36,10 @@ pub(super) const ROUGHDIELECTRIC: Plugin<Build> = Plugin {
     ],
     build: |params, t| {
         let eta = relative_ior(params, &INT_IOR, true)?;
-        let (distribution, alpha_u, alpha_v) = roughness(params, t)?;
+        let roughness = roughness(params, t)?;
         Ok(Bsdf::RoughDielectric(RoughDielectric {
             eta,
-            distribution,
-            alpha_u,
-            alpha_v,
+            roughness,
             specular: specular_factors(params, t)?,
         }))
     },
