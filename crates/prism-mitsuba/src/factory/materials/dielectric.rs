@@ -6,7 +6,7 @@ use super::{Build, SPECULAR_REFLECTANCE, colour};
 use crate::factory::textures::{TextureCache, optional_spectrum_texture};
 use crate::params::Params;
 use crate::registry::{Origin, ParamSpec, Plugin, Range, params};
-use prism_core::bsdf::dielectric::SpecularFactorTextures;
+use prism_core::bsdf::dielectric::{SmoothInterface, SpecularFactorTextures};
 use prism_core::bsdf::{Bsdf, Dielectric, RoughDielectric, ThinDielectric};
 use prism_core::error::Result;
 
@@ -18,8 +18,7 @@ pub(super) const DIELECTRIC: Plugin<Build> = Plugin {
     params: SMOOTH_INTERFACE,
     build: |params, t| {
         Ok(Bsdf::Dielectric(Dielectric {
-            eta: relative_ior(params, &INT_IOR, false)?,
-            specular: specular_factors(params, t)?,
+            interface: smooth_interface(params, t)?,
         }))
     },
 };
@@ -53,8 +52,7 @@ pub(super) const THINDIELECTRIC: Plugin<Build> = Plugin {
     params: SMOOTH_INTERFACE,
     build: |params, t| {
         Ok(Bsdf::ThinDielectric(ThinDielectric {
-            eta: relative_ior(params, &INT_IOR, false)?,
-            specular: specular_factors(params, t)?,
+            interface: smooth_interface(params, t)?,
         }))
     },
 };
@@ -70,6 +68,14 @@ const SMOOTH_INTERFACE: &[ParamSpec] = &[
     SPECULAR_REFLECTANCE,
     SPECULAR_TRANSMITTANCE,
 ];
+
+/// The relative index and the specular factors of a smooth interface.
+fn smooth_interface(params: &Params, t: &mut TextureCache) -> Result<SmoothInterface> {
+    Ok(SmoothInterface {
+        eta: relative_ior(params, &INT_IOR, false)?,
+        specular: specular_factors(params, t)?,
+    })
+}
 
 /// The optional factors on an interface's reflection and transmission.
 fn specular_factors(params: &Params, t: &mut TextureCache) -> Result<SpecularFactorTextures> {
