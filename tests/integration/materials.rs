@@ -406,8 +406,8 @@ fn textures_vary_with_uv() {
     let Bsdf::RoughConductor(rc) = &referenced else {
         panic!()
     };
-    assert_eq!(rc.alpha_u.eval_1(Vec2::new(0.1, 0.1)), 0.2);
-    assert_eq!(rc.alpha_v.eval_1(Vec2::new(0.7, 0.1)), 0.3);
+    assert_eq!(rc.roughness.alpha_u.eval_1(Vec2::new(0.1, 0.1)), 0.2);
+    assert_eq!(rc.roughness.alpha_v.eval_1(Vec2::new(0.7, 0.1)), 0.3);
 
     // A 2 × 1 PNG, left texel grey, right texel red: decoded to linear and upsampled.
     let dir = temp_dir("bitmap");
@@ -629,7 +629,7 @@ fn rawconstant_is_not_upsampled() {
     let Bsdf::RoughConductor(rc) = &bsdf else {
         panic!()
     };
-    assert_eq!(rc.alpha_u.eval_1(Vec2::ZERO), 0.3);
+    assert_eq!(rc.roughness.alpha_u.eval_1(Vec2::ZERO), 0.3);
     let lambda = wavelengths();
     assert_eq!(
         rc.specular_reflectance.eval(Vec2::ZERO, &lambda).0,

@@ -21,8 +21,8 @@
 
 use glam::Vec3;
 
-use super::perturbed::{Tilt, resolve_perturbed};
-use super::{Adapter, Bsdf, BsdfFlags, BxdfTree, NodeId, ResolveContext, ShadingPoint};
+use super::ShadingPoint;
+use super::perturbed::{Perturbation, Perturbed};
 use crate::texture::Texture;
 use crate::texture::TextureValues;
 
@@ -30,15 +30,17 @@ use crate::texture::TextureValues;
 pub struct BumpMap {
     pub height: Texture,
     pub scale: f32,
-    pub nested: Box<Bsdf>,
-    pub flip_invalid_normals: bool,
-    pub use_shadowing_function: bool,
+    pub perturbed: Perturbed,
 }
 
-impl BumpMap {
-    /// The bump-mapped normal in the local shading frame (not normalised).
+impl Perturbation for BumpMap {
+    fn perturbed(&self) -> &Perturbed {
+        &self.perturbed
+    }
+
+    /// The bump-mapped normal.
     #[inline]
-    fn perturbed_normal(&self, sp: &ShadingPoint) -> Vec3 {
+    fn normal(&self, sp: &ShadingPoint) -> Vec3 {
         let gradient = self.height.eval_1_grad(sp.at()) * self.scale;
         let n = sp.frame.n;
         let dp_du = sp.dp_du + n * (gradient.x - n.dot(sp.dp_du));
@@ -50,23 +52,5 @@ impl BumpMap {
             normal
         };
         sp.frame.to_local(normal)
-    }
-}
-
-impl Adapter for BumpMap {
-    const OWN_FLAGS: BsdfFlags = BsdfFlags::NONE;
-
-    fn nested(&self) -> &[Box<Bsdf>] {
-        std::slice::from_ref(&self.nested)
-    }
-
-    #[inline]
-    fn resolve<'a>(&'a self, context: &ResolveContext, tree: &mut BxdfTree<'a>) -> NodeId {
-        let tilt = Tilt {
-            normal: self.perturbed_normal(context.point),
-            flip_invalid_normals: self.flip_invalid_normals,
-            use_shadowing_function: self.use_shadowing_function,
-        };
-        resolve_perturbed(&self.nested, tilt, context, tree)
     }
 }

@@ -32,10 +32,32 @@ use crate::texture::{Texture, TexturePoint};
 
 #[derive(Clone, Debug)]
 pub struct Dielectric {
+    pub interface: SmoothInterface,
+}
+
+/// A smooth interface between two dielectrics as `dielectric` and `thindielectric` describe it.
+#[derive(Clone, Debug)]
+pub struct SmoothInterface {
     /// η = n_interior / n_exterior.
     pub eta: RelativeIor,
-    pub specular_reflectance: Option<Texture>,
-    pub specular_transmittance: Option<Texture>,
+    pub specular: SpecularFactorTextures,
+}
+
+/// A [`SmoothInterface`] at a point, for a path's wavelengths.
+#[derive(Clone, Copy, Debug)]
+pub struct SmoothInterfaceAt {
+    pub eta: SampledIor,
+    pub specular: SpecularFactors,
+}
+
+impl SmoothInterface {
+    #[inline]
+    pub fn at(&self, at: TexturePoint, lambda: &SampledWavelengths) -> SmoothInterfaceAt {
+        SmoothInterfaceAt {
+            eta: SampledIor::at(&self.eta, lambda),
+            specular: self.specular.at(at, lambda),
+        }
+    }
 }
 
 /// An optional factor evaluated at a point: 1 when absent.
@@ -59,17 +81,19 @@ pub struct SpecularFactors {
     pub transmittance: SampledSpectrum,
 }
 
-impl SpecularFactors {
+/// The textures of a dielectric's [`SpecularFactors`], each optional.
+#[derive(Clone, Debug)]
+pub struct SpecularFactorTextures {
+    pub reflectance: Option<Texture>,
+    pub transmittance: Option<Texture>,
+}
+
+impl SpecularFactorTextures {
     #[inline]
-    pub fn at(
-        reflectance: &Option<Texture>,
-        transmittance: &Option<Texture>,
-        at: TexturePoint,
-        lambda: &SampledWavelengths,
-    ) -> SpecularFactors {
+    pub fn at(&self, at: TexturePoint, lambda: &SampledWavelengths) -> SpecularFactors {
         SpecularFactors {
-            reflectance: optional_factor(reflectance, at, lambda),
-            transmittance: optional_factor(transmittance, at, lambda),
+            reflectance: optional_factor(&self.reflectance, at, lambda),
+            transmittance: optional_factor(&self.transmittance, at, lambda),
         }
     }
 }
@@ -110,19 +134,13 @@ impl LeafBsdf for Dielectric {
         .union(BsdfFlags::TRANSMISSION);
 
     fn is_dispersive(&self) -> bool {
-        self.eta.is_dispersive()
+        self.interface.eta.is_dispersive()
     }
 
     #[inline]
     fn lobes(&self, at: TexturePoint, lambda: &SampledWavelengths) -> DielectricLobes {
         DielectricLobes {
-            eta: SampledIor::at(&self.eta, lambda),
-            specular: SpecularFactors::at(
-                &self.specular_reflectance,
-                &self.specular_transmittance,
-                at,
-                lambda,
-            ),
+            interface: self.interface.at(at, lambda),
         }
     }
 }
@@ -130,8 +148,7 @@ impl LeafBsdf for Dielectric {
 /// The reflected and refracted lobes at a point.
 #[derive(Clone, Copy, Debug)]
 pub struct DielectricLobes {
-    pub eta: SampledIor,
-    pub specular: SpecularFactors,
+    pub interface: SmoothInterfaceAt,
 }
 
 impl Bxdf for DielectricLobes {
@@ -140,10 +157,12 @@ impl Bxdf for DielectricLobes {
         if cos_o == 0.0 || !cos_o.is_finite() {
             return None;
         }
-        let hero = fresnel_dielectric(cos_o, self.eta.hero());
-        let dispersive = self.eta.dispersive;
+        let hero = fresnel_dielectric(cos_o, self.interface.eta.hero());
+        let dispersive = self.interface.eta.dispersive;
         let reflectance = if dispersive {
-            SampledSpectrum::from_fn(|i| fresnel_dielectric(cos_o, self.eta.eta[i]).reflectance)
+            SampledSpectrum::from_fn(|i| {
+                fresnel_dielectric(cos_o, self.interface.eta.eta[i]).reflectance
+            })
         } else {
             SampledSpectrum::splat(hero.reflectance)
         };
@@ -153,7 +172,7 @@ impl Bxdf for DielectricLobes {
             hero.reflectance
         };
         if u_lobe < p_reflect {
-            let weight = reflectance * (1.0 / p_reflect) * self.specular.reflectance;
+            let weight = reflectance * (1.0 / p_reflect) * self.interface.specular.reflectance;
             return Some(BsdfSample::new(
                 reflect_z(wo),
                 weight,
@@ -168,7 +187,7 @@ impl Bxdf for DielectricLobes {
         let p_transmit = 1.0 - p_reflect;
         let transmittance = (SampledSpectrum::ONE - reflectance) * (1.0 / p_transmit);
         let radiance_scale = hero.eta_ti * hero.eta_ti;
-        let weight = transmittance * radiance_scale * self.specular.transmittance;
+        let weight = transmittance * radiance_scale * self.interface.specular.transmittance;
         Some(BsdfSample {
             wi: refract_z(wo, hero.cos_theta_t, hero.eta_ti),
             weight,

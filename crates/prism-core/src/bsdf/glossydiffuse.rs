@@ -5,9 +5,54 @@
 
 use glam::{Vec2, Vec3};
 
-use super::{BsdfEval, BsdfFlags, BsdfSample, Bxdf, BxdfTree, mixture_sample};
+use super::{BsdfEval, BsdfFlags, BsdfSample, Bxdf, BxdfTree, choice_probability, mixture_sample};
 use crate::sampling::warp::{cosine_hemisphere_pdf, sample_cosine_hemisphere};
-use crate::spectrum::SampledSpectrum;
+use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+use crate::texture::{Texture, TexturePoint, TextureValues};
+
+/// The flags of every glossy-over-diffuse BSDF: a glossy and a diffuse reflection.
+pub const GLOSSY_OVER_DIFFUSE: BsdfFlags = BsdfFlags::GLOSSY
+    .union(BsdfFlags::DIFFUSE)
+    .union(BsdfFlags::REFLECTION);
+
+/// The reflectances of Mitsuba 0.6's `phong` and `ward`: ρ_s and ρ_d, both multiplied by
+/// `scale` (1, or less where ρ_s + ρ_d exceeds 1, to conserve energy: Mitsuba 0.6's
+/// `ensureEnergyConservation`).
+#[derive(Clone, Debug)]
+pub struct ScaledReflectances {
+    pub specular: Texture,
+    pub diffuse: Texture,
+    /// Factor applied to both reflectances.
+    pub scale: f32,
+}
+
+/// [`ScaledReflectances`] at a point, with the probability of sampling the glossy lobe in
+/// proportion to the mean reflectances: p = ρ̄_s / (ρ̄_s + ρ̄_d).
+#[derive(Clone, Copy, Debug)]
+pub struct ScaledReflectancesAt {
+    pub specular: SampledSpectrum,
+    pub diffuse: SampledSpectrum,
+    pub p_glossy: f32,
+}
+
+impl ScaledReflectances {
+    /// The scaled diffuse reflectance s ρ_d.
+    pub fn albedo(&self, at: TexturePoint, lambda: &SampledWavelengths) -> SampledSpectrum {
+        self.scale * self.diffuse.eval(at, lambda)
+    }
+
+    #[inline]
+    pub fn at(&self, at: TexturePoint, lambda: &SampledWavelengths) -> ScaledReflectancesAt {
+        let specular = self.specular.eval(at, lambda) * self.scale;
+        let diffuse = self.diffuse.eval(at, lambda) * self.scale;
+        let (s, d) = (specular.average(), diffuse.average());
+        ScaledReflectancesAt {
+            specular,
+            diffuse,
+            p_glossy: choice_probability(s, d),
+        }
+    }
+}
 
 /// What tells one glossy-over-diffuse BSDF's lobes from another's; their [`Bxdf`] follows.
 pub trait GlossyDiffuseLobes {

@@ -20,6 +20,7 @@ use std::f32::consts::PI;
 use glam::{Vec2, Vec3};
 
 use crate::sampling::warp::sample_uniform_disk_concentric;
+use crate::texture::{Texture, TexturePoint, TextureValues};
 
 /// Which normal distribution.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -37,6 +38,23 @@ pub struct Microfacet {
     pub kind: MicrofacetKind,
     pub alpha_u: f32,
     pub alpha_v: f32,
+}
+
+/// A microfacet BSDF's distribution and its roughness textures, α_u along ∂p/∂u and α_v along
+/// ∂p/∂v (Mitsuba's `distribution`, `alpha_u` and `alpha_v`).
+#[derive(Clone, Debug)]
+pub struct MicrofacetRoughness {
+    pub kind: MicrofacetKind,
+    pub alpha_u: Texture,
+    pub alpha_v: Texture,
+}
+
+impl MicrofacetRoughness {
+    /// The distribution at a point.
+    #[inline]
+    pub fn at(&self, at: TexturePoint) -> Microfacet {
+        Microfacet::new(self.kind, self.alpha_u.eval_1(at), self.alpha_v.eval_1(at))
+    }
 }
 
 /// Smallest roughness used (Mitsuba clamps likewise; smaller values underflow D).

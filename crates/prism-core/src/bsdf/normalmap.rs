@@ -17,33 +17,25 @@
 
 use glam::Vec3;
 
-use super::perturbed::{Tilt, resolve_perturbed};
-use super::{Adapter, Bsdf, BsdfFlags, BxdfTree, NodeId, ResolveContext};
+use super::ShadingPoint;
+use super::perturbed::{Perturbation, Perturbed};
 use crate::texture::Texture;
 use crate::texture::TextureValues;
 
 #[derive(Clone, Debug)]
 pub struct NormalMap {
     pub normals: Texture,
-    pub nested: Box<Bsdf>,
-    pub flip_invalid_normals: bool,
-    pub use_shadowing_function: bool,
+    pub perturbed: Perturbed,
 }
 
-impl Adapter for NormalMap {
-    const OWN_FLAGS: BsdfFlags = BsdfFlags::NONE;
-
-    fn nested(&self) -> &[Box<Bsdf>] {
-        std::slice::from_ref(&self.nested)
+impl Perturbation for NormalMap {
+    fn perturbed(&self) -> &Perturbed {
+        &self.perturbed
     }
 
+    /// The texture's RGB in [0, 1]³ mapped to [−1, 1]³.
     #[inline]
-    fn resolve<'a>(&'a self, context: &ResolveContext, tree: &mut BxdfTree<'a>) -> NodeId {
-        let tilt = Tilt {
-            normal: self.normals.eval_3(context.point.at()) * 2.0 - Vec3::ONE,
-            flip_invalid_normals: self.flip_invalid_normals,
-            use_shadowing_function: self.use_shadowing_function,
-        };
-        resolve_perturbed(&self.nested, tilt, context, tree)
+    fn normal(&self, point: &ShadingPoint) -> Vec3 {
+        self.normals.eval_3(point.at()) * 2.0 - Vec3::ONE
     }
 }

@@ -13,30 +13,53 @@
 use glam::{Vec2, Vec3};
 
 use super::{
-    Bsdf, BsdfEval, BsdfModel, BsdfSample, Bxdf, BxdfTree, NodeId, ResolveContext, ShadingPoint,
+    Adapter, Bsdf, BsdfEval, BsdfFlags, BsdfModel, BsdfSample, Bxdf, BxdfTree, NodeId,
+    ResolveContext, ShadingPoint,
 };
 use crate::math::Frame;
 
-/// How a bump or normal map tilts the frame at a point.
-#[derive(Clone, Copy, Debug)]
-pub struct Tilt {
-    /// The new normal in the local shading frame (not necessarily of unit length).
-    pub normal: Vec3,
+/// The BSDF a bump or normal map nests, and how its frame is tilted.
+#[derive(Clone, Debug)]
+pub struct Perturbed {
+    pub nested: Box<Bsdf>,
     pub flip_invalid_normals: bool,
     pub use_shadowing_function: bool,
 }
 
-/// Adds the lobes of `nested` seen in the frame tilted by `tilt` for the outgoing direction
-/// `wo`, and the node that carries directions into that frame.
-pub(crate) fn resolve_perturbed<'a>(
-    nested: &'a Bsdf,
-    tilt: Tilt,
+/// A bump or normal map: the nested BSDF seen in a frame tilted to a normal of the adapter's
+/// own at each point. Its [`Adapter`] follows: no lobes of its own, one node over the nested
+/// BSDF's.
+pub trait Perturbation {
+    /// The nested BSDF and how it is tilted.
+    fn perturbed(&self) -> &Perturbed;
+    /// The new normal at `point` in its local shading frame (not necessarily of unit length).
+    fn normal(&self, point: &ShadingPoint) -> Vec3;
+}
+
+impl<P: Perturbation> Adapter for P {
+    const OWN_FLAGS: BsdfFlags = BsdfFlags::NONE;
+
+    fn nested(&self) -> &[Box<Bsdf>] {
+        std::slice::from_ref(&self.perturbed().nested)
+    }
+
+    #[inline]
+    fn resolve<'a>(&'a self, context: &ResolveContext, tree: &mut BxdfTree<'a>) -> NodeId {
+        resolve_perturbed(self.perturbed(), self.normal(context.point), context, tree)
+    }
+}
+
+/// Adds the lobes of the nested BSDF seen in the frame tilted to `normal` for the outgoing
+/// direction `wo`, and the node that carries directions into that frame.
+fn resolve_perturbed<'a>(
+    perturbed: &'a Perturbed,
+    normal: Vec3,
     context: &ResolveContext,
     tree: &mut BxdfTree<'a>,
 ) -> NodeId {
     let ResolveContext { point, wo, lambda } = *context;
-    let mut n = tilt.normal;
-    if tilt.flip_invalid_normals && wo.z * wo.dot(n) <= 0.0 {
+    let mut n = normal;
+    if perturbed.flip_invalid_normals && wo.z * wo.dot(n) <= 0.0 {
         n = Vec3::new(-n.x, -n.y, n.z);
     }
     let n = n.try_normalize().unwrap_or(Vec3::Z);
@@ -59,10 +82,10 @@ pub(crate) fn resolve_perturbed<'a>(
         wo: local.to_local(wo),
         lambda,
     };
-    let nested = nested.resolve(&tilted, tree);
+    let nested = perturbed.nested.resolve(&tilted, tree);
     tree.push(PerturbedLobes {
         local,
-        shadowing: tilt.use_shadowing_function,
+        shadowing: perturbed.use_shadowing_function,
         nested,
     })
 }

@@ -22,8 +22,10 @@ use std::f32::consts::{FRAC_1_PI, PI};
 use glam::{Vec2, Vec3};
 
 use super::fresnel::reflect_z;
-use super::glossydiffuse::GlossyDiffuseLobes;
-use super::{BsdfFlags, LeafBsdf, choice_probability};
+use super::glossydiffuse::{
+    GLOSSY_OVER_DIFFUSE, GlossyDiffuseLobes, ScaledReflectances, ScaledReflectancesAt,
+};
+use super::{BsdfFlags, LeafBsdf};
 use crate::math::Frame;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use crate::texture::Texture;
@@ -33,33 +35,23 @@ use crate::texture::TextureValues;
 #[derive(Clone, Debug)]
 pub struct Phong {
     pub exponent: Texture,
-    pub specular_reflectance: Texture,
-    pub diffuse_reflectance: Texture,
-    /// Factor applied to both reflectances (1, or less to conserve energy).
-    pub scale: f32,
+    pub reflectances: ScaledReflectances,
 }
 
 impl LeafBsdf for Phong {
     type Lobes<'a> = PhongLobes;
-    const FLAGS: BsdfFlags = BsdfFlags::GLOSSY
-        .union(BsdfFlags::DIFFUSE)
-        .union(BsdfFlags::REFLECTION);
+    const FLAGS: BsdfFlags = GLOSSY_OVER_DIFFUSE;
 
     /// The diffuse reflectance, scaled as the lobes are.
     fn albedo(&self, at: TexturePoint, lambda: &SampledWavelengths) -> SampledSpectrum {
-        self.scale * self.diffuse_reflectance.eval(at, lambda)
+        self.reflectances.albedo(at, lambda)
     }
 
     #[inline]
     fn lobes(&self, at: TexturePoint, lambda: &SampledWavelengths) -> PhongLobes {
-        let specular = self.specular_reflectance.eval(at, lambda) * self.scale;
-        let diffuse = self.diffuse_reflectance.eval(at, lambda) * self.scale;
-        let (s, d) = (specular.average(), diffuse.average());
         PhongLobes {
             exponent: self.exponent.eval_1(at),
-            specular,
-            diffuse,
-            p_glossy: choice_probability(s, d),
+            reflectances: self.reflectances.at(at, lambda),
         }
     }
 }
@@ -68,10 +60,7 @@ impl LeafBsdf for Phong {
 #[derive(Clone, Copy, Debug)]
 pub struct PhongLobes {
     pub exponent: f32,
-    pub specular: SampledSpectrum,
-    pub diffuse: SampledSpectrum,
-    /// The probability of sampling the glossy lobe.
-    pub p_glossy: f32,
+    pub reflectances: ScaledReflectancesAt,
 }
 
 impl GlossyDiffuseLobes for PhongLobes {
@@ -83,12 +72,12 @@ impl GlossyDiffuseLobes for PhongLobes {
         } else {
             0.0
         };
-        (self.specular * glossy + self.diffuse * FRAC_1_PI) * wi.z
+        (self.reflectances.specular * glossy + self.reflectances.diffuse * FRAC_1_PI) * wi.z
     }
 
     #[inline]
     fn glossy_probability(&self, _wo: Vec3) -> f32 {
-        self.p_glossy
+        self.reflectances.p_glossy
     }
 
     /// cos α = u^(1/(n+1)) around the mirror direction.

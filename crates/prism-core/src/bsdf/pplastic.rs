@@ -31,8 +31,8 @@ use glam::{Vec2, Vec3};
 
 use super::dielectric::optional_factor;
 use super::fresnel::{fresnel_dielectric, reflect};
-use super::glossydiffuse::GlossyDiffuseLobes;
-use super::microfacet::{Microfacet, MicrofacetKind};
+use super::glossydiffuse::{GLOSSY_OVER_DIFFUSE, GlossyDiffuseLobes};
+use super::microfacet::{Microfacet, MicrofacetRoughness};
 use super::{BsdfFlags, LeafBsdf, choice_probability};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use crate::texture::Texture;
@@ -43,18 +43,14 @@ use crate::texture::TextureValues;
 pub struct PolarizedPlastic {
     /// The relative index η = int_ior / ext_ior.
     pub eta: f32,
-    pub distribution: MicrofacetKind,
-    pub alpha_u: Texture,
-    pub alpha_v: Texture,
+    pub roughness: MicrofacetRoughness,
     pub diffuse_reflectance: Texture,
     pub specular_reflectance: Option<Texture>,
 }
 
 impl LeafBsdf for PolarizedPlastic {
     type Lobes<'a> = PolarizedPlasticLobes;
-    const FLAGS: BsdfFlags = BsdfFlags::GLOSSY
-        .union(BsdfFlags::DIFFUSE)
-        .union(BsdfFlags::REFLECTION);
+    const FLAGS: BsdfFlags = GLOSSY_OVER_DIFFUSE;
 
     /// The diffuse reflectance of the base.
     fn albedo(&self, at: TexturePoint, lambda: &SampledWavelengths) -> SampledSpectrum {
@@ -68,11 +64,7 @@ impl LeafBsdf for PolarizedPlastic {
         let (s, d) = (specular.average(), diffuse.average());
         PolarizedPlasticLobes {
             eta: self.eta,
-            distribution: Microfacet::new(
-                self.distribution,
-                self.alpha_u.eval_1(at),
-                self.alpha_v.eval_1(at),
-            ),
+            distribution: self.roughness.at(at),
             diffuse,
             specular,
             p_specular: choice_probability(s, d),

@@ -22,7 +22,7 @@ use glam::{Vec2, Vec3};
 
 use super::conductor::ConductorIor;
 use super::fresnel::reflect;
-use super::microfacet::{Microfacet, MicrofacetKind};
+use super::microfacet::{Microfacet, MicrofacetRoughness};
 use super::{BsdfEval, BsdfFlags, BsdfSample, Bxdf, BxdfTree, LeafBsdf};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use crate::texture::Texture;
@@ -31,9 +31,7 @@ use crate::texture::TextureValues;
 
 #[derive(Clone, Debug)]
 pub struct RoughConductor {
-    pub distribution: MicrofacetKind,
-    pub alpha_u: Texture,
-    pub alpha_v: Texture,
+    pub roughness: MicrofacetRoughness,
     pub eta: Texture,
     pub k: Texture,
     pub specular_reflectance: Texture,
@@ -50,11 +48,7 @@ impl LeafBsdf for RoughConductor {
     #[inline]
     fn lobes(&self, at: TexturePoint, lambda: &SampledWavelengths) -> RoughConductorLobes {
         RoughConductorLobes {
-            distribution: Microfacet::new(
-                self.distribution,
-                self.alpha_u.eval_1(at),
-                self.alpha_v.eval_1(at),
-            ),
+            distribution: self.roughness.at(at),
             ior: ConductorIor::at(&self.eta, &self.k, self.ext_eta, at, lambda),
             specular_reflectance: self.specular_reflectance.eval(at, lambda),
         }

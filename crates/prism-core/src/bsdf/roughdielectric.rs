@@ -25,24 +25,19 @@
 
 use glam::{Vec2, Vec3};
 
-use super::dielectric::SpecularFactors;
+use super::dielectric::{SpecularFactorTextures, SpecularFactors};
 use super::fresnel::{fresnel_dielectric, reflect, refract};
-use super::microfacet::{Microfacet, MicrofacetKind};
+use super::microfacet::{Microfacet, MicrofacetRoughness};
 use super::{BsdfEval, BsdfFlags, BsdfSample, Bxdf, BxdfTree, LeafBsdf};
 use crate::spectrum::ior::RelativeIor;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
-use crate::texture::Texture;
 use crate::texture::TexturePoint;
-use crate::texture::TextureValues;
 
 #[derive(Clone, Debug)]
 pub struct RoughDielectric {
     pub eta: RelativeIor,
-    pub distribution: MicrofacetKind,
-    pub alpha_u: Texture,
-    pub alpha_v: Texture,
-    pub specular_reflectance: Option<Texture>,
-    pub specular_transmittance: Option<Texture>,
+    pub roughness: MicrofacetRoughness,
+    pub specular: SpecularFactorTextures,
 }
 
 /// No diffuse reflectance: only glossy lobes (Mitsuba 3 evaluates the BSDF towards the normal
@@ -62,17 +57,8 @@ impl LeafBsdf for RoughDielectric {
         RoughDielectricLobes {
             eta_hero: self.eta.at(lambda.lambda(0)),
             dispersive: self.eta.is_dispersive(),
-            distribution: Microfacet::new(
-                self.distribution,
-                self.alpha_u.eval_1(at),
-                self.alpha_v.eval_1(at),
-            ),
-            specular: SpecularFactors::at(
-                &self.specular_reflectance,
-                &self.specular_transmittance,
-                at,
-                lambda,
-            ),
+            distribution: self.roughness.at(at),
+            specular: self.specular.at(at, lambda),
         }
     }
 }

@@ -29,7 +29,7 @@ use rayon::prelude::*;
 
 use super::dielectric::optional_factor;
 use super::fresnel::{fresnel_dielectric, reflect, refract};
-use super::glossydiffuse::GlossyDiffuseLobes;
+use super::glossydiffuse::{GLOSSY_OVER_DIFFUSE, GlossyDiffuseLobes};
 use super::microfacet::{GaussLegendre, Microfacet, MicrofacetKind};
 use super::plastic::effective_diffuse;
 use super::{BsdfFlags, LeafBsdf, choice_probability};
@@ -150,9 +150,7 @@ impl RoughPlastic {
 
 impl LeafBsdf for RoughPlastic {
     type Lobes<'a> = RoughPlasticLobes<'a>;
-    const FLAGS: BsdfFlags = BsdfFlags::GLOSSY
-        .union(BsdfFlags::DIFFUSE)
-        .union(BsdfFlags::REFLECTION);
+    const FLAGS: BsdfFlags = GLOSSY_OVER_DIFFUSE;
 
     /// The diffuse reflectance under the coating.
     fn albedo(&self, at: TexturePoint, lambda: &SampledWavelengths) -> SampledSpectrum {

@@ -17,19 +17,15 @@
 
 use glam::{Vec2, Vec3};
 
-use super::dielectric::{SampledIor, SpecularFactors};
+use super::dielectric::{SmoothInterface, SmoothInterfaceAt};
 use super::fresnel::{fresnel_dielectric, reflect_z};
 use super::{BsdfFlags, BsdfSample, Bxdf, BxdfTree, LeafBsdf};
-use crate::spectrum::ior::RelativeIor;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
-use crate::texture::Texture;
 use crate::texture::TexturePoint;
 
 #[derive(Clone, Debug)]
 pub struct ThinDielectric {
-    pub eta: RelativeIor,
-    pub specular_reflectance: Option<Texture>,
-    pub specular_transmittance: Option<Texture>,
+    pub interface: SmoothInterface,
 }
 
 /// Not dispersive: the pane does not bend light, so a dispersive index changes only how much
@@ -43,13 +39,7 @@ impl LeafBsdf for ThinDielectric {
     #[inline]
     fn lobes(&self, at: TexturePoint, lambda: &SampledWavelengths) -> ThinDielectricLobes {
         ThinDielectricLobes {
-            eta: SampledIor::at(&self.eta, lambda),
-            specular: SpecularFactors::at(
-                &self.specular_reflectance,
-                &self.specular_transmittance,
-                at,
-                lambda,
-            ),
+            interface: self.interface.at(at, lambda),
         }
     }
 }
@@ -57,8 +47,7 @@ impl LeafBsdf for ThinDielectric {
 /// The reflected and passing lobes at a point.
 #[derive(Clone, Copy, Debug)]
 pub struct ThinDielectricLobes {
-    pub eta: SampledIor,
-    pub specular: SpecularFactors,
+    pub interface: SmoothInterfaceAt,
 }
 
 impl Bxdf for ThinDielectricLobes {
@@ -71,14 +60,14 @@ impl Bxdf for ThinDielectricLobes {
             let r = fresnel_dielectric(cos_o, eta).reflectance;
             2.0 * r / (1.0 + r)
         };
-        let r = if self.eta.dispersive {
-            SampledSpectrum::from_fn(|i| reflectance(self.eta.eta[i]))
+        let r = if self.interface.eta.dispersive {
+            SampledSpectrum::from_fn(|i| reflectance(self.interface.eta.eta[i]))
         } else {
-            SampledSpectrum::splat(reflectance(self.eta.hero()))
+            SampledSpectrum::splat(reflectance(self.interface.eta.hero()))
         };
         let p_reflect = r.average();
         if u_lobe < p_reflect {
-            let weight = r * (1.0 / p_reflect) * self.specular.reflectance;
+            let weight = r * (1.0 / p_reflect) * self.interface.specular.reflectance;
             Some(BsdfSample::new(
                 reflect_z(wo),
                 weight,
@@ -87,8 +76,9 @@ impl Bxdf for ThinDielectricLobes {
             ))
         } else {
             let p_transmit = 1.0 - p_reflect;
-            let weight =
-                (SampledSpectrum::ONE - r) * (1.0 / p_transmit) * self.specular.transmittance;
+            let weight = (SampledSpectrum::ONE - r)
+                * (1.0 / p_transmit)
+                * self.interface.specular.transmittance;
             Some(BsdfSample::new(-wo, weight, p_transmit, BsdfFlags::NULL))
         }
     }

@@ -30,8 +30,10 @@ use std::f32::consts::{FRAC_1_PI, PI};
 use glam::{Vec2, Vec3};
 
 use super::fresnel::reflect;
-use super::glossydiffuse::GlossyDiffuseLobes;
-use super::{BsdfFlags, LeafBsdf, choice_probability};
+use super::glossydiffuse::{
+    GLOSSY_OVER_DIFFUSE, GlossyDiffuseLobes, ScaledReflectances, ScaledReflectancesAt,
+};
+use super::{BsdfFlags, LeafBsdf};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use crate::texture::Texture;
 use crate::texture::TexturePoint;
@@ -53,35 +55,25 @@ pub struct Ward {
     pub variant: WardVariant,
     pub alpha_u: Texture,
     pub alpha_v: Texture,
-    pub specular_reflectance: Texture,
-    pub diffuse_reflectance: Texture,
-    /// Factor applied to both reflectances (1, or less to conserve energy).
-    pub scale: f32,
+    pub reflectances: ScaledReflectances,
 }
 
 impl LeafBsdf for Ward {
     type Lobes<'a> = WardLobes;
-    const FLAGS: BsdfFlags = BsdfFlags::GLOSSY
-        .union(BsdfFlags::DIFFUSE)
-        .union(BsdfFlags::REFLECTION);
+    const FLAGS: BsdfFlags = GLOSSY_OVER_DIFFUSE;
 
     /// The diffuse reflectance, scaled as the lobes are.
     fn albedo(&self, at: TexturePoint, lambda: &SampledWavelengths) -> SampledSpectrum {
-        self.scale * self.diffuse_reflectance.eval(at, lambda)
+        self.reflectances.albedo(at, lambda)
     }
 
     #[inline]
     fn lobes(&self, at: TexturePoint, lambda: &SampledWavelengths) -> WardLobes {
-        let specular = self.specular_reflectance.eval(at, lambda) * self.scale;
-        let diffuse = self.diffuse_reflectance.eval(at, lambda) * self.scale;
-        let (s, d) = (specular.average(), diffuse.average());
         WardLobes {
             variant: self.variant,
             alpha_u: self.alpha_u.eval_1(at),
             alpha_v: self.alpha_v.eval_1(at),
-            specular,
-            diffuse,
-            p_glossy: choice_probability(s, d),
+            reflectances: self.reflectances.at(at, lambda),
         }
     }
 }
@@ -92,10 +84,7 @@ pub struct WardLobes {
     pub variant: WardVariant,
     pub alpha_u: f32,
     pub alpha_v: f32,
-    pub specular: SampledSpectrum,
-    pub diffuse: SampledSpectrum,
-    /// The probability of sampling the glossy lobe.
-    pub p_glossy: f32,
+    pub reflectances: ScaledReflectancesAt,
 }
 
 impl WardLobes {
@@ -135,12 +124,12 @@ impl GlossyDiffuseLobes for WardLobes {
             WardVariant::Balanced => h.dot(h) / (area * h.z.powi(4)),
         };
         let glossy = normalisation * self.gaussian(h);
-        (self.specular * glossy + self.diffuse * FRAC_1_PI) * wi.z
+        (self.reflectances.specular * glossy + self.reflectances.diffuse * FRAC_1_PI) * wi.z
     }
 
     #[inline]
     fn glossy_probability(&self, _wo: Vec3) -> f32 {
-        self.p_glossy
+        self.reflectances.p_glossy
     }
 
     #[inline]

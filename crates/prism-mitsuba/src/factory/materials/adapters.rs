@@ -6,6 +6,7 @@ use crate::description::{PluginClass, PluginNode};
 use crate::factory::textures::{TextureCache, build_texture, float_texture};
 use crate::params::Params;
 use crate::registry::{Bounds, Default, Origin, ParamKind, ParamSpec, Plugin, params};
+use prism_core::bsdf::perturbed::Perturbed;
 use prism_core::bsdf::{
     Blend, Bsdf, BsdfFlags, BsdfModel, BumpMap, Mask, NormalMap, Null, TwoSided,
 };
@@ -205,9 +206,7 @@ fn build_bumpmap(params: &Params, t: &mut TextureCache) -> Result<Bsdf> {
     Ok(Bsdf::BumpMap(BumpMap {
         height: build_texture(&height.node, TextureUse::Scalar, t)?,
         scale,
-        nested: Box::new(single_nested_bsdf(params, t)?),
-        flip_invalid_normals: params.boolean(&FLIP_INVALID_NORMALS)?,
-        use_shadowing_function: params.boolean(&USE_SHADOWING_FUNCTION)?,
+        perturbed: perturbed(params, t)?,
     }))
 }
 
@@ -228,10 +227,17 @@ fn build_normalmap(params: &Params, t: &mut TextureCache) -> Result<Bsdf> {
     }
     Ok(Bsdf::NormalMap(NormalMap {
         normals: build_texture(&normals.node, TextureUse::Rgb, t)?,
+        perturbed: perturbed(params, t)?,
+    }))
+}
+
+/// The nested BSDF of a `bumpmap` or `normalmap` and how its frame is tilted.
+fn perturbed(params: &Params, t: &mut TextureCache) -> Result<Perturbed> {
+    Ok(Perturbed {
         nested: Box::new(single_nested_bsdf(params, t)?),
         flip_invalid_normals: params.boolean(&FLIP_INVALID_NORMALS)?,
         use_shadowing_function: params.boolean(&USE_SHADOWING_FUNCTION)?,
-    }))
+    })
 }
 
 /// The one BSDF nested in an adapter (`mask`, `bumpmap`, `normalmap`).

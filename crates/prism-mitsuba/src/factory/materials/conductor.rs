@@ -38,11 +38,9 @@ pub(super) const ROUGHCONDUCTOR: Plugin<Build> = Plugin {
     params: microfacet_params![MATERIAL, ETA, K, CONDUCTOR_SPECULAR, EXT_ETA],
     build: |params, t| {
         let (eta, k) = conductor_ior(params, t)?;
-        let (distribution, alpha_u, alpha_v) = roughness(params, t)?;
+        let roughness = roughness(params, t)?;
         Ok(Bsdf::RoughConductor(RoughConductor {
-            distribution,
-            alpha_u,
-            alpha_v,
+            roughness,
             eta,
             k,
             specular_reflectance: spectrum_texture(params, &CONDUCTOR_SPECULAR, t)?,

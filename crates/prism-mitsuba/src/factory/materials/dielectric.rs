@@ -6,10 +6,9 @@ use super::{Build, SPECULAR_REFLECTANCE, colour};
 use crate::factory::textures::{TextureCache, optional_spectrum_texture};
 use crate::params::Params;
 use crate::registry::{Origin, ParamSpec, Plugin, Range, params};
+use prism_core::bsdf::dielectric::{SmoothInterface, SpecularFactorTextures};
 use prism_core::bsdf::{Bsdf, Dielectric, RoughDielectric, ThinDielectric};
 use prism_core::error::Result;
-use prism_core::spectrum::ior::RelativeIor;
-use prism_core::texture::Texture;
 
 pub(super) const DIELECTRIC: Plugin<Build> = Plugin {
     name: "dielectric",
@@ -18,11 +17,8 @@ pub(super) const DIELECTRIC: Plugin<Build> = Plugin {
               Behind a dispersive index each wavelength refracts its own way.",
     params: SMOOTH_INTERFACE,
     build: |params, t| {
-        let (eta, specular_reflectance, specular_transmittance) = smooth_interface(params, t)?;
         Ok(Bsdf::Dielectric(Dielectric {
-            eta,
-            specular_reflectance,
-            specular_transmittance,
+            interface: smooth_interface(params, t)?,
         }))
     },
 };
@@ -39,14 +35,11 @@ pub(super) const ROUGHDIELECTRIC: Plugin<Build> = Plugin {
     ],
     build: |params, t| {
         let eta = relative_ior(params, &INT_IOR, true)?;
-        let (distribution, alpha_u, alpha_v) = roughness(params, t)?;
+        let roughness = roughness(params, t)?;
         Ok(Bsdf::RoughDielectric(RoughDielectric {
             eta,
-            distribution,
-            alpha_u,
-            alpha_v,
-            specular_reflectance: optional_spectrum_texture(params, &SPECULAR_REFLECTANCE, t)?,
-            specular_transmittance: optional_spectrum_texture(params, &SPECULAR_TRANSMITTANCE, t)?,
+            roughness,
+            specular: specular_factors(params, t)?,
         }))
     },
 };
@@ -58,11 +51,8 @@ pub(super) const THINDIELECTRIC: Plugin<Build> = Plugin {
               undeflected.",
     params: SMOOTH_INTERFACE,
     build: |params, t| {
-        let (eta, specular_reflectance, specular_transmittance) = smooth_interface(params, t)?;
         Ok(Bsdf::ThinDielectric(ThinDielectric {
-            eta,
-            specular_reflectance,
-            specular_transmittance,
+            interface: smooth_interface(params, t)?,
         }))
     },
 };
@@ -80,13 +70,17 @@ const SMOOTH_INTERFACE: &[ParamSpec] = &[
 ];
 
 /// The relative index and the specular factors of a smooth interface.
-fn smooth_interface(
-    params: &Params,
-    t: &mut TextureCache,
-) -> Result<(RelativeIor, Option<Texture>, Option<Texture>)> {
-    Ok((
-        relative_ior(params, &INT_IOR, false)?,
-        optional_spectrum_texture(params, &SPECULAR_REFLECTANCE, t)?,
-        optional_spectrum_texture(params, &SPECULAR_TRANSMITTANCE, t)?,
-    ))
+fn smooth_interface(params: &Params, t: &mut TextureCache) -> Result<SmoothInterface> {
+    Ok(SmoothInterface {
+        eta: relative_ior(params, &INT_IOR, false)?,
+        specular: specular_factors(params, t)?,
+    })
+}
+
+/// The optional factors on an interface's reflection and transmission.
+fn specular_factors(params: &Params, t: &mut TextureCache) -> Result<SpecularFactorTextures> {
+    Ok(SpecularFactorTextures {
+        reflectance: optional_spectrum_texture(params, &SPECULAR_REFLECTANCE, t)?,
+        transmittance: optional_spectrum_texture(params, &SPECULAR_TRANSMITTANCE, t)?,
+    })
 }

@@ -7,6 +7,7 @@ use crate::params::Params;
 use crate::registry::{
     Bounds, Choice, Default, Origin, ParamKind, ParamSpec, Plugin, Range, params,
 };
+use prism_core::bsdf::glossydiffuse::ScaledReflectances;
 use prism_core::bsdf::{Bsdf, Phong, Ward, WardVariant};
 use prism_core::error::Result;
 use prism_core::spectrum::LAMBDA_MIN;
@@ -19,15 +20,9 @@ pub(super) const PHONG: Plugin<Build> = Plugin {
               reflectances summing above 1 are scaled down, as Mitsuba 0.6 does. One-sided.",
     params: &[EXPONENT, PHONG_SPECULAR, DIFFUSE_REFLECTANCE],
     build: |params, t| {
-        let exponent = float_texture(params, &EXPONENT, t)?;
-        let specular = spectrum_texture(params, &PHONG_SPECULAR, t)?;
-        let diffuse = spectrum_texture(params, &DIFFUSE_REFLECTANCE, t)?;
-        let total = largest_sum(&specular, &diffuse);
         Ok(Bsdf::Phong(Phong {
-            exponent,
-            specular_reflectance: specular,
-            diffuse_reflectance: diffuse,
-            scale: if total > 1.0 { 1.0 / total } else { 1.0 },
+            exponent: float_texture(params, &EXPONENT, t)?,
+            reflectances: scaled_reflectances(params, t)?,
         }))
     },
 };
@@ -71,17 +66,25 @@ fn build_ward(params: &Params, t: &mut TextureCache) -> Result<Bsdf> {
         }
     };
     let (alpha_u, alpha_v) = (along(&WARD_ALPHA_U)?, along(&WARD_ALPHA_V)?);
-    let specular = spectrum_texture(params, &PHONG_SPECULAR, t)?;
-    let diffuse = spectrum_texture(params, &DIFFUSE_REFLECTANCE, t)?;
-    let total = largest_sum(&specular, &diffuse);
     Ok(Bsdf::Ward(Ward {
         variant,
         alpha_u,
         alpha_v,
-        specular_reflectance: specular,
-        diffuse_reflectance: diffuse,
-        scale: if total > 1.0 { 1.0 / total } else { 1.0 },
+        reflectances: scaled_reflectances(params, t)?,
     }))
+}
+
+/// The reflectances of `phong` and `ward`, scaled down together where their sum exceeds 1
+/// (Mitsuba 0.6's `ensureEnergyConservation`).
+fn scaled_reflectances(params: &Params, t: &mut TextureCache) -> Result<ScaledReflectances> {
+    let specular = spectrum_texture(params, &PHONG_SPECULAR, t)?;
+    let diffuse = spectrum_texture(params, &DIFFUSE_REFLECTANCE, t)?;
+    let total = largest_sum(&specular, &diffuse);
+    Ok(ScaledReflectances {
+        specular,
+        diffuse,
+        scale: if total > 1.0 { 1.0 / total } else { 1.0 },
+    })
 }
 
 /// The largest value of the sum of two reflectances (Mitsuba 0.6's `ensureEnergyConservation`

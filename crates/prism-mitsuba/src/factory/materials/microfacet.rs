@@ -4,9 +4,8 @@
 use crate::factory::textures::{TextureCache, float_texture};
 use crate::params::Params;
 use crate::registry::{Bounds, Choice, Default, ParamKind, ParamSpec, params};
-use prism_core::bsdf::microfacet::MicrofacetKind;
+use prism_core::bsdf::microfacet::{MicrofacetKind, MicrofacetRoughness};
 use prism_core::error::{Error, Result};
-use prism_core::texture::Texture;
 
 params! {
     pub(super) DISTRIBUTION = ParamSpec::new("distribution", ParamKind::Choice(&[Choice::new("beckmann", &MicrofacetKind::Beckmann), Choice::new("ggx", &MicrofacetKind::Ggx)]), Default::Str("beckmann"), "the microfacet distribution");
@@ -22,8 +21,8 @@ params! {
 pub(super) fn roughness(
     params: &Params,
     textures: &mut TextureCache,
-) -> Result<(MicrofacetKind, Texture, Texture)> {
-    let distribution = params.choice(&DISTRIBUTION)?;
+) -> Result<MicrofacetRoughness> {
+    let kind = params.choice(&DISTRIBUTION)?;
     params.boolean(&SAMPLE_VISIBLE)?;
     let (has_u, has_v) = (params.has(&ALPHA_U), params.has(&ALPHA_V));
     if has_u || has_v {
@@ -44,10 +43,16 @@ pub(super) fn roughness(
             )
             .with_help("give both alpha_u and alpha_v"));
         }
-        let u = float_texture(params, &ALPHA_U, textures)?;
-        let v = float_texture(params, &ALPHA_V, textures)?;
-        return Ok((distribution, u, v));
+        return Ok(MicrofacetRoughness {
+            kind,
+            alpha_u: float_texture(params, &ALPHA_U, textures)?,
+            alpha_v: float_texture(params, &ALPHA_V, textures)?,
+        });
     }
     let alpha = float_texture(params, &ALPHA, textures)?;
-    Ok((distribution, alpha.clone(), alpha))
+    Ok(MicrofacetRoughness {
+        kind,
+        alpha_u: alpha.clone(),
+        alpha_v: alpha,
+    })
 }

@@ -76,12 +76,10 @@ pub(super) const PPLASTIC: Plugin<Build> = Plugin {
     ],
     build: |params, t| {
         let eta = constant_relative_ior(params, true)?;
-        let (distribution, alpha_u, alpha_v) = roughness(params, t)?;
+        let roughness = roughness(params, t)?;
         Ok(Bsdf::PolarizedPlastic(PolarizedPlastic {
             eta,
-            distribution,
-            alpha_u,
-            alpha_v,
+            roughness,
             diffuse_reflectance: spectrum_texture(params, &DIFFUSE_REFLECTANCE, t)?,
             specular_reflectance: optional_spectrum_texture(params, &SPECULAR_REFLECTANCE, t)?,
         }))
