@@ -42,6 +42,7 @@ impl<'a> SampleEstimator<'a> {
     /// Traces sample `index` of `pixel` (full-film coordinates): its film offset from the
     /// pixel's centre, the filter weight the one-pixel estimator gives it, and its CIE XYZ
     /// weighted by the shutter's filter; its extra channels, weighted alike, go to `aovs`.
+    #[inline]
     pub(super) fn trace(
         &self,
         sampler: &mut Sampler,
@@ -69,6 +70,7 @@ impl<'a> SampleEstimator<'a> {
     /// The one-pixel estimate of sample `index` of `pixel` (full-film coordinates): its
     /// filter-weighted CIE XYZ; the sample's extra channels, weighted by the same filter weight,
     /// go to `aovs`. Under filter MIS the same sample also feeds the pixels around.
+    #[inline]
     pub fn estimate(
         &self,
         sampler: &mut Sampler,
