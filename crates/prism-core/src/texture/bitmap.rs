@@ -338,6 +338,10 @@ impl TextureValues for BitmapTexture {
     fn mean_value(&self) -> f32 {
         mean_over_cells(self, self.width.max(1), self.height.max(1))
     }
+
+    fn aspect_ratio(&self) -> f64 {
+        self.width as f64 / self.height as f64
+    }
 }
 
 #[cfg(test)]

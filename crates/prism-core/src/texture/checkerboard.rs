@@ -78,6 +78,10 @@ impl TextureValues for Checkerboard {
     fn mean_value(&self) -> f32 {
         mean_over_cells(self, 256, 256)
     }
+
+    fn aspect_ratio(&self) -> f64 {
+        1.0
+    }
 }
 
 #[cfg(test)]

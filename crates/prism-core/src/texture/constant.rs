@@ -40,4 +40,8 @@ impl TextureValues for Spectrum {
     fn mean_value(&self) -> f32 {
         self.eval_1(Vec2::ZERO)
     }
+
+    fn aspect_ratio(&self) -> f64 {
+        1.0
+    }
 }

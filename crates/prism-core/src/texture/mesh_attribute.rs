@@ -73,6 +73,10 @@ impl TextureValues for MeshAttributeTexture {
     fn mean_value(&self) -> f32 {
         self.scale
     }
+
+    fn aspect_ratio(&self) -> f64 {
+        1.0
+    }
 }
 
 #[cfg(test)]

@@ -56,6 +56,10 @@ plugin_class! {
         /// The mean of [`Self::eval_1`] over [0, 1]²: at an image's texel centres, or on a
         /// grid of 256 × 256 cell centres for a pattern ([`mean_over_cells`]).
         fn mean_value(&self) -> f32;
+
+        /// The width over the height of the texture's image, which sets the shape of what
+        /// projects it (a projector's field of view); 1 for a texture without an image.
+        fn aspect_ratio(&self) -> f64;
     }
 
     /// A texture.

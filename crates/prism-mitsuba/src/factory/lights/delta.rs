@@ -12,7 +12,7 @@ use crate::registry::{Bounds, Default, Origin, ParamKind, ParamSpec, Plugin, Ran
 use glam::{DVec3, Vec3};
 use prism_core::error::{Error, Result};
 use prism_core::light::{DirectionalLight, Light, PointLight, Projector, SpotLight};
-use prism_core::texture::{Texture, TextureUse};
+use prism_core::texture::{Texture, TextureUse, TextureValues};
 
 pub(super) const POINT: Plugin<Build> = Plugin {
     name: "point",
@@ -158,10 +158,7 @@ fn build_projector(params: &Params, textures: &mut TextureCache) -> Result<Light
     let (irradiance, aspect) = match params.named_child(&PROJECTOR_IRRADIANCE) {
         Some(child) if child.node.class == PluginClass::Texture => {
             let texture = emission_texture_child(params, &PROJECTOR_IRRADIANCE, child, textures)?;
-            let aspect = match &texture {
-                Texture::Bitmap(bitmap) => bitmap.width as f64 / bitmap.height as f64,
-                _ => 1.0,
-            };
+            let aspect = texture.aspect_ratio();
             (texture, aspect)
         }
         _ => (
