@@ -53,7 +53,7 @@ pub struct RenderArgs {
     #[arg(long, value_name = "S")]
     pub seed: Option<u64>,
     /// Set a scene parameter declared with `<default name=... value=...>` (repeatable)
-    #[arg(short = 'D', value_name = "NAME=VALUE", value_parser = parse_define)]
+    #[arg(short = 'D', long = "define", value_name = "NAME=VALUE", value_parser = parse_define)]
     pub defines: Vec<(String, String)>,
     /// Render only the pixels x0 <= x < x1, y0 <= y < y1 of the film
     #[arg(long, value_name = "X0,Y0,X1,Y1", value_parser = parse_crop)]

@@ -9,6 +9,7 @@ mod determinism;
 mod embree;
 mod errors;
 mod estimators;
+mod help;
 mod image_formation;
 mod layers;
 mod leniency;
