@@ -158,32 +158,25 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     Ok(())
 }
 
-/// One scene's measurement as a JSON object (on one line).
+/// One scene's measurement as a JSON object (on one line); a measurement without a value (an
+/// Embree rate in a build without Embree) is `null`.
 fn json(m: &Measurement, threads: usize) -> String {
-    format!(
-        concat!(
-            "{{\"scene\":\"{}\",\"threads\":{},\"primitives\":{},\"bvh_build_seconds\":{:.6},",
-            "\"geometry_bytes\":{},\"bytes_per_primitive\":{:.2},\"rays_per_second\":{:.1},",
-            "\"samples_per_second\":{:.1},\"spp\":{},\"render_seconds\":{:.4},",
-            "\"rel_mse\":{:.6e},\"efficiency\":{:.4},\"embree_rays_per_second\":{},",
-            "\"shadow_rays_per_second\":{:.1},\"embree_shadow_rays_per_second\":{}}}"
-        ),
-        m.scene,
-        threads,
-        m.primitives,
-        m.bvh_build_seconds,
-        m.geometry_bytes,
-        m.bytes_per_primitive(),
-        m.rays_per_second,
-        m.samples_per_second,
-        m.spp,
-        m.render_seconds,
-        m.rel_mse,
-        m.efficiency,
-        m.embree_rays_per_second
-            .map_or("null".to_string(), |r| format!("{r:.1}")),
-        m.shadow_rays_per_second,
-        m.embree_shadow_rays_per_second
-            .map_or("null".to_string(), |r| format!("{r:.1}"))
-    )
+    serde_json::json!({
+        "scene": m.scene,
+        "threads": threads,
+        "primitives": m.primitives,
+        "bvh_build_seconds": m.bvh_build_seconds,
+        "geometry_bytes": m.geometry_bytes,
+        "bytes_per_primitive": m.bytes_per_primitive(),
+        "rays_per_second": m.rays_per_second,
+        "samples_per_second": m.samples_per_second,
+        "spp": m.spp,
+        "render_seconds": m.render_seconds,
+        "rel_mse": m.rel_mse,
+        "efficiency": m.efficiency,
+        "embree_rays_per_second": m.embree_rays_per_second,
+        "shadow_rays_per_second": m.shadow_rays_per_second,
+        "embree_shadow_rays_per_second": m.embree_shadow_rays_per_second,
+    })
+    .to_string()
 }
