@@ -93,6 +93,10 @@ pub struct RenderArgs {
     /// sample feeds every pixel its filter covers) or pixel (the lecture's one-pixel estimator)
     #[arg(long, value_name = "METHOD", value_parser = parse_reconstruction)]
     pub reconstruction: Option<Reconstruction>,
+    /// Print no progress bar and no summary line (warnings, errors and how to resume an
+    /// interrupted render are still printed)
+    #[arg(short, long)]
+    pub quiet: bool,
 }
 
 pub(crate) fn parse_define(text: &str) -> Result<(String, String), String> {
@@ -359,8 +363,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         interrupt: Some(interrupt),
         threads: args.threads,
         seed,
-        progress: std::io::stderr()
-            .is_terminal()
+        progress: (!args.quiet && std::io::stderr().is_terminal())
             .then(|| Arc::new(TerminalProgress::default()) as Arc<dyn ProgressReport>),
     };
     let (exr_path, png_path) = output_paths(args);
@@ -454,7 +457,8 @@ fn resume_arguments(args: &RenderArgs) -> String {
     text
 }
 
-/// The summary line, and the pixels where samples were dropped as non-finite.
+/// The pixels where samples were dropped as non-finite, and (unless `--quiet`) the summary
+/// line.
 fn report(
     args: &RenderArgs,
     scene: &Scene,
@@ -462,6 +466,12 @@ fn report(
     exr: &Path,
     png: &Path,
 ) {
+    if let Some(line) = rejected_report(&output.film) {
+        eprintln!("{line}");
+    }
+    if args.quiet {
+        return;
+    }
     let seconds = output.elapsed.as_secs_f64().max(1e-9);
     let stopped = match output.stop {
         StopReason::Completed => "",
@@ -486,9 +496,6 @@ fn report(
         exr.display(),
         png.display(),
     );
-    if let Some(line) = rejected_report(&output.film) {
-        eprintln!("{line}");
-    }
 }
 
 /// `--pixel x,y`: renders the samples `range` drawn for one pixel and prints each with its

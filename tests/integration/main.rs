@@ -3,13 +3,13 @@
 
 mod bench;
 mod chi2;
+mod command_line;
 mod common;
 mod determinism;
 #[cfg(feature = "embree")]
 mod embree;
 mod errors;
 mod estimators;
-mod help;
 mod image_formation;
 mod layers;
 mod leniency;

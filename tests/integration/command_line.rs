@@ -1,5 +1,5 @@
-//! The command line's help fits a terminal: at 80 columns (`COLUMNS=80`) no line of `prism
-//! --help` or of any subcommand's `--help` is wider, and the help names every option it has.
+//! The command line's help and output: at 80 columns (`COLUMNS=80`) no line of `prism --help`
+//! or of any subcommand's `--help` is wider; `--quiet` renders without a word.
 
 use std::process::Command;
 
@@ -40,4 +40,30 @@ fn no_help_line_is_wider_than_80_columns() {
 fn defines_have_a_long_form() {
     let text = help(&["render"], 80);
     assert!(text.contains("-D, --define <NAME=VALUE>"), "{text}");
+}
+
+#[test]
+fn a_quiet_render_prints_nothing() {
+    let out = std::env::temp_dir().join(format!("prism-quiet-{}.exr", std::process::id()));
+    let output = Command::new(env!("CARGO_BIN_EXE_prism"))
+        .args([
+            "render",
+            "scenes/cornell-box/scene.xml",
+            "--spp",
+            "1",
+            "--quiet",
+            "-o",
+        ])
+        .arg(&out)
+        .args(["-D", "resx=16", "-D", "resy=16"])
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .expect("the prism binary runs");
+    let _ = std::fs::remove_file(&out);
+    let _ = std::fs::remove_file(out.with_extension("png"));
+    assert!(output.status.success(), "{output:?}");
+    assert!(
+        output.stdout.is_empty() && output.stderr.is_empty(),
+        "{output:?}"
+    );
 }
