@@ -1,5 +1,8 @@
 //! The terminal's progress bar: a [`ProgressReport`] drawn by `indicatif` on standard error,
-//! with the samples done, their rate and, once a pass is done, the image's mean relative error.
+//! with the samples done, their rate and, once a pass is done, the image's mean relative error
+//! and, under a time limit, the time left.
+
+use std::time::Duration;
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use prism_core::render::ProgressReport;
@@ -8,12 +11,16 @@ use prism_core::render::ProgressReport;
 #[derive(Debug)]
 pub struct TerminalProgress {
     bar: ProgressBar,
+    /// The render's time limit, counted from the bar's start.
+    time_limit: Option<Duration>,
 }
 
-impl Default for TerminalProgress {
-    fn default() -> TerminalProgress {
+impl TerminalProgress {
+    /// A bar for a render that stops after `time_limit`, if it has one.
+    pub fn new(time_limit: Option<Duration>) -> TerminalProgress {
         TerminalProgress {
             bar: ProgressBar::with_draw_target(None, ProgressDrawTarget::stderr()),
+            time_limit,
         }
     }
 }
@@ -39,10 +46,39 @@ impl ProgressReport for TerminalProgress {
     }
 
     fn pass_done(&self, spp: u32, error: f64) {
-        self.bar.set_message(format!("{spp} spp, error {error:.4}"));
+        let mut message = format!("{spp} spp, error {error:.4}");
+        if let Some(limit) = self.time_limit {
+            let left = limit.saturating_sub(self.bar.elapsed()).as_secs_f64();
+            message += &format!(", {left:.0} s left");
+        }
+        self.bar.set_message(message);
     }
 
     fn end(&self) {
         self.bar.finish_and_clear();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn under_a_time_limit_the_message_gives_the_time_left() {
+        let progress = TerminalProgress::new(Some(Duration::from_secs(60)));
+        progress.begin(None);
+        progress.pass_done(4, 0.05);
+        let message = progress.bar.message();
+        assert!(message.starts_with("4 spp, error 0.0500, "), "{message}");
+        assert!(message.ends_with(" s left"), "{message}");
+        let left: f64 = message["4 spp, error 0.0500, ".len()..message.len() - " s left".len()]
+            .parse()
+            .unwrap();
+        assert!((59.0..=60.0).contains(&left), "{message}");
+
+        let unlimited = TerminalProgress::new(None);
+        unlimited.begin(Some(100));
+        unlimited.pass_done(1, 0.5);
+        assert_eq!(unlimited.bar.message(), "1 spp, error 0.5000");
     }
 }

@@ -364,7 +364,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         threads: args.threads,
         seed,
         progress: (!args.quiet && std::io::stderr().is_terminal())
-            .then(|| Arc::new(TerminalProgress::default()) as Arc<dyn ProgressReport>),
+            .then(|| Arc::new(TerminalProgress::new(stop.time_limit)) as Arc<dyn ProgressReport>),
     };
     let (exr_path, png_path) = output_paths(args);
     let png_path = png_path.with_extension(scene.ldr_output.format.extension());
