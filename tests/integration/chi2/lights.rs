@@ -18,7 +18,7 @@ use prism_core::light::{
 };
 use prism_core::math::{Frame, Transform};
 use prism_core::sampling::chi2::{
-    Suite, chi2_discrete, chi2_from_counts, chi2_rectangle, simpson_2d,
+    Cells, Suite, chi2_discrete, chi2_from_counts, chi2_rectangle, simpson_2d,
 };
 use prism_core::sampling::rng::Pcg32;
 use prism_core::spectrum::{SampledWavelengths, Spectrum};
@@ -65,10 +65,12 @@ fn cone_chi2(distance: f32, seed: u64, name: &str) {
     let expected_pdf = 1.0 / (2.0 * PI * one_minus_cos_max);
     let outcome = chi2_rectangle(
         SAMPLES,
-        (0.0, 1.0),
-        (0.0, 2.0 * PI),
-        30,
-        60,
+        Cells {
+            x: (0.0, 1.0),
+            y: (0.0, 2.0 * PI),
+            nx: 30,
+            ny: 60,
+        },
         seed,
         |rng| {
             let sample = s.sample_from(Vec3::ZERO, 0.5, u2(rng), ShapeSampling::SolidAngle)?;
@@ -138,10 +140,12 @@ fn rectangle_light_chi2(reference: Vec3, seed: u64, name: &str) {
     let solid_angle = simpson_2d(directional, (-0.7, 1.3), (-0.4, 0.8), 800);
     let outcome = chi2_rectangle(
         SAMPLES,
-        (-0.7, 1.3),
-        (-0.4, 0.8),
-        40,
-        24,
+        Cells {
+            x: (-0.7, 1.3),
+            y: (-0.4, 0.8),
+            nx: 40,
+            ny: 24,
+        },
         seed,
         |rng| {
             let ls = light.sample_incident(LightQuery {
@@ -204,10 +208,12 @@ fn by_area_chi2(shear: f64, sampling: ShapeSampling, seed: u64, name: &str) {
     let (e1, e2) = (DVec3::new(2.0, 0.0, 0.0), DVec3::new(1.2 * shear, 1.2, 0.0));
     let outcome = chi2_rectangle(
         SAMPLES,
-        (0.0, 1.0),
-        (0.0, 1.0),
-        30,
-        20,
+        Cells {
+            x: (0.0, 1.0),
+            y: (0.0, 1.0),
+            nx: 30,
+            ny: 20,
+        },
         seed,
         |rng| {
             let ls = light.sample_incident(LightQuery {

@@ -8,7 +8,7 @@ use prism_core::geometry::TriangleMesh;
 use prism_core::geometry::{ShapeGeometry, ShapeSampling, Sphere};
 use prism_core::light::{LightBounds, LightSampler, LightSelection, Receiver};
 use prism_core::sampling::chi2::{
-    Suite, chi2_discrete, chi2_interval, chi2_rectangle, chi2_sphere,
+    Cells, Suite, chi2_discrete, chi2_interval, chi2_rectangle, chi2_sphere,
 };
 use prism_core::sampling::rng::Pcg32;
 use prism_core::sampling::warp;
@@ -73,10 +73,12 @@ fn uniform_sphere_sampling_is_uniform() {
 fn concentric_disk_sampling_is_uniform() {
     let outcome = chi2_rectangle(
         SAMPLES,
-        (0.0, 1.0),
-        (0.0, 2.0 * PI),
-        40,
-        40,
+        Cells {
+            x: (0.0, 1.0),
+            y: (0.0, 2.0 * PI),
+            nx: 40,
+            ny: 40,
+        },
         3,
         |rng| {
             let p = warp::sample_uniform_disk_concentric(u2(rng)).as_dvec2();
@@ -284,10 +286,12 @@ fn triangle_mesh_area_sampling_is_uniform() {
     let mesh = uneven_square_mesh();
     let outcome = chi2_rectangle(
         SAMPLES,
-        (0.0, 1.0),
-        (0.0, 1.0),
-        40,
-        40,
+        Cells {
+            x: (0.0, 1.0),
+            y: (0.0, 1.0),
+            nx: 40,
+            ny: 40,
+        },
         7,
         |rng| {
             let s = mesh.sample_area(rng.next_f32(), u2(rng))?;
@@ -321,10 +325,12 @@ fn sphere_cone_sampling_is_uniform_over_the_visible_cone() {
     let frame = prism_core::math::Frame::from_normal(Vec3::Z);
     let outcome = chi2_rectangle(
         SAMPLES,
-        (cos_max, 1.0),
-        (0.0, 2.0 * PI),
-        30,
-        60,
+        Cells {
+            x: (cos_max, 1.0),
+            y: (0.0, 2.0 * PI),
+            nx: 30,
+            ny: 60,
+        },
         8,
         |rng| {
             let sample = s.sample_from(reference, 0.5, u2(rng), ShapeSampling::SolidAngle)?;

@@ -7,7 +7,7 @@
 use std::path::Path;
 
 use glam::UVec2;
-use prism_core::sampling::chi2::{assert_passes, chi2_rectangle};
+use prism_core::sampling::chi2::{Cells, assert_passes, chi2_rectangle};
 use prism_core::sampling::rng::Pcg32;
 use prism_core::sampling::sampler::{Sampler, SamplerKind};
 use prism_mitsuba::factory::build_scene;
@@ -181,10 +181,12 @@ fn points_are_uniform() {
     for (name, kind, requested, x, y) in cases {
         let outcome = chi2_rectangle(
             SAMPLES,
-            (0.0, 1.0),
-            (0.0, 1.0),
-            40,
-            40,
+            Cells {
+                x: (0.0, 1.0),
+                y: (0.0, 1.0),
+                nx: 40,
+                ny: 40,
+            },
             17,
             |rng| Some(random_point(kind, requested, x, y, rng)),
             |_, _| 1.0,

@@ -22,7 +22,7 @@ use std::path::Path;
 use glam::{DVec3, Vec2, Vec3};
 use prism_core::light::{BoundingSphere, Light, LightQuery, LightSource};
 use prism_core::math::Frame;
-use prism_core::sampling::chi2::{Suite, chi2_from_counts, chi2_rectangle};
+use prism_core::sampling::chi2::{Cells, Suite, chi2_from_counts, chi2_rectangle};
 use prism_core::sampling::rng::Pcg32;
 use prism_core::spectrum::SampledWavelengths;
 use prism_mitsuba::factory::build_scene;
@@ -708,10 +708,12 @@ fn sun_sampling_follows_its_density() {
     let mut rng = Pcg32::seeded(72);
     let outcome = chi2_rectangle(
         SAMPLES,
-        (0.0, 1.0),
-        (0.0, 2.0 * PI),
-        20,
-        40,
+        Cells {
+            x: (0.0, 1.0),
+            y: (0.0, 2.0 * PI),
+            nx: 20,
+            ny: 40,
+        },
         72,
         |_| {
             let wi = sample_direction(&light, &mut rng)?.as_dvec3();

@@ -10,7 +10,7 @@ use prism_core::geometry::Shape;
 use prism_core::geometry::ShapeGeometry;
 use prism_core::geometry::shape::Cylinder;
 use prism_core::math::{Ray, Transform};
-use prism_core::sampling::chi2::{Suite, chi2_rectangle};
+use prism_core::sampling::chi2::{Cells, Suite, chi2_rectangle};
 use prism_core::sampling::rng::Pcg32;
 use prism_mitsuba::load_scene;
 
@@ -97,10 +97,12 @@ fn area_samples_are_uniform_with_the_claimed_density() {
     let expected_pdf = 1.0 / (2.0 * PI * 0.7 * 1.9);
     let outcome = chi2_rectangle(
         1_000_000,
-        (0.0, 1.0),
-        (0.0, 1.0),
-        40,
-        20,
+        Cells {
+            x: (0.0, 1.0),
+            y: (0.0, 1.0),
+            nx: 40,
+            ny: 20,
+        },
         17,
         |rng: &mut Pcg32| {
             let s = c

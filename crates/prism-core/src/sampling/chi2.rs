@@ -342,20 +342,26 @@ pub fn chi2_interval(
     )
 }
 
-/// A density on the rectangle [x0, x1) × [y0, y1) in nx × ny equal cells; expected counts by an
-/// 8×8 composite Simpson rule per cell. Fails at once on samples outside the rectangle or NaN,
-/// on a total pdf integral above 1.1, and on samples in cells of zero expectation.
-#[allow(clippy::too_many_arguments)] // the rectangle's bounds and resolution, as for the others
+/// The rectangle [x.0, x.1) × [y.0, y.1) cut into nx × ny equal cells.
+#[derive(Clone, Copy, Debug)]
+pub struct Cells {
+    pub x: (f64, f64),
+    pub y: (f64, f64),
+    pub nx: usize,
+    pub ny: usize,
+}
+
+/// A density on the rectangle of `cells`; expected counts by an 8×8 composite Simpson rule per
+/// cell. Fails at once on samples outside the rectangle or NaN, on a total pdf integral above
+/// 1.1, and on samples in cells of zero expectation.
 pub fn chi2_rectangle(
     samples: usize,
-    x: (f64, f64),
-    y: (f64, f64),
-    nx: usize,
-    ny: usize,
+    cells: Cells,
     seed: u64,
     mut sample: impl FnMut(&mut Pcg32) -> Option<(f64, f64)>,
     pdf: impl Fn(f64, f64) -> f64,
 ) -> Result<Chi2Outcome, String> {
+    let Cells { x, y, nx, ny } = cells;
     let dx = (x.1 - x.0) / nx as f64;
     let dy = (y.1 - y.0) / ny as f64;
     let corner = |cell: usize| (x.0 + (cell % nx) as f64 * dx, y.0 + (cell / nx) as f64 * dy);
@@ -519,6 +525,14 @@ mod tests {
     use glam::Vec2;
 
     use super::*;
+
+    /// The unit square in 40 × 40 cells.
+    const UNIT_40: Cells = Cells {
+        x: (0.0, 1.0),
+        y: (0.0, 1.0),
+        nx: 40,
+        ny: 40,
+    };
 
     /// Samples per test, as docs/testing.md asks of chi-square tests.
     const SAMPLES: usize = 1_000_000;
@@ -785,16 +799,25 @@ mod tests {
     fn product_density_on_the_square_passes_and_uniform_samples_fail() {
         let pdf = |x: f64, y: f64| 4.0 * x * y;
         let sqrt = |rng: &mut Pcg32| Some((rng.next_f64().sqrt(), rng.next_f64().sqrt()));
-        let right = chi2_rectangle(SAMPLES, (0.0, 1.0), (0.0, 1.0), 40, 40, 9, sqrt, pdf).unwrap();
+        let right = chi2_rectangle(SAMPLES, UNIT_40, 9, sqrt, pdf).unwrap();
         SUITE.assert_passes("p(x, y) = 4xy", &right);
 
         let uniform = |rng: &mut Pcg32| Some((rng.next_f64(), rng.next_f64()));
-        let wrong =
-            chi2_rectangle(SAMPLES, (0.0, 1.0), (0.0, 1.0), 40, 40, 9, uniform, pdf).unwrap();
+        let wrong = chi2_rectangle(SAMPLES, UNIT_40, 9, uniform, pdf).unwrap();
         assert_fails("p(x, y) = 4xy by uniform samples", &wrong);
 
         let outside = |_: &mut Pcg32| Some((0.5, 1.0));
-        let result = chi2_rectangle(10, (0.0, 1.0), (0.0, 1.0), 4, 4, 9, outside, pdf);
+        let result = chi2_rectangle(
+            10,
+            Cells {
+                nx: 4,
+                ny: 4,
+                ..UNIT_40
+            },
+            9,
+            outside,
+            pdf,
+        );
         assert_error(result, "outside");
     }
 

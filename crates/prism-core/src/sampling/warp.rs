@@ -162,7 +162,7 @@ mod tests {
     use std::f64::consts::TAU;
 
     use super::*;
-    use crate::sampling::chi2::{Suite, chi2_rectangle};
+    use crate::sampling::chi2::{Cells, Suite, chi2_rectangle};
     use crate::sampling::rng::Pcg32;
 
     /// The polynomial cosine and sine agree with the exact values over the whole range they
@@ -266,10 +266,12 @@ mod tests {
         let one_minus_cos_max = f64::from(1.0 - cos_max);
         let outcome = chi2_rectangle(
             1_000_000,
-            (0.0, one_minus_cos_max),
-            (0.0, TAU),
-            40,
-            80,
+            Cells {
+                x: (0.0, one_minus_cos_max),
+                y: (0.0, TAU),
+                nx: 40,
+                ny: 80,
+            },
             12,
             sample,
             pdf,
