@@ -116,6 +116,8 @@ pub fn render_with_checkpoints(
     // Sums of extra channels per pixel.
     let k = AOV_SUMS_PER_CHANNEL * estimator.aov_count();
     let mut sums = tile_major(&tiles, crop.size, k, options.initial.as_ref())?;
+    // What a pass writes into: the sums before it stay whole until it completes.
+    let mut spare = Vec::new();
     let progress = options.progress.as_deref().unwrap_or(&Silent);
     let total = stop
         .sample_end
@@ -168,9 +170,8 @@ pub fn render_with_checkpoints(
         let left = stop.sample_end.map_or(u32::MAX - next, |end| end - next);
         let count = next_pass(in_passes, next - first, left, &stop, start.elapsed(), error);
         let range = next..next + count;
-        let pass_result = pool.install(|| pass.render(&sums, range.clone()));
-        let Some((new_sums, pass_rays)) = pass_result.filter(|_| !abort.load(Ordering::Relaxed))
-        else {
+        let pass_result = pool.install(|| pass.render(&sums, &mut spare, range.clone()));
+        let Some(pass_rays) = pass_result.filter(|_| !abort.load(Ordering::Relaxed)) else {
             let interrupted = options
                 .interrupt
                 .as_ref()
@@ -181,7 +182,7 @@ pub fn render_with_checkpoints(
                 StopReason::TimeLimit
             };
         };
-        sums = new_sums;
+        std::mem::swap(&mut sums, &mut spare);
         rays.fetch_add(pass_rays, Ordering::Relaxed);
         next += count;
         error = relative_error(sums.iter().flat_map(|t| &t.pixels));

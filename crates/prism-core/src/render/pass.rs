@@ -21,20 +21,22 @@ use crate::sampling::sampler::Sampler;
 /// many bytes (a batch has at least one index).
 const SHARED_SAMPLES_BYTES: usize = 64 << 20;
 
-/// Adds the samples `range` of every pixel of a tile to a copy of its sums; None when the pass
-/// was cancelled before the tile was done.
+/// Writes into `out` the sums of a tile with the samples `range` of every pixel added; returns
+/// the rays traced, or None when the pass was cancelled before the tile was done.
 fn render_tile(
     estimator: &SampleEstimator,
     tile: Tile,
     sums: &TileSums,
+    out: &mut TileSums,
     range: Range<u32>,
     options: &RenderOptions,
     cancel: &Cancel,
-) -> Option<(TileSums, u64)> {
+) -> Option<u64> {
     let scene = estimator.scene;
     let mut sampler = Sampler::new(scene.sampler.kind, options.samples_per_pixel, options.seed);
     let mut count = RayCount::default();
-    let mut sums = sums.clone();
+    out.clone_from(sums);
+    let sums = out;
     let k = estimator.aov_count();
     let stride = AOV_SUMS_PER_CHANNEL * k;
     // One sample's extra channels, reused for every sample of the tile.
@@ -55,7 +57,7 @@ fn render_tile(
             }
         }
     }
-    Some((sums, count.rays))
+    Some(count.rays)
 }
 
 /// What every pass of a render works with.
@@ -68,16 +70,19 @@ pub(super) struct Pass<'p, 's> {
 }
 
 impl Pass<'_, '_> {
-    /// Adds the samples `range` of every pixel to copies of the tiles' `sums`, in parallel; None
-    /// when the pass was cancelled.
+    /// Writes into `out` the tiles' `sums` with the samples `range` of every pixel added, the
+    /// tiles in parallel; returns the rays traced, or None when the pass was cancelled (`out`
+    /// then holds no useful sums). `out`'s allocations are reused.
     pub(super) fn render(
         &self,
         sums: &[TileSums],
+        out: &mut Vec<TileSums>,
         range: Range<u32>,
-    ) -> Option<(Vec<TileSums>, u64)> {
+    ) -> Option<u64> {
+        out.resize_with(sums.len(), TileSums::default);
         match &self.estimator.shared {
-            Some(mis) => self.render_shared(mis, sums, range),
-            None => self.render_one_pixel(sums, range),
+            Some(mis) => self.render_shared(mis, sums, out, range),
+            None => self.render_one_pixel(sums, out, range),
         }
     }
 
@@ -85,17 +90,26 @@ impl Pass<'_, '_> {
     fn render_one_pixel(
         &self,
         sums: &[TileSums],
+        out: &mut [TileSums],
         range: Range<u32>,
-    ) -> Option<(Vec<TileSums>, u64)> {
+    ) -> Option<u64> {
         let pass = u64::from(range.end - range.start);
         let (estimator, options, cancel) = (self.estimator, self.options, self.cancel);
-        let results: Vec<Option<(TileSums, u64)>> = self
+        let results: Vec<Option<u64>> = self
             .tiles
             .par_iter()
             .zip(sums)
-            .map(|(&tile, tile_sums)| {
-                let result =
-                    render_tile(estimator, tile, tile_sums, range.clone(), options, cancel);
+            .zip(out)
+            .map(|((&tile, tile_sums), tile_out)| {
+                let result = render_tile(
+                    estimator,
+                    tile,
+                    tile_sums,
+                    tile_out,
+                    range.clone(),
+                    options,
+                    cancel,
+                );
                 if result.is_some() {
                     self.progress
                         .advance(u64::from(tile.size.x * tile.size.y) * pass);
@@ -103,14 +117,7 @@ impl Pass<'_, '_> {
                 result
             })
             .collect();
-        let mut rays = 0;
-        let mut new_sums = Vec::with_capacity(results.len());
-        for result in results {
-            let (tile_sums, tile_rays) = result?;
-            new_sums.push(tile_sums);
-            rays += tile_rays;
-        }
-        Some((new_sums, rays))
+        results.into_iter().sum()
     }
 
     /// Filter MIS: for each batch of sample indices, the samples of every pixel within reach of
@@ -121,8 +128,9 @@ impl Pass<'_, '_> {
         &self,
         mis: &FilterMis,
         sums: &[TileSums],
+        out: &mut [TileSums],
         range: Range<u32>,
-    ) -> Option<(Vec<TileSums>, u64)> {
+    ) -> Option<u64> {
         let estimator = self.estimator;
         let film = &estimator.scene.film;
         let reach = UVec2::splat(mis.reach());
@@ -134,7 +142,9 @@ impl Pass<'_, '_> {
         let batch = (SHARED_SAMPLES_BYTES / bytes_per_index)
             .clamp(1, (range.end - range.start) as usize) as u32;
         let mut samples = SharedSamples::new(origin, size, batch, k, mis.reach());
-        let mut new_sums = sums.to_vec();
+        for (tile_out, tile_sums) in out.iter_mut().zip(sums) {
+            tile_out.clone_from(tile_sums);
+        }
         let mut rays = 0;
         let mut start = range.start;
         while start < range.end {
@@ -146,8 +156,7 @@ impl Pass<'_, '_> {
                 self.options,
                 self.cancel,
             )?;
-            new_sums
-                .par_iter_mut()
+            out.par_iter_mut()
                 .zip(self.tiles)
                 .for_each(|(tile_sums, &tile)| {
                     gather_tile(
@@ -165,6 +174,6 @@ impl Pass<'_, '_> {
                 });
             start = batch_range.end;
         }
-        Some((new_sums, rays))
+        Some(rays)
     }
 }

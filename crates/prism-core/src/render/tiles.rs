@@ -32,10 +32,26 @@ pub(super) fn tiles(size: UVec2) -> Vec<Tile> {
 
 /// The sums of a tile's pixels, row-major within the tile: the image's and the extra channels'
 /// (2K per pixel).
-#[derive(Clone, Debug, Default)]
+#[derive(Debug, Default)]
 pub(super) struct TileSums {
     pub(super) pixels: Vec<PixelSums>,
     pub(super) aovs: Vec<ValueSum>,
+}
+
+impl Clone for TileSums {
+    fn clone(&self) -> Self {
+        TileSums {
+            pixels: self.pixels.clone(),
+            aovs: self.aovs.clone(),
+        }
+    }
+
+    /// Copies into the allocations `self` has: a pass writes into the sums of the pass before
+    /// the last without allocating (and faulting in) a film's worth of memory.
+    fn clone_from(&mut self, source: &Self) {
+        self.pixels.clone_from(&source.pixels);
+        self.aovs.clone_from(&source.aovs);
+    }
 }
 
 /// Pixel sums regrouped by tile (each tile's pixels row-major), from row-major sums with `k`
