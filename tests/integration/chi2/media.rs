@@ -1,10 +1,12 @@
-//! Chi-square tests of the media's sampling routines: the Henyey–Greenstein and blended phase
-//! functions against their densities, and free-flight distances against m·exp(−m t) with the
+//! Chi-square tests of the media's sampling routines: the Henyey–Greenstein, Rayleigh,
+//! tabulated and blended phase functions against their densities, and free-flight distances against m·exp(−m t) with the
 //! probability exp(−m L) of passing the segment.
 
 use glam::{Vec2, Vec3};
 use prism_core::medium::sample_free_flight;
-use prism_core::medium::{BlendPhase, HenyeyGreenstein, Isotropic, PhaseFunction, PhaseModel};
+use prism_core::medium::{
+    BlendPhase, HenyeyGreenstein, Isotropic, PhaseFunction, PhaseModel, Rayleigh, TabulatedPhase,
+};
 use prism_core::sampling::chi2::{Suite, chi2_interval, chi2_sphere};
 
 /// The chi-square tests of this module, one name per statistic: the suite of Šidák's correction.
@@ -13,6 +15,9 @@ const SUITE: Suite = Suite::new(&[
     "hg g = -0.4",
     "isotropic",
     "blendphase",
+    "rayleigh",
+    "tabphase forward",
+    "tabphase two bumps",
     "free flight m = 0.8",
     "free flight m = 3",
 ]);
@@ -88,6 +93,50 @@ fn blendphase_follows_the_mixture_density() {
         }),
         Vec3::new(0.1, 0.9, 0.4),
         4,
+    );
+}
+
+#[test]
+fn rayleigh_follows_its_density() {
+    phase_chi2(
+        "rayleigh",
+        &PhaseFunction::Rayleigh(Rayleigh),
+        Vec3::new(0.2, -0.7, 0.3),
+        5,
+    );
+}
+
+#[test]
+fn tabphase_follows_its_density() {
+    // Mostly forward scattering, and a table with a zero stretch between two bumps.
+    let forward = TabulatedPhase::new(&[0.1, 0.2, 0.4, 1.0, 3.0, 9.0]).unwrap();
+    phase_chi2(
+        "tabphase forward",
+        &PhaseFunction::Tabulated(forward),
+        Vec3::new(0.6, 0.1, -0.4),
+        6,
+    );
+    let bumps = TabulatedPhase::new(&[2.0, 0.5, 0.0, 0.0, 0.0, 1.0, 4.0, 0.3]).unwrap();
+    phase_chi2(
+        "tabphase two bumps",
+        &PhaseFunction::Tabulated(bumps),
+        Vec3::new(-0.1, 0.2, 0.95),
+        7,
+    );
+}
+
+#[test]
+fn tabphase_scatters_forward_where_its_table_is_large_at_cosine_one() {
+    // Physics convention: the table's last value is forward scattering, wi = −wo.
+    let forward = TabulatedPhase::new(&[0.0, 0.0, 1.0]).unwrap();
+    let wo = Vec3::new(0.0, 0.0, 1.0);
+    assert!(forward.eval(wo, -wo) > 0.3);
+    assert_eq!(forward.eval(wo, wo), 0.0);
+    let s = forward.sample(wo, Vec2::new(0.99, 0.3));
+    assert!(
+        s.wi.dot(-wo) > 0.8,
+        "a sample near u = 1 is close to forward: {:?}",
+        s.wi
     );
 }
 

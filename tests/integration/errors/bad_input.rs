@@ -924,6 +924,38 @@ fn media_cases() -> Vec<Case> {
             "(-1, 1)",
         ),
         render_scene(
+            "tabphase value not a number",
+            scene!(
+                "    <medium type=\"homogeneous\" id=\"fog\"><phase type=\"tabphase\"><string name=\"values\" value=\"1, x, 2\"/></phase></medium>"
+            ),
+            "scene.xml:3:",
+            "\"x\" is not a number",
+        ),
+        render_scene(
+            "tabphase with a negative value",
+            scene!(
+                "    <medium type=\"homogeneous\" id=\"fog\"><phase type=\"tabphase\"><string name=\"values\" value=\"1, -2, 2\"/></phase></medium>"
+            ),
+            "scene.xml:3:",
+            "none negative",
+        ),
+        render_scene(
+            "tabphase without values",
+            scene!(
+                "    <medium type=\"homogeneous\" id=\"fog\"><phase type=\"tabphase\"/></medium>"
+            ),
+            "scene.xml:3:",
+            "needs its \"values\"",
+        ),
+        render_scene(
+            "tabphase with one value",
+            scene!(
+                "    <medium type=\"homogeneous\" id=\"fog\"><phase type=\"tabphase\"><string name=\"values\" value=\"3\"/></phase></medium>"
+            ),
+            "scene.xml:3:",
+            "at least two",
+        ),
+        render_scene(
             "misspelt medium parameter",
             scene!(
                 "    <medium type=\"homogeneous\" id=\"fog\"><float name=\"sigmat\" value=\"1\"/></medium>"

@@ -44,7 +44,10 @@ pub mod volume;
 
 use glam::Vec3;
 
-pub use phase::{BlendPhase, HenyeyGreenstein, Isotropic, PhaseFunction, PhaseModel, PhaseSample};
+pub use phase::{
+    BlendPhase, HenyeyGreenstein, Isotropic, PhaseFunction, PhaseModel, PhaseSample, Rayleigh,
+    TabulatedPhase,
+};
 pub use volume::{GridFilter, GridVolume, Volume};
 
 use crate::dispatch::plugin_class;

@@ -1,5 +1,5 @@
 //! Phase functions: the angular distribution of light scattered in a medium (Mitsuba 3's
-//! `isotropic`, `hg` and `blendphase`).
+//! `isotropic`, `hg`, `rayleigh`, `tabphase` and `blendphase`).
 //!
 //! Conventions follow the BSDFs': `wo` points back along the path (towards the camera), `wi`
 //! towards where the light comes from, both unit vectors in world space. Every phase function
@@ -12,6 +12,7 @@ use glam::{Vec2, Vec3};
 
 use crate::dispatch::plugin_class;
 use crate::math::Frame;
+use crate::sampling::distribution::PiecewiseLinear1D;
 use crate::sampling::warp::{sample_uniform_sphere, uniform_sphere_pdf};
 
 plugin_class! {
@@ -30,6 +31,8 @@ plugin_class! {
     pub enum PhaseFunction {
         Isotropic(Isotropic),
         HenyeyGreenstein(HenyeyGreenstein),
+        Rayleigh(Rayleigh),
+        Tabulated(TabulatedPhase),
         Blend(BlendPhase),
     }
 }
@@ -100,6 +103,86 @@ impl PhaseModel for HenyeyGreenstein {
         PhaseSample {
             wi,
             pdf: henyey_greenstein(cos_theta, g),
+        }
+    }
+}
+
+/// The direction at polar angle θ from `axis` (cos θ given) and azimuth 2π·`u_phi` around it.
+#[inline]
+fn direction_around(axis: Vec3, cos_theta: f32, u_phi: f32) -> Vec3 {
+    let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
+    let phi = 2.0 * PI * u_phi;
+    let local = Vec3::new(sin_theta * phi.cos(), sin_theta * phi.sin(), cos_theta);
+    Frame::from_normal(axis).to_world(local).normalize()
+}
+
+/// Rayleigh scattering by particles much smaller than the wavelength, Mitsuba 3's `rayleigh`:
+/// p(θ) = 3 (1 + cos²θ) / (16π), symmetric between forward and backward (Chandrasekhar 1960,
+/// "Radiative Transfer", §17; the wavelength dependence of the scattering coefficient belongs to
+/// the medium's σ_s, not to the phase function).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Rayleigh;
+
+/// The Rayleigh density for cos θ.
+#[inline]
+pub fn rayleigh(cos_theta: f32) -> f32 {
+    3.0 / (16.0 * PI) * (1.0 + cos_theta * cos_theta)
+}
+
+impl PhaseModel for Rayleigh {
+    #[inline]
+    fn eval(&self, wo: Vec3, wi: Vec3) -> f32 {
+        rayleigh(wo.dot(wi))
+    }
+
+    /// By inverting the CDF of μ = cos θ, F(μ) = (μ³ + 3μ + 4)/8: the cubic μ³ + 3μ − 2z = 0
+    /// with z = 2(2u₀ − 1) has the one real root μ = ∛(z + √(z² + 1)) + ∛(z − √(z² + 1))
+    /// (Cardano; as Mitsuba 3), and φ = 2π·u₁.
+    fn sample(&self, wo: Vec3, u: Vec2) -> PhaseSample {
+        let z = 2.0 * (2.0 * u.x - 1.0);
+        let root = (z * z + 1.0).sqrt();
+        let cos_theta = ((z + root).cbrt() + (z - root).cbrt()).clamp(-1.0, 1.0);
+        let wi = direction_around(wo, cos_theta, u.y);
+        PhaseSample {
+            wi,
+            pdf: rayleigh(cos_theta),
+        }
+    }
+}
+
+/// A phase function tabulated over the cosine of the scattering angle, Mitsuba 3's `tabphase`:
+/// the values at equally spaced cosines from −1 to 1, interpolated linearly and normalised.
+///
+/// The table's cosine is that of the physics convention, where 1 is forward scattering: with
+/// `wo` and `wi` both pointing away from the scattering point, cos θ = −wo·wi. The density per
+/// unit solid angle is p(cos θ)/(2π), p the normalised piecewise-linear density on [−1, 1], and a
+/// sample draws cos θ from p and the azimuth uniformly.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TabulatedPhase {
+    cosines: PiecewiseLinear1D,
+}
+
+impl TabulatedPhase {
+    /// The phase function through `values` (at least two, finite, non-negative, not all zero);
+    /// None otherwise.
+    pub fn new(values: &[f32]) -> Option<TabulatedPhase> {
+        PiecewiseLinear1D::new(values, -1.0, 1.0).map(|cosines| TabulatedPhase { cosines })
+    }
+}
+
+impl PhaseModel for TabulatedPhase {
+    #[inline]
+    fn eval(&self, wo: Vec3, wi: Vec3) -> f32 {
+        self.cosines.pdf((-wo.dot(wi)).clamp(-1.0, 1.0)) / (2.0 * PI)
+    }
+
+    fn sample(&self, wo: Vec3, u: Vec2) -> PhaseSample {
+        let cos_theta = self.cosines.sample(u.x);
+        // Forward scattering continues the path's direction, −wo.
+        let wi = direction_around(-wo, cos_theta, u.y);
+        PhaseSample {
+            wi,
+            pdf: self.eval(wo, wi),
         }
     }
 }

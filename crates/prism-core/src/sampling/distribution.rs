@@ -1,6 +1,6 @@
 //! Tabulated distributions: a piecewise-constant density on an interval (sampled by its inverse
-//! CDF), its extension to the unit square, and the alias table for discrete choices in constant
-//! time.
+//! CDF), its extension to the unit square, a piecewise-linear density on an interval, and the
+//! alias table for discrete choices in constant time.
 
 use glam::Vec2;
 
@@ -234,6 +234,89 @@ impl PiecewiseConstant2D {
         let row = ((p.y * self.rows.len() as f32) as usize).min(self.rows.len() - 1);
         let ux = self.rows[row].invert(p.x)?;
         Some(Vec2::new(ux, uy))
+    }
+}
+
+/// A piecewise-linear density on `[min, max]` through values at `n ≥ 2` equally spaced nodes
+/// (the first at `min`, the last at `max`), normalised to integrate to one: Mitsuba 3's
+/// `ContinuousDistribution`. Sampled by its inverse CDF: the interval [x_i, x_i+1] is found
+/// from the cumulative trapezoid areas, and within it the density y(s) = y_i + (y_i+1 − y_i) s/Δ
+/// has the area A(s) = y_i s + (y_i+1 − y_i) s²/(2Δ), so the point with A(s) = a is
+/// s = 2a / (y_i + sqrt(y_i² + 2 (y_i+1 − y_i) a/Δ)) (the root of the quadratic written without
+/// cancellation; it is a/y_i where the density is flat).
+#[derive(Clone, Debug, PartialEq)]
+pub struct PiecewiseLinear1D {
+    /// The normalised density at each node.
+    density: Vec<f64>,
+    /// cdf[i] = the probability of [min, x_i]; cdf[0] = 0, cdf[n − 1] = 1.
+    cdf: Vec<f64>,
+    min: f64,
+    max: f64,
+    /// The spacing Δ of the nodes, (max − min) / (n − 1).
+    spacing: f64,
+}
+
+impl PiecewiseLinear1D {
+    /// The density through `values` (at least two, finite and non-negative, not all zero) on
+    /// `[min, max]` (min < max); None otherwise.
+    pub fn new(values: &[f32], min: f32, max: f32) -> Option<PiecewiseLinear1D> {
+        let valid = values.len() >= 2
+            && min < max
+            && values.iter().all(|v| v.is_finite() && *v >= 0.0)
+            && values.iter().any(|v| *v > 0.0);
+        if !valid {
+            return None;
+        }
+        let (min, max) = (f64::from(min), f64::from(max));
+        let spacing = (max - min) / (values.len() - 1) as f64;
+        let mut cdf = Vec::with_capacity(values.len());
+        let mut total = 0.0;
+        cdf.push(total);
+        for pair in values.windows(2) {
+            total += 0.5 * (f64::from(pair[0]) + f64::from(pair[1])) * spacing;
+            cdf.push(total);
+        }
+        for c in &mut cdf {
+            *c /= total;
+        }
+        Some(PiecewiseLinear1D {
+            density: values.iter().map(|v| f64::from(*v) / total).collect(),
+            cdf,
+            min,
+            max,
+            spacing,
+        })
+    }
+
+    /// The density at `x` (zero outside `[min, max]`).
+    pub fn pdf(&self, x: f32) -> f32 {
+        let x = f64::from(x);
+        if !(x >= self.min && x <= self.max) {
+            return 0.0;
+        }
+        let position = (x - self.min) / self.spacing;
+        let i = (position as usize).min(self.density.len() - 2);
+        let t = position - i as f64;
+        (self.density[i] * (1.0 - t) + self.density[i + 1] * t) as f32
+    }
+
+    /// Maps `u` in [0, 1) to a point of `[min, max]` with density [`Self::pdf`].
+    pub fn sample(&self, u: f32) -> f32 {
+        let u = f64::from(u);
+        // The interval whose cumulative probabilities bracket u (never one of zero width).
+        let i = (self.cdf.partition_point(|c| *c <= u).max(1) - 1).min(self.cdf.len() - 2);
+        let area = (u - self.cdf[i]).max(0.0);
+        let (y0, y1) = (self.density[i], self.density[i + 1]);
+        let root = (y0 * y0 + 2.0 * (y1 - y0) * area / self.spacing)
+            .max(0.0)
+            .sqrt();
+        let s = if y0 + root > 0.0 {
+            2.0 * area / (y0 + root)
+        } else {
+            0.0
+        };
+        let x = self.min + i as f64 * self.spacing + s.min(self.spacing);
+        (x.min(self.max) as f32).max(self.min as f32)
     }
 }
 

@@ -1,5 +1,6 @@
 //! Participating media, their phase functions and volumes: Mitsuba 3's `homogeneous` and
-//! `heterogeneous` media, `isotropic`, `hg` and `blendphase` phase functions, and `constvolume`
+//! `heterogeneous` media, `isotropic`, `hg`, `rayleigh`, `tabphase` and `blendphase` phase
+//! functions, and `constvolume`
 //! and `gridvolume` volumes (Mitsuba's binary `.vol` files).
 
 use glam::DMat4;
@@ -15,7 +16,8 @@ use prism_core::math::Transform;
 use prism_core::medium::volume::parse_vol;
 use prism_core::medium::{
     BlendPhase, GridFilter, GridVolume, HenyeyGreenstein, Heterogeneous, Homogeneous,
-    HomogeneousAbsorbingScattering, Isotropic, Medium, MediumKind, PhaseFunction, Volume,
+    HomogeneousAbsorbingScattering, Isotropic, Medium, MediumKind, PhaseFunction, Rayleigh,
+    TabulatedPhase, Volume,
 };
 use prism_core::spectrum::Spectrum;
 
@@ -75,6 +77,23 @@ pub static PHASES: Registry<BuildPhase> = Registry {
             build: build_hg,
         },
         Plugin {
+            name: "rayleigh",
+            origin: Origin::Mitsuba3,
+            summary: "Rayleigh scattering by small particles, p = 3 (1 + cos²θ)/(16π); sampled \
+                      exactly.",
+            params: &[],
+            build: |_| Ok(PhaseFunction::Rayleigh(Rayleigh)),
+        },
+        Plugin {
+            name: "tabphase",
+            origin: Origin::Mitsuba3,
+            summary: "Tabulated over the cosine of the scattering angle (1 = forward), values at \
+                      equal steps from −1 to 1, interpolated linearly and normalised; sampled \
+                      exactly.",
+            params: &[PHASE_VALUES],
+            build: build_tabphase,
+        },
+        Plugin {
             name: "blendphase",
             origin: Origin::Mitsuba3,
             summary: "(1 − weight) · p₀ + weight · p₁ of two nested phase functions.",
@@ -117,6 +136,7 @@ params! {
     SAMPLE_EMITTERS = ParamSpec::new("sample_emitters", ParamKind::Boolean, Default::Boolean(true), "sample lights at scattering points in the medium (next-event estimation)");
     PHASE = ParamSpec::nested(PluginClass::Phase, Default::Text("`isotropic`"), "the phase function");
     G = ParamSpec::new("g", ParamKind::Float, Default::Float(0.8), "mean cosine of the deflection, in (−1, 1): > 0 forward, < 0 backward");
+    PHASE_VALUES = ParamSpec::new("values", ParamKind::String, Default::Required, "the phase function's values at equally spaced cosines from −1 to 1, separated by commas or spaces (at least two, not negative, not all zero)");
     PHASE_WEIGHT = ParamSpec::new("weight", ParamKind::FloatIn(Bounds::UNIT), Default::Float(0.5), "weight of the second phase function");
     BLENDED_PHASES = ParamSpec::nested(PluginClass::Phase, Default::Required, "the two phase functions");
     VALUE = ParamSpec::new("value", ParamKind::Spectrum { range: Range::Coefficient, textured: false, }, Default::Float(1.0), "the value");
@@ -295,6 +315,44 @@ fn build_hg(params: &Params) -> Result<PhaseFunction> {
     Ok(PhaseFunction::HenyeyGreenstein(HenyeyGreenstein {
         g: g as f32,
     }))
+}
+
+fn build_tabphase(params: &Params) -> Result<PhaseFunction> {
+    let node = params.node();
+    let text = params.string_opt(&PHASE_VALUES)?.ok_or_else(|| {
+        Error::input(
+            &node.location,
+            format!("{} needs its \"values\"", node.describe()),
+        )
+        .with_help("add <string name=\"values\" value=\"0.5, 1, 2\"/>: the phase function at equally spaced cosines from -1 to 1")
+    })?;
+    let location = params.location_of(&PHASE_VALUES);
+    let mut values = Vec::new();
+    for item in text
+        .split([',', ' '])
+        .filter(|item| !item.trim().is_empty())
+    {
+        let value: f32 = item.trim().parse().map_err(|_| {
+            Error::input(
+                location,
+                format!("the tabphase value \"{}\" is not a number", item.trim()),
+            )
+        })?;
+        values.push(value);
+    }
+    TabulatedPhase::new(&values)
+        .map(PhaseFunction::Tabulated)
+        .ok_or_else(|| {
+            Error::input(
+                location,
+                format!(
+                    "a tabphase needs at least two finite values, none negative and not all zero; \
+                     {} were given",
+                    values.len()
+                ),
+            )
+            .with_help("list the phase function at equally spaced cosines from -1 to 1, such as \"0.5, 1, 2\"")
+        })
 }
 
 fn build_blendphase(params: &Params) -> Result<PhaseFunction> {
