@@ -12,11 +12,12 @@ use std::ops::Range;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, AtomicI32, Ordering};
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 use clap::Args;
 use glam::UVec2;
 
+use super::display_server::{DisplayServer, parse_address};
 use super::progress_bar::TerminalProgress;
 use crate::accel::Accel;
 use prism_core::error::{Error, Result};
@@ -26,8 +27,8 @@ use prism_core::film::{CropWindow, PixelSums, Reconstruction};
 use prism_core::integrator::RayCount;
 use prism_core::render::state::{RenderIdentity, RenderState};
 use prism_core::render::{
-    Checkpoints, ProgressReport, RenderOptions, SampleEstimator, Snapshot, StopReason, StopRule,
-    StopRuleNames, render_with_checkpoints,
+    Checkpoints, Preview, ProgressReport, RenderOptions, SampleEstimator, Snapshot, StopReason,
+    StopRule, StopRuleNames, render_with_preview,
 };
 use prism_core::sampling::sampler::Sampler;
 use prism_core::scene::Scene;
@@ -97,6 +98,16 @@ pub struct RenderArgs {
     /// interrupted render are still printed)
     #[arg(short, long)]
     pub quiet: bool,
+    /// Print how long loading the scene, building its BVH and rendering took
+    #[arg(short, long, conflicts_with = "quiet")]
+    pub verbose: bool,
+    /// Show the image in a viewer speaking tev's protocol at HOST:PORT (tev listens on
+    /// 127.0.0.1:14158): sent when the render starts, after every pass and at the end
+    #[arg(long, value_name = "HOST:PORT", value_parser = parse_address)]
+    pub display_server: Option<String>,
+    /// Replace the EXR and PNG with the image so far every --checkpoint-every seconds
+    #[arg(long)]
+    pub write_partial_images: bool,
 }
 
 pub(crate) fn parse_define(text: &str) -> Result<(String, String), String> {
@@ -261,12 +272,18 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         ));
     }
     args.accel.check_available()?;
+    let load_start = Instant::now();
     let loaded = load_scene(&args.scene, &args.defines)?;
+    let load_time = load_start.elapsed();
     for warning in &loaded.warnings {
         eprintln!("{warning}");
     }
     let mut scene = loaded.scene;
+    let accel_start = Instant::now();
     args.accel.apply(&mut scene.world.geometry)?;
+    if args.verbose {
+        print_load_times(&scene, load_time, accel_start.elapsed());
+    }
     let crop = match (args.crop, args.pixel) {
         (Some(_), Some(_)) => return Err(Error::usage("give either --crop or --pixel, not both")),
         (Some([x0, y0, x1, y1]), None) => Some([x0, y0, x1, y1]),
@@ -399,14 +416,47 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     };
     let checkpoints =
         args.checkpoint.is_some() || args.resume.is_some() || args.sample_range.is_some();
-    let output = render_with_checkpoints(
+    let every = Duration::from_secs_f64(args.checkpoint_every);
+    let mut display = args.display_server.as_deref().map(|address| {
+        let size = scene.film.crop.size;
+        DisplayServer::connect(address, &exr_path.display().to_string(), size.x, size.y)
+    });
+    let previewing = display.is_some() || args.write_partial_images;
+    let mut last_partial_images = Instant::now();
+    let mut preview = |snapshot: &Snapshot| -> Result<()> {
+        let partial_images_due =
+            args.write_partial_images && last_partial_images.elapsed() >= every;
+        if display.is_none() && !partial_images_due {
+            return Ok(());
+        }
+        let film = snapshot.film(&scene);
+        if let Some(display) = &mut display {
+            display.show(&film);
+        }
+        if partial_images_due {
+            write_images_with(&film, &exr_path, &png_path, &scene.ldr_output)?;
+            last_partial_images = Instant::now();
+        }
+        Ok(())
+    };
+    let output = render_with_preview(
         &scene,
         &options,
-        checkpoints.then(|| Checkpoints {
-            every: Duration::from_secs_f64(args.checkpoint_every),
+        checkpoints.then_some(Checkpoints {
+            every,
             write: &mut write_checkpoint,
         }),
+        previewing.then_some(&mut preview as Preview),
     )?;
+    if let Some(display) = &mut display {
+        display.show(&output.film);
+    }
+    if args.verbose {
+        eprintln!(
+            "prism: rendering took {:.3} s",
+            output.elapsed.as_secs_f64()
+        );
+    }
     write_images_with(&output.film, &exr_path, &png_path, &scene.ldr_output)?;
     if output.stop == StopReason::Interrupted && !checkpoints {
         // An interrupted render always leaves a state to resume from.
@@ -431,6 +481,28 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         std::process::exit(128 + if received == 0 { 2 } else { received });
     }
     Ok(())
+}
+
+/// `--verbose`: how long reading the scene and its meshes took, and building the BVH (which
+/// loading includes), and Embree's scene when it answers the queries (`embree_time`).
+fn print_load_times(scene: &Scene, load_time: Duration, embree_time: Duration) {
+    let geometry = &scene.world.geometry;
+    let bvh_time = geometry.build_time();
+    eprintln!(
+        "prism: loading the scene took {:.3} s (the scene file and its meshes)",
+        load_time.saturating_sub(bvh_time).as_secs_f64()
+    );
+    eprintln!(
+        "prism: building the BVH took {:.3} s ({} primitives)",
+        bvh_time.as_secs_f64(),
+        geometry.primitive_count()
+    );
+    if Accel::of(geometry) == Accel::Embree {
+        eprintln!(
+            "prism: building Embree's scene took {:.3} s",
+            embree_time.as_secs_f64()
+        );
+    }
 }
 
 /// The arguments a resumed render must repeat.

@@ -1,5 +1,6 @@
 //! The command line's help and output: at 80 columns (`COLUMNS=80`) no line of `prism --help`
-//! or of any subcommand's `--help` is wider; `--quiet` renders without a word.
+//! or of any subcommand's `--help` is wider; `--quiet` renders without a word, `--verbose`
+//! says how long loading, the BVH build and rendering took.
 
 use std::process::Command;
 
@@ -66,4 +67,38 @@ fn a_quiet_render_prints_nothing() {
         output.stdout.is_empty() && output.stderr.is_empty(),
         "{output:?}"
     );
+}
+
+#[test]
+fn a_verbose_render_gives_its_times() {
+    let out = std::env::temp_dir().join(format!("prism-verbose-{}.exr", std::process::id()));
+    let output = Command::new(env!("CARGO_BIN_EXE_prism"))
+        .args([
+            "render",
+            "scenes/cornell-box/scene.xml",
+            "--spp",
+            "1",
+            "-v",
+            "-o",
+        ])
+        .arg(&out)
+        .args(["-D", "resx=16", "-D", "resy=16"])
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .expect("the prism binary runs");
+    let _ = std::fs::remove_file(&out);
+    let _ = std::fs::remove_file(out.with_extension("png"));
+    assert!(output.status.success(), "{output:?}");
+    let text = String::from_utf8_lossy(&output.stderr);
+    for line in [
+        "prism: loading the scene took ",
+        "prism: building the BVH took ",
+        "prism: rendering took ",
+    ] {
+        assert!(
+            text.lines()
+                .any(|l| l.starts_with(line) && l.contains(" s")),
+            "no line \"{line}...\" in:\n{text}"
+        );
+    }
 }
