@@ -1,5 +1,6 @@
 //! The command line's help and output: at 80 columns (`COLUMNS=80`) no line of `prism --help`
-//! or of any subcommand's `--help` is wider; `--quiet` renders without a word, `--verbose`
+//! or of any subcommand's `--help` is wider, and `prism render --help` groups its options under
+//! headings and ends with examples; `--quiet` renders without a word, `--verbose`
 //! says how long loading, the BVH build and rendering took.
 
 use std::process::Command;
@@ -35,6 +36,33 @@ fn no_help_line_is_wider_than_80_columns() {
             wide.join("\n")
         );
     }
+}
+
+#[test]
+fn render_help_groups_its_options_and_ends_with_three_examples() {
+    let text = help(&["render"], 80);
+    for heading in [
+        "Scene:",
+        "Output:",
+        "Sampling:",
+        "Stopping:",
+        "Checkpoints and render farms:",
+        "Progress and preview:",
+        "Performance:",
+    ] {
+        assert!(
+            text.lines().any(|l| l == heading),
+            "no {heading} in:\n{text}"
+        );
+    }
+    let examples = text
+        .split_once("\nExamples:\n")
+        .map(|(_, examples)| examples)
+        .unwrap_or_else(|| panic!("no examples in:\n{text}"));
+    let commands = examples
+        .lines()
+        .filter(|l| l.starts_with("  prism render "));
+    assert_eq!(commands.count(), 3, "{examples}");
 }
 
 #[test]
