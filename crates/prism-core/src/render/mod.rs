@@ -51,7 +51,7 @@ use tiles::{row_major, tile_major, tiles};
 /// run to depths of a few hundred. Only the pages used are ever touched.
 const WORKER_STACK_BYTES: usize = 64 << 20;
 
-/// The state of a render between two passes, handed to the checkpoint writer.
+/// The state of a render between two passes, handed to the checkpoint writer and the preview.
 pub struct Snapshot<'a> {
     /// The sample indices every pixel has had in this render (after its initial state).
     pub samples: Range<u32>,
