@@ -13,6 +13,7 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Render a scene to an OpenEXR image (linear) and a PNG (sRGB) beside it.
+    #[command(after_help = prism::cli::render::EXAMPLES)]
     Render(prism::cli::render::RenderArgs),
     /// Compare two EXR images: means, MSE, relative MSE, a z-test, a difference image.
     Compare(prism::cli::compare::CompareArgs),

@@ -1,8 +1,10 @@
-//! The subcommands of the `prism` program, one per file.
+//! The subcommands of the `prism` program, one per file, and what `prism render` shows while it
+//! runs: the progress bar and the image sent to a display server.
 
 pub mod bench;
 pub mod compare;
 pub mod converge;
+pub mod display_server;
 pub mod merge;
 pub mod plugins;
 pub mod progress_bar;

@@ -12,11 +12,12 @@ use std::ops::Range;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, AtomicI32, Ordering};
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 use clap::Args;
 use glam::UVec2;
 
+use super::display_server::{DisplayServer, parse_address};
 use super::progress_bar::TerminalProgress;
 use crate::accel::Accel;
 use prism_core::error::{Error, Result};
@@ -26,8 +27,8 @@ use prism_core::film::{CropWindow, PixelSums, Reconstruction};
 use prism_core::integrator::RayCount;
 use prism_core::render::state::{RenderIdentity, RenderState};
 use prism_core::render::{
-    Checkpoints, ProgressReport, RenderOptions, SampleEstimator, Snapshot, StopReason, StopRule,
-    StopRuleNames, render_with_checkpoints,
+    Checkpoints, Preview, ProgressReport, RenderOptions, SampleEstimator, Snapshot, StopReason,
+    StopRule, StopRuleNames, render_with_preview,
 };
 use prism_core::sampling::sampler::Sampler;
 use prism_core::scene::Scene;
@@ -35,68 +36,98 @@ use prism_core::spectrum::WavelengthSampling;
 use prism_mitsuba::fingerprint::{override_reconstruction, override_wavelengths};
 use prism_mitsuba::load_scene;
 
+/// The headings grouping `prism render --help`'s options.
+const SCENE: &str = "Scene";
+const OUTPUT: &str = "Output";
+const SAMPLING: &str = "Sampling";
+const STOPPING: &str = "Stopping";
+const CHECKPOINTS: &str = "Checkpoints and render farms";
+const PROGRESS: &str = "Progress and preview";
+const PERFORMANCE: &str = "Performance";
+const DEBUGGING: &str = "Debugging";
+
+/// The examples at the end of `prism render --help`.
+pub const EXAMPLES: &str = "\
+Examples:
+  prism render scenes/cornell-box/scene.xml --spp 64
+      the Cornell box at 64 samples per pixel: cornell-box.exr and .png
+  prism render scene.xml --time-limit 600 --checkpoint run.state
+      ten minutes of samples; `--resume run.state --spp 4096` carries on
+  prism render scene.xml -D resx=1920 --display-server 127.0.0.1:14158
+      a parameter set, the image shown as it develops in tev";
+
 #[derive(Args, Debug)]
 pub struct RenderArgs {
     /// The Mitsuba 3 XML scene file.
     pub scene: PathBuf,
+    /// Set a scene parameter declared with `<default name=... value=...>` (repeatable)
+    #[arg(short = 'D', long = "define", value_name = "NAME=VALUE", value_parser = parse_define, help_heading = SCENE)]
+    pub defines: Vec<(String, String)>,
     /// Output EXR file; the PNG goes beside it [default: the scene's name in the current folder;
     /// for a file called scene.xml, the name of its folder]
-    #[arg(short, long, value_name = "OUT.exr")]
+    #[arg(short, long, value_name = "OUT.exr", help_heading = OUTPUT)]
     pub output: Option<PathBuf>,
     /// Samples per pixel [default: the scene's sampler]
-    #[arg(long, value_name = "N")]
+    #[arg(long, value_name = "N", help_heading = SAMPLING)]
     pub spp: Option<u32>,
-    /// Worker threads [default: one per core]
-    #[arg(long, value_name = "T")]
-    pub threads: Option<usize>,
     /// Seed of the random numbers [default: the sampler's seed, else 0]
-    #[arg(long, value_name = "S")]
+    #[arg(long, value_name = "S", help_heading = SAMPLING)]
     pub seed: Option<u64>,
-    /// Set a scene parameter declared with `<default name=... value=...>` (repeatable)
-    #[arg(short = 'D', long = "define", value_name = "NAME=VALUE", value_parser = parse_define)]
-    pub defines: Vec<(String, String)>,
     /// Render only the pixels x0 <= x < x1, y0 <= y < y1 of the film
-    #[arg(long, value_name = "X0,Y0,X1,Y1", value_parser = parse_crop)]
+    #[arg(long, value_name = "X0,Y0,X1,Y1", value_parser = parse_crop, help_heading = OUTPUT)]
     pub crop: Option<[u32; 4]>,
     /// Stop after this many seconds (the pass running then is dropped); without --spp the
     /// number of samples is open-ended
-    #[arg(long, value_name = "SECONDS")]
+    #[arg(long, value_name = "SECONDS", help_heading = STOPPING)]
     pub time_limit: Option<f64>,
     /// Render in passes until the image's mean relative standard error is at most E; without
     /// --spp the number of samples is open-ended
-    #[arg(long, value_name = "E")]
+    #[arg(long, value_name = "E", help_heading = STOPPING)]
     pub target_error: Option<f64>,
     /// Save the render state here every --checkpoint-every seconds and at the end
-    #[arg(long, value_name = "PATH")]
+    #[arg(long, value_name = "PATH", help_heading = CHECKPOINTS)]
     pub checkpoint: Option<PathBuf>,
     /// Seconds between checkpoints
-    #[arg(long, value_name = "SECONDS", default_value_t = 60.0)]
+    #[arg(long, value_name = "SECONDS", default_value_t = 60.0, help_heading = CHECKPOINTS)]
     pub checkpoint_every: f64,
     /// Continue the render saved in this state (to the requested samples per pixel)
-    #[arg(long, value_name = "PATH")]
+    #[arg(long, value_name = "PATH", help_heading = CHECKPOINTS)]
     pub resume: Option<PathBuf>,
     /// Render only the sample indices START..END of every pixel, for `prism merge`
-    #[arg(long, value_name = "START..END", value_parser = parse_range)]
+    #[arg(long, value_name = "START..END", value_parser = parse_range, help_heading = CHECKPOINTS)]
     pub sample_range: Option<Range<u32>>,
     /// Render only pixel x,y and print every sample's value (to find the source of NaNs)
-    #[arg(long, value_name = "X,Y", value_parser = parse_pixel)]
+    #[arg(long, value_name = "X,Y", value_parser = parse_pixel, help_heading = DEBUGGING)]
     pub pixel: Option<[u32; 2]>,
+    /// Worker threads [default: one per core]
+    #[arg(long, value_name = "T", help_heading = PERFORMANCE)]
+    pub threads: Option<usize>,
     /// Trace rays with our BVH (bvh) or, for comparison, with Embree (embree; needs a build
     /// with `--features embree`)
-    #[arg(long, value_name = "ACCEL", default_value = "bvh")]
+    #[arg(long, value_name = "ACCEL", default_value = "bvh", help_heading = PERFORMANCE)]
     pub accel: Accel,
     /// Draw wavelengths from this density instead of the film's `wavelength_sampling`:
     /// balanced, cie_sum, visible or uniform
-    #[arg(long, value_name = "DENSITY", value_parser = parse_wavelengths)]
+    #[arg(long, value_name = "DENSITY", value_parser = parse_wavelengths, help_heading = SAMPLING)]
     pub wavelengths: Option<WavelengthSampling>,
     /// How samples become pixels, instead of the film's `reconstruction`: filter_mis (every
     /// sample feeds every pixel its filter covers) or pixel (the lecture's one-pixel estimator)
-    #[arg(long, value_name = "METHOD", value_parser = parse_reconstruction)]
+    #[arg(long, value_name = "METHOD", value_parser = parse_reconstruction, help_heading = SAMPLING)]
     pub reconstruction: Option<Reconstruction>,
     /// Print no progress bar and no summary line (warnings, errors and how to resume an
     /// interrupted render are still printed)
-    #[arg(short, long)]
+    #[arg(short, long, help_heading = PROGRESS)]
     pub quiet: bool,
+    /// Print how long loading the scene, building its BVH and rendering took
+    #[arg(short, long, conflicts_with = "quiet", help_heading = PROGRESS)]
+    pub verbose: bool,
+    /// Show the image in a viewer speaking tev's protocol at HOST:PORT (tev listens on
+    /// 127.0.0.1:14158): sent when the render starts, after every pass and at the end
+    #[arg(long, value_name = "HOST:PORT", value_parser = parse_address, help_heading = PROGRESS)]
+    pub display_server: Option<String>,
+    /// Replace the EXR and PNG with the image so far every --checkpoint-every seconds
+    #[arg(long, help_heading = PROGRESS)]
+    pub write_partial_images: bool,
 }
 
 pub(crate) fn parse_define(text: &str) -> Result<(String, String), String> {
@@ -261,12 +292,18 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         ));
     }
     args.accel.check_available()?;
+    let load_start = Instant::now();
     let loaded = load_scene(&args.scene, &args.defines)?;
+    let load_time = load_start.elapsed();
     for warning in &loaded.warnings {
         eprintln!("{warning}");
     }
     let mut scene = loaded.scene;
+    let accel_start = Instant::now();
     args.accel.apply(&mut scene.world.geometry)?;
+    if args.verbose {
+        print_load_times(&scene, load_time, accel_start.elapsed());
+    }
     let crop = match (args.crop, args.pixel) {
         (Some(_), Some(_)) => return Err(Error::usage("give either --crop or --pixel, not both")),
         (Some([x0, y0, x1, y1]), None) => Some([x0, y0, x1, y1]),
@@ -399,14 +436,47 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     };
     let checkpoints =
         args.checkpoint.is_some() || args.resume.is_some() || args.sample_range.is_some();
-    let output = render_with_checkpoints(
+    let every = Duration::from_secs_f64(args.checkpoint_every);
+    let mut display = args.display_server.as_deref().map(|address| {
+        let size = scene.film.crop.size;
+        DisplayServer::connect(address, &exr_path.display().to_string(), size.x, size.y)
+    });
+    let previewing = display.is_some() || args.write_partial_images;
+    let mut last_partial_images = Instant::now();
+    let mut preview = |snapshot: &Snapshot| -> Result<()> {
+        let partial_images_due =
+            args.write_partial_images && last_partial_images.elapsed() >= every;
+        if display.is_none() && !partial_images_due {
+            return Ok(());
+        }
+        let film = snapshot.film(&scene);
+        if let Some(display) = &mut display {
+            display.show(&film);
+        }
+        if partial_images_due {
+            write_images_with(&film, &exr_path, &png_path, &scene.ldr_output)?;
+            last_partial_images = Instant::now();
+        }
+        Ok(())
+    };
+    let output = render_with_preview(
         &scene,
         &options,
-        checkpoints.then(|| Checkpoints {
-            every: Duration::from_secs_f64(args.checkpoint_every),
+        checkpoints.then_some(Checkpoints {
+            every,
             write: &mut write_checkpoint,
         }),
+        previewing.then_some(&mut preview as Preview),
     )?;
+    if let Some(display) = &mut display {
+        display.show(&output.film);
+    }
+    if args.verbose {
+        eprintln!(
+            "prism: rendering took {:.3} s",
+            output.elapsed.as_secs_f64()
+        );
+    }
     write_images_with(&output.film, &exr_path, &png_path, &scene.ldr_output)?;
     if output.stop == StopReason::Interrupted && !checkpoints {
         // An interrupted render always leaves a state to resume from.
@@ -431,6 +501,28 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         std::process::exit(128 + if received == 0 { 2 } else { received });
     }
     Ok(())
+}
+
+/// `--verbose`: how long reading the scene and its meshes took, and building the BVH (which
+/// loading includes), and Embree's scene when it answers the queries (`embree_time`).
+fn print_load_times(scene: &Scene, load_time: Duration, embree_time: Duration) {
+    let geometry = &scene.world.geometry;
+    let bvh_time = geometry.build_time();
+    eprintln!(
+        "prism: loading the scene took {:.3} s (the scene file and its meshes)",
+        load_time.saturating_sub(bvh_time).as_secs_f64()
+    );
+    eprintln!(
+        "prism: building the BVH took {:.3} s ({} primitives)",
+        bvh_time.as_secs_f64(),
+        geometry.primitive_count()
+    );
+    if Accel::of(geometry) == Accel::Embree {
+        eprintln!(
+            "prism: building Embree's scene took {:.3} s",
+            embree_time.as_secs_f64()
+        );
+    }
 }
 
 /// The arguments a resumed render must repeat.

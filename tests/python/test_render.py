@@ -1,5 +1,5 @@
 """Rendering: the same arrays as the command line's EXR, for any number of threads; the
-stopping rules; progress reports."""
+stopping rules; progress reports; the preview of the developing image."""
 
 import math
 import subprocess
@@ -104,6 +104,27 @@ def test_an_exception_in_the_progress_callback_stops_the_render(cornell):
 
     with pytest.raises(ValueError, match="stop here"):
         pr.render(cornell, time_limit=60, progress=fail)
+
+
+def test_the_preview_sees_the_image_develop_and_last_the_result(cornell):
+    images = []
+    image = pr.render(cornell, spp=64, progress=False, preview=images.append)
+    assert_same_image(images[-1], image)
+    reference = pr.render(cornell, spp=64, progress=False)
+    assert_same_image(images[-1], reference)
+    spps = [shown.spp for shown in images]
+    assert spps == sorted(set(spps)) and spps[-1] == 64
+    for shown in images[:-1]:
+        assert 1 <= shown.spp < 64 and shown.rgb.shape == image.rgb.shape
+        assert not np.array_equal(shown.rgb, image.rgb)
+
+
+def test_an_exception_in_the_preview_stops_the_render(cornell):
+    def fail(image):
+        raise ValueError("seen enough")
+
+    with pytest.raises(ValueError, match="seen enough"):
+        pr.render(cornell, time_limit=60, progress=False, preview=fail)
 
 
 def test_without_tqdm_progress_is_a_line_on_stderr(cornell, monkeypatch, capsys):

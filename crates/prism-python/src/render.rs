@@ -1,11 +1,13 @@
 //! `render`: the scene rendered on worker threads while the calling thread, holding the GIL
-//! only briefly, reports progress and watches for Ctrl-C. An interruption (or an exception
-//! from the progress callback) raises the render's stop flag; the render finishes the tiles in
-//! flight, its threads are joined, and the exception is raised.
+//! only briefly, reports progress, hands the developing image to a preview callback and watches
+//! for Ctrl-C. An interruption (or an exception from a callback) raises the render's stop flag;
+//! the render finishes the tiles in flight, its threads are joined, and the exception is raised.
 
-use std::sync::Arc;
+use std::cell::Cell;
+use std::ops::Range;
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::time::Duration;
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
 
 use pyo3::exceptions::PyRuntimeError;
 use pyo3::prelude::*;
@@ -14,9 +16,9 @@ use crate::error::{IntoPyResult, to_py};
 use crate::image::Image;
 use crate::scene::Scene;
 use prism_core::error::Error;
-use prism_core::film::FilmImages;
+use prism_core::film::{Film, FilmImages};
 use prism_core::render::{
-    ProgressCounter, RenderOptions, StopRule, StopRuleNames, render as render_scene,
+    Preview, ProgressCounter, RenderOptions, Snapshot, StopRule, StopRuleNames, render_with_preview,
 };
 
 /// How often the calling thread checks for signals and reports progress.
@@ -40,16 +42,20 @@ pub struct RenderSettings {
 /// Renders `scene` as `settings` say. `progress`, if given, is called as
 /// `progress(samples, total, error)` about ten times a second and once at the end, with the
 /// camera samples taken, those the render will take (None when open-ended) and the image's mean
-/// relative error (infinite before the first pass). The image is the same for every number of
-/// threads.
+/// relative error (infinite before the first pass). `preview`, if given, is called as
+/// `preview(image)` with the developing [`Image`] after passes (the newest, when several
+/// finished since the last call) and last with the image returned, unless the last pass's
+/// image, equal to it, was shown already. The image is the same for
+/// every number of threads.
 #[pyfunction]
-#[pyo3(signature = (scene, settings, progress = None))]
+#[pyo3(signature = (scene, settings, progress = None, preview = None))]
 pub fn render(
     py: Python<'_>,
     scene: &Scene,
     settings: RenderSettings,
     progress: Option<Bound<'_, PyAny>>,
-) -> PyResult<Image> {
+    preview: Option<Bound<'_, PyAny>>,
+) -> PyResult<Py<Image>> {
     let RenderSettings {
         spp,
         seed,
@@ -93,12 +99,44 @@ pub fn render(
             None => Ok(()),
         }
     };
+    // The newest pass's image not yet shown, with its samples.
+    let developing: Mutex<Option<(Film, Range<u32>)>> = Mutex::new(None);
+    // The samples of the last image shown.
+    let shown: Cell<Option<Range<u32>>> = Cell::new(None);
+    let start = Instant::now();
+    let show_developing = || -> PyResult<()> {
+        let newest = developing
+            .lock()
+            .expect("no thread panics holding it")
+            .take();
+        match (&preview, newest) {
+            (Some(callback), Some((film, samples))) => {
+                shown.set(Some(samples.clone()));
+                let image = image_of(py, &film, samples, start.elapsed().as_secs_f64())?;
+                callback.call1((image,)).map(drop)
+            }
+            _ => Ok(()),
+        }
+    };
 
+    let previewing = preview.is_some();
     let caller = std::thread::current();
     let done = AtomicBool::new(false);
     let (outcome, raised) = std::thread::scope(|scope| {
         let worker = scope.spawn(|| {
-            let output = render_scene(&loaded.scene, &options);
+            let mut keep = |snapshot: &Snapshot| {
+                let film = snapshot.film(&loaded.scene);
+                *developing.lock().expect("no thread panics holding it") =
+                    Some((film, snapshot.samples.clone()));
+                caller.unpark();
+                Ok(())
+            };
+            let output = render_with_preview(
+                &loaded.scene,
+                &options,
+                None,
+                previewing.then_some(&mut keep as Preview),
+            );
             done.store(true, Ordering::Release);
             caller.unpark();
             output
@@ -108,7 +146,9 @@ pub fn render(
         while !done.load(Ordering::Acquire) && !worker.is_finished() {
             py.detach(|| std::thread::park_timeout(POLL));
             if raised.is_none()
-                && let Err(error) = py.check_signals().and_then(|()| report())
+                && let Err(error) = (py.check_signals())
+                    .and_then(|()| report())
+                    .and_then(|()| show_developing())
             {
                 interrupt.store(true, Ordering::SeqCst);
                 raised = Some(error);
@@ -123,9 +163,25 @@ pub fn render(
         .map_err(|_| PyRuntimeError::new_err("the render's thread panicked"))?
         .into_py_result(py)?;
     report()?;
-    let spp = output.samples.end - output.samples.start;
-    let seconds = output.elapsed.as_secs_f64();
-    let film = &output.film;
+    let image = Py::new(
+        py,
+        image_of(
+            py,
+            &output.film,
+            output.samples.clone(),
+            output.elapsed.as_secs_f64(),
+        )?,
+    )?;
+    if let Some(callback) = &preview
+        && shown.take() != Some(output.samples)
+    {
+        callback.call1((image.clone_ref(py),))?;
+    }
+    Ok(image)
+}
+
+/// The image of `film`, which holds the sample indices `samples`, rendered in `seconds`.
+fn image_of(py: Python<'_>, film: &Film, samples: Range<u32>, seconds: f64) -> PyResult<Image> {
     let (images, aovs) = py.detach(|| {
         let aovs = (film.aov_names.iter().cloned())
             .enumerate()
@@ -133,5 +189,5 @@ pub fn render(
             .collect();
         (FilmImages::of(film), aovs)
     });
-    Image::new(py, images, aovs, spp, seconds)
+    Image::new(py, images, aovs, samples.end - samples.start, seconds)
 }

@@ -11,6 +11,7 @@
 
 use std::fmt::Debug;
 use std::sync::Arc;
+use std::time::{Duration, Instant};
 
 use glam::Vec3;
 
@@ -82,6 +83,8 @@ pub struct Aggregate<P> {
     primitive_count: usize,
     /// Another structure that answers the queries instead of `bvh`.
     external: Option<Arc<dyn ExternalRayQueries<P>>>,
+    /// How long [`Aggregate::new`] took.
+    build_time: Duration,
 }
 
 impl<P: AggregateElement> Aggregate<P> {
@@ -89,6 +92,7 @@ impl<P: AggregateElement> Aggregate<P> {
     /// an element intersected whole, or 2.7·10⁸ triangles (2²⁶ packs of the BVH): far more
     /// than fits in memory.
     pub fn new(primitives: Vec<P>) -> Aggregate<P> {
+        let start = Instant::now();
         let mut build = Vec::new();
         let mut first_id = Vec::with_capacity(primitives.len() + 1);
         let mut next_id = 0u64;
@@ -134,12 +138,14 @@ impl<P: AggregateElement> Aggregate<P> {
             );
         }
         first_id.push(next_id as u32);
+        let bvh = Bvh::build(&build);
         Aggregate {
             primitives,
-            bvh: Bvh::build(&build),
+            bvh,
             first_id,
             primitive_count: build.len(),
             external: None,
+            build_time: start.elapsed(),
         }
     }
 
@@ -159,6 +165,12 @@ impl<P: AggregateElement> Aggregate<P> {
     /// The name of the structure answering the queries when it is not our BVH.
     pub fn external_name(&self) -> Option<&'static str> {
         self.external.as_ref().map(|e| e.name())
+    }
+
+    /// How long building the hierarchy took (an instanced shape's own hierarchy, built with
+    /// the shape, not included).
+    pub fn build_time(&self) -> Duration {
+        self.build_time
     }
 
     /// The number of BVH primitives (triangles plus elements intersected whole).

@@ -51,7 +51,7 @@ use tiles::{row_major, tile_major, tiles};
 /// run to depths of a few hundred. Only the pages used are ever touched.
 const WORKER_STACK_BYTES: usize = 64 << 20;
 
-/// The state of a render between two passes, handed to the checkpoint writer.
+/// The state of a render between two passes, handed to the checkpoint writer and the preview.
 pub struct Snapshot<'a> {
     /// The sample indices every pixel has had in this render (after its initial state).
     pub samples: Range<u32>,
@@ -61,11 +61,27 @@ pub struct Snapshot<'a> {
     pub aovs: &'a [ValueSum],
 }
 
+impl Snapshot<'_> {
+    /// The developing image: the film of `scene` holding the snapshot's sums.
+    pub fn film(&self, scene: &Scene) -> Film {
+        Film {
+            size: scene.film.size,
+            crop: scene.film.crop,
+            pixels: self.pixels.to_vec(),
+            aov_names: scene.integrator.aov_names(),
+            aovs: self.aovs.to_vec(),
+        }
+    }
+}
+
 /// Something that saves the render's state every so often.
 pub struct Checkpoints<'a> {
     pub every: Duration,
     pub write: &'a mut dyn FnMut(&Snapshot) -> Result<()>,
 }
+
+/// Receives the developing image after every pass (see [`render_with_preview`]).
+pub type Preview<'a> = &'a mut dyn FnMut(&Snapshot) -> Result<()>;
 
 /// What a render produced.
 pub struct RenderOutput {
@@ -92,7 +108,19 @@ pub fn render(scene: &Scene, options: &RenderOptions) -> Result<RenderOutput> {
 pub fn render_with_checkpoints(
     scene: &Scene,
     options: &RenderOptions,
+    checkpoints: Option<Checkpoints>,
+) -> Result<RenderOutput> {
+    render_with_preview(scene, options, checkpoints, None)
+}
+
+/// As [`render_with_checkpoints`], also handing the developing image to `preview` after every
+/// pass (for a live preview or partial images; [`Snapshot::film`] makes it a film). An error
+/// from `preview` ends the render with that error.
+pub fn render_with_preview(
+    scene: &Scene,
+    options: &RenderOptions,
     mut checkpoints: Option<Checkpoints>,
+    mut preview: Option<Preview>,
 ) -> Result<RenderOutput> {
     let crop = scene.film.crop;
     let estimator = SampleEstimator::new(scene);
@@ -103,7 +131,7 @@ pub fn render_with_checkpoints(
         ..options.clone()
     };
     let stop = options.stop;
-    let in_passes = options.in_passes(checkpoints.is_some());
+    let in_passes = options.in_passes(checkpoints.is_some() || preview.is_some());
 
     let mut builder = rayon::ThreadPoolBuilder::new().stack_size(WORKER_STACK_BYTES);
     if let Some(threads) = options.threads {
@@ -187,16 +215,24 @@ pub fn render_with_checkpoints(
         next += count;
         error = relative_error(sums.iter().flat_map(|t| &t.pixels));
         progress.pass_done(next - first, error);
-        if let Some(checkpoint) = &mut checkpoints
-            && last_checkpoint.elapsed() >= checkpoint.every
-        {
+        let checkpoint_due = (checkpoints.as_ref())
+            .is_some_and(|checkpoint| last_checkpoint.elapsed() >= checkpoint.every);
+        if checkpoint_due || preview.is_some() {
             let (pixels, aovs) = row_major(&tiles, crop.size, k, &sums);
-            (checkpoint.write)(&Snapshot {
+            let snapshot = Snapshot {
                 samples: first..next,
                 pixels: &pixels,
                 aovs: &aovs,
-            })?;
-            last_checkpoint = Instant::now();
+            };
+            if let Some(preview) = &mut preview {
+                preview(&snapshot)?;
+            }
+            if let Some(checkpoint) = &mut checkpoints
+                && checkpoint_due
+            {
+                (checkpoint.write)(&snapshot)?;
+                last_checkpoint = Instant::now();
+            }
         }
     };
     let elapsed = start.elapsed();

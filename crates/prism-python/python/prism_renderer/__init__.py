@@ -46,6 +46,7 @@ __all__ = [
 ]
 
 ProgressCallback = Callable[[int, Optional[int], float], object]
+PreviewCallback = Callable[[Image], object]
 
 
 def load_file(path: Union[str, os.PathLike], **defines: object) -> Scene:
@@ -74,6 +75,7 @@ def render(
     progress: Union[bool, ProgressCallback] = True,
     time_limit: Optional[float] = None,
     target_error: Optional[float] = None,
+    preview: Optional[PreviewCallback] = None,
 ) -> Image:
     """Renders ``scene`` and returns its :class:`Image`.
 
@@ -88,9 +90,15 @@ def render(
     installed; else a line on standard error), False none; a callable is called as
     ``progress(samples, total, error)`` about ten times a second.
 
+    ``preview``: a callable called as ``preview(image)`` with the developing :class:`Image`
+    after passes (the newest, when several finished since the last call; ``image.spp`` says how
+    many samples it holds), the last image shown equal to the one ``render`` returns: to show a
+    render as it develops (in a notebook, say).
+
     The render runs on worker threads without the GIL, so other Python threads keep running.
     Ctrl-C stops it: the worker threads finish their tiles and are joined, and
-    KeyboardInterrupt is raised.
+    KeyboardInterrupt is raised; an exception raised by ``progress`` or ``preview`` stops it the
+    same way.
     """
     callback: Optional[ProgressCallback]
     bar: Optional[_ProgressBar] = None
@@ -112,6 +120,7 @@ def render(
                 "target_error": target_error,
             },
             callback,
+            preview,
         )
     finally:
         if bar is not None:

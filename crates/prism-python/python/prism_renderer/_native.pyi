@@ -207,9 +207,10 @@ def render(
     scene: Scene,
     settings: _RenderSettings,
     progress: Optional[Callable[[int, Optional[int], float], object]] = None,
+    preview: Optional[Callable[[Image], object]] = None,
 ) -> Image:
     """Renders ``scene`` (see :func:`prism_renderer.render`, whose keywords ``settings``
-    holds); ``progress`` is a callable or None."""
+    holds); ``progress`` and ``preview`` are callables or None."""
 
 def compare(
     test: Union[Image, str, os.PathLike],
