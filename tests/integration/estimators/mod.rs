@@ -4,6 +4,7 @@
 mod aov;
 mod closed_form;
 mod convergence;
+mod depth;
 mod direct;
 mod moment;
 mod strict_normals;

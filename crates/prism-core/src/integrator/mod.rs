@@ -17,6 +17,7 @@
 
 pub mod aov;
 pub mod context;
+pub mod depth;
 pub mod direct;
 pub mod distribution;
 pub mod mis;
@@ -29,6 +30,7 @@ pub mod volpathmis;
 
 pub use aov::AovIntegrator;
 pub use context::{RayCount, SampleContext};
+pub use depth::DepthIntegrator;
 pub use direct::DirectIntegrator;
 pub use distribution::DistributionIntegrator;
 pub use moment::MomentIntegrator;
@@ -76,6 +78,7 @@ integrator_enum! {
         Moment(MomentIntegrator),
         Aov(AovIntegrator),
         VolPath(VolPathIntegrator),
+        Depth(DepthIntegrator),
     }
 }
 
@@ -99,7 +102,9 @@ impl Integrator {
             Integrator::Direct(_) => LightSelection::Exhaustive,
             Integrator::Distribution(distrib) => distrib.light_selection(),
             Integrator::VolPath(volpath) => volpath.light_selection,
-            Integrator::Moment(_) | Integrator::Aov(_) => LightSelection::Power,
+            Integrator::Moment(_) | Integrator::Aov(_) | Integrator::Depth(_) => {
+                LightSelection::Power
+            }
         }
     }
 
@@ -111,7 +116,8 @@ impl Integrator {
             Integrator::Path(_)
             | Integrator::Direct(_)
             | Integrator::Distribution(_)
-            | Integrator::VolPath(_) => &[],
+            | Integrator::VolPath(_)
+            | Integrator::Depth(_) => &[],
         };
         nested.iter().map(|(_, integrator)| integrator)
     }
@@ -123,6 +129,7 @@ impl Integrator {
             Integrator::Direct(direct) => direct.hide_emitters,
             Integrator::Distribution(distrib) => distrib.hide_emitters,
             Integrator::VolPath(volpath) => volpath.hide_emitters,
+            Integrator::Depth(_) => false,
             Integrator::Moment(_) | Integrator::Aov(_) => match self.nested().next() {
                 Some(first) => first.hides_emitters(),
                 None => true,
@@ -145,7 +152,8 @@ impl Integrator {
             Integrator::Path(_)
             | Integrator::Direct(_)
             | Integrator::Distribution(_)
-            | Integrator::VolPath(_) => Vec::new(),
+            | Integrator::VolPath(_)
+            | Integrator::Depth(_) => Vec::new(),
             Integrator::Moment(moment) => moment.aov_names(),
             Integrator::Aov(aov) => aov.aov_names(),
         }
@@ -202,6 +210,7 @@ impl PreparedIntegrator<'_> {
             Integrator::Distribution(integrator) => integrator.radiance(ctx, ray, lambda),
             Integrator::Moment(_) => MomentIntegrator::radiance(ctx, ray, lambda, aovs),
             Integrator::Aov(integrator) => integrator.radiance(ctx, ray, lambda, aovs),
+            Integrator::Depth(_) => DepthIntegrator::radiance(ctx, &ray),
             Integrator::VolPath(integrator) => match integrator.tracking {
                 Tracking::Spectral => integrator.trace(SpectralTracking::new(), ctx, ray, lambda),
                 Tracking::HeroMis { spectral_mis } => {

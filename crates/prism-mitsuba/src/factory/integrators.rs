@@ -11,8 +11,8 @@ use prism_core::film::output::IMAGE_CHANNELS;
 use prism_core::integrator::aov::{Aov, AovKind};
 use prism_core::integrator::distribution::DirectLights;
 use prism_core::integrator::{
-    AovIntegrator, DirectIntegrator, DistributionIntegrator, Integrator, MomentIntegrator,
-    PathIntegrator, Tracking, VolPathIntegrator,
+    AovIntegrator, DepthIntegrator, DirectIntegrator, DistributionIntegrator, Integrator,
+    MomentIntegrator, PathIntegrator, Tracking, VolPathIntegrator,
 };
 use prism_core::light::LightSelection;
 
@@ -68,6 +68,14 @@ pub static INTEGRATORS: Registry<Build> = Registry {
                       the image is the first nested integrator's.",
             params: &[AOVS, NESTED_IMAGE_INTEGRATORS],
             build: build_aov,
+        },
+        Plugin {
+            name: "depth",
+            origin: Origin::Mitsuba3,
+            summary: "The distance from the camera to the first surface along each camera ray \
+                      (0 where it leaves the scene), as a constant spectrum.",
+            params: &[],
+            build: |_| Ok(Integrator::Depth(DepthIntegrator)),
         },
         Plugin {
             name: "distrib",
