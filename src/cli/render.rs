@@ -330,7 +330,12 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         override_reconstruction(&mut scene, reconstruction);
     }
     let seed = args.seed.unwrap_or(loaded.seed);
-    let spp = args.spp.unwrap_or(scene.sampler.samples_per_pixel);
+    // The pixel's samples (a count the sampler can stratify), and the blocks its stratification
+    // works in: under filter MIS two blocks of half as many, the control variate's halves.
+    let spp = scene
+        .sampler
+        .kind
+        .sample_count(args.spp.unwrap_or(scene.sampler.samples_per_pixel));
     let strata = scene.strata(spp);
     if let Some([x, y]) = args.pixel {
         let samples = args.sample_range.clone().unwrap_or(0..spp);
@@ -379,7 +384,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         previous_ranges.push(range.clone());
         initial = Some((state.pixels, state.aovs));
     }
-    let stop = stop_rule(args, strata)?;
+    let stop = stop_rule(args, spp)?;
     if let Some(end) = stop.sample_end
         && first_sample >= end
     {
@@ -393,7 +398,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let signal = Arc::new(AtomicI32::new(0));
     install_signal_handlers(interrupt.clone(), signal.clone())?;
     let options = RenderOptions {
-        samples_per_pixel: strata,
+        samples_per_pixel: spp,
         first_sample,
         initial,
         stop,

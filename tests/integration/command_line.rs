@@ -130,3 +130,50 @@ fn a_verbose_render_gives_its_times() {
         );
     }
 }
+
+/// A render takes the samples per pixel the scene's sampler asks for, whatever the
+/// reconstruction: under filter MIS (a tent here) the sampler stratifies two blocks of half as
+/// many, but the pixel still gets them all; `--spp` overrides the count.
+#[test]
+fn a_render_takes_the_scenes_sample_count_under_every_reconstruction() {
+    let dir = std::env::temp_dir().join(format!("prism-spp-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    for (sampler, filter, count, spp, expected) in [
+        ("independent", "tent", "6", None, "6 spp"),
+        ("independent", "box", "6", None, "6 spp"),
+        ("stratified", "gaussian", "16", None, "16 spp"),
+        ("independent", "tent", "6", Some("10"), "10 spp"),
+    ] {
+        let scene = dir.join("scene.xml");
+        std::fs::write(
+            &scene,
+            format!(
+                r#"<scene version="3.0.0">
+    <sensor type="perspective">
+        <sampler type="{sampler}"><integer name="sample_count" value="{count}"/></sampler>
+        <film type="hdrfilm"><integer name="width" value="4"/><integer name="height" value="4"/><rfilter type="{filter}"/></film>
+    </sensor>
+    <emitter type="constant"/>
+</scene>"#
+            ),
+        )
+        .unwrap();
+        let mut command = Command::new(env!("CARGO_BIN_EXE_prism"));
+        command
+            .arg("render")
+            .arg(&scene)
+            .arg("-o")
+            .arg(dir.join("out.exr"));
+        if let Some(spp) = spp {
+            command.args(["--spp", spp]);
+        }
+        let output = command.output().expect("the prism binary runs");
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert!(output.status.success(), "{stderr}");
+        assert!(
+            stderr.contains(&format!("(4×4, {expected})")),
+            "{sampler} {count} with a {filter} filter, --spp {spp:?}: {stderr}"
+        );
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
