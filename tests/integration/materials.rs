@@ -426,7 +426,7 @@ fn a_null_surface_counts_as_a_bounce() {
 
 /// A light seen through a fully transparent mask keeps its radiance: the null pass is a delta
 /// lobe, so the emitter it leads to is not weighted against light sampling (which cannot reach
-/// it: shadow rays stop at masks).
+/// it: `path`'s shadow rays stop at masks).
 #[test]
 fn lights_seen_through_a_transparent_mask_keep_their_radiance() {
     let xml = r#"<scene version="3.0.0">
