@@ -5,6 +5,7 @@ mod bench;
 mod chi2;
 mod command_line;
 mod common;
+mod depth_parity;
 mod determinism;
 #[cfg(feature = "embree")]
 mod embree;

@@ -324,6 +324,71 @@ fn null_lobe_passes_straight_through() {
     }
 }
 
+/// What a shadow ray carries through a surface with null lobes (Mitsuba 3's
+/// `eval_null_transmission`) is what BSDF sampling carries through it on average: the weights of
+/// its null samples averaged over the lobe choice, stratified in `u_lobe` (the choice is a step
+/// function of it, so the average is exact to 1/N). Zero for a BSDF without null lobes.
+#[test]
+fn null_transmission_is_the_mean_weight_of_null_samples() {
+    let n = 20_000;
+    for (name, xml) in [
+        ("null", r#"<bsdf type="null"/>"#),
+        ("thin glass", r#"<bsdf type="thindielectric"/>"#),
+        (
+            "thin dispersive glass, tinted",
+            r#"<bsdf type="thindielectric"><spectrum type="sellmeier" name="int_ior"><string name="glass" value="N-SF11"/></spectrum><rgb name="specular_transmittance" value="0.9, 0.5, 0.2"/></bsdf>"#,
+        ),
+        (
+            "mask of a two-sided diffuse",
+            r#"<bsdf type="mask"><float name="opacity" value="0.3"/><bsdf type="twosided"><bsdf type="diffuse"/></bsdf></bsdf>"#,
+        ),
+        (
+            "mask of thin glass",
+            r#"<bsdf type="mask"><float name="opacity" value="0.6"/><bsdf type="thindielectric"/></bsdf>"#,
+        ),
+        (
+            "blend of thin glass and diffuse",
+            r#"<bsdf type="blendbsdf"><float name="weight" value="0.7"/><bsdf type="thindielectric"/><bsdf type="diffuse"/></bsdf>"#,
+        ),
+        (
+            "normal-mapped thin glass",
+            r#"<bsdf type="normalmap"><texture type="checkerboard" name="normalmap"><rgb name="color0" value="0.7, 0.5, 0.9"/><rgb name="color1" value="0.7, 0.5, 0.9"/></texture><bsdf type="thindielectric"/></bsdf>"#,
+        ),
+        ("diffuse", r#"<bsdf type="diffuse"/>"#),
+    ] {
+        let bsdf = bsdf_from_xml(xml);
+        for wo in [
+            direction(0.0, 0.0),
+            direction(60.0, 30.0),
+            -direction(80.0, 200.0),
+        ] {
+            let at = bsdf.at(&point(), wo, &wavelengths());
+            let mut mean = [0.0f64; 4];
+            for i in 0..n {
+                let u_lobe = (i as f32 + 0.5) / n as f32;
+                let Some(s) = at.sample(u_lobe, Vec2::new(0.3, 0.7)) else {
+                    continue;
+                };
+                if s.flags.contains(BsdfFlags::NULL) {
+                    assert!((s.wi + wo).length() < 1e-6, "{name}: a null sample turns");
+                    for (m, w) in mean.iter_mut().zip(s.weight.0) {
+                        *m += f64::from(w) / n as f64;
+                    }
+                }
+            }
+            let expected = at.null_transmission();
+            for c in 0..4 {
+                assert!(
+                    (mean[c] - f64::from(expected[c])).abs() < 1e-3,
+                    "{name} at wo {wo}: null samples carry {:?} on average, null transmission {:?}",
+                    mean,
+                    expected.0
+                );
+            }
+        }
+    }
+}
+
 /// Passing through a `null` surface counts as a bounce, as in Mitsuba 3's `path`: Mitsuba 3.9.1
 /// renders a light behind a null rectangle black at `max_depth` 1 and at its radiance at 2.
 /// Both integrators agree; shadow rays stop at the surface, so the light is found by BSDF
@@ -361,7 +426,7 @@ fn a_null_surface_counts_as_a_bounce() {
 
 /// A light seen through a fully transparent mask keeps its radiance: the null pass is a delta
 /// lobe, so the emitter it leads to is not weighted against light sampling (which cannot reach
-/// it: shadow rays stop at masks).
+/// it: `path`'s shadow rays stop at masks).
 #[test]
 fn lights_seen_through_a_transparent_mask_keep_their_radiance() {
     let xml = r#"<scene version="3.0.0">

@@ -8,7 +8,7 @@ use glam::{Vec2, Vec3};
 use prism_core::bsdf::{Bsdf, BsdfEval, BsdfSample, BxdfTree, Scattering, ShadingPoint};
 use prism_core::sampling::chi2::{Chi2Outcome, chi2_sphere};
 use prism_core::sampling::rng::Pcg32;
-use prism_core::spectrum::{SampledWavelengths, WavelengthSampling};
+use prism_core::spectrum::{SampledSpectrum, SampledWavelengths, WavelengthSampling};
 
 /// Sphere resolution for BSDF chi-square tests: an odd number of cos θ bins (the horizon on a
 /// row's middle node), twice as many φ bins.
@@ -52,6 +52,12 @@ impl Query<'_> {
     pub fn sample(&self, u_lobe: f32, u: Vec2) -> Option<BsdfSample> {
         let mut lobes = BxdfTree::empty();
         Scattering::new(self.bsdf, &self.point, self.wo, &self.lambda, &mut lobes).sample(u_lobe, u)
+    }
+
+    pub fn null_transmission(&self) -> SampledSpectrum {
+        let mut lobes = BxdfTree::empty();
+        Scattering::new(self.bsdf, &self.point, self.wo, &self.lambda, &mut lobes)
+            .null_transmission()
     }
 }
 

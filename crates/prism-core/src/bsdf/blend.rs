@@ -91,4 +91,11 @@ impl Bxdf for BlendLobes {
         s.pdf = blend.pdf;
         Some(s)
     }
+
+    /// The nested BSDFs' blended by the weight (Mitsuba 3's `blendbsdf`).
+    fn null_transmission(&self, tree: &BxdfTree, wo: Vec3) -> SampledSpectrum {
+        let w = self.weight;
+        tree.null_transmission(self.nested[0], wo) * (1.0 - w)
+            + tree.null_transmission(self.nested[1], wo) * w
+    }
 }

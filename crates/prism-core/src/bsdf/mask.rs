@@ -9,8 +9,10 @@
 //! ```
 //! `opacity` α (a number in [0, 1] or a texture, clamped to [0, 1]; default 0.5). The BSDF is
 //! α f_nested plus a null lobe (1 − α) δ(wi + wo), chosen with probability 1 − α; the null pass
-//! works from both sides. Shadow rays treat the surface as opaque (as Mitsuba 3's `path`), so
-//! light through the transparent part is found by BSDF sampling alone.
+//! works from both sides. In `path` shadow rays treat the surface as opaque (as Mitsuba 3's), so
+//! light through the transparent part is found by BSDF sampling alone; the volumetric path
+//! tracers cross the null lobe without a bounce and let shadow rays through with its value
+//! 1 − α (1 − t_nested), t_nested the nested BSDF's own (Mitsuba 3's `volpath`).
 
 use glam::{Vec2, Vec3};
 
@@ -78,5 +80,12 @@ impl Bxdf for MaskLobes {
                 BsdfFlags::NULL,
             ))
         }
+    }
+
+    /// 1 − α (1 − t_nested): its own null lobe and the nested BSDF's, t_nested (Mitsuba 3's
+    /// `mask`).
+    fn null_transmission(&self, tree: &BxdfTree, wo: Vec3) -> SampledSpectrum {
+        let nested = tree.null_transmission(self.nested, wo);
+        SampledSpectrum::ONE - (SampledSpectrum::ONE - nested) * self.opacity
     }
 }

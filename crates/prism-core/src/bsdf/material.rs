@@ -92,6 +92,29 @@ impl Material {
         matches!(self.front, Bsdf::Null(_)) && matches!(self.back, None | Some(Bsdf::Null(_)))
     }
 
+    /// Whether some lobe of either side lets light through unchanged (`null`, `mask`,
+    /// `thindielectric`, and adapters around them).
+    pub fn has_null_lobe(&self) -> bool {
+        self.front.flags().has_null_lobe()
+            || self
+                .back
+                .as_ref()
+                .is_some_and(|back| back.flags().has_null_lobe())
+    }
+
+    /// The value of the null lobes at the hit `si` for light passing straight through towards
+    /// `wo` (world space, unit) on the side `wo` sees ([`Scattering::null_transmission`]).
+    pub fn null_transmission(
+        &self,
+        si: &SurfaceInteraction,
+        wo: Vec3,
+        lambda: &SampledWavelengths,
+    ) -> SampledSpectrum {
+        let mut tree = BxdfTree::empty();
+        self.scattering(si, wo, lambda, &mut tree)
+            .null_transmission()
+    }
+
     /// The most [`BxdfTree`] nodes either side takes.
     pub fn node_count(&self) -> usize {
         let back = self.back.as_ref().map_or(0, Bsdf::node_count);
@@ -154,6 +177,14 @@ impl<'t, 'm> Scattering<'t, 'm> {
     #[inline]
     pub fn eval(&self, wi: Vec3) -> BsdfEval {
         self.tree.eval(self.root, self.wo, self.frame.to_local(wi))
+    }
+
+    /// The value of the null lobes for light passing straight through towards the outgoing
+    /// direction ([`super::Bxdf::null_transmission`]): what a shadow ray crossing the surface
+    /// carries on.
+    #[inline]
+    pub fn null_transmission(&self) -> SampledSpectrum {
+        self.tree.null_transmission(self.root, self.wo)
     }
 
     /// Draws an incident direction: `u_lobe` chooses a lobe, `u` the direction within it; the

@@ -145,6 +145,11 @@ impl BsdfFlags {
         self.0 & (BsdfFlags::DIFFUSE.0 | BsdfFlags::GLOSSY.0) != 0
     }
 
+    /// Whether some lobe lets light through unchanged (a null lobe).
+    pub const fn has_null_lobe(self) -> bool {
+        self.0 & BsdfFlags::NULL.0 != 0
+    }
+
     /// Whether this is (or includes) a delta lobe: specular or null.
     pub const fn is_delta(self) -> bool {
         self.0 & (BsdfFlags::SPECULAR.0 | BsdfFlags::NULL.0) != 0
@@ -382,6 +387,14 @@ pub trait Bxdf {
     }
     /// Draws `wi` given `wo`: `u_lobe` chooses a lobe, `u` the direction within it.
     fn sample(&self, tree: &BxdfTree, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<BsdfSample>;
+    /// The value of the null lobes for light passing straight through from −wo to wo (Mitsuba
+    /// 3's `eval_null_transmission`): the probability of sampling them times their weight, so
+    /// that a shadow ray through the surface carries what the path that crosses it by sampling
+    /// would carry on average. A BSDF without null lobes keeps this default: none passes.
+    fn null_transmission(&self, tree: &BxdfTree, wo: Vec3) -> SampledSpectrum {
+        let _ = (tree, wo);
+        SampledSpectrum::ZERO
+    }
 }
 
 /// Index of a node in a [`BxdfTree`].
@@ -431,6 +444,12 @@ impl<'a> BxdfTree<'a> {
     #[inline]
     pub fn sample(&self, id: NodeId, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<BsdfSample> {
         self.nodes[id as usize].sample(self, wo, u_lobe, u)
+    }
+
+    /// [`Bxdf::null_transmission`] of node `id`.
+    #[inline]
+    pub fn null_transmission(&self, id: NodeId, wo: Vec3) -> SampledSpectrum {
+        self.nodes[id as usize].null_transmission(self, wo)
     }
 }
 
@@ -527,6 +546,13 @@ macro_rules! bsdfs {
             fn sample(&self, tree: &BxdfTree, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<BsdfSample> {
                 match self {
                     $(Node::$node(b) => b.sample(tree, wo, u_lobe, u),)+
+                }
+            }
+
+            #[inline]
+            fn null_transmission(&self, tree: &BxdfTree, wo: Vec3) -> SampledSpectrum {
+                match self {
+                    $(Node::$node(b) => b.null_transmission(tree, wo),)+
                 }
             }
         }

@@ -7,9 +7,9 @@
 //! A single null lobe δ(wi + wo) on both sides, with weight 1: `sample` returns −wo with
 //! probability 1, nothing can be evaluated. As in Mitsuba 3's `path` integrator, passing through
 //! counts as a bounce towards `max_depth`, and shadow rays see the surface as opaque (light
-//! beyond it is found by BSDF sampling alone), as for `mask`. As in Mitsuba 3's `volpath`, the
-//! volumetric path tracer crosses it without a bounce and lets shadow rays through
-//! ([`crate::integrator::volpath`]).
+//! beyond it is found by BSDF sampling alone), as for `mask`. As in Mitsuba 3's `volpath` and
+//! `volpathmis`, the volumetric path tracers cross it without a bounce and let shadow rays
+//! through ([`crate::integrator::volpath`]).
 
 use glam::{Vec2, Vec3};
 
@@ -38,5 +38,10 @@ pub struct NullLobes;
 impl Bxdf for NullLobes {
     fn sample(&self, _tree: &BxdfTree, wo: Vec3, _u_lobe: f32, _u: Vec2) -> Option<BsdfSample> {
         Some(BsdfSample::new(-wo, SampledSpectrum::ONE, 1.0, Null::FLAGS))
+    }
+
+    /// All light passes.
+    fn null_transmission(&self, _tree: &BxdfTree, _wo: Vec3) -> SampledSpectrum {
+        SampledSpectrum::ONE
     }
 }

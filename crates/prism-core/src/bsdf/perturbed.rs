@@ -17,6 +17,7 @@ use super::{
     ResolveContext, ShadingPoint,
 };
 use crate::math::Frame;
+use crate::spectrum::SampledSpectrum;
 
 /// The BSDF a bump or normal map nests, and how its frame is tilted.
 #[derive(Clone, Debug)]
@@ -135,5 +136,18 @@ impl Bxdf for PerturbedLobes {
         s.wi = wi;
         s.weight *= self.shadowing(wi);
         Some(s)
+    }
+
+    /// The nested BSDF's, seen in the tilted frame, with the shadowing term that `sample` gives
+    /// a sample passing straight through; zero where the tilted frame puts the straight
+    /// direction on the other side, as `sample` does. (Mitsuba 3's `bumpmap` and `normalmap`
+    /// return zero here, which leaves the pass-through of a bump-mapped `thindielectric` or
+    /// `mask` to BSDF samples that MIS weighs against light samples that cannot find it.)
+    fn null_transmission(&self, tree: &BxdfTree, wo: Vec3) -> SampledSpectrum {
+        let wo_p = self.local.to_local(wo);
+        if !(wo.z * wo_p.z > 0.0) {
+            return SampledSpectrum::ZERO;
+        }
+        tree.null_transmission(self.nested, wo_p) * self.shadowing(-wo)
     }
 }

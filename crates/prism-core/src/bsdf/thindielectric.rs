@@ -13,7 +13,10 @@
 //! Fresnel reflectance of one interface (Mitsuba 3, `thindielectric.cpp`); the rest, 1 − R',
 //! passes straight through (a null lobe). Both are delta lobes, chosen with probabilities R'
 //! and 1 − R' (R' averaged over the path's wavelengths when the index is dispersive; the
-//! direction does not depend on it, so all wavelengths are kept).
+//! direction does not depend on it, so all wavelengths are kept). As in Mitsuba 3, `path`
+//! counts the pass as a bounce and its shadow rays see the pane as opaque, while the volumetric
+//! path tracers cross it without a bounce and let shadow rays through with the null lobe's
+//! value, (1 − R') times `specular_transmittance`.
 
 use glam::{Vec2, Vec3};
 
@@ -50,21 +53,29 @@ pub struct ThinDielectricLobes {
     pub interface: SmoothInterfaceAt,
 }
 
+impl ThinDielectricLobes {
+    /// R' = 2R / (1 + R) for each wavelength, seen at |cos θ| = `cos_o`.
+    #[inline]
+    fn reflectance(&self, cos_o: f32) -> SampledSpectrum {
+        let reflectance = |eta: f32| {
+            let r = fresnel_dielectric(cos_o, eta).reflectance;
+            2.0 * r / (1.0 + r)
+        };
+        if self.interface.eta.dispersive {
+            SampledSpectrum::from_fn(|i| reflectance(self.interface.eta.eta[i]))
+        } else {
+            SampledSpectrum::splat(reflectance(self.interface.eta.hero()))
+        }
+    }
+}
+
 impl Bxdf for ThinDielectricLobes {
     fn sample(&self, _tree: &BxdfTree, wo: Vec3, u_lobe: f32, _u: Vec2) -> Option<BsdfSample> {
         let cos_o = wo.z.abs();
         if !(cos_o > 0.0) {
             return None;
         }
-        let reflectance = |eta: f32| {
-            let r = fresnel_dielectric(cos_o, eta).reflectance;
-            2.0 * r / (1.0 + r)
-        };
-        let r = if self.interface.eta.dispersive {
-            SampledSpectrum::from_fn(|i| reflectance(self.interface.eta.eta[i]))
-        } else {
-            SampledSpectrum::splat(reflectance(self.interface.eta.hero()))
-        };
+        let r = self.reflectance(cos_o);
         let p_reflect = r.average();
         if u_lobe < p_reflect {
             let weight = r * (1.0 / p_reflect) * self.interface.specular.reflectance;
@@ -81,5 +92,14 @@ impl Bxdf for ThinDielectricLobes {
                 * self.interface.specular.transmittance;
             Some(BsdfSample::new(-wo, weight, p_transmit, BsdfFlags::NULL))
         }
+    }
+
+    /// (1 − R') times `specular_transmittance`.
+    fn null_transmission(&self, _tree: &BxdfTree, wo: Vec3) -> SampledSpectrum {
+        let cos_o = wo.z.abs();
+        if !(cos_o > 0.0) {
+            return SampledSpectrum::ZERO;
+        }
+        (SampledSpectrum::ONE - self.reflectance(cos_o)) * self.interface.specular.transmittance
     }
 }

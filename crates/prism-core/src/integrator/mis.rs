@@ -27,6 +27,7 @@ use glam::Vec3;
 use crate::bsdf::{BsdfEval, Scattering};
 use crate::geometry::{SurfaceInteraction, SurfaceSample};
 use crate::integrator::SampleContext;
+use crate::integrator::transmittance::ShadowTransmittance;
 use crate::integrator::vertex::normals_agree;
 use crate::light::{AreaLight, Light, LightQuery, LightSample, LightSource, Receiver};
 use crate::math::Ray;
@@ -173,14 +174,15 @@ pub fn emission_found(
 
 /// The factors of one light sample at a vertex: the BSDF's or phase function's value towards
 /// the light and its solid-angle density of that direction, the light sample's density (the
-/// light's choice included), the transmittance of the shadow ray and the radiance.
+/// light's choice included), the transmittance of the shadow ray (media and null surfaces) and
+/// the radiance.
 #[derive(Clone, Copy, Debug)]
 pub struct LightSampleTerms {
     pub value: SampledSpectrum,
     pub direction_pdf: f32,
     pub light_pdf: f32,
     pub is_delta: bool,
-    pub transmittance: SampledSpectrum,
+    pub transmittance: ShadowTransmittance,
     pub radiance: SampledSpectrum,
 }
 
@@ -197,7 +199,7 @@ impl LightSampleTerms {
                 strategies.bsdf_samples * self.direction_pdf,
             )
         };
-        self.value * self.transmittance * self.radiance * (weight / self.light_pdf)
+        self.value * self.transmittance.total() * self.radiance * (weight / self.light_pdf)
     }
 }
 
@@ -225,15 +227,15 @@ pub fn sample_point_on(
 /// One light sample at `receiver` at `time`: a light chosen by the light sampler and a point on
 /// it. `reach` is the vertex's side of it: the vertex's value and density towards the sample
 /// (its BSDF's or phase function's) and the transmittance of the shadow ray (1 or 0 through
-/// vacuum, the media's through media), or None where no light arrives; it is asked only for a
-/// sample that exists.
+/// vacuum, that of the media and null surfaces crossed in volumetric path tracing), or None
+/// where no light arrives; it is asked only for a sample that exists.
 #[inline]
 pub fn sample_light(
     ctx: &mut SampleContext,
     receiver: &Receiver,
     time: f32,
     lambda: &SampledWavelengths,
-    reach: impl FnOnce(&mut SampleContext, &LightSample) -> Option<(BsdfEval, SampledSpectrum)>,
+    reach: impl FnOnce(&mut SampleContext, &LightSample) -> Option<(BsdfEval, ShadowTransmittance)>,
 ) -> Option<LightSampleTerms> {
     let u_light = ctx.sampler.next_1d();
     let u_choice = ctx.sampler.next_1d();
@@ -291,6 +293,6 @@ pub fn sample_light_at_surface(
         if strict_normals && !normals_agree(si, ls.wi) {
             return None;
         }
-        unoccluded(ctx, si, scattering, ls).map(|f| (f, SampledSpectrum::ONE))
+        unoccluded(ctx, si, scattering, ls).map(|f| (f, ShadowTransmittance::ONE))
     })
 }

@@ -1,7 +1,7 @@
 //! What a ray crosses between two points of a scene with participating media: the media it
 //! travels in (they change where it crosses a shape that bounds one), and the transmittance of
-//! a shadow ray through them and through index-matched boundaries, the hook that the volumetric
-//! path tracers give to light sampling ([`super::mis::sample_light`]).
+//! a shadow ray through them and through the surfaces with null lobes, the hook that the
+//! volumetric path tracers give to light sampling ([`super::mis::sample_light`]).
 
 use glam::Vec3;
 
@@ -32,10 +32,47 @@ pub fn medium_after(
     }
 }
 
+/// The transmittance of a shadow ray in its two factors: that of the media it crosses, and the
+/// product of the null transmissions of the surfaces it passes (Mitsuba 3's
+/// `eval_null_transmission`: 1 for `null`, 1 − R' for `thindielectric`, 1 − α(1 − t_nested)
+/// for `mask`). A path crosses the media by free flights, whose densities `volpathmis` weighs
+/// by MIS, and the surfaces by choosing a null lobe, which is no scattering vertex.
+#[derive(Clone, Copy, Debug)]
+pub struct ShadowTransmittance {
+    pub media: SampledSpectrum,
+    pub surfaces: SampledSpectrum,
+}
+
+impl ShadowTransmittance {
+    /// Nothing in the way (vacuum).
+    pub const ONE: ShadowTransmittance = ShadowTransmittance {
+        media: SampledSpectrum::ONE,
+        surfaces: SampledSpectrum::ONE,
+    };
+
+    /// Blocked.
+    pub const ZERO: ShadowTransmittance = ShadowTransmittance {
+        media: SampledSpectrum::ZERO,
+        surfaces: SampledSpectrum::ZERO,
+    };
+
+    /// The whole transmittance: media times surfaces.
+    #[inline]
+    pub fn total(&self) -> SampledSpectrum {
+        self.media * self.surfaces
+    }
+
+    /// Whether no light passes.
+    #[inline]
+    pub fn is_black(&self) -> bool {
+        self.media.is_black() || self.surfaces.is_black()
+    }
+}
+
 /// The transmittance from `origin` to `end` at `time` for a ray starting in `medium`: the
 /// product of the transmittances of the media crossed (closed form in homogeneous media, ratio
-/// tracking in heterogeneous ones), through index-matched (`null`) boundaries; zero when
-/// another surface is in the way.
+/// tracking in heterogeneous ones) and of the null transmissions of the surfaces crossed; zero
+/// when a surface without a null lobe is in the way.
 pub fn shadow_transmittance(
     ctx: &mut SampleContext,
     origin: Vec3,
@@ -43,11 +80,11 @@ pub fn shadow_transmittance(
     time: f32,
     mut medium: Option<u32>,
     lambda: &SampledWavelengths,
-) -> SampledSpectrum {
+) -> ShadowTransmittance {
     let world = ctx.world();
     let d = (end - origin).normalize();
     let mut o = origin;
-    let mut transmittance = SampledSpectrum::ONE;
+    let mut transmittance = ShadowTransmittance::ONE;
     loop {
         let remaining = (end - o).dot(d);
         if !(remaining > 0.0) {
@@ -57,17 +94,25 @@ pub fn shadow_transmittance(
         let hit = ctx.intersect(&segment);
         if let Some(m) = medium {
             let t = hit.map_or(remaining, |si| si.t);
-            transmittance *= world.media[m as usize]
-                .transmittance(&segment, t, lambda, || ctx.sampler.next_1d());
-            if transmittance.is_black() {
+            transmittance.media *=
+                world.media[m as usize]
+                    .transmittance(&segment, t, lambda, || ctx.sampler.next_1d());
+            if transmittance.media.is_black() {
                 return transmittance;
             }
         }
         let Some(si) = hit else {
             return transmittance;
         };
-        if !world.material(&si).is_null() {
-            return SampledSpectrum::ZERO;
+        let material = world.material(&si);
+        if !material.is_null() {
+            if !material.has_null_lobe() {
+                return ShadowTransmittance::ZERO;
+            }
+            transmittance.surfaces *= material.null_transmission(&si, -d, lambda);
+            if transmittance.surfaces.is_black() {
+                return transmittance;
+            }
         }
         medium = medium_after(world, &si, d, medium);
         o = si.spawn_ray(d).o;

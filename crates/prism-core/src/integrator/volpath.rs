@@ -11,14 +11,19 @@
 //! importance sampling with the power heuristic on their solid-angle densities, exactly as a
 //! BSDF and a light are at a surface (Mitsuba's volpath does the same). Shadow rays carry the
 //! transmittance of every medium they cross (closed form for homogeneous media, ratio tracking
-//! for heterogeneous ones) and pass through index-matched boundaries (`null` BSDFs); any other
-//! surface blocks them.
+//! for heterogeneous ones) and pass through the surfaces that have a null lobe, weighted by its
+//! value (Mitsuba 3's `eval_null_transmission`: 1 for `null`, 1 − R' for `thindielectric`,
+//! 1 − α(1 − t_nested) for `mask`; [`super::transmittance`]); any other surface blocks them.
 //!
 //! * Media change where a path crosses a shape that names an `interior` or `exterior`
 //!   medium: the medium on the side the path leaves to; shapes that name none leave it as it
 //!   is. The camera sits in the sensor's medium.
-//! * A `null` surface is not a bounce: the path crosses it without changing direction, depth,
-//!   or the vertex its MIS weights refer to (Mitsuba's treatment of null-BSDF interactions).
+//! * A null interaction is not a bounce (Mitsuba 3's `volpath` and `volpathmis`): where the
+//!   BSDF sample is a null lobe (a `null` surface, the pass-through of `thindielectric` or
+//!   `mask`), the path crosses the surface with the sample's weight and without changing
+//!   direction, depth, or the vertex its MIS weights refer to. A surface with a null lobe is
+//!   sampled even at the last depth, where only a null sample lets the path go on; light
+//!   sampling there needs a bounce left, as at any surface.
 //! * Depth counts surface and medium scattering vertices; a path of depth d has d bounces,
 //!   `max_depth` as in `path`. Russian roulette on the path's potential (throughput times η²)
 //!   starts after `rr_depth` bounces (depth > rr_depth, as Mitsuba's volpath).
@@ -109,6 +114,11 @@ pub(super) trait PathWeights {
     /// delta lobe, or a medium without `sample_emitters`), whose emission then counts in full.
     fn scatter(&mut self, weight: SampledSpectrum, pdf: f32, unweighted: bool);
 
+    /// A surface crossed by a null lobe with the sample's `weight`: not a scattering vertex, so
+    /// the densities that MIS refers to stay those of the last one. The crossing is weighed
+    /// outside MIS, as the light sample's factor of null transmission is.
+    fn pass_through(&mut self, weight: SampledSpectrum);
+
     /// Whether emission found next is weighted against light sampling (so its light density
     /// is needed).
     fn weights_emission(&self) -> bool;
@@ -184,6 +194,11 @@ impl PathWeights for SpectralTracking {
     }
 
     #[inline]
+    fn pass_through(&mut self, weight: SampledSpectrum) {
+        self.throughput *= weight;
+    }
+
+    #[inline]
     fn weights_emission(&self) -> bool {
         !self.unweighted
     }
@@ -206,8 +221,11 @@ impl PathWeights for SpectralTracking {
         } else {
             power_heuristic(s.light_pdf, s.direction_pdf)
         };
-        self.result +=
-            self.throughput * s.value * s.transmittance * s.radiance * (weight / s.light_pdf);
+        self.result += self.throughput
+            * s.value
+            * s.transmittance.total()
+            * s.radiance
+            * (weight / s.light_pdf);
     }
 
     #[inline]
@@ -352,17 +370,20 @@ impl VolPathIntegrator {
             let wo = -ray.d;
 
             // An index-matched boundary: cross it without a bounce.
-            if world.material(&si).is_null() {
+            let material = world.material(&si);
+            if material.is_null() {
                 medium = medium_after(world, &si, ray.d, medium);
                 ray = si.spawn_ray(ray.d);
                 continue;
             }
-            if !allows_next_vertex(self.max_depth, depth) {
+            // Without a bounce left, only a null lobe lets the path go on.
+            let may_bounce = allows_next_vertex(self.max_depth, depth);
+            if !may_bounce && !material.has_null_lobe() {
                 break;
             }
 
             let scattering = surface_scattering(world, &si, wo, &mut lambda, &mut lobes);
-            if scattering.flags().has_smooth_lobe() {
+            if may_bounce && scattering.flags().has_smooth_lobe() {
                 let receiver = Receiver::surface(si.p, si.shading.n);
                 let terms = sample_light(ctx, &receiver, si.time, &lambda, |ctx, ls| {
                     let f = scattering.eval(ls.wi);
@@ -386,6 +407,18 @@ impl VolPathIntegrator {
             let Some(bs) = scattering.sample(u_lobe, u) else {
                 break;
             };
+            if bs.flags.has_null_lobe() {
+                weights.pass_through(bs.weight);
+                if weights.throughput().is_black() {
+                    break;
+                }
+                medium = medium_after(world, &si, ray.d, medium);
+                ray = si.spawn_ray(ray.d);
+                continue;
+            }
+            if !may_bounce {
+                break;
+            }
             lambda = wavelengths_after(&lambda, &bs);
             weights.scatter(bs.weight, bs.pdf, bs.flags.is_delta());
             eta_scale *= bs.eta;
@@ -426,7 +459,7 @@ impl VolPathIntegrator {
 
     /// One light sample at the point `p` of `med` (index `medium`), scattered towards `wo` by
     /// its phase function (the path's weight already carries σ_s of the real collision), with
-    /// the transmittance of the media the shadow ray crosses.
+    /// the transmittance of the media and null surfaces the shadow ray crosses.
     fn light_sample_in_medium(
         ctx: &mut SampleContext,
         p: Vec3,

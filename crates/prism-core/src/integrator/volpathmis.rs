@@ -39,9 +39,15 @@
 //! N by the light sample's density of the same events (1 for a homogeneous segment, whose
 //! transmittance is exact, and mⱼ e^{−mⱼΔ} per collision and e^{−mⱼΔ} at its end for ratio
 //! tracking). Emission found by the path adds Lₑ βᵢ / (mean U + p_light mean N); a light sample
-//! at a vertex adds f Tr Lₑ βᵢ / (p_light mean U + p_dir mean(U·Tr)), since the unidirectional
+//! at a vertex adds f Tr t Lₑ βᵢ / (p_light mean U + p_dir mean(U·Tr)), since the unidirectional
 //! technique would have had to pass the shadow ray's segment with density Tr (pⱼ(null)/p_nee
 //! = σ_n,ⱼ/mⱼ per ratio-tracking collision, which is ratio tracking's own factor).
+//!
+//! A surface crossed by a null lobe (`null`, the pass-through of `thindielectric` or `mask`) is
+//! no event of these sums: the path multiplies β by the sample's weight (the lobe's value over
+//! the probability of choosing it) and keeps U and N, and a light sample's shadow ray carries
+//! the surfaces' null transmission t in its value alone (t above; Tr is the media's), as
+//! Mitsuba's does. Both techniques then cross the surface alike, so its weights cancel.
 //!
 //! Differences from Mitsuba's implementation: the real or null choice uses the hero's
 //! σ_t,₀/m₀ (Mitsuba weighs it by the path's throughput as spectral tracking does), and the
@@ -195,6 +201,12 @@ impl PathWeights for SpectralMis {
         };
     }
 
+    /// β times the weight; U and N as they were (the crossing is no technique of the MIS).
+    #[inline]
+    fn pass_through(&mut self, weight: SampledSpectrum) {
+        self.beta *= weight;
+    }
+
     #[inline]
     fn weights_emission(&self) -> bool {
         !self.unweighted
@@ -209,12 +221,12 @@ impl PathWeights for SpectralMis {
         self.hero_result += over(found, self.uni[0] + light_pdf * self.nee[0]);
     }
 
-    /// f Tr Lₑ βᵢ / (p_light mean U + p_dir mean(U·Tr)), p_dir = 0 for a delta light.
+    /// f Tr Lₑ βᵢ / (p_light mean U + p_dir mean(U·Tr_media)), p_dir = 0 for a delta light.
     #[inline]
     fn add_light_sample(&mut self, s: &LightSampleTerms) {
-        let found = self.beta * s.value * s.transmittance * s.radiance;
+        let found = self.beta * s.value * s.transmittance.total() * s.radiance;
         let direction_pdf = if s.is_delta { 0.0 } else { s.direction_pdf };
-        let passing = self.uni * s.transmittance;
+        let passing = self.uni * s.transmittance.media;
         self.result += over(
             found,
             s.light_pdf * self.uni.average() + direction_pdf * passing.average(),

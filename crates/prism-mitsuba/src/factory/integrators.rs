@@ -101,8 +101,9 @@ pub static INTEGRATORS: Registry<Build> = Registry {
             summary: "Volumetric path tracing: `path` with participating media between the \
                       surfaces, free flights by spectral tracking with one majorant for the \
                       path's four wavelengths, shadow rays through media (closed-form or \
-                      ratio-tracking transmittance) and `null` boundaries, light and phase \
-                      samples in media combined by MIS.",
+                      ratio-tracking transmittance) and the null lobes of `null`, \
+                      `thindielectric` and `mask` (no bounce, as in Mitsuba 3), light and \
+                      phase samples in media combined by MIS.",
             params: &[MAX_DEPTH, RR_DEPTH, HIDE_EMITTERS, EMITTER_SAMPLING],
             build: build_volpath,
         },

@@ -31,7 +31,9 @@ pub(super) const MASK: Plugin<Build> = Plugin {
     name: "mask",
     origin: Origin::Mitsuba3,
     summary: "A partly transparent surface: light passes straight through with \
-              probability 1 − α. Shadow rays see it as opaque.",
+              probability 1 − α. In `path` shadow rays see it as opaque; in `volpath` and \
+              `volpathmis` the pass is no bounce and shadow rays pass with weight 1 − α, \
+              as in Mitsuba 3.",
     params: &[OPACITY, NESTED_BSDF],
     build: |params, t| {
         Ok(Bsdf::Mask(Mask {
@@ -46,8 +48,8 @@ pub(super) const NULL: Plugin<Build> = Plugin {
     origin: Origin::Mitsuba3,
     summary: "Light passes straight through, unchanged (an index-matched boundary, the \
               outline of a medium, an invisible shape); in `path` it counts as a bounce \
-              and shadow rays see it as opaque, in `volpath` it is no bounce and shadow \
-              rays pass, as in Mitsuba 3.",
+              and shadow rays see it as opaque, in `volpath` and `volpathmis` it is no \
+              bounce and shadow rays pass, as in Mitsuba 3.",
     params: &[],
     build: |_, _| Ok(Bsdf::Null(Null)),
 };

@@ -48,7 +48,8 @@ pub(super) const THINDIELECTRIC: Plugin<Build> = Plugin {
     name: "thindielectric",
     origin: Origin::Mitsuba3,
     summary: "A thin pane of glass: reflects R' = 2R/(1 + R) and lets the rest through \
-              undeflected.",
+              undeflected; in `volpath` and `volpathmis` that pass is no bounce and shadow \
+              rays pass with weight 1 − R', as in Mitsuba 3.",
     params: SMOOTH_INTERFACE,
     build: |params, t| {
         Ok(Bsdf::ThinDielectric(ThinDielectric {
