@@ -20,3 +20,4 @@ mod references;
 mod reliability;
 mod shapes;
 mod signposts;
+mod transforms;

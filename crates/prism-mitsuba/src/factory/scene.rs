@@ -10,8 +10,8 @@ use super::instancing::ShapeGroups;
 use super::sensor::SensorSettings;
 use super::textures::TextureCache;
 use super::{integrators, lights, materials, media, sensor, shapes, textures};
-use crate::description::{NestedPlugin, PluginClass, PluginNode};
-use crate::params::{Params, Warning};
+use crate::description::{NestedPlugin, PluginClass, PluginNode, Warning};
+use crate::params::Params;
 use crate::registry::{Default, ParamSpec, params};
 use prism_core::bsdf::Material;
 use prism_core::error::{Error, Result, SourceLocation};
@@ -28,8 +28,8 @@ pub struct LoadedScene {
     pub scene: Scene,
     /// The sampler's `seed` parameter.
     pub seed: u64,
-    /// Parameters of the file that Prism reads but ignores (Mitsuba 0.6 forms), one warning
-    /// each, in the order they were read.
+    /// Parameters of the file that Prism reads but ignores (Mitsuba 0.6 forms), and where
+    /// Mitsuba would render the file otherwise, one warning each, in the order they were read.
     pub warnings: Vec<Warning>,
 }
 

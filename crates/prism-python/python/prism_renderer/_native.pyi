@@ -69,7 +69,8 @@ class Transform:
         """This transform times the scaling by ``factors`` (one number or three)."""
     def rotate(self, axis: Sequence[float], angle: float) -> Transform:
         """This transform times the right-handed rotation by ``angle`` degrees about
-        ``axis``. Raises ValueError for a zero axis."""
+        ``axis``, taken as given as Mitsuba 3 does: an axis not of unit length also stretches
+        and shears. Raises ValueError for a zero axis."""
     def look_at(
         self,
         origin: Sequence[float],
