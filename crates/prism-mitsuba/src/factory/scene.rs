@@ -52,7 +52,8 @@ const SCENE: &[ParamSpec] = &[
 /// reports its errors in the order Mitsuba would.
 pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
     let params = Params::new(root, SCENE);
-    let integrator = integrator(&params)?;
+    let integrator_child = params.single_child(&INTEGRATOR)?;
+    let integrator = integrator(integrator_child)?;
     let sensor = single_sensor(root, &params)?;
     let mut builder = SceneBuilder::default();
     builder.shapes(&params)?;
@@ -74,12 +75,17 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
     builder.declared_media(&params)?;
     params.finish()?;
     check_renders_media(&integrator, &builder.media)?;
-    Ok(builder.finish(root, integrator, sensor, camera_medium))
+    let delta_light_warning = integrator_child.and_then(|child| {
+        integrators::direct_delta_light_warning(&child.node, &integrator, &builder.lights)
+    });
+    let mut loaded = builder.finish(root, integrator, sensor, camera_medium);
+    loaded.warnings.extend(delta_light_warning);
+    Ok(loaded)
 }
 
 /// The scene's integrator, `path` by default.
-fn integrator(params: &Params) -> Result<Integrator> {
-    match params.single_child(&INTEGRATOR)? {
+fn integrator(child: Option<&NestedPlugin>) -> Result<Integrator> {
+    match child {
         Some(child) => {
             let integrator = integrators::build_integrator(&child.node)?;
             integrators::check_channel_names(&integrator, &child.location)?;
