@@ -52,6 +52,10 @@ pub struct RenderArgs {
     /// Seed of the random numbers [default: the sampler's seed, else 0]
     #[arg(long, value_name = "S")]
     pub seed: Option<u64>,
+    /// Render through this sensor of a scene with several: its id, or its index from 0 in
+    /// document order [default: the first]
+    #[arg(long, value_name = "INDEX|ID")]
+    pub sensor: Option<String>,
     /// Set a scene parameter declared with `<default name=... value=...>` (repeatable)
     #[arg(short = 'D', long = "define", value_name = "NAME=VALUE", value_parser = parse_define)]
     pub defines: Vec<(String, String)>,
@@ -261,9 +265,12 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         ));
     }
     args.accel.check_available()?;
-    let loaded = load_scene(&args.scene, &args.defines)?;
+    let mut loaded = load_scene(&args.scene, &args.defines)?;
     for warning in &loaded.warnings {
         eprintln!("{warning}");
+    }
+    if let Some(choice) = &args.sensor {
+        loaded.select_sensor(loaded.find_sensor(choice)?)?;
     }
     let mut scene = loaded.scene;
     args.accel.apply(&mut scene.world.geometry)?;

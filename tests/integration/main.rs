@@ -18,6 +18,7 @@ mod materials;
 mod media;
 mod references;
 mod reliability;
+mod several_sensors;
 mod shapes;
 mod signposts;
 mod transforms;
