@@ -63,6 +63,10 @@ pub struct RenderArgs {
     /// Set a scene parameter declared with `<default name=... value=...>` (repeatable)
     #[arg(short = 'D', long = "define", value_name = "NAME=VALUE", value_parser = parse_define, help_heading = SCENE)]
     pub defines: Vec<(String, String)>,
+    /// Render through this sensor of a scene with several: its id, or its index from 0 in
+    /// document order [default: the first]
+    #[arg(long, value_name = "INDEX|ID", help_heading = SCENE)]
+    pub sensor: Option<String>,
     /// Output EXR file; the PNG goes beside it [default: the scene's name in the current folder;
     /// for a file called scene.xml, the name of its folder]
     #[arg(short, long, value_name = "OUT.exr", help_heading = OUTPUT)]
@@ -293,10 +297,13 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     }
     args.accel.check_available()?;
     let load_start = Instant::now();
-    let loaded = load_scene(&args.scene, &args.defines)?;
+    let mut loaded = load_scene(&args.scene, &args.defines)?;
     let load_time = load_start.elapsed();
     for warning in &loaded.warnings {
         eprintln!("{warning}");
+    }
+    if let Some(choice) = &args.sensor {
+        loaded.select_sensor(loaded.find_sensor(choice)?)?;
     }
     let mut scene = loaded.scene;
     let accel_start = Instant::now();

@@ -20,5 +20,7 @@ mod media;
 mod preview;
 mod references;
 mod reliability;
+mod several_sensors;
 mod shapes;
 mod signposts;
+mod transforms;

@@ -25,6 +25,13 @@ def test_rotate_is_right_handed_in_degrees():
         T().rotate([0, 0, 0], 90)
 
 
+def test_rotate_takes_its_axis_as_given_as_mitsuba_3():
+    # About a = (0, 0, 2) by θ = 90°, the matrix also scales by |a| = 2 across the axis and by
+    # cos θ + (1 - cos θ) |a|² = 4 along it.
+    assert np.allclose(apply(T().rotate([0, 0, 2], 90), [1, 0, 0]), [0, 2, 0])
+    assert np.allclose(apply(T().rotate([0, 0, 2], 90), [0, 0, 1]), [0, 0, 4])
+
+
 def test_look_at_has_mitsubas_columns():
     m = T().look_at(origin=[0, 0, 5], target=[0, 0, 0], up=[0, 1, 0]).matrix
     assert np.allclose(m[:3, 2], [0, 0, -1])  # the view direction

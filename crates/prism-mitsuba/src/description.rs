@@ -6,6 +6,7 @@
 //! into renderable objects, reading properties through [`super::params::Params`], which reports
 //! unknown, misspelled and wrongly typed parameters.
 
+use std::fmt;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -76,6 +77,21 @@ impl PluginClass {
         PluginClass::ALL
             .into_iter()
             .find(|class| class.tag() == tag)
+    }
+}
+
+/// Something in the scene file that Prism reads but renders otherwise than its words or another
+/// renderer suggest (a Mitsuba 0.6 parameter it ignores, a `<rotate>` about an axis not of unit
+/// length, ...): where it is written and why.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Warning {
+    pub location: SourceLocation,
+    pub message: String,
+}
+
+impl fmt::Display for Warning {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}: warning: {}", self.location, self.message)
     }
 }
 

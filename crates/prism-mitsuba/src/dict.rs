@@ -458,8 +458,9 @@ pub mod transform {
         crate::transform_ops::scaling(factors)
     }
 
-    /// `<rotate>`: the right-handed rotation by `angle` degrees about `axis`; the error names
-    /// the problem with the axis.
+    /// `<rotate>` of a Mitsuba 3 scene: by `angle` degrees about `axis` as given (right-handed
+    /// for a unit axis; a longer or shorter one also stretches and shears, as in Mitsuba 3); the
+    /// error names the problem with the axis.
     pub fn rotate(axis: DVec3, angle: f64) -> Result<DMat4, &'static str> {
         crate::transform_ops::rotation(axis, angle)
     }

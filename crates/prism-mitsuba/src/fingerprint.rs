@@ -51,6 +51,19 @@ pub fn override_reconstruction(scene: &mut Scene, reconstruction: Reconstruction
     mix_into_fingerprint(scene, "reconstruction", reconstruction.name());
 }
 
+/// The fingerprint of a scene seen through its sensor `index`: the description's, mixed with the
+/// index but for the first sensor.
+pub fn with_sensor(description: u64, index: usize) -> u64 {
+    if index == 0 {
+        return description;
+    }
+    let mut hash = Fnv64::default();
+    hash.write(&description.to_le_bytes());
+    hash.write_str("sensor");
+    hash.write(&(index as u64).to_le_bytes());
+    hash.finish()
+}
+
 fn mix_into_fingerprint(scene: &mut Scene, setting: &str, value: &str) {
     let mut hash = Fnv64::default();
     hash.write(&scene.fingerprint.to_le_bytes());

@@ -32,8 +32,11 @@ pub fn load_scene_dict(root: &dict::Dict) -> Result<LoadedScene> {
     factory::build_scene(&tree)
 }
 
-/// Reads a Mitsuba XML scene file (with `-D name=value` overrides) and builds it.
+/// Reads a Mitsuba XML scene file (with `-D name=value` overrides) and builds it; the reader's
+/// warnings come first.
 pub fn load_scene(path: &Path, defines: &[(String, String)]) -> Result<LoadedScene> {
-    let root = reader::read_scene_file(path, defines)?;
-    factory::build_scene(&root)
+    let document = reader::read_scene_document(path, defines)?;
+    let mut loaded = factory::build_scene(&document.root)?;
+    loaded.warnings.splice(0..0, document.warnings);
+    Ok(loaded)
 }

@@ -8,28 +8,14 @@
 //! 0.6 forms Prism reads but does not implement) into one [`Warning`] each.
 
 use std::cell::Cell;
-use std::fmt;
 
 use glam::{DMat4, DVec3};
 
-use crate::description::{NestedPlugin, PluginNode, Property, PropertyValue};
+use crate::description::{NestedPlugin, PluginNode, Property, PropertyValue, Warning};
 use crate::registry::{Choice, Default, ParamKind, ParamSpec};
 use crate::suggest::closest_match;
 use prism_core::error::{Error, Result, SourceLocation};
 use prism_core::math::{AnimatedTransform, Transform};
-
-/// A parameter of the scene that Prism reads but ignores, where it is written and why.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct Warning {
-    pub location: SourceLocation,
-    pub message: String,
-}
-
-impl fmt::Display for Warning {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}: warning: {}", self.location, self.message)
-    }
-}
 
 /// Reads the properties of one plugin node through its plugin's declared parameters, and
 /// remembers which were read.

@@ -58,12 +58,12 @@ use glam::{DMat4, DVec3};
 use roxmltree::{Node, NodeType};
 
 use super::description::{
-    NestedPlugin, PluginClass, PluginNode, Property, PropertyValue, find_file,
+    NestedPlugin, PluginClass, PluginNode, Property, PropertyValue, Warning, find_file,
 };
 use super::element::{Attribute, Element, quote};
 use super::property_values;
 use super::substitution::{Parameters, camel_to_snake};
-use super::transform_ops;
+use super::transform_ops::{self, Dialect};
 use crate::suggest::closest_match;
 use comments::tolerate_hyphens_in_comments;
 use prism_core::error::{Error, Result, SourceLocation};
@@ -73,8 +73,20 @@ pub const MAX_NESTING: usize = 256;
 /// Deepest nesting of `<include>`s (Mitsuba's `MI_XML_INCLUDE_MAX_RECURSION`).
 pub const MAX_INCLUDE_DEPTH: usize = 15;
 
+/// A scene file read: its root `<scene>`, and what the reader warns about in document order
+/// (a `<rotate>` whose axis is not of unit length, ...: see `transform_ops.rs`).
+pub struct SceneDocument {
+    pub root: Arc<PluginNode>,
+    pub warnings: Vec<Warning>,
+}
+
 /// Reads a scene file; `defines` are the command line's `-D name=value` overrides.
 pub fn read_scene_file(path: &Path, defines: &[(String, String)]) -> Result<Arc<PluginNode>> {
+    read_scene_document(path, defines).map(|document| document.root)
+}
+
+/// As [`read_scene_file`], with the reader's warnings.
+pub fn read_scene_document(path: &Path, defines: &[(String, String)]) -> Result<SceneDocument> {
     let text = std::fs::read_to_string(path).map_err(|err| {
         if err.kind() == std::io::ErrorKind::NotFound {
             Error::usage(format!("scene file \"{}\" not found", path.display()))
@@ -83,7 +95,7 @@ pub fn read_scene_file(path: &Path, defines: &[(String, String)]) -> Result<Arc<
             Error::io(path, &err, "read the scene file")
         }
     })?;
-    read_scene_str(&text, path, defines)
+    read_scene_str_document(&text, path, defines)
 }
 
 /// Same, from a string; `path` names the (possibly virtual) file for messages and relative lookups.
@@ -92,6 +104,15 @@ pub fn read_scene_str(
     path: &Path,
     defines: &[(String, String)],
 ) -> Result<Arc<PluginNode>> {
+    read_scene_str_document(text, path, defines).map(|document| document.root)
+}
+
+/// As [`read_scene_str`], with the reader's warnings.
+pub fn read_scene_str_document(
+    text: &str,
+    path: &Path,
+    defines: &[(String, String)],
+) -> Result<SceneDocument> {
     let mut reader = Reader {
         parameters: Parameters::new(defines)?,
         drafts: Vec::new(),
@@ -99,11 +120,15 @@ pub fn read_scene_str(
         main_dir: folder_of(path),
         path_dirs: Vec::new(),
         search_path_cache: HashMap::new(),
+        warnings: Vec::new(),
     };
     reader.read_main(text, path)?;
     let root = resolve(std::mem::take(&mut reader.drafts), &reader.ids)?;
     reader.parameters.check_defines_used()?;
-    Ok(root)
+    Ok(SceneDocument {
+        root,
+        warnings: reader.warnings,
+    })
 }
 
 /// The folder of `path`, or `.` for a bare file name.
@@ -248,6 +273,7 @@ struct Reader {
     path_dirs: Vec<PathBuf>,
     /// Search paths by the folder of the file holding an element; cleared by `<path>`.
     search_path_cache: HashMap<PathBuf, Arc<Vec<PathBuf>>>,
+    warnings: Vec<Warning>,
 }
 
 /// Parses XML; a syntax error is reported where the parser found it.
@@ -700,7 +726,15 @@ impl Reader {
                 NodeType::Element => {
                     let operation = self.element(source, child, None)?;
                     expect_no_content(source, child, &operation)?;
-                    matrix = transform_ops::operation_matrix(&operation)? * matrix;
+                    let dialect = if source.legacy {
+                        Dialect::Mitsuba06
+                    } else {
+                        Dialect::Mitsuba3
+                    };
+                    let (operation_matrix, warning) =
+                        transform_ops::operation_matrix(&operation, dialect)?;
+                    self.warnings.extend(warning);
+                    matrix = operation_matrix * matrix;
                     if !matrix.is_finite() {
                         return Err(Error::input(
                             &operation.location,

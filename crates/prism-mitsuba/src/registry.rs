@@ -235,7 +235,7 @@ pub enum Default {
     /// Absent means absent (an optional factor, an optional nested plugin).
     None,
     /// A Mitsuba 0.6 parameter whose meaning is clear but which Prism does not implement: it is
-    /// read and ignored, with a warning ([`crate::params::Warning`]).
+    /// read and ignored, with a warning ([`crate::description::Warning`]).
     Ignored,
 }
 

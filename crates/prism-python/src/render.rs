@@ -28,7 +28,8 @@ const POLL: Duration = Duration::from_millis(100);
 /// samples per pixel (None: the sampler's `sample_count`), the random streams of `seed` (None:
 /// the sampler's `seed`), `threads` worker threads (None: one per core), and with a
 /// `time_limit` in seconds or a `target_error` (the image's mean relative standard error) the
-/// render stops at whichever comes first, `spp` then only capping the samples.
+/// render stops at whichever comes first, `spp` then only capping the samples; `sensor` is the
+/// sensor to look through.
 #[derive(FromPyObject)]
 #[pyo3(from_item_all)]
 pub struct RenderSettings {
@@ -37,6 +38,14 @@ pub struct RenderSettings {
     threads: Option<usize>,
     time_limit: Option<f64>,
     target_error: Option<f64>,
+    sensor: SensorChoice,
+}
+
+/// A sensor of the scene, by its index from 0 in document order or by its id.
+#[derive(FromPyObject)]
+pub enum SensorChoice {
+    Index(usize),
+    Id(String),
 }
 
 /// Renders `scene` as `settings` say. `progress`, if given, is called as
@@ -51,7 +60,7 @@ pub struct RenderSettings {
 #[pyo3(signature = (scene, settings, progress = None, preview = None))]
 pub fn render(
     py: Python<'_>,
-    scene: &Scene,
+    scene: &Bound<'_, Scene>,
     settings: RenderSettings,
     progress: Option<Bound<'_, PyAny>>,
     preview: Option<Bound<'_, PyAny>>,
@@ -62,10 +71,13 @@ pub fn render(
         threads,
         time_limit,
         target_error,
+        sensor,
     } = settings;
     if threads == Some(0) {
         return Err(to_py(py, &Error::usage("threads must be at least 1")));
     }
+    select_sensor(py, scene, sensor)?;
+    let scene = scene.borrow();
     let loaded = &scene.loaded;
     let samples_per_pixel = loaded
         .scene
@@ -190,4 +202,23 @@ fn image_of(py: Python<'_>, film: &Film, samples: Range<u32>, seconds: f64) -> P
         (FilmImages::of(film), aovs)
     });
     Image::new(py, images, aovs, samples.end - samples.start, seconds)
+}
+
+/// Makes `scene` seen through the sensor `choice` names; changing it needs the scene not to be
+/// rendering.
+fn select_sensor(py: Python<'_>, scene: &Bound<'_, Scene>, choice: SensorChoice) -> PyResult<()> {
+    let index = match choice {
+        SensorChoice::Index(index) => index,
+        SensorChoice::Id(id) => scene.borrow().loaded.find_sensor(&id).into_py_result(py)?,
+    };
+    if scene.borrow().loaded.selected_sensor() == index {
+        return Ok(());
+    }
+    let mut scene = scene.try_borrow_mut().map_err(|_| {
+        to_py(
+            py,
+            &Error::usage("the scene is rendering: render through another of its sensors after that render ends"),
+        )
+    })?;
+    scene.loaded.select_sensor(index).into_py_result(py)
 }

@@ -87,6 +87,21 @@ impl Scene {
         Ok(())
     }
 
+    /// The index of the sensor the scene is seen through: 0 after loading, then the one the
+    /// last render used; `width`, `height`, `spp` and `seed` are its.
+    #[getter]
+    fn sensor(&self) -> usize {
+        self.loaded.selected_sensor()
+    }
+
+    /// The `id` of every sensor (None for one without), in document order.
+    #[getter]
+    fn sensor_ids(&self) -> Vec<Option<String>> {
+        (self.loaded.sensors().iter())
+            .map(|sensor| sensor.id.clone())
+            .collect()
+    }
+
     fn __repr__(&self) -> String {
         format!(
             "Scene({}×{} pixels, {} spp)",

@@ -88,7 +88,8 @@ impl Transform {
     }
 
     /// This transform followed on the right by the rotation by `angle` degrees about `axis`
-    /// (right-handed).
+    /// (right-handed), taken as given as Mitsuba 3 does: an axis not of unit length also
+    /// stretches and shears.
     fn rotate(&self, axis: [f64; 3], angle: f64) -> PyResult<Transform> {
         let rotation = transform::rotate(DVec3::from_array(axis), angle)
             .map_err(|problem| PyValueError::new_err(format!("rotate: {problem}")))?;

@@ -636,7 +636,7 @@ fn sky_sampling_follows_its_density() {
     let light = sunsky(
         r#"<emitter type="sunsky"><vector name="sun_direction" x="-0.3" y="0.7" z="0.3"/>
             <float name="sun_scale" value="0"/><float name="turbidity" value="4"/>
-            <transform name="to_world"><rotate x="1" y="0.5" angle="-70"/></transform></emitter>"#,
+            <transform name="to_world"><rotate x="0.894427190999916" y="0.447213595499958" angle="-70"/></transform></emitter>"#,
     );
     let to_world =
         glam::DMat4::from_axis_angle(DVec3::new(1.0, 0.5, 0.0).normalize(), (-70f64).to_radians());

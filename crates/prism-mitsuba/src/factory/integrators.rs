@@ -2,7 +2,7 @@
 //! [`prism_core::light::sampler`]), `direct`, `moment`, `aov`, the lecture's `distrib`, and
 //! `volpath` and `volpathmis` for media.
 
-use crate::description::{PluginClass, PluginNode};
+use crate::description::{PluginClass, PluginNode, Warning};
 use crate::params::Params;
 use crate::registry::{Choice, Default, Origin, ParamKind, ParamSpec, Plugin, Registry, params};
 use crate::suggest::closest_match;
@@ -14,7 +14,7 @@ use prism_core::integrator::{
     AovIntegrator, DepthIntegrator, DirectIntegrator, DistributionIntegrator, Integrator,
     MomentIntegrator, PathIntegrator, Tracking, VolPathIntegrator,
 };
-use prism_core::light::LightSelection;
+use prism_core::light::{Light, LightSelection};
 
 type Build = fn(&Params) -> Result<Integrator>;
 
@@ -262,6 +262,53 @@ fn build_direct(params: &Params) -> Result<Integrator> {
         bsdf_samples,
         hide_emitters: params.boolean(&HIDE_EMITTERS)?,
     }))
+}
+
+/// Mitsuba 3's `direct` weighs each light sample by 1/`emitter_samples`, except a sample of a
+/// delta light (its `mis` is 1 when `ds.delta`, without the weight), so with n > 1 emitter
+/// samples its delta lights come out n times too bright. Prism does not copy that defect; this
+/// is the warning, at the integrator's sample count, for a `direct` `node` with several emitter
+/// samples in a scene with delta lights.
+pub fn direct_delta_light_warning(
+    node: &PluginNode,
+    integrator: &Integrator,
+    lights: &[Light],
+) -> Option<Warning> {
+    let Integrator::Direct(direct) = integrator else {
+        return None;
+    };
+    let mut kinds: Vec<&str> = lights.iter().filter_map(delta_light_name).collect();
+    kinds.sort_unstable();
+    kinds.dedup();
+    if direct.emitter_samples < 2 || kinds.is_empty() {
+        return None;
+    }
+    let location = [EMITTER_SAMPLES.name, SHADING_SAMPLES.name]
+        .iter()
+        .find_map(|name| node.properties.iter().find(|p| p.name == *name))
+        .map_or(&node.location, |property| &property.location);
+    let n = direct.emitter_samples;
+    Some(Warning {
+        location: location.clone(),
+        message: format!(
+            "direct with {n} emitter samples in a scene with {} lights: Mitsuba 3 counts each \
+             sample of a point, spot, projector or directional light with weight 1 instead of \
+             1/{n}, so its image of them is {n} times too bright; Prism weighs every light \
+             sample 1/{n}",
+            kinds.join(", ")
+        ),
+    })
+}
+
+/// The Mitsuba name of a delta light (a point or a direction), None for other lights.
+fn delta_light_name(light: &Light) -> Option<&'static str> {
+    match light {
+        Light::Point(_) => Some("point"),
+        Light::Spot(_) => Some("spot"),
+        Light::Projector(_) => Some("projector"),
+        Light::Directional(_) => Some("directional"),
+        Light::Area(_) | Light::Constant(_) | Light::Envmap(_) | Light::Sunsky(_) => None,
+    }
 }
 
 /// The nested integrators of `spec`, each with the name its channels carry: its `name`

@@ -16,8 +16,10 @@ pub mod materials;
 pub mod media;
 mod scene;
 pub mod sensor;
+mod sensor_choice;
 pub mod shapes;
 pub mod spectra;
 pub mod textures;
 
 pub use scene::{LoadedScene, build_scene};
+pub use sensor_choice::SceneSensor;

@@ -1,4 +1,4 @@
-//! The scene builder: reads the sections of the root `<scene>` (integrator, sensor, shapes,
+//! The scene builder: reads the sections of the root `<scene>` (integrator, sensors, shapes,
 //! emitters, and the BSDFs, textures, samplers and media declared to be referenced by id) into
 //! a renderable [`Scene`], each object built once however often it is referenced.
 
@@ -8,10 +8,11 @@ use std::sync::Arc;
 
 use super::instancing::ShapeGroups;
 use super::sensor::SensorSettings;
+use super::sensor_choice::SceneSensor;
 use super::textures::TextureCache;
 use super::{integrators, lights, materials, media, sensor, shapes, textures};
-use crate::description::{NestedPlugin, PluginClass, PluginNode};
-use crate::params::{Params, Warning};
+use crate::description::{NestedPlugin, PluginClass, PluginNode, Warning};
+use crate::params::Params;
 use crate::registry::{Default, ParamSpec, params};
 use prism_core::bsdf::Material;
 use prism_core::error::{Error, Result, SourceLocation};
@@ -25,17 +26,25 @@ use prism_core::world::{ShapeInfo, World};
 
 /// A renderable scene and the settings its file gives for rendering it.
 pub struct LoadedScene {
+    /// The scene, seen through the selected sensor (the first until [`Self::select_sensor`]).
     pub scene: Scene,
-    /// The sampler's `seed` parameter.
+    /// The selected sensor's sampler's `seed` parameter.
     pub seed: u64,
-    /// Parameters of the file that Prism reads but ignores (Mitsuba 0.6 forms), one warning
-    /// each, in the order they were read.
+    /// Parameters of the file that Prism reads but ignores (Mitsuba 0.6 forms), and where
+    /// Mitsuba would render the file otherwise, one warning each, in the order they were read.
     pub warnings: Vec<Warning>,
+    /// Every `<sensor>`, in document order (Mitsuba loads them all and renders the first unless
+    /// told otherwise).
+    pub(super) sensors: Vec<SceneSensor>,
+    /// The index of the sensor `scene` is seen through.
+    pub(super) selected: usize,
+    /// The fingerprint of the scene's description, before any choice of sensor or override.
+    pub(super) description_fingerprint: u64,
 }
 
 params! {
     INTEGRATOR = ParamSpec::nested(PluginClass::Integrator, Default::Text("`path`"), "the integrator");
-    SENSOR = ParamSpec::nested(PluginClass::Sensor, Default::Required, "the camera");
+    SENSOR = ParamSpec::nested(PluginClass::Sensor, Default::Required, "the cameras: Prism renders the first, or the one `prism render --sensor` names (an id or an index from 0)");
     SHAPES = ParamSpec::nested(PluginClass::Shape, Default::None, "the shapes");
     EMITTERS = ParamSpec::nested(PluginClass::Emitter, Default::None, "lights; an `area` emitter here is attached to the shape that references its id");
     BSDFS = ParamSpec::nested(PluginClass::Bsdf, Default::None, "BSDFs declared to be referenced by id");
@@ -52,8 +61,9 @@ const SCENE: &[ParamSpec] = &[
 /// reports its errors in the order Mitsuba would.
 pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
     let params = Params::new(root, SCENE);
-    let integrator = integrator(&params)?;
-    let sensor = single_sensor(root, &params)?;
+    let integrator_child = params.single_child(&INTEGRATOR)?;
+    let integrator = integrator(integrator_child)?;
+    let sensors = sensors(root, &params)?;
     let mut builder = SceneBuilder::default();
     builder.shapes(&params)?;
     builder.emitters(&params)?;
@@ -63,23 +73,42 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
         // Checked even when no sensor references it.
         sensor::sampler::build_sampler(&child.node)?;
     }
-    let camera_medium = match &sensor.medium {
-        Some(node) => Some(builder.media.index(&NestedPlugin {
-            name: None,
-            node: node.clone(),
-            location: node.location.clone(),
-        })?),
-        None => None,
-    };
+    let mut scene_sensors = Vec::with_capacity(sensors.len());
+    let mut warnings = Vec::new();
+    for (id, sensor) in sensors {
+        let medium = match &sensor.medium {
+            Some(node) => Some(builder.media.index(&NestedPlugin {
+                name: None,
+                node: node.clone(),
+                location: node.location.clone(),
+            })?),
+            None => None,
+        };
+        warnings.extend(sensor.warnings);
+        scene_sensors.push(SceneSensor {
+            id,
+            camera: sensor.camera,
+            shutter: sensor.shutter,
+            film: sensor.film,
+            sampler: sensor.sampler,
+            seed: sensor.seed,
+            ldr_output: sensor.ldr_output,
+            medium,
+        });
+    }
     builder.declared_media(&params)?;
     params.finish()?;
     check_renders_media(&integrator, &builder.media)?;
-    Ok(builder.finish(root, integrator, sensor, camera_medium))
+    let delta_light_warning = integrator_child.and_then(|child| {
+        integrators::direct_delta_light_warning(&child.node, &integrator, &builder.lights)
+    });
+    warnings.extend(delta_light_warning);
+    Ok(builder.finish(root, integrator, scene_sensors, warnings))
 }
 
 /// The scene's integrator, `path` by default.
-fn integrator(params: &Params) -> Result<Integrator> {
-    match params.single_child(&INTEGRATOR)? {
+fn integrator(child: Option<&NestedPlugin>) -> Result<Integrator> {
+    match child {
         Some(child) => {
             let integrator = integrators::build_integrator(&child.node)?;
             integrators::check_channel_names(&integrator, &child.location)?;
@@ -89,20 +118,16 @@ fn integrator(params: &Params) -> Result<Integrator> {
     }
 }
 
-/// The scene's one sensor.
-fn single_sensor(root: &PluginNode, params: &Params) -> Result<SensorSettings> {
+/// The scene's sensors with their ids, in document order; a scene needs one.
+fn sensors(root: &PluginNode, params: &Params) -> Result<Vec<(Option<String>, SensorSettings)>> {
     let sensors = params.children(&SENSOR);
-    let Some(sensor) = sensors.first() else {
+    if sensors.is_empty() {
         return Err(Error::input(&root.location, "the scene has no <sensor>")
             .with_help("add a <sensor type=\"perspective\"> with a film and a sampler"));
-    };
-    if let Some(second) = sensors.get(1) {
-        return Err(
-            Error::input(&second.location, "the scene has more than one <sensor>")
-                .with_help("Prism renders one sensor per scene: remove the others"),
-        );
     }
-    sensor::build_sensor(&sensor.node)
+    (sensors.iter())
+        .map(|child| Ok((child.node.id.clone(), sensor::build_sensor(&child.node)?)))
+        .collect()
 }
 
 /// The distrib integrator estimates no participating media: a scene with media and distrib is
@@ -327,13 +352,13 @@ impl SceneBuilder {
         Ok(())
     }
 
-    /// The scene, from the parts read.
+    /// The scene, from the parts read, seen through the first sensor.
     fn finish(
         self,
         root: &PluginNode,
         integrator: Integrator,
-        sensor: SensorSettings,
-        camera_medium: Option<u32>,
+        sensors: Vec<SceneSensor>,
+        warnings: Vec<Warning>,
     ) -> LoadedScene {
         let mut world = World::new(
             Geometry::new(self.shapes),
@@ -346,21 +371,20 @@ impl SceneBuilder {
             world.medium_interfaces = self.medium_interfaces;
         }
         world.media = self.media.media;
-        world.camera_medium = camera_medium;
-        let mut scene = Scene::new(
-            world,
-            sensor.camera,
-            sensor.film,
-            sensor.sampler,
-            integrator,
-        );
-        scene.shutter = sensor.shutter;
-        scene.ldr_output = sensor.ldr_output;
-        scene.fingerprint = crate::fingerprint::scene_fingerprint(root);
+        let first = sensors[0].clone();
+        world.camera_medium = first.medium;
+        let mut scene = Scene::new(world, first.camera, first.film, first.sampler, integrator);
+        scene.shutter = first.shutter;
+        scene.ldr_output = first.ldr_output;
+        let description_fingerprint = crate::fingerprint::scene_fingerprint(root);
+        scene.fingerprint = description_fingerprint;
         LoadedScene {
             scene,
-            seed: sensor.seed,
-            warnings: sensor.warnings,
+            seed: first.seed,
+            warnings,
+            sensors,
+            selected: 0,
+            description_fingerprint,
         }
     }
 }

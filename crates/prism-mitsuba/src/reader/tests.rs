@@ -499,8 +499,6 @@ fn transform_operations_compose_left_to_right() {
 fn rotate_is_right_handed_in_degrees() {
     let m = transform_of(r#"<rotate z="1" angle="90"/>"#).unwrap();
     assert_close(m.transform_vector3(DVec3::X), DVec3::Y);
-    let m = transform_of(r#"<rotate value="0, 0, 5" angle="90"/>"#).unwrap();
-    assert_close(m.transform_vector3(DVec3::X), DVec3::Y);
     assert_error(
         &transform_of(r#"<rotate angle="90"/>"#).unwrap_err(),
         &["zero rotation axis"],
@@ -509,6 +507,32 @@ fn rotate_is_right_handed_in_degrees() {
         &transform_of(r#"<rotate x="1"/>"#).unwrap_err(),
         &["missing the attribute \"angle\""],
     );
+}
+
+/// About an axis of length 5, Mitsuba 3's rotation also scales by 5 across the axis; Mitsuba
+/// 0.6's normalises the axis. Both warn, at the `<rotate>`.
+#[test]
+fn rotate_reads_a_long_axis_as_the_file_version_does() {
+    let rotate = r#"<shape type="sphere"><transform name="to_world"><rotate value="0, 0, 5" angle="90"/></transform></shape>"#;
+    for (version, image_of_x) in [("3.0.0", DVec3::Y * 5.0), ("0.6.0", DVec3::Y)] {
+        let xml = format!("<scene version=\"{version}\">{rotate}</scene>");
+        let document = read_scene_str_document(&xml, Path::new("/virtual/test.xml"), &[]).unwrap();
+        let PropertyValue::Transform(m) = property(&document.root.children[0].node, "to_world")
+        else {
+            panic!("not a transform");
+        };
+        assert_close(m.transform_vector3(DVec3::X), image_of_x);
+        assert_eq!(document.warnings.len(), 1);
+        let warning = &document.warnings[0];
+        assert_eq!((warning.location.line, warning.location.column), (1, 72));
+        assert!(
+            warning
+                .message
+                .starts_with("<rotate> has an axis of length 5.0000, not 1"),
+            "{}",
+            warning.message
+        );
+    }
 }
 
 #[test]
@@ -529,6 +553,27 @@ fn matrices_are_row_major() {
         .unwrap_err(),
         &["non-finite"],
     );
+}
+
+/// Mitsuba 3 drops a projective last row, with a warning; a 0.6 file keeps it (for the shape to
+/// refuse).
+#[test]
+fn a_projective_matrix_row_is_dropped_in_mitsuba_3_files() {
+    let matrix = r#"<shape type="sphere"><transform name="to_world"><matrix value="2 0 0 1  0 1 0 0  0 0 1 0  0.5 0 0 3"/></transform></shape>"#;
+    for (version, last_row, warnings) in [
+        ("3.0.0", DVec4::W, 1),
+        ("0.6.0", DVec4::new(0.5, 0.0, 0.0, 3.0), 0),
+    ] {
+        let xml = format!("<scene version=\"{version}\">{matrix}</scene>");
+        let document = read_scene_str_document(&xml, Path::new("/virtual/test.xml"), &[]).unwrap();
+        let PropertyValue::Transform(m) = property(&document.root.children[0].node, "to_world")
+        else {
+            panic!("not a transform");
+        };
+        assert_eq!(m.row(3), last_row);
+        assert_eq!(m.row(0), DVec4::new(2.0, 0.0, 0.0, 1.0));
+        assert_eq!(document.warnings.len(), warnings);
+    }
 }
 
 #[test]

@@ -76,6 +76,7 @@ def render(
     time_limit: Optional[float] = None,
     target_error: Optional[float] = None,
     preview: Optional[PreviewCallback] = None,
+    sensor: Union[int, str] = 0,
 ) -> Image:
     """Renders ``scene`` and returns its :class:`Image`.
 
@@ -84,7 +85,9 @@ def render(
     is the same for a seed whatever the number of ``threads`` (default: one per core) and equal
     to ``prism render --seed``'s. With ``time_limit`` (seconds) or ``target_error`` (the image's
     mean relative standard error) the render stops at whichever comes first, ``spp`` then only
-    capping the samples.
+    capping the samples. ``sensor``: which ``<sensor>`` of a scene with several to look
+    through, its index from 0 in document order or its ``id`` (as Mitsuba's
+    ``mi.render(scene, sensor=...)`` and ``prism render --sensor``).
 
     ``progress``: True shows a progress bar (tqdm's, in a terminal or a notebook, if tqdm is
     installed; else a line on standard error), False none; a callable is called as
@@ -118,6 +121,7 @@ def render(
                 "threads": threads,
                 "time_limit": time_limit,
                 "target_error": target_error,
+                "sensor": sensor,
             },
             callback,
             preview,

@@ -54,6 +54,13 @@ class Scene:
         :class:`PrismError`."""
     @reconstruction.setter
     def reconstruction(self, name: str) -> None: ...
+    @property
+    def sensor(self) -> int:
+        """The index of the sensor the scene is seen through: 0 after loading, then the one the
+        last :func:`render` used. ``width``, ``height``, ``spp`` and ``seed`` are its."""
+    @property
+    def sensor_ids(self) -> List[Optional[str]]:
+        """The ``id`` of every ``<sensor>`` (None for one without), in document order."""
 
 class Transform:
     """A 4 × 4 transform acting on column vectors, composed like Mitsuba's
@@ -69,7 +76,8 @@ class Transform:
         """This transform times the scaling by ``factors`` (one number or three)."""
     def rotate(self, axis: Sequence[float], angle: float) -> Transform:
         """This transform times the right-handed rotation by ``angle`` degrees about
-        ``axis``. Raises ValueError for a zero axis."""
+        ``axis``, taken as given as Mitsuba 3 does: an axis not of unit length also stretches
+        and shears. Raises ValueError for a zero axis."""
     def look_at(
         self,
         origin: Sequence[float],
@@ -202,6 +210,7 @@ class _RenderSettings(TypedDict):
     threads: Optional[int]
     time_limit: Optional[float]
     target_error: Optional[float]
+    sensor: Union[int, str]
 
 def render(
     scene: Scene,

@@ -2,8 +2,8 @@
 //! how `ldrfilm` tonemaps its 8-bit image.
 
 use super::rfilter::build_filter;
-use crate::description::{PluginClass, PluginNode};
-use crate::params::{Params, Warning};
+use crate::description::{PluginClass, PluginNode, Warning};
+use crate::params::Params;
 use crate::registry::{Choice, Default, Origin, ParamKind, ParamSpec, Plugin, Registry, params};
 use glam::UVec2;
 use prism_core::error::{Error, Result};

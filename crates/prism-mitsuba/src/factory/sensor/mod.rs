@@ -5,9 +5,9 @@ pub mod film;
 pub mod rfilter;
 pub mod sampler;
 
-use crate::description::{PluginClass, PluginNode};
+use crate::description::{PluginClass, PluginNode, Warning};
 use crate::factory::fov::{FOCAL_LENGTH, FOV, FOV_AXIS, horizontal_fov_param};
-use crate::params::{Params, Warning};
+use crate::params::Params;
 use crate::registry::{Default, Origin, ParamKind, ParamSpec, Plugin, Registry, params};
 use film::{build_film, default_film};
 use glam::Vec2;
