@@ -21,8 +21,10 @@ use super::progress_bar::TerminalProgress;
 use crate::accel::Accel;
 use prism_core::error::{Error, Result};
 use prism_core::film::stats::rejected_report;
-use prism_core::film::write_images_with;
-use prism_core::film::{CropWindow, PixelSums, Reconstruction};
+use prism_core::film::{
+    ComponentFormat, CropWindow, ImageOutput, PixelSums, Reconstruction, RenderMetadata,
+    write_images_with,
+};
 use prism_core::integrator::RayCount;
 use prism_core::render::state::{RenderIdentity, RenderState};
 use prism_core::render::{
@@ -93,6 +95,10 @@ pub struct RenderArgs {
     /// sample feeds every pixel its filter covers) or pixel (the lecture's one-pixel estimator)
     #[arg(long, value_name = "METHOD", value_parser = parse_reconstruction)]
     pub reconstruction: Option<Reconstruction>,
+    /// Store the EXR's colour and extra channels as half floats (the film's component_format
+    /// float16); the variances stay 32-bit
+    #[arg(long)]
+    pub half: bool,
     /// Print no progress bar and no summary line (warnings, errors and how to resume an
     /// interrupted render are still printed)
     #[arg(short, long)]
@@ -292,6 +298,9 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     if let Some(reconstruction) = args.reconstruction {
         override_reconstruction(&mut scene, reconstruction);
     }
+    if args.half {
+        scene.exr_output.component_format = ComponentFormat::Float16;
+    }
     let seed = args.seed.unwrap_or(loaded.seed);
     let spp = args.spp.unwrap_or(scene.sampler.samples_per_pixel);
     let strata = scene.strata(spp);
@@ -332,7 +341,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
                 range.end
             )));
         }
-        if state.aov_names != scene.integrator.aov_names() {
+        if state.aov_names != scene.aov_names() {
             return Err(Error::usage(format!(
                 "cannot resume from \"{}\": its integrator wrote other extra channels",
                 path.display()
@@ -373,7 +382,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         .clone()
         .or_else(|| args.resume.clone())
         .unwrap_or_else(|| exr_path.with_extension("state"));
-    let aov_names = scene.integrator.aov_names();
+    let aov_names = scene.aov_names();
     let state_of = |snapshot: &Snapshot| {
         let mut ranges = previous_ranges.clone();
         if !snapshot.samples.is_empty() {
@@ -407,7 +416,16 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             write: &mut write_checkpoint,
         }),
     )?;
-    write_images_with(&output.film, &exr_path, &png_path, &scene.ldr_output)?;
+    let images = ImageOutput {
+        exr: scene.exr_output,
+        ldr: scene.ldr_output,
+        metadata: Some(RenderMetadata {
+            spp: output.film.pixels.first().map_or(0, |p| p.samples) as u32,
+            seed,
+            seconds: Some(output.elapsed.as_secs_f64()),
+        }),
+    };
+    write_images_with(&output.film, &exr_path, &png_path, &images)?;
     if output.stop == StopReason::Interrupted && !checkpoints {
         // An interrupted render always leaves a state to resume from.
         state_of(&Snapshot {

@@ -16,6 +16,7 @@ mod leniency;
 mod lights;
 mod materials;
 mod media;
+mod output_formats;
 mod references;
 mod reliability;
 mod shapes;

@@ -14,7 +14,7 @@ use crate::error::{IntoPyResult, to_py};
 use crate::image::Image;
 use crate::scene::Scene;
 use prism_core::error::Error;
-use prism_core::film::FilmImages;
+use prism_core::film::{FilmImages, RenderMetadata};
 use prism_core::render::{
     ProgressCounter, RenderOptions, StopRule, StopRuleNames, render as render_scene,
 };
@@ -123,8 +123,11 @@ pub fn render(
         .map_err(|_| PyRuntimeError::new_err("the render's thread panicked"))?
         .into_py_result(py)?;
     report()?;
-    let spp = output.samples.end - output.samples.start;
-    let seconds = output.elapsed.as_secs_f64();
+    let metadata = RenderMetadata {
+        spp: output.samples.end - output.samples.start,
+        seed: options.seed,
+        seconds: Some(output.elapsed.as_secs_f64()),
+    };
     let film = &output.film;
     let (images, aovs) = py.detach(|| {
         let aovs = (film.aov_names.iter().cloned())
@@ -133,5 +136,5 @@ pub fn render(
             .collect();
         (FilmImages::of(film), aovs)
     });
-    Image::new(py, images, aovs, spp, seconds)
+    Image::new(py, images, aovs, Some(metadata))
 }

@@ -201,7 +201,7 @@ pub fn render_with_checkpoints(
     let elapsed = start.elapsed();
     progress.end();
 
-    let mut film = Film::with_aovs(scene.film.size, crop, scene.integrator.aov_names());
+    let mut film = Film::with_aovs(scene.film.size, crop, scene.aov_names());
     (film.pixels, film.aovs) = row_major(&tiles, crop.size, k, &sums);
     if let Some(checkpoint) = &mut checkpoints {
         (checkpoint.write)(&Snapshot {

@@ -355,6 +355,7 @@ impl SceneBuilder {
             integrator,
         );
         scene.shutter = sensor.shutter;
+        scene.exr_output = sensor.exr_output;
         scene.ldr_output = sensor.ldr_output;
         scene.fingerprint = crate::fingerprint::scene_fingerprint(root);
         LoadedScene {
