@@ -1,8 +1,10 @@
 //! `render`: the scene rendered on worker threads while the calling thread, holding the GIL
 //! only briefly, reports progress and watches for Ctrl-C. An interruption (or an exception
 //! from the progress callback) raises the render's stop flag; the render finishes the tiles in
-//! flight, its threads are joined, and the exception is raised.
+//! flight, its threads are joined, and the exception is raised. A crop window, checkpoints and
+//! resuming work as `prism render --crop/--checkpoint/--resume` do, with the same state files.
 
+use std::path::PathBuf;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
@@ -13,11 +15,15 @@ use pyo3::prelude::*;
 use crate::error::{IntoPyResult, to_py};
 use crate::image::Image;
 use crate::scene::Scene;
+use glam::UVec2;
 use prism_core::error::Error;
-use prism_core::film::{FilmImages, RenderMetadata};
+use prism_core::film::{CropWindow, FilmImages, RenderMetadata};
+use prism_core::render::resume::Continuation;
 use prism_core::render::{
-    ProgressCounter, RenderOptions, StopRule, StopRuleNames, render as render_scene,
+    Checkpoints, ProgressCounter, RenderOptions, Snapshot, StopRule, StopRuleNames,
+    render_with_checkpoints,
 };
+use prism_mitsuba::LoadedScene;
 
 /// How often the calling thread checks for signals and reports progress.
 const POLL: Duration = Duration::from_millis(100);
@@ -26,7 +32,10 @@ const POLL: Duration = Duration::from_millis(100);
 /// samples per pixel (None: the sampler's `sample_count`), the random streams of `seed` (None:
 /// the sampler's `seed`), `threads` worker threads (None: one per core), and with a
 /// `time_limit` in seconds or a `target_error` (the image's mean relative standard error) the
-/// render stops at whichever comes first, `spp` then only capping the samples.
+/// render stops at whichever comes first, `spp` then only capping the samples. `crop`
+/// (x0, y0, x1, y1) renders the pixels x0 ≤ x < x1, y0 ≤ y < y1 only; `checkpoint` saves the
+/// render state there every `checkpoint_every` seconds and at the end; `resume` continues the
+/// state saved there (and saves to it, without a `checkpoint`).
 #[derive(FromPyObject)]
 #[pyo3(from_item_all)]
 pub struct RenderSettings {
@@ -35,18 +44,55 @@ pub struct RenderSettings {
     threads: Option<usize>,
     time_limit: Option<f64>,
     target_error: Option<f64>,
+    crop: Option<[u32; 4]>,
+    checkpoint: Option<PathBuf>,
+    checkpoint_every: f64,
+    resume: Option<PathBuf>,
 }
 
 /// Renders `scene` as `settings` say. `progress`, if given, is called as
 /// `progress(samples, total, error)` about ten times a second and once at the end, with the
 /// camera samples taken, those the render will take (None when open-ended) and the image's mean
 /// relative error (infinite before the first pass). The image is the same for every number of
-/// threads.
+/// threads. With a crop window the scene is held exclusively while it renders.
 #[pyfunction]
 #[pyo3(signature = (scene, settings, progress = None))]
 pub fn render(
     py: Python<'_>,
-    scene: &Scene,
+    scene: &Bound<'_, Scene>,
+    settings: RenderSettings,
+    progress: Option<Bound<'_, PyAny>>,
+) -> PyResult<Image> {
+    let Some([x0, y0, x1, y1]) = settings.crop else {
+        return render_loaded(py, &scene.borrow().loaded, settings, progress);
+    };
+    let mut scene = scene.try_borrow_mut()?;
+    let film = &mut scene.loaded.scene.film;
+    if !(x0 < x1 && y0 < y1 && x1 <= film.size.x && y1 <= film.size.y) {
+        return Err(to_py(
+            py,
+            &Error::usage(format!(
+                "the crop window ({x0}, {y0}, {x1}, {y1}) is empty or reaches outside the \
+                 {}×{} film",
+                film.size.x, film.size.y
+            ))
+            .with_help("give crop=(x0, y0, x1, y1) with x0 < x1 <= width, y0 < y1 <= height"),
+        ));
+    }
+    let whole = film.crop;
+    film.crop = CropWindow {
+        offset: UVec2::new(x0, y0),
+        size: UVec2::new(x1 - x0, y1 - y0),
+    };
+    let image = render_loaded(py, &scene.loaded, settings, progress);
+    scene.loaded.scene.film.crop = whole;
+    image
+}
+
+/// Renders a loaded scene (its crop window set) as [`render`] does.
+fn render_loaded(
+    py: Python<'_>,
+    loaded: &LoadedScene,
     settings: RenderSettings,
     progress: Option<Bound<'_, PyAny>>,
 ) -> PyResult<Image> {
@@ -56,11 +102,20 @@ pub fn render(
         threads,
         time_limit,
         target_error,
+        crop: _,
+        checkpoint,
+        checkpoint_every,
+        resume,
     } = settings;
     if threads == Some(0) {
         return Err(to_py(py, &Error::usage("threads must be at least 1")));
     }
-    let loaded = &scene.loaded;
+    if !(checkpoint_every > 0.0 && checkpoint_every.is_finite()) {
+        return Err(to_py(
+            py,
+            &Error::usage("checkpoint_every must be a positive number of seconds"),
+        ));
+    }
     let samples_per_pixel = loaded
         .scene
         .sampler
@@ -73,16 +128,42 @@ pub fn render(
     };
     let stop = StopRule::requested(spp, samples_per_pixel, time_limit, target_error, &names)
         .into_py_result(py)?;
+    let seed = seed.unwrap_or(loaded.seed);
+    let strata = loaded
+        .scene
+        .strata(spp.unwrap_or(loaded.scene.sampler.samples_per_pixel));
+    let mut continuation = Continuation::new(&loaded.scene, seed, strata);
+    let (first_sample, initial) = match &resume {
+        Some(path) => {
+            let (end, sums) = py
+                .detach(|| continuation.resume(path, 0))
+                .into_py_result(py)?;
+            (end, Some(sums))
+        }
+        None => (0, None),
+    };
+    if let Some(end) = stop.sample_end
+        && first_sample >= end
+    {
+        return Err(to_py(
+            py,
+            &Error::usage(format!(
+                "nothing to render: the samples before {end} are done already"
+            ))
+            .with_help("ask for more with spp"),
+        ));
+    }
+    let state_path = checkpoint.or(resume);
     let interrupt = Arc::new(AtomicBool::new(false));
     let counter = Arc::new(ProgressCounter::default());
     let options = RenderOptions {
         samples_per_pixel,
-        first_sample: 0,
-        initial: None,
+        first_sample,
+        initial,
         stop,
         interrupt: Some(interrupt.clone()),
         threads,
-        seed: seed.unwrap_or(loaded.seed),
+        seed,
         progress: Some(counter.clone()),
     };
     let report = || -> PyResult<()> {
@@ -98,7 +179,15 @@ pub fn render(
     let done = AtomicBool::new(false);
     let (outcome, raised) = std::thread::scope(|scope| {
         let worker = scope.spawn(|| {
-            let output = render_scene(&loaded.scene, &options);
+            let mut write = |snapshot: &Snapshot| match &state_path {
+                Some(path) => continuation.save(snapshot, path),
+                None => Ok(()),
+            };
+            let checkpoints = state_path.as_ref().map(|_| Checkpoints {
+                every: Duration::from_secs_f64(checkpoint_every),
+                write: &mut write,
+            });
+            let output = render_with_checkpoints(&loaded.scene, &options, checkpoints);
             done.store(true, Ordering::Release);
             caller.unpark();
             output
@@ -124,8 +213,8 @@ pub fn render(
         .into_py_result(py)?;
     report()?;
     let metadata = RenderMetadata {
-        spp: output.samples.end - output.samples.start,
-        seed: options.seed,
+        spp: output.film.pixels.first().map_or(0, |p| p.samples) as u32,
+        seed,
         seconds: Some(output.elapsed.as_secs_f64()),
     };
     let film = &output.film;

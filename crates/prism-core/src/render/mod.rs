@@ -24,6 +24,7 @@ mod filter_mis;
 mod options;
 mod pass;
 mod progress;
+pub mod resume;
 pub mod state;
 mod stop;
 mod tiles;

@@ -19,7 +19,7 @@ import math
 import os
 import sys
 import time
-from typing import Any, Callable, Optional, Sequence, Union
+from typing import Any, Callable, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -81,6 +81,10 @@ def render(
     progress: Union[bool, ProgressCallback] = True,
     time_limit: Optional[float] = None,
     target_error: Optional[float] = None,
+    crop: Optional[Tuple[int, int, int, int]] = None,
+    checkpoint: Optional[Union[str, os.PathLike]] = None,
+    checkpoint_every: float = 60.0,
+    resume: Optional[Union[str, os.PathLike]] = None,
 ) -> Image:
     """Renders ``scene`` and returns its :class:`Image`.
 
@@ -90,6 +94,14 @@ def render(
     to ``prism render --seed``'s. With ``time_limit`` (seconds) or ``target_error`` (the image's
     mean relative standard error) the render stops at whichever comes first, ``spp`` then only
     capping the samples.
+
+    ``crop=(x0, y0, x1, y1)``: render only the pixels x0 <= x < x1, y0 <= y < y1 of the film
+    (the scene is held exclusively while it renders). ``checkpoint``: save the render state to
+    this file every ``checkpoint_every`` seconds and at the end. ``resume``: continue the render
+    saved in this state (with the same scene, ``spp``, ``seed`` and ``crop``), saving to it
+    unless ``checkpoint`` names another file. These are ``prism render``'s ``--crop``,
+    ``--checkpoint``, ``--checkpoint-every`` and ``--resume``: the state files are the same, and
+    so is the image, bit for bit.
 
     ``progress``: True shows a progress bar (tqdm's, in a terminal or a notebook, if tqdm is
     installed; else a line on standard error), False none; a callable is called as
@@ -117,6 +129,10 @@ def render(
                 "threads": threads,
                 "time_limit": time_limit,
                 "target_error": target_error,
+                "crop": crop,
+                "checkpoint": None if checkpoint is None else os.fspath(checkpoint),
+                "checkpoint_every": float(checkpoint_every),
+                "resume": None if resume is None else os.fspath(resume),
             },
             callback,
         )

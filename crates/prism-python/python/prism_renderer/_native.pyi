@@ -213,6 +213,10 @@ class _RenderSettings(TypedDict):
     threads: Optional[int]
     time_limit: Optional[float]
     target_error: Optional[float]
+    crop: Optional[Tuple[int, int, int, int]]
+    checkpoint: Optional[str]
+    checkpoint_every: float
+    resume: Optional[str]
 
 def render(
     scene: Scene,
