@@ -238,3 +238,43 @@ fn merge_keeps_the_alpha_of_the_states() {
     );
     std::fs::remove_dir_all(dir).unwrap();
 }
+
+/// Mitsuba 0.6's `ldrfilm` with an alpha channel: its 8-bit alpha is the coverage the EXR
+/// holds as `A`, rounded to 8 bits.
+#[test]
+fn an_ldrfilm_alpha_is_the_coverage() {
+    let dir = scratch("ldr-alpha");
+    let scene = std::fs::read_to_string(SCENE)
+        .unwrap()
+        .replace(r#"<film type="hdrfilm">"#, r#"<film type="ldrfilm">"#)
+        .replace(
+            r#"<string name="component_format" value="$component_format"/>"#,
+            "",
+        )
+        .replace("$pixel_format", "rgba");
+    let path = dir.join("scene.xml");
+    std::fs::write(&path, scene).unwrap();
+    let out = dir.join("a.exr");
+    prism(&[
+        "render",
+        path.to_str().unwrap(),
+        "-q",
+        "--spp",
+        "16",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    let (image, _) = read_exr_with_header(&out).unwrap();
+    let coverage = image.channel("A").unwrap();
+    assert!(coverage.contains(&0.0) && coverage.contains(&1.0));
+    let png = prism_core::image::read_bitmap(&dir.join("a.png")).unwrap();
+    assert_eq!(png.channels, 4);
+    for (i, &a) in coverage.iter().enumerate() {
+        let stored = png.data[4 * i + 3];
+        assert!(
+            (stored - a).abs() <= 0.5 / 255.0 + 1e-6,
+            "pixel {i}: {stored} for {a}"
+        );
+    }
+    std::fs::remove_dir_all(dir).unwrap();
+}

@@ -4,6 +4,7 @@
 use glam::UVec2;
 
 use crate::camera::{Camera, Shutter};
+use crate::film::output::ALPHA_CHANNEL;
 use crate::film::{CropWindow, ExrOutput, Filter, LdrOutput, Reconstruction};
 use crate::integrator::Integrator;
 pub use crate::sampling::sampler::SamplerKind;
@@ -77,7 +78,7 @@ impl Scene {
     pub fn aov_names(&self) -> Vec<String> {
         let mut names = self.integrator.aov_names();
         if self.exr_output.pixel_format.has_alpha() {
-            names.push("A".into());
+            names.push(ALPHA_CHANNEL.into());
         }
         names
     }

@@ -34,6 +34,10 @@ pub const IMAGE_CHANNELS: [&str; 10] = [
     "relative_error.Y",
 ];
 
+/// The name of the coverage alpha channel, which the film records as an extra channel where
+/// the pixel format has one.
+pub const ALPHA_CHANNEL: &str = "A";
+
 /// The colour channels of the EXR, as Mitsuba's `hdrfilm` names them in its `pixel_format`;
 /// X, Y, Z (Y alone for the luminance formats) with their statistics are always written.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -301,12 +305,15 @@ pub fn write_images_with(
         .collect();
     let (image, header) = FilmImages::of(film).exr(aovs, &output.exr, output.metadata.as_ref());
     write_exr_with(exr_path, &image, &header)?;
-    let ldr = &output.ldr;
-    ldr.write(
+    let alpha = (film.aov_names.iter())
+        .position(|name| name == ALPHA_CHANNEL)
+        .map(|c| film.aov(c));
+    output.ldr.write(
         ldr_path,
         film.crop.size.x,
         film.crop.size.y,
         &film.linear_srgb(),
+        alpha.as_deref(),
     )
 }
 

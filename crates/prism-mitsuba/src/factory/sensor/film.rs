@@ -98,7 +98,7 @@ params! {
     HIGH_QUALITY_EDGES = ParamSpec::new("high_quality_edges", ParamKind::Boolean, Default::Ignored, "Mitsuba 0.6's sampling of a margin outside the film; Prism samples the film's pixels only");
     HDR_GAMMA = ParamSpec::new("gamma", ParamKind::Float, Default::Ignored, "a gamma on an HDR film, as Mitsuba 0.6 scenes give it; the EXR is linear");
     LDR_FILE_FORMAT = ParamSpec::new("file_format", ParamKind::Choice(&[Choice::new("png", &LdrFormat::Png), Choice::new("jpeg", &LdrFormat::Jpeg), Choice::new("jpg", &LdrFormat::Jpeg)]), Default::Str("png"), "the 8-bit file: PNG, or JPEG of quality 100 (extension `.jpg`)");
-    LDR_PIXEL_FORMAT = ParamSpec::new("pixel_format", ParamKind::Choice(&[Choice::new("rgb", &Channels::Rgb), Choice::new("rgba", &Channels::Rgba), Choice::new("luminance", &Channels::Luminance), Choice::new("luminanceAlpha", &Channels::LuminanceAlpha)]), Default::Str("rgb"), "the 8-bit image's channels; Prism's alpha is opaque (its film records no coverage), and a JPEG drops it, as Mitsuba 0.6 does");
+    LDR_PIXEL_FORMAT = ParamSpec::new("pixel_format", ParamKind::Choice(&[Choice::new("rgb", &Channels::Rgb), Choice::new("rgba", &Channels::Rgba), Choice::new("luminance", &Channels::Luminance), Choice::new("luminanceAlpha", &Channels::LuminanceAlpha)]), Default::Str("rgb"), "the 8-bit image's channels; the alpha is the coverage (also written to the EXR as `A`), and a JPEG drops it, as Mitsuba 0.6 does");
 }
 
 /// How `ldrfilm` maps radiance to 8-bit values.
@@ -226,9 +226,17 @@ fn build_ldrfilm(params: &Params) -> Result<FilmParts> {
             exposure: exposure as f32,
         },
     };
+    // The film records the coverage that the 8-bit alpha holds.
+    let pixel_format = match channels {
+        Channels::Rgba | Channels::LuminanceAlpha => PixelFormat::Rgba,
+        Channels::Rgb | Channels::Luminance => PixelFormat::Rgb,
+    };
     Ok(FilmParts {
         film,
-        exr: ExrOutput::default(),
+        exr: ExrOutput {
+            pixel_format,
+            ..ExrOutput::default()
+        },
         ldr: LdrOutput {
             tonemap,
             curve,
