@@ -21,7 +21,7 @@ pub struct CompareArgs {
     /// Write the signed difference (test − reference) as a false-colour PNG
     #[arg(long, value_name = "OUT.png")]
     pub diff: Option<PathBuf>,
-    /// Channels to compare [default: R,G,B if both images have them, else X,Y,Z]
+    /// Channels to compare [default: R,G,B if both images have them, else X,Y,Z, else Y]
     #[arg(long, value_delimiter = ',', value_name = "NAMES")]
     pub channels: Option<Vec<String>>,
 }

@@ -1,15 +1,19 @@
 //! `prism merge`: combines render states of disjoint sample ranges (from `--sample-range` renders
 //! on several machines) into the image one render of all their samples gives — bit for bit,
-//! since pixel sums are exact.
+//! since pixel sums are exact. It reads the states, not the renders' EXR files, so how those
+//! were stored (half floats, luminance only) does not matter; the merged EXR holds R, G, B,
+//! X, Y, Z, their statistics and the extra channels the states carry (the coverage alpha
+//! among them), as 32-bit floats or, with `--half`, half floats.
 
 use std::path::PathBuf;
 
 use clap::Args;
 
 use prism_core::error::{Error, Result};
-use prism_core::film::Film;
 use prism_core::film::stats::rejected_report;
-use prism_core::film::write_images;
+use prism_core::film::{
+    ComponentFormat, ExrOutput, Film, ImageOutput, LdrOutput, RenderMetadata, write_images_with,
+};
 use prism_core::render::state::RenderState;
 
 #[derive(Args, Debug)]
@@ -23,6 +27,9 @@ pub struct MergeArgs {
     /// Also write the merged render state here
     #[arg(long, value_name = "PATH")]
     pub state: Option<PathBuf>,
+    /// Store the EXR's colour and extra channels as half floats; the variances stay 32-bit
+    #[arg(long)]
+    pub half: bool,
 }
 
 pub fn run(args: &MergeArgs) -> Result<()> {
@@ -52,7 +59,23 @@ pub fn run(args: &MergeArgs) -> Result<()> {
         args.output.with_extension("exr")
     };
     let png = exr.with_extension("png");
-    write_images(&film, &exr, &png)?;
+    let output = ImageOutput {
+        exr: ExrOutput {
+            component_format: if args.half {
+                ComponentFormat::Float16
+            } else {
+                ComponentFormat::Float32
+            },
+            ..ExrOutput::default()
+        },
+        ldr: LdrOutput::default(),
+        metadata: Some(RenderMetadata {
+            spp: merged.sample_count(),
+            seed: identity.seed,
+            seconds: None,
+        }),
+    };
+    write_images_with(&film, &exr, &png, &output)?;
     if let Some(path) = &args.state {
         merged.write(path)?;
     }

@@ -22,10 +22,12 @@ use super::progress_bar::TerminalProgress;
 use crate::accel::Accel;
 use prism_core::error::{Error, Result};
 use prism_core::film::stats::rejected_report;
-use prism_core::film::write_images_with;
-use prism_core::film::{CropWindow, PixelSums, Reconstruction};
+use prism_core::film::{
+    ComponentFormat, CropWindow, ImageOutput, PixelSums, Reconstruction, RenderMetadata,
+    write_images_with,
+};
 use prism_core::integrator::RayCount;
-use prism_core::render::state::{RenderIdentity, RenderState};
+use prism_core::render::resume::Continuation;
 use prism_core::render::{
     Checkpoints, Preview, ProgressReport, RenderOptions, SampleEstimator, Snapshot, StopReason,
     StopRule, StopRuleNames, render_with_preview,
@@ -118,6 +120,10 @@ pub struct RenderArgs {
     /// sample feeds every pixel its filter covers) or pixel (the lecture's one-pixel estimator)
     #[arg(long, value_name = "METHOD", value_parser = parse_reconstruction, help_heading = SAMPLING)]
     pub reconstruction: Option<Reconstruction>,
+    /// Store the EXR's colour and extra channels as half floats (the film's component_format
+    /// float16); the variances stay 32-bit
+    #[arg(long)]
+    pub half: bool,
     /// Print no progress bar and no summary line (warnings, errors and how to resume an
     /// interrupted render are still printed)
     #[arg(short, long, help_heading = PROGRESS)]
@@ -336,6 +342,9 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     if let Some(reconstruction) = args.reconstruction {
         override_reconstruction(&mut scene, reconstruction);
     }
+    if args.half {
+        scene.exr_output.component_format = ComponentFormat::Float16;
+    }
     let seed = args.seed.unwrap_or(loaded.seed);
     // The pixel's samples (a count the sampler can stratify), and the blocks its stratification
     // works in: under filter MIS two blocks of half as many, the control variate's halves.
@@ -348,48 +357,14 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         let samples = args.sample_range.clone().unwrap_or(0..spp);
         return trace_pixel(&scene, UVec2::new(x, y), strata, samples, seed);
     }
-    let identity = RenderIdentity {
-        scene: scene.fingerprint,
-        seed,
-        sampler: scene.sampler.kind.name().to_string(),
-        samples_per_pixel: strata,
-        film_size: scene.film.size,
-        crop: scene.film.crop,
-    };
-
     // Where the samples start: the range asked for, or past a resumed state's samples.
+    let mut continuation = Continuation::new(&scene, seed, strata);
     let mut first_sample = args.sample_range.as_ref().map_or(0, |r| r.start);
     let mut initial = None;
-    let mut previous_ranges: Vec<Range<u32>> = Vec::new();
     if let Some(path) = &args.resume {
-        let state = RenderState::read(path)?;
-        if let Some(reason) = identity.mismatch(&state.identity) {
-            return Err(Error::usage(format!("cannot resume from \"{}\": {reason}", path.display()))
-                .with_help("resume with the same scene, -D values, --spp, --seed, --crop, --wavelengths and --reconstruction as the interrupted render"));
-        }
-        let [range] = state.ranges.as_slice() else {
-            return Err(Error::usage(format!(
-                "\"{}\" holds several sample ranges (a merge); it cannot be resumed",
-                path.display()
-            )));
-        };
-        if range.start != first_sample {
-            return Err(Error::usage(format!(
-                "\"{}\" holds samples {}..{}, which do not start where this render's range starts ({first_sample})",
-                path.display(),
-                range.start,
-                range.end
-            )));
-        }
-        if state.aov_names != scene.integrator.aov_names() {
-            return Err(Error::usage(format!(
-                "cannot resume from \"{}\": its integrator wrote other extra channels",
-                path.display()
-            )));
-        }
-        first_sample = range.end;
-        previous_ranges.push(range.clone());
-        initial = Some((state.pixels, state.aovs));
+        let (end, sums) = continuation.resume(path, first_sample)?;
+        first_sample = end;
+        initial = Some(sums);
     }
     let stop = stop_rule(args, spp)?;
     if let Some(end) = stop.sample_end
@@ -422,30 +397,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         .clone()
         .or_else(|| args.resume.clone())
         .unwrap_or_else(|| exr_path.with_extension("state"));
-    let aov_names = scene.integrator.aov_names();
-    let state_of = |snapshot: &Snapshot| {
-        let mut ranges = previous_ranges.clone();
-        if !snapshot.samples.is_empty() {
-            match ranges.last_mut() {
-                Some(last) if last.end == snapshot.samples.start => last.end = snapshot.samples.end,
-                _ => ranges.push(snapshot.samples.clone()),
-            }
-        }
-        RenderState {
-            identity: identity.clone(),
-            ranges,
-            pixels: snapshot.pixels.to_vec(),
-            aov_names: aov_names.clone(),
-            aovs: snapshot.aovs.to_vec(),
-        }
-    };
-    let mut write_checkpoint = |snapshot: &Snapshot| -> Result<()> {
-        let state = state_of(snapshot);
-        if state.ranges.is_empty() {
-            return Ok(());
-        }
-        state.write(&state_path)
-    };
+    let mut write_checkpoint = |snapshot: &Snapshot| continuation.save(snapshot, &state_path);
     let checkpoints =
         args.checkpoint.is_some() || args.resume.is_some() || args.sample_range.is_some();
     let every = Duration::from_secs_f64(args.checkpoint_every);
@@ -466,7 +418,16 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             display.show(&film);
         }
         if partial_images_due {
-            write_images_with(&film, &exr_path, &png_path, &scene.ldr_output)?;
+            let images = ImageOutput {
+                exr: scene.exr_output,
+                ldr: scene.ldr_output,
+                metadata: Some(RenderMetadata {
+                    spp: film.pixels.first().map_or(0, |p| p.samples) as u32,
+                    seed,
+                    seconds: None,
+                }),
+            };
+            write_images_with(&film, &exr_path, &png_path, &images)?;
             last_partial_images = Instant::now();
         }
         Ok(())
@@ -489,15 +450,24 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             output.elapsed.as_secs_f64()
         );
     }
-    write_images_with(&output.film, &exr_path, &png_path, &scene.ldr_output)?;
+    let images = ImageOutput {
+        exr: scene.exr_output,
+        ldr: scene.ldr_output,
+        metadata: Some(RenderMetadata {
+            spp: output.film.pixels.first().map_or(0, |p| p.samples) as u32,
+            seed,
+            seconds: Some(output.elapsed.as_secs_f64()),
+        }),
+    };
+    write_images_with(&output.film, &exr_path, &png_path, &images)?;
     if output.stop == StopReason::Interrupted && !checkpoints {
         // An interrupted render always leaves a state to resume from.
-        state_of(&Snapshot {
+        let snapshot = Snapshot {
             samples: output.samples.clone(),
             pixels: &output.film.pixels,
             aovs: &output.film.aovs,
-        })
-        .write(&state_path)?;
+        };
+        continuation.state(&snapshot).write(&state_path)?;
     }
     report(args, &scene, &output, &exr_path, &png_path);
     if output.stop == StopReason::Interrupted {

@@ -17,6 +17,7 @@ mod leniency;
 mod lights;
 mod materials;
 mod media;
+mod output_formats;
 mod preview;
 mod references;
 mod reliability;

@@ -244,3 +244,53 @@ def test_an_aov_that_is_no_longer_an_image_is_an_error(aov_scene_path, tmp_path)
     with pytest.raises(pr.PrismError) as raised:
         image.write(tmp_path / "bad.exr")
     assert "dd.y.T" in raised.value.message
+
+
+def _cli_render(prism_cli, cornell_path, exr, *arguments):
+    subprocess.run(
+        [str(prism_cli), "render", str(cornell_path), "-o", str(exr), "--seed", "7", "-q",
+         "-D", f"resx={SIZE['resx']}", "-D", f"resy={SIZE['resy']}", *arguments],
+        check=True,
+        capture_output=True,
+    )
+    return pr.Image.read(exr)
+
+
+def test_a_crop_renders_the_command_lines_crop(cornell_path, prism_cli, tmp_path):
+    scene = pr.load_file(cornell_path, resx=SIZE["resx"], resy=SIZE["resy"])
+    cropped = pr.render(scene, spp=3, seed=7, crop=(4, 3, 15, 12), progress=False)
+    assert (cropped.width, cropped.height) == (11, 9)
+    cli = _cli_render(prism_cli, cornell_path, tmp_path / "crop.exr", "--spp", "3",
+                      "--crop", "4,3,15,12")
+    assert_same_image(cropped, cli)
+    # The scene keeps its whole film, whose pixels in the window are the crop's.
+    whole = pr.render(scene, spp=3, seed=7, progress=False)
+    assert whole.rgb.shape[:2] == (SIZE["resy"], SIZE["resx"])
+    assert np.array_equal(whole.xyz[3:12, 4:15], cropped.xyz)
+    with pytest.raises(pr.PrismError, match="outside"):
+        pr.render(scene, crop=(0, 0, SIZE["resx"] + 1, 2), progress=False)
+
+
+def test_checkpoints_and_resuming_are_the_command_lines(cornell_path, prism_cli, tmp_path):
+    scene = pr.load_file(cornell_path, resx=SIZE["resx"], resy=SIZE["resy"])
+    whole = pr.render(scene, spp=5, seed=7, progress=False)
+    # Python's state is the command line's, byte for byte.
+    python_state, cli_state = tmp_path / "python.state", tmp_path / "cli.state"
+    checkpointed = pr.render(scene, spp=5, seed=7, checkpoint=python_state, progress=False)
+    assert_same_image(checkpointed, whole)
+    _cli_render(prism_cli, cornell_path, tmp_path / "a.exr", "--spp", "5",
+                "--checkpoint", str(cli_state))
+    assert python_state.read_bytes() == cli_state.read_bytes()
+    # Python continues the command line's partial render (samples 0..2 of 5) to the image of
+    # one render, writing the state back to the file it resumed.
+    part = tmp_path / "part.state"
+    _cli_render(prism_cli, cornell_path, tmp_path / "b.exr", "--spp", "5",
+                "--sample-range", "0..2", "--checkpoint", str(part))
+    resumed = pr.render(scene, spp=5, seed=7, resume=part, progress=False)
+    assert resumed.spp == 5
+    assert_same_image(resumed, whole)
+    assert part.read_bytes() == cli_state.read_bytes()
+    with pytest.raises(pr.PrismError, match="nothing to render"):
+        pr.render(scene, spp=5, seed=7, resume=part, progress=False)
+    with pytest.raises(pr.PrismError, match="seed"):
+        pr.render(scene, spp=5, seed=8, resume=part, progress=False)

@@ -4,7 +4,8 @@
 use glam::UVec2;
 
 use crate::camera::{Camera, Shutter};
-use crate::film::{CropWindow, Filter, LdrOutput, Reconstruction};
+use crate::film::output::ALPHA_CHANNEL;
+use crate::film::{CropWindow, ExrOutput, Filter, LdrOutput, Reconstruction};
 use crate::integrator::Integrator;
 pub use crate::sampling::sampler::SamplerKind;
 use crate::spectrum::WavelengthSampling;
@@ -40,6 +41,8 @@ pub struct Scene {
     pub integrator: Integrator,
     /// When camera rays are taken (the sensor's shutter interval and temporal filter).
     pub shutter: Shutter,
+    /// Which channels the EXR holds and how it stores them.
+    pub exr_output: ExrOutput,
     /// How the 8-bit image beside the EXR is tonemapped and written.
     pub ldr_output: LdrOutput,
     /// Hash of the scene's description and the files it loads, which render states record so
@@ -49,7 +52,7 @@ pub struct Scene {
 
 impl Scene {
     /// A scene from its parts, with an instantaneous shutter, the lecture's wavelength
-    /// density and the default sRGB PNG.
+    /// density, a 32-bit RGB EXR and the default sRGB PNG.
     pub fn new(
         world: World,
         camera: Camera,
@@ -64,9 +67,20 @@ impl Scene {
             sampler,
             integrator,
             shutter: Shutter::instant(),
+            exr_output: ExrOutput::default(),
             ldr_output: LdrOutput::default(),
             fingerprint: 0,
         }
+    }
+
+    /// The names of the film's extra channels: the integrator's, then the coverage alpha `A`
+    /// where the EXR has one.
+    pub fn aov_names(&self) -> Vec<String> {
+        let mut names = self.integrator.aov_names();
+        if self.exr_output.pixel_format.has_alpha() {
+            names.push(ALPHA_CHANNEL.into());
+        }
+        names
     }
 
     /// The samples per pixel of one stratified block of the sampler, for a render asked for

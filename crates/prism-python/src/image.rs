@@ -1,7 +1,7 @@
 //! A rendered image as numpy arrays, written as OpenEXR or PNG and shown by notebooks, and the
 //! comparison of two images (`prism compare`'s statistics).
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use numpy::ndarray::{Array2, Array3, Dimension};
 use numpy::{
@@ -13,17 +13,17 @@ use pyo3::types::{PyBytes, PyDict};
 
 use crate::error::{IntoPyResult, to_py};
 use prism_core::error::{Error, ErrorKind};
-use prism_core::film::FilmImages;
 use prism_core::film::output::IMAGE_CHANNELS;
+use prism_core::film::{FilmImages, RenderMetadata};
 use prism_core::image::compare as stats;
-use prism_core::image::{ChannelImage, read_exr, write_exr};
+use prism_core::image::{ChannelImage, ExrHeader, read_exr, read_exr_with_header, write_exr_with};
 
 /// A rendered image: H × W × 3 float32 arrays `rgb` (linear sRGB), `xyz` (CIE 1931) and
 /// `variance` (the estimated variance of each pixel's mean of X, Y and Z), the H × W array
 /// `relative_error` (each pixel's relative standard error of luminance), and `aovs`, the
 /// integrator's extra channels (`aov`, `moment`) by their EXR names as H × W float32 arrays.
 /// The arrays are the render's own memory (no copy); `write` and `_repr_png_` use their
-/// current values.
+/// current values. `numpy.asarray(image)` is `rgb`.
 #[pyclass(module = "prism_renderer", frozen)]
 pub struct Image {
     #[pyo3(get)]
@@ -39,20 +39,24 @@ pub struct Image {
     /// Samples per pixel taken.
     #[pyo3(get)]
     spp: u32,
-    /// The render's duration in seconds (0 for an image read from a file).
+    /// The render's duration in seconds (as its EXR records it for an image read from a file;
+    /// 0 where it records none).
     #[pyo3(get)]
     seconds: f64,
+    /// The seed of the render's random numbers (None for an image read from a file that does
+    /// not record it).
+    #[pyo3(get)]
+    seed: Option<u64>,
 }
 
 impl Image {
     /// The image of `images` and the extra channels `aovs` (name, one value per pixel), which
-    /// the arrays take over.
+    /// the arrays take over, rendered with `metadata`'s samples per pixel, seed and time.
     pub fn new(
         py: Python<'_>,
         images: FilmImages,
         aovs: Vec<(String, Vec<f32>)>,
-        spp: u32,
-        seconds: f64,
+        metadata: Option<RenderMetadata>,
     ) -> PyResult<Image> {
         let (h, w) = (images.height, images.width);
         let one = |values: Vec<f32>| {
@@ -76,8 +80,18 @@ impl Image {
             variance: three(images.variance),
             relative_error: one(images.relative_error).unbind(),
             aovs: channels.unbind(),
-            spp,
-            seconds,
+            spp: metadata.map_or(0, |m| m.spp),
+            seconds: metadata.and_then(|m| m.seconds).unwrap_or(0.0),
+            seed: metadata.map(|m| m.seed),
+        })
+    }
+
+    /// The samples per pixel, seed and time the EXR's header records, where the seed is known.
+    fn metadata(&self) -> Option<RenderMetadata> {
+        self.seed.map(|seed| RenderMetadata {
+            spp: self.spp,
+            seed,
+            seconds: Some(self.seconds),
         })
     }
 
@@ -128,16 +142,23 @@ impl Image {
 
 #[pymethods]
 impl Image {
-    /// Reads an OpenEXR image that Prism wrote (channels R, G, B, X, Y, Z, variance.X/Y/Z and
-    /// relative_error.Y); its other channels are the `aovs`.
+    /// Reads an OpenEXR image that Prism wrote with the film's default `pixel_format` `rgb`
+    /// (channels R, G, B, X, Y, Z, variance.X/Y/Z and relative_error.Y, 32-bit or half), with
+    /// the samples per pixel, seed and time its header records; its other channels are the
+    /// `aovs`.
     #[staticmethod]
     fn read(py: Python<'_>, path: PathBuf) -> PyResult<Image> {
-        let exr = py.detach(|| load_exr(&path)).into_py_result(py)?;
+        let (exr, header) = py
+            .detach(|| read_exr_with_header(&path).map_err(as_input_error))
+            .into_py_result(py)?;
         let images = FilmImages::from_channels(&exr).map_err(|missing| {
             to_py(
                 py,
                 &Error::usage(format!("\"{}\" has no channel {missing}", path.display()))
-                    .with_help("read an image that Prism rendered; compare() reads any EXR"),
+                    .with_help(
+                        "read an image that Prism rendered with pixel_format rgb; \
+                         read_image() and compare() read any EXR",
+                    ),
             )
         })?;
         let aovs = exr
@@ -145,7 +166,28 @@ impl Image {
             .into_iter()
             .filter(|(name, _)| !IMAGE_CHANNELS.contains(&name.as_str()))
             .collect();
-        Image::new(py, images, aovs, 0, 0.0)
+        Image::new(py, images, aovs, RenderMetadata::of(&header))
+    }
+
+    /// The `rgb` array (`numpy.asarray(image)`), converted to `dtype` or copied where asked.
+    #[pyo3(signature = (dtype = None, copy = None))]
+    fn __array__<'py>(
+        &self,
+        py: Python<'py>,
+        dtype: Option<Bound<'py, PyAny>>,
+        copy: Option<bool>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let rgb = self.rgb.bind(py).clone().into_any();
+        match (dtype, copy) {
+            (None, None | Some(false)) => Ok(rgb),
+            (dtype, _) => {
+                let dtype = match dtype {
+                    Some(dtype) => dtype,
+                    None => rgb.getattr("dtype")?,
+                };
+                rgb.call_method1("astype", (dtype,))
+            }
+        }
     }
 
     /// The width in pixels.
@@ -170,7 +212,11 @@ impl Image {
         let result = match extension.as_deref() {
             Some("exr") => {
                 let image = self.channels(py)?;
-                py.detach(|| write_exr(&path, &image))
+                let header = ExrHeader {
+                    half_channels: Vec::new(),
+                    attributes: self.metadata().map(|m| m.attributes()).unwrap_or_default(),
+                };
+                py.detach(|| write_exr_with(&path, &image, &header))
             }
             Some("png") => {
                 let images = self.images(py);
@@ -208,12 +254,10 @@ fn values<D: Dimension>(array: &Bound<'_, PyArray<f32, D>>) -> Vec<f32> {
     array.readonly().as_array().iter().copied().collect()
 }
 
-/// An EXR file given to read, whose failures are the input's fault.
-fn load_exr(path: &Path) -> prism_core::error::Result<ChannelImage> {
-    read_exr(path).map_err(|mut e| {
-        e.kind = ErrorKind::Input;
-        e
-    })
+/// A file given to read, whose failures are the input's fault.
+pub(crate) fn as_input_error(mut error: Error) -> Error {
+    error.kind = ErrorKind::Input;
+    error
 }
 
 /// One side of a comparison: a rendered image or the path of an EXR file.
@@ -227,7 +271,9 @@ impl Operand<'_> {
     fn channels(&self, py: Python<'_>) -> PyResult<ChannelImage> {
         match self {
             Operand::Image(image) => image.get().channels(py),
-            Operand::Path(path) => py.detach(|| load_exr(path)).into_py_result(py),
+            Operand::Path(path) => py
+                .detach(|| read_exr(path).map_err(as_input_error))
+                .into_py_result(py),
         }
     }
 }

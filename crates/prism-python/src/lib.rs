@@ -7,6 +7,7 @@
 mod dict;
 mod error;
 mod image;
+mod image_files;
 mod render;
 mod scene;
 mod transform;
@@ -26,5 +27,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(scene::load_dict, m)?)?;
     m.add_function(wrap_pyfunction!(render::render, m)?)?;
     m.add_function(wrap_pyfunction!(image::compare, m)?)?;
+    m.add_function(wrap_pyfunction!(image_files::read_image, m)?)?;
+    m.add_function(wrap_pyfunction!(image_files::write_image, m)?)?;
     Ok(())
 }

@@ -2,9 +2,12 @@
 //! only briefly, reports progress, hands the developing image to a preview callback and watches
 //! for Ctrl-C. An interruption (or an exception from a callback) raises the render's stop flag;
 //! the render finishes the tiles in flight, its threads are joined, and the exception is raised.
+//! A crop window, checkpoints and resuming work as `prism render --crop/--checkpoint/--resume`
+//! do, with the same state files.
 
 use std::cell::Cell;
 use std::ops::Range;
+use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
@@ -15,11 +18,15 @@ use pyo3::prelude::*;
 use crate::error::{IntoPyResult, to_py};
 use crate::image::Image;
 use crate::scene::Scene;
+use glam::UVec2;
 use prism_core::error::Error;
-use prism_core::film::{Film, FilmImages};
+use prism_core::film::{CropWindow, Film, FilmImages, RenderMetadata};
+use prism_core::render::resume::Continuation;
 use prism_core::render::{
-    Preview, ProgressCounter, RenderOptions, Snapshot, StopRule, StopRuleNames, render_with_preview,
+    Checkpoints, Preview, ProgressCounter, RenderOptions, Snapshot, StopRule, StopRuleNames,
+    render_with_preview,
 };
+use prism_mitsuba::LoadedScene;
 
 /// How often the calling thread checks for signals and reports progress.
 const POLL: Duration = Duration::from_millis(100);
@@ -29,7 +36,10 @@ const POLL: Duration = Duration::from_millis(100);
 /// the sampler's `seed`), `threads` worker threads (None: one per core), and with a
 /// `time_limit` in seconds or a `target_error` (the image's mean relative standard error) the
 /// render stops at whichever comes first, `spp` then only capping the samples; `sensor` is the
-/// sensor to look through.
+/// sensor to look through. `crop` (x0, y0, x1, y1) renders the pixels x0 ≤ x < x1,
+/// y0 ≤ y < y1 only; `checkpoint` saves the render state there every `checkpoint_every` seconds
+/// and at the end; `resume` continues the state saved there (and saves to it, without a
+/// `checkpoint`).
 #[derive(FromPyObject)]
 #[pyo3(from_item_all)]
 pub struct RenderSettings {
@@ -39,6 +49,10 @@ pub struct RenderSettings {
     time_limit: Option<f64>,
     target_error: Option<f64>,
     sensor: SensorChoice,
+    crop: Option<[u32; 4]>,
+    checkpoint: Option<PathBuf>,
+    checkpoint_every: f64,
+    resume: Option<PathBuf>,
 }
 
 /// A sensor of the scene, by its index from 0 in document order or by its id.
@@ -48,14 +62,20 @@ pub enum SensorChoice {
     Id(String),
 }
 
+/// The callbacks of a render: `progress(samples, total, error)` and `preview(image)`.
+struct Callbacks<'py> {
+    progress: Option<Bound<'py, PyAny>>,
+    preview: Option<Bound<'py, PyAny>>,
+}
+
 /// Renders `scene` as `settings` say. `progress`, if given, is called as
 /// `progress(samples, total, error)` about ten times a second and once at the end, with the
 /// camera samples taken, those the render will take (None when open-ended) and the image's mean
 /// relative error (infinite before the first pass). `preview`, if given, is called as
 /// `preview(image)` with the developing [`Image`] after passes (the newest, when several
 /// finished since the last call) and last with the image returned, unless the last pass's
-/// image, equal to it, was shown already. The image is the same for
-/// every number of threads.
+/// image, equal to it, was shown already. The image is the same for every number of threads.
+/// With a crop window the scene is held exclusively while it renders.
 #[pyfunction]
 #[pyo3(signature = (scene, settings, progress = None, preview = None))]
 pub fn render(
@@ -65,20 +85,63 @@ pub fn render(
     progress: Option<Bound<'_, PyAny>>,
     preview: Option<Bound<'_, PyAny>>,
 ) -> PyResult<Py<Image>> {
+    select_sensor(py, scene, &settings.sensor)?;
+    let callbacks = Callbacks { progress, preview };
+    let Some([x0, y0, x1, y1]) = settings.crop else {
+        return render_loaded(py, &scene.borrow().loaded, settings, callbacks);
+    };
+    let mut scene = scene.try_borrow_mut()?;
+    let film = &mut scene.loaded.scene.film;
+    if !(x0 < x1 && y0 < y1 && x1 <= film.size.x && y1 <= film.size.y) {
+        return Err(to_py(
+            py,
+            &Error::usage(format!(
+                "the crop window ({x0}, {y0}, {x1}, {y1}) is empty or reaches outside the \
+                 {}×{} film",
+                film.size.x, film.size.y
+            ))
+            .with_help("give crop=(x0, y0, x1, y1) with x0 < x1 <= width, y0 < y1 <= height"),
+        ));
+    }
+    let whole = film.crop;
+    film.crop = CropWindow {
+        offset: UVec2::new(x0, y0),
+        size: UVec2::new(x1 - x0, y1 - y0),
+    };
+    let image = render_loaded(py, &scene.loaded, settings, callbacks);
+    scene.loaded.scene.film.crop = whole;
+    image
+}
+
+/// Renders a loaded scene (its sensor chosen and its crop window set) as [`render`] does.
+fn render_loaded(
+    py: Python<'_>,
+    loaded: &LoadedScene,
+    settings: RenderSettings,
+    callbacks: Callbacks<'_>,
+) -> PyResult<Py<Image>> {
     let RenderSettings {
         spp,
         seed,
         threads,
         time_limit,
         target_error,
-        sensor,
+        sensor: _,
+        crop: _,
+        checkpoint,
+        checkpoint_every,
+        resume,
     } = settings;
+    let Callbacks { progress, preview } = callbacks;
     if threads == Some(0) {
         return Err(to_py(py, &Error::usage("threads must be at least 1")));
     }
-    select_sensor(py, scene, sensor)?;
-    let scene = scene.borrow();
-    let loaded = &scene.loaded;
+    if !(checkpoint_every > 0.0 && checkpoint_every.is_finite()) {
+        return Err(to_py(
+            py,
+            &Error::usage("checkpoint_every must be a positive number of seconds"),
+        ));
+    }
     let samples_per_pixel = loaded
         .scene
         .sampler
@@ -91,16 +154,40 @@ pub fn render(
     };
     let stop = StopRule::requested(spp, samples_per_pixel, time_limit, target_error, &names)
         .into_py_result(py)?;
+    let seed = seed.unwrap_or(loaded.seed);
+    let strata = loaded.scene.strata(samples_per_pixel);
+    let mut continuation = Continuation::new(&loaded.scene, seed, strata);
+    let (first_sample, initial) = match &resume {
+        Some(path) => {
+            let (end, sums) = py
+                .detach(|| continuation.resume(path, 0))
+                .into_py_result(py)?;
+            (end, Some(sums))
+        }
+        None => (0, None),
+    };
+    if let Some(end) = stop.sample_end
+        && first_sample >= end
+    {
+        return Err(to_py(
+            py,
+            &Error::usage(format!(
+                "nothing to render: the samples before {end} are done already"
+            ))
+            .with_help("ask for more with spp"),
+        ));
+    }
+    let state_path = checkpoint.or(resume);
     let interrupt = Arc::new(AtomicBool::new(false));
     let counter = Arc::new(ProgressCounter::default());
     let options = RenderOptions {
         samples_per_pixel,
-        first_sample: 0,
-        initial: None,
+        first_sample,
+        initial,
         stop,
         interrupt: Some(interrupt.clone()),
         threads,
-        seed: seed.unwrap_or(loaded.seed),
+        seed,
         progress: Some(counter.clone()),
     };
     let report = || -> PyResult<()> {
@@ -123,8 +210,8 @@ pub fn render(
             .take();
         match (&preview, newest) {
             (Some(callback), Some((film, samples))) => {
-                shown.set(Some(samples.clone()));
-                let image = image_of(py, &film, samples, start.elapsed().as_secs_f64())?;
+                shown.set(Some(samples));
+                let image = image_of(py, &film, seed, start.elapsed().as_secs_f64())?;
                 callback.call1((image,)).map(drop)
             }
             _ => Ok(()),
@@ -136,6 +223,14 @@ pub fn render(
     let done = AtomicBool::new(false);
     let (outcome, raised) = std::thread::scope(|scope| {
         let worker = scope.spawn(|| {
+            let mut write = |snapshot: &Snapshot| match &state_path {
+                Some(path) => continuation.save(snapshot, path),
+                None => Ok(()),
+            };
+            let checkpoints = state_path.as_ref().map(|_| Checkpoints {
+                every: Duration::from_secs_f64(checkpoint_every),
+                write: &mut write,
+            });
             let mut keep = |snapshot: &Snapshot| {
                 let film = snapshot.film(&loaded.scene);
                 *developing.lock().expect("no thread panics holding it") =
@@ -146,7 +241,7 @@ pub fn render(
             let output = render_with_preview(
                 &loaded.scene,
                 &options,
-                None,
+                checkpoints,
                 previewing.then_some(&mut keep as Preview),
             );
             done.store(true, Ordering::Release);
@@ -177,12 +272,7 @@ pub fn render(
     report()?;
     let image = Py::new(
         py,
-        image_of(
-            py,
-            &output.film,
-            output.samples.clone(),
-            output.elapsed.as_secs_f64(),
-        )?,
+        image_of(py, &output.film, seed, output.elapsed.as_secs_f64())?,
     )?;
     if let Some(callback) = &preview
         && shown.take() != Some(output.samples)
@@ -192,8 +282,14 @@ pub fn render(
     Ok(image)
 }
 
-/// The image of `film`, which holds the sample indices `samples`, rendered in `seconds`.
-fn image_of(py: Python<'_>, film: &Film, samples: Range<u32>, seconds: f64) -> PyResult<Image> {
+/// The image of `film`, rendered with the random streams of `seed` in `seconds`; its samples
+/// per pixel are those its pixels hold (a resumed render's included).
+fn image_of(py: Python<'_>, film: &Film, seed: u64, seconds: f64) -> PyResult<Image> {
+    let metadata = RenderMetadata {
+        spp: film.pixels.first().map_or(0, |p| p.samples) as u32,
+        seed,
+        seconds: Some(seconds),
+    };
     let (images, aovs) = py.detach(|| {
         let aovs = (film.aov_names.iter().cloned())
             .enumerate()
@@ -201,15 +297,15 @@ fn image_of(py: Python<'_>, film: &Film, samples: Range<u32>, seconds: f64) -> P
             .collect();
         (FilmImages::of(film), aovs)
     });
-    Image::new(py, images, aovs, samples.end - samples.start, seconds)
+    Image::new(py, images, aovs, Some(metadata))
 }
 
 /// Makes `scene` seen through the sensor `choice` names; changing it needs the scene not to be
 /// rendering.
-fn select_sensor(py: Python<'_>, scene: &Bound<'_, Scene>, choice: SensorChoice) -> PyResult<()> {
+fn select_sensor(py: Python<'_>, scene: &Bound<'_, Scene>, choice: &SensorChoice) -> PyResult<()> {
     let index = match choice {
-        SensorChoice::Index(index) => index,
-        SensorChoice::Id(id) => scene.borrow().loaded.find_sensor(&id).into_py_result(py)?,
+        SensorChoice::Index(index) => *index,
+        SensorChoice::Id(id) => scene.borrow().loaded.find_sensor(id).into_py_result(py)?,
     };
     if scene.borrow().loaded.selected_sensor() == index {
         return Ok(());

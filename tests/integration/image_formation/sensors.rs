@@ -349,7 +349,8 @@ fn ldrfilm_writes_reinhard_luminance() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
-/// `fileFormat="jpeg"` writes `out.jpg` (and no PNG); an RGBA PNG has an opaque alpha.
+/// `fileFormat="jpeg"` writes `out.jpg` (and no PNG); an RGBA PNG's alpha is the coverage,
+/// complete under the constant environment.
 #[test]
 fn ldrfilm_writes_jpeg_and_rgba() {
     let dir = render_ldrfilm("ldr-jpeg", r#"<string name="fileFormat" value="jpeg"/>"#);

@@ -11,8 +11,9 @@
 //!    L_white = max(L) · key / L̄ and b = clamp(1 − burn, 10⁻⁸, 1),
 //!    L' = Lp (1 + Lp / (L_white² b⁴)) / (1 + Lp), and every channel is scaled by L'/L.
 //! 2. Clamping to [0, 1] and the transfer curve: sRGB for `gamma` = −1, otherwise v^(1/γ).
-//! 3. Rounding to 8 bits, as luminance or RGB, with an alpha channel where asked; Prism's film
-//!    records no coverage, so the alpha it writes is opaque.
+//! 3. Rounding to 8 bits, as luminance or RGB, with an alpha channel where asked: the film's
+//!    coverage alpha (the share of a pixel's camera rays that meet something, as Mitsuba 0.6
+//!    writes it), stored linearly.
 
 use std::path::Path;
 
@@ -82,13 +83,14 @@ fn luminance(rgb: [f32; 3]) -> f32 {
 
 impl LdrOutput {
     /// The 8-bit values of an image of linear sRGB pixels (top row first), `channels` per
-    /// pixel.
-    pub fn encode(&self, rgb: &[[f32; 3]]) -> Vec<u8> {
+    /// pixel, with the coverage `alpha` of each pixel where the channels have one (opaque
+    /// without it).
+    pub fn encode(&self, rgb: &[[f32; 3]], alpha: Option<&[f32]>) -> Vec<u8> {
         let grey = matches!(
             self.channels,
             Channels::Luminance | Channels::LuminanceAlpha
         );
-        let alpha = matches!(self.channels, Channels::Rgba | Channels::LuminanceAlpha);
+        let has_alpha = matches!(self.channels, Channels::Rgba | Channels::LuminanceAlpha);
         let pixels: Vec<[f32; 3]> = if grey {
             rgb.iter().map(|&p| [luminance(p); 3]).collect()
         } else {
@@ -96,13 +98,14 @@ impl LdrOutput {
         };
         let scale = self.scales(&pixels);
         let mut bytes = Vec::with_capacity(self.channels.count() * pixels.len());
-        for (pixel, scale) in pixels.iter().zip(scale) {
+        for (i, (pixel, scale)) in pixels.iter().zip(scale).enumerate() {
             let components = if grey { &pixel[..1] } else { &pixel[..] };
             for &v in components {
                 bytes.push(self.encode_value(v * scale));
             }
-            if alpha {
-                bytes.push(u8::MAX);
+            if has_alpha {
+                let coverage = alpha.map_or(1.0, |alpha| alpha[i].clamp(0.0, 1.0));
+                bytes.push((coverage * 255.0).round() as u8);
             }
         }
         bytes
@@ -150,9 +153,17 @@ impl LdrOutput {
         (encoded * 255.0).round() as u8
     }
 
-    /// Writes the image of `rgb` (`width` × `height` linear sRGB pixels) to `path`.
-    pub fn write(&self, path: &Path, width: u32, height: u32, rgb: &[[f32; 3]]) -> Result<()> {
-        let bytes = self.encode(rgb);
+    /// Writes the image of `rgb` (`width` × `height` linear sRGB pixels) and their coverage
+    /// `alpha` to `path`.
+    pub fn write(
+        &self,
+        path: &Path,
+        width: u32,
+        height: u32,
+        rgb: &[[f32; 3]],
+        alpha: Option<&[f32]>,
+    ) -> Result<()> {
+        let bytes = self.encode(rgb, alpha);
         match self.format {
             LdrFormat::Png => write_png_u8(
                 path,
@@ -175,7 +186,7 @@ mod tests {
     #[test]
     fn the_default_is_the_srgb_curve() {
         let pixels = [[0.0, 0.5, 1.0], [0.18, 2.0, -1.0]];
-        let bytes = LdrOutput::default().encode(&pixels);
+        let bytes = LdrOutput::default().encode(&pixels, None);
         let expected: Vec<u8> = pixels
             .iter()
             .flatten()
@@ -185,7 +196,7 @@ mod tests {
     }
 
     /// Exposure doubles per stop; a gamma of 2 takes the square root; luminance is the Y of the
-    /// BT.709 primaries; an alpha channel is opaque.
+    /// BT.709 primaries; an alpha channel is the coverage, clamped, or opaque without one.
     #[test]
     fn exposure_gamma_luminance_and_alpha() {
         let output = LdrOutput {
@@ -194,9 +205,14 @@ mod tests {
             format: LdrFormat::Png,
             channels: Channels::LuminanceAlpha,
         };
-        let bytes = output.encode(&[[0.32, 0.32, 0.32], [1.0, 0.0, 0.0]]);
+        let pixels = [[0.32, 0.32, 0.32], [1.0, 0.0, 0.0]];
         let expected_red = ((2.0f32 * 0.212_671).sqrt() * 255.0).round() as u8;
-        assert_eq!(bytes, vec![204, 255, expected_red, 255]);
+        assert_eq!(
+            output.encode(&pixels, None),
+            vec![204, 255, expected_red, 255]
+        );
+        let bytes = output.encode(&pixels, Some(&[0.25, 1.5]));
+        assert_eq!(bytes, vec![204, 64, expected_red, 255]);
     }
 
     /// Reinhard's operator: the log-average luminance maps to `key` · (1 + …)/(1 + key) and the
@@ -228,6 +244,6 @@ mod tests {
         }
         assert!((f64::from(scales[1]) * l[1] - 1.0).abs() < 1e-5);
         // A black image stays black.
-        assert_eq!(output.encode(&[[0.0; 3]; 2]), vec![0; 6]);
+        assert_eq!(output.encode(&[[0.0; 3]; 2], None), vec![0; 6]);
     }
 }

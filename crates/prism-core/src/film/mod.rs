@@ -15,5 +15,8 @@ pub use filter::{
     TentFilter,
 };
 pub use ldr::{LdrFormat, LdrOutput, Tonemap, TransferCurve};
-pub use output::{FilmImages, write_images, write_images_with};
+pub use output::{
+    ComponentFormat, ExrOutput, FilmImages, ImageOutput, PixelFormat, RenderMetadata, write_images,
+    write_images_with,
+};
 pub use reconstruction::{FilterMis, Reconstruction};

@@ -78,7 +78,7 @@ impl fmt::Display for Comparison {
 }
 
 /// Compares two images of the same size on `channels` (default: R, G, B if both images have
-/// them, else X, Y, Z), with the z-test where the variances are there.
+/// them, else X, Y, Z, else Y), with the z-test where the variances are there.
 pub fn compare(
     test: &ChannelImage,
     reference: &ChannelImage,
@@ -250,7 +250,7 @@ pub fn z_test(
     }
 }
 
-/// The channels to compare: the requested ones, or R,G,B, or X,Y,Z.
+/// The channels to compare: the requested ones, or R,G,B, or X,Y,Z, or Y (luminance images).
 pub fn chosen_channels(
     requested: Option<&[String]>,
     test: &ChannelImage,
@@ -267,13 +267,13 @@ pub fn chosen_channels(
         }
         return Ok(names.to_vec());
     }
-    for set in [["R", "G", "B"], ["X", "Y", "Z"]] {
+    for set in [&["R", "G", "B"][..], &["X", "Y", "Z"], &["Y"]] {
         if set.iter().all(|n| both(n)) {
             return Ok(set.iter().map(|s| s.to_string()).collect());
         }
     }
     Err(
-        Error::usage("the images share neither R, G, B nor X, Y, Z channels")
+        Error::usage("the images share neither R, G, B nor a Y channel")
             .with_help("name them with --channels"),
     )
 }

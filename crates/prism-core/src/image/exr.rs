@@ -1,12 +1,14 @@
-//! OpenEXR files of named 32-bit float channels: the renderer's images and the references it
-//! compares against.
+//! OpenEXR files of named float channels: the renderer's images and the references it compares
+//! against. Each channel is stored as a 32-bit float or, where asked, as a 16-bit half float;
+//! the header may carry attributes of its own (the render's samples per pixel, seed, ...).
 
 use std::io;
 use std::path::Path;
 
+use exr::meta::attribute::AttributeValue;
 use exr::prelude::{
     AnyChannel, AnyChannels, Blocks, Compression, Encoding, FlatSamples, Image, Layer,
-    LayerAttributes, LineOrder, ReadChannels, ReadLayers, SmallVec, Text, WritableImage,
+    LayerAttributes, LineOrder, ReadChannels, ReadLayers, SmallVec, Text, WritableImage, f16,
 };
 
 use super::write_atomically;
@@ -30,6 +32,35 @@ impl ChannelImage {
     }
 }
 
+/// An attribute of an EXR header, of the kinds Prism writes and reads.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Attribute {
+    Int(i32),
+    Double(f64),
+    Text(String),
+}
+
+/// What an EXR file holds beside its channels' values: which channels are stored as half
+/// floats, and the header's own attributes.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ExrHeader {
+    /// Channels stored as IEEE 754 binary16 (11 significant bits, largest finite value 65504,
+    /// smallest normal 6.1·10⁻⁵; larger values become infinite); the others are 32-bit floats.
+    pub half_channels: Vec<String>,
+    /// Attributes by name, beside the ones every EXR file has.
+    pub attributes: Vec<(String, Attribute)>,
+}
+
+impl ExrHeader {
+    /// The attribute called `name`, if there is one.
+    pub fn attribute(&self, name: &str) -> Option<&Attribute> {
+        self.attributes
+            .iter()
+            .find(|(attribute, _)| attribute == name)
+            .map(|(_, value)| value)
+    }
+}
+
 /// How EXR pixel data is compressed: ZIP over blocks of 16 scanlines, which every EXR reader
 /// supports. The random low mantissa bits of rendered f32 data hardly compress with any method,
 /// and ZIP writes fastest of those that compress at all.
@@ -39,6 +70,12 @@ const EXR_COMPRESSION: Compression = Compression::ZIP16;
 /// compression (see `EXR_COMPRESSION`). Channel names are stored as given; the file lists them
 /// alphabetically, as the format requires.
 pub fn write_exr(path: &Path, image: &ChannelImage) -> Result<()> {
+    write_exr_with(path, image, &ExrHeader::default())
+}
+
+/// As [`write_exr`], with the channels `header` names stored as half floats (rounded to the
+/// nearest) and its attributes in the file's header.
+pub fn write_exr_with(path: &Path, image: &ChannelImage, header: &ExrHeader) -> Result<()> {
     let invalid = |message: String| Error::io(path, &io::Error::other(message), "write");
     let pixels = image.width * image.height;
     if pixels == 0 || image.channels.is_empty() {
@@ -61,7 +98,25 @@ pub fn write_exr(path: &Path, image: &ChannelImage) -> Result<()> {
         }
         let text = Text::new_or_none(name)
             .ok_or_else(|| invalid(format!("channel name \"{name}\" is not Latin-1 text")))?;
-        channels.push(AnyChannel::new(text, FlatSamples::F32(samples.clone())));
+        let samples = if header.half_channels.contains(name) {
+            FlatSamples::F16(samples.iter().map(|&v| f16::from_f32(v)).collect())
+        } else {
+            FlatSamples::F32(samples.clone())
+        };
+        channels.push(AnyChannel::new(text, samples));
+    }
+    let mut attributes = LayerAttributes::default();
+    for (name, value) in &header.attributes {
+        let text = |value: &str| {
+            Text::new_or_none(value)
+                .ok_or_else(|| invalid(format!("attribute \"{value}\" is not Latin-1 text")))
+        };
+        let value = match value {
+            Attribute::Int(v) => AttributeValue::I32(*v),
+            Attribute::Double(v) => AttributeValue::F64(*v),
+            Attribute::Text(v) => AttributeValue::Text(text(v)?),
+        };
+        attributes.other.insert(text(name)?, value);
     }
     let encoding = Encoding {
         compression: EXR_COMPRESSION,
@@ -70,7 +125,7 @@ pub fn write_exr(path: &Path, image: &ChannelImage) -> Result<()> {
     };
     let layer = Layer::new(
         (image.width, image.height),
-        LayerAttributes::default(),
+        attributes,
         encoding,
         AnyChannels::sort(channels),
     );
@@ -84,6 +139,12 @@ pub fn write_exr(path: &Path, image: &ChannelImage) -> Result<()> {
 /// largest resolution level, over the data window. A multi-part file whose parts share one size
 /// gives channels named `part.channel`. A missing or corrupt file is an error naming the file.
 pub fn read_exr(path: &Path) -> Result<ChannelImage> {
+    read_exr_with_header(path).map(|(image, _)| image)
+}
+
+/// As [`read_exr`], with the half channels and the integer, floating-point and text attributes
+/// of the header (of every part).
+pub fn read_exr_with_header(path: &Path) -> Result<(ChannelImage, ExrHeader)> {
     let read_error = |err| Error::io(path, &exr_to_io(err), "read");
     let image = exr::prelude::read()
         .no_deep_data()
@@ -102,21 +163,38 @@ pub fn read_exr(path: &Path) -> Result<ChannelImage> {
         )));
     };
     let mut channels = Vec::new();
+    let mut header = ExrHeader::default();
+    let shared = image.attributes.other.iter();
+    for (name, value) in shared.chain(layers.iter().flat_map(|l| l.attributes.other.iter())) {
+        let value = match value {
+            AttributeValue::I32(v) => Attribute::Int(*v),
+            AttributeValue::F32(v) => Attribute::Double(f64::from(*v)),
+            AttributeValue::F64(v) => Attribute::Double(*v),
+            AttributeValue::Text(v) => Attribute::Text(v.to_string()),
+            _ => continue,
+        };
+        header.attributes.push((name.to_string(), value));
+    }
     for layer in layers {
         let prefix = match &layer.attributes.layer_name {
             Some(name) if layers.len() > 1 => format!("{name}."),
             _ => String::new(),
         };
         for channel in &layer.channel_data.list {
+            let name = format!("{prefix}{}", channel.name);
+            if matches!(channel.sample_data, FlatSamples::F16(_)) {
+                header.half_channels.push(name.clone());
+            }
             let samples = channel.sample_data.values_as_f32().collect();
-            channels.push((format!("{prefix}{}", channel.name), samples));
+            channels.push((name, samples));
         }
     }
-    Ok(ChannelImage {
+    let image = ChannelImage {
         width: size.width(),
         height: size.height(),
         channels,
-    })
+    };
+    Ok((image, header))
 }
 
 /// An exr error as an I/O error: file-system errors pass through, format errors become
@@ -189,6 +267,51 @@ mod tests {
             assert!(!dir.join(format!("{}.exr.tmp", names.len())).exists());
             assert_bit_exact(&image, &read_exr(&path).unwrap());
         }
+        fs::remove_dir_all(dir).unwrap();
+    }
+
+    /// Half channels hold the nearest binary16 value of each sample (exactly those of values
+    /// that have one); the attributes come back as written.
+    #[test]
+    fn half_channels_and_attributes_round_trip() {
+        let dir = scratch_dir("exr-half");
+        let mut image = random_image(6, 4, &["R", "G", "variance.Y"], 4);
+        image.channels[0].1[3] = 0.1;
+        image.channels[1].1[3] = 1.5;
+        let header = ExrHeader {
+            half_channels: vec!["G".into(), "R".into()],
+            attributes: vec![
+                ("prism.seconds".into(), Attribute::Double(1.25)),
+                ("prism.spp".into(), Attribute::Int(64)),
+                ("prism.version".into(), Attribute::Text("1.2.3".into())),
+            ],
+        };
+        let path = dir.join("half.exr");
+        write_exr_with(&path, &image, &header).unwrap();
+        let (read, read_header) = read_exr_with_header(&path).unwrap();
+
+        let mut half_channels = read_header.half_channels.clone();
+        half_channels.sort();
+        assert_eq!(half_channels, header.half_channels);
+        let mut attributes = read_header.attributes.clone();
+        attributes.sort_by(|a, b| a.0.cmp(&b.0));
+        assert_eq!(attributes, header.attributes);
+        assert_eq!(
+            read_header.attribute("prism.spp"),
+            Some(&Attribute::Int(64))
+        );
+
+        for (name, samples) in &image.channels {
+            let back = read.channel(name).unwrap();
+            let half = name != "variance.Y";
+            for (&v, &b) in samples.iter().zip(back) {
+                let expected = if half { f16::from_f32(v).to_f32() } else { v };
+                assert_eq!(b.to_bits(), expected.to_bits(), "{name}: {v}");
+            }
+        }
+        assert_eq!(read.channel("G").unwrap()[3], 1.5);
+        assert_eq!(read.channel("R").unwrap()[3], 0.099975586);
+        assert_eq!(read.channel("R").unwrap()[2], f32::INFINITY);
         fs::remove_dir_all(dir).unwrap();
     }
 

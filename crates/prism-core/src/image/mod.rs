@@ -18,7 +18,9 @@ use std::io::{self, BufWriter, Write};
 use std::path::{Path, PathBuf};
 
 pub use bitmap::{Bitmap, Encoding, read_bitmap};
-pub use exr::{ChannelImage, read_exr, write_exr};
+pub use exr::{
+    Attribute, ChannelImage, ExrHeader, read_exr, read_exr_with_header, write_exr, write_exr_with,
+};
 pub use png::{Channels, png_srgb_bytes, write_jpeg_u8, write_png_srgb, write_png_u8};
 
 use crate::error::{Error, Result};

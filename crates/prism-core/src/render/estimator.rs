@@ -1,11 +1,13 @@
 //! The estimate of one camera sample: its wavelengths, film position, time and lens position
-//! drawn from the sampler, its camera ray, and the integrator's radiance along it in CIE XYZ.
+//! drawn from the sampler, its camera ray, and the integrator's radiance along it in CIE XYZ
+//! (with the coverage alpha where the film records it).
 
 use glam::{UVec2, Vec2};
 
 use crate::camera::CameraModel;
 use crate::film::{FilterMis, FilterSampler};
 use crate::integrator::{PreparedIntegrator, RayCount};
+use crate::math::Ray;
 use crate::sampling::sampler::Sampler;
 use crate::scene::Scene;
 use crate::spectrum::SampledWavelengths;
@@ -18,6 +20,8 @@ pub struct SampleEstimator<'a> {
     integrator: PreparedIntegrator<'a>,
     filter: FilterSampler,
     pub(super) shared: Option<FilterMis>,
+    /// Whether each sample also writes its coverage alpha, after the integrator's channels.
+    alpha: bool,
 }
 
 impl<'a> SampleEstimator<'a> {
@@ -31,12 +35,25 @@ impl<'a> SampleEstimator<'a> {
                 .reconstruction
                 .shares_samples(film.filter)
                 .then(|| FilterMis::new(film.filter, film.size.x, film.size.y)),
+            alpha: scene.exr_output.pixel_format.has_alpha(),
         }
     }
 
     /// How many extra channels each sample writes.
     pub fn aov_count(&self) -> usize {
-        self.integrator.aov_count()
+        self.integrator.aov_count() + usize::from(self.alpha)
+    }
+
+    /// The coverage alpha of a camera ray, as Mitsuba 3's path tracer defines it: 1 where it
+    /// meets a surface, or wherever the environment light shows (the scene has one and the
+    /// integrator does not hide emitters), else 0.
+    fn coverage(&self, ray: &Ray, count: &mut RayCount) -> f32 {
+        let world = &self.scene.world;
+        if world.environment.is_some() && !self.scene.integrator.hides_emitters() {
+            return 1.0;
+        }
+        count.rays += 1;
+        f32::from(u8::from(world.geometry.occluded(ray)))
     }
 
     /// Traces sample `index` of `pixel` (full-film coordinates): its film offset from the
@@ -59,7 +76,13 @@ impl<'a> SampleEstimator<'a> {
         let (time, time_weight) = scene.shutter.sample(primary.time);
         let film_position = pixel.as_vec2() + Vec2::splat(0.5) + offset;
         let ray = scene.camera.generate_ray(film_position, primary.lens, time);
-        let radiance = self.integrator.radiance(ray, &lambda, sampler, count, aovs);
+        let (aovs_of_integrator, alpha) = aovs.split_at_mut(self.integrator.aov_count());
+        if let Some(alpha) = alpha.first_mut() {
+            *alpha = self.coverage(&ray, count);
+        }
+        let radiance = self
+            .integrator
+            .radiance(ray, &lambda, sampler, count, aovs_of_integrator);
         for v in aovs.iter_mut() {
             *v *= time_weight;
         }

@@ -24,6 +24,7 @@ mod filter_mis;
 mod options;
 mod pass;
 mod progress;
+pub mod resume;
 pub mod state;
 mod stop;
 mod tiles;
@@ -238,7 +239,7 @@ pub fn render_with_preview(
     let elapsed = start.elapsed();
     progress.end();
 
-    let mut film = Film::with_aovs(scene.film.size, crop, scene.integrator.aov_names());
+    let mut film = Film::with_aovs(scene.film.size, crop, scene.aov_names());
     (film.pixels, film.aovs) = row_major(&tiles, crop.size, k, &sums);
     if let Some(checkpoint) = &mut checkpoints {
         (checkpoint.write)(&Snapshot {

@@ -92,6 +92,7 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
             film: sensor.film,
             sampler: sensor.sampler,
             seed: sensor.seed,
+            exr_output: sensor.exr_output,
             ldr_output: sensor.ldr_output,
             medium,
         });
@@ -375,6 +376,7 @@ impl SceneBuilder {
         world.camera_medium = first.medium;
         let mut scene = Scene::new(world, first.camera, first.film, first.sampler, integrator);
         scene.shutter = first.shutter;
+        scene.exr_output = first.exr_output;
         scene.ldr_output = first.ldr_output;
         let description_fingerprint = crate::fingerprint::scene_fingerprint(root);
         scene.fingerprint = description_fingerprint;

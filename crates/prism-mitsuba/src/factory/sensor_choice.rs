@@ -5,7 +5,7 @@
 use super::scene::LoadedScene;
 use prism_core::camera::{Camera, Shutter};
 use prism_core::error::{Error, Result};
-use prism_core::film::LdrOutput;
+use prism_core::film::{ExrOutput, LdrOutput};
 use prism_core::scene::{FilmSettings, SamplerSettings};
 
 /// One `<sensor>`: what a render through it takes from it.
@@ -18,6 +18,7 @@ pub struct SceneSensor {
     pub(super) film: FilmSettings,
     pub(super) sampler: SamplerSettings,
     pub(super) seed: u64,
+    pub(super) exr_output: ExrOutput,
     pub(super) ldr_output: LdrOutput,
     /// The index of the medium the camera sits in.
     pub(super) medium: Option<u32>,
@@ -79,7 +80,7 @@ impl LoadedScene {
     }
 
     /// Sees the scene through sensor `index` from now on: its camera, shutter, film, sampler,
-    /// 8-bit output, medium and seed. A wavelength density or a reconstruction set in place of
+    /// outputs, medium and seed. A wavelength density or a reconstruction set in place of
     /// the film's (see [`crate::fingerprint`]) carries over to the new film. The index joins the
     /// fingerprint (but for the first sensor), so that a render state records it.
     pub fn select_sensor(&mut self, index: usize) -> Result<()> {
@@ -98,6 +99,7 @@ impl LoadedScene {
         self.scene.shutter = sensor.shutter;
         self.scene.film = sensor.film;
         self.scene.sampler = sensor.sampler;
+        self.scene.exr_output = sensor.exr_output;
         self.scene.ldr_output = sensor.ldr_output;
         self.scene.world.camera_medium = sensor.medium;
         self.seed = sensor.seed;

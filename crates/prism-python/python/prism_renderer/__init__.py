@@ -3,8 +3,10 @@
     import prism_renderer as pr
     scene = pr.load_file("scenes/cornell-box/scene.xml", spp=16)
     image = pr.render(scene, seed=1)
-    image.rgb            # numpy array, H x W x 3, linear sRGB
+    image.rgb            # numpy array, H x W x 3, linear sRGB (np.asarray(image) too)
     image.write("cornell.exr")
+    pr.write_image("red.png", np.full((8, 8, 3), [1.0, 0.0, 0.0], np.float32))
+    pixels = pr.read_image("mitsuba.exr")   # any EXR, PNG, JPEG or HDR as a float32 array
 
 The API follows Mitsuba's (``load_file``, ``load_dict``, ``render``); the scene is read, checked
 and rendered by the same Rust code as the ``prism`` command, so the images and error messages
@@ -17,7 +19,10 @@ import math
 import os
 import sys
 import time
-from typing import Any, Callable, Optional, Sequence, Union
+from typing import Any, Callable, Optional, Sequence, Tuple, Union
+
+import numpy as np
+import numpy.typing as npt
 
 from ._native import (
     ChannelDifference,
@@ -42,7 +47,9 @@ __all__ = [
     "compare",
     "load_dict",
     "load_file",
+    "read_image",
     "render",
+    "write_image",
 ]
 
 ProgressCallback = Callable[[int, Optional[int], float], object]
@@ -77,6 +84,10 @@ def render(
     target_error: Optional[float] = None,
     preview: Optional[PreviewCallback] = None,
     sensor: Union[int, str] = 0,
+    crop: Optional[Tuple[int, int, int, int]] = None,
+    checkpoint: Optional[Union[str, os.PathLike]] = None,
+    checkpoint_every: float = 60.0,
+    resume: Optional[Union[str, os.PathLike]] = None,
 ) -> Image:
     """Renders ``scene`` and returns its :class:`Image`.
 
@@ -88,6 +99,14 @@ def render(
     capping the samples. ``sensor``: which ``<sensor>`` of a scene with several to look
     through, its index from 0 in document order or its ``id`` (as Mitsuba's
     ``mi.render(scene, sensor=...)`` and ``prism render --sensor``).
+
+    ``crop=(x0, y0, x1, y1)``: render only the pixels x0 <= x < x1, y0 <= y < y1 of the film
+    (the scene is held exclusively while it renders). ``checkpoint``: save the render state to
+    this file every ``checkpoint_every`` seconds and at the end. ``resume``: continue the render
+    saved in this state (with the same scene, ``spp``, ``seed`` and ``crop``), saving to it
+    unless ``checkpoint`` names another file. These are ``prism render``'s ``--crop``,
+    ``--checkpoint``, ``--checkpoint-every`` and ``--resume``: the state files are the same, and
+    so is the image, bit for bit.
 
     ``progress``: True shows a progress bar (tqdm's, in a terminal or a notebook, if tqdm is
     installed; else a line on standard error), False none; a callable is called as
@@ -122,6 +141,10 @@ def render(
                 "time_limit": time_limit,
                 "target_error": target_error,
                 "sensor": sensor,
+                "crop": crop,
+                "checkpoint": None if checkpoint is None else os.fspath(checkpoint),
+                "checkpoint_every": float(checkpoint_every),
+                "resume": None if resume is None else os.fspath(resume),
             },
             callback,
             preview,
@@ -152,6 +175,42 @@ def compare(
         operand(reference),
         None if channels is None else list(channels),
         None if diff is None else os.fspath(diff),
+    )
+
+
+def read_image(
+    path: Union[str, os.PathLike], channels: Optional[Sequence[str]] = None
+) -> npt.NDArray[np.float32]:
+    """The linear values of an image file as a float32 array, H x W x C, or H x W for one
+    channel.
+
+    OpenEXR (Prism's, Mitsuba's or any renderer's; 32-bit or half floats): the channels named
+    by ``channels``, or else the first of R,G,B,A / R,G,B / X,Y,Z,A / X,Y,Z / Y,A / Y the
+    file has in full, or else all of its channels in the file's (alphabetical) order. PNG
+    and JPEG: decoded from the sRGB curve to linear values in [0, 1] (alpha as stored); a grey
+    image with alpha gives RGBA. Radiance HDR: as stored.
+    """
+    return _native.read_image(os.fspath(path), None if channels is None else list(channels))
+
+
+def write_image(
+    path: Union[str, os.PathLike],
+    array: npt.ArrayLike,
+    channels: Optional[Sequence[str]] = None,
+) -> None:
+    """Writes an H x W or H x W x C array of linear values as an image file.
+
+    ``.exr``: one OpenEXR channel per C, named ``channels`` (default: Y; Y,A; R,G,B; R,G,B,A
+    for 1 to 4 channels), stored as half floats if the array's dtype is float16, else as
+    32-bit floats. ``.png`` (1 to 4 channels: grey, grey and alpha, RGB, RGBA) and ``.jpg`` or
+    ``.jpeg`` (1 or 3 channels, quality 100): 8-bit values through the sRGB curve, alpha stored
+    linearly, all clamped to [0, 1]. :func:`read_image` reads them back.
+    """
+    values = np.asarray(array)
+    half = values.dtype == np.float16
+    values = np.ascontiguousarray(values, dtype=np.float32)
+    _native.write_image(
+        os.fspath(path), values, None if channels is None else list(channels), half
     )
 
 

@@ -97,7 +97,7 @@ class Transform:
 
 class Image:
     """A rendered image. The arrays are the render's own memory (no copy); ``write`` and
-    ``_repr_png_`` use their current values."""
+    ``_repr_png_`` use their current values. ``numpy.asarray(image)`` is ``rgb``."""
 
     @property
     def rgb(self) -> npt.NDArray[np.float32]:
@@ -117,18 +117,29 @@ class Image:
         H × W; empty for other integrators. :meth:`write` writes them."""
     @property
     def spp(self) -> int:
-        """Samples per pixel taken (0 for an image read from a file)."""
+        """Samples per pixel taken (for an image read from a file, as its header records
+        them, else 0)."""
     @property
     def seconds(self) -> float:
-        """How long the render took (0 for an image read from a file)."""
+        """How long the render took (for an image read from a file, as its header records
+        it, else 0)."""
+    @property
+    def seed(self) -> Optional[int]:
+        """The seed of the render's random numbers (None for a file that does not record
+        it)."""
     @property
     def width(self) -> int: ...
     @property
     def height(self) -> int: ...
     @staticmethod
     def read(path: Union[str, os.PathLike]) -> Image:
-        """Reads an OpenEXR file that Prism wrote (``prism render`` or :meth:`write`); its
-        channels other than the image's are the ``aovs``."""
+        """Reads an OpenEXR file that Prism wrote (``prism render`` or :meth:`write`) with
+        the film's default ``pixel_format`` ``rgb``, 32-bit or half; its channels other than
+        the image's are the ``aovs``. :func:`read_image` reads any image file."""
+    def __array__(
+        self, dtype: Optional[npt.DTypeLike] = None, copy: Optional[bool] = None
+    ) -> npt.NDArray[np.float32]:
+        """``rgb``, converted to ``dtype`` or copied where asked."""
     def write(self, path: Union[str, os.PathLike]) -> None:
         """Writes ``.exr`` (every array and the ``aovs``, the channels ``prism render``
         writes) or ``.png``
@@ -211,6 +222,10 @@ class _RenderSettings(TypedDict):
     time_limit: Optional[float]
     target_error: Optional[float]
     sensor: Union[int, str]
+    crop: Optional[Tuple[int, int, int, int]]
+    checkpoint: Optional[str]
+    checkpoint_every: float
+    resume: Optional[str]
 
 def render(
     scene: Scene,
@@ -229,3 +244,18 @@ def compare(
 ) -> Comparison:
     """``prism compare``'s statistics of ``test`` against ``reference``; with ``diff``, the
     false-colour difference PNG written there."""
+
+def read_image(
+    path: Union[str, os.PathLike], channels: Optional[List[str]] = None
+) -> npt.NDArray[np.float32]:
+    """The linear values of an OpenEXR, PNG, JPEG or Radiance HDR file (see
+    :func:`prism_renderer.read_image`)."""
+
+def write_image(
+    path: Union[str, os.PathLike],
+    array: npt.NDArray[np.float32],
+    channels: Optional[List[str]] = None,
+    half: bool = False,
+) -> None:
+    """Writes a float32 array as OpenEXR, PNG or JPEG (see
+    :func:`prism_renderer.write_image`)."""

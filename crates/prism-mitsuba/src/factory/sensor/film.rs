@@ -8,8 +8,8 @@ use crate::registry::{Choice, Default, Origin, ParamKind, ParamSpec, Plugin, Reg
 use glam::UVec2;
 use prism_core::error::{Error, Result};
 use prism_core::film::{
-    CropWindow, Filter, GaussianFilter, LdrFormat, LdrOutput, Reconstruction, Tonemap,
-    TransferCurve,
+    ComponentFormat, CropWindow, ExrOutput, Filter, GaussianFilter, LdrFormat, LdrOutput,
+    PixelFormat, Reconstruction, Tonemap, TransferCurve,
 };
 use prism_core::image::Channels;
 use prism_core::scene::FilmSettings;
@@ -36,7 +36,14 @@ macro_rules! film_params {
     };
 }
 
-type FilmBuild = fn(&Params) -> Result<(FilmSettings, LdrOutput)>;
+/// A film's settings and how its EXR and 8-bit image are written.
+pub struct FilmParts {
+    pub film: FilmSettings,
+    pub exr: ExrOutput,
+    pub ldr: LdrOutput,
+}
+
+type FilmBuild = fn(&Params) -> Result<FilmParts>;
 
 pub static FILMS: Registry<FilmBuild> = Registry {
     class: PluginClass::Film,
@@ -44,8 +51,8 @@ pub static FILMS: Registry<FilmBuild> = Registry {
         Plugin {
             name: "hdrfilm",
             origin: Origin::Mitsuba3,
-            summary: "A high dynamic range film; Prism writes it as 32-bit OpenEXR (RGB, XYZ, per-pixel \
-                      variance and relative error) and an sRGB PNG.",
+            summary: "A high dynamic range film; Prism writes it as OpenEXR (the colour channels of \
+                      `pixel_format`, XYZ, per-pixel variance and relative error) and an sRGB PNG.",
             params: film_params!(
                 [FILE_FORMAT, PIXEL_FORMAT, COMPONENT_FORMAT],
                 [ATTACH_LOG, HIGH_QUALITY_EDGES, HDR_GAMMA]
@@ -82,16 +89,16 @@ params! {
     CROP_WIDTH = ParamSpec::new("crop_width", ParamKind::Integer, Default::Text("`width` − `crop_offset_x`"), "columns rendered");
     CROP_HEIGHT = ParamSpec::new("crop_height", ParamKind::Integer, Default::Text("`height` − `crop_offset_y`"), "rows rendered");
     FILE_FORMAT = ParamSpec::new("file_format", ParamKind::Choice(&Choice::accepted(["openexr", "exr"])), Default::Str("openexr"), "accepted; the output is always OpenEXR");
-    PIXEL_FORMAT = ParamSpec::new("pixel_format", ParamKind::Choice(&Choice::accepted(["rgb", "rgba", "xyz", "xyza", "luminance", "luminance_alpha"])), Default::Str("rgb"), "accepted; the output always holds RGB and XYZ");
+    PIXEL_FORMAT = ParamSpec::new("pixel_format", ParamKind::Choice(&[Choice::new("rgb", &PixelFormat::Rgb), Choice::new("rgba", &PixelFormat::Rgba), Choice::new("xyz", &PixelFormat::Xyz), Choice::new("xyza", &PixelFormat::Xyza), Choice::new("luminance", &PixelFormat::Luminance), Choice::new("luminance_alpha", &PixelFormat::LuminanceAlpha)]), Default::Str("rgb"), "the EXR's colour channels: R, G, B (`rgb`), X, Y, Z (`xyz`) or Y (`luminance`), with the coverage alpha A for `rgba`, `xyza` and `luminance_alpha`; X, Y, Z (Y for luminance), their variances and the relative error of Y are always written; see docs/cli.md");
     RECONSTRUCTION = ParamSpec::new("reconstruction", ParamKind::Choice(&[Choice::new("filter_mis", &Reconstruction::FilterMis), Choice::new("pixel", &Reconstruction::Pixel)]), Default::Str("filter_mis"), "Prism only (Mitsuba rejects it): how samples become pixels: `filter_mis` (every sample feeds every pixel its filter covers, unbiased, with less noise than Mitsuba's splatting) or `pixel` (each sample counts for its own pixel, the lecture's estimator); the same for a `box` filter; see docs/reconstruction.md");
     WAVELENGTH_SAMPLING = ParamSpec::new("wavelength_sampling", ParamKind::Choice(&[Choice::new("balanced", &WavelengthSampling::Balanced), Choice::new("cie_sum", &WavelengthSampling::CieSum), Choice::new("visible", &WavelengthSampling::Visible), Choice::new("uniform", &WavelengthSampling::Uniform)]), Default::Str("visible"), "Prism only (Mitsuba rejects it): the density wavelengths are drawn from: `visible` (Mitsuba's and pbrt's, the quietest on the Cornell boxes), `balanced` (least error of luminance and linear sRGB under white light), `cie_sum` (∝ x̄+ȳ+z̄, the lecture's), `uniform`; see docs/wavelengths.md");
-    COMPONENT_FORMAT = ParamSpec::new("component_format", ParamKind::Choice(&Choice::accepted(["float16", "float32", "uint32"])), Default::Str("float32"), "accepted; the output is always 32-bit float");
+    COMPONENT_FORMAT = ParamSpec::new("component_format", ParamKind::Choice(&[Choice::new("float16", &ComponentFormat::Float16), Choice::new("float32", &ComponentFormat::Float32)]), Default::Str("float32"), "how the EXR stores values: `float16` (half floats; the variances and relative error stay 32-bit) or `float32`; Mitsuba's default is `float16`, Prism's `float32`, and `prism render --half` gives `float16`");
     BANNER = ParamSpec::new("banner", ParamKind::Boolean, Default::Ignored, "Mitsuba 0.6's \"rendered by Mitsuba\" banner; Prism writes none");
     ATTACH_LOG = ParamSpec::new("attach_log", ParamKind::Boolean, Default::Ignored, "Mitsuba 0.6's render log in the image's metadata; Prism attaches none");
     HIGH_QUALITY_EDGES = ParamSpec::new("high_quality_edges", ParamKind::Boolean, Default::Ignored, "Mitsuba 0.6's sampling of a margin outside the film; Prism samples the film's pixels only");
     HDR_GAMMA = ParamSpec::new("gamma", ParamKind::Float, Default::Ignored, "a gamma on an HDR film, as Mitsuba 0.6 scenes give it; the EXR is linear");
     LDR_FILE_FORMAT = ParamSpec::new("file_format", ParamKind::Choice(&[Choice::new("png", &LdrFormat::Png), Choice::new("jpeg", &LdrFormat::Jpeg), Choice::new("jpg", &LdrFormat::Jpeg)]), Default::Str("png"), "the 8-bit file: PNG, or JPEG of quality 100 (extension `.jpg`)");
-    LDR_PIXEL_FORMAT = ParamSpec::new("pixel_format", ParamKind::Choice(&[Choice::new("rgb", &Channels::Rgb), Choice::new("rgba", &Channels::Rgba), Choice::new("luminance", &Channels::Luminance), Choice::new("luminanceAlpha", &Channels::LuminanceAlpha)]), Default::Str("rgb"), "the 8-bit image's channels; Prism's alpha is opaque (its film records no coverage), and a JPEG drops it, as Mitsuba 0.6 does");
+    LDR_PIXEL_FORMAT = ParamSpec::new("pixel_format", ParamKind::Choice(&[Choice::new("rgb", &Channels::Rgb), Choice::new("rgba", &Channels::Rgba), Choice::new("luminance", &Channels::Luminance), Choice::new("luminanceAlpha", &Channels::LuminanceAlpha)]), Default::Str("rgb"), "the 8-bit image's channels; the alpha is the coverage (also written to the EXR as `A`), and a JPEG drops it, as Mitsuba 0.6 does");
 }
 
 /// How `ldrfilm` maps radiance to 8-bit values.
@@ -118,10 +125,11 @@ const MAX_FILM_SIDE: i64 = 1 << 16;
 
 const MAX_FILM_PIXELS: i64 = 1 << 25;
 
-/// Mitsuba's default film: 768 × 576 with a Gaussian filter.
-pub(super) fn default_film() -> FilmSettings {
+/// Mitsuba's default film: 768 × 576 with a Gaussian filter, written as a 32-bit RGB EXR and
+/// an sRGB PNG.
+pub(super) fn default_film() -> FilmParts {
     let size = UVec2::new(768, 576);
-    FilmSettings {
+    let film = FilmSettings {
         size,
         crop: CropWindow {
             offset: UVec2::ZERO,
@@ -130,33 +138,44 @@ pub(super) fn default_film() -> FilmSettings {
         filter: Filter::Gaussian(GaussianFilter { stddev: 0.5 }),
         reconstruction: Reconstruction::default(),
         wavelength_sampling: WavelengthSampling::default(),
+    };
+    FilmParts {
+        film,
+        exr: ExrOutput::default(),
+        ldr: LdrOutput::default(),
     }
 }
 
 /// The film a node describes, how its 8-bit image is written, and a warning for each ignored
 /// parameter it gives.
-pub(super) fn build_film(node: &PluginNode) -> Result<(FilmSettings, LdrOutput, Vec<Warning>)> {
+pub(super) fn build_film(node: &PluginNode) -> Result<(FilmParts, Vec<Warning>)> {
     let plugin = FILMS.find(node)?;
     let params = Params::new(node, plugin.params);
-    let (film, ldr) = (plugin.build)(&params)?;
+    let parts = (plugin.build)(&params)?;
     let warnings = params.finish_with_warnings()?;
-    Ok((film, ldr, warnings))
+    Ok((parts, warnings))
 }
 
 /// `hdrfilm`: `width` (768), `height` (576), `crop_offset_x/y`, `crop_width/height`, a nested
-/// `rfilter` (Gaussian by default). `file_format`, `pixel_format` and `component_format` are
-/// accepted for compatibility; Prism always writes 32-bit linear RGB and XYZ to EXR.
-fn build_hdrfilm(params: &Params) -> Result<(FilmSettings, LdrOutput)> {
+/// `rfilter` (Gaussian by default), the EXR's `pixel_format` and `component_format`;
+/// `file_format` is accepted for compatibility (the output is always OpenEXR).
+fn build_hdrfilm(params: &Params) -> Result<FilmParts> {
     let film = film_settings(params)?;
-    for spec in [&FILE_FORMAT, &PIXEL_FORMAT, &COMPONENT_FORMAT] {
-        params.choice::<()>(spec)?;
-    }
-    Ok((film, LdrOutput::default()))
+    params.choice::<()>(&FILE_FORMAT)?;
+    let exr = ExrOutput {
+        pixel_format: params.choice(&PIXEL_FORMAT)?,
+        component_format: params.choice(&COMPONENT_FORMAT)?,
+    };
+    Ok(FilmParts {
+        film,
+        exr,
+        ldr: LdrOutput::default(),
+    })
 }
 
 /// `ldrfilm` (Mitsuba 0.6's `src/films/ldrfilm.cpp`): the film of `hdrfilm`, and how its 8-bit
 /// image is tonemapped ([`prism_core::film::ldr`]).
-fn build_ldrfilm(params: &Params) -> Result<(FilmSettings, LdrOutput)> {
+fn build_ldrfilm(params: &Params) -> Result<FilmParts> {
     let film = film_settings(params)?;
     let format = params.choice(&LDR_FILE_FORMAT)?;
     // A JPEG has no alpha channel.
@@ -207,15 +226,24 @@ fn build_ldrfilm(params: &Params) -> Result<(FilmSettings, LdrOutput)> {
             exposure: exposure as f32,
         },
     };
-    Ok((
+    // The film records the coverage that the 8-bit alpha holds.
+    let pixel_format = match channels {
+        Channels::Rgba | Channels::LuminanceAlpha => PixelFormat::Rgba,
+        Channels::Rgb | Channels::Luminance => PixelFormat::Rgb,
+    };
+    Ok(FilmParts {
         film,
-        LdrOutput {
+        exr: ExrOutput {
+            pixel_format,
+            ..ExrOutput::default()
+        },
+        ldr: LdrOutput {
             tonemap,
             curve,
             format,
             channels,
         },
-    ))
+    })
 }
 
 /// The size, crop window, filter and wavelength density that `hdrfilm` and `ldrfilm` share.

@@ -13,7 +13,7 @@ use film::{build_film, default_film};
 use glam::Vec2;
 use prism_core::camera::{Camera, OrthographicCamera, PerspectiveCamera, Shutter};
 use prism_core::error::{Error, Result};
-use prism_core::film::LdrOutput;
+use prism_core::film::{ExrOutput, LdrOutput};
 use prism_core::scene::{FilmSettings, SamplerKind, SamplerSettings};
 use rfilter::build_filter;
 use sampler::build_sampler;
@@ -112,6 +112,9 @@ pub struct SensorSettings {
     pub film: FilmSettings,
     pub sampler: SamplerSettings,
     pub seed: u64,
+    /// Which channels the EXR holds and how it stores them (`hdrfilm`'s `pixel_format` and
+    /// `component_format`).
+    pub exr_output: ExrOutput,
     /// How the 8-bit image is written (`ldrfilm`), or the default sRGB PNG.
     pub ldr_output: LdrOutput,
     /// The parameters read and ignored, one warning each.
@@ -133,6 +136,7 @@ pub fn build_sensor(node: &PluginNode) -> Result<SensorSettings> {
 /// parameters), its sampler and the sampler's seed.
 struct SensorParts {
     film: FilmSettings,
+    exr_output: ExrOutput,
     ldr_output: LdrOutput,
     warnings: Vec<Warning>,
     sampler: SamplerSettings,
@@ -140,9 +144,9 @@ struct SensorParts {
 }
 
 fn sensor_parts(params: &Params) -> Result<SensorParts> {
-    let (film, ldr_output, warnings) = match params.single_child(&FILM)? {
+    let (film, warnings) = match params.single_child(&FILM)? {
         Some(child) => build_film(&child.node)?,
-        None => (default_film(), LdrOutput::default(), Vec::new()),
+        None => (default_film(), Vec::new()),
     };
     let (sampler, seed) = match params.single_child(&SAMPLER)? {
         Some(child) => build_sampler(&child.node)?,
@@ -155,8 +159,9 @@ fn sensor_parts(params: &Params) -> Result<SensorParts> {
         ),
     };
     Ok(SensorParts {
-        film,
-        ldr_output,
+        film: film.film,
+        exr_output: film.exr,
+        ldr_output: film.ldr,
         warnings,
         sampler,
         seed,
@@ -197,6 +202,7 @@ fn build_orthographic(params: &Params, _thinlens: bool) -> Result<SensorSettings
         film: parts.film,
         sampler: parts.sampler,
         seed: parts.seed,
+        exr_output: parts.exr_output,
         ldr_output: parts.ldr_output,
         warnings: parts.warnings,
         medium: params.single_child(&SENSOR_MEDIUM)?.map(|c| c.node.clone()),
@@ -206,6 +212,7 @@ fn build_orthographic(params: &Params, _thinlens: bool) -> Result<SensorSettings
 fn build_sensor_of(params: &Params, thinlens: bool) -> Result<SensorSettings> {
     let SensorParts {
         film,
+        exr_output,
         ldr_output,
         warnings,
         sampler,
@@ -246,6 +253,7 @@ fn build_sensor_of(params: &Params, thinlens: bool) -> Result<SensorSettings> {
         film,
         sampler,
         seed,
+        exr_output,
         ldr_output,
         warnings,
         medium: params.single_child(&SENSOR_MEDIUM)?.map(|c| c.node.clone()),
