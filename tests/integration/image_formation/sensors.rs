@@ -1,7 +1,7 @@
 //! The sensor plugins as the scene reader builds them from Mitsuba XML: the field of view
 //! from `fov`, `fov_axis` and `focal_length` (Mitsuba 3's `parse_fov`), `focus_distance`,
 //! which Mitsuba 3 reads on every projective camera, the orthographic camera against closed
-//! forms, Mitsuba 0.6's ignored film parameters and its `ldrfilm`.
+//! forms, the radiance meter, Mitsuba 0.6's ignored film parameters and its `ldrfilm`.
 
 use std::path::Path;
 
@@ -35,7 +35,7 @@ fn load_sensor(
 fn tan_half_fov_x(scene: &Scene) -> f64 {
     match &scene.camera {
         Camera::Perspective(camera) => f64::from(camera.tan_half_fov_x),
-        Camera::Orthographic(_) => panic!("not a perspective camera"),
+        Camera::Orthographic(_) | Camera::RadianceMeter(_) => panic!("not a perspective camera"),
     }
 }
 
@@ -414,4 +414,68 @@ fn the_orthographic_image_of_a_disk_has_the_disks_area() {
     let film = render_film(&scene, 256, 2, None);
     let expected = std::f64::consts::PI * 0.36 / (2.0 * s * 1.5 * s);
     assert_mean_luminance("orthographic image of a disk", &film, expected);
+}
+
+/// A scene seen by a `radiancemeter` placed by `placement`, with `body` after the sensor.
+fn radiance_meter_scene(placement: &str, body: &str) -> prism_core::error::Result<Scene> {
+    let text = format!(
+        r#"<scene version="3.0.0">
+    <sensor type="radiancemeter">
+        {placement}
+        <sampler type="independent"><integer name="sample_count" value="16384"/></sampler>
+        <film type="hdrfilm"><integer name="width" value="1"/><integer name="height" value="1"/><rfilter type="box"/></film>
+    </sensor>
+    {body}
+</scene>"#
+    );
+    let root = read_scene_str(&text, Path::new("meter.xml"), &[])?;
+    Ok(build_scene(&root)?.scene)
+}
+
+/// A radiance meter sees the radiance along its one ray: an emitter of radiance 3 (a constant
+/// spectrum, so Y = 3) straight ahead, whichever way the sensor is placed; beside the emitter
+/// it sees nothing.
+#[test]
+fn a_radiance_meter_measures_the_radiance_along_its_ray() {
+    let emitter = r#"<shape type="rectangle">
+        <transform name="to_world"><scale value="0.5"/><rotate y="1" angle="180"/><translate z="2"/></transform>
+        <emitter type="area"><spectrum name="radiance" value="3"/></emitter>
+    </shape>"#;
+    for placement in [
+        r#"<point name="origin" x="0.1" y="-0.2" z="-1"/><vector name="direction" x="0" y="0" z="2"/>"#,
+        r#"<transform name="to_world"><lookat origin="0.1, -0.2, -1" target="0.1, -0.2, 0" up="0, 1, 0"/></transform>"#,
+    ] {
+        let scene = radiance_meter_scene(placement, emitter).unwrap();
+        let film = render_film(&scene, 16384, 3, None);
+        assert_mean_luminance(placement, &film, 3.0);
+    }
+    let aside = radiance_meter_scene(
+        r#"<point name="origin" x="2" y="0" z="-1"/><vector name="direction" x="0" y="0" z="1"/>"#,
+        emitter,
+    )
+    .unwrap();
+    let film = render_film(&aside, 64, 3, None);
+    assert_eq!(film.pixels[0].mean()[1], 0.0);
+}
+
+#[test]
+fn a_radiance_meter_needs_a_one_pixel_film_and_both_origin_and_direction() {
+    let error = load_sensor("radiancemeter", "", 2, 1)
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(error.contains("must be 1 × 1 pixels"), "{error}");
+    let error = radiance_meter_scene(r#"<point name="origin" x="0" y="0" z="0"/>"#, "")
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(error.contains("needs both"), "{error}");
+    let error = radiance_meter_scene(
+        r#"<point name="origin" x="0" y="0" z="0"/><vector name="direction" x="0" y="0" z="0"/>"#,
+        "",
+    )
+    .err()
+    .unwrap()
+    .to_string();
+    assert!(error.contains("has no length"), "{error}");
 }

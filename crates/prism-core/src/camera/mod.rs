@@ -1,11 +1,14 @@
-//! Cameras: turning a point on the film (and on the lens, at a time) into a ray.
+//! Cameras: turning a point on the film (and on the lens, at a time) into a ray; the radiance
+//! meter, a sensor of one ray.
 
 pub mod orthographic;
 pub mod perspective;
+pub mod radiancemeter;
 pub mod shutter;
 
 pub use orthographic::OrthographicCamera;
 pub use perspective::PerspectiveCamera;
+pub use radiancemeter::RadianceMeter;
 pub use shutter::Shutter;
 
 use glam::Vec2;
@@ -27,6 +30,7 @@ plugin_class! {
     pub enum Camera {
         Perspective(PerspectiveCamera),
         Orthographic(OrthographicCamera),
+        RadianceMeter(RadianceMeter),
     }
 }
 

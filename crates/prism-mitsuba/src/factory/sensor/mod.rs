@@ -1,5 +1,6 @@
-//! The sensor: the `perspective`, `thinlens` and `orthographic` cameras with their shutter, and
-//! the film and sampler they carry (each class's registry in its own module).
+//! The sensor: the `perspective`, `thinlens` and `orthographic` cameras and the `radiancemeter`,
+//! with their shutter, and the film and sampler they carry (each class's registry in its own
+//! module).
 
 pub mod film;
 pub mod rfilter;
@@ -10,10 +11,11 @@ use crate::factory::fov::{FOCAL_LENGTH, FOV, FOV_AXIS, horizontal_fov_param};
 use crate::params::Params;
 use crate::registry::{Default, Origin, ParamKind, ParamSpec, Plugin, Registry, params};
 use film::{build_film, default_film};
-use glam::Vec2;
-use prism_core::camera::{Camera, OrthographicCamera, PerspectiveCamera, Shutter};
+use glam::{DMat4, DVec3, Vec2};
+use prism_core::camera::{Camera, OrthographicCamera, PerspectiveCamera, RadianceMeter, Shutter};
 use prism_core::error::{Error, Result};
-use prism_core::film::{ExrOutput, LdrOutput};
+use prism_core::film::{ExrOutput, Kernel, LdrOutput};
+use prism_core::math::{AnimatedTransform, Transform};
 use prism_core::scene::{FilmSettings, SamplerKind, SamplerSettings};
 use rfilter::build_filter;
 use sampler::build_sampler;
@@ -84,6 +86,24 @@ pub static SENSORS: Registry<SensorBuild> = Registry {
             ),
             build: build_orthographic,
         },
+        Plugin {
+            name: "radiancemeter",
+            origin: Origin::Mitsuba3,
+            summary: "The radiance arriving along one ray, from `origin` along `direction` (or \
+                      from `to_world`'s origin along its +z axis), on a film of one pixel.",
+            params: &[
+                METER_TO_WORLD,
+                METER_ORIGIN,
+                METER_DIRECTION,
+                SHUTTER_OPEN,
+                SHUTTER_CLOSE,
+                SHUTTER_FILTER,
+                FILM,
+                SAMPLER,
+                SENSOR_MEDIUM,
+            ],
+            build: build_radiancemeter,
+        },
     ],
 };
 
@@ -102,6 +122,9 @@ params! {
     FOCUS_DISTANCE = ParamSpec::new("focus_distance", ParamKind::Float, Default::Text("`far_clip`"), "distance of the plane in focus");
     PINHOLE_FOCUS_DISTANCE = ParamSpec::new("focus_distance", ParamKind::Float, Default::Text("`far_clip`"), "read as Mitsuba 3 reads it on every projective camera; a pinhole has everything in focus");
     FOCAL_DISTANCE = ParamSpec::new("focal_distance", ParamKind::Float, Default::None, "Prism only, the lecture's name for `focus_distance`");
+    METER_TO_WORLD = ParamSpec::new("to_world", ParamKind::AnimatedTransform, Default::Text("identity"), "sensor to world: the ray leaves its origin along its +z axis (wins over `origin` and `direction`)");
+    METER_ORIGIN = ParamSpec::new("origin", ParamKind::Point, Default::None, "where the ray starts, with `direction`");
+    METER_DIRECTION = ParamSpec::new("direction", ParamKind::Vector, Default::None, "the direction of the ray, with `origin`");
     ORTHOGRAPHIC_TO_WORLD = ParamSpec::new("to_world", ParamKind::AnimatedTransform, Default::Text("identity"), "camera to world, scales included (they set the film's extent in the scene), or an `<animation>` of them");
 }
 
@@ -207,6 +230,87 @@ fn build_orthographic(params: &Params, _thinlens: bool) -> Result<SensorSettings
         warnings: parts.warnings,
         medium: params.single_child(&SENSOR_MEDIUM)?.map(|c| c.node.clone()),
     })
+}
+
+/// `radiancemeter` (Mitsuba 3's `radiancemeter.cpp`): `to_world` if given, else the frame
+/// Mitsuba's `look_at(origin, origin + direction, up)` builds, with `up` the first tangent of
+/// the direction's coordinate system; one ray whatever the film position, on a 1 × 1 film.
+fn build_radiancemeter(params: &Params, _thinlens: bool) -> Result<SensorSettings> {
+    let mut parts = sensor_parts(params)?;
+    let origin = params.point_opt(&METER_ORIGIN)?;
+    let direction = params.vector_opt(&METER_DIRECTION)?;
+    let to_world = if params.has(&METER_TO_WORLD) {
+        params.animated_transform(&METER_TO_WORLD)?
+    } else {
+        match (origin, direction) {
+            (None, None) => AnimatedTransform::fixed(Transform::IDENTITY),
+            (Some(origin), Some(direction)) => {
+                let frame = ray_frame(origin, direction).ok_or_else(|| {
+                    Error::input(
+                        params.location_of(&METER_DIRECTION),
+                        format!("the radiance meter's direction {direction} has no length"),
+                    )
+                })?;
+                AnimatedTransform::fixed(frame)
+            }
+            (Some(_), None) | (None, Some(_)) => {
+                return Err(Error::input(
+                    params.location(),
+                    "a radiancemeter given by \"origin\" and \"direction\" needs both",
+                )
+                .with_help("add the missing one, or place the sensor with a to_world transform"));
+            }
+        }
+    };
+    if parts.film.size != glam::UVec2::ONE {
+        return Err(Error::input(
+            params.location(),
+            format!(
+                "a radiancemeter measures one ray: its film must be 1 × 1 pixels, not {} × {}",
+                parts.film.size.x, parts.film.size.y
+            ),
+        )
+        .with_help("set the film's width and height to 1"));
+    }
+    if parts.film.filter.radius() > 0.5 + 1e-4 {
+        parts.warnings.push(Warning {
+            location: params.location().clone(),
+            message: "a radiancemeter should have a reconstruction filter of radius 0.5 or less \
+                      (the box, Mitsuba's advice): its one ray is the same for every sample"
+                .into(),
+        });
+    }
+    let shutter = shutter(params)?;
+    Ok(SensorSettings {
+        camera: Camera::RadianceMeter(RadianceMeter { to_world }),
+        shutter,
+        film: parts.film,
+        sampler: parts.sampler,
+        seed: parts.seed,
+        exr_output: parts.exr_output,
+        ldr_output: parts.ldr_output,
+        warnings: parts.warnings,
+        medium: params.single_child(&SENSOR_MEDIUM)?.map(|c| c.node.clone()),
+    })
+}
+
+/// Mitsuba 3's `look_at(origin, origin + direction, up)` with `up` the first tangent of
+/// `coordinate_system(normalize(direction))` (Duff et al. 2017): columns left, up, direction,
+/// origin. None for a direction of no length.
+fn ray_frame(origin: DVec3, direction: DVec3) -> Option<Transform> {
+    let d = direction.try_normalize()?;
+    let sign = 1.0f64.copysign(d.z);
+    let a = -1.0 / (sign + d.z);
+    let b = d.x * d.y * a;
+    let tangent = DVec3::new(1.0 + sign * d.x * d.x * a, sign * b, -sign * d.x);
+    let left = tangent.cross(d).normalize();
+    let up = d.cross(left);
+    Transform::new(DMat4::from_cols(
+        left.extend(0.0),
+        up.extend(0.0),
+        d.extend(0.0),
+        origin.extend(1.0),
+    ))
 }
 
 fn build_sensor_of(params: &Params, thinlens: bool) -> Result<SensorSettings> {
