@@ -24,7 +24,7 @@ use prism_mitsuba::reader::read_scene_str;
 
 use crate::common::scenes::{
     Object, assert_mean_luminance, build, camera, image_mean_and_standard_error,
-    pixel_mean_and_variance, render_film,
+    pixel_mean_and_variance, render_film, scene_from_xml,
 };
 
 /// A box [−s, s] (one scale per axis) with outward normals.
@@ -774,8 +774,7 @@ fn phase_functions_match_mitsuba() {
         ),
     ] {
         let xml = PHASE_SCENE.replace("PHASE", phase);
-        let root = read_scene_str(&xml, std::path::Path::new("phase.xml"), &[]).unwrap();
-        let scene = build_scene(&root).unwrap().scene;
+        let scene = scene_from_xml(&xml, "phase.xml").unwrap();
         let film = render_film(&scene, 1024, 7, None);
         let (mean, se) = image_mean_and_standard_error(&film, 1);
         let tolerance = 4.0 * (se * se + (0.0025 * mitsuba_y).powi(2)).sqrt();

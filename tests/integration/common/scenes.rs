@@ -91,6 +91,13 @@ pub fn build(
     )
 }
 
+/// The scene of the Mitsuba XML `xml`, files it names resolved beside the (virtual) file
+/// `name`.
+pub fn scene_from_xml(xml: &str, name: &str) -> prism_core::error::Result<Scene> {
+    let root = prism_mitsuba::reader::read_scene_str(xml, std::path::Path::new(name), &[])?;
+    Ok(prism_mitsuba::factory::build_scene(&root)?.scene)
+}
+
 /// Renders with a fixed seed and no progress bar.
 pub fn render_film(scene: &Scene, spp: u32, seed: u64, threads: Option<usize>) -> Film {
     render(scene, &RenderOptions::fixed(spp, seed, threads))

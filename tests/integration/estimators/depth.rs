@@ -1,11 +1,11 @@
 //! The `depth` integrator: the distance to the first surface, as a constant spectrum, against
 //! its closed form on a plane seen head-on; zero where the rays leave the scene.
 
-use std::path::Path;
-
 use prism_core::scene::Scene;
 
-use crate::common::scenes::{assert_mean_luminance, image_mean_and_standard_error, render_film};
+use crate::common::scenes::{
+    assert_mean_luminance, image_mean_and_standard_error, render_film, scene_from_xml,
+};
 
 fn scene(body: &str) -> Scene {
     let xml = format!(
@@ -19,8 +19,7 @@ fn scene(body: &str) -> Scene {
     {body}
 </scene>"#
     );
-    let root = prism_mitsuba::reader::read_scene_str(&xml, Path::new("depth.xml"), &[]).unwrap();
-    prism_mitsuba::factory::build_scene(&root).unwrap().scene
+    scene_from_xml(&xml, "depth.xml").unwrap()
 }
 
 /// A camera at height D = 2 looks straight down at the plane z = 0 with a 40° field of view.

@@ -11,7 +11,7 @@ use prism_core::scene::Scene;
 use prism_mitsuba::factory::build_scene;
 use prism_mitsuba::reader::read_scene_str;
 
-use crate::common::scenes::{assert_mean_luminance, render_film};
+use crate::common::scenes::{assert_mean_luminance, render_film, scene_from_xml};
 
 /// Builds a scene holding one sensor, whose inner XML is `sensor` and film `width` × `height`.
 fn load_sensor(
@@ -428,8 +428,7 @@ fn radiance_meter_scene(placement: &str, body: &str) -> prism_core::error::Resul
     {body}
 </scene>"#
     );
-    let root = read_scene_str(&text, Path::new("meter.xml"), &[])?;
-    Ok(build_scene(&root)?.scene)
+    scene_from_xml(&text, "meter.xml")
 }
 
 /// A radiance meter sees the radiance along its one ray: an emitter of radiance 3 (a constant

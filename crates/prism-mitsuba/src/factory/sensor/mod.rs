@@ -191,6 +191,26 @@ fn sensor_parts(params: &Params) -> Result<SensorParts> {
     })
 }
 
+/// The sensor of `camera` and `shutter` with what every sensor carries.
+fn sensor_settings(
+    params: &Params,
+    parts: SensorParts,
+    camera: Camera,
+    shutter: Shutter,
+) -> Result<SensorSettings> {
+    Ok(SensorSettings {
+        camera,
+        shutter,
+        film: parts.film,
+        sampler: parts.sampler,
+        seed: parts.seed,
+        exr_output: parts.exr_output,
+        ldr_output: parts.ldr_output,
+        warnings: parts.warnings,
+        medium: params.single_child(&SENSOR_MEDIUM)?.map(|c| c.node.clone()),
+    })
+}
+
 /// `near_clip` and `far_clip`, as Mitsuba 3's projective cameras check them.
 fn clip_distances(params: &Params) -> Result<(f64, f64)> {
     let near_clip = params.float(&NEAR_CLIP)?;
@@ -219,17 +239,7 @@ fn build_orthographic(params: &Params, _thinlens: bool) -> Result<SensorSettings
         near_clip: near_clip as f32,
         far_clip: far_clip as f32,
     });
-    Ok(SensorSettings {
-        camera,
-        shutter,
-        film: parts.film,
-        sampler: parts.sampler,
-        seed: parts.seed,
-        exr_output: parts.exr_output,
-        ldr_output: parts.ldr_output,
-        warnings: parts.warnings,
-        medium: params.single_child(&SENSOR_MEDIUM)?.map(|c| c.node.clone()),
-    })
+    sensor_settings(params, parts, camera, shutter)
 }
 
 /// `radiancemeter` (Mitsuba 3's `radiancemeter.cpp`): `to_world` if given, else the frame
@@ -281,17 +291,8 @@ fn build_radiancemeter(params: &Params, _thinlens: bool) -> Result<SensorSetting
         });
     }
     let shutter = shutter(params)?;
-    Ok(SensorSettings {
-        camera: Camera::RadianceMeter(RadianceMeter { to_world }),
-        shutter,
-        film: parts.film,
-        sampler: parts.sampler,
-        seed: parts.seed,
-        exr_output: parts.exr_output,
-        ldr_output: parts.ldr_output,
-        warnings: parts.warnings,
-        medium: params.single_child(&SENSOR_MEDIUM)?.map(|c| c.node.clone()),
-    })
+    let camera = Camera::RadianceMeter(RadianceMeter { to_world });
+    sensor_settings(params, parts, camera, shutter)
 }
 
 /// Mitsuba 3's `look_at(origin, origin + direction, up)` with `up` the first tangent of
@@ -314,16 +315,9 @@ fn ray_frame(origin: DVec3, direction: DVec3) -> Option<Transform> {
 }
 
 fn build_sensor_of(params: &Params, thinlens: bool) -> Result<SensorSettings> {
-    let SensorParts {
-        film,
-        exr_output,
-        ldr_output,
-        warnings,
-        sampler,
-        seed,
-    } = sensor_parts(params)?;
-
-    let aspect = f64::from(film.size.x) / f64::from(film.size.y);
+    let parts = sensor_parts(params)?;
+    let film_size = parts.film.size;
+    let aspect = f64::from(film_size.x) / f64::from(film_size.y);
     let fov_x = horizontal_fov_param(params, aspect)?;
     let (near_clip, far_clip) = clip_distances(params)?;
     let to_world = params.animated_transform(&SENSOR_TO_WORLD)?;
@@ -344,24 +338,14 @@ fn build_sensor_of(params: &Params, thinlens: bool) -> Result<SensorSettings> {
 
     let camera = Camera::Perspective(PerspectiveCamera {
         to_world,
-        film_size: Vec2::new(film.size.x as f32, film.size.y as f32),
+        film_size: Vec2::new(film_size.x as f32, film_size.y as f32),
         tan_half_fov_x: (0.5 * fov_x).to_radians().tan() as f32,
         near_clip: near_clip as f32,
         far_clip: far_clip as f32,
         lens_radius: lens_radius as f32,
         focus_distance: focus_distance as f32,
     });
-    Ok(SensorSettings {
-        camera,
-        shutter,
-        film,
-        sampler,
-        seed,
-        exr_output,
-        ldr_output,
-        warnings,
-        medium: params.single_child(&SENSOR_MEDIUM)?.map(|c| c.node.clone()),
-    })
+    sensor_settings(params, parts, camera, shutter)
 }
 
 /// The thin lens: `aperture_radius` (Mitsuba) or the lecture's aperture area `aperture_area`
