@@ -40,3 +40,12 @@ pub fn load_scene(path: &Path, defines: &[(String, String)]) -> Result<LoadedSce
     loaded.warnings.splice(0..0, document.warnings);
     Ok(loaded)
 }
+
+/// Reads a Mitsuba XML scene given as text and builds it, as [`load_scene`]; messages name the
+/// text `<string>`, and relative file names are found from the current folder.
+pub fn load_scene_str(text: &str, defines: &[(String, String)]) -> Result<LoadedScene> {
+    let document = reader::read_scene_str_document(text, Path::new("<string>"), defines)?;
+    let mut loaded = factory::build_scene(&document.root)?;
+    loaded.warnings.splice(0..0, document.warnings);
+    Ok(loaded)
+}

@@ -12,7 +12,7 @@ use prism_core::error::Error;
 use prism_core::film::Reconstruction;
 use prism_core::spectrum::WavelengthSampling;
 use prism_mitsuba::fingerprint::{override_reconstruction, override_wavelengths};
-use prism_mitsuba::{LoadedScene, load_scene, load_scene_dict};
+use prism_mitsuba::{LoadedScene, load_scene, load_scene_dict, load_scene_str};
 
 /// A scene ready to render. Its settings that `prism render` can override from the command
 /// line are properties that may be set (not while the scene renders).
@@ -119,6 +119,21 @@ impl Scene {
 pub fn load_file(py: Python<'_>, path: PathBuf, defines: Vec<(String, String)>) -> PyResult<Scene> {
     let loaded = py
         .detach(|| load_scene(&path, &defines))
+        .into_py_result(py)?;
+    Ok(Scene { loaded })
+}
+
+/// Loads a Mitsuba XML scene given as the string `text`, with `defines` as in [`load_file`];
+/// relative file names are found from the current folder.
+#[pyfunction]
+#[pyo3(signature = (text, defines = Vec::new()))]
+pub fn load_string(
+    py: Python<'_>,
+    text: String,
+    defines: Vec<(String, String)>,
+) -> PyResult<Scene> {
+    let loaded = py
+        .detach(|| load_scene_str(&text, &defines))
         .into_py_result(py)?;
     Ok(Scene { loaded })
 }

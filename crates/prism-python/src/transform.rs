@@ -1,10 +1,11 @@
 //! `Transform`, a 4 × 4 matrix acting on column vectors, composed like Mitsuba's
 //! `ScalarTransform4f`: each operation multiplies on the right, `T().translate(v).scale(s)` =
 //! translate · scale (the scaling is applied first). The operations are those of the XML
-//! reader's `<transform>` ([`prism_mitsuba::dict::transform`]).
+//! reader's `<transform>` ([`prism_mitsuba::dict::transform`]). `T @ p` applies it to points as
+//! Mitsuba's `Transform4f @ Point3f` does: p' = (M·(p, 1))_xyz / (M·(p, 1))_w.
 
-use glam::{DMat4, DVec3};
-use numpy::{PyArray2, PyReadonlyArray2};
+use glam::{DMat4, DVec3, DVec4};
+use numpy::{IntoPyArray, PyArray2, PyReadonlyArray2};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
@@ -28,6 +29,20 @@ impl Transform {
             matrix: self.matrix * operation,
         }
     }
+
+    /// The point `p` transformed, with the projective division by w.
+    fn apply(&self, p: [f64; 3]) -> [f64; 3] {
+        let h = self.matrix * DVec4::new(p[0], p[1], p[2], 1.0);
+        (h.truncate() / h.w).to_array()
+    }
+}
+
+/// The right operand of `@`: a transform, one point, or a list of points (N × 3).
+#[derive(FromPyObject)]
+enum Operand<'py> {
+    Transform(Bound<'py, Transform>),
+    Point([f64; 3]),
+    Points(Vec<[f64; 3]>),
 }
 
 /// Three numbers, or one repeated three times.
@@ -134,8 +149,21 @@ impl Transform {
         )
     }
 
-    fn __matmul__(&self, other: &Transform) -> Transform {
-        self.then(other.matrix)
+    /// The product with another transform; or the point (three numbers) or points (N × 3)
+    /// transformed, as a numpy float64 array of the same shape.
+    fn __matmul__<'py>(&self, py: Python<'py>, other: Operand<'py>) -> PyResult<Bound<'py, PyAny>> {
+        Ok(match other {
+            Operand::Transform(other) => Bound::new(py, self.then(other.get().matrix))?.into_any(),
+            Operand::Point(p) => self.apply(p).to_vec().into_pyarray(py).into_any(),
+            Operand::Points(points) => {
+                let rows = points.len();
+                let values: Vec<f64> = points.into_iter().flat_map(|p| self.apply(p)).collect();
+                numpy::ndarray::Array2::from_shape_vec((rows, 3), values)
+                    .expect("three values per point")
+                    .into_pyarray(py)
+                    .into_any()
+            }
+        })
     }
 
     fn __eq__(&self, other: &Transform) -> bool {

@@ -8,7 +8,9 @@
     pr.write_image("red.png", np.full((8, 8, 3), [1.0, 0.0, 0.0], np.float32))
     pixels = pr.read_image("mitsuba.exr")   # any EXR, PNG, JPEG or HDR as a float32 array
 
-The API follows Mitsuba's (``load_file``, ``load_dict``, ``render``); the scene is read, checked
+The API follows Mitsuba's (``load_file``, ``load_dict``, ``render``), and Mitsuba's own names
+(``set_variant``, ``load_string``, ``ScalarTransform4f``, ``util.write_bitmap``,
+``cornell_box``) let its scripts run with ``import prism_renderer as mi``; the scene is read, checked
 and rendered by the same Rust code as the ``prism`` command, so the images and error messages
 are the same. See docs/python.md.
 """
@@ -34,7 +36,12 @@ from ._native import (
     ZTest,
     load_dict,
 )
-from . import _native
+from . import _native, util
+from ._variants import set_variant, variant, variants
+from .util import cornell_box
+
+ScalarTransform4f = Transform
+"""Mitsuba's name of :class:`Transform`."""
 
 __all__ = [
     "ChannelDifference",
@@ -42,13 +49,20 @@ __all__ = [
     "Image",
     "PrismError",
     "Scene",
+    "ScalarTransform4f",
     "Transform",
     "ZTest",
     "compare",
+    "cornell_box",
     "load_dict",
     "load_file",
+    "load_string",
     "read_image",
     "render",
+    "set_variant",
+    "util",
+    "variant",
+    "variants",
     "write_image",
 ]
 
@@ -66,6 +80,14 @@ def load_file(path: Union[str, os.PathLike], **defines: object) -> Scene:
     """
     pairs = [(name, _define_text(value)) for name, value in defines.items()]
     return _native.load_file(os.fspath(path), pairs)
+
+
+def load_string(text: str, **defines: object) -> Scene:
+    """Loads a Mitsuba XML scene given as the string ``text``, as Mitsuba's ``load_string``:
+    keywords set its ``<default>`` parameters as in :func:`load_file`, relative file names are
+    found from the current folder, and a :class:`PrismError` names the text ``<string>``."""
+    pairs = [(name, _define_text(value)) for name, value in defines.items()]
+    return _native.load_string(text, pairs)
 
 
 def _define_text(value: object) -> str:

@@ -1,7 +1,17 @@
 """Type stubs of the native module (crates/prism-python/src); the package re-exports these."""
 
 import os
-from typing import Callable, Dict, List, Optional, Sequence, Tuple, TypedDict, Union
+from typing import (
+    Callable,
+    Dict,
+    List,
+    Optional,
+    Sequence,
+    Tuple,
+    TypedDict,
+    Union,
+    overload,
+)
 
 import numpy as np
 import numpy.typing as npt
@@ -93,7 +103,13 @@ class Transform:
     @property
     def matrix(self) -> npt.NDArray[np.float64]:
         """The 4 × 4 matrix, rows first (a new array)."""
-    def __matmul__(self, other: Transform) -> Transform: ...
+    @overload
+    def __matmul__(self, other: Transform) -> Transform:
+        """The product: ``(a @ b)`` applies ``b``, then ``a``."""
+    @overload
+    def __matmul__(self, other: npt.ArrayLike) -> npt.NDArray[np.float64]:
+        """The point (three numbers) or points (N × 3) transformed, with the division by w,
+        as Mitsuba's ``Transform4f @ Point3f``; an array of the same shape."""
 
 class Image:
     """A rendered image. The arrays are the render's own memory (no copy); ``write`` and
@@ -214,6 +230,10 @@ def load_dict(scene: dict) -> Scene:
     (wavelength, value) pairs) or ``{"type": "spectrum", "filename": ...}``,
     ``{"type": "ref", "id": ...}``, and nested plugins. Plugins directly in the scene can be
     referred to by their key. Raises :class:`PrismError` with ``file`` the key path."""
+
+def load_string(text: str, defines: List[Tuple[str, str]] = ...) -> Scene:
+    """Loads a Mitsuba XML scene given as text with ``(name, value)`` defines; messages name
+    it ``<string>``."""
 
 class _RenderSettings(TypedDict):
     spp: Optional[int]
