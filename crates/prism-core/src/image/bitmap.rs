@@ -6,7 +6,7 @@
 use std::io::Cursor;
 use std::path::Path;
 
-use image::{DynamicImage, ImageDecoder, ImageFormat, ImageReader, Limits};
+use image::{DynamicImage, ImageDecoder, ImageError, ImageFormat, ImageReader, Limits};
 
 use super::{pfm, srgb};
 use crate::error::{Error, ErrorKind, Result};
@@ -151,31 +151,36 @@ fn unreadable(path: &Path, reason: impl std::fmt::Display) -> Error {
 pub fn read_bitmap(path: &Path) -> Result<Bitmap> {
     let bytes = std::fs::read(path).map_err(|e| Error::io(path, &e, "open the image"))?;
     let format = FileFormat::detect(&bytes, path).map_err(|reason| unreadable(path, reason))?;
-    decode_bitmap(&bytes, format).map_err(|reason| unreadable(path, reason))
+    decode_bitmap(&bytes, format, MAX_PIXELS).map_err(|reason| unreadable(path, reason))
 }
 
-/// Decodes the bytes of an image file of the given format. Sizes are checked against
-/// [`MAX_PIXELS`] before any pixel is allocated. The error says what is wrong, without the file's
-/// name.
-pub fn decode_bitmap(bytes: &[u8], format: FileFormat) -> std::result::Result<Bitmap, String> {
+/// Decodes the bytes of an image file of the given format, of at most `max_pixels` pixels
+/// ([`MAX_PIXELS`] for a scene's files): the size the header declares is checked before any
+/// pixel is allocated. The error says what is wrong, without the file's name.
+pub fn decode_bitmap(
+    bytes: &[u8],
+    format: FileFormat,
+    max_pixels: u64,
+) -> std::result::Result<Bitmap, String> {
     let Some(image_format) = format.image_format() else {
-        let bitmap = pfm::decode_pfm(bytes, MAX_PIXELS)?;
+        let bitmap = pfm::decode_pfm(bytes, max_pixels)?;
         check_finite(&bitmap)?;
         return Ok(bitmap);
     };
     let mut decoder = ImageReader::with_format(Cursor::new(bytes), image_format)
         .into_decoder()
-        .map_err(|e| e.to_string())?;
+        .map_err(describe)?;
     let (width, height) = decoder.dimensions();
-    if u64::from(width) * u64::from(height) > MAX_PIXELS || width == 0 || height == 0 {
+    if u64::from(width) * u64::from(height) > max_pixels || width == 0 || height == 0 {
         return Err(format!(
-            "{width} × {height} pixels is outside the supported size (1 to {MAX_PIXELS} pixels)"
+            "{width} × {height} pixels is outside the supported size (1 to {max_pixels} pixels)"
         ));
     }
+    // At most 4 channels of 32-bit floats per pixel.
     let mut limits = Limits::default();
-    limits.max_alloc = Some(MAX_PIXELS * 16);
-    decoder.set_limits(limits).map_err(|e| e.to_string())?;
-    let image = DynamicImage::from_decoder(decoder).map_err(|e| e.to_string())?;
+    limits.max_alloc = Some(max_pixels * 16);
+    decoder.set_limits(limits).map_err(describe)?;
+    let image = DynamicImage::from_decoder(decoder).map_err(describe)?;
     let encoding = match image {
         DynamicImage::ImageRgb32F(_) | DynamicImage::ImageRgba32F(_) => Encoding::Linear,
         _ => Encoding::Srgb,
@@ -194,6 +199,16 @@ pub fn decode_bitmap(bytes: &[u8], format: FileFormat) -> std::result::Result<Bi
     };
     check_finite(&bitmap)?;
     Ok(bitmap)
+}
+
+/// The `image` crate's error in words; running out of bytes means a truncated file.
+fn describe(error: ImageError) -> String {
+    match error {
+        ImageError::IoError(e) if e.kind() == std::io::ErrorKind::UnexpectedEof => {
+            "the file is truncated: it ends before all its pixels".into()
+        }
+        e => e.to_string(),
+    }
 }
 
 fn check_finite(bitmap: &Bitmap) -> std::result::Result<(), String> {
@@ -385,8 +400,8 @@ mod tests {
         let huge_ppm = b"P6\n100000 100000\n255\n\0\0\0";
         let huge_pfm = b"PF\n100000 100000\n-1\n\0\0\0\0";
         let cases: [(&str, &[u8], &str); 6] = [
-            ("truncated.bmp", &bmp[..bmp.len() - 5], "truncated.bmp"),
-            ("truncated.ppm", b"P6\n2 2\n255\n\x01\x02", "truncated.ppm"),
+            ("truncated.bmp", &bmp[..bmp.len() - 5], "is truncated"),
+            ("truncated.ppm", b"P6\n2 2\n255\n\x01\x02", "is truncated"),
             ("huge.ppm", huge_ppm, "outside the supported size"),
             ("huge.pfm", huge_pfm, "outside the supported size"),
             ("t.gif", b"GIF89a\x01\x00\x01\x00", "Gif is not supported"),
