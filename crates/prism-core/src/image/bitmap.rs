@@ -83,7 +83,7 @@ impl FileFormat {
             return Ok(FileFormat::Pfm);
         }
         let unsupported = |format: ImageFormat| {
-            format!("the image format {format:?} is not supported (only {SUPPORTED})",)
+            format!("the image format {format:?} is not supported (only {SUPPORTED})")
         };
         if let Ok(format) = image::guess_format(bytes) {
             return Self::from_image_format(format).ok_or_else(|| unsupported(format));
