@@ -307,6 +307,53 @@ fn glass_and_mirror_spheres_vanish_in_a_furnace() {
     }
 }
 
+/// A 2 × 2 uncompressed 24-bit BMP of one grey code (rows of 6 bytes padded to 8).
+fn grey_bmp(code: u8) -> Vec<u8> {
+    let mut bytes = b"BM".to_vec();
+    for v in [54u32 + 16, 0, 54, 40, 2, 2] {
+        bytes.extend(v.to_le_bytes());
+    }
+    bytes.extend([1, 0, 24, 0]);
+    bytes.extend([0u8; 24]);
+    for _ in 0..2 {
+        bytes.extend([code; 6]);
+        bytes.extend([0, 0]);
+    }
+    bytes
+}
+
+/// A diffuse sphere textured with a BMP (Mitsuba's projector docs scene uses one) renders as
+/// the same sphere with the texel's colour given as `<rgb>`: decoded from sRGB, or as stored
+/// when `raw`. In the furnace a convex diffuse sphere shows ρ, so a texel read with the wrong
+/// encoding (0.216 against 0.502) moves the mean by far more than its standard error.
+#[test]
+fn a_bmp_texture_renders_as_its_colour() {
+    let dir = temp_dir("bmp");
+    let bmp = dir.join("grey.bmp");
+    std::fs::write(&bmp, grey_bmp(128)).unwrap();
+    let code = 128.0 / 255.0_f64;
+    let linear = ((code + 0.055) / 1.055).powf(2.4);
+    for (raw, value) in [(false, linear), (true, code)] {
+        let textured = furnace_scene(&format!(
+            r#"<bsdf type="diffuse"><texture type="bitmap" name="reflectance">
+                <string name="filename" value="{}"/><boolean name="raw" value="{raw}"/>
+            </texture></bsdf>"#,
+            bmp.display()
+        ));
+        let plain = furnace_scene(&format!(
+            r#"<bsdf type="diffuse"><rgb name="reflectance" value="{value}"/></bsdf>"#
+        ));
+        let (mean, se) = render_mean(&textured, 16, 3);
+        let (expected, expected_se) = render_mean(&plain, 16, 3);
+        let tolerance = 4.0 * se.hypot(expected_se) + 1e-5;
+        assert!(
+            (mean - expected).abs() < tolerance,
+            "raw = {raw}: BMP texture mean {mean} ± {se}, <rgb> {value}: {expected}"
+        );
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
 /// The `null` BSDF passes light unchanged from both sides, and nothing can be evaluated.
 #[test]
 fn null_lobe_passes_straight_through() {

@@ -1,6 +1,6 @@
-//! Image files: decoding the images scenes reference (PNG, JPEG, OpenEXR, Radiance HDR) into
-//! floating-point pixels, writing renders as OpenEXR (linear) and PNG (sRGB), and the sRGB
-//! transfer curve. This module sits below everything that uses images (textures, environment
+//! Image files: decoding the images scenes reference (PNG, JPEG, OpenEXR, Radiance HDR, BMP, TGA,
+//! PPM/PGM, PFM) into floating-point pixels, writing renders as OpenEXR (linear) and PNG (sRGB),
+//! and the sRGB transfer curve. This module sits below everything that uses images (textures, environment
 //! maps, the film) and knows nothing of them.
 //!
 //! Writers go through [`write_atomically`]: the file is written to `<path>.tmp` and renamed over
@@ -10,6 +10,7 @@
 pub mod bitmap;
 pub mod compare;
 pub mod exr;
+pub mod pfm;
 pub mod png;
 pub mod srgb;
 
@@ -17,7 +18,7 @@ use std::fs::{self, File};
 use std::io::{self, BufWriter, Write};
 use std::path::{Path, PathBuf};
 
-pub use bitmap::{Bitmap, Encoding, read_bitmap};
+pub use bitmap::{Bitmap, Encoding, FileFormat, MAX_PIXELS, decode_bitmap, read_bitmap};
 pub use exr::{
     Attribute, ChannelImage, ExrHeader, read_exr, read_exr_with_header, write_exr, write_exr_with,
 };

@@ -76,7 +76,7 @@ pub static TEXTURES: Registry<Build> = Registry {
 params! {
     ATTRIBUTE_NAME = ParamSpec::new("name", ParamKind::String, Default::Required, "the attribute, starting with `vertex_` or `face_`");
     ATTRIBUTE_SCALE = ParamSpec::new("scale", ParamKind::Float, Default::Float(1.0), "a factor applied to the attribute's value");
-    FILENAME = ParamSpec::new("filename", ParamKind::String, Default::Required, "the image: PNG, JPEG, OpenEXR or Radiance HDR");
+    FILENAME = ParamSpec::new("filename", ParamKind::String, Default::Required, "the image: PNG, JPEG, BMP, TGA, PPM/PGM (8-bit: sRGB), OpenEXR, Radiance HDR or PFM (linear)");
     FILTER_TYPE = ParamSpec::new("filter_type", ParamKind::Choice(&[Choice::new("bilinear", &FilterType::Bilinear), Choice::new("nearest", &FilterType::Nearest), Choice::new("trilinear", &FilterType::Bilinear), Choice::new("ewa", &FilterType::Bilinear)]), Default::Str("bilinear"), "interpolate the four nearest texels, or take the one containing the point; Mitsuba 0.6's mip-mapped `trilinear` and `ewa` are read as `bilinear` (docs/mitsuba-compatibility.md)");
     WRAP_MODE = ParamSpec::new("wrap_mode", ParamKind::Choice(&[Choice::new("repeat", &WrapMode::Repeat), Choice::new("mirror", &WrapMode::Mirror), Choice::new("clamp", &WrapMode::Clamp)]), Default::Str("repeat"), "how coordinates outside [0, 1] map into the image");
     RAW = ParamSpec::new("raw", ParamKind::Boolean, Default::Boolean(false), "read 8- and 16-bit values as they are, without sRGB decoding (normal maps need it)");

@@ -64,7 +64,7 @@ pub(super) const SUNSKY: Plugin<Build> = Plugin {
 
 params! {
     RADIANCE = ParamSpec::new("radiance", ParamKind::Spectrum { range: Range::Emission, textured: false, }, D65, "emitted radiance; or a nested `<spectrum type=\"blackbody\">`");
-    ENVMAP_FILENAME = ParamSpec::new("filename", ParamKind::String, Default::Required, "the image: OpenEXR, Radiance HDR, PNG or JPEG, at least 2 × 3 pixels");
+    ENVMAP_FILENAME = ParamSpec::new("filename", ParamKind::String, Default::Required, "the image: OpenEXR, Radiance HDR, PFM, PNG, JPEG, BMP, TGA or PPM/PGM, at least 2 × 3 pixels");
     ENVMAP_SCALE = ParamSpec::new("scale", ParamKind::Float, Default::Float(1.0), "factor on the image's values");
     SUN_DIRECTION = ParamSpec::new("sun_direction", ParamKind::Vector, Default::Text("from the place and time"), "the sun's direction (world space); not together with the place and time");
     LATITUDE = ParamSpec::new("latitude", ParamKind::Float, Default::Float(35.6894), "degrees north (Tokyo by default)");
