@@ -8,6 +8,7 @@ use glam::Vec3;
 use prism_core::geometry::ShapeGeometry;
 use prism_core::geometry::shape::MeshAttribute;
 use prism_core::geometry::{TriangleMesh, triangle::TriangleHit};
+use prism_core::image::srgb;
 use prism_core::math::Ray;
 use prism_mitsuba::load_scene;
 
@@ -182,5 +183,49 @@ fn a_uniform_ply_face_colour_renders_as_that_rgb() {
         ("ply", "quad.ply"),
         "face_color",
         "0.6, 0.1, 0.3",
+    );
+}
+
+/// A binary PLY as Mitsuba's `write_ply` names its colours (`color_0 color_1 color_2`, the
+/// `vertex_color` attribute), with `ushort` face colours, which Mitsuba reads divided by 65535
+/// and decoded from sRGB.
+#[test]
+fn binary_ply_with_prefixed_vertex_colours_and_integer_face_colours() {
+    let mut ply = b"ply\nformat binary_little_endian 1.0\nelement vertex 4\nproperty float x\n\
+        property float y\nproperty float z\nproperty float color_0\nproperty float color_1\n\
+        property float color_2\nelement face 2\nproperty list uchar int vertex_indices\n\
+        property ushort red\nproperty ushort green\nproperty ushort blue\nend_header\n"
+        .to_vec();
+    for (x, y) in [(-1.0f32, -1.0f32), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
+        for v in [x, y, 0.0, 0.2, 0.5, 0.8] {
+            ply.extend_from_slice(&v.to_le_bytes());
+        }
+    }
+    let face_color: [u16; 3] = [32768, 13107, 65535];
+    for corners in [[0i32, 1, 2], [0, 2, 3]] {
+        ply.push(3);
+        for corner in corners {
+            ply.extend_from_slice(&corner.to_le_bytes());
+        }
+        for channel in face_color {
+            ply.extend_from_slice(&channel.to_le_bytes());
+        }
+    }
+    let files = [("quad.ply", ply)];
+    assert_renders_as_rgb(
+        "ply-prefixed",
+        &files,
+        ("ply", "quad.ply"),
+        "vertex_color",
+        "0.2, 0.5, 0.8",
+    );
+    let [r, g, b] = face_color.map(|c| srgb::decode(f32::from(c) / 65535.0));
+    assert!((r - 0.214_048_1).abs() < 1e-6, "{r}");
+    assert_renders_as_rgb(
+        "ply-ushort-face",
+        &files,
+        ("ply", "quad.ply"),
+        "face_color",
+        &format!("{r}, {g}, {b}"),
     );
 }

@@ -22,15 +22,17 @@
 //!   coordinates named `u v`, `texture_u texture_v`, `s t` or `texture_s texture_t` (the first
 //!   complete pair, in that order). These must have floating-point types: Mitsuba would rescale
 //!   integers to [0, 1], which is never what a position means. Texture coordinates are not
-//!   flipped (Mitsuba flips only OBJ's). Vertex colours `r g b` or `red green blue` become the
-//!   `vertex_color` attribute, read as their values whatever their type: like Mitsuba (which
-//!   warns about it), integer channels are not rescaled, so a `uchar` 0–255 colour reads as
-//!   values above 1, clamped to 1 when upsampled. Other properties are skipped.
+//!   flipped (Mitsuba flips only OBJ's). Vertex colours `r g b`, `red green blue`, `color_0
+//!   color_1 color_2`, `color_1 color_2 color_3` or `color_x color_y color_z` (the first
+//!   complete triple) become the `vertex_color` attribute, as Mitsuba's `find_other_fields`
+//!   names them. Their channels are read as Mitsuba 3.9 reads them: floats as they are, `uchar`
+//!   as its value 0–255 (not rescaled, though Mitsuba warns about it: such a colour reads as
+//!   values above 1, clamped to 1 when upsampled), other integers divided by their type's
+//!   largest value and decoded from sRGB. Other properties are skipped.
 //! - Element `face`: the list `vertex_indices` (or `vertex_index`) of integer indices into the
-//!   vertices; each polygon, of 3 to 65536 vertices, is triangulated as a fan. Face colours
-//!   `r g b` or `red green blue` become the `face_color` attribute (as Mitsuba's
-//!   `find_other_fields` names them), one per triangle of the fan, read as their values like the
-//!   vertex colours. Other properties are skipped.
+//!   vertices; each polygon, of 3 to 65536 vertices, is triangulated as a fan. Face colours,
+//!   named and read like the vertex colours, become the `face_color` attribute, one per
+//!   triangle of the fan. Other properties are skipped.
 //! - Other elements are skipped. A file without faces is an error, and so is anything after the
 //!   last element (as in Mitsuba).
 //!
@@ -44,6 +46,7 @@ use glam::{Vec2, Vec3};
 
 use super::{MeshData, file_error};
 use prism_core::error::{Error, Result, SourceLocation};
+use prism_core::image::srgb;
 
 /// The most vertices a face may have; a longer list means a corrupt file.
 const MAX_FACE_VERTICES: u64 = 1 << 16;
@@ -376,8 +379,17 @@ struct Layout {
     has_face_colors: bool,
 }
 
-/// Alternative names of the vertex and face colour channels, in order of preference.
-const COLOR_NAMES: [[&str; 3]; 2] = [["r", "g", "b"], ["red", "green", "blue"]];
+/// Alternative names of the vertex and face colour channels, in order of preference: Mitsuba's
+/// unprefixed `r g b` and `red green blue`, then its prefixed groups that it names
+/// `{vertex|face}_color`: the prefix `color` with the suffixes `0 1 2`, `1 2 3` or `x y z`
+/// (with `r g b`, Mitsuba names the group `{vertex|face}_color_color`).
+const COLOR_NAMES: [[&str; 3]; 5] = [
+    ["r", "g", "b"],
+    ["red", "green", "blue"],
+    ["color_0", "color_1", "color_2"],
+    ["color_1", "color_2", "color_3"],
+    ["color_x", "color_y", "color_z"],
+];
 
 /// Alternative names of the texture coordinate pair, in order of preference.
 const UV_NAMES: [[&str; 2]; 4] = [
@@ -641,7 +653,11 @@ fn read_body(reader: &mut impl BodyReader, header: &Header, layout: &Layout) -> 
                         axis,
                         ty,
                     } => {
-                        let value = reader.read(ty)?.to_f64() as f32;
+                        let value = reader.read(ty)?;
+                        let value = match attribute {
+                            Attribute::Color | Attribute::FaceColor => color_channel(value, ty),
+                            _ => value.to_f64() as f32,
+                        };
                         if !value.is_finite() {
                             let what = match attribute {
                                 Attribute::Position => "vertex coordinate",
@@ -685,6 +701,25 @@ fn read_body(reader: &mut impl BodyReader, header: &Header, layout: &Layout) -> 
     }
     reader.finish()?;
     Ok(mesh)
+}
+
+/// A colour channel as Mitsuba 3.9 reads it (measured with its `scalar_rgb` variant): a float
+/// as it is; an integer other than `uchar` divided by its type's largest value and decoded from
+/// sRGB (`mitsuba::PLYMesh` marks integer properties normalised and gamma-encoded); a `uchar`
+/// as its value 0–255, not rescaled.
+fn color_channel(value: Value, ty: ScalarType) -> f32 {
+    use ScalarType::*;
+    let largest = match ty {
+        Int8 => i8::MAX as f64,
+        Int16 => i16::MAX as f64,
+        UInt16 => u16::MAX as f64,
+        Int32 => i32::MAX as f64,
+        UInt32 => u32::MAX as f64,
+        Int64 => i64::MAX as f64,
+        UInt64 => u64::MAX as f64,
+        UInt8 | Float16 | Float32 | Float64 => return value.to_f64() as f32,
+    };
+    srgb::decode((value.to_f64() / largest) as f32)
 }
 
 /// Reads a number of an integer type that must not be negative.
@@ -1121,6 +1156,116 @@ mod tests {
             message.contains("mesh.ply:9") && message.contains("face property \"r\""),
             "{message}"
         );
+    }
+
+    /// Colour channels of each type read as Mitsuba 3.9.1 reads them. The expected values are
+    /// its renders (`scalar_rgb`, a diffuse quad with the colour as its `mesh_attribute`
+    /// reflectance, under a constant emitter, 16 spp), divided by the render of a channel of
+    /// float value 1: `char` 64 → 0.2177031, `short` 16384 → 0.2140551, `ushort` 32768 →
+    /// 0.2140481, `uint` 128 → 2.306681e-9, `int` 128 → 4.613362e-9, `uchar` 128 → 128.0000
+    /// and 64 → 64.0000. They agree with the closed form (v / largest, then sRGB decoding) to 1e-6
+    /// relative.
+    #[test]
+    fn integer_colour_channels_read_as_mitsuba_reads_them() {
+        let cases: [(&str, [f64; 3], [f32; 3]); 6] = [
+            ("char", [64.0, 0.0, 127.0], [0.217_703_1, 0.0, 1.0]),
+            ("short", [16384.0, 0.0, 32767.0], [0.214_055_1, 0.0, 1.0]),
+            ("ushort", [32768.0, 0.0, 65535.0], [0.214_048_1, 0.0, 1.0]),
+            ("uint", [128.0, 0.0, 4294967295.0], [2.306_681e-9, 0.0, 1.0]),
+            ("int", [128.0, 0.0, 2147483647.0], [4.613_362e-9, 0.0, 1.0]),
+            ("uchar", [128.0, 64.0, 255.0], [128.0, 64.0, 255.0]),
+        ];
+        for format in FORMATS {
+            for (ty, channels, expected) in cases {
+                for (kind, names) in [
+                    ("vertex", ["r", "g", "b"]),
+                    ("face", ["red", "green", "blue"]),
+                ] {
+                    let color_header = names.map(|n| format!("property {ty} {n}\n")).concat();
+                    let (vertex_colors, face_colors) = if kind == "vertex" {
+                        (color_header.as_str(), "")
+                    } else {
+                        ("", color_header.as_str())
+                    };
+                    let header = format!(
+                        "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n\
+                         {vertex_colors}element face 1\nproperty list uchar int vertex_indices\n\
+                         {face_colors}"
+                    );
+                    let color = channels.map(|c| (ty, c));
+                    let mut values = Vec::new();
+                    for corner in [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]] {
+                        values.extend([("float", corner[0]), ("float", corner[1]), ("float", 0.0)]);
+                        if kind == "vertex" {
+                            values.extend(color);
+                        }
+                    }
+                    values.extend([("uchar", 3.0), ("int", 0.0), ("int", 1.0), ("int", 2.0)]);
+                    if kind == "face" {
+                        values.extend(color);
+                    }
+                    let mesh = parse(&ply(format, &header, &values)).unwrap();
+                    let read = if kind == "vertex" {
+                        mesh.colors.unwrap()[2]
+                    } else {
+                        mesh.face_colors.unwrap()[0]
+                    };
+                    for (got, want) in read.to_array().into_iter().zip(expected) {
+                        assert!(
+                            (got - want).abs() <= 2e-6 * want,
+                            "{format} {ty} {kind}: {read} against {expected:?}"
+                        );
+                    }
+                }
+            }
+        }
+    }
+
+    /// Mitsuba's prefixed colour groups named `vertex_color` and `face_color`, as its
+    /// `write_ply` writes them (`color_0 color_1 color_2`); `color_r color_g color_b` is
+    /// Mitsuba's `vertex_color_color`, not a colour Prism reads.
+    #[test]
+    fn prefixed_colour_groups() {
+        for suffixes in [["0", "1", "2"], ["1", "2", "3"], ["x", "y", "z"]] {
+            let names = suffixes
+                .map(|s| format!("property float color_{s}\n"))
+                .concat();
+            let header = format!(
+                "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n\
+                 {names}element face 1\nproperty list uchar int vertex_indices\n{names}"
+            );
+            let mut values = Vec::new();
+            for corner in [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]] {
+                values.extend([("float", corner[0]), ("float", corner[1]), ("float", 0.0)]);
+                values.extend([("float", 0.25), ("float", 0.5), ("float", corner[0])]);
+            }
+            values.extend([("uchar", 3.0), ("int", 0.0), ("int", 1.0), ("int", 2.0)]);
+            values.extend([("float", 0.125), ("float", 0.375), ("float", 0.625)]);
+            for format in FORMATS {
+                let mesh = parse(&ply(format, &header, &values)).unwrap();
+                let colors = mesh.colors.as_deref().unwrap();
+                assert_eq!(
+                    colors[1],
+                    Vec3::new(0.25, 0.5, 1.0),
+                    "{format} {suffixes:?}"
+                );
+                assert_eq!(
+                    mesh.face_colors,
+                    Some(vec![Vec3::new(0.125, 0.375, 0.625)]),
+                    "{format} {suffixes:?}"
+                );
+            }
+        }
+        let header = "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n\
+                      property float color_r\nproperty float color_g\nproperty float color_b\n\
+                      element face 1\nproperty list uchar int vertex_indices\n";
+        let mut values = Vec::new();
+        for corner in [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]] {
+            values.extend([("float", corner[0]), ("float", corner[1]), ("float", 0.0)]);
+            values.extend([("float", 0.5); 3]);
+        }
+        values.extend([("uchar", 3.0), ("int", 0.0), ("int", 1.0), ("int", 2.0)]);
+        assert_eq!(parse(&ply("ascii", header, &values)).unwrap().colors, None);
     }
 
     #[test]
