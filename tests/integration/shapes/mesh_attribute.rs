@@ -29,11 +29,13 @@ fn attributes_are_interpolated_barycentrically_and_faces_are_constant() {
         MeshAttribute {
             name: "vertex_color".into(),
             per_face: false,
+            channels: 3,
             values: vertex.to_vec(),
         },
         MeshAttribute {
             name: "face_color".into(),
             per_face: true,
+            channels: 3,
             values: vec![Vec3::splat(0.1), Vec3::splat(0.9)],
         },
     ]);
@@ -228,4 +230,65 @@ fn binary_ply_with_prefixed_vertex_colours_and_integer_face_colours() {
         "face_color",
         &format!("{r}, {g}, {b}"),
     );
+}
+
+/// Mitsuba's `face_weight` of its mesh-attribute test scenes (a PLY face property `weight_0`):
+/// an attribute of one channel, read as a number by a `blendbsdf`'s weight and as a grey by a
+/// reflectance. Mitsuba 3.9.1 (`scalar_rgb`, a quad under a constant emitter, weight 0.3
+/// between diffuse 0.2 and 0.8) renders the blend as 0.38.
+#[test]
+fn a_one_channel_face_attribute_is_a_number_and_a_grey() {
+    let mut ply = b"ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n\
+        property float z\nelement face 2\nproperty list uchar int vertex_indices\n\
+        property float weight_0\nend_header\n"
+        .to_vec();
+    for (x, y) in [(-1, -1), (1, -1), (1, 1), (-1, 1)] {
+        ply.extend_from_slice(format!("{x} {y} 0\n").as_bytes());
+    }
+    ply.extend_from_slice(b"3 0 1 2 0.3\n3 0 2 3 0.3\n");
+    let files = [("quad.ply", ply)];
+    assert_renders_as_rgb(
+        "ply-weight",
+        &files,
+        ("ply", "quad.ply"),
+        "face_weight",
+        "0.3, 0.3, 0.3",
+    );
+
+    let dir = std::env::temp_dir().join(format!("prism-face-weight-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let folder = Folder(dir);
+    std::fs::write(folder.0.join("quad.ply"), &files[0].1).unwrap();
+    let films: Vec<_> = [
+        r#"<texture type="mesh_attribute" name="weight"><string name="name" value="face_weight"/></texture>"#,
+        r#"<float name="weight" value="0.3"/>"#,
+    ]
+    .iter()
+    .map(|weight| {
+        let blend = format!(
+            r#"<bsdf type="blendbsdf">{weight}<bsdf type="diffuse"><rgb name="reflectance" value="0.2"/></bsdf><bsdf type="diffuse"><rgb name="reflectance" value="0.8"/></bsdf></bsdf>"#
+        );
+        let scene = quad_scene(("ply", "quad.ply"), "").replace(
+            r#"<bsdf type="diffuse"></bsdf>"#,
+            &blend,
+        );
+        let path = folder.0.join("scene.xml");
+        std::fs::write(&path, scene).unwrap();
+        let loaded = load_scene(&path, &[]).unwrap_or_else(|e| panic!("{e}"));
+        render_film(&loaded.scene, 16, 5, Some(1))
+    })
+    .collect();
+    let mut lit = 0;
+    for i in 0..films[0].pixels.len() {
+        for c in 0..3 {
+            let (a, _) = pixel_mean_and_variance(&films[0], i, c);
+            let (b, _) = pixel_mean_and_variance(&films[1], i, c);
+            assert!(
+                (a - b).abs() <= 1e-5 * b.abs().max(1e-3),
+                "pixel {i}, channel {c}: {a} with the attribute, {b} with the number"
+            );
+            lit += usize::from(b > 0.0);
+        }
+    }
+    assert!(lit > 0, "the quad was not seen");
 }

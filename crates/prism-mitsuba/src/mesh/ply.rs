@@ -28,11 +28,14 @@
 //!   names them. Their channels are read as Mitsuba 3.9 reads them: floats as they are, `uchar`
 //!   as its value 0–255 (not rescaled, though Mitsuba warns about it: such a colour reads as
 //!   values above 1, clamped to 1 when upsampled), other integers divided by their type's
-//!   largest value and decoded from sRGB. Other properties are skipped.
+//!   largest value and decoded from sRGB. Other numbers named `{prefix}_{suffix}` become
+//!   attributes of 1 or 3 channels as Mitsuba groups them (see [`group_attributes`]), read like
+//!   colours; the rest are skipped.
 //! - Element `face`: the list `vertex_indices` (or `vertex_index`) of integer indices into the
-//!   vertices; each polygon, of 3 to 65536 vertices, is triangulated as a fan. Face colours,
-//!   named and read like the vertex colours, become the `face_color` attribute, one per
-//!   triangle of the fan. Other properties are skipped.
+//!   vertices; each polygon, of 3 to 65536 vertices, is triangulated as a fan. Face colours and
+//!   other attributes, named and read like the vertex ones, become the `face_color` and
+//!   `face_{prefix}` attributes, one value per triangle of the fan. Other properties are
+//!   skipped.
 //! - Other elements are skipped. A file without faces is an error, and so is anything after the
 //!   last element (as in Mitsuba).
 //!
@@ -46,6 +49,7 @@ use glam::{Vec2, Vec3};
 
 use super::{MeshData, file_error};
 use prism_core::error::{Error, Result, SourceLocation};
+use prism_core::geometry::shape::MeshAttribute;
 use prism_core::image::srgb;
 
 /// The most vertices a face may have; a longer list means a corrupt file.
@@ -358,6 +362,12 @@ enum Field {
         axis: usize,
         ty: ScalarType,
     },
+    /// Channel `channel` of the attribute `index` of [`Layout::attributes`].
+    Attribute {
+        index: usize,
+        channel: usize,
+        ty: ScalarType,
+    },
     /// The vertex indices of a face.
     Indices {
         length: ScalarType,
@@ -377,6 +387,16 @@ struct Layout {
     has_uvs: bool,
     has_colors: bool,
     has_face_colors: bool,
+    /// Mitsuba's other attributes, found by [`group_attributes`].
+    attributes: Vec<AttributeGroup>,
+}
+
+/// An attribute of Mitsuba's naming scheme: its name and number of channels (1 or 3), and
+/// whether it belongs to the faces.
+struct AttributeGroup {
+    name: String,
+    channels: usize,
+    per_face: bool,
 }
 
 /// Alternative names of the vertex and face colour channels, in order of preference: Mitsuba's
@@ -535,6 +555,12 @@ impl Layout {
             }
         }
 
+        let mut attributes = Vec::new();
+        for (element, kind) in [(vertex_element, "vertex"), (face_element, "face")] {
+            let properties = &header.elements[element].properties;
+            group_attributes(properties, kind, &mut fields[element], &mut attributes);
+        }
+
         Ok(Layout {
             fields,
             vertex_element,
@@ -543,8 +569,101 @@ impl Layout {
             has_uvs,
             has_colors,
             has_face_colors,
+            attributes,
         })
     }
+}
+
+/// The suffixes of Mitsuba's attribute groups: `SUFFIXES[k][scheme]` is the suffix of the
+/// k-th property of a group in one of the schemes `x y z w`, `r g b a`, `0 1 2 3`, `1 2 3 4`.
+const SUFFIXES: [[u8; 4]; 4] = [*b"xr01", *b"yg12", *b"zb23", *b"wa34"];
+
+/// Mitsuba's `find_other_fields` (`src/shapes/ply.h`): among the properties of an element that
+/// Prism does not otherwise read, consecutive numbers `{prefix}_{suffix}` whose suffixes follow
+/// one scheme of [`SUFFIXES`] form the attribute `{kind}_{prefix}` (`{kind}_{prefix}_color`
+/// for `r g b a`). A group of 1 or 3 properties becomes an attribute of 1 or 3 channels; other
+/// groups, a group whose suffixes break the scheme, and a prefix met again after its group are
+/// skipped, as Mitsuba skips them (with a warning).
+fn group_attributes(
+    properties: &[Property],
+    kind: &str,
+    fields: &mut [Field],
+    attributes: &mut Vec<AttributeGroup>,
+) {
+    struct Group<'a> {
+        prefix: &'a str,
+        scheme: usize,
+        members: Vec<(usize, ScalarType)>,
+    }
+    let mut kept: Vec<String> = Vec::new();
+    let mut group: Option<Group> = None;
+    let mut skipped_prefix: Option<&str> = None;
+    let mut flush = |group: &mut Option<Group>, fields: &mut [Field], kept: &mut Vec<String>| {
+        let Some(Group {
+            prefix,
+            scheme,
+            members,
+        }) = group.take()
+        else {
+            return;
+        };
+        if members.len() != 1 && members.len() != 3 {
+            return;
+        }
+        let index = attributes.len();
+        for (channel, &(property, ty)) in members.iter().enumerate() {
+            fields[property] = Field::Attribute { index, channel, ty };
+        }
+        let color = if scheme == 1 { "_color" } else { "" };
+        attributes.push(AttributeGroup {
+            name: format!("{kind}_{prefix}{color}"),
+            channels: members.len(),
+            per_face: kind == "face",
+        });
+        kept.push(prefix.to_string());
+    };
+    for (i, property) in properties.iter().enumerate() {
+        let (Field::Skip(_), PropertyType::Scalar(ty)) = (fields[i], property.ty) else {
+            continue;
+        };
+        let name = property.name.as_str();
+        if let Some(prefix) = skipped_prefix {
+            if name.starts_with(prefix) {
+                continue;
+            }
+            skipped_prefix = None;
+        }
+        let Some((prefix, &[suffix])) = name.rsplit_once('_').map(|(p, s)| (p, s.as_bytes()))
+        else {
+            flush(&mut group, fields, &mut kept);
+            continue;
+        };
+        if group.as_ref().is_some_and(|g| g.prefix != prefix) {
+            flush(&mut group, fields, &mut kept);
+        }
+        match &mut group {
+            None if kept.iter().any(|k| k == prefix) => skipped_prefix = Some(prefix),
+            None => {
+                if let Some(scheme) = SUFFIXES[0].iter().position(|&c| c == suffix) {
+                    group = Some(Group {
+                        prefix,
+                        scheme,
+                        members: vec![(i, ty)],
+                    });
+                }
+            }
+            Some(g) => {
+                let k = g.members.len();
+                if k < SUFFIXES.len() && SUFFIXES[k][g.scheme] == suffix {
+                    g.members.push((i, ty));
+                } else {
+                    group = None;
+                    skipped_prefix = Some(prefix);
+                }
+            }
+        }
+    }
+    flush(&mut group, fields, &mut kept);
 }
 
 /// Refuses a header whose counts need more bytes than the body has, before anything is
@@ -561,7 +680,7 @@ fn check_body_size(header: &Header, layout: &Layout, file_size: usize, path: &Pa
         let record: u64 = fields
             .iter()
             .map(|field| match *field {
-                Field::Vertex { ty, .. } => size(ty),
+                Field::Vertex { ty, .. } | Field::Attribute { ty, .. } => size(ty),
                 Field::Indices { length, item } => size(length) + 3 * size(item),
                 Field::Skip(PropertyType::Scalar(ty)) => size(ty),
                 Field::Skip(PropertyType::List { length, .. }) => size(length),
@@ -633,9 +752,20 @@ fn read_body(reader: &mut impl BodyReader, header: &Header, layout: &Layout) -> 
             .has_colors
             .then(|| Vec::with_capacity(vertex_capacity)),
         face_colors: layout.has_face_colors.then(Vec::new),
+        attributes: layout
+            .attributes
+            .iter()
+            .map(|group| MeshAttribute {
+                name: group.name.clone(),
+                per_face: group.per_face,
+                channels: group.channels as u8,
+                values: Vec::new(),
+            })
+            .collect(),
         triangles: Vec::new(),
     };
     let mut polygon = Vec::new();
+    let mut attribute_values = vec![Vec3::ZERO; layout.attributes.len()];
     for (i, (element, fields)) in header.elements.iter().zip(&layout.fields).enumerate() {
         if fields.is_empty() {
             continue;
@@ -669,6 +799,14 @@ fn read_body(reader: &mut impl BodyReader, header: &Header, layout: &Layout) -> 
                         }
                         vertex[attribute as usize][axis] = value;
                     }
+                    Field::Attribute { index, channel, ty } => {
+                        let value = color_channel(reader.read(ty)?, ty);
+                        if !value.is_finite() {
+                            let name = &layout.attributes[index].name;
+                            return Err(reader.error(format!("{name} is not a finite number")));
+                        }
+                        attribute_values[index][channel] = value;
+                    }
                     Field::Indices { length, item } => {
                         read_polygon(reader, length, item, layout.vertex_count, &mut polygon)?;
                         if let Some((&first, rest)) = polygon.split_first() {
@@ -679,8 +817,22 @@ fn read_body(reader: &mut impl BodyReader, header: &Header, layout: &Layout) -> 
                     Field::Skip(ty) => skip(reader, ty)?,
                 }
             }
+            let triangles = mesh.triangles.len() - triangles_before;
+            for (attribute, &value) in mesh.attributes.iter_mut().zip(&attribute_values) {
+                let value = if attribute.channels == 1 {
+                    Vec3::splat(value.x)
+                } else {
+                    value
+                };
+                if attribute.per_face {
+                    attribute
+                        .values
+                        .extend(std::iter::repeat_n(value, triangles));
+                } else if i == layout.vertex_element {
+                    attribute.values.push(value);
+                }
+            }
             if let Some(face_colors) = &mut mesh.face_colors {
-                let triangles = mesh.triangles.len() - triangles_before;
                 let color = Vec3::from(vertex[Attribute::FaceColor as usize]);
                 face_colors.extend(std::iter::repeat_n(color, triangles));
             }
@@ -1067,6 +1219,7 @@ mod tests {
             uvs: Some(corners.iter().map(|&c| Vec2::from(c)).collect()),
             colors: None,
             face_colors: None,
+            attributes: Vec::new(),
             triangles: vec![[0, 1, 2], [0, 2, 3], [3, 1, 2]],
         }
     }
@@ -1266,6 +1419,62 @@ mod tests {
         }
         values.extend([("uchar", 3.0), ("int", 0.0), ("int", 1.0), ("int", 2.0)]);
         assert_eq!(parse(&ply("ascii", header, &values)).unwrap().colors, None);
+    }
+
+    /// Other properties grouped as Mitsuba's `find_other_fields` groups them.
+    #[test]
+    fn other_properties_are_grouped_into_attributes_as_mitsuba_does() {
+        let header = "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n\
+                      property float foo_x\nproperty float foo_y\nproperty float foo_z\n\
+                      property float bar_r\nproperty float bar_g\nproperty float bar_b\n\
+                      property float two_0\nproperty float two_1\n\
+                      property float bad_x\nproperty float bad_z\n\
+                      property ushort level_1\nproperty float plain\n\
+                      property float foo_0\n\
+                      element face 1\nproperty float weight_0\n\
+                      property list uchar int vertex_indices\n";
+        let mut values = Vec::new();
+        for corner in [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]] {
+            values.extend([("float", corner[0]), ("float", corner[1]), ("float", 0.0)]);
+            values.extend([("float", 1.0), ("float", 2.0), ("float", corner[0])]);
+            values.extend([("float", 0.5), ("float", 0.25), ("float", 0.125)]);
+            values.extend([
+                ("float", 7.0),
+                ("float", 8.0),
+                ("float", 9.0),
+                ("float", 9.0),
+            ]);
+            values.extend([("ushort", 65535.0), ("float", 3.0), ("float", 4.0)]);
+        }
+        values.extend([("float", 0.3), ("uchar", 3.0), ("int", 0.0), ("int", 1.0)]);
+        values.push(("int", 2.0));
+        for format in FORMATS {
+            let mesh = parse(&ply(format, header, &values)).unwrap();
+            let summary: Vec<_> = mesh
+                .attributes
+                .iter()
+                .map(|a| {
+                    (
+                        a.name.as_str(),
+                        a.per_face,
+                        a.channels,
+                        *a.values.last().unwrap(),
+                    )
+                })
+                .collect();
+            assert_eq!(
+                summary,
+                [
+                    ("vertex_foo", false, 3, Vec3::new(1.0, 2.0, 0.0)),
+                    ("vertex_bar_color", false, 3, Vec3::new(0.5, 0.25, 0.125)),
+                    ("vertex_level", false, 1, Vec3::ONE),
+                    ("face_weight", true, 1, Vec3::splat(0.3)),
+                ]
+                .to_vec(),
+                "{format}"
+            );
+            mesh.validate(Path::new("mesh.ply")).unwrap();
+        }
     }
 
     #[test]
