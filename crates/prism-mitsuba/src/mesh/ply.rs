@@ -29,7 +29,7 @@
 //!   as its value 0–255 (not rescaled, though Mitsuba warns about it: such a colour reads as
 //!   values above 1, clamped to 1 when upsampled), other integers divided by their type's
 //!   largest value and decoded from sRGB. Other numbers named `{prefix}_{suffix}` become
-//!   attributes of 1 or 3 channels as Mitsuba groups them (see [`group_attributes`]), read like
+//!   attributes of 1 or 3 channels as Mitsuba groups them (see `group_attributes`), read like
 //!   colours; the rest are skipped.
 //! - Element `face`: the list `vertex_indices` (or `vertex_index`) of integer indices into the
 //!   vertices; each polygon, of 3 to 65536 vertices, is triangulated as a fan. Face colours and
