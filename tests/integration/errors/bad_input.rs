@@ -762,14 +762,24 @@ fn cases() -> Vec<Case> {
             "scene.xml:3:",
             "must start with \"vertex_\" or \"face_\"",
         ),
-        render_scene(
-            "mesh_attribute: a colour read as a number",
-            scene!(
-                "    <shape type=\"sphere\"><bsdf type=\"roughconductor\"><texture type=\"mesh_attribute\" name=\"alpha\"><string name=\"name\" value=\"vertex_color\"/></texture></bsdf></shape>"
-            ),
-            "scene.xml:3:",
-            "only as a colour",
-        ),
+        Case {
+            name: "mesh_attribute: a colour read as a number",
+            files: &[
+                (
+                    "scene.xml",
+                    scene!(
+                        "    <shape type=\"ply\"><string name=\"filename\" value=\"mesh.ply\"/><bsdf type=\"roughconductor\"><texture type=\"mesh_attribute\" name=\"alpha\"><string name=\"name\" value=\"vertex_color\"/></texture></bsdf></shape>"
+                    ),
+                ),
+                (
+                    "mesh.ply",
+                    "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nproperty float r\nproperty float g\nproperty float b\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0 1 0 0\n1 0 0 1 0 0\n0 1 0 1 0 0\n3 0 1 2\n",
+                ),
+            ],
+            arguments: RENDER,
+            location: "scene.xml:3:5",
+            says: "is a colour of three channels, which its BSDF reads as a number",
+        },
         render_scene(
             "mesh_attribute: no name",
             scene!(

@@ -8,6 +8,7 @@ use glam::Vec3;
 use prism_core::geometry::ShapeGeometry;
 use prism_core::geometry::shape::MeshAttribute;
 use prism_core::geometry::{TriangleMesh, triangle::TriangleHit};
+use prism_core::image::srgb;
 use prism_core::math::Ray;
 use prism_mitsuba::load_scene;
 
@@ -28,11 +29,13 @@ fn attributes_are_interpolated_barycentrically_and_faces_are_constant() {
         MeshAttribute {
             name: "vertex_color".into(),
             per_face: false,
+            channels: 3,
             values: vertex.to_vec(),
         },
         MeshAttribute {
             name: "face_color".into(),
             per_face: true,
+            channels: 3,
             values: vec![Vec3::splat(0.1), Vec3::splat(0.9)],
         },
     ]);
@@ -183,4 +186,109 @@ fn a_uniform_ply_face_colour_renders_as_that_rgb() {
         "face_color",
         "0.6, 0.1, 0.3",
     );
+}
+
+/// A binary PLY as Mitsuba's `write_ply` names its colours (`color_0 color_1 color_2`, the
+/// `vertex_color` attribute), with `ushort` face colours, which Mitsuba reads divided by 65535
+/// and decoded from sRGB.
+#[test]
+fn binary_ply_with_prefixed_vertex_colours_and_integer_face_colours() {
+    let mut ply = b"ply\nformat binary_little_endian 1.0\nelement vertex 4\nproperty float x\n\
+        property float y\nproperty float z\nproperty float color_0\nproperty float color_1\n\
+        property float color_2\nelement face 2\nproperty list uchar int vertex_indices\n\
+        property ushort red\nproperty ushort green\nproperty ushort blue\nend_header\n"
+        .to_vec();
+    for (x, y) in [(-1.0f32, -1.0f32), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
+        for v in [x, y, 0.0, 0.2, 0.5, 0.8] {
+            ply.extend_from_slice(&v.to_le_bytes());
+        }
+    }
+    let face_color: [u16; 3] = [32768, 13107, 65535];
+    for corners in [[0i32, 1, 2], [0, 2, 3]] {
+        ply.push(3);
+        for corner in corners {
+            ply.extend_from_slice(&corner.to_le_bytes());
+        }
+        for channel in face_color {
+            ply.extend_from_slice(&channel.to_le_bytes());
+        }
+    }
+    let files = [("quad.ply", ply)];
+    assert_renders_as_rgb(
+        "ply-prefixed",
+        &files,
+        ("ply", "quad.ply"),
+        "vertex_color",
+        "0.2, 0.5, 0.8",
+    );
+    let [r, g, b] = face_color.map(|c| srgb::decode(f32::from(c) / 65535.0));
+    assert!((r - 0.214_048_1).abs() < 1e-6, "{r}");
+    assert_renders_as_rgb(
+        "ply-ushort-face",
+        &files,
+        ("ply", "quad.ply"),
+        "face_color",
+        &format!("{r}, {g}, {b}"),
+    );
+}
+
+/// Mitsuba's `face_weight` of its mesh-attribute test scenes (a PLY face property `weight_0`):
+/// an attribute of one channel, read as a number by a `blendbsdf`'s weight and as a grey by a
+/// reflectance. Mitsuba 3.9.1 (`scalar_rgb`, a quad under a constant emitter, weight 0.3
+/// between diffuse 0.2 and 0.8) renders the blend as 0.38.
+#[test]
+fn a_one_channel_face_attribute_is_a_number_and_a_grey() {
+    let mut ply = b"ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n\
+        property float z\nelement face 2\nproperty list uchar int vertex_indices\n\
+        property float weight_0\nend_header\n"
+        .to_vec();
+    for (x, y) in [(-1, -1), (1, -1), (1, 1), (-1, 1)] {
+        ply.extend_from_slice(format!("{x} {y} 0\n").as_bytes());
+    }
+    ply.extend_from_slice(b"3 0 1 2 0.3\n3 0 2 3 0.3\n");
+    let files = [("quad.ply", ply)];
+    assert_renders_as_rgb(
+        "ply-weight",
+        &files,
+        ("ply", "quad.ply"),
+        "face_weight",
+        "0.3, 0.3, 0.3",
+    );
+
+    let dir = std::env::temp_dir().join(format!("prism-face-weight-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let folder = Folder(dir);
+    std::fs::write(folder.0.join("quad.ply"), &files[0].1).unwrap();
+    let films: Vec<_> = [
+        r#"<texture type="mesh_attribute" name="weight"><string name="name" value="face_weight"/></texture>"#,
+        r#"<float name="weight" value="0.3"/>"#,
+    ]
+    .iter()
+    .map(|weight| {
+        let blend = format!(
+            r#"<bsdf type="blendbsdf">{weight}<bsdf type="diffuse"><rgb name="reflectance" value="0.2"/></bsdf><bsdf type="diffuse"><rgb name="reflectance" value="0.8"/></bsdf></bsdf>"#
+        );
+        let scene = quad_scene(("ply", "quad.ply"), "").replace(
+            r#"<bsdf type="diffuse"></bsdf>"#,
+            &blend,
+        );
+        let path = folder.0.join("scene.xml");
+        std::fs::write(&path, scene).unwrap();
+        let loaded = load_scene(&path, &[]).unwrap_or_else(|e| panic!("{e}"));
+        render_film(&loaded.scene, 16, 5, Some(1))
+    })
+    .collect();
+    let mut lit = 0;
+    for i in 0..films[0].pixels.len() {
+        for c in 0..3 {
+            let (a, _) = pixel_mean_and_variance(&films[0], i, c);
+            let (b, _) = pixel_mean_and_variance(&films[1], i, c);
+            assert!(
+                (a - b).abs() <= 1e-5 * b.abs().max(1e-3),
+                "pixel {i}, channel {c}: {a} with the attribute, {b} with the number"
+            );
+            lit += usize::from(b > 0.0);
+        }
+    }
+    assert!(lit > 0, "the quad was not seen");
 }

@@ -21,6 +21,7 @@ fn expected(shape: &SerializedShape) -> MeshData {
             .map(|uvs| uvs.iter().map(|&uv| Vec2::from(uv)).collect()),
         colors: shape.colors.as_ref().map(vec3),
         face_colors: None,
+        attributes: Vec::new(),
         triangles: shape.triangles.clone(),
     }
 }

@@ -5,7 +5,9 @@
 //! A colour attribute holds linear RGB; as in Mitsuba 3.9's spectral variants (measured: the
 //! interpolated coefficients of the upsampled corner spectra came out up to 1.5 % off its
 //! renders), the RGB is interpolated and the result upsampled (Jakob & Hanika 2019) at each
-//! lookup: at barycentrics b, the spectrum of Σ bᵢ rgbᵢ, times the texture's `scale`.
+//! lookup: at barycentrics b, the spectrum of Σ bᵢ rgbᵢ, times the texture's `scale`. An
+//! attribute of one channel (a number v, held as the grey (v, v, v)) reads as that number, or
+//! as a colour as the constant spectrum v.
 //!
 //! A scene reads at most [`MAX_MESH_ATTRIBUTES`] distinct attribute names. Each gets a slot; a
 //! mesh fills, at each hit, the slots of the attributes it has ([`AttributeValues`], plain data
@@ -43,12 +45,11 @@ impl TextureValues for MeshAttributeTexture {
         SampledSpectrum(value.to_array())
     }
 
-    /// The mean of the spectrum over 360–830 nm (the scene reader reads colour attributes only
-    /// as colours, as Mitsuba does; this keeps the function total).
+    /// A number attribute's value times the texture's `scale` (the scene reader reads only
+    /// attributes of one channel as numbers, as Mitsuba does; of a colour this is its red).
     fn eval_1(&self, at: impl Into<TexturePoint>) -> f32 {
         let values = &at.into().attributes;
-        let rgb = self.polynomial(values).linear_srgb();
-        self.scale * (rgb[0] + rgb[1] + rgb[2]) / 3.0
+        self.scale * values.0[usize::from(self.slot)].x
     }
 
     fn eval_1_grad(&self, _at: impl Into<TexturePoint>) -> Vec2 {
@@ -69,7 +70,7 @@ impl TextureValues for MeshAttributeTexture {
         0.0
     }
 
-    /// No (u, v) map: its bound (the scene reader reads mesh attributes only as colours).
+    /// No (u, v) map: its bound.
     fn mean_value(&self) -> f32 {
         self.scale
     }
@@ -105,6 +106,26 @@ mod tests {
                 let expected = 0.5 * polynomial.eval(lambda.lambda(i));
                 assert!((value[i] - expected).abs() <= 1e-6, "{rgb:?}: {value:?}");
             }
+        }
+    }
+
+    #[test]
+    fn a_number_reads_back_as_itself_and_as_a_constant_spectrum() {
+        let mut values = AttributeValues::default();
+        values.0[1] = Vec3::splat(0.3);
+        let texture = MeshAttributeTexture {
+            slot: 1,
+            scale: 0.5,
+        };
+        let at = TexturePoint {
+            uv: glam::Vec2::ZERO,
+            attributes: values,
+        };
+        assert_eq!(texture.eval_1(at), 0.15);
+        let lambda = SampledWavelengths::sample(0.7, WavelengthSampling::default());
+        let value = texture.eval(at, &lambda);
+        for i in 0..4 {
+            assert!((value[i] - 0.15).abs() <= 1e-6, "{value:?}");
         }
     }
 }

@@ -239,11 +239,7 @@ impl SceneBuilder {
             Some(emitter) => Some(self.attach_emitter(&shape, shape_index, emitter)?),
             None => None,
         };
-        bind_mesh_attributes(
-            &mut shape,
-            self.textures.material_attributes(material),
-            &child.node,
-        )?;
+        bind_mesh_attributes(&mut shape, material, &self.textures, &child.node)?;
         let interface = shape_media(&shape_params, &mut self.media)?;
         shape_params.finish()?;
         if area == 0.0 && !curve {
@@ -506,14 +502,17 @@ fn shape_media(shape_params: &Params, media: &mut MediaCache) -> Result<MediumIn
     Ok(interface)
 }
 
-/// Makes the shape's mesh fill the attribute slots its BSDF's `mesh_attribute` textures read;
-/// a shape without one of those attributes is an error (Mitsuba's "invalid attribute
-/// requested", which it reports while rendering).
+/// Makes the shape's mesh fill the attribute slots its BSDF (`material`)'s `mesh_attribute`
+/// textures read; a shape without one of those attributes, or with a colour attribute that a
+/// texture reads as a number, is an error (Mitsuba's "invalid attribute requested" and
+/// "requested but had size 3", which it reports while rendering).
 fn bind_mesh_attributes(
     shape: &mut Primitive,
-    attributes: &[(u8, String)],
+    material: u32,
+    textures: &TextureCache,
     node: &PluginNode,
 ) -> Result<()> {
+    let attributes = textures.material_attributes(material);
     let Some((_, first)) = attributes.first() else {
         return Ok(());
     };
@@ -534,6 +533,18 @@ fn bind_mesh_attributes(
         .with_help("give the attribute to a ply or serialized mesh that has it"));
     };
     for (slot, name) in attributes {
+        let channels = mesh.attribute(name).map(|a| a.channels);
+        if channels == Some(3) && textures.reads_as_number(name) {
+            return Err(Error::input(
+                &node.location,
+                format!(
+                    "{}'s attribute \"{name}\" is a colour of three channels, which its BSDF \
+                     reads as a number (Mitsuba: attribute requested but had size 3)",
+                    node.describe()
+                ),
+            )
+            .with_help("read it as a colour, or give the mesh a one-channel attribute"));
+        }
         if !mesh.bind_attribute(name, *slot) {
             let names: Vec<&str> = mesh.attribute_names().collect();
             let has = if names.is_empty() {

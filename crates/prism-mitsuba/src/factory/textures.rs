@@ -98,6 +98,8 @@ pub struct TextureCache {
     used_slots: Vec<u8>,
     /// The mesh attributes (slot, name) each material's textures read, by material index.
     material_attributes: HashMap<u32, Vec<(u8, String)>>,
+    /// The names of the mesh attributes some texture reads as a number.
+    numeric_attributes: Vec<String>,
 }
 
 impl TextureCache {
@@ -118,6 +120,11 @@ impl TextureCache {
         if !attributes.is_empty() {
             self.material_attributes.insert(index, attributes);
         }
+    }
+
+    /// Whether some texture reads the mesh attribute `name` as a number.
+    pub fn reads_as_number(&self, name: &str) -> bool {
+        self.numeric_attributes.iter().any(|n| n == name)
     }
 
     /// The mesh attributes (slot, name) that material `index` reads; none for most.
@@ -326,15 +333,23 @@ fn build_mesh_attribute(
              \"face_color\" (PLY face colours)",
         ));
     }
-    if usage != TextureUse::Spectral {
-        return Err(Error::input(
-            &params.node().location,
-            format!(
-                "the mesh attribute \"{name}\" is a colour of three channels; Mitsuba reads \
-                 such an attribute only as a colour, not as a number or a normal map"
-            ),
-        )
-        .with_help("use it for a colour parameter such as a reflectance"));
+    match usage {
+        TextureUse::Spectral => {}
+        TextureUse::Scalar => {
+            if !cache.reads_as_number(name) {
+                cache.numeric_attributes.push(name.to_string());
+            }
+        }
+        TextureUse::Rgb | TextureUse::Emission => {
+            return Err(Error::input(
+                &params.node().location,
+                format!(
+                    "the mesh attribute \"{name}\" is read here as an RGB triple or an \
+                     emission; Prism reads mesh attributes only as colours and numbers"
+                ),
+            )
+            .with_help("use it for a colour parameter such as a reflectance, or a weight"));
+        }
     }
     let scale = params.float(&ATTRIBUTE_SCALE)? as f32;
     let slot = match cache.attribute_slots.iter().position(|n| n == name) {

@@ -25,6 +25,7 @@ use std::path::Path;
 use glam::{Vec2, Vec3};
 
 use prism_core::error::{Error, Result};
+use prism_core::geometry::shape::MeshAttribute;
 
 pub use obj::parse_obj;
 pub use ply::parse_ply;
@@ -44,6 +45,9 @@ pub struct MeshData {
     /// One linear RGB colour per triangle when present (Mitsuba's `face_color` attribute; a
     /// polygon's colour is repeated for each triangle of its fan).
     pub face_colors: Option<Vec<Vec3>>,
+    /// Mitsuba's other attributes (`vertex_{prefix}`, `face_{prefix}`: PLY property groups),
+    /// per vertex or, a polygon's value repeated for each triangle of its fan, per triangle.
+    pub attributes: Vec<MeshAttribute>,
     /// Counter-clockwise seen from the side the face normal points to.
     pub triangles: Vec<[u32; 3]>,
 }
@@ -151,6 +155,14 @@ impl MeshData {
         vertices.check("texture coordinate", "texture coordinates", uvs)?;
         vertices.check("colour", "colours", self.colors.as_deref())?;
         triangles.check("colour", "face colours", self.face_colors.as_deref())?;
+        for attribute in &self.attributes {
+            let elements = if attribute.per_face {
+                &triangles
+            } else {
+                &vertices
+            };
+            elements.check("value", &attribute.name, Some(&attribute.values))?;
+        }
         Ok(())
     }
 

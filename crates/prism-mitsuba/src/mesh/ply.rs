@@ -22,15 +22,20 @@
 //!   coordinates named `u v`, `texture_u texture_v`, `s t` or `texture_s texture_t` (the first
 //!   complete pair, in that order). These must have floating-point types: Mitsuba would rescale
 //!   integers to [0, 1], which is never what a position means. Texture coordinates are not
-//!   flipped (Mitsuba flips only OBJ's). Vertex colours `r g b` or `red green blue` become the
-//!   `vertex_color` attribute, read as their values whatever their type: like Mitsuba (which
-//!   warns about it), integer channels are not rescaled, so a `uchar` 0–255 colour reads as
-//!   values above 1, clamped to 1 when upsampled. Other properties are skipped.
+//!   flipped (Mitsuba flips only OBJ's). Vertex colours `r g b`, `red green blue`, `color_0
+//!   color_1 color_2`, `color_1 color_2 color_3` or `color_x color_y color_z` (the first
+//!   complete triple) become the `vertex_color` attribute, as Mitsuba's `find_other_fields`
+//!   names them. Their channels are read as Mitsuba 3.9 reads them: floats as they are, `uchar`
+//!   as its value 0–255 (not rescaled, though Mitsuba warns about it: such a colour reads as
+//!   values above 1, clamped to 1 when upsampled), other integers divided by their type's
+//!   largest value and decoded from sRGB. Other numbers named `{prefix}_{suffix}` become
+//!   attributes of 1 or 3 channels as Mitsuba groups them (see `group_attributes`), read like
+//!   colours; the rest are skipped.
 //! - Element `face`: the list `vertex_indices` (or `vertex_index`) of integer indices into the
-//!   vertices; each polygon, of 3 to 65536 vertices, is triangulated as a fan. Face colours
-//!   `r g b` or `red green blue` become the `face_color` attribute (as Mitsuba's
-//!   `find_other_fields` names them), one per triangle of the fan, read as their values like the
-//!   vertex colours. Other properties are skipped.
+//!   vertices; each polygon, of 3 to 65536 vertices, is triangulated as a fan. Face colours and
+//!   other attributes, named and read like the vertex ones, become the `face_color` and
+//!   `face_{prefix}` attributes, one value per triangle of the fan. Other properties are
+//!   skipped.
 //! - Other elements are skipped. A file without faces is an error, and so is anything after the
 //!   last element (as in Mitsuba).
 //!
@@ -44,6 +49,8 @@ use glam::{Vec2, Vec3};
 
 use super::{MeshData, file_error};
 use prism_core::error::{Error, Result, SourceLocation};
+use prism_core::geometry::shape::MeshAttribute;
+use prism_core::image::srgb;
 
 /// The most vertices a face may have; a longer list means a corrupt file.
 const MAX_FACE_VERTICES: u64 = 1 << 16;
@@ -355,6 +362,12 @@ enum Field {
         axis: usize,
         ty: ScalarType,
     },
+    /// Channel `channel` of the attribute `index` of [`Layout::attributes`].
+    Attribute {
+        index: usize,
+        channel: usize,
+        ty: ScalarType,
+    },
     /// The vertex indices of a face.
     Indices {
         length: ScalarType,
@@ -374,10 +387,29 @@ struct Layout {
     has_uvs: bool,
     has_colors: bool,
     has_face_colors: bool,
+    /// Mitsuba's other attributes, found by [`group_attributes`].
+    attributes: Vec<AttributeGroup>,
 }
 
-/// Alternative names of the vertex and face colour channels, in order of preference.
-const COLOR_NAMES: [[&str; 3]; 2] = [["r", "g", "b"], ["red", "green", "blue"]];
+/// An attribute of Mitsuba's naming scheme: its name and number of channels (1 or 3), and
+/// whether it belongs to the faces.
+struct AttributeGroup {
+    name: String,
+    channels: usize,
+    per_face: bool,
+}
+
+/// Alternative names of the vertex and face colour channels, in order of preference: Mitsuba's
+/// unprefixed `r g b` and `red green blue`, then its prefixed groups that it names
+/// `{vertex|face}_color`: the prefix `color` with the suffixes `0 1 2`, `1 2 3` or `x y z`
+/// (with `r g b`, Mitsuba names the group `{vertex|face}_color_color`).
+const COLOR_NAMES: [[&str; 3]; 5] = [
+    ["r", "g", "b"],
+    ["red", "green", "blue"],
+    ["color_0", "color_1", "color_2"],
+    ["color_1", "color_2", "color_3"],
+    ["color_x", "color_y", "color_z"],
+];
 
 /// Alternative names of the texture coordinate pair, in order of preference.
 const UV_NAMES: [[&str; 2]; 4] = [
@@ -523,6 +555,12 @@ impl Layout {
             }
         }
 
+        let mut attributes = Vec::new();
+        for (element, kind) in [(vertex_element, "vertex"), (face_element, "face")] {
+            let properties = &header.elements[element].properties;
+            group_attributes(properties, kind, &mut fields[element], &mut attributes);
+        }
+
         Ok(Layout {
             fields,
             vertex_element,
@@ -531,8 +569,101 @@ impl Layout {
             has_uvs,
             has_colors,
             has_face_colors,
+            attributes,
         })
     }
+}
+
+/// The suffixes of Mitsuba's attribute groups: `SUFFIXES[k][scheme]` is the suffix of the
+/// k-th property of a group in one of the schemes `x y z w`, `r g b a`, `0 1 2 3`, `1 2 3 4`.
+const SUFFIXES: [[u8; 4]; 4] = [*b"xr01", *b"yg12", *b"zb23", *b"wa34"];
+
+/// Mitsuba's `find_other_fields` (`src/shapes/ply.h`): among the properties of an element that
+/// Prism does not otherwise read, consecutive numbers `{prefix}_{suffix}` whose suffixes follow
+/// one scheme of [`SUFFIXES`] form the attribute `{kind}_{prefix}` (`{kind}_{prefix}_color`
+/// for `r g b a`). A group of 1 or 3 properties becomes an attribute of 1 or 3 channels; other
+/// groups, a group whose suffixes break the scheme, and a prefix met again after its group are
+/// skipped, as Mitsuba skips them (with a warning).
+fn group_attributes(
+    properties: &[Property],
+    kind: &str,
+    fields: &mut [Field],
+    attributes: &mut Vec<AttributeGroup>,
+) {
+    struct Group<'a> {
+        prefix: &'a str,
+        scheme: usize,
+        members: Vec<(usize, ScalarType)>,
+    }
+    let mut kept: Vec<String> = Vec::new();
+    let mut group: Option<Group> = None;
+    let mut skipped_prefix: Option<&str> = None;
+    let mut flush = |group: &mut Option<Group>, fields: &mut [Field], kept: &mut Vec<String>| {
+        let Some(Group {
+            prefix,
+            scheme,
+            members,
+        }) = group.take()
+        else {
+            return;
+        };
+        if members.len() != 1 && members.len() != 3 {
+            return;
+        }
+        let index = attributes.len();
+        for (channel, &(property, ty)) in members.iter().enumerate() {
+            fields[property] = Field::Attribute { index, channel, ty };
+        }
+        let color = if scheme == 1 { "_color" } else { "" };
+        attributes.push(AttributeGroup {
+            name: format!("{kind}_{prefix}{color}"),
+            channels: members.len(),
+            per_face: kind == "face",
+        });
+        kept.push(prefix.to_string());
+    };
+    for (i, property) in properties.iter().enumerate() {
+        let (Field::Skip(_), PropertyType::Scalar(ty)) = (fields[i], property.ty) else {
+            continue;
+        };
+        let name = property.name.as_str();
+        if let Some(prefix) = skipped_prefix {
+            if name.starts_with(prefix) {
+                continue;
+            }
+            skipped_prefix = None;
+        }
+        let Some((prefix, &[suffix])) = name.rsplit_once('_').map(|(p, s)| (p, s.as_bytes()))
+        else {
+            flush(&mut group, fields, &mut kept);
+            continue;
+        };
+        if group.as_ref().is_some_and(|g| g.prefix != prefix) {
+            flush(&mut group, fields, &mut kept);
+        }
+        match &mut group {
+            None if kept.iter().any(|k| k == prefix) => skipped_prefix = Some(prefix),
+            None => {
+                if let Some(scheme) = SUFFIXES[0].iter().position(|&c| c == suffix) {
+                    group = Some(Group {
+                        prefix,
+                        scheme,
+                        members: vec![(i, ty)],
+                    });
+                }
+            }
+            Some(g) => {
+                let k = g.members.len();
+                if k < SUFFIXES.len() && SUFFIXES[k][g.scheme] == suffix {
+                    g.members.push((i, ty));
+                } else {
+                    group = None;
+                    skipped_prefix = Some(prefix);
+                }
+            }
+        }
+    }
+    flush(&mut group, fields, &mut kept);
 }
 
 /// Refuses a header whose counts need more bytes than the body has, before anything is
@@ -549,7 +680,7 @@ fn check_body_size(header: &Header, layout: &Layout, file_size: usize, path: &Pa
         let record: u64 = fields
             .iter()
             .map(|field| match *field {
-                Field::Vertex { ty, .. } => size(ty),
+                Field::Vertex { ty, .. } | Field::Attribute { ty, .. } => size(ty),
                 Field::Indices { length, item } => size(length) + 3 * size(item),
                 Field::Skip(PropertyType::Scalar(ty)) => size(ty),
                 Field::Skip(PropertyType::List { length, .. }) => size(length),
@@ -621,9 +752,20 @@ fn read_body(reader: &mut impl BodyReader, header: &Header, layout: &Layout) -> 
             .has_colors
             .then(|| Vec::with_capacity(vertex_capacity)),
         face_colors: layout.has_face_colors.then(Vec::new),
+        attributes: layout
+            .attributes
+            .iter()
+            .map(|group| MeshAttribute {
+                name: group.name.clone(),
+                per_face: group.per_face,
+                channels: group.channels as u8,
+                values: Vec::new(),
+            })
+            .collect(),
         triangles: Vec::new(),
     };
     let mut polygon = Vec::new();
+    let mut attribute_values = vec![Vec3::ZERO; layout.attributes.len()];
     for (i, (element, fields)) in header.elements.iter().zip(&layout.fields).enumerate() {
         if fields.is_empty() {
             continue;
@@ -641,7 +783,11 @@ fn read_body(reader: &mut impl BodyReader, header: &Header, layout: &Layout) -> 
                         axis,
                         ty,
                     } => {
-                        let value = reader.read(ty)?.to_f64() as f32;
+                        let value = reader.read(ty)?;
+                        let value = match attribute {
+                            Attribute::Color | Attribute::FaceColor => color_channel(value, ty),
+                            _ => value.to_f64() as f32,
+                        };
                         if !value.is_finite() {
                             let what = match attribute {
                                 Attribute::Position => "vertex coordinate",
@@ -653,6 +799,14 @@ fn read_body(reader: &mut impl BodyReader, header: &Header, layout: &Layout) -> 
                         }
                         vertex[attribute as usize][axis] = value;
                     }
+                    Field::Attribute { index, channel, ty } => {
+                        let value = color_channel(reader.read(ty)?, ty);
+                        if !value.is_finite() {
+                            let name = &layout.attributes[index].name;
+                            return Err(reader.error(format!("{name} is not a finite number")));
+                        }
+                        attribute_values[index][channel] = value;
+                    }
                     Field::Indices { length, item } => {
                         read_polygon(reader, length, item, layout.vertex_count, &mut polygon)?;
                         if let Some((&first, rest)) = polygon.split_first() {
@@ -663,8 +817,22 @@ fn read_body(reader: &mut impl BodyReader, header: &Header, layout: &Layout) -> 
                     Field::Skip(ty) => skip(reader, ty)?,
                 }
             }
+            let triangles = mesh.triangles.len() - triangles_before;
+            for (attribute, &value) in mesh.attributes.iter_mut().zip(&attribute_values) {
+                let value = if attribute.channels == 1 {
+                    Vec3::splat(value.x)
+                } else {
+                    value
+                };
+                if attribute.per_face {
+                    attribute
+                        .values
+                        .extend(std::iter::repeat_n(value, triangles));
+                } else if i == layout.vertex_element {
+                    attribute.values.push(value);
+                }
+            }
             if let Some(face_colors) = &mut mesh.face_colors {
-                let triangles = mesh.triangles.len() - triangles_before;
                 let color = Vec3::from(vertex[Attribute::FaceColor as usize]);
                 face_colors.extend(std::iter::repeat_n(color, triangles));
             }
@@ -685,6 +853,25 @@ fn read_body(reader: &mut impl BodyReader, header: &Header, layout: &Layout) -> 
     }
     reader.finish()?;
     Ok(mesh)
+}
+
+/// A colour channel as Mitsuba 3.9 reads it (measured with its `scalar_rgb` variant): a float
+/// as it is; an integer other than `uchar` divided by its type's largest value and decoded from
+/// sRGB (`mitsuba::PLYMesh` marks integer properties normalised and gamma-encoded); a `uchar`
+/// as its value 0–255, not rescaled.
+fn color_channel(value: Value, ty: ScalarType) -> f32 {
+    use ScalarType::*;
+    let largest = match ty {
+        Int8 => i8::MAX as f64,
+        Int16 => i16::MAX as f64,
+        UInt16 => u16::MAX as f64,
+        Int32 => i32::MAX as f64,
+        UInt32 => u32::MAX as f64,
+        Int64 => i64::MAX as f64,
+        UInt64 => u64::MAX as f64,
+        UInt8 | Float16 | Float32 | Float64 => return value.to_f64() as f32,
+    };
+    srgb::decode((value.to_f64() / largest) as f32)
 }
 
 /// Reads a number of an integer type that must not be negative.
@@ -1032,6 +1219,7 @@ mod tests {
             uvs: Some(corners.iter().map(|&c| Vec2::from(c)).collect()),
             colors: None,
             face_colors: None,
+            attributes: Vec::new(),
             triangles: vec![[0, 1, 2], [0, 2, 3], [3, 1, 2]],
         }
     }
@@ -1121,6 +1309,172 @@ mod tests {
             message.contains("mesh.ply:9") && message.contains("face property \"r\""),
             "{message}"
         );
+    }
+
+    /// Colour channels of each type read as Mitsuba 3.9.1 reads them. The expected values are
+    /// its renders (`scalar_rgb`, a diffuse quad with the colour as its `mesh_attribute`
+    /// reflectance, under a constant emitter, 16 spp), divided by the render of a channel of
+    /// float value 1: `char` 64 → 0.2177031, `short` 16384 → 0.2140551, `ushort` 32768 →
+    /// 0.2140481, `uint` 128 → 2.306681e-9, `int` 128 → 4.613362e-9, `uchar` 128 → 128.0000
+    /// and 64 → 64.0000. They agree with the closed form (v / largest, then sRGB decoding) to 1e-6
+    /// relative.
+    #[test]
+    fn integer_colour_channels_read_as_mitsuba_reads_them() {
+        let cases: [(&str, [f64; 3], [f32; 3]); 6] = [
+            ("char", [64.0, 0.0, 127.0], [0.217_703_1, 0.0, 1.0]),
+            ("short", [16384.0, 0.0, 32767.0], [0.214_055_1, 0.0, 1.0]),
+            ("ushort", [32768.0, 0.0, 65535.0], [0.214_048_1, 0.0, 1.0]),
+            ("uint", [128.0, 0.0, 4294967295.0], [2.306_681e-9, 0.0, 1.0]),
+            ("int", [128.0, 0.0, 2147483647.0], [4.613_362e-9, 0.0, 1.0]),
+            ("uchar", [128.0, 64.0, 255.0], [128.0, 64.0, 255.0]),
+        ];
+        for format in FORMATS {
+            for (ty, channels, expected) in cases {
+                for (kind, names) in [
+                    ("vertex", ["r", "g", "b"]),
+                    ("face", ["red", "green", "blue"]),
+                ] {
+                    let color_header = names.map(|n| format!("property {ty} {n}\n")).concat();
+                    let (vertex_colors, face_colors) = if kind == "vertex" {
+                        (color_header.as_str(), "")
+                    } else {
+                        ("", color_header.as_str())
+                    };
+                    let header = format!(
+                        "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n\
+                         {vertex_colors}element face 1\nproperty list uchar int vertex_indices\n\
+                         {face_colors}"
+                    );
+                    let color = channels.map(|c| (ty, c));
+                    let mut values = Vec::new();
+                    for corner in [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]] {
+                        values.extend([("float", corner[0]), ("float", corner[1]), ("float", 0.0)]);
+                        if kind == "vertex" {
+                            values.extend(color);
+                        }
+                    }
+                    values.extend([("uchar", 3.0), ("int", 0.0), ("int", 1.0), ("int", 2.0)]);
+                    if kind == "face" {
+                        values.extend(color);
+                    }
+                    let mesh = parse(&ply(format, &header, &values)).unwrap();
+                    let read = if kind == "vertex" {
+                        mesh.colors.unwrap()[2]
+                    } else {
+                        mesh.face_colors.unwrap()[0]
+                    };
+                    for (got, want) in read.to_array().into_iter().zip(expected) {
+                        assert!(
+                            (got - want).abs() <= 2e-6 * want,
+                            "{format} {ty} {kind}: {read} against {expected:?}"
+                        );
+                    }
+                }
+            }
+        }
+    }
+
+    /// Mitsuba's prefixed colour groups named `vertex_color` and `face_color`, as its
+    /// `write_ply` writes them (`color_0 color_1 color_2`); `color_r color_g color_b` is
+    /// Mitsuba's `vertex_color_color`, not a colour Prism reads.
+    #[test]
+    fn prefixed_colour_groups() {
+        for suffixes in [["0", "1", "2"], ["1", "2", "3"], ["x", "y", "z"]] {
+            let names = suffixes
+                .map(|s| format!("property float color_{s}\n"))
+                .concat();
+            let header = format!(
+                "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n\
+                 {names}element face 1\nproperty list uchar int vertex_indices\n{names}"
+            );
+            let mut values = Vec::new();
+            for corner in [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]] {
+                values.extend([("float", corner[0]), ("float", corner[1]), ("float", 0.0)]);
+                values.extend([("float", 0.25), ("float", 0.5), ("float", corner[0])]);
+            }
+            values.extend([("uchar", 3.0), ("int", 0.0), ("int", 1.0), ("int", 2.0)]);
+            values.extend([("float", 0.125), ("float", 0.375), ("float", 0.625)]);
+            for format in FORMATS {
+                let mesh = parse(&ply(format, &header, &values)).unwrap();
+                let colors = mesh.colors.as_deref().unwrap();
+                assert_eq!(
+                    colors[1],
+                    Vec3::new(0.25, 0.5, 1.0),
+                    "{format} {suffixes:?}"
+                );
+                assert_eq!(
+                    mesh.face_colors,
+                    Some(vec![Vec3::new(0.125, 0.375, 0.625)]),
+                    "{format} {suffixes:?}"
+                );
+            }
+        }
+        let header = "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n\
+                      property float color_r\nproperty float color_g\nproperty float color_b\n\
+                      element face 1\nproperty list uchar int vertex_indices\n";
+        let mut values = Vec::new();
+        for corner in [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]] {
+            values.extend([("float", corner[0]), ("float", corner[1]), ("float", 0.0)]);
+            values.extend([("float", 0.5); 3]);
+        }
+        values.extend([("uchar", 3.0), ("int", 0.0), ("int", 1.0), ("int", 2.0)]);
+        assert_eq!(parse(&ply("ascii", header, &values)).unwrap().colors, None);
+    }
+
+    /// Other properties grouped as Mitsuba's `find_other_fields` groups them.
+    #[test]
+    fn other_properties_are_grouped_into_attributes_as_mitsuba_does() {
+        let header = "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n\
+                      property float foo_x\nproperty float foo_y\nproperty float foo_z\n\
+                      property float bar_r\nproperty float bar_g\nproperty float bar_b\n\
+                      property float two_0\nproperty float two_1\n\
+                      property float bad_x\nproperty float bad_z\n\
+                      property ushort level_1\nproperty float plain\n\
+                      property float foo_0\n\
+                      element face 1\nproperty float weight_0\n\
+                      property list uchar int vertex_indices\n";
+        let mut values = Vec::new();
+        for corner in [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]] {
+            values.extend([("float", corner[0]), ("float", corner[1]), ("float", 0.0)]);
+            values.extend([("float", 1.0), ("float", 2.0), ("float", corner[0])]);
+            values.extend([("float", 0.5), ("float", 0.25), ("float", 0.125)]);
+            values.extend([
+                ("float", 7.0),
+                ("float", 8.0),
+                ("float", 9.0),
+                ("float", 9.0),
+            ]);
+            values.extend([("ushort", 65535.0), ("float", 3.0), ("float", 4.0)]);
+        }
+        values.extend([("float", 0.3), ("uchar", 3.0), ("int", 0.0), ("int", 1.0)]);
+        values.push(("int", 2.0));
+        for format in FORMATS {
+            let mesh = parse(&ply(format, header, &values)).unwrap();
+            let summary: Vec<_> = mesh
+                .attributes
+                .iter()
+                .map(|a| {
+                    (
+                        a.name.as_str(),
+                        a.per_face,
+                        a.channels,
+                        *a.values.last().unwrap(),
+                    )
+                })
+                .collect();
+            assert_eq!(
+                summary,
+                [
+                    ("vertex_foo", false, 3, Vec3::new(1.0, 2.0, 0.0)),
+                    ("vertex_bar_color", false, 3, Vec3::new(0.5, 0.25, 0.125)),
+                    ("vertex_level", false, 1, Vec3::ONE),
+                    ("face_weight", true, 1, Vec3::splat(0.3)),
+                ]
+                .to_vec(),
+                "{format}"
+            );
+            mesh.validate(Path::new("mesh.ply")).unwrap();
+        }
     }
 
     #[test]

@@ -142,6 +142,7 @@ pub fn parse_serialized(bytes: &[u8], shape_index: u32, path: &Path) -> Result<M
         uvs,
         colors,
         face_colors: None,
+        attributes: Vec::new(),
         triangles,
     };
     mesh.validate(path)?;

@@ -70,12 +70,14 @@ struct Rectangle {
 }
 
 /// Values a mesh carries per vertex or per triangle, under a Mitsuba attribute name
-/// (`vertex_...` or `face_...`); a colour is linear RGB.
+/// (`vertex_...` or `face_...`): colours (linear RGB) or numbers.
 #[derive(Clone, Debug, PartialEq)]
 pub struct MeshAttribute {
     pub name: String,
     /// One value per triangle (else one per vertex).
     pub per_face: bool,
+    /// 3 for a colour, 1 for a number (held in all three components of each value).
+    pub channels: u8,
     pub values: Vec<Vec3>,
 }
 
@@ -158,6 +160,11 @@ impl TriangleMesh {
     /// The names of the mesh's attributes.
     pub fn attribute_names(&self) -> impl Iterator<Item = &str> {
         self.attributes.iter().map(|a| a.name.as_str())
+    }
+
+    /// The attribute `name`, if the mesh has it.
+    pub fn attribute(&self, name: &str) -> Option<&MeshAttribute> {
+        self.attributes.iter().find(|a| a.name == name)
     }
 
     /// Makes every hit fill `slot` with the attribute `name`; false when the mesh has none of

@@ -186,6 +186,7 @@ pub fn transform_mesh(
     if let Some(colors) = data.face_colors {
         attributes.push(color_attribute(colors, true));
     }
+    attributes.extend(data.attributes);
     if !attributes.is_empty() {
         mesh.set_attributes(attributes);
     }
@@ -203,6 +204,7 @@ fn color_attribute(colors: Vec<Vec3>, per_face: bool) -> MeshAttribute {
         }
         .to_string(),
         per_face,
+        channels: 3,
         values: colors,
     }
 }
@@ -225,6 +227,7 @@ pub fn rectangle() -> MeshData {
         ]),
         colors: None,
         face_colors: None,
+        attributes: Vec::new(),
         triangles: vec![[0, 1, 2], [2, 3, 0]],
     }
 }
@@ -238,6 +241,7 @@ pub fn cube() -> MeshData {
         uvs: Some(Vec::new()),
         colors: None,
         face_colors: None,
+        attributes: Vec::new(),
         triangles: Vec::new(),
     };
     let axes = [Vec3::X, Vec3::Y, Vec3::Z];
