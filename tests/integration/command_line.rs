@@ -71,16 +71,18 @@ fn defines_have_a_long_form() {
     assert!(text.contains("-D, --define <NAME=VALUE>"), "{text}");
 }
 
-#[test]
-fn a_quiet_render_prints_nothing() {
-    let out = std::env::temp_dir().join(format!("prism-quiet-{}.exr", std::process::id()));
+/// Renders the Cornell box at 16 × 16 pixels and 1 spp with the option `option` (into a
+/// temporary file, removed) and returns what the command printed.
+fn render_cornell_box_with(option: &str) -> std::process::Output {
+    let out =
+        std::env::temp_dir().join(format!("prism-option{}-{}.exr", option, std::process::id()));
     let output = Command::new(env!("CARGO_BIN_EXE_prism"))
         .args([
             "render",
             "scenes/cornell-box/scene.xml",
             "--spp",
             "1",
-            "--quiet",
+            option,
             "-o",
         ])
         .arg(&out)
@@ -91,6 +93,12 @@ fn a_quiet_render_prints_nothing() {
     let _ = std::fs::remove_file(&out);
     let _ = std::fs::remove_file(out.with_extension("png"));
     assert!(output.status.success(), "{output:?}");
+    output
+}
+
+#[test]
+fn a_quiet_render_prints_nothing() {
+    let output = render_cornell_box_with("--quiet");
     assert!(
         output.stdout.is_empty() && output.stderr.is_empty(),
         "{output:?}"
@@ -99,24 +107,7 @@ fn a_quiet_render_prints_nothing() {
 
 #[test]
 fn a_verbose_render_gives_its_times() {
-    let out = std::env::temp_dir().join(format!("prism-verbose-{}.exr", std::process::id()));
-    let output = Command::new(env!("CARGO_BIN_EXE_prism"))
-        .args([
-            "render",
-            "scenes/cornell-box/scene.xml",
-            "--spp",
-            "1",
-            "-v",
-            "-o",
-        ])
-        .arg(&out)
-        .args(["-D", "resx=16", "-D", "resy=16"])
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .expect("the prism binary runs");
-    let _ = std::fs::remove_file(&out);
-    let _ = std::fs::remove_file(out.with_extension("png"));
-    assert!(output.status.success(), "{output:?}");
+    let output = render_cornell_box_with("-v");
     let text = String::from_utf8_lossy(&output.stderr);
     for line in [
         "prism: loading the scene took ",

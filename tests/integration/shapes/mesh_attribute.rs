@@ -5,6 +5,7 @@
 use std::path::PathBuf;
 
 use glam::Vec3;
+use prism_core::film::Film;
 use prism_core::geometry::ShapeGeometry;
 use prism_core::geometry::shape::MeshAttribute;
 use prism_core::geometry::{TriangleMesh, triangle::TriangleHit};
@@ -118,19 +119,7 @@ fn assert_renders_as_rgb(
             render_film(&loaded.scene, 16, 5, Some(1))
         })
         .collect();
-    let mut lit = 0;
-    for i in 0..films[0].pixels.len() {
-        for c in 0..3 {
-            let (a, _) = pixel_mean_and_variance(&films[0], i, c);
-            let (b, _) = pixel_mean_and_variance(&films[1], i, c);
-            assert!(
-                (a - b).abs() <= 1e-5 * b.abs().max(1e-3),
-                "{name}: pixel {i}, channel {c}: {a} with the attribute, {b} with <rgb>"
-            );
-            lit += usize::from(b > 0.0);
-        }
-    }
-    assert!(lit > 0, "{name}: the quad was not seen");
+    assert_same_lit_image(name, &films[0], &films[1]);
 }
 
 #[test]
@@ -278,17 +267,24 @@ fn a_one_channel_face_attribute_is_a_number_and_a_grey() {
         render_film(&loaded.scene, 16, 5, Some(1))
     })
     .collect();
+    assert_same_lit_image("face_weight", &films[0], &films[1]);
+}
+
+/// Asserts that `attribute`, the quad rendered with a mesh attribute, equals `constant`, the
+/// same quad with the attribute's value written in the scene, pixel by pixel (the same random
+/// numbers), and that the quad was seen.
+fn assert_same_lit_image(name: &str, attribute: &Film, constant: &Film) {
     let mut lit = 0;
-    for i in 0..films[0].pixels.len() {
+    for i in 0..attribute.pixels.len() {
         for c in 0..3 {
-            let (a, _) = pixel_mean_and_variance(&films[0], i, c);
-            let (b, _) = pixel_mean_and_variance(&films[1], i, c);
+            let (a, _) = pixel_mean_and_variance(attribute, i, c);
+            let (b, _) = pixel_mean_and_variance(constant, i, c);
             assert!(
                 (a - b).abs() <= 1e-5 * b.abs().max(1e-3),
-                "pixel {i}, channel {c}: {a} with the attribute, {b} with the number"
+                "{name}: pixel {i}, channel {c}: {a} with the attribute, {b} written out"
             );
             lit += usize::from(b > 0.0);
         }
     }
-    assert!(lit > 0, "the quad was not seen");
+    assert!(lit > 0, "{name}: the quad was not seen");
 }
