@@ -5,7 +5,10 @@
 //!   pixel and index), the four wavelengths drawn from the film's density, the filter offset
 //!   drawn from the tent's closed form, the shutter time and the camera ray;
 //! - `to_xyz`: a sample's spectral radiance at its four wavelengths turned into CIE XYZ;
-//! - `pixel_sums`: an XYZ value added to the exact sums (and sums of squares) of a pixel.
+//! - `pixel_sums`: an XYZ value added to the exact sums (and sums of squares) of a pixel;
+//! - `cosine_hemisphere_one_lane` and `cosine_hemisphere_lanes`: the cosine-weighted direction
+//!   of a diffuse bounce, written once ([`prism_core::math::lanes::Real`]), one sample at a
+//!   time and [`F32s::LANES`] at a time (the gain of running a stage in lanes).
 //!
 //! The camera is the bundled Cornell box's at 256 × 256, the sampler `independent`; each
 //! iteration covers 4,096 samples (a 64 × 64 block of pixels, one sample each, at sample index
@@ -20,8 +23,10 @@ use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use glam::{UVec2, Vec2};
 use prism_core::camera::CameraModel;
 use prism_core::film::{Filter, FilterSampler, PixelSums, TentFilter};
+use prism_core::math::lanes::{F32s, Real};
 use prism_core::sampling::rng::Pcg32;
 use prism_core::sampling::sampler::Sampler;
+use prism_core::sampling::warp::cosine_hemisphere;
 use prism_core::spectrum::{SampledSpectrum, SampledWavelengths};
 use prism_mitsuba::load_scene;
 
@@ -93,6 +98,31 @@ fn stages(c: &mut Criterion) {
             }
         });
     });
+
+    let us: Vec<f32> = (0..BLOCK * BLOCK).map(|_| rng.next_f32()).collect();
+    let vs: Vec<f32> = (0..BLOCK * BLOCK).map(|_| rng.next_f32()).collect();
+    let mut zs = vec![0.0f32; us.len()];
+    group.bench_function("cosine_hemisphere_one_lane", |b| {
+        b.iter(|| {
+            for ((z, &u), &v) in zs.iter_mut().zip(&us).zip(&vs) {
+                let (x, y, w) = cosine_hemisphere((black_box(u), v));
+                *z = x + y + w;
+            }
+        });
+    });
+    group.bench_function("cosine_hemisphere_lanes", |b| {
+        b.iter(|| {
+            let lanes = us
+                .chunks_exact(F32s::LANES)
+                .zip(vs.chunks_exact(F32s::LANES));
+            for (z, (u, v)) in zs.chunks_exact_mut(F32s::LANES).zip(lanes) {
+                let (x, y, w) =
+                    cosine_hemisphere((F32s::from_lanes(black_box(u)), F32s::from_lanes(v)));
+                (x + y + w).write_lanes(z);
+            }
+        });
+    });
+    black_box(&zs);
     group.finish();
 }
 

@@ -5,6 +5,7 @@
 
 pub mod animated;
 pub mod frame;
+pub mod lanes;
 pub mod quadrature;
 pub mod ray;
 pub mod special;

@@ -6,36 +6,44 @@ use std::f32::consts::{FRAC_1_PI, FRAC_PI_2, FRAC_PI_4, PI};
 
 use glam::{Vec2, Vec3};
 
+use crate::math::lanes::Real;
+
 /// Shirley–Chiu concentric map of the square onto the unit disk (Shirley & Chiu 1997, "A
 /// Low Distortion Map Between Disk and Square"); uniform density 1/π.
 pub fn sample_uniform_disk_concentric(u: Vec2) -> Vec2 {
-    let offset = 2.0 * u - Vec2::ONE;
-    if offset == Vec2::ZERO {
-        return Vec2::ZERO;
-    }
-    // θ = π/4 · y/x in the wedges about ±x, π/2 − π/4 · x/y in those about ±y, whose cosine
-    // and sine are the sine and cosine of π/4 · x/y.
-    if offset.x.abs() > offset.y.abs() {
-        let (cos, sin) = cos_sin_within_quarter_pi(FRAC_PI_4 * (offset.y / offset.x));
-        offset.x * Vec2::new(cos, sin)
-    } else {
-        let (cos, sin) = cos_sin_within_quarter_pi(FRAC_PI_4 * (offset.x / offset.y));
-        offset.y * Vec2::new(sin, cos)
-    }
+    let (x, y) = concentric_disk((u.x, u.y));
+    Vec2::new(x, y)
+}
+
+/// [`sample_uniform_disk_concentric`] for one lane or for lanes ([`Real`]): the point (x, y)
+/// of the disk for u = (u₀, u₁).
+#[inline]
+pub fn concentric_disk<F: Real>((u0, u1): (F, F)) -> (F, F) {
+    let (a, b) = (u0 * 2.0 - 1.0, u1 * 2.0 - 1.0);
+    // θ = π/4 · b/a in the wedges about ±x, where the point is a (cos θ, sin θ); in those about
+    // ±y, θ = π/2 − π/4 · a/b and the point is b (sin(π/4 · a/b), cos(π/4 · a/b)).
+    let about_x = a.abs().gt(b.abs());
+    let (r, other) = (F::select(about_x, a, b), F::select(about_x, b, a));
+    let (cos, sin) = cos_sin_within_quarter_pi(other / r * FRAC_PI_4);
+    let x = r * F::select(about_x, cos, sin);
+    let y = r * F::select(about_x, sin, cos);
+    // The centre (where other / r is 0/0).
+    let zero = F::splat(0.0);
+    let centre = a.eq(zero) & b.eq(zero);
+    (F::select(centre, zero, x), F::select(centre, zero, y))
 }
 
 /// (cos a, sin a) for |a| ≤ π/4 by their Taylor series to a⁸ and a⁹, whose remainders there,
 /// a¹⁰/10! ≤ 2.5·10⁻⁸ and a¹¹/11! ≤ 1.8·10⁻⁹, are under half an f32 ulp of the results: no range
 /// reduction is needed, which makes this several times cheaper than the library's `sin_cos`.
 #[inline]
-fn cos_sin_within_quarter_pi(a: f32) -> (f32, f32) {
+fn cos_sin_within_quarter_pi<F: Real>(a: F) -> (F, F) {
     let a2 = a * a;
     let cos =
-        1.0 + a2 * (-1.0 / 2.0 + a2 * (1.0 / 24.0 + a2 * (-1.0 / 720.0 + a2 * (1.0 / 40_320.0))));
+        a2 * (a2 * (a2 * (a2 * (1.0 / 40_320.0) + -1.0 / 720.0) + 1.0 / 24.0) + -1.0 / 2.0) + 1.0;
     let sin = a
-        * (1.0
-            + a2 * (-1.0 / 6.0
-                + a2 * (1.0 / 120.0 + a2 * (-1.0 / 5_040.0 + a2 * (1.0 / 362_880.0)))));
+        * (a2 * (a2 * (a2 * (a2 * (1.0 / 362_880.0) + -1.0 / 5_040.0) + 1.0 / 120.0) + -1.0 / 6.0)
+            + 1.0);
     (cos, sin)
 }
 
@@ -76,9 +84,16 @@ pub fn invert_uniform_disk_concentric(p: Vec2) -> Vec2 {
 /// (The lecture's slide writes the lift as 1 - sqrt(x² + y²); that is a slip: docs/architecture.md,
 /// The lecture's errata.)
 pub fn sample_cosine_hemisphere(u: Vec2) -> Vec3 {
-    let d = sample_uniform_disk_concentric(u);
-    let z = (1.0 - d.length_squared()).max(0.0).sqrt();
-    Vec3::new(d.x, d.y, z)
+    let (x, y, z) = cosine_hemisphere((u.x, u.y));
+    Vec3::new(x, y, z)
+}
+
+/// [`sample_cosine_hemisphere`] for one lane or for lanes ([`Real`]).
+#[inline]
+pub fn cosine_hemisphere<F: Real>(u: (F, F)) -> (F, F, F) {
+    let (x, y) = concentric_disk(u);
+    let z = (F::splat(1.0) - (x * x + y * y)).max(F::splat(0.0)).sqrt();
+    (x, y, z)
 }
 
 /// Density of [`sample_cosine_hemisphere`] per unit solid angle: cos θ / π, zero below the horizon.
@@ -147,8 +162,15 @@ pub fn invert_uniform_cone(w: Vec3, cos_theta_max: f32) -> Vec2 {
 /// Uniform barycentric coordinates (b0, b1) on a triangle, b2 = 1 - b0 - b1 (the square-root
 /// parametrisation, Osada et al. 2002, "Shape Distributions", eq. 1).
 pub fn sample_uniform_triangle(u: Vec2) -> Vec2 {
-    let su = u.x.sqrt();
-    Vec2::new(1.0 - su, u.y * su)
+    let (b0, b1) = uniform_triangle((u.x, u.y));
+    Vec2::new(b0, b1)
+}
+
+/// [`sample_uniform_triangle`] for one lane or for lanes ([`Real`]).
+#[inline]
+pub fn uniform_triangle<F: Real>((u0, u1): (F, F)) -> (F, F) {
+    let su = u0.sqrt();
+    (F::splat(1.0) - su, u1 * su)
 }
 
 /// Inverse of [`sample_uniform_triangle`].
