@@ -241,8 +241,8 @@ fn area_light_on_a_shape_without_area() {
 #[test]
 fn emitters_nested_where_mitsuba_does_not_allow_them() {
     let dir = scene(
-        "point-in-shape",
-        "    <shape type=\"sphere\">\n        <emitter type=\"point\"/>\n    </shape>",
+        "environment-in-shape",
+        "    <shape type=\"sphere\">\n        <emitter type=\"constant\"/>\n    </shape>",
     );
     assert_error(&dir, "scene.xml:9:9", &["cannot be attached to a shape"]);
     let dir = scene(

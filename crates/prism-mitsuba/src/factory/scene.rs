@@ -223,6 +223,7 @@ impl SceneBuilder {
         // to send its power from (Mitsuba refuses it too).
         if area == 0.0
             && let Some(emitter) = &emitter
+            && !lights::is_delta(&emitter.node)
         {
             return Err(Error::input(
                 &emitter.location,
@@ -236,7 +237,7 @@ impl SceneBuilder {
             &mut self.textures,
         )?;
         let light = match emitter {
-            Some(emitter) => Some(self.attach_emitter(&shape, shape_index, emitter)?),
+            Some(emitter) => self.attach_emitter(&shape, shape_index, emitter)?,
             None => None,
         };
         bind_mesh_attributes(&mut shape, material, &self.textures, &child.node)?;
@@ -251,13 +252,24 @@ impl SceneBuilder {
         Ok(())
     }
 
-    /// The area light of the shape with index `shape_index`; the index of the light.
+    /// The emitter nested in the shape with index `shape_index`: the index of its area light,
+    /// or None for a delta emitter (`point`, `spot`, `projector`, `directional`). Mitsuba 3
+    /// lets a shape hold one of those: its radiance on the shape's surface is zero and it lights
+    /// the scene from its own `to_world`, as if declared at the top level, while the shape
+    /// takes the black default BSDF of emitting shapes; Prism does the same.
     fn attach_emitter(
         &mut self,
         shape: &Primitive,
         shape_index: u32,
         emitter: &NestedPlugin,
-    ) -> Result<u32> {
+    ) -> Result<Option<u32>> {
+        self.attach_once(emitter)?;
+        if lights::is_delta(&emitter.node) {
+            let (light, weight) = lights::build_scene_light(&emitter.node, &mut self.textures)?;
+            self.lights.push(light);
+            self.sampling_weights.push(weight);
+            return Ok(None);
+        }
         if let Primitive::Instance(instance) = shape
             && !instance.to_world.is_similarity()
         {
@@ -269,6 +281,15 @@ impl SceneBuilder {
                 "animate the emitter with rotations, translations and uniform scales only",
             ));
         }
+        let (light, weight) =
+            lights::build_area_light(&emitter.node, shape_index, &mut self.textures)?;
+        self.lights.push(light);
+        self.sampling_weights.push(weight);
+        Ok(Some((self.lights.len() - 1) as u32))
+    }
+
+    /// Records that `emitter` is attached to a shape; an error if it already is to another.
+    fn attach_once(&mut self, emitter: &NestedPlugin) -> Result<()> {
         if let Some(first) = self
             .attached_emitters
             .insert(Arc::as_ptr(&emitter.node), emitter.location.clone())
@@ -281,15 +302,11 @@ impl SceneBuilder {
                 ),
             )
             .with_help(
-                "an area emitter can be attached to a single shape (as in Mitsuba): \
-                 give each shape its own <emitter type=\"area\">",
+                "an emitter can be attached to a single shape (as in Mitsuba): \
+                 give each shape its own <emitter>",
             ));
         }
-        let (light, weight) =
-            lights::build_area_light(&emitter.node, shape_index, &mut self.textures)?;
-        self.lights.push(light);
-        self.sampling_weights.push(weight);
-        Ok((self.lights.len() - 1) as u32)
+        Ok(())
     }
 
     /// The `<emitter>` section: the lights other than area lights, and the area emitters

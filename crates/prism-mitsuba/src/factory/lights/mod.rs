@@ -72,7 +72,7 @@ pub fn build_area_light(
             ),
         )
         .with_help(
-            "only an \"area\" emitter can be nested in a shape; declare other emitters at the top level of the scene",
+            "a shape holds an \"area\" emitter, or a point, spot, projector or directional one that lights the scene from its own to_world; declare environment emitters at the top level of the scene",
         ));
     }
     let params = Params::new(node, plugin.params);
@@ -88,6 +88,19 @@ pub fn default_emitter_material() -> Material {
     Material::new(Diffuse {
         reflectance: prism_core::texture::Texture::constant(0.0),
     })
+}
+
+/// Whether `node` is an emitter of a single point or direction (`point`, `spot`, `projector`,
+/// `directional`), whose radiance on any surface is zero.
+pub fn is_delta(node: &PluginNode) -> bool {
+    node.class == PluginClass::Emitter
+        && [
+            delta::POINT.name,
+            delta::SPOT.name,
+            delta::PROJECTOR.name,
+            delta::DIRECTIONAL.name,
+        ]
+        .contains(&node.plugin_type.as_str())
 }
 
 /// Whether `node` is an `area` emitter, which emits from the shape it is attached to.

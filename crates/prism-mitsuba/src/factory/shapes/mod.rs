@@ -63,7 +63,7 @@ params! {
     /// The BSDF of every shape.
     pub BSDF = ParamSpec::nested(PluginClass::Bsdf, Default::Text("diffuse 0.5 (black when emitting)"), "what the shape is made of");
     /// The emitter of every shape.
-    pub EMITTER = ParamSpec::nested(PluginClass::Emitter, Default::None, "an `area` emitter");
+    pub EMITTER = ParamSpec::nested(PluginClass::Emitter, Default::None, "an `area` emitter; or a `point`, `spot`, `projector` or `directional` one, which lights from its own `to_world` (as in Mitsuba 3)");
     /// The medium inside a shape (the side its normals point away from).
     pub INTERIOR = ParamSpec::new("interior", ParamKind::Nested(PluginClass::Medium), Default::None, "a `<medium name=\"interior\">` (or `<ref name=\"interior\" id=\"...\"/>`) inside the shape");
     /// The medium outside a shape.
