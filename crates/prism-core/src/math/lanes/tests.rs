@@ -3,7 +3,10 @@
 
 use super::*;
 use crate::sampling::rng::Pcg32;
-use crate::sampling::warp::{concentric_disk, cosine_hemisphere, uniform_triangle};
+use crate::sampling::warp::{
+    concentric_disk, cos_sin_of_turn, cosine_hemisphere, uniform_cone, uniform_sphere,
+    uniform_triangle,
+};
 
 /// Signed zeros, infinities, NaN, tiny, huge and exact values, then random ones.
 fn numbers(n: usize, seed: u64) -> Vec<f32> {
@@ -178,7 +181,7 @@ fn lanes_compute_what_one_lane_computes<V: Real>() {
     vs.rotate_left(3);
     let mirrored: Vec<f32> = us.iter().map(|u| 1.0 - u).collect();
     for vs in [&vs, &us, &mirrored] {
-        let warps: [Warp<V>; 3] = [
+        let warps: [Warp<V>; 6] = [
             (
                 "concentric disk",
                 |u| {
@@ -194,6 +197,27 @@ fn lanes_compute_what_one_lane_computes<V: Real>() {
                 "cosine hemisphere",
                 |u| cosine_hemisphere(u).into(),
                 |u| cosine_hemisphere(u).into(),
+            ),
+            (
+                "uniform sphere",
+                |u| uniform_sphere(u).into(),
+                |u| uniform_sphere(u).into(),
+            ),
+            (
+                "uniform cone",
+                |u| uniform_cone(u, u.1 * 0.5).into(),
+                |u| uniform_cone(u, u.1 * 0.5).into(),
+            ),
+            (
+                "turn",
+                |(u, _)| {
+                    let (c, s) = cos_sin_of_turn(u);
+                    [c, s, s]
+                },
+                |(u, _)| {
+                    let (c, s) = cos_sin_of_turn(u);
+                    [c, s, s]
+                },
             ),
             (
                 "uniform triangle",
