@@ -227,6 +227,7 @@ mod tests {
     use std::f64::consts::TAU;
 
     use super::*;
+    use crate::math::lanes::F32x8;
     use crate::sampling::chi2::{Cells, Suite, chi2_rectangle};
     use crate::sampling::rng::Pcg32;
 
@@ -369,5 +370,117 @@ mod tests {
             assert!(b.x >= 0.0 && b.y >= 0.0 && b.x + b.y <= 1.0 + 1e-6);
             assert!((invert_uniform_triangle(b) - u).abs().max_element() < 1e-3);
         }
+    }
+
+    /// Numbers in [0, 1): the ends, the centre, points on the diagonals of the square, random.
+    fn unit_numbers(n: usize, seed: u64) -> Vec<f32> {
+        let mut values = vec![0.0, 0.5, 0.25, 0.75, 1.0 - f32::EPSILON / 2.0, 1e-30, 0.125];
+        let mut rng = Pcg32::seeded(seed);
+        while values.len() < n {
+            values.push(rng.next_f32());
+        }
+        values
+    }
+
+    /// A warp written once, named, as called with lanes and with one `f32`; its up to three
+    /// coordinates.
+    type Warp<V> = (
+        &'static str,
+        fn((V, V)) -> [V; 3],
+        fn((f32, f32)) -> [f32; 3],
+    );
+
+    fn same(got: f32, want: f32) -> bool {
+        got.to_bits() == want.to_bits() || (got.is_nan() && want.is_nan())
+    }
+
+    /// The warps written once ([`Real`]) give in every lane of `V`, bit for bit, what they give
+    /// for one `f32`, on random points, the square's centre, corners and diagonals.
+    fn warps_in_lanes_compute_what_one_lane_computes<V: Real>() {
+        let us = unit_numbers(4096, 3);
+        let mut vs = unit_numbers(4096, 4);
+        vs.rotate_left(3);
+        let mirrored: Vec<f32> = us.iter().map(|u| 1.0 - u).collect();
+        for vs in [&vs, &us, &mirrored] {
+            let warps: [Warp<V>; 6] = [
+                (
+                    "concentric disk",
+                    |u| {
+                        let (x, y) = concentric_disk(u);
+                        [x, y, y]
+                    },
+                    |u| {
+                        let (x, y) = concentric_disk(u);
+                        [x, y, y]
+                    },
+                ),
+                (
+                    "cosine hemisphere",
+                    |u| cosine_hemisphere(u).into(),
+                    |u| cosine_hemisphere(u).into(),
+                ),
+                (
+                    "uniform sphere",
+                    |u| uniform_sphere(u).into(),
+                    |u| uniform_sphere(u).into(),
+                ),
+                (
+                    "uniform cone",
+                    |u| uniform_cone(u, u.1 * 0.5).into(),
+                    |u| uniform_cone(u, u.1 * 0.5).into(),
+                ),
+                (
+                    "turn",
+                    |(u, _)| {
+                        let (c, s) = cos_sin_of_turn(u);
+                        [c, s, s]
+                    },
+                    |(u, _)| {
+                        let (c, s) = cos_sin_of_turn(u);
+                        [c, s, s]
+                    },
+                ),
+                (
+                    "uniform triangle",
+                    |u| {
+                        let (a, b) = uniform_triangle(u);
+                        [a, b, b]
+                    },
+                    |u| {
+                        let (a, b) = uniform_triangle(u);
+                        [a, b, b]
+                    },
+                ),
+            ];
+            for (name, lanes, one) in warps {
+                for (cu, cv) in us.chunks_exact(V::LANES).zip(vs.chunks_exact(V::LANES)) {
+                    let got = lanes((V::from_lanes(cu), V::from_lanes(cv)));
+                    for i in 0..V::LANES {
+                        let want = one((cu[i], cv[i]));
+                        for c in 0..3 {
+                            assert!(
+                                same(got[c].lane(i), want[c]),
+                                "{name}({}, {}), coordinate {c}: lane {i} gives {}, one lane {}",
+                                cu[i],
+                                cv[i],
+                                got[c].lane(i),
+                                want[c]
+                            );
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn warps_in_eight_lanes_compute_what_one_lane_computes() {
+        warps_in_lanes_compute_what_one_lane_computes::<F32x8>();
+    }
+
+    #[cfg(all(target_arch = "x86_64", target_feature = "avx512f"))]
+    #[test]
+    fn warps_in_sixteen_lanes_compute_what_one_lane_computes() {
+        warps_in_lanes_compute_what_one_lane_computes::<crate::math::lanes::F32x16>();
     }
 }
