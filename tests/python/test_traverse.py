@@ -53,6 +53,7 @@ def test_the_keys_are_mitsubas():
     x_fov = 2 * np.degrees(np.arctan(np.tan(np.radians(39.3077 / 2)) * aspect))
     assert params["sensor.x_fov"] == pytest.approx(x_fov, rel=1e-12)
     assert "red.reflectance.value" in repr(params)
+    assert params["integrator.rr_depth"] == 5, "the path integrator's default"
 
 
 def test_veach_mis_keys():
@@ -77,9 +78,11 @@ def edit(scene: Dict[str, Any], path: str, value: Any) -> Dict[str, Any]:
 LOOK = T().look_at(origin=[0.1, 0.2, 3.8], target=[0.0, 0.1, 0.0], up=[0, 1, 0])
 
 MOVED = T().translate([0.3, -0.7, 0.4]).rotate([0, 1, 0], -20).scale(0.3)
+LAMP = T().translate([0.2, 0.99, 0.1]).rotate([1, 0, 0], 90).scale([0.3, 0.15, 0.15])
 
 # (key, new value, its plugin, the entry of the dictionary it is written in, as written there):
-# a colour, a camera's transform and field of view, an emitter's radiance, a shape's transform.
+# a colour, a camera's transform and field of view, an emitter's radiance, a shape's transform
+# and an emitting shape's, and a parameter the scene leaves at its default.
 CHANGES = [
     ("red.reflectance.value", [0.2, 0.5, 0.9], "red", "red.reflectance.value", [0.2, 0.5, 0.9]),
     ("sensor.to_world", LOOK, "sensor", "sensor.to_world", LOOK),
@@ -92,6 +95,8 @@ CHANGES = [
         [9.0, 6.0, 2.5],
     ),
     ("small-box.to_world", MOVED, "small-box", "small-box.to_world", MOVED),
+    ("light.to_world", LAMP, "light", "light.to_world", LAMP),
+    ("integrator.rr_depth", 1, "integrator", "integrator.rr_depth", 1),
 ]
 
 

@@ -4,7 +4,8 @@
 //! change and `params.update()` applies the changes.
 //!
 //! A parameter is a value written in the scene's description (a property of one of its
-//! plugins). An update writes the new values into a copy of the description (plugins that
+//! plugins), or a number, integer or boolean its plugin declares and the description leaves at
+//! its default (set, it is written). An update writes the new values into a copy of the description (plugins that
 //! share a node keep sharing it) and builds the scene again from it, reading no file again
 //! ([`crate::scene::Scene::rebuild`]): the scene is the one the edited description loads from
 //! scratch, by construction. When no changed parameter belongs to a `<shape>`, the hierarchy
@@ -96,6 +97,8 @@ struct Parameter {
     /// The property the value is written in.
     property: String,
     kind: Kind,
+    /// The plugin's default, for a parameter its description does not write.
+    default: Option<PropertyValue>,
 }
 
 /// The parameters of a scene, by key, and the changes recorded but not yet applied.
@@ -160,7 +163,8 @@ impl SceneParameters {
         let node = node_at(scene.description(), &parameter.node);
         let value = (node.properties.iter())
             .find(|p| p.name == parameter.property)
-            .map(|p| &p.value);
+            .map(|p| &p.value)
+            .or(parameter.default.as_ref());
         match (&parameter.kind, value) {
             (Kind::HorizontalFov { axis, aspect }, Some(PropertyValue::Float(fov))) => {
                 Ok(horizontal_fov(*fov, *axis, *aspect)
@@ -168,7 +172,7 @@ impl SceneParameters {
                     .into_any())
             }
             (_, Some(value)) => to_python(py, value),
-            (_, None) => unreachable!("a listed parameter is written in its plugin"),
+            (_, None) => unreachable!("a listed parameter is written or has a default"),
         }
     }
 
@@ -356,17 +360,22 @@ impl Listing {
         if !self.seen.insert(Arc::as_ptr(node)) {
             return;
         }
-        for property in &node.properties {
-            let Some((mut suffix, kind)) = property_kind(&property.value) else {
+        let written = node.properties.iter().map(|p| (&p.name, &p.value, None));
+        let defaults = self.unwritten_defaults(node);
+        let defaults = (defaults.iter()).map(|(name, value)| (name, value, Some(value.clone())));
+        for (property, value, default) in written.chain(defaults) {
+            let Some((mut suffix, kind)) = property_kind(value) else {
                 continue;
             };
-            if suffix.is_empty() && self.is_textured(node, &property.name) {
+            if suffix.is_empty() && self.is_textured(node, property) {
                 suffix = ".value";
             }
-            self.push(node, &name, &path, &property.name, suffix, kind);
+            let parameter = Parameter::new(node, &name, &path, property, kind, default);
+            (self.parameters).push((format!("{name}.{property}{suffix}"), parameter));
         }
         if let Some(kind) = horizontal_fov_kind(node) {
-            self.push(node, &name, &path, "fov", "", kind);
+            let parameter = Parameter::new(node, &name, &path, "fov", kind, None);
+            self.parameters.push((format!("{name}.x_fov"), parameter));
         }
         let names = child_names(node, Some(&name));
         for (index, (child, child_name)) in node.children.iter().zip(names).enumerate() {
@@ -374,6 +383,38 @@ impl Listing {
             child_path.push(index);
             self.plugin(&child.node, child_name, child_path);
         }
+    }
+
+    /// The parameters of the plugin `node` that its description leaves at a default number,
+    /// integer or boolean (those neither written as properties nor given as nested plugins),
+    /// with their defaults, in the order the plugin declares them.
+    fn unwritten_defaults(&self, node: &PluginNode) -> Vec<(String, PropertyValue)> {
+        let Some(specs) = self.declared.get(&(node.class, node.plugin_type.as_str())) else {
+            return Vec::new();
+        };
+        let given = |name: &str| {
+            node.properties.iter().any(|p| p.name == name)
+                || (node.children.iter()).any(|c| c.name.as_deref() == Some(name))
+        };
+        (specs.iter())
+            .filter(|spec| !given(spec.name))
+            .filter_map(|spec| {
+                let value = match (spec.default, spec.kind) {
+                    (
+                        Default::Float(v),
+                        ParamKind::Float
+                        | ParamKind::FloatIn(_)
+                        | ParamKind::FloatTexture(_)
+                        | ParamKind::Spectrum { .. }
+                        | ParamKind::Volume(_),
+                    ) => PropertyValue::Float(v),
+                    (Default::Integer(n), ParamKind::Integer) => PropertyValue::Integer(n),
+                    (Default::Boolean(b), ParamKind::Boolean) => PropertyValue::Boolean(b),
+                    _ => return None,
+                };
+                Some((spec.name.to_string(), value))
+            })
+            .collect()
     }
 
     /// Whether the plugin's parameter `name` is a spectrum or texture (a nested plugin in
@@ -388,31 +429,27 @@ impl Listing {
             )
         })
     }
+}
 
-    fn push(
-        &mut self,
+impl Parameter {
+    /// The parameter written in `property` of the plugin `node`, called `plugin`, at `path`.
+    fn new(
         node: &PluginNode,
         plugin: &str,
         path: &NodePath,
         property: &str,
-        suffix: &str,
         kind: Kind,
-    ) {
-        let key = match kind {
-            Kind::HorizontalFov { .. } => format!("{plugin}.x_fov"),
-            _ => format!("{plugin}.{property}{suffix}"),
-        };
-        self.parameters.push((
-            key,
-            Parameter {
-                plugin: plugin.to_string(),
-                describe: node.describe(),
-                class: node.class,
-                node: path.clone(),
-                property: property.to_string(),
-                kind,
-            },
-        ));
+        default: Option<PropertyValue>,
+    ) -> Parameter {
+        Parameter {
+            plugin: plugin.to_string(),
+            describe: node.describe(),
+            class: node.class,
+            node: path.clone(),
+            property: property.to_string(),
+            kind,
+            default,
+        }
     }
 }
 
