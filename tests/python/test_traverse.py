@@ -245,6 +245,24 @@ def test_a_refused_update_leaves_the_scene_as_it_was():
     assert_same_image(render(scene), before)
 
 
+def test_keep_keeps_the_keys_its_patterns_match():
+    params = pr.traverse(pr.load_dict(small_cornell_box()))
+    params["white.reflectance.value"] = 0.5
+    params["red.reflectance.value"] = 0.5
+    params.keep([r".*\.reflectance\.value", "sensor.to_world"])
+    assert sorted(params) == [
+        "green.reflectance.value",
+        "red.reflectance.value",
+        "sensor.to_world",
+        "white.reflectance.value",
+    ]
+    params.keep("red")
+    assert params.keys() == ["red.reflectance.value"]
+    assert params.update() == [("red", {"red.reflectance.value"})]
+    with pytest.raises(KeyError, match='did you mean "red.reflectance.value"'):
+        params.keep("red.reflectanse.value")
+
+
 def test_a_matrix_sets_a_transform():
     scene = pr.load_dict(small_cornell_box())
     params = pr.traverse(scene)

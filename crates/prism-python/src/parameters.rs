@@ -101,6 +101,13 @@ struct Parameter {
     default: Option<PropertyValue>,
 }
 
+/// The argument of [`SceneParameters::keep`]: one pattern or several.
+#[derive(FromPyObject)]
+pub enum Patterns {
+    One(String),
+    Many(Vec<String>),
+}
+
 /// The parameters of a scene, by key, and the changes recorded but not yet applied.
 #[pyclass(module = "prism_renderer", mapping)]
 pub struct SceneParameters {
@@ -239,6 +246,37 @@ impl SceneParameters {
         Ok(updated)
     }
 
+    /// Keeps only the parameters whose keys `patterns` match: a regular expression or a list of
+    /// them, each matched at the start of a key (Python's `re.match`), as Mitsuba's `keep`
+    /// (changes recorded for the other keys are dropped); None keeps them all. A pattern that
+    /// matches no key raises `KeyError`.
+    fn keep(&mut self, py: Python<'_>, patterns: Option<Patterns>) -> PyResult<()> {
+        let patterns = match patterns {
+            None => return Ok(()),
+            Some(Patterns::One(pattern)) => vec![pattern],
+            Some(Patterns::Many(patterns)) => patterns,
+        };
+        let re = py.import("re")?;
+        let mut kept = HashSet::new();
+        for pattern in &patterns {
+            let compiled = re.call_method1("compile", (pattern,))?;
+            let mut matched = false;
+            for key in &self.keys {
+                if !compiled.call_method1("match", (key,))?.is_none() {
+                    kept.insert(key.clone());
+                    matched = true;
+                }
+            }
+            if !matched {
+                return Err(self.unknown(pattern));
+            }
+        }
+        self.keys.retain(|key| kept.contains(key));
+        self.parameters.retain(|key, _| kept.contains(key));
+        self.changes.retain(|key, _| kept.contains(key));
+        Ok(())
+    }
+
     /// A table of the parameters: key, type and plugin.
     fn __repr__(&self) -> String {
         let width = self
@@ -268,16 +306,19 @@ impl SceneParameters {
 impl SceneParameters {
     /// The parameter `key`; else a `KeyError` that suggests the closest key.
     fn parameter(&self, key: &str) -> PyResult<&Parameter> {
-        self.parameters.get(key).ok_or_else(|| {
-            let keys: Vec<&str> = self.keys.iter().map(String::as_str).collect();
-            let hint = match closest_match(key, &keys) {
-                Some(close) => format!("; did you mean \"{close}\"?"),
-                None => String::new(),
-            };
-            PyKeyError::new_err(format!(
-                "the scene has no parameter \"{key}\"{hint} (params.keys() lists them)"
-            ))
-        })
+        self.parameters.get(key).ok_or_else(|| self.unknown(key))
+    }
+
+    /// The `KeyError` for `key`, which no parameter has: it suggests the closest key.
+    fn unknown(&self, key: &str) -> PyErr {
+        let keys: Vec<&str> = self.keys.iter().map(String::as_str).collect();
+        let hint = match closest_match(key, &keys) {
+            Some(close) => format!("; did you mean \"{close}\"?"),
+            None => String::new(),
+        };
+        PyKeyError::new_err(format!(
+            "the scene has no parameter \"{key}\"{hint} (params.keys() lists them)"
+        ))
     }
 }
 

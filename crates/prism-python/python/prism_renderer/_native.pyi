@@ -100,6 +100,11 @@ class SceneParameters:
         :class:`Transform`. A change recorded and not yet applied is shown."""
     def __setitem__(self, key: str, value: ParameterValueIn) -> None:
         """Records a change; :meth:`update` applies it."""
+    def keep(self, patterns: Union[None, str, Sequence[str]]) -> None:
+        """Keeps only the parameters whose keys ``patterns`` match: a regular expression or a
+        list of them, each matched at the start of a key (``re.match``), as Mitsuba's
+        ``keep`` (changes recorded for the other keys are dropped); None keeps them
+        all. A pattern that matches no key raises ``KeyError``."""
     def update(
         self, values: Optional[Dict[str, ParameterValueIn]] = None
     ) -> List[Tuple[str, Set[str]]]:
