@@ -204,6 +204,23 @@ def test_the_sensor_and_overrides_stay_after_an_update():
     assert_same_image(render(scene), render(reference))
 
 
+def test_the_sensor_rendered_last_stays_seen_through():
+    from test_sensors import SCENE
+
+    scene = pr.load_string(SCENE)
+    pr.render(scene, sensor="side", progress=False)
+    params = pr.traverse(scene)
+    assert params["side.film.width"] == 5
+    params["shape_1.radius"] = 0.6
+    params.update()
+    assert (scene.sensor, scene.width, scene.height, scene.seed) == (1, 5, 3, 5)
+    reference = pr.load_string(SCENE.replace('value="0.4"', 'value="0.6"'))
+    assert_same_image(
+        pr.render(scene, sensor="side", progress=False),
+        pr.render(reference, sensor="side", progress=False),
+    )
+
+
 def test_an_unknown_key_names_the_closest():
     params = pr.traverse(pr.load_dict(small_cornell_box()))
     with pytest.raises(KeyError, match='did you mean "red.reflectance.value"'):
