@@ -170,6 +170,34 @@ def test_no_mesh_file_is_read_again(tmp_path):
     assert not np.array_equal(after.rgb, before.rgb)
 
 
+def test_no_image_file_is_read_again(tmp_path):
+    pixels = np.linspace(0.1, 0.9, 4 * 6 * 3, dtype=np.float32).reshape(4, 6, 3)
+    pr.write_image(tmp_path / "texture.exr", pixels)
+    scene_text = """<scene version="3.0.0">
+        <sensor type="perspective">
+            <float name="fov" value="{fov}"/>
+            <transform name="to_world"><lookat origin="0, 0, 3" target="0, 0, 0" up="0, 1, 0"/></transform>
+            <sampler type="independent"><integer name="sample_count" value="4"/></sampler>
+            <film type="hdrfilm"><integer name="width" value="8"/><integer name="height" value="6"/></film>
+        </sensor>
+        <shape type="rectangle">
+            <bsdf type="diffuse"><texture name="reflectance" type="bitmap"><string name="filename" value="texture.exr"/></texture></bsdf>
+        </shape>
+        <emitter type="constant"/>
+    </scene>"""
+    loaded = tmp_path / "loaded.xml"
+    loaded.write_text(scene_text.format(fov=45))
+    edited = tmp_path / "edited.xml"
+    edited.write_text(scene_text.format(fov=30))
+    reference = render(pr.load_file(edited))
+    scene = pr.load_file(loaded)
+    (tmp_path / "texture.exr").unlink()
+    params = pr.traverse(scene)
+    params["sensor.x_fov"] = 30
+    params.update()
+    assert_same_image(render(scene), reference)
+
+
 def test_a_sampled_spectrum_keeps_its_wavelengths(cornell_path, tmp_path):
     scene = pr.load_file(cornell_path, **SIZE)
     params = pr.traverse(scene)

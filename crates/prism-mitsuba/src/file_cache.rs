@@ -1,5 +1,5 @@
-//! The files a scene names (meshes, curves, grids), kept so that a scene built again from an
-//! edited description reads none of them twice.
+//! The files a scene names (meshes, curves, grids, images), kept so that a scene built again
+//! from an edited description reads none of them twice.
 //!
 //! The readers take a file's bytes through [`read`], and what they make of them (a mesh)
 //! through [`parsed`]: from the cache that [`FileCache::scope`] put in place on this thread,

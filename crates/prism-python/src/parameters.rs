@@ -4,20 +4,20 @@
 //! change and `params.update()` applies the changes.
 //!
 //! A parameter is a value written in the scene's description (a property of one of its
-//! plugins), or a number, integer or boolean its plugin declares and the description leaves at
-//! its default (set, it is written). An update writes the new values into a copy of the description (plugins that
-//! share a node keep sharing it) and builds the scene again from it, reading no file again
-//! ([`crate::scene::Scene::rebuild`]): the scene is the one the edited description loads from
-//! scratch, by construction. When no changed parameter belongs to a `<shape>`, the hierarchy
-//! over the shapes is kept.
+//! plugins), or a number, integer or boolean that its plugin declares and the description
+//! leaves at its default (set, it is written). An update writes the new values into a copy of
+//! the description (plugins that share a node keep sharing it) and builds the scene again
+//! from it, reading no file again ([`crate::scene::Scene::rebuild`]): the scene is the one the
+//! edited description loads from scratch, by construction. When no changed parameter belongs
+//! to a `<shape>`, the hierarchy over the shapes is kept.
 //!
 //! Keys: a plugin with an `id` is called by it; one without by its `name` (its key in a
 //! dictionary) or else its class, numbered from 0 when several siblings share it, after its
 //! parent's name and a dot (`light.emitter`, `sensor.film`; in the scene itself `sensor`,
-//! `shape_0`, `shape_1`). A property is `<plugin>.<name>`,
-//! a colour or spectrum `<plugin>.<name>.value` (`.values` for one sampled at wavelengths), and
-//! a `perspective` or `thinlens` sensor with a `fov` has `<sensor>.x_fov`, its horizontal field
-//! of view.
+//! `shape_0`, `shape_1`). A property is `<plugin>.<name>`, a colour, a spectrum or a number
+//! where a texture may stand `<plugin>.<name>.value` (`.values` for a spectrum sampled at
+//! wavelengths), and a `perspective` or `thinlens` sensor with a `fov` has `<sensor>.x_fov`,
+//! its horizontal field of view.
 
 use std::collections::{BTreeMap, HashMap, HashSet};
 use std::sync::Arc;
