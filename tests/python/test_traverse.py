@@ -308,6 +308,19 @@ def test_keep_keeps_the_keys_its_patterns_match():
         params.keep("red.reflectanse.value")
 
 
+def test_a_scene_cannot_change_while_it_renders():
+    scene = pr.load_dict(small_cornell_box())
+    params = pr.traverse(scene)
+    params["red.reflectance.value"] = 0.3
+
+    def progress(samples: int, total: object, error: float) -> None:
+        params.update()
+
+    with pytest.raises(pr.PrismError, match="the scene is rendering"):
+        pr.render(scene, progress=progress)
+    assert params["red.reflectance.value"].tolist() == [0.3] * 3, "the change stays recorded"
+
+
 def test_a_matrix_sets_a_transform():
     scene = pr.load_dict(small_cornell_box())
     params = pr.traverse(scene)

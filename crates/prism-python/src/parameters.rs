@@ -121,16 +121,27 @@ pub struct SceneParameters {
 
 /// The parameters of `scene`, to read and change.
 #[pyfunction]
-pub fn traverse(scene: Bound<'_, Scene>) -> SceneParameters {
+pub fn traverse(scene: Bound<'_, Scene>) -> PyResult<SceneParameters> {
     let mut listing = Listing::default();
-    listing.plugins(&scene.borrow().description().clone());
+    let description = (scene.try_borrow().map_err(|_| rendering(scene.py()))?)
+        .description()
+        .clone();
+    listing.plugins(&description);
     let parameters = listing.parameters.iter().cloned().collect();
-    SceneParameters {
+    Ok(SceneParameters {
         scene: scene.unbind(),
         parameters,
         keys: listing.parameters.into_iter().map(|(key, _)| key).collect(),
         changes: BTreeMap::new(),
-    }
+    })
+}
+
+/// The error for a scene held by a render that changes it (one with a crop window).
+fn rendering(py: Python<'_>) -> PyErr {
+    to_py(
+        py,
+        &Error::usage("the scene is rendering: read or change its parameters after the render"),
+    )
 }
 
 #[pymethods]
@@ -166,7 +177,7 @@ impl SceneParameters {
         if let Some(value) = self.changes.get(key) {
             return to_python(py, value);
         }
-        let scene = self.scene.borrow(py);
+        let scene = self.scene.try_borrow(py).map_err(|_| rendering(py))?;
         let node = node_at(scene.description(), &parameter.node);
         let value = (node.properties.iter())
             .find(|p| p.name == parameter.property)
@@ -214,12 +225,7 @@ impl SceneParameters {
             return Ok(Vec::new());
         }
         let scene = self.scene.bind(py);
-        let mut scene = scene.try_borrow_mut().map_err(|_| {
-            to_py(
-                py,
-                &Error::usage("the scene is rendering: update its parameters after the render"),
-            )
-        })?;
+        let mut scene = scene.try_borrow_mut().map_err(|_| rendering(py))?;
         let mut edits: HashMap<*const PluginNode, Vec<(String, PropertyValue)>> = HashMap::new();
         let mut same_shapes = true;
         for (key, value) in &self.changes {
