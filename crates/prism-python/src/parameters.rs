@@ -19,6 +19,7 @@
 //! wavelengths), and a `perspective` or `thinlens` sensor with a `fov` has `<sensor>.x_fov`,
 //! its horizontal field of view.
 
+use std::collections::btree_map::Entry;
 use std::collections::{BTreeMap, HashMap, HashSet};
 use std::sync::Arc;
 
@@ -127,11 +128,20 @@ pub fn traverse(scene: Bound<'_, Scene>) -> PyResult<SceneParameters> {
         .description()
         .clone();
     listing.plugins(&description);
-    let parameters = listing.parameters.iter().cloned().collect();
+    // Where two plugins would give one key (an `id` equal to another plugin's generated
+    // name), the first in document order has it.
+    let mut parameters = BTreeMap::new();
+    let mut keys = Vec::new();
+    for (key, parameter) in listing.parameters {
+        if let Entry::Vacant(entry) = parameters.entry(key.clone()) {
+            entry.insert(parameter);
+            keys.push(key);
+        }
+    }
     Ok(SceneParameters {
         scene: scene.unbind(),
         parameters,
-        keys: listing.parameters.into_iter().map(|(key, _)| key).collect(),
+        keys,
         changes: BTreeMap::new(),
     })
 }
