@@ -117,6 +117,26 @@ def test_an_update_renders_as_the_edited_scene_from_scratch(key, value, plugin, 
     assert not np.array_equal(after.rgb, before.rgb), "the change shows in the image"
 
 
+def test_a_dielectrics_eta_is_its_relative_index():
+    def with_glass(**indices: float) -> Dict[str, Any]:
+        scene = small_cornell_box()
+        scene["large-box"]["bsdf"] = {"type": "dielectric", **indices}
+        return scene
+
+    scene = pr.load_dict(with_glass())
+    before = render(scene)
+    params = pr.traverse(scene)
+    assert params["large-box.bsdf.eta"] == pytest.approx(1.5046 / 1.000277, rel=1e-6)
+    params["large-box.bsdf.eta"] = 1.33
+    params.update()
+    assert params["large-box.bsdf.eta"] == 1.33
+    after = render(scene)
+    assert_same_image(after, render(pr.load_dict(with_glass(int_ior=1.33, ext_ior=1.0))))
+    assert not np.array_equal(after.rgb, before.rgb)
+    with pytest.raises(pr.PrismError, match="a positive number"):
+        params["large-box.bsdf.eta"] = 0
+
+
 def test_several_changes_and_update_with_values():
     scene = pr.load_dict(small_cornell_box())
     params = pr.traverse(scene)

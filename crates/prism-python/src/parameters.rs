@@ -34,6 +34,7 @@ use crate::scene::Scene;
 use crate::transform::Transform;
 use prism_core::camera::perspective::{FovAxis, horizontal_fov};
 use prism_core::error::Error;
+use prism_core::spectrum::ior::named_ior;
 use prism_mitsuba::description::{
     NestedPlugin, PluginClass, PluginNode, Property, PropertyValue, SpectrumValue,
 };
@@ -68,13 +69,23 @@ enum Kind {
         axis: FovAxis,
         aspect: f64,
     },
+    /// Mitsuba's `eta` of a dielectric interface, `int_ior` / `ext_ior` (each a number or a
+    /// name; absent, the named default `interior` or `exterior`); set, it becomes `int_ior`
+    /// over an `ext_ior` of 1.
+    RelativeIor {
+        interior: &'static str,
+        exterior: &'static str,
+    },
 }
 
 impl Kind {
     /// The parameter's type, for the table and for messages.
     fn describe(&self) -> &'static str {
         match self {
-            Kind::Float | Kind::UniformSpectrum | Kind::HorizontalFov { .. } => "float",
+            Kind::Float
+            | Kind::UniformSpectrum
+            | Kind::HorizontalFov { .. }
+            | Kind::RelativeIor { .. } => "float",
             Kind::Integer => "int",
             Kind::Boolean => "bool",
             Kind::Rgb => "rgb",
@@ -189,6 +200,10 @@ impl SceneParameters {
         }
         let scene = self.scene.try_borrow(py).map_err(|_| rendering(py))?;
         let node = node_at(scene.description(), &parameter.node);
+        if let Kind::RelativeIor { interior, exterior } = parameter.kind {
+            let eta = relative_ior(node, interior, exterior).expect("listed with numeric indices");
+            return Ok(eta.into_pyobject(py)?.into_any());
+        }
         let value = (node.properties.iter())
             .find(|p| p.name == parameter.property)
             .map(|p| &p.value)
@@ -244,8 +259,14 @@ impl SceneParameters {
             same_shapes &= parameter.class != PluginClass::Shape;
             let edits = edits.entry(Arc::as_ptr(node)).or_default();
             edits.push((parameter.property.clone(), value.clone()));
-            if let Kind::HorizontalFov { .. } = parameter.kind {
-                edits.push(("fov_axis".into(), PropertyValue::String("x".into())));
+            match parameter.kind {
+                Kind::HorizontalFov { .. } => {
+                    edits.push(("fov_axis".into(), PropertyValue::String("x".into())));
+                }
+                Kind::RelativeIor { .. } => {
+                    edits.push(("ext_ior".into(), PropertyValue::Float(1.0)))
+                }
+                _ => {}
             }
         }
         let description = edited(scene.description(), &edits, &mut HashMap::new());
@@ -434,6 +455,10 @@ impl Listing {
             let parameter = Parameter::new(node, &name, &path, "fov", kind, None);
             self.parameters.push((format!("{name}.x_fov"), parameter));
         }
+        if let Some(kind) = self.relative_ior_kind(node) {
+            let parameter = Parameter::new(node, &name, &path, "int_ior", kind, None);
+            self.parameters.push((format!("{name}.eta"), parameter));
+        }
         let names = child_names(node, Some(&name));
         for (index, (child, child_name)) in node.children.iter().zip(names).enumerate() {
             let mut child_path = path.clone();
@@ -472,6 +497,24 @@ impl Listing {
                 Some((spec.name.to_string(), value))
             })
             .collect()
+    }
+
+    /// Mitsuba's `eta` of a plugin that declares `int_ior` and `ext_ior`, when both are numbers
+    /// or names (not spectra).
+    fn relative_ior_kind(&self, node: &PluginNode) -> Option<Kind> {
+        let specs = self
+            .declared
+            .get(&(node.class, node.plugin_type.as_str()))?;
+        let default = |name: &str| {
+            let spec = specs.iter().find(|spec| spec.name == name)?;
+            match spec.default {
+                Default::Str(index) => Some(index),
+                _ => None,
+            }
+        };
+        let (interior, exterior) = (default("int_ior")?, default("ext_ior")?);
+        relative_ior(node, interior, exterior)?;
+        Some(Kind::RelativeIor { interior, exterior })
     }
 
     /// Whether the plugin's parameter `name` is a spectrum or texture (a nested plugin in
@@ -606,6 +649,21 @@ fn horizontal_fov_kind(node: &PluginNode) -> Option<Kind> {
     Some(Kind::HorizontalFov { axis, aspect })
 }
 
+/// `int_ior` / `ext_ior` of the plugin `node`, each a number or a name, or absent the named
+/// default (`interior`, `exterior`); None when either is a spectrum.
+fn relative_ior(node: &PluginNode, interior: &str, exterior: &str) -> Option<f64> {
+    let index = |name: &str, default: &str| {
+        let value = (node.properties.iter()).find(|p| p.name == name);
+        match value.map(|p| &p.value) {
+            Some(PropertyValue::Float(v)) => Some(*v),
+            Some(PropertyValue::String(named)) => named_ior(named).map(f64::from),
+            None => named_ior(default).map(f64::from),
+            Some(_) => None,
+        }
+    };
+    Some(index("int_ior", interior)? / index("ext_ior", exterior)?)
+}
+
 /// A value of the description as the Python value of the parameter.
 fn to_python<'py>(py: Python<'py>, value: &PropertyValue) -> PyResult<Bound<'py, PyAny>> {
     let array = |values: Vec<f64>| values.into_pyarray(py).into_any();
@@ -679,6 +737,13 @@ fn from_python(
                 return Err(refuse("an angle in degrees between 0 and 180"));
             }
             PropertyValue::Float(fov)
+        }
+        Kind::RelativeIor { .. } => {
+            let eta = number("a positive number")?;
+            if eta <= 0.0 {
+                return Err(refuse("a positive number"));
+            }
+            PropertyValue::Float(eta)
         }
         Kind::UniformSpectrum => {
             PropertyValue::Spectrum(SpectrumValue::Uniform(number("a finite number")?))
