@@ -16,8 +16,9 @@
 //! parent's name and a dot (`light.emitter`, `sensor.film`; in the scene itself `sensor`,
 //! `shape_0`, `shape_1`). A property is `<plugin>.<name>`, a colour, a spectrum or a number
 //! where a texture may stand `<plugin>.<name>.value` (`.values` for a spectrum sampled at
-//! wavelengths), and a `perspective` or `thinlens` sensor with a `fov` has `<sensor>.x_fov`,
-//! its horizontal field of view.
+//! wavelengths); a `perspective` or `thinlens` sensor with a `fov` has `<sensor>.x_fov`, its
+//! horizontal field of view, and a BSDF with `int_ior` and `ext_ior` has `<bsdf>.eta`, their
+//! ratio.
 
 use std::collections::btree_map::Entry;
 use std::collections::{BTreeMap, HashMap, HashSet};
