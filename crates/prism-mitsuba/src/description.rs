@@ -13,6 +13,7 @@ use std::sync::Arc;
 use glam::{DMat4, DVec3};
 
 use crate::element::quote;
+use crate::file_cache;
 use prism_core::error::{Error, Result, SourceLocation};
 
 /// The kind of object an XML element declares; the element's tag name.
@@ -200,15 +201,17 @@ impl PluginNode {
     }
 }
 
-/// Finds the file `name`: an absolute path as it is, a relative one in `dirs`, in order; the
-/// error, at `location`, says where it looked.
+/// Finds the file `name`: an absolute path as it is, a relative one in `dirs`, in order (a file
+/// the [`file_cache`] in scope holds is found even if it no longer exists); the error, at
+/// `location`, says where it looked.
 pub fn find_file(name: &str, dirs: &[PathBuf], location: &SourceLocation) -> Result<PathBuf> {
     let path = Path::new(name);
+    let exists = |path: &Path| path.exists() || file_cache::holds(path);
     if path.is_absolute() {
-        if path.exists() {
+        if exists(path) {
             return Ok(path.to_path_buf());
         }
-    } else if let Some(found) = dirs.iter().map(|dir| dir.join(path)).find(|p| p.exists()) {
+    } else if let Some(found) = dirs.iter().map(|dir| dir.join(path)).find(|p| exists(p)) {
         return Ok(found);
     }
     let searched: Vec<String> = dirs

@@ -90,7 +90,7 @@ fn add_node(hash: &mut Fnv64, node: &PluginNode) {
         if property.name == "filename"
             && let PropertyValue::String(name) = &property.value
             && let Ok(path) = node.resolve_file(name, &property.location)
-            && let Ok(bytes) = std::fs::read(path)
+            && let Ok(bytes) = crate::file_cache::read(&path)
         {
             hash.write(&bytes);
         }

@@ -10,6 +10,7 @@ pub mod description;
 pub mod dict;
 mod element;
 pub mod factory;
+pub mod file_cache;
 pub mod fingerprint;
 pub mod mesh;
 pub mod params;
@@ -26,25 +27,10 @@ use std::path::Path;
 pub use factory::LoadedScene;
 use prism_core::error::Result;
 
-/// Reads a scene in Mitsuba 3's dictionary form (see [`dict`]) and builds it.
-pub fn load_scene_dict(root: &dict::Dict) -> Result<LoadedScene> {
-    let tree = dict::read_scene_dict(root)?;
-    factory::build_scene(&tree)
-}
-
 /// Reads a Mitsuba XML scene file (with `-D name=value` overrides) and builds it; the reader's
 /// warnings come first.
 pub fn load_scene(path: &Path, defines: &[(String, String)]) -> Result<LoadedScene> {
     let document = reader::read_scene_document(path, defines)?;
-    let mut loaded = factory::build_scene(&document.root)?;
-    loaded.warnings.splice(0..0, document.warnings);
-    Ok(loaded)
-}
-
-/// Reads a Mitsuba XML scene given as text and builds it, as [`load_scene`]; messages name the
-/// text `<string>`, and relative file names are found from the current folder.
-pub fn load_scene_str(text: &str, defines: &[(String, String)]) -> Result<LoadedScene> {
-    let document = reader::read_scene_str_document(text, Path::new("<string>"), defines)?;
     let mut loaded = factory::build_scene(&document.root)?;
     loaded.warnings.splice(0..0, document.warnings);
     Ok(loaded)

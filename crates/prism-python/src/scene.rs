@@ -1,24 +1,117 @@
 //! Loading scenes: from a Mitsuba XML file with `-D`-style defines, or from Mitsuba's
 //! dictionary form; both build through prism-mitsuba's factory, with its checks and messages.
+//! A scene keeps its description and the files it read, to be built again when its
+//! parameters change ([`crate::parameters`]).
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::dict::dict_of;
 use crate::error::{IntoPyResult, to_py};
-use prism_core::error::Error;
+use prism_core::error::{Error, Result};
 use prism_core::film::Reconstruction;
+use prism_core::geometry::Geometry;
 use prism_core::spectrum::WavelengthSampling;
+use prism_mitsuba::description::{PluginNode, Warning};
+use prism_mitsuba::factory::build_scene_with_geometry;
+use prism_mitsuba::file_cache::FileCache;
 use prism_mitsuba::fingerprint::{override_reconstruction, override_wavelengths};
-use prism_mitsuba::{LoadedScene, load_scene, load_scene_dict, load_scene_str};
+use prism_mitsuba::reader::{SceneDocument, read_scene_document, read_scene_str_document};
+use prism_mitsuba::{LoadedScene, dict};
 
 /// A scene ready to render. Its settings that `prism render` can override from the command
 /// line are properties that may be set (not while the scene renders).
 #[pyclass(module = "prism_renderer")]
 pub struct Scene {
     pub loaded: LoadedScene,
+    /// The description the scene was built from.
+    description: Arc<PluginNode>,
+    /// The reader's warnings about the description, which lead `loaded`'s.
+    reader_warnings: Vec<Warning>,
+    /// The files the build read, for building the scene again.
+    files: FileCache,
+    /// The wavelength density and the reconstruction set in place of the film's.
+    wavelengths: Option<WavelengthSampling>,
+    reconstruction: Option<Reconstruction>,
+}
+
+impl Scene {
+    /// Builds the scene a reader described.
+    fn build(py: Python<'_>, document: SceneDocument) -> PyResult<Scene> {
+        let files = FileCache::default();
+        let description = document.root;
+        let loaded = py
+            .detach(|| files.scope(|| build(&description, &mut None, &document.warnings)))
+            .into_py_result(py)?;
+        Ok(Scene {
+            loaded,
+            description,
+            reader_warnings: document.warnings,
+            files,
+            wavelengths: None,
+            reconstruction: None,
+        })
+    }
+
+    /// The description the scene was built from.
+    pub fn description(&self) -> &Arc<PluginNode> {
+        &self.description
+    }
+
+    /// Builds the scene again from `description`, an edit of its own with the same plugins,
+    /// reading no file again. With `same_shapes` (no parameter of a `<shape>` changed) the
+    /// hierarchy over the shapes is kept rather than built again. The scene is seen through
+    /// the same sensor, with the same overrides; on an error it is left as it was.
+    pub fn rebuild(
+        &mut self,
+        py: Python<'_>,
+        description: Arc<PluginNode>,
+        same_shapes: bool,
+    ) -> PyResult<()> {
+        let mut geometry = same_shapes.then(|| {
+            let world = &mut self.loaded.scene.world;
+            std::mem::replace(&mut world.geometry, Geometry::new(Vec::new()))
+        });
+        let files = &self.files;
+        let warnings = &self.reader_warnings;
+        let built = py.detach(|| files.scope(|| build(&description, &mut geometry, warnings)));
+        let mut loaded = match built {
+            Ok(loaded) => loaded,
+            Err(error) => {
+                if let Some(geometry) = geometry {
+                    self.loaded.scene.world.geometry = geometry;
+                }
+                return Err(to_py(py, &error));
+            }
+        };
+        (loaded.select_sensor(self.loaded.selected_sensor())).into_py_result(py)?;
+        if let Some(density) = self.wavelengths {
+            override_wavelengths(&mut loaded.scene, density);
+        }
+        if let Some(reconstruction) = self.reconstruction {
+            override_reconstruction(&mut loaded.scene, reconstruction);
+        }
+        self.loaded = loaded;
+        self.description = description;
+        Ok(())
+    }
+}
+
+/// The scene `description` describes, with the hierarchy `geometry` holds if any, its
+/// warnings led by the reader's.
+fn build(
+    description: &PluginNode,
+    geometry: &mut Option<Geometry>,
+    reader_warnings: &[Warning],
+) -> Result<LoadedScene> {
+    let mut loaded = build_scene_with_geometry(description, geometry)?;
+    loaded
+        .warnings
+        .splice(0..0, reader_warnings.iter().cloned());
+    Ok(loaded)
 }
 
 #[pymethods]
@@ -64,6 +157,7 @@ impl Scene {
             &WavelengthSampling::NAMES,
         )?;
         override_wavelengths(&mut self.loaded.scene, density);
+        self.wavelengths = Some(density);
         Ok(())
     }
 
@@ -84,6 +178,7 @@ impl Scene {
             &Reconstruction::NAMES,
         )?;
         override_reconstruction(&mut self.loaded.scene, reconstruction);
+        self.reconstruction = Some(reconstruction);
         Ok(())
     }
 
@@ -117,14 +212,15 @@ impl Scene {
 #[pyfunction]
 #[pyo3(signature = (path, defines = Vec::new()))]
 pub fn load_file(py: Python<'_>, path: PathBuf, defines: Vec<(String, String)>) -> PyResult<Scene> {
-    let loaded = py
-        .detach(|| load_scene(&path, &defines))
+    let document = py
+        .detach(|| read_scene_document(&path, &defines))
         .into_py_result(py)?;
-    Ok(Scene { loaded })
+    Scene::build(py, document)
 }
 
 /// Loads a Mitsuba XML scene given as the string `text`, with `defines` as in [`load_file`];
-/// relative file names are found from the current folder.
+/// relative file names are found from the current folder, and messages name the text
+/// `<string>`.
 #[pyfunction]
 #[pyo3(signature = (text, defines = Vec::new()))]
 pub fn load_string(
@@ -132,18 +228,24 @@ pub fn load_string(
     text: String,
     defines: Vec<(String, String)>,
 ) -> PyResult<Scene> {
-    let loaded = py
-        .detach(|| load_scene_str(&text, &defines))
+    let document = py
+        .detach(|| read_scene_str_document(&text, Path::new("<string>"), &defines))
         .into_py_result(py)?;
-    Ok(Scene { loaded })
+    Scene::build(py, document)
 }
 
 /// Loads a scene given in Mitsuba's dictionary form.
 #[pyfunction]
 pub fn load_dict(py: Python<'_>, scene: &Bound<'_, PyDict>) -> PyResult<Scene> {
     let root = dict_of(scene, "scene")?;
-    let loaded = py.detach(|| load_scene_dict(&root)).into_py_result(py)?;
-    Ok(Scene { loaded })
+    let description = py
+        .detach(|| dict::read_scene_dict(&root))
+        .into_py_result(py)?;
+    let document = SceneDocument {
+        root: description,
+        warnings: Vec::new(),
+    };
+    Scene::build(py, document)
 }
 
 /// The setting called `name`, read by `from_name`; else a usage error that names the `what` and

@@ -15,7 +15,7 @@ use prism_mitsuba::dict::transform;
 #[pyclass(module = "prism_renderer", frozen)]
 #[derive(Clone, Copy)]
 pub struct Transform {
-    matrix: DMat4,
+    pub matrix: DMat4,
 }
 
 impl Transform {

@@ -150,8 +150,13 @@ fn unreadable(path: &Path, reason: impl std::fmt::Display) -> Error {
 /// with [`Error::at`].
 pub fn read_bitmap(path: &Path) -> Result<Bitmap> {
     let bytes = std::fs::read(path).map_err(|e| Error::io(path, &e, "open the image"))?;
-    let format = FileFormat::detect(&bytes, path).map_err(|reason| unreadable(path, reason))?;
-    decode_bitmap(&bytes, format, MAX_PIXELS).map_err(|reason| unreadable(path, reason))
+    decode_bitmap_file(&bytes, path)
+}
+
+/// Decodes `bytes`, read from the image file at `path`, with [`read_bitmap`]'s errors.
+pub fn decode_bitmap_file(bytes: &[u8], path: &Path) -> Result<Bitmap> {
+    let format = FileFormat::detect(bytes, path).map_err(|reason| unreadable(path, reason))?;
+    decode_bitmap(bytes, format, MAX_PIXELS).map_err(|reason| unreadable(path, reason))
 }
 
 /// Decodes the bytes of an image file of the given format, of at most `max_pixels` pixels

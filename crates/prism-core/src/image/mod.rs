@@ -18,7 +18,9 @@ use std::fs::{self, File};
 use std::io::{self, BufWriter, Write};
 use std::path::{Path, PathBuf};
 
-pub use bitmap::{Bitmap, Encoding, FileFormat, MAX_PIXELS, decode_bitmap, read_bitmap};
+pub use bitmap::{
+    Bitmap, Encoding, FileFormat, MAX_PIXELS, decode_bitmap, decode_bitmap_file, read_bitmap,
+};
 pub use exr::{
     Attribute, ChannelImage, ExrHeader, read_exr, read_exr_with_header, write_exr, write_exr_with,
 };

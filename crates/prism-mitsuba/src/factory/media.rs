@@ -395,7 +395,7 @@ fn build_gridvolume(params: &Params, range: Range) -> Result<Volume> {
     })?;
     let location = params.location_of(&FILENAME);
     let path = node.resolve_file(filename, location)?;
-    let bytes = std::fs::read(&path).map_err(|e| {
+    let bytes = crate::file_cache::read(&path).map_err(|e| {
         Error::input(
             location,
             format!("cannot read the grid \"{}\": {e}", path.display()),

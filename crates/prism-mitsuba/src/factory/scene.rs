@@ -60,6 +60,17 @@ const SCENE: &[ParamSpec] = &[
 /// Builds the scene described by the root `<scene>` node, section by section; each section
 /// reports its errors in the order Mitsuba would.
 pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
+    build_scene_with_geometry(root, &mut None)
+}
+
+/// Builds the scene as [`build_scene`] does, but with the hierarchy `geometry` holds in place of
+/// one built over the shapes, taken from it when the build succeeds (and left there when it
+/// fails). The caller vouches that `geometry` was built from the same shapes: those of a
+/// description whose `<shape>` plugins, shape groups and instances are all unchanged.
+pub fn build_scene_with_geometry(
+    root: &PluginNode,
+    geometry: &mut Option<Geometry>,
+) -> Result<LoadedScene> {
     let params = Params::new(root, SCENE);
     let integrator_child = params.single_child(&INTEGRATOR)?;
     let integrator = integrator(integrator_child)?;
@@ -104,7 +115,8 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
         integrators::direct_delta_light_warning(&child.node, &integrator, &builder.lights)
     });
     warnings.extend(delta_light_warning);
-    Ok(builder.finish(root, integrator, scene_sensors, warnings))
+    let geometry = geometry.take();
+    Ok(builder.finish(root, integrator, scene_sensors, warnings, geometry))
 }
 
 /// The scene's integrator, `path` by default.
@@ -366,16 +378,18 @@ impl SceneBuilder {
         Ok(())
     }
 
-    /// The scene, from the parts read, seen through the first sensor.
+    /// The scene, from the parts read, seen through the first sensor; `geometry`, when given,
+    /// is the hierarchy over the shapes read.
     fn finish(
         self,
         root: &PluginNode,
         integrator: Integrator,
         sensors: Vec<SceneSensor>,
         warnings: Vec<Warning>,
+        geometry: Option<Geometry>,
     ) -> LoadedScene {
         let mut world = World::new(
-            Geometry::new(self.shapes),
+            geometry.unwrap_or_else(|| Geometry::new(self.shapes)),
             self.shape_info,
             self.materials.materials,
             self.lights,

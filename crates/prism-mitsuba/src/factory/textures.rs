@@ -7,10 +7,12 @@
 //! (element, use), so a bitmap referenced by many materials is read and stored once.
 
 use std::collections::HashMap;
+use std::path::Path;
 use std::sync::Arc;
 
 use super::spectra::spectrum_param;
 use crate::description::{PluginClass, PluginNode, PropertyValue, SpectrumValue};
+use crate::file_cache;
 use crate::params::Params;
 use crate::registry::Range;
 use crate::registry::{
@@ -18,7 +20,7 @@ use crate::registry::{
 };
 use prism_core::error::{Error, Result};
 use prism_core::geometry::interaction::MAX_MESH_ATTRIBUTES;
-use prism_core::image::{Bitmap, Encoding, read_bitmap};
+use prism_core::image::{Bitmap, Encoding, decode_bitmap_file};
 use prism_core::spectrum::{LAMBDA_MAX, LAMBDA_MIN, RgbIntent, Spectrum};
 use prism_core::texture::{
     BitmapTexture, Checkerboard, FilterType, TextureUse, UvTransform, WrapMode,
@@ -508,7 +510,7 @@ fn build_bitmap(params: &Params, usage: TextureUse) -> Result<Texture> {
     let raw = params.boolean(&RAW)?;
     let to_uv = UvTransform::from_matrix(&params.transform(&TO_UV)?);
     let path = node.resolve_file(filename, location)?;
-    let mut bitmap = read_bitmap(&path).map_err(|e| e.at(location))?;
+    let mut bitmap = read_image_file(&path).map_err(|e| e.at(location))?;
     if usage == TextureUse::Rgb && !raw && bitmap.encoding == Encoding::Srgb {
         return Err(Error::input(
             params.location(),
@@ -526,4 +528,11 @@ fn build_bitmap(params: &Params, usage: TextureUse) -> Result<Texture> {
     Ok(Texture::Bitmap(Arc::new(BitmapTexture::new(
         &bitmap, usage, filter, wrap, to_uv,
     ))))
+}
+
+/// The image file at `path`, decoded (`bitmap` textures and environment maps); its bytes come
+/// through the [`file_cache`] in scope, so that a scene built again reads it once.
+pub fn read_image_file(path: &Path) -> Result<Bitmap> {
+    let bytes = file_cache::read(path).map_err(|e| Error::io(path, &e, "open the image"))?;
+    decode_bitmap_file(&bytes, path)
 }

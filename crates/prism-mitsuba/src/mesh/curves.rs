@@ -11,6 +11,7 @@ use std::path::Path;
 
 use glam::Vec4;
 
+use crate::file_cache;
 use prism_core::error::{Error, Result, SourceLocation};
 
 /// The longest line Mitsuba's reader takes, in bytes (its buffer of 1025 less the terminator).
@@ -28,7 +29,7 @@ pub struct CurveData {
 /// Reads a curve file (see the module documentation) whose curves have at least `min_points`
 /// control points each.
 pub fn load_curves(path: &Path, min_points: usize) -> Result<CurveData> {
-    let bytes = std::fs::read(path).map_err(|e| Error::io(path, &e, "read the curves"))?;
+    let bytes = file_cache::read(path).map_err(|e| Error::io(path, &e, "read the curves"))?;
     parse_curves(&bytes, path, min_points)
 }
 

@@ -24,6 +24,7 @@ use std::path::Path;
 
 use glam::{Vec2, Vec3};
 
+use crate::file_cache;
 use prism_core::error::{Error, Result};
 use prism_core::geometry::shape::MeshAttribute;
 
@@ -54,20 +55,24 @@ pub struct MeshData {
 
 /// Reads a Wavefront OBJ file (see [`obj`]).
 pub fn load_obj(path: &Path) -> Result<MeshData> {
-    let bytes = std::fs::read(path).map_err(|e| Error::io(path, &e, "read the mesh"))?;
-    parse_obj(&bytes, path)
+    file_cache::parsed(path, "obj", || parse_obj(&read_mesh(path)?, path))
 }
 
 /// Reads a Stanford PLY file (see [`ply`]).
 pub fn load_ply(path: &Path) -> Result<MeshData> {
-    let bytes = std::fs::read(path).map_err(|e| Error::io(path, &e, "read the mesh"))?;
-    parse_ply(&bytes, path)
+    file_cache::parsed(path, "ply", || parse_ply(&read_mesh(path)?, path))
 }
 
 /// Reads shape `shape_index` of a Mitsuba serialized file (see [`serialized`]).
 pub fn load_serialized(path: &Path, shape_index: u32) -> Result<MeshData> {
-    let bytes = std::fs::read(path).map_err(|e| Error::io(path, &e, "read the mesh"))?;
-    parse_serialized(&bytes, shape_index, path)
+    file_cache::parsed(path, &format!("serialized shape {shape_index}"), || {
+        parse_serialized(&read_mesh(path)?, shape_index, path)
+    })
+}
+
+/// The bytes of the mesh file at `path` ([`file_cache::read`]).
+fn read_mesh(path: &Path) -> Result<std::sync::Arc<[u8]>> {
+    file_cache::read(path).map_err(|e| Error::io(path, &e, "read the mesh"))
 }
 
 /// An input error about a mesh file where no line and column apply (a binary file, or the

@@ -5,6 +5,9 @@
     image = pr.render(scene, seed=1)
     image.rgb            # numpy array, H x W x 3, linear sRGB (np.asarray(image) too)
     image.write("cornell.exr")
+    params = pr.traverse(scene)                # Mitsuba's keys: params["sensor.x_fov"] = 30
+    params["luminaire.reflectance.value"] = 0.5
+    params.update()                            # rebuilt from the edited description
     pr.write_image("red.png", np.full((8, 8, 3), [1.0, 0.0, 0.0], np.float32))
     pixels = pr.read_image("mitsuba.exr")   # any EXR, PNG, JPEG or HDR as a float32 array
 
@@ -32,9 +35,11 @@ from ._native import (
     Image,
     PrismError,
     Scene,
+    SceneParameters,
     Transform,
     ZTest,
     load_dict,
+    traverse,
 )
 from . import _native, util
 from ._variants import set_variant, variant, variants
@@ -49,6 +54,7 @@ __all__ = [
     "Image",
     "PrismError",
     "Scene",
+    "SceneParameters",
     "ScalarTransform4f",
     "Transform",
     "ZTest",
@@ -60,6 +66,7 @@ __all__ = [
     "read_image",
     "render",
     "set_variant",
+    "traverse",
     "util",
     "variant",
     "variants",

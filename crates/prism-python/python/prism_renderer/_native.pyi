@@ -2,11 +2,14 @@
 
 import os
 from typing import (
+    Any,
     Callable,
     Dict,
+    Iterator,
     List,
     Optional,
     Sequence,
+    Set,
     Tuple,
     TypedDict,
     Union,
@@ -71,6 +74,50 @@ class Scene:
     @property
     def sensor_ids(self) -> List[Optional[str]]:
         """The ``id`` of every ``<sensor>`` (None for one without), in document order."""
+
+ParameterValueIn = Union[float, int, bool, npt.ArrayLike, Transform]
+"""A value :class:`SceneParameters` takes: a number, a bool, numbers (a list, tuple or numpy
+array), a 4 × 4 matrix or a :class:`Transform`."""
+
+class SceneParameters:
+    """The parameters of a scene, from :func:`traverse`: a mapping from keys named as Mitsuba
+    3's ``mi.traverse`` names them (``red.reflectance.value``, ``sensor.to_world``,
+    ``sensor.x_fov``, ``light.emitter.radiance.value``) to their values. ``params[key] =
+    value`` records a change (checked against the parameter's type and shape, else
+    :class:`PrismError`); :meth:`update` applies the changes. An unknown key raises
+    ``KeyError`` naming the closest key."""
+
+    def keys(self) -> List[str]:
+        """The keys, in the order of the scene's description."""
+    def items(self) -> List[Tuple[str, Any]]:
+        """``(key, value)`` for every parameter, in the order of :meth:`keys`."""
+    def __len__(self) -> int: ...
+    def __contains__(self, key: str) -> bool: ...
+    def __iter__(self) -> Iterator[str]: ...
+    def __getitem__(self, key: str) -> Any:
+        """The value: a float, int or bool; a float64 array for a colour (3), a point or a
+        vector (3) or a sampled spectrum's values (one per wavelength); a
+        :class:`Transform`. A change recorded and not yet applied is shown."""
+    def __setitem__(self, key: str, value: ParameterValueIn) -> None:
+        """Records a change; :meth:`update` applies it."""
+    def keep(self, patterns: Union[None, str, Sequence[str]]) -> None:
+        """Keeps only the parameters whose keys ``patterns`` match: a regular expression or a
+        list of them, each matched at the start of a key (``re.match``), as Mitsuba's
+        ``keep`` (changes recorded for the other keys are dropped); None keeps them
+        all. A pattern that matches no key raises ``KeyError``."""
+    def update(
+        self, values: Optional[Dict[str, ParameterValueIn]] = None
+    ) -> List[Tuple[str, Set[str]]]:
+        """Applies the changes recorded (after setting ``values``, if given): the scene is
+        built again from its description with the new values, exactly as if that scene were
+        loaded from scratch, but reading no file again, and keeping the hierarchy over the
+        shapes when no shape's parameter changed. Returns ``(plugin, {keys})`` for each
+        plugin changed, as Mitsuba's ``update``. When the scene refuses a value,
+        :class:`PrismError` is raised, the scene stays as it was and the changes stay
+        recorded."""
+
+def traverse(scene: Scene) -> SceneParameters:
+    """The parameters of ``scene``, as Mitsuba's ``mi.traverse``."""
 
 class Transform:
     """A 4 × 4 transform acting on column vectors, composed like Mitsuba's

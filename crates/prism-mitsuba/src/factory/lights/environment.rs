@@ -2,11 +2,11 @@
 
 use super::{Build, D65, SAMPLING_WEIGHT, TO_WORLD, emission_param, invertible};
 use crate::factory::spectra::spectrum_param;
+use crate::factory::textures::read_image_file;
 use crate::params::Params;
 use crate::registry::{Bounds, Default, Origin, ParamKind, ParamSpec, Plugin, Range, params};
 use glam::Vec3;
 use prism_core::error::{Error, Result};
-use prism_core::image::read_bitmap;
 use prism_core::light::sunsky::sun_position::{DateTime, Location, sun_angles};
 use prism_core::light::{ConstantLight, EnvironmentMap, Light, Sunsky, SunskySettings};
 
@@ -96,7 +96,7 @@ fn build_envmap(params: &Params) -> Result<Light> {
     };
     let location = params.location_of(&ENVMAP_FILENAME);
     let path = node.resolve_file(filename, location)?;
-    let bitmap = read_bitmap(&path).map_err(|e| e.at(location))?;
+    let bitmap = read_image_file(&path).map_err(|e| e.at(location))?;
     if bitmap.width < 2 || bitmap.height < 3 {
         return Err(Error::input(
             location,

@@ -82,8 +82,8 @@ pub static FILMS: Registry<FilmBuild> = Registry {
 };
 
 params! {
-    WIDTH = ParamSpec::new("width", ParamKind::Integer, Default::Integer(768), "pixels across");
-    HEIGHT = ParamSpec::new("height", ParamKind::Integer, Default::Integer(576), "pixels down");
+    pub WIDTH = ParamSpec::new("width", ParamKind::Integer, Default::Integer(768), "pixels across");
+    pub HEIGHT = ParamSpec::new("height", ParamKind::Integer, Default::Integer(576), "pixels down");
     CROP_OFFSET_X = ParamSpec::new("crop_offset_x", ParamKind::Integer, Default::Integer(0), "first column rendered");
     CROP_OFFSET_Y = ParamSpec::new("crop_offset_y", ParamKind::Integer, Default::Integer(0), "first row rendered");
     CROP_WIDTH = ParamSpec::new("crop_width", ParamKind::Integer, Default::Text("`width` − `crop_offset_x`"), "columns rendered");
