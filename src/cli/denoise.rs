@@ -25,7 +25,7 @@ use prism_core::render::{RenderOptions, render};
 use prism_core::scene::Scene;
 
 /// Samples per pixel of the guides rendered for a scene that has none.
-pub const GUIDE_SPP: u32 = 64;
+pub const GUIDE_SPP: u32 = 16;
 
 /// The denoiser's guides: albedo and shading normal, three interleaved values per pixel.
 struct Guides {
