@@ -8,8 +8,8 @@
 //! film, averaged over the image's samples. For any other scene they are rendered after the
 //! image, with the scene's sampler, filter and seed, by an `aov` integrator alone at
 //! [`GUIDE_SPP`] samples per pixel: camera rays to their first hit, which cost little beside the
-//! image's paths and leave the guides free of noise but for antialiasing (so that the denoiser
-//! may keep their detail). These are written too, as `denoise.albedo.R`, `.G`, `.B` and
+//! image's paths and leave the guides free of noise but at edges (antialiasing, defocus), so
+//! that the denoiser may keep their detail. These are written too, as `denoise.albedo.R`, `.G`, `.B` and
 //! `denoise.normal.X`, `.Y`, `.Z`.
 
 use std::path::Path;
@@ -31,8 +31,8 @@ pub const GUIDE_SPP: u32 = 16;
 struct Guides {
     albedo: Vec<f32>,
     normal: Vec<f32>,
-    /// Whether they were rendered here at [`GUIDE_SPP`] (and so are free of noise and written
-    /// to the EXR) rather than taken from the scene's film.
+    /// Whether they were rendered here at [`GUIDE_SPP`] (and so are treated as free of noise
+    /// and written to the EXR) rather than taken from the scene's film.
     rendered: bool,
 }
 
