@@ -17,6 +17,7 @@ use std::time::{Duration, Instant};
 use clap::Args;
 use glam::UVec2;
 
+use super::denoise::write_denoised_images;
 use super::display_server::{DisplayServer, parse_address};
 use super::progress_bar::TerminalProgress;
 use crate::accel::Accel;
@@ -120,6 +121,10 @@ pub struct RenderArgs {
     /// sample feeds every pixel its filter covers) or pixel (the lecture's one-pixel estimator)
     #[arg(long, value_name = "METHOD", value_parser = parse_reconstruction, help_heading = SAMPLING)]
     pub reconstruction: Option<Reconstruction>,
+    /// Also write the image denoised by Open Image Denoise: as the EXR's channels denoised.R,
+    /// .G, .B (the noisy ones stay) and as the PNG; needs a build with `--features denoise`
+    #[arg(long, conflicts_with = "pixel", help_heading = OUTPUT)]
+    pub denoise: bool,
     /// Store the EXR's colour and extra channels as half floats (the film's component_format
     /// float16); the variances stay 32-bit
     #[arg(long)]
@@ -302,6 +307,9 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         ));
     }
     args.accel.check_available()?;
+    if args.denoise {
+        crate::denoise::check_available()?;
+    }
     let load_start = Instant::now();
     let mut loaded = load_scene(&args.scene, &args.defines)?;
     let load_time = load_start.elapsed();
@@ -459,7 +467,19 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             seconds: Some(output.elapsed.as_secs_f64()),
         }),
     };
-    write_images_with(&output.film, &exr_path, &png_path, &images)?;
+    if args.denoise {
+        write_denoised_images(
+            &mut scene,
+            &output.film,
+            seed,
+            args.threads,
+            &exr_path,
+            &png_path,
+            &images,
+        )?;
+    } else {
+        write_images_with(&output.film, &exr_path, &png_path, &images)?;
+    }
     if output.stop == StopReason::Interrupted && !checkpoints {
         // An interrupted render always leaves a state to resume from.
         let snapshot = Snapshot {

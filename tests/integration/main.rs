@@ -5,6 +5,8 @@ mod bench;
 mod chi2;
 mod command_line;
 mod common;
+#[cfg(feature = "denoise")]
+mod denoise;
 mod depth_parity;
 mod determinism;
 #[cfg(feature = "embree")]

@@ -320,6 +320,31 @@ fn accel_embree_needs_the_feature() {
     assert!(stderr.contains("bvh or embree"), "{stderr}");
 }
 
+/// `--denoise` renders in a build with the feature `denoise` and otherwise says, before
+/// rendering, how to get one.
+#[test]
+fn denoise_needs_the_feature() {
+    let dir = folder("denoise");
+    write(
+        &dir,
+        "scene.xml",
+        &scene("    <shape type=\"sphere\"/>", ""),
+    );
+    let (status, stderr) = render(&dir, &["--denoise"]);
+    if cfg!(feature = "denoise") {
+        assert_eq!(status, 0, "{stderr}");
+    } else {
+        assert_eq!(status, 2, "{stderr}");
+        assert!(
+            stderr.contains("--denoise is not available")
+                && stderr.contains("tools/fetch-oidn")
+                && stderr.contains("cargo build --release --features denoise"),
+            "{stderr}"
+        );
+        assert!(!dir.join("out.exr").exists(), "nothing is rendered");
+    }
+}
+
 #[test]
 fn missing_scene_file() {
     let dir = folder("missing-scene");
