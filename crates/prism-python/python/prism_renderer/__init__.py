@@ -42,6 +42,7 @@ from ._native import (
     traverse,
 )
 from . import _native, util
+from ._denoise import denoise
 from ._variants import set_variant, variant, variants
 from .util import cornell_box
 
@@ -60,6 +61,7 @@ __all__ = [
     "ZTest",
     "compare",
     "cornell_box",
+    "denoise",
     "load_dict",
     "load_file",
     "load_string",
