@@ -4,9 +4,9 @@
 //! which is what makes each `unsafe` intrinsic call below sound.
 
 use std::arch::x86_64::*;
-use std::ops::{Add, BitAnd, BitOr, Div, Mul, Neg, Not, Sub};
+use std::ops::{Neg, Not};
 
-use super::{LaneMask, Real, lane_operators};
+use super::{LaneMask, Real, lane_operators, wrapped_binary_operator};
 
 /// 16 floats in one AVX-512 register.
 #[derive(Clone, Copy, Debug)]
@@ -16,37 +16,10 @@ pub struct F32x16(__m512);
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Mask16(__mmask16);
 
-impl Add for F32x16 {
-    type Output = F32x16;
-    #[inline(always)]
-    fn add(self, other: F32x16) -> F32x16 {
-        unsafe { F32x16(_mm512_add_ps(self.0, other.0)) }
-    }
-}
-
-impl Sub for F32x16 {
-    type Output = F32x16;
-    #[inline(always)]
-    fn sub(self, other: F32x16) -> F32x16 {
-        unsafe { F32x16(_mm512_sub_ps(self.0, other.0)) }
-    }
-}
-
-impl Mul for F32x16 {
-    type Output = F32x16;
-    #[inline(always)]
-    fn mul(self, other: F32x16) -> F32x16 {
-        unsafe { F32x16(_mm512_mul_ps(self.0, other.0)) }
-    }
-}
-
-impl Div for F32x16 {
-    type Output = F32x16;
-    #[inline(always)]
-    fn div(self, other: F32x16) -> F32x16 {
-        unsafe { F32x16(_mm512_div_ps(self.0, other.0)) }
-    }
-}
+wrapped_binary_operator!(F32x16, Add, add, |a, b| unsafe { _mm512_add_ps(a, b) });
+wrapped_binary_operator!(F32x16, Sub, sub, |a, b| unsafe { _mm512_sub_ps(a, b) });
+wrapped_binary_operator!(F32x16, Mul, mul, |a, b| unsafe { _mm512_mul_ps(a, b) });
+wrapped_binary_operator!(F32x16, Div, div, |a, b| unsafe { _mm512_div_ps(a, b) });
 
 impl Neg for F32x16 {
     type Output = F32x16;
@@ -153,21 +126,8 @@ impl Real for F32x16 {
     }
 }
 
-impl BitAnd for Mask16 {
-    type Output = Mask16;
-    #[inline(always)]
-    fn bitand(self, other: Mask16) -> Mask16 {
-        Mask16(self.0 & other.0)
-    }
-}
-
-impl BitOr for Mask16 {
-    type Output = Mask16;
-    #[inline(always)]
-    fn bitor(self, other: Mask16) -> Mask16 {
-        Mask16(self.0 | other.0)
-    }
-}
+wrapped_binary_operator!(Mask16, BitAnd, bitand, |a, b| a & b);
+wrapped_binary_operator!(Mask16, BitOr, bitor, |a, b| a | b);
 
 impl Not for Mask16 {
     type Output = Mask16;

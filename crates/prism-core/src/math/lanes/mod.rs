@@ -224,5 +224,21 @@ macro_rules! lane_operators {
 }
 use lane_operators;
 
+/// Implements the binary operator `$trait::$method` of the one-field wrapper `$t` by `$op` on
+/// the two wrapped values `$a` and `$b`.
+macro_rules! wrapped_binary_operator {
+    ($t:ident, $trait:ident, $method:ident, |$a:ident, $b:ident| $op:expr) => {
+        impl std::ops::$trait for $t {
+            type Output = $t;
+            #[inline(always)]
+            fn $method(self, other: $t) -> $t {
+                let ($a, $b) = (self.0, other.0);
+                $t($op)
+            }
+        }
+    };
+}
+use wrapped_binary_operator;
+
 #[cfg(test)]
 mod tests;

@@ -1,10 +1,10 @@
 //! 8 lanes on the `wide` crate's `f32x8` (AVX2, two SSE or NEON registers, or an array).
 
-use std::ops::{Add, BitAnd, BitOr, Div, Mul, Neg, Not, Sub};
+use std::ops::{Neg, Not};
 
 use wide::{CmpEq, CmpGe, CmpGt, CmpLe, CmpLt, f32x8};
 
-use super::{LaneMask, Real, lane_operators};
+use super::{LaneMask, Real, lane_operators, wrapped_binary_operator};
 
 /// 8 floats side by side.
 #[derive(Clone, Copy, Debug)]
@@ -14,37 +14,10 @@ pub struct F32x8(f32x8);
 #[derive(Clone, Copy, Debug)]
 pub struct Mask8(f32x8);
 
-impl Add for F32x8 {
-    type Output = F32x8;
-    #[inline(always)]
-    fn add(self, other: F32x8) -> F32x8 {
-        F32x8(self.0 + other.0)
-    }
-}
-
-impl Sub for F32x8 {
-    type Output = F32x8;
-    #[inline(always)]
-    fn sub(self, other: F32x8) -> F32x8 {
-        F32x8(self.0 - other.0)
-    }
-}
-
-impl Mul for F32x8 {
-    type Output = F32x8;
-    #[inline(always)]
-    fn mul(self, other: F32x8) -> F32x8 {
-        F32x8(self.0 * other.0)
-    }
-}
-
-impl Div for F32x8 {
-    type Output = F32x8;
-    #[inline(always)]
-    fn div(self, other: F32x8) -> F32x8 {
-        F32x8(self.0 / other.0)
-    }
-}
+wrapped_binary_operator!(F32x8, Add, add, |a, b| a + b);
+wrapped_binary_operator!(F32x8, Sub, sub, |a, b| a - b);
+wrapped_binary_operator!(F32x8, Mul, mul, |a, b| a * b);
+wrapped_binary_operator!(F32x8, Div, div, |a, b| a / b);
 
 impl Neg for F32x8 {
     type Output = F32x8;
@@ -138,21 +111,8 @@ impl Real for F32x8 {
     }
 }
 
-impl BitAnd for Mask8 {
-    type Output = Mask8;
-    #[inline(always)]
-    fn bitand(self, other: Mask8) -> Mask8 {
-        Mask8(self.0 & other.0)
-    }
-}
-
-impl BitOr for Mask8 {
-    type Output = Mask8;
-    #[inline(always)]
-    fn bitor(self, other: Mask8) -> Mask8 {
-        Mask8(self.0 | other.0)
-    }
-}
+wrapped_binary_operator!(Mask8, BitAnd, bitand, |a, b| a & b);
+wrapped_binary_operator!(Mask8, BitOr, bitor, |a, b| a | b);
 
 impl Not for Mask8 {
     type Output = Mask8;
