@@ -1,10 +1,10 @@
 //! The estimate of one camera sample: its wavelengths, film position, time and lens position
-//! drawn from the sampler, its camera ray, and the integrator's radiance along it in CIE XYZ
-//! (with the coverage alpha where the film records it).
+//! drawn from the sampler, its camera ray, and the integrator's radiance along it times the
+//! ray's weight, in CIE XYZ (with the coverage alpha where the film records it).
 
 use glam::{UVec2, Vec2};
 
-use crate::camera::CameraModel;
+use crate::camera::{CameraModel, CameraRay};
 use crate::film::{FilterMis, FilterSampler};
 use crate::integrator::{PreparedIntegrator, RayCount};
 use crate::math::Ray;
@@ -75,7 +75,10 @@ impl<'a> SampleEstimator<'a> {
         let (offset, filter_weight) = self.filter.sample(primary.film);
         let (time, time_weight) = scene.shutter.sample(primary.time);
         let film_position = pixel.as_vec2() + Vec2::splat(0.5) + offset;
-        let ray = scene.camera.generate_ray(film_position, primary.lens, time);
+        let CameraRay {
+            ray,
+            weight: ray_weight,
+        } = scene.camera.generate_ray(film_position, primary.lens, time);
         let (aovs_of_integrator, alpha) = aovs.split_at_mut(self.integrator.aov_count());
         if let Some(alpha) = alpha.first_mut() {
             *alpha = self.coverage(&ray, count);
@@ -86,7 +89,9 @@ impl<'a> SampleEstimator<'a> {
         for v in aovs.iter_mut() {
             *v *= time_weight;
         }
-        let xyz = lambda.to_xyz(&radiance).map(|v| v * time_weight);
+        let xyz = lambda
+            .to_xyz(&radiance)
+            .map(|v| v * ray_weight * time_weight);
         (offset, filter_weight, xyz)
     }
 

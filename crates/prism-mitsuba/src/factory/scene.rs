@@ -15,10 +15,11 @@ use crate::description::{NestedPlugin, PluginClass, PluginNode, Warning};
 use crate::params::Params;
 use crate::registry::{Default, ParamSpec, params};
 use prism_core::bsdf::Material;
+use prism_core::camera::CameraModel;
 use prism_core::error::{Error, Result, SourceLocation};
 use prism_core::geometry::{Geometry, Primitive, Shape};
 use prism_core::integrator::{Integrator, PathIntegrator};
-use prism_core::light::Light;
+use prism_core::light::{BoundingSphere, Light};
 use prism_core::medium::{Medium, MediumInterface};
 use prism_core::scene::Scene;
 use prism_core::texture::TextureUse;
@@ -63,9 +64,11 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
     let params = Params::new(root, SCENE);
     let integrator_child = params.single_child(&INTEGRATOR)?;
     let integrator = integrator(integrator_child)?;
-    let sensors = sensors(root, &params)?;
+    let mut sensors = top_level_sensors(&params)?;
     let mut builder = SceneBuilder::default();
     builder.shapes(&params)?;
+    sensors.append(&mut builder.shape_sensors);
+    let sensors = in_document_order(root, sensors)?;
     builder.emitters(&params)?;
     builder.declared_bsdfs(&params)?;
     builder.declared_textures(&params)?;
@@ -119,16 +122,42 @@ fn integrator(child: Option<&NestedPlugin>) -> Result<Integrator> {
     }
 }
 
-/// The scene's sensors with their ids, in document order; a scene needs one.
-fn sensors(root: &PluginNode, params: &Params) -> Result<Vec<(Option<String>, SensorSettings)>> {
-    let sensors = params.children(&SENSOR);
+/// A sensor of the scene with its id, and the child of the `<scene>` that declares it (the
+/// `<sensor>` itself, or the `<shape>` that carries it).
+struct DeclaredSensor {
+    declared_by: *const PluginNode,
+    id: Option<String>,
+    settings: SensorSettings,
+}
+
+/// The `<sensor>`s at the top level of the scene.
+fn top_level_sensors(params: &Params) -> Result<Vec<DeclaredSensor>> {
+    (params.children(&SENSOR).iter())
+        .map(|child| {
+            Ok(DeclaredSensor {
+                declared_by: Arc::as_ptr(&child.node),
+                id: child.node.id.clone(),
+                settings: sensor::build_sensor(&child.node)?,
+            })
+        })
+        .collect()
+}
+
+/// The scene's sensors with their ids, in document order, as Mitsuba lists them (a sensor
+/// carried by a shape stands where its shape does); a scene needs one.
+fn in_document_order(
+    root: &PluginNode,
+    mut sensors: Vec<DeclaredSensor>,
+) -> Result<Vec<(Option<String>, SensorSettings)>> {
     if sensors.is_empty() {
         return Err(Error::input(&root.location, "the scene has no <sensor>")
             .with_help("add a <sensor type=\"perspective\"> with a film and a sampler"));
     }
-    (sensors.iter())
-        .map(|child| Ok((child.node.id.clone(), sensor::build_sensor(&child.node)?)))
-        .collect()
+    let position = |declared_by: *const PluginNode| {
+        (root.children.iter()).position(|child| Arc::as_ptr(&child.node) == declared_by)
+    };
+    sensors.sort_by_key(|sensor| position(sensor.declared_by));
+    Ok(sensors.into_iter().map(|s| (s.id, s.settings)).collect())
 }
 
 /// The distrib integrator estimates no participating media: a scene with media and distrib is
@@ -160,6 +189,8 @@ struct SceneBuilder {
     /// The area emitters attached to shapes, with where each was attached (an emitter declared
     /// at the top level with an id reaches its shape by a `<ref>`).
     attached_emitters: HashMap<*const PluginNode, SourceLocation>,
+    /// The sensors shapes carry (irradiance meters).
+    shape_sensors: Vec<DeclaredSensor>,
 }
 
 impl SceneBuilder {
@@ -241,6 +272,13 @@ impl SceneBuilder {
         };
         bind_mesh_attributes(&mut shape, material, &self.textures, &child.node)?;
         let interface = shape_media(&shape_params, &mut self.media)?;
+        if let Some(meter) = shape_params.single_child(&shapes::SENSOR)? {
+            self.shape_sensors.push(DeclaredSensor {
+                declared_by: Arc::as_ptr(&child.node),
+                id: meter.node.id.clone(),
+                settings: sensor::build_shape_sensor(&meter.node, &child.node, &shape)?,
+            });
+        }
         shape_params.finish()?;
         if area == 0.0 && !curve {
             return Ok(());
@@ -368,6 +406,11 @@ impl SceneBuilder {
             world.medium_interfaces = self.medium_interfaces;
         }
         world.media = self.media.media;
+        let bounds = BoundingSphere::around_box(world.geometry.bounds());
+        let mut sensors = sensors;
+        for sensor in &mut sensors {
+            sensor.camera.set_scene_bounds(bounds);
+        }
         let first = sensors[0].clone();
         world.camera_medium = first.medium;
         let mut scene = Scene::new(world, first.camera, first.film, first.sampler, integrator);
