@@ -82,6 +82,7 @@ pub fn build(
             filter: Filter::Box(BoxFilter { radius: 0.5 }),
             reconstruction: Reconstruction::default(),
             wavelength_sampling: WavelengthSampling::default(),
+            bands: Vec::new(),
         },
         SamplerSettings {
             kind: SamplerKind::Independent,

@@ -725,3 +725,83 @@ fn meter_and_batch_errors_name_the_element() {
         );
     }
 }
+
+/// A `specfilm` over a constant environment of radiance L(λ) = 1 + 2 (λ − 400)/300 on
+/// 400–700 nm (zero elsewhere): each channel is ∫ s L dλ, unnormalised, as Mitsuba 3 writes it.
+/// A box response of 1 on 500–600 nm gives 200, a ramp s = 2 (λ − 400)/300 gives
+/// ∫₀¹ 2t (1 + 2t) 300 dt = 700, a constant 0.5 gives 300. Mitsuba 3.9.1 (`mitsuba-ref`, the
+/// first two seen by a radiance meter on an emitter of that radiance, scalar_spectral, 65536
+/// spp, seed 3, 2 threads) gives 199.95 and 699.38 (it refuses a constant response). The
+/// EXR holds the channels by their names beside Y and its statistics.
+#[test]
+fn a_spectral_film_integrates_the_radiance_against_each_response() {
+    let text = r#"<scene version="3.0.0">
+    <integrator type="path"/>
+    <sensor type="perspective">
+        <sampler type="independent"><integer name="sample_count" value="64"/></sampler>
+        <film type="specfilm">
+            <integer name="width" value="32"/><integer name="height" value="32"/>
+            <rfilter type="box"/>
+            <spectrum name="zeta" value="500:1, 600:1"/>
+            <spectrum name="alpha" value="400:0, 700:2"/>
+            <spectrum name="flat" value="0.5"/>
+        </film>
+    </sensor>
+    <emitter type="constant"><spectrum name="radiance" value="400:1, 700:3"/></emitter>
+</scene>"#;
+    let scene = scene_from_xml(text, "specfilm.xml").unwrap();
+    assert_eq!(scene.aov_names(), ["zeta", "alpha", "flat"]);
+    assert_eq!(
+        scene.exr_output.pixel_format,
+        prism_core::film::PixelFormat::Luminance
+    );
+    let film = render_film(&scene, 64, 10, None);
+    for (channel, expected) in [(0, 200.0), (1, 700.0), (2, 300.0)] {
+        let values = film.aov(channel);
+        let n = values.len() as f64;
+        let mean = values.iter().map(|&v| f64::from(v)).sum::<f64>() / n;
+        let variance = values
+            .iter()
+            .map(|&v| (f64::from(v) - mean).powi(2))
+            .sum::<f64>()
+            / (n - 1.0);
+        let se = (variance / n).sqrt();
+        assert!(se < 0.0025 * expected, "channel {channel}: {se}");
+        assert!(
+            (mean - expected).abs() < 4.0 * se,
+            "channel {channel}: {mean} ± {se}, not {expected}"
+        );
+    }
+}
+
+/// A spectral film's responses must be finite, lie in Prism's wavelength range and not take the
+/// image's channel names; it needs one.
+#[test]
+fn spectral_film_errors_name_the_spectrum() {
+    let error = |bands: &str| {
+        let text = format!(
+            r#"<scene version="3.0.0">
+    <sensor type="perspective"><film type="specfilm">{bands}</film></sensor>
+</scene>"#
+        );
+        scene_from_xml(&text, "bad.xml").err().unwrap().to_string()
+    };
+    for (bands, expected) in [
+        ("", "at least one response"),
+        (
+            r#"<spectrum name="Y" value="1"/>"#,
+            "would replace the image's own",
+        ),
+        (
+            r#"<spectrum name="nir" value="800:1, 900:1"/>"#,
+            "not zero at 900 nm",
+        ),
+    ] {
+        let message = error(bands);
+        assert!(message.contains(expected), "{bands}: {message}");
+        assert!(
+            message.contains("bad.xml:"),
+            "{bands}: no location in {message}"
+        );
+    }
+}

@@ -5,6 +5,7 @@
 use glam::{UVec2, Vec2};
 
 use crate::camera::{CameraModel, CameraRay};
+use crate::film::spectral_bands::band_values;
 use crate::film::{FilterMis, FilterSampler};
 use crate::integrator::{PreparedIntegrator, RayCount};
 use crate::math::Ray;
@@ -39,9 +40,9 @@ impl<'a> SampleEstimator<'a> {
         }
     }
 
-    /// How many extra channels each sample writes.
+    /// How many extra channels each sample writes: the integrator's, the alpha, the bands.
     pub fn aov_count(&self) -> usize {
-        self.integrator.aov_count() + usize::from(self.alpha)
+        self.integrator.aov_count() + usize::from(self.alpha) + self.scene.film.bands.len()
     }
 
     /// The coverage alpha of a camera ray, as Mitsuba 3's path tracer defines it: 1 where it
@@ -79,13 +80,20 @@ impl<'a> SampleEstimator<'a> {
             ray,
             weight: ray_weight,
         } = scene.camera.generate_ray(film_position, primary.lens, time);
-        let (aovs_of_integrator, alpha) = aovs.split_at_mut(self.integrator.aov_count());
+        let (aovs_of_integrator, film_channels) = aovs.split_at_mut(self.integrator.aov_count());
+        let (alpha, bands) = film_channels.split_at_mut(usize::from(self.alpha));
         if let Some(alpha) = alpha.first_mut() {
             *alpha = self.coverage(&ray, count);
         }
         let radiance = self
             .integrator
             .radiance(ray, &lambda, sampler, count, aovs_of_integrator);
+        if !bands.is_empty() {
+            band_values(&scene.film.bands, &lambda, &radiance, bands);
+            for v in bands.iter_mut() {
+                *v *= ray_weight;
+            }
+        }
         for v in aovs.iter_mut() {
             *v *= time_weight;
         }

@@ -79,6 +79,8 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
     let mut scene_sensors = Vec::with_capacity(sensors.len());
     let mut warnings = Vec::new();
     for (id, sensor) in sensors {
+        let integrator_location = integrator_child.map_or(&root.location, |c| &c.location);
+        check_band_names(&integrator, &sensor, integrator_location)?;
         let medium = match &sensor.medium {
             Some(node) => Some(builder.media.index(&NestedPlugin {
                 name: None,
@@ -158,6 +160,26 @@ fn in_document_order(
     };
     sensors.sort_by_key(|sensor| position(sensor.declared_by));
     Ok(sensors.into_iter().map(|s| (s.id, s.settings)).collect())
+}
+
+/// A spectral film's channels must not take the names of the integrator (at `location`).
+fn check_band_names(
+    integrator: &Integrator,
+    sensor: &SensorSettings,
+    location: &SourceLocation,
+) -> Result<()> {
+    let names = integrator.aov_names();
+    match (sensor.film.bands.iter()).find(|band| names.contains(&band.name)) {
+        Some(band) => Err(Error::input(
+            location,
+            format!(
+                "the spectral film's channel \"{}\" would replace the integrator's",
+                band.name
+            ),
+        )
+        .with_help("rename the spectrum or the integrator's channel")),
+        None => Ok(()),
+    }
 }
 
 /// The distrib integrator estimates no participating media: a scene with media and distrib is
