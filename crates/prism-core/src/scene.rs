@@ -8,7 +8,7 @@ use crate::film::output::ALPHA_CHANNEL;
 use crate::film::{CropWindow, ExrOutput, Filter, LdrOutput, Reconstruction, SpectralBand};
 use crate::integrator::Integrator;
 pub use crate::sampling::sampler::SamplerKind;
-use crate::spectrum::WavelengthSampling;
+use crate::spectrum::{Spectrum, WavelengthSampling};
 use crate::world::World;
 
 /// Film settings: size, crop window and reconstruction filter.
@@ -24,6 +24,9 @@ pub struct FilmSettings {
     /// The channels of a spectral film (`specfilm`), each an integral of the radiance against
     /// a response; none for other films.
     pub bands: Vec<SpectralBand>,
+    /// The sensor's spectral response (Mitsuba's `srf`), by which the radiance arriving is
+    /// multiplied at each wavelength before it becomes XYZ; None for a response of 1.
+    pub response: Option<Spectrum>,
 }
 
 /// Which per-pixel sampler to use and how many samples per pixel.

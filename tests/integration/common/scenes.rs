@@ -83,6 +83,7 @@ pub fn build(
             reconstruction: Reconstruction::default(),
             wavelength_sampling: WavelengthSampling::default(),
             bands: Vec::new(),
+            response: None,
         },
         SamplerSettings {
             kind: SamplerKind::Independent,

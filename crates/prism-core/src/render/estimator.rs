@@ -85,9 +85,12 @@ impl<'a> SampleEstimator<'a> {
         if let Some(alpha) = alpha.first_mut() {
             *alpha = self.coverage(&ray, count);
         }
-        let radiance = self
-            .integrator
-            .radiance(ray, &lambda, sampler, count, aovs_of_integrator);
+        let mut radiance =
+            self.integrator
+                .radiance(ray, &lambda, sampler, count, aovs_of_integrator);
+        if let Some(response) = &scene.film.response {
+            radiance *= response.sample(&lambda);
+        }
         if !bands.is_empty() {
             band_values(&scene.film.bands, &lambda, &radiance, bands);
             for v in bands.iter_mut() {

@@ -154,6 +154,7 @@ pub(super) fn default_film() -> FilmParts {
         reconstruction: Reconstruction::default(),
         wavelength_sampling: WavelengthSampling::default(),
         bands: Vec::new(),
+        response: None,
     };
     FilmParts {
         film,
@@ -395,5 +396,6 @@ fn film_settings(params: &Params) -> Result<FilmSettings> {
         reconstruction,
         wavelength_sampling,
         bands: Vec::new(),
+        response: None,
     })
 }

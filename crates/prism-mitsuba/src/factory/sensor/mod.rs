@@ -13,8 +13,9 @@ pub use meters::build_shape_sensor;
 
 use crate::description::{PluginClass, PluginNode, Warning};
 use crate::factory::fov::{FOCAL_LENGTH, FOV, FOV_AXIS, horizontal_fov_param};
+use crate::factory::spectra::spectrum_param;
 use crate::params::Params;
-use crate::registry::{Default, Origin, ParamKind, ParamSpec, Plugin, Registry, params};
+use crate::registry::{Default, Origin, ParamKind, ParamSpec, Plugin, Range, Registry, params};
 use film::{build_film, default_film};
 use glam::{DMat4, DVec3, Vec2};
 use prism_core::camera::{Camera, OrthographicCamera, PerspectiveCamera, RadianceMeter, Shutter};
@@ -41,6 +42,7 @@ macro_rules! camera_params {
             SHUTTER_FILTER,
             FILM,
             SAMPLER,
+            SRF,
             $($after,)*
         ]
     };
@@ -105,6 +107,7 @@ pub static SENSORS: Registry<SensorBuild> = Registry {
                 SHUTTER_FILTER,
                 FILM,
                 SAMPLER,
+                SRF,
                 SENSOR_MEDIUM,
             ],
             build: build_radiancemeter,
@@ -121,6 +124,7 @@ pub static SENSORS: Registry<SensorBuild> = Registry {
                 SHUTTER_FILTER,
                 FILM,
                 SAMPLER,
+                SRF,
                 SENSOR_MEDIUM,
             ],
             build: meters::build_irradiancemeter_alone,
@@ -140,6 +144,7 @@ pub static SENSORS: Registry<SensorBuild> = Registry {
                 SHUTTER_FILTER,
                 FILM,
                 SAMPLER,
+                SRF,
                 SENSOR_MEDIUM,
             ],
             build: meters::build_distant,
@@ -156,6 +161,7 @@ pub static SENSORS: Registry<SensorBuild> = Registry {
                 SHUTTER_FILTER,
                 FILM,
                 SAMPLER,
+                SRF,
                 SENSOR_MEDIUM,
             ],
             build: batch::build_batch,
@@ -172,6 +178,7 @@ params! {
     SHUTTER_FILTER = ParamSpec::new("shutter_filter", ParamKind::Nested(PluginClass::Rfilter), Default::Text("box"), "Prism only: a nested `<rfilter name=\"shutter_filter\">` weighting time within the shutter interval");
     FILM = ParamSpec::nested(PluginClass::Film, Default::Text("`hdrfilm`, 768 × 576, gaussian"), "the film");
     SAMPLER = ParamSpec::nested(PluginClass::Sampler, Default::Text("`independent`, 4 samples"), "the sampler");
+    SRF = ParamSpec::new("srf", ParamKind::Spectrum { range: Range::Coefficient, textured: false }, Default::Text("1"), "the sensor's spectral response: the radiance is multiplied by it at each wavelength (not with a `specfilm`)");
     SENSOR_MEDIUM = ParamSpec::nested(PluginClass::Medium, Default::None, "the medium the camera sits in (for `volpath`)");
     APERTURE_RADIUS = ParamSpec::new("aperture_radius", ParamKind::Float, Default::Required, "radius of the lens (or give `aperture_area`)");
     APERTURE_AREA = ParamSpec::new("aperture_area", ParamKind::Float, Default::None, "Prism only, the lecture's form: the lens's area a, radius √(a/π)");
@@ -242,6 +249,17 @@ pub(super) fn sensor_parts(params: &Params) -> Result<SensorParts> {
             0,
         ),
     };
+    let mut film = film;
+    if params.property(&SRF).is_some() {
+        if !film.film.bands.is_empty() {
+            return Err(Error::input(
+                params.location_of(&SRF),
+                "a sensor with an \"srf\" cannot have a specfilm, whose bands are its responses",
+            )
+            .with_help("remove the srf, or use an hdrfilm"));
+        }
+        film.film.response = Some(spectrum_param(params, &SRF)?);
+    }
     Ok(SensorParts {
         film: film.film,
         exr_output: film.exr,
