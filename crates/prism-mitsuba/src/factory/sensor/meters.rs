@@ -145,11 +145,11 @@ pub(super) fn build_distant(params: &Params, _thinlens: bool) -> Result<SensorSe
     sensor_settings(params, parts, camera, shutter)
 }
 
-/// The `target` of a distant sensor: a `<point name="target">`, a nested
-/// `<shape name="target">` (built in world space, sampled by area, not part of the scene), or
-/// none (the scene's cross-section).
+/// The `target` of a distant sensor: a `<point name="target">` (or a `<vector>`, as Mitsuba
+/// reads either), a nested `<shape name="target">` (built in world space, sampled by area, not
+/// part of the scene), or none (the scene's cross-section).
 fn distant_target(params: &Params) -> Result<DistantTarget> {
-    if let Some(point) = params.point_opt(&DISTANT_TARGET)? {
+    if let Some(point) = params.vector_opt(&DISTANT_TARGET)? {
         return Ok(DistantTarget::Point(point.as_vec3()));
     }
     let Some(child) = params.named_child(&DISTANT_TARGET) else {
