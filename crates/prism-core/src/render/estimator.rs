@@ -1,6 +1,7 @@
 //! The estimate of one camera sample: its wavelengths, film position, time and lens position
 //! drawn from the sampler, its camera ray, and the integrator's radiance along it times the
-//! ray's weight, in CIE XYZ (with the coverage alpha where the film records it).
+//! ray's weight and the sensor's spectral response, in CIE XYZ (with the coverage alpha where
+//! the film records it, and a spectral film's bands).
 
 use glam::{UVec2, Vec2};
 

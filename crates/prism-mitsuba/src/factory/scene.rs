@@ -78,8 +78,8 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
     }
     let mut scene_sensors = Vec::with_capacity(sensors.len());
     let mut warnings = Vec::new();
+    let integrator_location = integrator_child.map_or(&root.location, |c| &c.location);
     for (id, sensor) in sensors {
-        let integrator_location = integrator_child.map_or(&root.location, |c| &c.location);
         check_band_names(&integrator, &sensor, integrator_location)?;
         let medium = match &sensor.medium {
             Some(node) => Some(builder.media.index(&NestedPlugin {
@@ -414,7 +414,7 @@ impl SceneBuilder {
         self,
         root: &PluginNode,
         integrator: Integrator,
-        sensors: Vec<SceneSensor>,
+        mut sensors: Vec<SceneSensor>,
         warnings: Vec<Warning>,
     ) -> LoadedScene {
         let mut world = World::new(
@@ -429,7 +429,6 @@ impl SceneBuilder {
         }
         world.media = self.media.media;
         let bounds = BoundingSphere::around_box(world.geometry.bounds());
-        let mut sensors = sensors;
         for sensor in &mut sensors {
             sensor.camera.set_scene_bounds(bounds);
         }
