@@ -62,7 +62,7 @@ fn stages(c: &mut Criterion) {
                     let (offset, weight) = filter.sample(primary.film);
                     let (time, _) = scene.shutter.sample(primary.time);
                     let film = pixel.as_vec2() + Vec2::splat(0.5) + offset;
-                    let ray = scene.camera.generate_ray(film, primary.lens, time);
+                    let ray = scene.camera.generate_ray(film, primary.lens, time).ray;
                     black_box((lambda, weight, ray));
                 }
             }

@@ -61,7 +61,7 @@ impl Fixture {
             .map(|i| {
                 let cell = UVec2::new(i % GRID, i / GRID).as_vec2();
                 let position = (cell + u2(&mut rng)) / GRID as f32 * film;
-                scene.camera.generate_ray(position, u2(&mut rng), 0.0)
+                scene.camera.generate_ray(position, u2(&mut rng), 0.0).ray
             })
             .collect();
         // Bounce and shadow rays from the camera rays' hits, going round the camera rays again

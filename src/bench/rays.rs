@@ -67,7 +67,7 @@ fn rays_from_visible_surfaces(
     let mut failures_in_a_row = 0;
     while rays.len() < count && failures_in_a_row < 10_000 {
         let film = Vec2::new(rng.next_f32(), rng.next_f32()) * size;
-        let camera_ray = scene.camera.generate_ray(film, Vec2::splat(0.5), 0.0);
+        let camera_ray = scene.camera.generate_ray(film, Vec2::splat(0.5), 0.0).ray;
         match scene
             .world
             .geometry

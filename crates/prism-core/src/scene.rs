@@ -5,10 +5,10 @@ use glam::UVec2;
 
 use crate::camera::{Camera, Shutter};
 use crate::film::output::ALPHA_CHANNEL;
-use crate::film::{CropWindow, ExrOutput, Filter, LdrOutput, Reconstruction};
+use crate::film::{CropWindow, ExrOutput, Filter, LdrOutput, Reconstruction, SpectralBand};
 use crate::integrator::Integrator;
 pub use crate::sampling::sampler::SamplerKind;
-use crate::spectrum::WavelengthSampling;
+use crate::spectrum::{Spectrum, WavelengthSampling};
 use crate::world::World;
 
 /// Film settings: size, crop window and reconstruction filter.
@@ -21,6 +21,12 @@ pub struct FilmSettings {
     pub reconstruction: Reconstruction,
     /// The density the wavelengths of each camera sample are drawn from.
     pub wavelength_sampling: WavelengthSampling,
+    /// The channels of a spectral film (`specfilm`), each an integral of the radiance against
+    /// a response; none for other films.
+    pub bands: Vec<SpectralBand>,
+    /// The sensor's spectral response (Mitsuba's `srf`), by which the radiance arriving is
+    /// multiplied at each wavelength before it becomes XYZ; None for a response of 1.
+    pub response: Option<Spectrum>,
 }
 
 /// Which per-pixel sampler to use and how many samples per pixel.
@@ -74,12 +80,13 @@ impl Scene {
     }
 
     /// The names of the film's extra channels: the integrator's, then the coverage alpha `A`
-    /// where the EXR has one.
+    /// where the EXR has one, then a spectral film's bands.
     pub fn aov_names(&self) -> Vec<String> {
         let mut names = self.integrator.aov_names();
         if self.exr_output.pixel_format.has_alpha() {
             names.push(ALPHA_CHANNEL.into());
         }
+        names.extend(self.film.bands.iter().map(|band| band.name.clone()));
         names
     }
 

@@ -308,6 +308,21 @@ impl<'a> Params<'a> {
         found
     }
 
+    /// The `<spectrum>` properties whose names the plugin does not declare (the bands of a
+    /// `specfilm`, named by the scene), marked as used, in document order.
+    pub fn undeclared_spectra(&self) -> Vec<&'a Property> {
+        let mut found = Vec::new();
+        for (index, property) in self.node.properties.iter().enumerate() {
+            if matches!(property.value, PropertyValue::Spectrum(_))
+                && !self.declared.iter().any(|d| d.name == property.name)
+            {
+                self.used_properties[index].set(true);
+                found.push(property);
+            }
+        }
+        found
+    }
+
     /// At most one nested plugin of the class `spec` declares; two or more are an error.
     pub fn single_child(&self, spec: &ParamSpec) -> Result<Option<&'a NestedPlugin>> {
         let children = self.children(spec);

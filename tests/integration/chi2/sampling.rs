@@ -29,6 +29,7 @@ const SUITE: Suite = Suite::new(&[
     "light selection Power with weights",
     "light selection Exhaustive with weights",
     "triangle mesh area",
+    "triangle mesh position, triangle number reused",
     "sphere cone",
     "sphere from inside",
     "piecewise linear",
@@ -333,6 +334,32 @@ fn triangle_mesh_area_sampling_is_uniform() {
     )
     .unwrap();
     SUITE.assert_passes("triangle mesh area", &outcome);
+}
+
+/// Mitsuba's `sample_position` picks the triangle with the second number and reuses it for the
+/// point within: the points are still uniform over the square, triangle by triangle (an
+/// uneven square of four triangles, on a grid that cuts across their edges).
+#[test]
+fn triangle_mesh_position_sampling_with_a_reused_number_is_uniform() {
+    let mesh = uneven_square_mesh();
+    let outcome = chi2_rectangle(
+        SAMPLES,
+        Cells {
+            x: (0.0, 1.0),
+            y: (0.0, 1.0),
+            nx: 40,
+            ny: 40,
+        },
+        9,
+        |rng| {
+            let s = mesh.sample_position(u2(rng))?;
+            assert!((s.pdf - 1.0).abs() < 1e-5);
+            Some((f64::from(s.p.x), f64::from(s.p.y)))
+        },
+        |_, _| 1.0,
+    )
+    .unwrap();
+    SUITE.assert_passes("triangle mesh position, triangle number reused", &outcome);
 }
 
 fn sphere() -> Sphere {

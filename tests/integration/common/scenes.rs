@@ -82,6 +82,8 @@ pub fn build(
             filter: Filter::Box(BoxFilter { radius: 0.5 }),
             reconstruction: Reconstruction::default(),
             wavelength_sampling: WavelengthSampling::default(),
+            bands: Vec::new(),
+            response: None,
         },
         SamplerSettings {
             kind: SamplerKind::Independent,
@@ -190,7 +192,9 @@ pub fn disk_light_over_plane(size: UVec2) -> DiskOverPlane {
         },
     );
     let exitant = |film_position: Vec2| -> f64 {
-        let ray = camera.generate_ray(film_position, Vec2::splat(0.5), 0.0);
+        let ray = camera
+            .generate_ray(film_position, Vec2::splat(0.5), 0.0)
+            .ray;
         let t = -ray.o.z / ray.d.z;
         let x = (ray.o + ray.d * t).as_dvec3();
         let r2 = x.x * x.x + x.y * x.y;

@@ -277,7 +277,9 @@ fn point_light_over_a_diffuse_plane_with(integrator: Integrator, seed: u64) {
     let film = render_film(&scene, 256, seed, None);
 
     let radiance = |film_position: Vec2| -> f64 {
-        let ray = camera.generate_ray(film_position, Vec2::splat(0.5), 0.0);
+        let ray = camera
+            .generate_ray(film_position, Vec2::splat(0.5), 0.0)
+            .ray;
         let t = -ray.o.z / ray.d.z;
         let x = (ray.o + ray.d * t).as_dvec3();
         let to_light = light_position.as_dvec3() - x;

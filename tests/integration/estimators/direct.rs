@@ -107,11 +107,13 @@ fn exact_over_plane(camera: &Camera, size: UVec2, radiance: impl Fn(DVec3) -> f6
                 for i in 0..n {
                     let offset =
                         Vec2::new((i as f32 + 0.5) / n as f32, (j as f32 + 0.5) / n as f32);
-                    let ray = camera.generate_ray(
-                        Vec2::new(x as f32, y as f32) + offset,
-                        Vec2::splat(0.5),
-                        0.0,
-                    );
+                    let ray = camera
+                        .generate_ray(
+                            Vec2::new(x as f32, y as f32) + offset,
+                            Vec2::splat(0.5),
+                            0.0,
+                        )
+                        .ray;
                     let t = -ray.o.z / ray.d.z;
                     sum += radiance((ray.o + ray.d * t).as_dvec3());
                 }

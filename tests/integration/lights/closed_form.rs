@@ -58,11 +58,15 @@ fn footprint_average(camera: &Camera, x: u32, y: u32, exact: &impl Fn(&Ray) -> f
     for j in 0..n {
         for i in 0..n {
             let offset = Vec2::new((i as f32 + 0.5) / n as f32, (j as f32 + 0.5) / n as f32);
-            sum += exact(&camera.generate_ray(
-                Vec2::new(x as f32, y as f32) + offset,
-                Vec2::splat(0.5),
-                0.0,
-            ));
+            sum += exact(
+                &camera
+                    .generate_ray(
+                        Vec2::new(x as f32, y as f32) + offset,
+                        Vec2::splat(0.5),
+                        0.0,
+                    )
+                    .ray,
+            );
         }
     }
     sum / f64::from(n * n)

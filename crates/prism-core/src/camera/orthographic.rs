@@ -22,7 +22,8 @@
 
 use glam::{Vec2, Vec3};
 
-use super::{CameraModel, screen_position};
+use super::{CameraModel, CameraRay, screen_position};
+use crate::light::BoundingSphere;
 use crate::math::{AnimatedTransform, Ray};
 
 #[derive(Clone, Debug)]
@@ -40,18 +41,20 @@ impl CameraModel for OrthographicCamera {
     /// The ray through film position `film` (pixels, origin at the top-left of the full film)
     /// at time `time`.
     #[inline]
-    fn generate_ray(&self, film: Vec2, _lens: Vec2, time: f32) -> Ray {
+    fn generate_ray(&self, film: Vec2, _lens: Vec2, time: f32) -> CameraRay {
         let (screen, aspect) = screen_position(film, self.film_size);
         let local = Vec3::new(screen.x, screen.y / aspect, self.near_clip);
         let to_world = self.to_world.at(time);
         let d = to_world.vector(Vec3::Z).normalize();
-        Ray::new(
+        CameraRay::unweighted(Ray::new(
             to_world.point(local),
             d,
             self.far_clip - self.near_clip,
             time,
-        )
+        ))
     }
+
+    fn set_scene_bounds(&mut self, _bounds: BoundingSphere) {}
 }
 
 #[cfg(test)]
@@ -77,7 +80,7 @@ mod tests {
             (Vec2::new(100.0, 50.0), Vec3::new(0.0, 0.0, 0.5)),
             (Vec2::new(50.0, 0.0), Vec3::new(1.5, 1.0, 0.5)),
         ] {
-            let ray = camera.generate_ray(film, Vec2::ZERO, 0.0);
+            let ray = camera.generate_ray(film, Vec2::ZERO, 0.0).ray;
             assert!((ray.o - expected).length() < 1e-6, "{film}: {}", ray.o);
             assert!((ray.d - Vec3::Z).length() < 1e-7);
             assert!((ray.t_max - 9.5).abs() < 1e-6);

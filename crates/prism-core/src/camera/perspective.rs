@@ -33,7 +33,8 @@
 
 use glam::{Vec2, Vec3};
 
-use super::{CameraModel, screen_position};
+use super::{CameraModel, CameraRay, screen_position};
+use crate::light::BoundingSphere;
 use crate::math::{AnimatedTransform, Ray};
 use crate::sampling::warp::sample_uniform_disk_concentric;
 
@@ -106,7 +107,7 @@ impl CameraModel for PerspectiveCamera {
     /// through lens position `lens` ∈ [0, 1)² (unused by a pinhole) at time `time`. It starts on
     /// the near plane and ends on the far plane, as in Mitsuba.
     #[inline]
-    fn generate_ray(&self, film: Vec2, lens: Vec2, time: f32) -> Ray {
+    fn generate_ray(&self, film: Vec2, lens: Vec2, time: f32) -> CameraRay {
         let (screen, aspect) = screen_position(film, self.film_size);
         // The pinhole direction, with z = 1.
         let pinhole = Vec3::new(
@@ -128,8 +129,10 @@ impl CameraModel for PerspectiveCamera {
         let to_world = self.to_world.at(time);
         let d = to_world.vector(local).normalize();
         let o = to_world.point(origin) + d * near_t;
-        Ray::new(o, d, far_t - near_t, time)
+        CameraRay::unweighted(Ray::new(o, d, far_t - near_t, time))
     }
+
+    fn set_scene_bounds(&mut self, _bounds: BoundingSphere) {}
 }
 
 #[cfg(test)]
@@ -165,9 +168,9 @@ mod tests {
             focus_distance: 1.0,
         };
         let lens = Vec2::splat(0.5);
-        let center = camera.generate_ray(Vec2::new(100.0, 50.0), lens, 0.0);
+        let center = camera.generate_ray(Vec2::new(100.0, 50.0), lens, 0.0).ray;
         assert!((center.d - Vec3::Z).length() < 1e-6);
-        let top_left = camera.generate_ray(Vec2::ZERO, lens, 0.0);
+        let top_left = camera.generate_ray(Vec2::ZERO, lens, 0.0).ray;
         assert!(top_left.d.x > 0.0 && top_left.d.y > 0.0);
         // Horizontal half-angle 45 degrees; vertical half extent 0.5.
         let expected = Vec3::new(1.0, 0.5, 1.0).normalize();
@@ -191,7 +194,7 @@ mod tests {
         let points: Vec<Vec3> = [(0.1, 0.2), (0.9, 0.5), (0.5, 0.95)]
             .into_iter()
             .map(|(u, v)| {
-                let ray = camera.generate_ray(film, Vec2::new(u, v), 0.0);
+                let ray = camera.generate_ray(film, Vec2::new(u, v), 0.0).ray;
                 ray.at((5.0 - ray.o.z) / ray.d.z)
             })
             .collect();

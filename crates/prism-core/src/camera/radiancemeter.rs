@@ -15,11 +15,12 @@
 
 use glam::{Vec2, Vec3};
 
-use super::CameraModel;
+use super::{CameraModel, CameraRay};
+use crate::light::BoundingSphere;
 use crate::math::{AnimatedTransform, Ray};
 
 /// Mitsuba's `math::RayEpsilon<float>`: how far along its direction the ray starts.
-const RAY_EPSILON: f32 = 89.0 / (1u32 << 24) as f32;
+pub(crate) const RAY_EPSILON: f32 = 89.0 / (1u32 << 24) as f32;
 
 #[derive(Clone, Debug)]
 pub struct RadianceMeter {
@@ -30,12 +31,14 @@ pub struct RadianceMeter {
 
 impl CameraModel for RadianceMeter {
     #[inline]
-    fn generate_ray(&self, _film: Vec2, _lens: Vec2, time: f32) -> Ray {
+    fn generate_ray(&self, _film: Vec2, _lens: Vec2, time: f32) -> CameraRay {
         let to_world = self.to_world.at(time);
         let d = to_world.vector(Vec3::Z).normalize();
         let o = to_world.point(Vec3::ZERO) + d * RAY_EPSILON;
-        Ray::new(o, d, f32::INFINITY, time)
+        CameraRay::unweighted(Ray::new(o, d, f32::INFINITY, time))
     }
+
+    fn set_scene_bounds(&mut self, _bounds: BoundingSphere) {}
 }
 
 #[cfg(test)]
@@ -52,8 +55,12 @@ mod tests {
         let meter = RadianceMeter {
             to_world: AnimatedTransform::fixed(Transform::new(place).unwrap()),
         };
-        let a = meter.generate_ray(Vec2::new(0.1, 0.9), Vec2::new(0.3, 0.3), 0.0);
-        let b = meter.generate_ray(Vec2::new(0.7, 0.2), Vec2::new(0.9, 0.1), 0.0);
+        let a = meter
+            .generate_ray(Vec2::new(0.1, 0.9), Vec2::new(0.3, 0.3), 0.0)
+            .ray;
+        let b = meter
+            .generate_ray(Vec2::new(0.7, 0.2), Vec2::new(0.9, 0.1), 0.0)
+            .ray;
         assert_eq!((a.o, a.d), (b.o, b.d));
         assert!(a.d.distance(Vec3::X) < 1e-6, "{}", a.d);
         assert!(a.o.distance(Vec3::new(1.0, 2.0, 3.0)) < 1e-4);

@@ -1,5 +1,5 @@
 //! The film: reconstruction filters and their samplers, how samples become pixel values, per-pixel accumulation of XYZ, the
-//! error estimated from the samples, and the images written at the end (an EXR, and an 8-bit
+//! error estimated from the samples, a spectral film's channels, and the images written at the end (an EXR, and an 8-bit
 //! image tonemapped as the film asks).
 
 pub mod accumulation;
@@ -7,6 +7,7 @@ pub mod filter;
 pub mod ldr;
 pub mod output;
 pub mod reconstruction;
+pub mod spectral_bands;
 pub mod stats;
 
 pub use accumulation::{CropWindow, Film, PixelSums, ValueSum};
@@ -20,3 +21,4 @@ pub use output::{
     write_images_with,
 };
 pub use reconstruction::{FilterMis, Reconstruction};
+pub use spectral_bands::SpectralBand;

@@ -1,10 +1,12 @@
 //! The estimate of one camera sample: its wavelengths, film position, time and lens position
-//! drawn from the sampler, its camera ray, and the integrator's radiance along it in CIE XYZ
-//! (with the coverage alpha where the film records it).
+//! drawn from the sampler, its camera ray, and the integrator's radiance along it times the
+//! ray's weight and the sensor's spectral response, in CIE XYZ (with the coverage alpha where
+//! the film records it, and a spectral film's bands).
 
 use glam::{UVec2, Vec2};
 
-use crate::camera::CameraModel;
+use crate::camera::{CameraModel, CameraRay};
+use crate::film::spectral_bands::band_values;
 use crate::film::{FilterMis, FilterSampler};
 use crate::integrator::{PreparedIntegrator, RayCount};
 use crate::math::Ray;
@@ -39,9 +41,9 @@ impl<'a> SampleEstimator<'a> {
         }
     }
 
-    /// How many extra channels each sample writes.
+    /// How many extra channels each sample writes: the integrator's, the alpha, the bands.
     pub fn aov_count(&self) -> usize {
-        self.integrator.aov_count() + usize::from(self.alpha)
+        self.integrator.aov_count() + usize::from(self.alpha) + self.scene.film.bands.len()
     }
 
     /// The coverage alpha of a camera ray, as Mitsuba 3's path tracer defines it: 1 where it
@@ -75,18 +77,33 @@ impl<'a> SampleEstimator<'a> {
         let (offset, filter_weight) = self.filter.sample(primary.film);
         let (time, time_weight) = scene.shutter.sample(primary.time);
         let film_position = pixel.as_vec2() + Vec2::splat(0.5) + offset;
-        let ray = scene.camera.generate_ray(film_position, primary.lens, time);
-        let (aovs_of_integrator, alpha) = aovs.split_at_mut(self.integrator.aov_count());
+        let CameraRay {
+            ray,
+            weight: ray_weight,
+        } = scene.camera.generate_ray(film_position, primary.lens, time);
+        let (aovs_of_integrator, film_channels) = aovs.split_at_mut(self.integrator.aov_count());
+        let (alpha, bands) = film_channels.split_at_mut(usize::from(self.alpha));
         if let Some(alpha) = alpha.first_mut() {
             *alpha = self.coverage(&ray, count);
         }
-        let radiance = self
-            .integrator
-            .radiance(ray, &lambda, sampler, count, aovs_of_integrator);
+        let mut radiance =
+            self.integrator
+                .radiance(ray, &lambda, sampler, count, aovs_of_integrator);
+        if let Some(response) = &scene.film.response {
+            radiance *= response.sample(&lambda);
+        }
+        if !bands.is_empty() {
+            band_values(&scene.film.bands, &lambda, &radiance, bands);
+            for v in bands.iter_mut() {
+                *v *= ray_weight;
+            }
+        }
         for v in aovs.iter_mut() {
             *v *= time_weight;
         }
-        let xyz = lambda.to_xyz(&radiance).map(|v| v * time_weight);
+        let xyz = lambda
+            .to_xyz(&radiance)
+            .map(|v| v * ray_weight * time_weight);
         (offset, filter_weight, xyz)
     }
 

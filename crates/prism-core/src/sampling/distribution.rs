@@ -412,6 +412,32 @@ impl AliasTable {
         };
         (index, self.bins[index].pmf)
     }
+
+    /// As [`Self::sample`], and `u` made again into a number uniform in [0, 1) and independent
+    /// of the index drawn (Mitsuba's `sample_reuse`), so that one number both picks the index
+    /// and places a point within it: u·n lands in a bin, and where it lies within the part of
+    /// the bin that chose the index (the first `keep` of it, or the rest) is uniform whatever
+    /// the index. It keeps the bits of `u` left over after the bin, about 24 − log₂ n.
+    pub fn sample_reuse(&self, u: f32) -> (usize, f32, f32) {
+        let n = self.bins.len();
+        let scaled = u * n as f32;
+        let bin = (scaled as usize).min(n - 1);
+        let remapped = (scaled - bin as f32).clamp(0.0, 1.0f32.next_down());
+        let entry = self.bins[bin];
+        let (index, reused) = if remapped < entry.keep {
+            (bin, remapped / entry.keep)
+        } else {
+            (
+                entry.alias as usize,
+                (remapped - entry.keep) / (1.0 - entry.keep),
+            )
+        };
+        (
+            index,
+            self.bins[index].pmf,
+            reused.clamp(0.0, 1.0f32.next_down()),
+        )
+    }
 }
 
 #[cfg(test)]

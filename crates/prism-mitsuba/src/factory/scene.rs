@@ -15,10 +15,11 @@ use crate::description::{NestedPlugin, PluginClass, PluginNode, Warning};
 use crate::params::Params;
 use crate::registry::{Default, ParamSpec, params};
 use prism_core::bsdf::Material;
+use prism_core::camera::CameraModel;
 use prism_core::error::{Error, Result, SourceLocation};
 use prism_core::geometry::{Geometry, Primitive, Shape};
 use prism_core::integrator::{Integrator, PathIntegrator};
-use prism_core::light::Light;
+use prism_core::light::{BoundingSphere, Light};
 use prism_core::medium::{Medium, MediumInterface};
 use prism_core::scene::Scene;
 use prism_core::texture::TextureUse;
@@ -74,9 +75,11 @@ pub fn build_scene_with_geometry(
     let params = Params::new(root, SCENE);
     let integrator_child = params.single_child(&INTEGRATOR)?;
     let integrator = integrator(integrator_child)?;
-    let sensors = sensors(root, &params)?;
+    let mut sensors = top_level_sensors(&params)?;
     let mut builder = SceneBuilder::default();
     builder.shapes(&params)?;
+    sensors.append(&mut builder.shape_sensors);
+    let sensors = in_document_order(root, sensors)?;
     builder.emitters(&params)?;
     builder.declared_bsdfs(&params)?;
     builder.declared_textures(&params)?;
@@ -86,7 +89,9 @@ pub fn build_scene_with_geometry(
     }
     let mut scene_sensors = Vec::with_capacity(sensors.len());
     let mut warnings = Vec::new();
+    let integrator_location = integrator_child.map_or(&root.location, |c| &c.location);
     for (id, sensor) in sensors {
+        check_band_names(&integrator, &sensor, integrator_location)?;
         let medium = match &sensor.medium {
             Some(node) => Some(builder.media.index(&NestedPlugin {
                 name: None,
@@ -131,16 +136,62 @@ fn integrator(child: Option<&NestedPlugin>) -> Result<Integrator> {
     }
 }
 
-/// The scene's sensors with their ids, in document order; a scene needs one.
-fn sensors(root: &PluginNode, params: &Params) -> Result<Vec<(Option<String>, SensorSettings)>> {
-    let sensors = params.children(&SENSOR);
+/// A sensor of the scene with its id, and the child of the `<scene>` that declares it (the
+/// `<sensor>` itself, or the `<shape>` that carries it).
+struct DeclaredSensor {
+    declared_by: *const PluginNode,
+    id: Option<String>,
+    settings: SensorSettings,
+}
+
+/// The `<sensor>`s at the top level of the scene.
+fn top_level_sensors(params: &Params) -> Result<Vec<DeclaredSensor>> {
+    (params.children(&SENSOR).iter())
+        .map(|child| {
+            Ok(DeclaredSensor {
+                declared_by: Arc::as_ptr(&child.node),
+                id: child.node.id.clone(),
+                settings: sensor::build_sensor(&child.node)?,
+            })
+        })
+        .collect()
+}
+
+/// The scene's sensors with their ids, in document order, as Mitsuba lists them (a sensor
+/// carried by a shape stands where its shape does); a scene needs one.
+fn in_document_order(
+    root: &PluginNode,
+    mut sensors: Vec<DeclaredSensor>,
+) -> Result<Vec<(Option<String>, SensorSettings)>> {
     if sensors.is_empty() {
         return Err(Error::input(&root.location, "the scene has no <sensor>")
             .with_help("add a <sensor type=\"perspective\"> with a film and a sampler"));
     }
-    (sensors.iter())
-        .map(|child| Ok((child.node.id.clone(), sensor::build_sensor(&child.node)?)))
-        .collect()
+    let position = |declared_by: *const PluginNode| {
+        (root.children.iter()).position(|child| Arc::as_ptr(&child.node) == declared_by)
+    };
+    sensors.sort_by_key(|sensor| position(sensor.declared_by));
+    Ok(sensors.into_iter().map(|s| (s.id, s.settings)).collect())
+}
+
+/// A spectral film's channels must not take the names of the integrator (at `location`).
+fn check_band_names(
+    integrator: &Integrator,
+    sensor: &SensorSettings,
+    location: &SourceLocation,
+) -> Result<()> {
+    let names = integrator.aov_names();
+    match (sensor.film.bands.iter()).find(|band| names.contains(&band.name)) {
+        Some(band) => Err(Error::input(
+            location,
+            format!(
+                "the spectral film's channel \"{}\" would replace the integrator's",
+                band.name
+            ),
+        )
+        .with_help("rename the spectrum or the integrator's channel")),
+        None => Ok(()),
+    }
 }
 
 /// The distrib integrator estimates no participating media: a scene with media and distrib is
@@ -172,6 +223,8 @@ struct SceneBuilder {
     /// The area emitters attached to shapes, with where each was attached (an emitter declared
     /// at the top level with an id reaches its shape by a `<ref>`).
     attached_emitters: HashMap<*const PluginNode, SourceLocation>,
+    /// The sensors shapes carry (irradiance meters).
+    shape_sensors: Vec<DeclaredSensor>,
 }
 
 impl SceneBuilder {
@@ -254,6 +307,13 @@ impl SceneBuilder {
         };
         bind_mesh_attributes(&mut shape, material, &self.textures, &child.node)?;
         let interface = shape_media(&shape_params, &mut self.media)?;
+        if let Some(meter) = shape_params.single_child(&shapes::SENSOR)? {
+            self.shape_sensors.push(DeclaredSensor {
+                declared_by: Arc::as_ptr(&child.node),
+                id: meter.node.id.clone(),
+                settings: sensor::build_shape_sensor(&meter.node, &child.node, &shape)?,
+            });
+        }
         shape_params.finish()?;
         if area == 0.0 && !curve {
             return Ok(());
@@ -384,7 +444,7 @@ impl SceneBuilder {
         self,
         root: &PluginNode,
         integrator: Integrator,
-        sensors: Vec<SceneSensor>,
+        mut sensors: Vec<SceneSensor>,
         warnings: Vec<Warning>,
         geometry: Option<Geometry>,
     ) -> LoadedScene {
@@ -399,6 +459,10 @@ impl SceneBuilder {
             world.medium_interfaces = self.medium_interfaces;
         }
         world.media = self.media.media;
+        let bounds = BoundingSphere::around_box(world.geometry.bounds());
+        for sensor in &mut sensors {
+            sensor.camera.set_scene_bounds(bounds);
+        }
         let first = sensors[0].clone();
         world.camera_medium = first.medium;
         let mut scene = Scene::new(world, first.camera, first.film, first.sampler, integrator);

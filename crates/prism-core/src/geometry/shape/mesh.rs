@@ -277,6 +277,17 @@ impl TriangleMesh {
         }
     }
 
+    /// A point uniformly distributed over the mesh's area from two numbers, as Mitsuba's
+    /// `Mesh::sample_position` draws it: `u.y` picks a triangle in proportion to its area and
+    /// is reused ([`AliasTable::sample_reuse`]) with `u.x` for a uniform point in it. The pdf is
+    /// 1/area. None for a mesh of zero area.
+    pub fn sample_position(&self, u: Vec2) -> Option<SurfaceSample> {
+        let table = self.light_sampling().area_table.as_ref()?;
+        let (triangle, _, reused) = table.sample_reuse(u.y);
+        let b = sample_uniform_triangle(Vec2::new(u.x, reused));
+        Some(self.surface_sample(triangle, [b.x, b.y, 1.0 - b.x - b.y], 1.0 / self.area))
+    }
+
     /// The mesh's light-sampling tables, built on first use.
     fn light_sampling(&self) -> &LightSampling {
         self.light_sampling.get_or_init(|| {

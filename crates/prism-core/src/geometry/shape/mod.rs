@@ -167,6 +167,24 @@ pub enum ShapeSampling {
     Area,
 }
 
+impl Shape {
+    /// A point uniformly distributed over the surface from two numbers (Mitsuba's
+    /// `Shape::sample_position`, with which sensors sample the shape they measure on or aim
+    /// at): a mesh picks its triangle with `u.y` and reuses it
+    /// ([`TriangleMesh::sample_position`]); other shapes map `u` onto their surface. The pdf is
+    /// per unit area; None for a shape of zero area (curves).
+    pub fn sample_position(&self, u: Vec2) -> Option<SurfaceSample> {
+        match self {
+            Shape::Mesh(mesh) => mesh.sample_position(u),
+            Shape::Sphere(sphere) => sphere.sample_area(0.0, u),
+            Shape::Disk(disk) => disk.sample_area(0.0, u),
+            Shape::Cylinder(cylinder) => cylinder.sample_area(0.0, u),
+            Shape::LinearCurve(curve) => curve.sample_area(0.0, u),
+            Shape::BSplineCurve(curve) => curve.sample_area(0.0, u),
+        }
+    }
+}
+
 /// The segments of a curve, each a primitive of the hierarchy.
 #[derive(Clone, Copy, Debug)]
 pub enum Segments<'a> {

@@ -2,18 +2,23 @@
 //! how `ldrfilm` tonemaps its 8-bit image.
 
 use super::rfilter::build_filter;
-use crate::description::{PluginClass, PluginNode, Warning};
+use crate::description::{
+    PluginClass, PluginNode, Property, PropertyValue, SpectrumValue, Warning,
+};
 use crate::params::Params;
-use crate::registry::{Choice, Default, Origin, ParamKind, ParamSpec, Plugin, Registry, params};
+use crate::registry::{
+    Choice, Default, Origin, ParamKind, ParamSpec, Plugin, Range, Registry, params,
+};
 use glam::UVec2;
 use prism_core::error::{Error, Result};
+use prism_core::film::output::{ALPHA_CHANNEL, IMAGE_CHANNELS};
 use prism_core::film::{
     ComponentFormat, CropWindow, ExrOutput, Filter, GaussianFilter, LdrFormat, LdrOutput,
-    PixelFormat, Reconstruction, Tonemap, TransferCurve,
+    PixelFormat, Reconstruction, SpectralBand, Tonemap, TransferCurve,
 };
 use prism_core::image::Channels;
 use prism_core::scene::FilmSettings;
-use prism_core::spectrum::WavelengthSampling;
+use prism_core::spectrum::{LAMBDA_MAX, LAMBDA_MIN, PiecewiseLinear, Spectrum, WavelengthSampling};
 
 /// The parameters of a film: the size and crop window every film takes, its own `[format]`
 /// parameters, the filter and reconstruction every film takes, and its own `[after]`.
@@ -78,6 +83,15 @@ pub static FILMS: Registry<FilmBuild> = Registry {
             ),
             build: build_ldrfilm,
         },
+        Plugin {
+            name: "specfilm",
+            origin: Origin::Mitsuba3,
+            summary: "A spectral film: one OpenEXR channel per nested `<spectrum name=\"...\">`, \
+                      named as it, holding ∫ s(λ) L(λ) dλ, the radiance integrated against that \
+                      response (with Y and its statistics).",
+            params: film_params!([COMPONENT_FORMAT], [SPECTRAL_BANDS]),
+            build: build_specfilm,
+        },
     ],
 };
 
@@ -117,6 +131,7 @@ params! {
     KEY = ParamSpec::new("key", ParamKind::Float, Default::Float(0.18), "with `reinhard`, the value the log-average luminance maps to, in (0, 1]");
     BURN = ParamSpec::new("burn", ParamKind::Float, Default::Float(0.0), "with `reinhard`, how much highlights may burn out, in [0, 1]");
     RFILTER = ParamSpec::nested(PluginClass::Rfilter, Default::Text("`gaussian`"), "the reconstruction filter");
+    SPECTRAL_BANDS = ParamSpec::new("(any name)", ParamKind::Spectrum { range: Range::Coefficient, textured: false }, Default::Required, "one channel per `<spectrum name=\"...\">` (a response s over 360–830 nm), named as the spectrum");
 }
 
 /// Largest film side, and largest pixel count, accepted (each pixel keeps 112 bytes of sums,
@@ -138,6 +153,8 @@ pub(super) fn default_film() -> FilmParts {
         filter: Filter::Gaussian(GaussianFilter { stddev: 0.5 }),
         reconstruction: Reconstruction::default(),
         wavelength_sampling: WavelengthSampling::default(),
+        bands: Vec::new(),
+        response: None,
     };
     FilmParts {
         film,
@@ -170,6 +187,88 @@ fn build_hdrfilm(params: &Params) -> Result<FilmParts> {
         film,
         exr,
         ldr: LdrOutput::default(),
+    })
+}
+
+/// `specfilm` (Mitsuba 3's `specfilm.cpp`): the film of `hdrfilm`, whose EXR holds one channel
+/// per `<spectrum>` the film names ([`prism_core::film::spectral_bands`]) beside Y and its
+/// statistics.
+fn build_specfilm(params: &Params) -> Result<FilmParts> {
+    let mut film = film_settings(params)?;
+    for property in params.undeclared_spectra() {
+        film.bands.push(spectral_band(params, property)?);
+    }
+    if film.bands.is_empty() {
+        return Err(Error::input(
+            params.location(),
+            "a specfilm needs at least one response: a nested <spectrum name=\"...\">",
+        )
+        .with_help("add <spectrum name=\"band\" value=\"500:1, 600:1\"/>, one per channel"));
+    }
+    Ok(FilmParts {
+        film,
+        exr: ExrOutput {
+            pixel_format: PixelFormat::Luminance,
+            component_format: params.choice(&COMPONENT_FORMAT)?,
+        },
+        ldr: LdrOutput::default(),
+    })
+}
+
+/// One band of a `specfilm`: a channel name that is not one of the image's, and a finite
+/// response that is zero outside the 360–830 nm Prism draws wavelengths in.
+fn spectral_band(params: &Params, property: &Property) -> Result<SpectralBand> {
+    let name = &property.name;
+    if IMAGE_CHANNELS.contains(&name.as_str()) || name == ALPHA_CHANNEL {
+        return Err(Error::input(
+            &property.location,
+            format!("the spectral film's channel \"{name}\" would replace the image's own"),
+        )
+        .with_help(format!(
+            "rename the spectrum; the image's channels are {}, {ALPHA_CHANNEL}",
+            IMAGE_CHANNELS.join(", ")
+        )));
+    }
+    let response = match &property.value {
+        PropertyValue::Spectrum(SpectrumValue::Uniform(v)) if v.is_finite() => {
+            Spectrum::Constant(*v as f32)
+        }
+        PropertyValue::Spectrum(SpectrumValue::Samples(samples))
+            if samples.iter().all(|(l, v)| l.is_finite() && v.is_finite()) =>
+        {
+            let outside = samples.iter().find(|(lambda, value)| {
+                *value != 0.0 && !(f64::from(LAMBDA_MIN)..=f64::from(LAMBDA_MAX)).contains(lambda)
+            });
+            if let Some((lambda, _)) = outside {
+                return Err(Error::input(
+                    &property.location,
+                    format!(
+                        "the response \"{name}\" is not zero at {lambda} nm, outside the \
+                         {LAMBDA_MIN}–{LAMBDA_MAX} nm Prism draws wavelengths in"
+                    ),
+                )
+                .with_help("Prism's spectra end there: cut the response to that range"));
+            }
+            let samples: Vec<(f32, f32)> =
+                samples.iter().map(|&(l, v)| (l as f32, v as f32)).collect();
+            match PiecewiseLinear::new(&samples) {
+                Some(table) => Spectrum::PiecewiseLinear(table),
+                None => Spectrum::Constant(0.0),
+            }
+        }
+        _ => {
+            return Err(Error::input(
+                &property.location,
+                format!(
+                    "the response \"{name}\" of {} must be finite",
+                    params.node().describe()
+                ),
+            ));
+        }
+    };
+    Ok(SpectralBand {
+        name: name.clone(),
+        response,
     })
 }
 
@@ -296,5 +395,7 @@ fn film_settings(params: &Params) -> Result<FilmSettings> {
         filter,
         reconstruction,
         wavelength_sampling,
+        bands: Vec::new(),
+        response: None,
     })
 }

@@ -1,15 +1,21 @@
-//! The sensor: the `perspective`, `thinlens` and `orthographic` cameras and the `radiancemeter`,
+//! The sensor: the `perspective`, `thinlens` and `orthographic` cameras, the `radiancemeter`,
+//! `irradiancemeter` and `distant` meters ([`meters`]) and the `batch` of sensors ([`batch`]),
 //! with their shutter, and the film and sampler they carry (each class's registry in its own
 //! module).
 
+mod batch;
 pub mod film;
+mod meters;
 pub mod rfilter;
 pub mod sampler;
 
+pub use meters::build_shape_sensor;
+
 use crate::description::{PluginClass, PluginNode, Warning};
 use crate::factory::fov::{FOCAL_LENGTH, FOV, FOV_AXIS, horizontal_fov_param};
+use crate::factory::spectra::spectrum_param;
 use crate::params::Params;
-use crate::registry::{Default, Origin, ParamKind, ParamSpec, Plugin, Registry, params};
+use crate::registry::{Default, Origin, ParamKind, ParamSpec, Plugin, Range, Registry, params};
 use film::{build_film, default_film};
 use glam::{DMat4, DVec3, Vec2};
 use prism_core::camera::{Camera, OrthographicCamera, PerspectiveCamera, RadianceMeter, Shutter};
@@ -36,6 +42,7 @@ macro_rules! camera_params {
             SHUTTER_FILTER,
             FILM,
             SAMPLER,
+            SRF,
             $($after,)*
         ]
     };
@@ -100,9 +107,64 @@ pub static SENSORS: Registry<SensorBuild> = Registry {
                 SHUTTER_FILTER,
                 FILM,
                 SAMPLER,
+                SRF,
                 SENSOR_MEDIUM,
             ],
             build: build_radiancemeter,
+        },
+        Plugin {
+            name: "irradiancemeter",
+            origin: Origin::Mitsuba3,
+            summary: "Nested in a `<shape>`: the irradiance on the shape, averaged over its area \
+                      (π L along cosine-weighted rays from points uniform by area).",
+            params: &[
+                IRRADIANCE_TO_WORLD,
+                SHUTTER_OPEN,
+                SHUTTER_CLOSE,
+                SHUTTER_FILTER,
+                FILM,
+                SAMPLER,
+                SRF,
+                SENSOR_MEDIUM,
+            ],
+            build: meters::build_irradiancemeter_alone,
+        },
+        Plugin {
+            name: "distant",
+            origin: Origin::Mitsuba3,
+            summary: "The radiance leaving the scene along `direction` (or `to_world`'s +z axis), \
+                      averaged over a `target` point, shape or the scene's cross-section, on a film \
+                      of one pixel.",
+            params: &[
+                DISTANT_TO_WORLD,
+                DISTANT_DIRECTION,
+                DISTANT_TARGET,
+                SHUTTER_OPEN,
+                SHUTTER_CLOSE,
+                SHUTTER_FILTER,
+                FILM,
+                SAMPLER,
+                SRF,
+                SENSOR_MEDIUM,
+            ],
+            build: meters::build_distant,
+        },
+        Plugin {
+            name: "batch",
+            origin: Origin::Mitsuba3,
+            summary: "Several nested sensors rendered side by side into one film, each into a \
+                      block of width W/n.",
+            params: &[
+                BATCH_SENSORS,
+                SHUTTER_OPEN,
+                SHUTTER_CLOSE,
+                SHUTTER_FILTER,
+                FILM,
+                SAMPLER,
+                SRF,
+                SENSOR_MEDIUM,
+            ],
+            build: batch::build_batch,
         },
     ],
 };
@@ -116,6 +178,7 @@ params! {
     SHUTTER_FILTER = ParamSpec::new("shutter_filter", ParamKind::Nested(PluginClass::Rfilter), Default::Text("box"), "Prism only: a nested `<rfilter name=\"shutter_filter\">` weighting time within the shutter interval");
     FILM = ParamSpec::nested(PluginClass::Film, Default::Text("`hdrfilm`, 768 × 576, gaussian"), "the film");
     SAMPLER = ParamSpec::nested(PluginClass::Sampler, Default::Text("`independent`, 4 samples"), "the sampler");
+    SRF = ParamSpec::new("srf", ParamKind::Spectrum { range: Range::Coefficient, textured: false }, Default::Text("1"), "the sensor's spectral response: the radiance is multiplied by it at each wavelength (not with a `specfilm`)");
     SENSOR_MEDIUM = ParamSpec::nested(PluginClass::Medium, Default::None, "the medium the camera sits in (for `volpath`)");
     APERTURE_RADIUS = ParamSpec::new("aperture_radius", ParamKind::Float, Default::Required, "radius of the lens (or give `aperture_area`)");
     APERTURE_AREA = ParamSpec::new("aperture_area", ParamKind::Float, Default::None, "Prism only, the lecture's form: the lens's area a, radius √(a/π)");
@@ -125,6 +188,11 @@ params! {
     METER_TO_WORLD = ParamSpec::new("to_world", ParamKind::AnimatedTransform, Default::Text("identity"), "sensor to world: the ray leaves its origin along its +z axis (wins over `origin` and `direction`)");
     METER_ORIGIN = ParamSpec::new("origin", ParamKind::Point, Default::None, "where the ray starts, with `direction`");
     METER_DIRECTION = ParamSpec::new("direction", ParamKind::Vector, Default::None, "the direction of the ray, with `origin`");
+    IRRADIANCE_TO_WORLD = ParamSpec::new("to_world", ParamKind::Transform, Default::None, "not allowed: the meter takes its shape's placement");
+    DISTANT_TO_WORLD = ParamSpec::new("to_world", ParamKind::Transform, Default::Text("identity"), "sensor to world: the rays travel along its +z axis (or give `direction`)");
+    DISTANT_DIRECTION = ParamSpec::new("direction", ParamKind::Vector, Default::None, "the direction the rays travel in (the radiance leaving the scene towards −`direction` is measured)");
+    DISTANT_TARGET = ParamSpec::new("target", ParamKind::Point, Default::Text("the scene's cross-section"), "a point the rays aim at, or a nested `<shape name=\"target\">` they aim at uniformly by area");
+    BATCH_SENSORS = ParamSpec::nested(PluginClass::Sensor, Default::Required, "the sensors, left to right; their films, samplers and shutters give way to the batch's");
     ORTHOGRAPHIC_TO_WORLD = ParamSpec::new("to_world", ParamKind::AnimatedTransform, Default::Text("identity"), "camera to world, scales included (they set the film's extent in the scene), or an `<animation>` of them");
 }
 
@@ -146,7 +214,7 @@ pub struct SensorSettings {
     pub medium: Option<Arc<PluginNode>>,
 }
 
-/// Builds the sensor a node describes.
+/// Builds the sensor a node describes (a `<sensor>` of the scene or of a `batch`).
 pub fn build_sensor(node: &PluginNode) -> Result<SensorSettings> {
     let plugin = SENSORS.find(node)?;
     let params = Params::new(node, plugin.params);
@@ -157,7 +225,7 @@ pub fn build_sensor(node: &PluginNode) -> Result<SensorSettings> {
 
 /// What every sensor carries: its film (with the 8-bit output and the warnings of its ignored
 /// parameters), its sampler and the sampler's seed.
-struct SensorParts {
+pub(super) struct SensorParts {
     film: FilmSettings,
     exr_output: ExrOutput,
     ldr_output: LdrOutput,
@@ -166,7 +234,7 @@ struct SensorParts {
     seed: u64,
 }
 
-fn sensor_parts(params: &Params) -> Result<SensorParts> {
+pub(super) fn sensor_parts(params: &Params) -> Result<SensorParts> {
     let (film, warnings) = match params.single_child(&FILM)? {
         Some(child) => build_film(&child.node)?,
         None => (default_film(), Vec::new()),
@@ -181,6 +249,17 @@ fn sensor_parts(params: &Params) -> Result<SensorParts> {
             0,
         ),
     };
+    let mut film = film;
+    if params.property(&SRF).is_some() {
+        if !film.film.bands.is_empty() {
+            return Err(Error::input(
+                params.location_of(&SRF),
+                "a sensor with an \"srf\" cannot have a specfilm, whose bands are its responses",
+            )
+            .with_help("remove the srf, or use an hdrfilm"));
+        }
+        film.film.response = Some(spectrum_param(params, &SRF)?);
+    }
     Ok(SensorParts {
         film: film.film,
         exr_output: film.exr,
@@ -192,7 +271,7 @@ fn sensor_parts(params: &Params) -> Result<SensorParts> {
 }
 
 /// The sensor of `camera` and `shutter` with what every sensor carries.
-fn sensor_settings(
+pub(super) fn sensor_settings(
     params: &Params,
     parts: SensorParts,
     camera: Camera,
@@ -272,33 +351,48 @@ fn build_radiancemeter(params: &Params, _thinlens: bool) -> Result<SensorSetting
             }
         }
     };
-    if parts.film.size != glam::UVec2::ONE {
-        return Err(Error::input(
-            params.location(),
-            format!(
-                "a radiancemeter measures one ray: its film must be 1 × 1 pixels, not {} × {}",
-                parts.film.size.x, parts.film.size.y
-            ),
-        )
-        .with_help("set the film's width and height to 1"));
-    }
-    if parts.film.filter.radius() > 0.5 + 1e-4 {
-        parts.warnings.push(Warning {
-            location: params.location().clone(),
-            message: "a radiancemeter should have a reconstruction filter of radius 0.5 or less \
-                      (the box, Mitsuba's advice): its one ray is the same for every sample"
-                .into(),
-        });
-    }
+    check_one_pixel(params, &parts)?;
+    warn_wide_filter(params, &mut parts);
     let shutter = shutter(params)?;
     let camera = Camera::RadianceMeter(RadianceMeter { to_world });
     sensor_settings(params, parts, camera, shutter)
 }
 
+/// A one-pixel film, which a sensor whose rays do not depend on the film position needs.
+pub(super) fn check_one_pixel(params: &Params, parts: &SensorParts) -> Result<()> {
+    if parts.film.size == glam::UVec2::ONE {
+        return Ok(());
+    }
+    Err(Error::input(
+        params.location(),
+        format!(
+            "a {} sensor measures one quantity: its film must be 1 × 1 pixels, not {} × {}",
+            params.node().plugin_type,
+            parts.film.size.x,
+            parts.film.size.y
+        ),
+    )
+    .with_help("set the film's width and height to 1"))
+}
+
+/// Mitsuba's warning for a one-pixel sensor with a filter wider than the box.
+pub(super) fn warn_wide_filter(params: &Params, parts: &mut SensorParts) {
+    if parts.film.filter.radius() > 0.5 + 1e-4 {
+        parts.warnings.push(Warning {
+            location: params.location().clone(),
+            message: format!(
+                "a {} sensor should have a reconstruction filter of radius 0.5 or less (the box, \
+                 Mitsuba's advice): its rays do not depend on the film position",
+                params.node().plugin_type
+            ),
+        });
+    }
+}
+
 /// Mitsuba 3's `look_at(origin, origin + direction, up)` with `up` the first tangent of
 /// `coordinate_system(normalize(direction))` (Duff et al. 2017): columns left, up, direction,
 /// origin. None for a direction of no length.
-fn ray_frame(origin: DVec3, direction: DVec3) -> Option<Transform> {
+pub(super) fn ray_frame(origin: DVec3, direction: DVec3) -> Option<Transform> {
     let d = direction.try_normalize()?;
     let sign = 1.0f64.copysign(d.z);
     let a = -1.0 / (sign + d.z);
@@ -403,7 +497,7 @@ fn lens(params: &Params, far_clip: f64) -> Result<(f64, f64)> {
 
 /// `shutter_open`, `shutter_close` (default 0 and 0) and an optional nested temporal filter
 /// `<rfilter name="shutter_filter">`.
-fn shutter(params: &Params) -> Result<Shutter> {
+pub(super) fn shutter(params: &Params) -> Result<Shutter> {
     let open = params.float(&SHUTTER_OPEN)?;
     let close = params.float_opt(&SHUTTER_CLOSE)?.unwrap_or(open);
     if !open.is_finite() || !close.is_finite() || close < open {

@@ -5,7 +5,7 @@
 //! shutter is open: it is built in object space and placed by an [`Instance`].
 
 /// The parameters of a shape: its own, then those every shape takes (`to_world`, `bsdf`,
-/// `emitter`, `interior` and `exterior`).
+/// `emitter`, `interior`, `exterior` and `sensor`).
 macro_rules! shape_params {
     [$($own:expr),* $(,)?] => {
         &[
@@ -15,6 +15,7 @@ macro_rules! shape_params {
             $crate::factory::shapes::EMITTER,
             $crate::factory::shapes::INTERIOR,
             $crate::factory::shapes::EXTERIOR,
+            $crate::factory::shapes::SENSOR,
         ]
     };
 }
@@ -68,6 +69,8 @@ params! {
     pub INTERIOR = ParamSpec::new("interior", ParamKind::Nested(PluginClass::Medium), Default::None, "a `<medium name=\"interior\">` (or `<ref name=\"interior\" id=\"...\"/>`) inside the shape");
     /// The medium outside a shape.
     pub EXTERIOR = ParamSpec::new("exterior", ParamKind::Nested(PluginClass::Medium), Default::None, "a `<medium name=\"exterior\">` outside the shape");
+    /// The sensor a shape carries.
+    pub SENSOR = ParamSpec::nested(PluginClass::Sensor, Default::None, "an `irradiancemeter` measuring the irradiance on the shape");
 }
 
 /// Whether `plugin` makes curves: shapes that are hit but have no area (nor area sampling).
