@@ -438,9 +438,9 @@ fn selection_chi2(selection: LightSelection, seed: u64) {
     SUITE.assert_passes(&format!("light selection {selection:?}"), &outcome);
 }
 
-/// The closed form of the exhaustive selection at `receiver`: the lights at infinity (the
-/// directional and the constant one, the last two) by their share of the total power, the
-/// others by Φ min(1, (|n·(c − p)| + r)/d) / max(d², r²) of the boxes of `every_kind_of_light`.
+/// The closed form of the exhaustive selection at `receiver`: the two lights at infinity (the
+/// directional and the constant one, the last two) together with probability 2/3 (pbrt-v4's
+/// N_∞/(N_∞ + 1)), between them by power, the others by Φ min(1, (|n·(c − p)| + r)/d) / max(d², r²) of the boxes of `every_kind_of_light`.
 fn exhaustive_probabilities(powers: &[f64], receiver: &Receiver) -> Vec<f64> {
     let (p, n) = (receiver.p.as_dvec3(), receiver.n.map(|n| n.as_dvec3()));
     // Centres and squared radii: the floor [−2, 2]² × {0}, the sphere, the point, the spot.
@@ -462,13 +462,17 @@ fn exhaustive_probabilities(powers: &[f64], receiver: &Receiver) -> Vec<f64> {
             power * cosine / d2
         })
         .collect();
-    let total: f64 = powers.iter().sum();
-    let infinite_share = (powers[4] + powers[5]) / total;
+    let infinite_share = 2.0 / 3.0;
+    let infinite_power = powers[4] + powers[5];
     let finite: f64 = importance.iter().sum();
     importance
         .iter()
         .map(|i| (1.0 - infinite_share) * i / finite)
-        .chain(powers[4..].iter().map(|p| p / total))
+        .chain(
+            powers[4..]
+                .iter()
+                .map(|p| infinite_share * p / infinite_power),
+        )
         .collect()
 }
 
