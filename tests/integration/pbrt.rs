@@ -1,0 +1,157 @@
+//! pbrt-v4 scenes: the transcription of the Cornell box renders the XML's image, and malformed
+//! files are refused with their file, line and column.
+
+use std::path::{Path, PathBuf};
+
+use prism_core::film::Film;
+use prism_mitsuba::load_scene;
+
+use crate::common::scenes::{pixel_mean_and_variance, render_film};
+
+/// Mean and variance of the mean of channel `c` over the square block of `block` pixels whose
+/// top-left pixel is (x0, y0).
+fn block_mean(film: &Film, x0: usize, y0: usize, block: usize, c: usize) -> (f64, f64) {
+    let width = film.size.x as usize;
+    let n = (block * block) as f64;
+    let (mut sum, mut variance) = (0.0, 0.0);
+    for y in y0..y0 + block {
+        for x in x0..x0 + block {
+            let (m, v) = pixel_mean_and_variance(film, y * width + x, c);
+            sum += m;
+            variance += v;
+        }
+    }
+    (sum / n, variance / (n * n))
+}
+
+/// The largest |z| of the differences of the two films' 32 × 32 blocks in X, Y and Z.
+fn largest_block_z(a: &Film, b: &Film) -> f64 {
+    assert_eq!(a.size, b.size);
+    let block = 32;
+    let mut largest: f64 = 0.0;
+    for y0 in (0..a.size.y as usize).step_by(block) {
+        for x0 in (0..a.size.x as usize).step_by(block) {
+            for c in 0..3 {
+                let (ma, va) = block_mean(a, x0, y0, block, c);
+                let (mb, vb) = block_mean(b, x0, y0, block, c);
+                largest = largest.max((ma - mb).abs() / (va + vb).sqrt());
+            }
+        }
+    }
+    largest
+}
+
+#[test]
+fn the_cornell_box_in_pbrt_renders_the_xml_image() {
+    let xml = load_scene(Path::new("scenes/cornell-box/scene.xml"), &[]).unwrap();
+    let pbrt = load_scene(Path::new("scenes/cornell-box/scene.pbrt"), &[]).unwrap();
+    assert_eq!(pbrt.scene.film.size, xml.scene.film.size);
+    // Independent estimates (two seeds) of the same image: 64 blocks × 3 channels, so a bound
+    // of 4.5 standard errors fails a correct transcription with probability 1.3·10⁻³.
+    let spp = 16;
+    let a = render_film(&xml.scene, spp, 1, None);
+    let b = render_film(&pbrt.scene, spp, 2, None);
+    let z = largest_block_z(&a, &b);
+    assert!(
+        z < 4.5,
+        "the pbrt and XML images differ by {z:.1} standard errors"
+    );
+    // The test can fail: the XML image differs from itself mirrored (the red and green walls
+    // swapped), as a camera that ignored pbrt's left-handed camera space would render it.
+    let mut mirrored = a.clone();
+    let width = a.size.x as usize;
+    for (i, pixel) in mirrored.pixels.iter_mut().enumerate() {
+        let (x, y) = (i % width, i / width);
+        *pixel = a.pixels[y * width + (width - 1 - x)];
+    }
+    assert!(largest_block_z(&mirrored, &b) > 20.0);
+}
+
+/// A folder of its own for a test's files.
+fn folder(name: &str) -> PathBuf {
+    let folder = std::env::temp_dir().join(format!("prism-pbrt-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&folder).unwrap();
+    folder
+}
+
+/// The error message of loading `text` as `name`, in a folder of its own.
+fn error_of(name: &str, text: &str) -> String {
+    let folder = folder(name);
+    let path = folder.join(format!("{name}.pbrt"));
+    std::fs::write(&path, text).unwrap();
+    let message = match load_scene(&path, &[]) {
+        Ok(_) => panic!("{name}: the scene loaded"),
+        Err(error) => error.to_string(),
+    };
+    std::fs::remove_dir_all(&folder).unwrap();
+    message
+}
+
+#[test]
+fn errors_name_the_file_line_and_column() {
+    let cases = [
+        (
+            "unknown_directive",
+            "WorldBegin\n  Shape \"sphere\"\n  Sphere \"float radius\" 2\n",
+            "unknown_directive.pbrt:3:3: unknown directive \"Sphere\"",
+        ),
+        (
+            "bad_type",
+            "WorldBegin\nShape \"sphere\" \"float radius\" \"two\"\n",
+            "bad_type.pbrt:2:31: parameter \"float radius\" expects finite numbers",
+        ),
+        (
+            "wrong_type",
+            "WorldBegin\nShape \"sphere\" \"integer radius\" 2\n",
+            "wrong_type.pbrt:2:16: Shape \"sphere\": parameter \"integer radius\" must be of type float",
+        ),
+        (
+            "unterminated",
+            "WorldBegin\nShape \"sphere\" \"float radius 2\n",
+            "unterminated.pbrt:2:16: unterminated string",
+        ),
+        (
+            "missing_include",
+            "WorldBegin\n  Include \"geometry/missing.pbrt\"\n",
+            "missing_include.pbrt:2:11: file \"geometry/missing.pbrt\" not found",
+        ),
+        (
+            "unsupported_parameter",
+            "WorldBegin\nShape \"sphere\" \"float radius\" 1 \"float zmax\" 0.5\n",
+            "unsupported_parameter.pbrt:2:33: Shape \"sphere\": parameter \"float zmax\" cuts the shape",
+        ),
+        (
+            "unread_parameter",
+            "WorldBegin\nMaterial \"diffuse\" \"float sigma\" 20\n",
+            "unread_parameter.pbrt:2:20: Material \"diffuse\": parameter \"float sigma\" is not read by Prism",
+        ),
+        (
+            "coated",
+            "WorldBegin\nMaterial \"coateddiffuse\"\n",
+            "coated.pbrt:2:1: Material \"coateddiffuse\": pbrt-v4's coated materials are a random walk",
+        ),
+    ];
+    for (name, text, expected) in cases {
+        let message = error_of(name, text);
+        assert!(message.contains(expected), "{name}: {message}");
+    }
+}
+
+#[test]
+fn an_error_in_an_included_file_names_that_file() {
+    let folder = folder("include");
+    std::fs::create_dir_all(folder.join("geometry")).unwrap();
+    std::fs::write(
+        folder.join("geometry/shapes.pbrt"),
+        "# shapes\nShape \"sphere\"\nShape \"curve\"\n",
+    )
+    .unwrap();
+    let path = folder.join("scene.pbrt");
+    std::fs::write(&path, "WorldBegin\nInclude \"geometry/shapes.pbrt\"\n").unwrap();
+    let message = load_scene(&path, &[]).err().expect("refused").to_string();
+    std::fs::remove_dir_all(&folder).unwrap();
+    assert!(
+        message.contains("shapes.pbrt:3:1: Shape \"curve\": Prism has no shape"),
+        "{message}"
+    );
+}
