@@ -99,3 +99,6 @@ fn nest(
         location: location.clone(),
     });
 }
+
+#[cfg(test)]
+mod tests;
