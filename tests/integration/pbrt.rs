@@ -155,3 +155,16 @@ fn an_error_in_an_included_file_names_that_file() {
         "{message}"
     );
 }
+
+#[test]
+fn the_fuzzing_seeds_are_scenes_that_load() {
+    let mut count = 0;
+    for entry in std::fs::read_dir("fuzz/seeds/pbrt_scene").unwrap() {
+        let path = entry.unwrap().path();
+        if let Err(error) = load_scene(&path, &[]) {
+            panic!("{}: {error}", path.display());
+        }
+        count += 1;
+    }
+    assert!(count >= 2);
+}

@@ -441,7 +441,11 @@ impl Builder {
                         "is false: samples at the strata's centres do not converge",
                     ));
                 }
-                ("stratified", x * y)
+                if x < 1 {
+                    let parameter = list.get("xsamples").expect("given");
+                    return Err(list.error(parameter, "must be at least 1"));
+                }
+                ("stratified", x.saturating_mul(y))
             }
             "halton" | "sobol" | "paddedsobol" | "zsobol" | "pmj02bn" => {
                 list.ignore(&["randomization"]);

@@ -28,6 +28,11 @@ pub fn spectrum(
         SpectrumParam::Blackbody(kelvin) => {
             let samples = blackbody_samples(*kelvin);
             let peak = samples.iter().map(|s| s.1).fold(0.0, f64::max);
+            if !(peak > 0.0 && peak.is_finite()) {
+                return Err(
+                    list.error(parameter, "is a blackbody too cold to emit over 360-830 nm")
+                );
+            }
             PropertyValue::Spectrum(SpectrumValue::Samples(
                 samples.into_iter().map(|(l, v)| (l, v / peak)).collect(),
             ))
