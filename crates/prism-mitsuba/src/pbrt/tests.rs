@@ -345,3 +345,38 @@ fn options_and_world_directives_keep_their_places() {
             .contains("test.pbrt:1:41: this \"[\" is never closed")
     );
 }
+
+#[test]
+fn textures_map_pbrts_coordinates() {
+    let root = root(
+        "WorldBegin\nTexture \"image\" \"spectrum\" \"imagemap\" \"string filename\" \"grid.png\" \"float uscale\" 2 \"float vdelta\" 0.25\nTexture \"checks\" \"spectrum\" \"checkerboard\" \"float vscale\" 4\nMakeNamedMaterial \"a\" \"string type\" \"diffuse\" \"texture reflectance\" \"image\"\nMaterial \"diffuse\" \"texture reflectance\" \"checks\"\nShape \"sphere\"\nNamedMaterial \"a\"\nShape \"sphere\"",
+    );
+    let shapes = nodes(&root, PluginClass::Shape);
+    let texture = |shape: &PluginNode| {
+        let diffuse = shape.children[0].node.children[0].node.clone();
+        let child = &diffuse.children[0];
+        assert_eq!(child.name.as_deref(), Some("reflectance"));
+        child.node.clone()
+    };
+    let to_uv = |node: &PluginNode| match property(node, "to_uv") {
+        PropertyValue::Transform(m) => *m,
+        other => panic!("{other:?}"),
+    };
+    // Checkerboard: (s, t) = (u, 4v), halved for Prism's squares of ½.
+    let checks = texture(shapes[0]);
+    assert_eq!(checks.plugin_type, "checkerboard");
+    assert_close(to_uv(&checks), DMat4::from_scale(DVec3::new(0.5, 2.0, 1.0)));
+    // Image: (s, t) = (2u, v + 0.25), looked up at (s, 1 − t).
+    let image = texture(shapes[1]);
+    assert_eq!(image.plugin_type, "bitmap");
+    assert_eq!(property(&image, "raw"), &PropertyValue::Boolean(false));
+    assert_close(
+        to_uv(&image),
+        rows([
+            [2.0, 0.0, 0.0, 0.0],
+            [0.0, -1.0, 0.0, 0.75],
+            [0.0, 0.0, 1.0, 0.0],
+            [0.0, 0.0, 0.0, 1.0],
+        ]),
+    );
+}
