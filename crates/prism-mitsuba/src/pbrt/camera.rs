@@ -325,7 +325,10 @@ impl Builder {
             let x = list.float("xradius", default)?;
             let y = list.float("yradius", default)?;
             if x != y {
-                let parameter = list.get("yradius").expect("given");
+                let parameter = list
+                    .get("yradius")
+                    .or_else(|| list.get("xradius"))
+                    .expect("given");
                 return Err(list.error(
                     parameter,
                     "differs from xradius; Prism's filters are symmetric",
@@ -428,7 +431,10 @@ impl Builder {
                 let x = list.integer("xsamples", 4)?;
                 let y = list.integer("ysamples", 4)?;
                 if x != y {
-                    let parameter = list.get("ysamples").expect("given");
+                    let parameter = list
+                        .get("ysamples")
+                        .or_else(|| list.get("xsamples"))
+                        .expect("given");
                     return Err(list.error(
                         parameter,
                         "differs from xsamples; Prism's stratified sampler is square",

@@ -101,6 +101,9 @@ fn interpolate(samples: &[(f64, f64)], lambda: f64) -> f64 {
     if lambda < first.0 || lambda > last.0 {
         return 0.0;
     }
+    if samples.len() == 1 {
+        return first.1;
+    }
     let i = samples
         .partition_point(|s| s.0 <= lambda)
         .clamp(1, samples.len() - 1);
@@ -393,6 +396,9 @@ mod tests {
         assert_eq!(interpolate(&s, 399.0), 0.0);
         assert_eq!(interpolate(&s, 500.0), 3.0);
         assert_eq!(interpolate(&s, 501.0), 0.0);
+        // One sample is a spike at its wavelength.
+        assert_eq!(interpolate(&[(400.0, 2.0)], 400.0), 2.0);
+        assert_eq!(interpolate(&[(400.0, 2.0)], 401.0), 0.0);
     }
 
     #[test]
