@@ -380,3 +380,27 @@ fn textures_map_pbrts_coordinates() {
         ]),
     );
 }
+
+#[test]
+fn an_orthographic_camera_spans_the_shorter_axis() {
+    // pbrt spans [−1, 1] along the shorter axis (y on a 2:1 film), Mitsuba [−1, 1] along x:
+    // the camera is scaled by the aspect ratio.
+    let wide = root(
+        "Camera \"orthographic\"\nFilm \"rgb\" \"integer xresolution\" 20 \"integer yresolution\" 10\nWorldBegin\n",
+    );
+    let sensor = nodes(&wide, PluginClass::Sensor)[0];
+    assert_eq!(sensor.plugin_type, "orthographic");
+    assert_close(
+        transform(sensor),
+        DMat4::from_scale(DVec3::new(-2.0, 2.0, 1.0)),
+    );
+    // A tall film spans [−1, 1] along x in both.
+    let tall = root(
+        "Camera \"orthographic\"\nFilm \"rgb\" \"integer xresolution\" 10 \"integer yresolution\" 20\nWorldBegin\n",
+    );
+    let sensor = nodes(&tall, PluginClass::Sensor)[0];
+    assert_close(
+        transform(sensor),
+        DMat4::from_scale(DVec3::new(-1.0, 1.0, 1.0)),
+    );
+}
