@@ -345,3 +345,40 @@ fn mutated_scenes_are_read_or_refused_without_a_panic() {
         assert!(outcome.is_ok(), "mutation {i} panics:\n{text}");
     }
 }
+
+#[test]
+fn spectra_may_be_read_from_files() {
+    use prism_mitsuba::description::{PropertyValue, SpectrumValue};
+    let folder = folder("spectra");
+    std::fs::create_dir_all(folder.join("spds")).unwrap();
+    std::fs::write(
+        folder.join("spds/lamp.spd"),
+        "# a lamp\n400 1\n500 2 # peak\n600 1\n",
+    )
+    .unwrap();
+    std::fs::write(folder.join("spds/bad.spd"), "400 1\n500\n").unwrap();
+    let path = folder.join("scene.pbrt");
+    let scene = "WorldBegin\nAreaLightSource \"diffuse\" \"spectrum L\" \"spds/lamp.spd\" \"float scale\" 3\nShape \"sphere\"\n";
+    let read = prism_mitsuba::pbrt::read_pbrt_str(scene, &path);
+    let bad = prism_mitsuba::pbrt::read_pbrt_str(
+        "WorldBegin\nLightSource \"point\" \"spectrum I\" \"spds/bad.spd\"\n",
+        &path,
+    );
+    std::fs::remove_dir_all(&folder).unwrap();
+    let root = read.unwrap().root;
+    let shape = &root.children[2].node;
+    let emitter = &shape.children[1].node;
+    let PropertyValue::Spectrum(SpectrumValue::Samples(samples)) = &emitter.properties[0].value
+    else {
+        panic!("{:?}", emitter.properties);
+    };
+    // The file's shape, scaled to pbrt's luminance: 3 / luminance of the file's samples.
+    assert_eq!(samples.len(), 3);
+    assert!((samples[1].1 / samples[0].1 - 2.0).abs() < 1e-12);
+    let message = bad.err().expect("refused").to_string();
+    assert!(
+        message.contains("scene.pbrt:2:21:")
+            && message.contains("does not hold (wavelength, value) pairs"),
+        "{message}"
+    );
+}

@@ -33,6 +33,7 @@ impl Builder {
             value.as_ref().map(|v| v.1),
             value.as_ref().map(|v| &v.0),
             scale,
+            &self.search_paths,
         )
     }
 

@@ -91,7 +91,7 @@ impl Builder {
                 nest(node, Some(prism_name), texture, &parameter.location);
             }
             Some((value, parameter)) => {
-                let value = spectra::spectrum(list, parameter, &value)?;
+                let value = spectra::spectrum(list, parameter, &value, &self.search_paths)?;
                 set(node, prism_name, value, &parameter.location);
             }
             None => {
@@ -209,8 +209,8 @@ impl Builder {
             &list.location,
             &self.search_paths,
         );
-        let eta = list.spectrum("eta", true)?;
-        let k = list.spectrum("k", true)?;
+        let eta = list.spectrum("eta", false)?;
+        let k = list.spectrum("k", false)?;
         let metal = |value: &Option<(SpectrumParam, &super::parameters::Parameter)>, part: &str| {
             match value {
                 None => Some("Cu".to_string()),
@@ -235,22 +235,19 @@ impl Builder {
                     let Some((value, parameter)) = value else {
                         return Err(list.directive_error(
                             "needs eta and k of the same metal (metal-*-eta and metal-*-k of a \
-                             metal Prism knows), or both as spectrum samples",
+                             metal Prism knows), or both as spectra",
                         ));
                     };
-                    match value {
-                        SpectrumParam::Samples(samples) => set(
-                            &mut node,
-                            name,
-                            PropertyValue::Spectrum(crate::description::SpectrumValue::Samples(
-                                samples.clone(),
-                            )),
-                            &parameter.location,
-                        ),
+                    match spectra::spectrum(list, parameter, value, &self.search_paths)? {
+                        spectrum @ PropertyValue::Spectrum(_) => {
+                            set(&mut node, name, spectrum, &parameter.location)
+                        }
                         _ => {
                             return Err(list.error(
                                 parameter,
-                                "must be \"spectrum\" samples, or the metal-*-eta / metal-*-k pair of a metal Prism knows",
+                                "must be a spectrum (samples or a file), or the metal-*-eta / \
+                                 metal-*-k pair of a metal Prism knows; Prism reads RGB indices \
+                                 otherwise than pbrt",
                             ));
                         }
                     }
@@ -285,7 +282,9 @@ impl Builder {
                 PropertyValue::Float(list.float("eta", 1.5)?)
             }
             Some(_) => match list.spectrum("eta", false)? {
-                Some((value, parameter)) => spectra::spectrum(list, parameter, &value)?,
+                Some((value, parameter)) => {
+                    spectra::spectrum(list, parameter, &value, &self.search_paths)?
+                }
                 None => unreachable!("given"),
             },
             None => PropertyValue::Float(1.5),

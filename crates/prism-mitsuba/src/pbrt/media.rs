@@ -53,7 +53,7 @@ impl Builder {
         for name in ["sigma_a", "sigma_s"] {
             match list.spectrum(name, false)? {
                 Some((value, parameter)) => {
-                    let value = spectra::spectrum(list, parameter, &value)?;
+                    let value = spectra::spectrum(list, parameter, &value, &self.search_paths)?;
                     set(&mut node, name, value, &parameter.location);
                 }
                 None => set(&mut node, name, PropertyValue::Float(1.0), &location),

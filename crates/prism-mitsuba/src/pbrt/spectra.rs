@@ -8,9 +8,11 @@
 //! ([`illuminant`]). An RGB illuminant is the colour times D65 in both, D65 of luminance 1 in
 //! Prism's `<rgb>`, so it only takes the scale.
 
+use std::path::PathBuf;
+
 use super::parameters::{Parameter, ParameterList, SpectrumParam};
-use crate::description::{PropertyValue, SpectrumValue};
-use prism_core::error::Result;
+use crate::description::{PropertyValue, SpectrumValue, find_file};
+use prism_core::error::{Error, Result};
 use prism_core::spectrum::cie::{CIE_Y_INTEGRAL_F32, cie_y};
 
 /// A spectrum `value` of `parameter` that is not emitted (a reflectance, an index of
@@ -19,6 +21,7 @@ pub fn spectrum(
     list: &ParameterList,
     parameter: &Parameter,
     value: &SpectrumParam,
+    search_paths: &[PathBuf],
 ) -> Result<PropertyValue> {
     Ok(match value {
         SpectrumParam::Rgb(rgb) => PropertyValue::Rgb(*rgb),
@@ -39,7 +42,10 @@ pub fn spectrum(
         }
         SpectrumParam::Named(name) => match glass(name) {
             Some(samples) => PropertyValue::Spectrum(SpectrumValue::Samples(samples.to_vec())),
-            None => return Err(unknown_name(list, parameter, name)),
+            None => match spectrum_file(list, parameter, name, search_paths)? {
+                Some(samples) => PropertyValue::Spectrum(SpectrumValue::Samples(samples)),
+                None => return Err(unknown_name(list, parameter, name)),
+            },
         },
         SpectrumParam::Texture(_) => unreachable!("textures are resolved by the caller"),
     })
@@ -52,6 +58,7 @@ pub fn illuminant(
     parameter: Option<&Parameter>,
     value: Option<&SpectrumParam>,
     scale: f64,
+    search_paths: &[PathBuf],
 ) -> Result<PropertyValue> {
     let samples = match value {
         None => return Ok(PropertyValue::Rgb([scale; 3])),
@@ -63,9 +70,18 @@ pub fn illuminant(
         Some(SpectrumParam::Blackbody(kelvin)) => blackbody_samples(*kelvin),
         Some(SpectrumParam::Named(name)) => {
             let parameter = parameter.expect("a named spectrum comes from a parameter");
+            if let Some(samples) = spectrum_file(list, parameter, name, search_paths)? {
+                return illuminant(
+                    list,
+                    Some(parameter),
+                    Some(&SpectrumParam::Samples(samples)),
+                    scale,
+                    search_paths,
+                );
+            }
             return Err(unknown_name(list, parameter, name).with_help(
                 "Prism knows the illuminant \"stdillum-D65\"; give other illuminants as \
-                 \"spectrum\" samples or \"blackbody\"",
+                 \"spectrum\" samples, a file of samples or \"blackbody\"",
             ));
         }
         Some(SpectrumParam::Texture(_)) => unreachable!("lights take no textures"),
@@ -81,6 +97,51 @@ pub fn illuminant(
     Ok(PropertyValue::Spectrum(SpectrumValue::Samples(
         samples.into_iter().map(|(l, v)| (l, v * factor)).collect(),
     )))
+}
+
+/// The samples of the spectrum file `name` (pbrt-v4's `PiecewiseLinearSpectrum::Read`):
+/// wavelength and value pairs separated by whitespace, in increasing wavelength, `#` starting a
+/// comment; `None` when there is no such file.
+fn spectrum_file(
+    list: &ParameterList,
+    parameter: &Parameter,
+    name: &str,
+    search_paths: &[PathBuf],
+) -> Result<Option<Vec<(f64, f64)>>> {
+    let Ok(path) = find_file(name, search_paths, &parameter.location) else {
+        return Ok(None);
+    };
+    if !path.is_file() {
+        return Ok(None);
+    }
+    let text = std::fs::read_to_string(&path)
+        .map_err(|e| Error::io(&path, &e, "read the spectrum").at(&parameter.location))?;
+    let mut numbers = Vec::new();
+    for line in text.lines() {
+        let data = line.split('#').next().unwrap_or("");
+        for token in data.split_whitespace() {
+            match token.parse::<f64>() {
+                Ok(value) if value.is_finite() => numbers.push(value),
+                _ => {
+                    return Err(list.error(
+                        parameter,
+                        format!("names the file \"{name}\", in which \"{token}\" is not a number"),
+                    ));
+                }
+            }
+        }
+    }
+    let pairs: Vec<(f64, f64)> = numbers.chunks_exact(2).map(|c| (c[0], c[1])).collect();
+    if numbers.len() < 2 || numbers.len() % 2 != 0 || !pairs.windows(2).all(|w| w[0].0 < w[1].0) {
+        return Err(list.error(
+            parameter,
+            format!(
+                "names the file \"{name}\", which does not hold (wavelength, value) pairs in \
+                 increasing wavelength"
+            ),
+        ));
+    }
+    Ok(Some(pairs))
 }
 
 /// The luminance ∫ȳS / ∫ȳ of samples interpolated linearly (zero outside their range), summed
@@ -141,7 +202,8 @@ fn unknown_name(
     )
     .with_help(format!(
         "named spectra Prism reads: stdillum-D65 (lights), {} (indices of refraction), \
-         metal-*-eta and metal-*-k (conductors); or give \"spectrum\" samples",
+         metal-*-eta and metal-*-k (conductors); or give \"spectrum\" samples or the name of \
+         a file of samples",
         GLASSES.iter().map(|g| g.0).collect::<Vec<_>>().join(", ")
     ))
 }
