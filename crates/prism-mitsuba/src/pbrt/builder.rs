@@ -115,7 +115,8 @@ pub(super) struct Builder {
     pub sampler: Option<(String, ParameterList)>,
     pub filter: Option<(String, ParameterList)>,
     pub integrator: Option<(String, ParameterList)>,
-    pub seed: Option<(i64, SourceLocation)>,
+    /// `Option "seed"`.
+    pub seed: Option<i64>,
     world: bool,
     state: GraphicsState,
     saved: Vec<Saved>,
@@ -448,8 +449,8 @@ impl Builder {
             "TransformTimes" => stream.numbers(token, 2).map(|_| ()),
             "Option" => {
                 let list = stream.parameters("Option".into(), location)?;
-                if let Some(seed) = list.get("seed") {
-                    self.seed = Some((list.integer("seed", 0)?, seed.location.clone()));
+                if list.get("seed").is_some() {
+                    self.seed = Some(list.integer("seed", 0)?);
                 }
                 // The space rendering is done in does not change the image.
                 list.ignore(&["rendercoordsys"]);

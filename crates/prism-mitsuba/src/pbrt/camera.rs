@@ -464,9 +464,9 @@ impl Builder {
             }
             _ => return Err(list.directive_error("unknown sampler")),
         };
-        let seed = list.integer("seed", 0)?;
+        // The sampler's own seed wins over `Option "seed"`, as in pbrt-v4.
+        let seed = list.integer("seed", self.seed.unwrap_or(0))?;
         list.finish()?;
-        let seed = self.seed.as_ref().map_or(seed, |(seed, _)| *seed);
         let mut node = plugin(
             PluginClass::Sampler,
             plugin_type,

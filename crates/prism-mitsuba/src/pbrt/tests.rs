@@ -404,3 +404,21 @@ fn an_orthographic_camera_spans_the_shorter_axis() {
         DMat4::from_scale(DVec3::new(-1.0, 1.0, 1.0)),
     );
 }
+
+#[test]
+fn the_samplers_seed_wins_over_the_option() {
+    let seed = |text: &str| {
+        let root = root(text);
+        let sensor = nodes(&root, PluginClass::Sensor)[0];
+        let sampler = &sensor.children[1].node;
+        property(sampler, "seed").clone()
+    };
+    assert_eq!(
+        seed("Option \"integer seed\" 7\nWorldBegin"),
+        PropertyValue::Integer(7)
+    );
+    assert_eq!(
+        seed("Option \"integer seed\" 7\nSampler \"independent\" \"integer seed\" 3\nWorldBegin"),
+        PropertyValue::Integer(3)
+    );
+}
