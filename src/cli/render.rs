@@ -61,7 +61,7 @@ Examples:
 
 #[derive(Args, Debug)]
 pub struct RenderArgs {
-    /// The Mitsuba 3 XML scene file.
+    /// The scene file: Mitsuba 3 XML, or pbrt-v4 for a name ending in .pbrt.
     pub scene: PathBuf,
     /// Set a scene parameter declared with `<default name=... value=...>` (repeatable)
     #[arg(short = 'D', long = "define", value_name = "NAME=VALUE", value_parser = parse_define, help_heading = SCENE)]

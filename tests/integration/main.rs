@@ -20,6 +20,7 @@ mod lights;
 mod materials;
 mod media;
 mod output_formats;
+mod pbrt;
 mod preview;
 mod references;
 mod reliability;

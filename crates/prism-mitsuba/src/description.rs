@@ -151,6 +151,9 @@ pub enum PropertyValue {
     Transform(DMat4),
     /// An `<animation>`: (time, transform) keys in strictly increasing time, each invertible.
     Animation(Vec<(f64, DMat4)>),
+    /// A list of numbers, which XML cannot write: the arrays of a mesh given inline (the pbrt-v4
+    /// reader's `trianglemesh`).
+    Numbers(Vec<f64>),
 }
 
 impl PropertyValue {
@@ -167,6 +170,7 @@ impl PropertyValue {
             PropertyValue::Vector(_) => "vector",
             PropertyValue::Transform(_) => "transform",
             PropertyValue::Animation(_) => "animation",
+            PropertyValue::Numbers(_) => "list of numbers",
         }
     }
 }

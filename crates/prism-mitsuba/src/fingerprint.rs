@@ -86,7 +86,16 @@ fn add_node(hash: &mut Fnv64, node: &PluginNode) {
     hash.write_str(&node.plugin_type);
     for property in &node.properties {
         hash.write_str(&property.name);
-        hash.write_str(&format!("{:?}", property.value));
+        match &property.value {
+            // A mesh's arrays: their bits, without formatting millions of numbers.
+            PropertyValue::Numbers(values) => {
+                hash.write(&(values.len() as u64).to_le_bytes());
+                for value in values {
+                    hash.write(&value.to_le_bytes());
+                }
+            }
+            value => hash.write_str(&format!("{value:?}")),
+        }
         if property.name == "filename"
             && let PropertyValue::String(name) = &property.value
             && let Ok(path) = node.resolve_file(name, &property.location)

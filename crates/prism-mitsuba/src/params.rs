@@ -243,6 +243,17 @@ impl<'a> Params<'a> {
         }
     }
 
+    /// A list of numbers, if present.
+    pub fn numbers_opt(&self, spec: &ParamSpec) -> Result<Option<&'a [f64]>> {
+        match self.property(spec) {
+            None => Ok(None),
+            Some(p) => match &p.value {
+                PropertyValue::Numbers(v) => Ok(Some(v.as_slice())),
+                _ => Err(self.wrong_type(p, "a list of numbers")),
+            },
+        }
+    }
+
     /// A point, if present.
     pub fn point_opt(&self, spec: &ParamSpec) -> Result<Option<DVec3>> {
         match self.property(spec) {

@@ -83,6 +83,8 @@ pub enum ParamKind {
     Ior,
     /// A nested plugin of a class.
     Nested(PluginClass),
+    /// A list of numbers (no XML form: the pbrt-v4 reader writes it).
+    Numbers,
 }
 
 impl ParamKind {
@@ -119,6 +121,7 @@ impl ParamKind {
             ParamKind::FloatTexture(bounds) => format!("float or texture, {}", bounds.describe()),
             ParamKind::Ior => "index of refraction".into(),
             ParamKind::Nested(class) => format!("nested {}", class.tag()),
+            ParamKind::Numbers => "list of numbers".into(),
         }
     }
 }

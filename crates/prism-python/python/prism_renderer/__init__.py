@@ -80,7 +80,8 @@ PreviewCallback = Callable[[Image], object]
 
 
 def load_file(path: Union[str, os.PathLike], **defines: object) -> Scene:
-    """Loads the Mitsuba XML scene at ``path``.
+    """Loads the Mitsuba XML scene at ``path``, or the pbrt-v4 scene when its name ends in
+    ``.pbrt`` (docs/pbrt.md; a pbrt scene takes no keywords).
 
     Each keyword sets a ``<default>`` parameter of the scene, like ``prism render -D name=value``
     (``load_file("scene.xml", spp=16, resx=64)``); values are written as text, booleans as

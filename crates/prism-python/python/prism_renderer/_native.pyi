@@ -267,7 +267,7 @@ class Comparison:
         """None when the test image has no variances."""
 
 def load_file(path: Union[str, os.PathLike], defines: List[Tuple[str, str]] = ...) -> Scene:
-    """Loads a Mitsuba XML scene with ``(name, value)`` defines."""
+    """Loads a Mitsuba XML scene with ``(name, value)`` defines, or a pbrt-v4 scene (``.pbrt``)."""
 
 def load_dict(scene: dict) -> Scene:
     """Loads a scene in Mitsuba's dictionary form: ``{"type": "scene", "ball": {"type":

@@ -1,5 +1,5 @@
-//! Triangle meshes: read from `obj`, `ply` and `serialized` files, or the built-in `rectangle`
-//! and `cube`.
+//! Triangle meshes: read from `obj`, `ply` and `serialized` files, given inline
+//! (`trianglemesh`), or the built-in `rectangle` and `cube`.
 
 use super::{Build, FLIP_NORMALS};
 use crate::description::PluginNode;
@@ -39,6 +39,22 @@ pub(super) const SERIALIZED: Plugin<Build> = Plugin {
     build: |params, to_world| build_mesh_file(params, to_world, MeshFormat::Serialized),
 };
 
+pub(super) const TRIANGLEMESH: Plugin<Build> = Plugin {
+    name: "trianglemesh",
+    origin: Origin::Prism,
+    summary: "A triangle mesh given as lists of numbers, as the pbrt-v4 reader writes pbrt's \
+              `trianglemesh` (XML has no form for it). Without normals it shades flat; a \
+              transform that mirrors space keeps the transformed normal, as pbrt does.",
+    params: shape_params![
+        VERTEX_POSITIONS,
+        FACES,
+        VERTEX_NORMALS,
+        VERTEX_TEXCOORDS,
+        FLIP_NORMALS
+    ],
+    build: build_inline_mesh,
+};
+
 pub(super) const RECTANGLE: Plugin<Build> = Plugin {
     name: "rectangle",
     origin: Origin::Mitsuba3,
@@ -73,6 +89,10 @@ params! {
     FILENAME = ParamSpec::new("filename", ParamKind::String, Default::Required, "the mesh file");
     SHAPE_INDEX = ParamSpec::new("shape_index", ParamKind::Integer, Default::Integer(0), "which of the file's shapes to load, counted from 0");
     FACE_NORMALS = ParamSpec::new("face_normals", ParamKind::Boolean, Default::Boolean(false), "ignore vertex normals and shade flat");
+    VERTEX_POSITIONS = ParamSpec::new("vertex_positions", ParamKind::Numbers, Default::Required, "x, y, z of each vertex");
+    FACES = ParamSpec::new("faces", ParamKind::Numbers, Default::Required, "three vertex indices (from 0) per triangle, counter-clockwise seen from the front");
+    VERTEX_NORMALS = ParamSpec::new("vertex_normals", ParamKind::Numbers, Default::None, "x, y, z of each vertex's shading normal");
+    VERTEX_TEXCOORDS = ParamSpec::new("vertex_texcoords", ParamKind::Numbers, Default::None, "u, v of each vertex");
     FLIP_TEX_COORDS = ParamSpec::new("flip_tex_coords", ParamKind::Boolean, Default::Boolean(true), "flip texture coordinates, v → 1 − v, as Mitsuba's OBJ reader does");
 }
 
@@ -138,6 +158,107 @@ fn build_mesh_file(params: &Params, to_world: &Transform, format: MeshFormat) ->
         to_world,
         flip_normals,
         false,
+    )))
+}
+
+/// A mesh given inline, placed by `to_world`.
+fn build_inline_mesh(params: &Params, to_world: &Transform) -> Result<Shape> {
+    let node = params.node();
+    let missing = |spec: &ParamSpec| {
+        Error::input(
+            &node.location,
+            format!("{} needs \"{}\"", node.describe(), spec.name),
+        )
+    };
+    let positions = params
+        .numbers_opt(&VERTEX_POSITIONS)?
+        .ok_or_else(|| missing(&VERTEX_POSITIONS))?;
+    let faces = params.numbers_opt(&FACES)?.ok_or_else(|| missing(&FACES))?;
+    let bad = |spec: &ParamSpec, problem: String| {
+        Error::input(
+            params.location_of(spec),
+            format!("\"{}\" of {} {problem}", spec.name, node.describe()),
+        )
+    };
+    if positions.is_empty() || positions.len() % 3 != 0 {
+        return Err(bad(
+            &VERTEX_POSITIONS,
+            format!(
+                "has {} numbers, not a positive multiple of 3",
+                positions.len()
+            ),
+        ));
+    }
+    let vertex_count = positions.len() / 3;
+    if faces.is_empty() || faces.len() % 3 != 0 {
+        return Err(bad(
+            &FACES,
+            format!("has {} numbers, not a positive multiple of 3", faces.len()),
+        ));
+    }
+    if let Some(index) = faces
+        .iter()
+        .find(|&&i| !(i >= 0.0 && i < vertex_count as f64 && i.fract() == 0.0))
+    {
+        return Err(bad(
+            &FACES,
+            format!(
+                "has the index {index}, not a vertex from 0 to {}",
+                vertex_count - 1
+            ),
+        ));
+    }
+    let vectors = |values: &[f64]| -> Vec<Vec3> {
+        values
+            .chunks_exact(3)
+            .map(|c| Vec3::new(c[0] as f32, c[1] as f32, c[2] as f32))
+            .collect()
+    };
+    let normals = match params.numbers_opt(&VERTEX_NORMALS)? {
+        Some(normals) if normals.len() != positions.len() => {
+            return Err(bad(
+                &VERTEX_NORMALS,
+                format!(
+                    "has {} numbers, but the mesh has {vertex_count} vertices",
+                    normals.len()
+                ),
+            ));
+        }
+        normals => normals.map(vectors),
+    };
+    let uvs = match params.numbers_opt(&VERTEX_TEXCOORDS)? {
+        Some(uvs) if uvs.len() != 2 * vertex_count => {
+            return Err(bad(
+                &VERTEX_TEXCOORDS,
+                format!(
+                    "has {} numbers, but the mesh has {vertex_count} vertices",
+                    uvs.len()
+                ),
+            ));
+        }
+        uvs => uvs.map(|uvs| {
+            uvs.chunks_exact(2)
+                .map(|c| Vec2::new(c[0] as f32, c[1] as f32))
+                .collect()
+        }),
+    };
+    let data = MeshData {
+        positions: vectors(positions),
+        normals,
+        uvs,
+        colors: None,
+        face_colors: None,
+        attributes: Vec::new(),
+        triangles: faces
+            .chunks_exact(3)
+            .map(|c| [c[0] as u32, c[1] as u32, c[2] as u32])
+            .collect(),
+    };
+    Ok(Shape::Mesh(transform_mesh(
+        data,
+        to_world,
+        params.boolean(&FLIP_NORMALS)?,
+        true,
     )))
 }
 

@@ -1,6 +1,6 @@
-//! Shape plugins: triangle meshes (`obj`, `ply`, `serialized`, `rectangle`, `cube`), quadrics
-//! (`sphere`, `disk`, `cylinder`), curves (`linearcurve`, `bsplinecurve`), and the entries of the
-//! instancing plugins `shapegroup` and `instance`, which the scene builds
+//! Shape plugins: triangle meshes (`obj`, `ply`, `serialized`, `trianglemesh`, `rectangle`,
+//! `cube`), quadrics (`sphere`, `disk`, `cylinder`), curves (`linearcurve`, `bsplinecurve`),
+//! and the entries of the instancing plugins `shapegroup` and `instance`, which the scene builds
 //! ([`super::instancing`]). Any shape whose `to_world` is an `<animation>` moves while the
 //! shutter is open: it is built in object space and placed by an [`Instance`].
 
@@ -44,6 +44,7 @@ pub static SHAPES: Registry<Build> = Registry {
         meshes::OBJ,
         meshes::PLY,
         meshes::SERIALIZED,
+        meshes::TRIANGLEMESH,
         meshes::RECTANGLE,
         meshes::CUBE,
         quadrics::SPHERE,

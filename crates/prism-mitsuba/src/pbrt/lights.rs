@@ -1,0 +1,188 @@
+//! `LightSource` and `AreaLightSource`: pbrt-v4's lights as Mitsuba's emitters, their spectra
+//! scaled as pbrt-v4 scales them ([`super::spectra::illuminant`]).
+//!
+//! `point` → `point`, `spot` → `spot` (pbrt-v4's falloff is a smoothstep in cos θ, Mitsuba's
+//! linear in θ: a warning says so), `distant` → `directional`, `infinite` with a uniform `L` →
+//! `constant`; the area light `diffuse` → `area`. pbrt's image infinite light reads an
+//! equal-area octahedral map, which Prism's `envmap` (latitude-longitude) is not, so it is
+//! refused, as are `power`, `illuminance` and two-sided area lights.
+
+use glam::{DMat4, DVec3};
+
+use super::builder::Builder;
+use super::parameters::ParameterList;
+use super::spectra;
+use super::{plugin, set};
+use crate::description::{PluginClass, PluginNode, PropertyValue};
+use prism_core::error::Result;
+
+impl Builder {
+    /// The spectrum `name` (default: the colour space's illuminant) times `scale`.
+    fn emission(&self, list: &ParameterList, name: &str) -> Result<PropertyValue> {
+        for refused in ["power", "illuminance"] {
+            if let Some(parameter) = list.get(refused) {
+                return Err(list
+                    .error(parameter, "sets the light by a photometric quantity, which Prism's pbrt reader does not read")
+                    .with_help("give \"scale\" instead"));
+            }
+        }
+        let scale = list.float("scale", 1.0)?;
+        let value = list.spectrum(name, false)?;
+        spectra::illuminant(
+            list,
+            value.as_ref().map(|v| v.1),
+            value.as_ref().map(|v| &v.0),
+            scale,
+            &self.search_paths,
+        )
+    }
+
+    /// The light `ty`, placed by `ctm`.
+    pub(super) fn light(
+        &mut self,
+        ty: &str,
+        list: &ParameterList,
+        ctm: DMat4,
+    ) -> Result<PluginNode> {
+        let location = list.location.clone();
+        let mut node = match ty {
+            "point" => {
+                let intensity = self.emission(list, "I")?;
+                let from = list.point3("from", DVec3::ZERO)?;
+                let mut node = plugin(PluginClass::Emitter, "point", &location, &self.search_paths);
+                set(&mut node, "intensity", intensity, &location);
+                set(
+                    &mut node,
+                    "to_world",
+                    PropertyValue::Transform(ctm * DMat4::from_translation(from)),
+                    &location,
+                );
+                node
+            }
+            "spot" => {
+                let intensity = self.emission(list, "I")?;
+                let from = list.point3("from", DVec3::ZERO)?;
+                let to = list.point3("to", DVec3::Z)?;
+                let cone = list.float("coneangle", 30.0)?;
+                let delta = list.float("conedeltaangle", 5.0)?;
+                let Some(frame) = frame_towards(from, to) else {
+                    return Err(list.directive_error("\"from\" and \"to\" are the same point"));
+                };
+                self.warn(
+                    &location,
+                    "pbrt-v4's spot light falls off as a smoothstep in cos θ, Prism's (Mitsuba's) linearly in θ",
+                );
+                let mut node = plugin(PluginClass::Emitter, "spot", &location, &self.search_paths);
+                set(&mut node, "intensity", intensity, &location);
+                set(
+                    &mut node,
+                    "cutoff_angle",
+                    PropertyValue::Float(cone),
+                    &location,
+                );
+                set(
+                    &mut node,
+                    "beam_width",
+                    PropertyValue::Float((cone - delta).max(0.0)),
+                    &location,
+                );
+                set(
+                    &mut node,
+                    "to_world",
+                    PropertyValue::Transform(ctm * frame),
+                    &location,
+                );
+                node
+            }
+            "distant" => {
+                let irradiance = self.emission(list, "L")?;
+                let from = list.point3("from", DVec3::ZERO)?;
+                let to = list.point3("to", DVec3::Z)?;
+                let direction = ctm.transform_vector3(to - from);
+                if direction.length() == 0.0 {
+                    return Err(list.directive_error("\"from\" and \"to\" give no direction"));
+                }
+                let mut node = plugin(
+                    PluginClass::Emitter,
+                    "directional",
+                    &location,
+                    &self.search_paths,
+                );
+                set(&mut node, "irradiance", irradiance, &location);
+                set(
+                    &mut node,
+                    "direction",
+                    PropertyValue::Vector(direction),
+                    &location,
+                );
+                node
+            }
+            "infinite" => {
+                if let Some(parameter) = list.get("filename") {
+                    return Err(list
+                        .error(parameter, "is an equal-area octahedral environment map, which Prism does not read")
+                        .with_help("give a uniform \"L\", or write the scene in Mitsuba XML with an envmap (latitude-longitude)"));
+                }
+                if let Some(parameter) = list.get("portal") {
+                    return Err(list.error(parameter, "is not read by Prism"));
+                }
+                let radiance = self.emission(list, "L")?;
+                let mut node = plugin(
+                    PluginClass::Emitter,
+                    "constant",
+                    &location,
+                    &self.search_paths,
+                );
+                set(&mut node, "radiance", radiance, &location);
+                node
+            }
+            _ => {
+                return Err(list
+                    .directive_error("Prism has no light with this pbrt-v4 model")
+                    .with_help("Prism reads point, spot, distant and infinite (uniform)"));
+            }
+        };
+        list.finish()?;
+        node.location = location;
+        Ok(node)
+    }
+
+    /// The radiance of the area light `ty`.
+    pub(super) fn area_light(&mut self, ty: &str, list: &ParameterList) -> Result<PropertyValue> {
+        if ty != "diffuse" {
+            return Err(list
+                .directive_error("Prism has no area light with this pbrt-v4 model")
+                .with_help("use \"diffuse\""));
+        }
+        if list.boolean("twosided", false)? {
+            let parameter = list.get("twosided").expect("given");
+            return Err(list
+                .error(
+                    parameter,
+                    "asks for a two-sided area light; Prism's emit from the front only",
+                )
+                .with_help("use two shapes facing away from each other"));
+        }
+        if let Some(parameter) = list.get("filename") {
+            return Err(list.error(
+                parameter,
+                "is an image area light, which Prism does not read",
+            ));
+        }
+        let radiance = self.emission(list, "L")?;
+        list.finish()?;
+        Ok(radiance)
+    }
+}
+
+/// A frame at `from` whose +z points to `to`.
+fn frame_towards(from: DVec3, to: DVec3) -> Option<DMat4> {
+    let z = (to - from).try_normalize()?;
+    let (x, y) = z.any_orthonormal_pair();
+    Some(DMat4::from_cols(
+        x.extend(0.0),
+        y.extend(0.0),
+        z.extend(0.0),
+        from.extend(1.0),
+    ))
+}

@@ -1,0 +1,384 @@
+//! pbrt-v4 scenes: the transcription of the Cornell box renders the XML's image, and malformed
+//! files are refused with their file, line and column.
+
+use std::path::{Path, PathBuf};
+
+use prism_core::film::Film;
+use prism_mitsuba::load_scene;
+
+use crate::common::scenes::{pixel_mean_and_variance, render_film, scene_from_xml};
+
+/// Mean and variance of the mean of channel `c` over the square block of `block` pixels whose
+/// top-left pixel is (x0, y0).
+fn block_mean(film: &Film, x0: usize, y0: usize, block: usize, c: usize) -> (f64, f64) {
+    let width = film.size.x as usize;
+    let n = (block * block) as f64;
+    let (mut sum, mut variance) = (0.0, 0.0);
+    for y in y0..y0 + block {
+        for x in x0..x0 + block {
+            let (m, v) = pixel_mean_and_variance(film, y * width + x, c);
+            sum += m;
+            variance += v;
+        }
+    }
+    (sum / n, variance / (n * n))
+}
+
+/// The largest |z| of the differences of the two films' `block` × `block` blocks in X, Y and Z.
+fn largest_block_z(a: &Film, b: &Film, block: usize) -> f64 {
+    assert_eq!(a.size, b.size);
+    let mut largest: f64 = 0.0;
+    for y0 in (0..a.size.y as usize).step_by(block) {
+        for x0 in (0..a.size.x as usize).step_by(block) {
+            for c in 0..3 {
+                let (ma, va) = block_mean(a, x0, y0, block, c);
+                let (mb, vb) = block_mean(b, x0, y0, block, c);
+                largest = largest.max((ma - mb).abs() / (va + vb).sqrt());
+            }
+        }
+    }
+    largest
+}
+
+#[test]
+fn the_cornell_box_in_pbrt_renders_the_xml_image() {
+    let xml = load_scene(Path::new("scenes/cornell-box/scene.xml"), &[]).unwrap();
+    let pbrt = load_scene(Path::new("scenes/cornell-box/scene.pbrt"), &[]).unwrap();
+    assert_eq!(pbrt.scene.film.size, xml.scene.film.size);
+    // Independent estimates (two seeds) of the same image: 64 blocks × 3 channels, so a bound
+    // of 4.5 standard errors fails a correct transcription with probability 1.3·10⁻³.
+    let spp = 16;
+    let a = render_film(&xml.scene, spp, 1, None);
+    let b = render_film(&pbrt.scene, spp, 2, None);
+    let z = largest_block_z(&a, &b, 32);
+    assert!(
+        z < 4.5,
+        "the pbrt and XML images differ by {z:.1} standard errors"
+    );
+    // The test can fail: the XML image differs from itself mirrored (the red and green walls
+    // swapped), as a camera that ignored pbrt's left-handed camera space would render it.
+    let mut mirrored = a.clone();
+    let width = a.size.x as usize;
+    for (i, pixel) in mirrored.pixels.iter_mut().enumerate() {
+        let (x, y) = (i % width, i / width);
+        *pixel = a.pixels[y * width + (width - 1 - x)];
+    }
+    assert!(largest_block_z(&mirrored, &b, 32) > 20.0);
+}
+
+/// Instances, a medium, lights of four kinds and glass, in pbrt's format and in Mitsuba's.
+const INSTANCES_IN_FOG_PBRT: &str = r#"
+Scale -1 1 1
+LookAt 0 1.5 -6  0 0.8 0  0 1 0
+Camera "perspective" "float fov" 40
+Film "rgb" "integer xresolution" 32 "integer yresolution" 32
+PixelFilter "box"
+Sampler "independent" "integer pixelsamples" 64
+Integrator "volpath" "integer maxdepth" 5
+WorldBegin
+LightSource "infinite" "rgb L" [0.05 0.06 0.08]
+LightSource "point" "rgb I" [30 25 20] "point3 from" [2 3 -2]
+AttributeBegin
+    AreaLightSource "diffuse" "rgb L" [8 8 8]
+    Translate 0 3 0
+    Rotate 90 1 0 0
+    Shape "disk" "float radius" 1
+AttributeEnd
+Material "diffuse" "rgb reflectance" [0.5 0.5 0.5]
+Shape "trianglemesh" "point3 P" [-4 0 -4  -4 0 4  4 0 4  4 0 -4] "integer indices" [0 1 2  0 2 3]
+ObjectBegin "ball"
+    Material "dielectric" "float eta" 1.5
+    Translate 0 0.5 0
+    Shape "sphere" "float radius" 0.5
+ObjectEnd
+AttributeBegin
+    Translate -1.5 0 0
+    ObjectInstance "ball"
+AttributeEnd
+AttributeBegin
+    Translate 1.5 0 1
+    Scale 1.5 1.5 1.5
+    ObjectInstance "ball"
+AttributeEnd
+MakeNamedMedium "fog" "string type" "homogeneous" "rgb sigma_a" [0.5 0.5 0.5] "rgb sigma_s" [2 2 2] "float g" 0.5
+AttributeBegin
+    MediumInterface "fog" ""
+    Material "interface"
+    Translate 0 1 -2
+    Shape "sphere" "float radius" 1
+AttributeEnd
+"#;
+
+const INSTANCES_IN_FOG_XML: &str = r#"<scene version="3.0.0">
+    <integrator type="volpath"><integer name="max_depth" value="6"/></integrator>
+    <sensor type="perspective">
+        <float name="fov" value="40"/>
+        <string name="fov_axis" value="smaller"/>
+        <transform name="to_world"><lookat origin="0, 1.5, -6" target="0, 0.8, 0" up="0, 1, 0"/></transform>
+        <sampler type="independent"><integer name="sample_count" value="64"/></sampler>
+        <film type="hdrfilm">
+            <integer name="width" value="32"/><integer name="height" value="32"/>
+            <rfilter type="box"/>
+        </film>
+    </sensor>
+    <emitter type="constant"><rgb name="radiance" value="0.05, 0.06, 0.08"/></emitter>
+    <emitter type="point">
+        <rgb name="intensity" value="30, 25, 20"/>
+        <point name="position" value="2, 3, -2"/>
+    </emitter>
+    <shape type="disk">
+        <transform name="to_world">
+            <rotate x="1" angle="90"/><translate y="3"/>
+        </transform>
+        <emitter type="area"><rgb name="radiance" value="8, 8, 8"/></emitter>
+    </shape>
+    <shape type="rectangle">
+        <transform name="to_world"><scale value="4"/><rotate x="1" angle="-90"/></transform>
+        <bsdf type="diffuse"><rgb name="reflectance" value="0.5, 0.5, 0.5"/></bsdf>
+    </shape>
+    <shape type="shapegroup" id="ball">
+        <shape type="sphere">
+            <point name="center" value="0, 0.5, 0"/>
+            <float name="radius" value="0.5"/>
+            <bsdf type="dielectric">
+                <float name="int_ior" value="1.5"/><float name="ext_ior" value="1"/>
+            </bsdf>
+        </shape>
+    </shape>
+    <shape type="instance">
+        <ref id="ball"/>
+        <transform name="to_world"><translate x="-1.5"/></transform>
+    </shape>
+    <shape type="instance">
+        <ref id="ball"/>
+        <transform name="to_world"><scale value="1.5"/><translate x="1.5" z="1"/></transform>
+    </shape>
+    <shape type="sphere">
+        <point name="center" value="0, 1, -2"/>
+        <float name="radius" value="1"/>
+        <bsdf type="null"/>
+        <medium type="homogeneous" name="interior">
+            <rgb name="sigma_a" value="0.5, 0.5, 0.5"/>
+            <rgb name="sigma_s" value="2, 2, 2"/>
+            <phase type="hg"><float name="g" value="0.5"/></phase>
+        </medium>
+    </shape>
+</scene>"#;
+
+#[test]
+fn instances_in_fog_render_as_the_xml() {
+    let xml = scene_from_xml(INSTANCES_IN_FOG_XML, "fog.xml").unwrap();
+    let root = prism_mitsuba::pbrt::read_pbrt_str(INSTANCES_IN_FOG_PBRT, Path::new("fog.pbrt"))
+        .unwrap()
+        .root;
+    let pbrt = prism_mitsuba::factory::build_scene(&root).unwrap().scene;
+    // 16 blocks × 3 channels: 4.5 standard errors fail a correct translation with probability
+    // 3·10⁻⁴; at 256 samples per pixel the area light 10 % dimmer gives 6.8.
+    let a = render_film(&xml, 256, 1, None);
+    let b = render_film(&pbrt, 256, 2, None);
+    let z = largest_block_z(&a, &b, 8);
+    assert!(
+        z < 4.5,
+        "the pbrt and XML images differ by {z:.1} standard errors"
+    );
+}
+
+/// A folder of its own for a test's files.
+fn folder(name: &str) -> PathBuf {
+    let folder = std::env::temp_dir().join(format!("prism-pbrt-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&folder).unwrap();
+    folder
+}
+
+/// The error message of loading `text` as `name`, in a folder of its own.
+fn error_of(name: &str, text: &str) -> String {
+    let folder = folder(name);
+    let path = folder.join(format!("{name}.pbrt"));
+    std::fs::write(&path, text).unwrap();
+    let message = match load_scene(&path, &[]) {
+        Ok(_) => panic!("{name}: the scene loaded"),
+        Err(error) => error.to_string(),
+    };
+    std::fs::remove_dir_all(&folder).unwrap();
+    message
+}
+
+#[test]
+fn errors_name_the_file_line_and_column() {
+    let cases = [
+        (
+            "unknown_directive",
+            "WorldBegin\n  Shape \"sphere\"\n  Sphere \"float radius\" 2\n",
+            "unknown_directive.pbrt:3:3: unknown directive \"Sphere\"",
+        ),
+        (
+            "bad_type",
+            "WorldBegin\nShape \"sphere\" \"float radius\" \"two\"\n",
+            "bad_type.pbrt:2:31: parameter \"float radius\" expects finite numbers",
+        ),
+        (
+            "wrong_type",
+            "WorldBegin\nShape \"sphere\" \"integer radius\" 2\n",
+            "wrong_type.pbrt:2:16: Shape \"sphere\": parameter \"integer radius\" must be of type float",
+        ),
+        (
+            "unterminated",
+            "WorldBegin\nShape \"sphere\" \"float radius 2\n",
+            "unterminated.pbrt:2:16: unterminated string",
+        ),
+        (
+            "missing_include",
+            "WorldBegin\n  Include \"geometry/missing.pbrt\"\n",
+            "missing_include.pbrt:2:11: file \"geometry/missing.pbrt\" not found",
+        ),
+        (
+            "unsupported_parameter",
+            "WorldBegin\nShape \"sphere\" \"float radius\" 1 \"float zmax\" 0.5\n",
+            "unsupported_parameter.pbrt:2:33: Shape \"sphere\": parameter \"float zmax\" cuts the shape",
+        ),
+        (
+            "unread_parameter",
+            "WorldBegin\nMaterial \"diffuse\" \"float sigma\" 20\n",
+            "unread_parameter.pbrt:2:20: Material \"diffuse\": parameter \"float sigma\" is not read by Prism",
+        ),
+        (
+            "coated",
+            "WorldBegin\nMaterial \"coateddiffuse\"\n",
+            "coated.pbrt:2:1: Material \"coateddiffuse\": pbrt-v4's coated materials are a random walk",
+        ),
+    ];
+    for (name, text, expected) in cases {
+        let message = error_of(name, text);
+        assert!(message.contains(expected), "{name}: {message}");
+    }
+}
+
+#[test]
+fn an_error_in_an_included_file_names_that_file() {
+    let folder = folder("include");
+    std::fs::create_dir_all(folder.join("geometry")).unwrap();
+    std::fs::write(
+        folder.join("geometry/shapes.pbrt"),
+        "# shapes\nShape \"sphere\"\nShape \"curve\"\n",
+    )
+    .unwrap();
+    let path = folder.join("scene.pbrt");
+    std::fs::write(&path, "WorldBegin\nInclude \"geometry/shapes.pbrt\"\n").unwrap();
+    let message = load_scene(&path, &[]).err().expect("refused").to_string();
+    std::fs::remove_dir_all(&folder).unwrap();
+    assert!(
+        message.contains("shapes.pbrt:3:1: Shape \"curve\": Prism has no shape"),
+        "{message}"
+    );
+}
+
+#[test]
+fn the_fuzzing_seeds_are_scenes_that_load() {
+    let mut count = 0;
+    for entry in std::fs::read_dir("fuzz/seeds/pbrt_scene").unwrap() {
+        let path = entry.unwrap().path();
+        if let Err(error) = load_scene(&path, &[]) {
+            panic!("{}: {error}", path.display());
+        }
+        count += 1;
+    }
+    assert!(count >= 2);
+}
+
+/// A xorshift generator, for the mutations below.
+fn xorshift(state: &mut u64) -> u64 {
+    *state ^= *state << 13;
+    *state ^= *state >> 7;
+    *state ^= *state << 17;
+    *state
+}
+
+#[test]
+fn mutated_scenes_are_read_or_refused_without_a_panic() {
+    // The fuzzing target's check on 20,000 fixed mutations of its seeds (cut, deleted and
+    // replaced bytes, inserted tokens), so that every test run fuzzes a little.
+    let seeds = [
+        std::fs::read("fuzz/seeds/pbrt_scene/directives.pbrt").unwrap(),
+        std::fs::read("fuzz/seeds/pbrt_scene/cornell.pbrt").unwrap(),
+    ];
+    let tokens: [&[u8]; 12] = [
+        b"\"",
+        b"[",
+        b"]",
+        b"-1",
+        b"1e30",
+        b"AttributeEnd",
+        b"ObjectEnd",
+        b"Scale 0 0 0 ",
+        b"\"float xradius\" 1",
+        b"\"integer xsamples\" 3",
+        b"\"blackbody L\" 1",
+        b"\"integer indices\" [0 1 9]",
+    ];
+    let mut state = 12345;
+    for i in 0..20_000 {
+        let mut data = seeds[i % 2].clone();
+        for _ in 0..1 + xorshift(&mut state) % 4 {
+            let at = xorshift(&mut state) as usize % (data.len() + 1);
+            match xorshift(&mut state) % 4 {
+                0 => data.truncate(at),
+                1 if at < data.len() => {
+                    data.remove(at);
+                }
+                2 => {
+                    let token = tokens[xorshift(&mut state) as usize % tokens.len()];
+                    data.splice(at..at, token.iter().copied());
+                }
+                _ if at < data.len() => data[at] = (xorshift(&mut state) % 128) as u8,
+                _ => {}
+            }
+        }
+        let Ok(text) = String::from_utf8(data) else {
+            continue;
+        };
+        let outcome = std::panic::catch_unwind(|| {
+            let path = Path::new("/nonexistent-prism-test/scene.pbrt");
+            if let Ok(scene) = prism_mitsuba::pbrt::read_pbrt_str(&text, path) {
+                let _ = prism_mitsuba::factory::build_scene(&scene.root);
+            }
+        });
+        assert!(outcome.is_ok(), "mutation {i} panics:\n{text}");
+    }
+}
+
+#[test]
+fn spectra_may_be_read_from_files() {
+    use prism_mitsuba::description::{PropertyValue, SpectrumValue};
+    let folder = folder("spectra");
+    std::fs::create_dir_all(folder.join("spds")).unwrap();
+    std::fs::write(
+        folder.join("spds/lamp.spd"),
+        "# a lamp\n400 1\n500 2 # peak\n600 1\n",
+    )
+    .unwrap();
+    std::fs::write(folder.join("spds/bad.spd"), "400 1\n500\n").unwrap();
+    let path = folder.join("scene.pbrt");
+    let scene = "WorldBegin\nAreaLightSource \"diffuse\" \"spectrum L\" \"spds/lamp.spd\" \"float scale\" 3\nShape \"sphere\"\n";
+    let read = prism_mitsuba::pbrt::read_pbrt_str(scene, &path);
+    let bad = prism_mitsuba::pbrt::read_pbrt_str(
+        "WorldBegin\nLightSource \"point\" \"spectrum I\" \"spds/bad.spd\"\n",
+        &path,
+    );
+    std::fs::remove_dir_all(&folder).unwrap();
+    let root = read.unwrap().root;
+    let shape = &root.children[2].node;
+    let emitter = &shape.children[1].node;
+    let PropertyValue::Spectrum(SpectrumValue::Samples(samples)) = &emitter.properties[0].value
+    else {
+        panic!("{:?}", emitter.properties);
+    };
+    // The file's shape, scaled to pbrt's luminance: 3 / luminance of the file's samples.
+    assert_eq!(samples.len(), 3);
+    assert!((samples[1].1 / samples[0].1 - 2.0).abs() < 1e-12);
+    let message = bad.err().expect("refused").to_string();
+    assert!(
+        message.contains("scene.pbrt:2:21:")
+            && message.contains("does not hold (wavelength, value) pairs"),
+        "{message}"
+    );
+}
