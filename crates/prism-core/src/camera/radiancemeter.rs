@@ -15,7 +15,7 @@
 
 use glam::{Vec2, Vec3};
 
-use super::CameraModel;
+use super::{CameraModel, ImportanceSample};
 use crate::math::{AnimatedTransform, Ray};
 
 /// Mitsuba's `math::RayEpsilon<float>`: how far along its direction the ray starts.
@@ -35,6 +35,12 @@ impl CameraModel for RadianceMeter {
         let d = to_world.vector(Vec3::Z).normalize();
         let o = to_world.point(Vec3::ZERO) + d * RAY_EPSILON;
         Ray::new(o, d, f32::INFINITY, time)
+    }
+
+    /// None: one ray from one point, a delta in position and direction, which no connection
+    /// from a scene point can find.
+    fn sample_importance(&self, _p: Vec3, _u: Vec2, _time: f32) -> Option<ImportanceSample> {
+        None
     }
 }
 

@@ -1,4 +1,4 @@
-//! The film: reconstruction filters and their samplers, how samples become pixel values, per-pixel accumulation of XYZ, the
+//! The film: reconstruction filters and their samplers, how samples become pixel values, per-pixel accumulation of XYZ, splatting, the
 //! error estimated from the samples, and the images written at the end (an EXR, and an 8-bit
 //! image tonemapped as the film asks).
 
@@ -7,6 +7,7 @@ pub mod filter;
 pub mod ldr;
 pub mod output;
 pub mod reconstruction;
+pub mod splat;
 pub mod stats;
 
 pub use accumulation::{CropWindow, Film, PixelSums, ValueSum};
@@ -20,3 +21,4 @@ pub use output::{
     write_images_with,
 };
 pub use reconstruction::{FilterMis, Reconstruction};
+pub use splat::{SplatSums, SplatValue, Splatter};

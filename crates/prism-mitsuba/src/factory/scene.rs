@@ -131,13 +131,18 @@ fn sensors(root: &PluginNode, params: &Params) -> Result<Vec<(Option<String>, Se
         .collect()
 }
 
-/// The distrib integrator estimates no participating media: a scene with media and distrib is
-/// an error at the first medium.
+/// The distrib and ptracer integrators estimate no participating media: a scene with media
+/// and either is an error at the first medium.
 fn check_renders_media(integrator: &Integrator, media: &MediaCache) -> Result<()> {
-    if let (Integrator::Distribution(_), Some(location)) = (integrator, &media.first) {
+    let name = match integrator {
+        Integrator::Distribution(_) => "distrib",
+        Integrator::Particle(_) => "ptracer",
+        _ => return Ok(()),
+    };
+    if let Some(location) = &media.first {
         return Err(Error::input(
             location,
-            "the distrib integrator does not render participating media",
+            format!("the {name} integrator does not render participating media"),
         )
         .with_help(
             "render scenes with media with <integrator type=\"volpath\"> or \"volpathmis\"",
