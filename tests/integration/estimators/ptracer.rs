@@ -57,6 +57,33 @@ fn ptracer_matches_the_disk_light_closed_form() {
     assert!(bias.abs() < 4.0 * se, "mean differs by {bias} ± {se}");
 }
 
+/// The variance the film reports, by batch means over sample indices, predicts the spread
+/// between independent renders: E[(a − b)² − var_a − var_b] = 0. Over the pixels of three pairs
+/// of renders of the disk-light scene, the mean of that difference is within 4 standard errors
+/// (from its own scatter) of 0.
+#[test]
+fn ptracer_reported_variance_predicts_the_spread_between_renders() {
+    let mut scene = disk_light_over_plane(UVec2::new(24, 24)).scene;
+    scene.integrator = ptracer(2);
+    let mut excess = Vec::new();
+    for pair in 0..3 {
+        let a = render_film(&scene, 64, 2 * pair + 1, None);
+        let b = render_film(&scene, 64, 2 * pair + 2, None);
+        for i in 0..a.pixels.len() {
+            let (mean_a, variance_a) = pixel_mean_and_variance(&a, i, 1);
+            let (mean_b, variance_b) = pixel_mean_and_variance(&b, i, 1);
+            excess.push((mean_a - mean_b).powi(2) - variance_a - variance_b);
+        }
+    }
+    let n = excess.len() as f64;
+    let mean = excess.iter().sum::<f64>() / n;
+    let se = (excess.iter().map(|e| (e - mean).powi(2)).sum::<f64>() / ((n - 1.0) * n)).sqrt();
+    assert!(
+        mean.abs() < 4.0 * se,
+        "observed − predicted variance per pixel: {mean} ± {se}"
+    );
+}
+
 fn cornell_box(size: u32) -> Scene {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cornell-box/scene.xml");
     let defines = [
