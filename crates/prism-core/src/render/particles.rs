@@ -2,9 +2,9 @@
 //! the full film (keyed, as camera samples are, by the pixel and the index), splatted through
 //! the reconstruction filter onto the crop window ([`crate::film::splat`]).
 //!
-//! The light subpaths of one index are traced in parallel, a few rows of the film at a time;
-//! their contributions are gathered into exact sums, so the order in which the rows finish
-//! does not matter. The total that index s brings pixel j, T_s(j), is an unbiased estimate of
+//! The light subpaths of one index are traced in parallel, a few hundred pixels' worth at a
+//! time, in batches that bound the memory their contributions take before they are gathered
+//! into exact sums; the sums make the order in which they finish irrelevant. The total that index s brings pixel j, T_s(j), is an unbiased estimate of
 //! the pixel by itself: the image is the mean of the T_s over the indices, and the pixel's
 //! variance is estimated from their spread (batch means, each index a batch of W·H light
 //! subpaths). Per-sample variance does not apply, since one light subpath feeds many pixels
@@ -30,8 +30,10 @@ use crate::integrator::{LightPathSample, ParticleTracer, RayCount, Splat};
 use crate::sampling::sampler::Sampler;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 
-/// Rows of the full film whose light subpaths a worker traces at a time.
-const ROWS_PER_TASK: u32 = 4;
+/// Light subpaths a worker traces at a time (pixels of the full film, row-major).
+const PATHS_PER_TASK: u32 = 256;
+/// Tasks traced before their contributions are gathered.
+const TASKS_PER_BATCH: usize = 64;
 
 /// Gathers one task's contributions in CIE XYZ, spread over the pixels they reach.
 struct Collector<'a> {
@@ -81,9 +83,10 @@ impl Pass<'_, '_> {
         let film = &scene.film;
         let crop = film.crop;
         let splatter = Splatter::new(film.filter, crop);
-        let tasks: Vec<Range<u32>> = (0..film.size.y)
-            .step_by(ROWS_PER_TASK as usize)
-            .map(|y| y..(y + ROWS_PER_TASK).min(film.size.y))
+        let paths = film.size.x * film.size.y;
+        let tasks: Vec<Range<u32>> = (0..paths)
+            .step_by(PATHS_PER_TASK as usize)
+            .map(|start| start..(start + PATHS_PER_TASK).min(paths))
             .collect();
         for (tile_out, tile_sums) in out.iter_mut().zip(sums) {
             tile_out.clone_from(tile_sums);
@@ -95,58 +98,17 @@ impl Pass<'_, '_> {
         let mut image = SplatSums::default();
         let mut rays = 0;
         for index in range {
-            let traced: Vec<Option<(Vec<SplatValue>, u64)>> = tasks
-                .par_iter()
-                .map(|rows| {
-                    if self.cancel.raised() {
-                        return None;
-                    }
-                    let mut sampler = Sampler::new(
-                        scene.sampler.kind,
-                        self.options.samples_per_pixel,
-                        self.options.seed,
-                    );
-                    let mut count = RayCount::default();
-                    let mut collector = Collector {
-                        splatter: &splatter,
-                        lambda: SampledWavelengths::sample(0.5, film.wavelength_sampling),
-                        time_weight: 1.0,
-                        values: Vec::new(),
-                    };
-                    for y in rows.clone() {
-                        for x in 0..film.size.x {
-                            sampler.start_pixel_sample(UVec2::new(x, y), index);
-                            let primary = sampler.camera_sample();
-                            let lambda = SampledWavelengths::sample(
-                                primary.wavelength,
-                                film.wavelength_sampling,
-                            );
-                            let (time, time_weight) = scene.shutter.sample(primary.time);
-                            collector.lambda = lambda;
-                            collector.time_weight = time_weight;
-                            let sample = LightPathSample {
-                                camera: &scene.camera,
-                                lambda: &lambda,
-                                time,
-                                u_lens: primary.lens,
-                            };
-                            estimator.integrator.trace_light_paths(
-                                ptracer,
-                                &sample,
-                                &mut sampler,
-                                &mut count,
-                                &mut collector,
-                            );
-                        }
-                    }
-                    Some((collector.values, count.rays))
-                })
-                .collect();
             image.clear(crop_pixels as usize);
-            for task in traced {
-                let (values, task_rays) = task?;
-                image.add(&values);
-                rays += task_rays;
+            for batch in tasks.chunks(TASKS_PER_BATCH) {
+                let traced: Vec<Option<(Vec<SplatValue>, u64)>> = batch
+                    .par_iter()
+                    .map(|pixels| self.trace_task(ptracer, &splatter, pixels.clone(), index))
+                    .collect();
+                for task in traced {
+                    let (values, task_rays) = task?;
+                    image.add(&values);
+                    rays += task_rays;
+                }
             }
             out.par_iter_mut()
                 .zip(self.tiles)
@@ -167,5 +129,57 @@ impl Pass<'_, '_> {
             self.progress.advance(crop_pixels);
         }
         Some(rays)
+    }
+
+    /// Traces the light subpaths of sample `index` keyed by the full film's pixels `pixels`
+    /// (row-major indices); returns their contributions and the rays traced, or None when the
+    /// pass was cancelled.
+    fn trace_task(
+        &self,
+        ptracer: &ParticleTracer,
+        splatter: &Splatter,
+        pixels: Range<u32>,
+        index: u32,
+    ) -> Option<(Vec<SplatValue>, u64)> {
+        if self.cancel.raised() {
+            return None;
+        }
+        let scene = self.estimator.scene;
+        let film = &scene.film;
+        let mut sampler = Sampler::new(
+            scene.sampler.kind,
+            self.options.samples_per_pixel,
+            self.options.seed,
+        );
+        let mut count = RayCount::default();
+        let mut collector = Collector {
+            splatter,
+            lambda: SampledWavelengths::sample(0.5, film.wavelength_sampling),
+            time_weight: 1.0,
+            values: Vec::new(),
+        };
+        for pixel in pixels {
+            let pixel = UVec2::new(pixel % film.size.x, pixel / film.size.x);
+            sampler.start_pixel_sample(pixel, index);
+            let primary = sampler.camera_sample();
+            let lambda = SampledWavelengths::sample(primary.wavelength, film.wavelength_sampling);
+            let (time, time_weight) = scene.shutter.sample(primary.time);
+            collector.lambda = lambda;
+            collector.time_weight = time_weight;
+            let sample = LightPathSample {
+                camera: &scene.camera,
+                lambda: &lambda,
+                time,
+                u_lens: primary.lens,
+            };
+            self.estimator.integrator.trace_light_paths(
+                ptracer,
+                &sample,
+                &mut sampler,
+                &mut count,
+                &mut collector,
+            );
+        }
+        Some((collector.values, count.rays))
     }
 }
