@@ -17,6 +17,12 @@
 //! | `constant` | [`constant`] | uniform directions |
 //! | `envmap` | [`envmap`] | directions ∝ luminance · sin θ in the lat-long image |
 //! | `sunsky` | [`sunsky`] | the sky's luminance over (φ, cos θ), and the sun's cone |
+//!
+//! For tracing light from the lights' side (the particle tracer), every light also draws rays
+//! of its emission ([`LightSource::sample_emission`]): area lights a point by area and a
+//! cosine-distributed direction, point lights a uniform direction, spot lights a direction in
+//! their cone, projectors a point of their image, and lights at infinity a direction as for
+//! light sampling and a point on the disk of the scene's bounding sphere facing it.
 
 pub mod area;
 pub mod bounds;
