@@ -89,6 +89,7 @@ fn integrator_named(name: &str, scene: &Scene) -> Result<Integrator> {
         Integrator::Direct(_) => 2,
         Integrator::Distribution(d) => d.max_depth,
         Integrator::VolPath(v) => v.max_depth,
+        Integrator::Particle(p) => p.max_depth,
         Integrator::Moment(_) | Integrator::Aov(_) | Integrator::Depth(_) => -1,
     };
     let defaults: Integrator = match name {
@@ -155,6 +156,7 @@ fn integrator_label(integrator: &Integrator) -> &'static str {
         Integrator::Moment(_) => "moment",
         Integrator::Aov(_) => "aov",
         Integrator::Depth(_) => "depth",
+        Integrator::Particle(_) => "ptracer",
     }
 }
 

@@ -27,7 +27,7 @@ use prism_core::film::{
     ComponentFormat, CropWindow, ImageOutput, PixelSums, Reconstruction, RenderMetadata,
     write_images_with,
 };
-use prism_core::integrator::RayCount;
+use prism_core::integrator::{Integrator, RayCount};
 use prism_core::render::resume::Continuation;
 use prism_core::render::{
     Checkpoints, Preview, ProgressReport, RenderOptions, SampleEstimator, Snapshot, StopReason,
@@ -574,7 +574,7 @@ fn report(
         StopReason::Interrupted => ", interrupted",
     };
     eprintln!(
-        "prism: rendered {} ({}×{}, {} spp{stopped}{}) in {:.2} s: {:.3} M samples/s, {:.2} M rays/s, mean relative error {:.4} -> {}, {}",
+        "prism: rendered {} ({}×{}, {} spp{stopped}{}) in {:.2} s: {:.3} M samples/s, {:.2} M rays/s, mean relative error {:.4}{} -> {}, {}",
         args.scene.display(),
         scene.film.crop.size.x,
         scene.film.crop.size.y,
@@ -587,6 +587,11 @@ fn report(
         output.sample_count as f64 / seconds / 1e6,
         output.rays as f64 / seconds / 1e6,
         output.relative_error,
+        match scene.integrator {
+            // Light subpaths feed many pixels: the error is estimated from whole sample indices.
+            Integrator::Particle(_) => " (by batch means over sample indices)",
+            _ => "",
+        },
         exr.display(),
         png.display(),
     );
@@ -603,6 +608,13 @@ fn trace_pixel(
     seed: u64,
 ) -> Result<()> {
     let estimator = SampleEstimator::new(scene);
+    if estimator.particle_tracer().is_some() {
+        return Err(Error::usage(
+            "--pixel prints a pixel's camera samples, and ptracer takes none: its light \
+             subpaths reach pixels anywhere on the film",
+        )
+        .with_help("render a --crop around the pixel instead"));
+    }
     let mut sampler = Sampler::new(scene.sampler.kind, strata, seed);
     let mut count = RayCount::default();
     let mut sums = PixelSums::default();

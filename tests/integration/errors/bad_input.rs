@@ -888,7 +888,7 @@ const GRID_SCENE: &str = scene!(
 );
 
 /// Bad media: negative coefficients, albedos above 1, missing, truncated and foreign grids,
-/// phase functions out of range, misspelt parameters, and media where distrib renders.
+/// phase functions out of range, misspelt parameters, and media where distrib or ptracer renders.
 fn media_cases() -> Vec<Case> {
     let with_grid = |name: &'static str, bytes: &'static str, says: &'static str| Case {
         name,
@@ -988,6 +988,25 @@ fn media_cases() -> Vec<Case> {
             ),
             "scene.xml:4:",
             "volpath",
+        ),
+        render_scene(
+            "ptracer with a medium",
+            scene!(
+                "    <integrator type=\"ptracer\"/>\n    <medium type=\"homogeneous\" id=\"fog\"/>"
+            ),
+            "scene.xml:4:",
+            "the ptracer integrator does not render participating media",
+        ),
+        render_scene(
+            "ptracer with a radiance meter",
+            concat!(
+                "<scene version=\"3.0.0\">\n",
+                "    <sensor type=\"radiancemeter\"><film type=\"hdrfilm\"><integer name=\"width\" value=\"1\"/><integer name=\"height\" value=\"1\"/></film></sensor>\n",
+                "    <integrator type=\"ptracer\"/>\n",
+                "</scene>\n"
+            ),
+            "scene.xml:3:",
+            "cannot connect light paths to a radiancemeter sensor",
         ),
         render_scene("missing grid", GRID_SCENE, "scene.xml:3:", "not found"),
         with_grid(

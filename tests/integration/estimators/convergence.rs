@@ -105,7 +105,7 @@ fn reported_variance_predicts_the_spread_between_independent_renders() {
 /// Asserts that two films estimate the same image in channel `c` (0 = X, 1 = Y, 2 = Z): the
 /// pixels' differences, standardised by their reported variances, pass a chi-square test at
 /// significance 10⁻³, and the image means agree within 4 standard errors.
-fn assert_same_image(name: &str, a: &Film, b: &Film, c: usize) {
+pub(super) fn assert_same_image(name: &str, a: &Film, b: &Film, c: usize) {
     let mut statistic = 0.0;
     let (mut mean_difference, mut variance_sum, mut pixels) = (0.0, 0.0, 0.0);
     for (p, d) in a.pixels.iter().zip(&b.pixels) {

@@ -1,5 +1,5 @@
 //! The integrators' estimators against closed forms and against each other, their error, and
-//! the `aov` and `moment` integrators.
+//! the `aov` and `moment` integrators, and the particle tracer.
 
 mod aov;
 mod closed_form;
@@ -7,4 +7,5 @@ mod convergence;
 mod depth;
 mod direct;
 mod moment;
+mod ptracer;
 mod strict_normals;

@@ -13,9 +13,9 @@
 //! the sensors there are) and becomes x − i·w on that sensor's film of w × H pixels; the batch's
 //! film, sampler and shutter replace those of the sensors it holds.
 
-use glam::Vec2;
+use glam::{Vec2, Vec3};
 
-use super::{Camera, CameraModel, CameraRay};
+use super::{Camera, CameraModel, CameraRay, ImportanceSample};
 use crate::light::BoundingSphere;
 
 #[derive(Clone, Debug)]
@@ -39,5 +39,10 @@ impl CameraModel for BatchSensor {
         for sensor in &mut self.sensors {
             sensor.set_scene_bounds(bounds);
         }
+    }
+
+    /// None: a point may be seen by several of the sensors; the particle tracer refuses a batch.
+    fn sample_importance(&self, _p: Vec3, _u: Vec2, _time: f32) -> Option<ImportanceSample> {
+        None
     }
 }

@@ -28,7 +28,7 @@ use std::sync::Arc;
 
 use glam::{Vec2, Vec3};
 
-use super::{CameraModel, CameraRay};
+use super::{CameraModel, CameraRay, ImportanceSample};
 use crate::geometry::Shape;
 use crate::light::BoundingSphere;
 use crate::math::{Ray, Transform};
@@ -93,6 +93,11 @@ impl CameraModel for DistantSensor {
 
     fn set_scene_bounds(&mut self, bounds: BoundingSphere) {
         self.scene = bounds;
+    }
+
+    /// None: rays of one direction, a delta, which no connection from a scene point can find.
+    fn sample_importance(&self, _p: Vec3, _u: Vec2, _time: f32) -> Option<ImportanceSample> {
+        None
     }
 }
 

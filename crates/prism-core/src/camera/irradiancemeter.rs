@@ -32,7 +32,7 @@ use std::sync::Arc;
 
 use glam::{Vec2, Vec3};
 
-use super::{CameraModel, CameraRay};
+use super::{CameraModel, CameraRay, ImportanceSample};
 use crate::geometry::Shape;
 use crate::geometry::offset::offset_ray_origin;
 use crate::light::BoundingSphere;
@@ -68,6 +68,11 @@ impl CameraModel for IrradianceMeter {
     }
 
     fn set_scene_bounds(&mut self, _bounds: BoundingSphere) {}
+
+    /// None: the meter is not connected to; the particle tracer refuses it.
+    fn sample_importance(&self, _p: Vec3, _u: Vec2, _time: f32) -> Option<ImportanceSample> {
+        None
+    }
 }
 
 #[cfg(test)]

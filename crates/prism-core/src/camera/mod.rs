@@ -19,7 +19,7 @@ pub use perspective::PerspectiveCamera;
 pub use radiancemeter::RadianceMeter;
 pub use shutter::Shutter;
 
-use glam::Vec2;
+use glam::{Vec2, Vec3};
 
 use crate::dispatch::plugin_class;
 use crate::light::BoundingSphere;
@@ -53,6 +53,15 @@ plugin_class! {
         /// Tells the sensor the bounding sphere of the scene's geometry, once the scene is
         /// built (Mitsuba's `Sensor::set_scene`); only the distant sensor uses it.
         fn set_scene_bounds(&mut self, bounds: BoundingSphere);
+
+        /// The camera seen from the point `p` at `time`, for connecting a light subpath to it
+        /// (Mitsuba's `Sensor::sample_direction`): a point of its lens, drawn with `u` where it
+        /// has an aperture, the film position the light from `p` lands on, and the camera's
+        /// importance there ([`ImportanceSample`]). The film position may lie off the film:
+        /// camera samples of the pixels at its edges reach that far through the reconstruction
+        /// filter, so the caller decides which positions reach a pixel. None where `p` is behind
+        /// the camera or outside its clip range, or no connection can reach the camera.
+        fn sample_importance(&self, p: Vec3, u: Vec2, time: f32) -> Option<ImportanceSample>;
     }
 
     /// The scene's sensor.
@@ -75,4 +84,35 @@ pub(crate) fn screen_position(film: Vec2, film_size: Vec2) -> (Vec2, f32) {
     let ndc = film / film_size;
     let aspect = film_size.x / film_size.y;
     (Vec2::new(1.0 - 2.0 * ndc.x, 1.0 - 2.0 * ndc.y), aspect)
+}
+
+/// A connection from a scene point to the camera ([`CameraModel::sample_importance`]).
+///
+/// With the film's image I_j = ∫ k_j(u) L(u) du over film positions u in pixels (k_j the
+/// reconstruction filter around pixel j, ∫ k = 1), a light subpath whose vertex at `p` sends
+/// the radiance-weighted value V = β · f · |cos θ_p| towards the camera (β the subpath's
+/// throughput, f·|cos θ_p| its scattering there towards `wi`) adds V · `weight` · k_j(film − c_j)
+/// to I_j when the image is the sum over W·H light subpaths, W × H the full film's size: the
+/// importance is normalised to the whole film, as Mitsuba's is.
+#[derive(Clone, Copy, Debug)]
+pub struct ImportanceSample {
+    /// The position on the full film, in pixels (origin top-left).
+    pub film: Vec2,
+    /// The point of the lens (or of the orthographic camera's near plane) the light reaches.
+    pub p: Vec3,
+    /// The unit direction from the scene point towards `p`.
+    pub wi: Vec3,
+    /// The importance W_e with the camera's end of the geometry term, over the density of the
+    /// lens point: 1/(A cos³θ r²) for a perspective camera (A the area of the film on the plane
+    /// at distance 1, θ the angle from the optical axis, r the distance), 1/A for an
+    /// orthographic one (A the film's area in the scene).
+    pub weight: f32,
+}
+
+/// The full-film position (pixels, origin top-left) of the screen position `screen` (see
+/// [`screen_position`], whose inverse it is); None where it is not finite.
+#[inline]
+pub(crate) fn film_position(screen: Vec2, film_size: Vec2) -> Option<Vec2> {
+    let film = (Vec2::ONE - screen) * 0.5 * film_size;
+    film.is_finite().then_some(film)
 }

@@ -22,7 +22,7 @@
 
 use glam::{Vec2, Vec3};
 
-use super::{CameraModel, CameraRay, screen_position};
+use super::{CameraModel, CameraRay, ImportanceSample, film_position, screen_position};
 use crate::light::BoundingSphere;
 use crate::math::{AnimatedTransform, Ray};
 
@@ -55,6 +55,29 @@ impl CameraModel for OrthographicCamera {
     }
 
     fn set_scene_bounds(&mut self, _bounds: BoundingSphere) {}
+
+    /// The point of the near plane straight behind `p` along the view axis, and its film
+    /// position: film positions u (pixels) and points of that plane are related by
+    /// du = (W·H/A) dA, A the film's area in the scene, so per film of W·H light subpaths the
+    /// weight is 1/A (the cosine at `p` is the scattering's).
+    fn sample_importance(&self, p: Vec3, _u: Vec2, time: f32) -> Option<ImportanceSample> {
+        let to_world = self.to_world.at(time);
+        let q = to_world.inverse_point(p);
+        if !(q.z >= self.near_clip && q.z <= self.far_clip) {
+            return None;
+        }
+        let aspect = self.film_size.x / self.film_size.y;
+        let film = film_position(Vec2::new(q.x, q.y * aspect), self.film_size)?;
+        let width = to_world.vector(Vec3::X).length() * 2.0;
+        let height = to_world.vector(Vec3::Y).length() * 2.0 / aspect;
+        let on_plane = to_world.point(Vec3::new(q.x, q.y, self.near_clip));
+        Some(ImportanceSample {
+            film,
+            p: on_plane,
+            wi: -to_world.vector(Vec3::Z).normalize(),
+            weight: 1.0 / (width * height),
+        })
+    }
 }
 
 #[cfg(test)]

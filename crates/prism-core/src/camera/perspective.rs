@@ -33,7 +33,7 @@
 
 use glam::{Vec2, Vec3};
 
-use super::{CameraModel, CameraRay, screen_position};
+use super::{CameraModel, CameraRay, ImportanceSample, film_position, screen_position};
 use crate::light::BoundingSphere;
 use crate::math::{AnimatedTransform, Ray};
 use crate::sampling::warp::sample_uniform_disk_concentric;
@@ -133,6 +133,55 @@ impl CameraModel for PerspectiveCamera {
     }
 
     fn set_scene_bounds(&mut self, _bounds: BoundingSphere) {}
+
+    /// The pinhole (or, with an aperture, a point a of the lens drawn uniformly with `u`,
+    /// whose density 1/(πR²) cancels the lens's share of the measurement) and the film
+    /// position of the point q = `p` in the camera's frame: that of the focal-plane point the
+    /// line from a through q crosses. Film positions u (pixels) and directions ω from a are
+    /// related by du = (W·H/A) dω / cos³θ, with A = 4 tan²(fov_x/2) / aspect the film's area on
+    /// the plane z = 1, and dω = |cos θ_p| dA_p / r²; so, per film of W·H light subpaths, the
+    /// weight is 1/(A cos³θ r²) (Veach 1997, §10.2; Mitsuba's `importance`).
+    fn sample_importance(&self, p: Vec3, u: Vec2, time: f32) -> Option<ImportanceSample> {
+        let to_world = self.to_world.at(time);
+        let q = to_world.inverse_point(p);
+        if !(q.z >= self.near_clip && q.z <= self.far_clip) {
+            return None;
+        }
+        let aperture = if self.lens_radius > 0.0 {
+            let on_lens = sample_uniform_disk_concentric(u) * self.lens_radius;
+            Vec3::new(on_lens.x, on_lens.y, 0.0)
+        } else {
+            Vec3::ZERO
+        };
+        let d = q - aperture;
+        if !(d.z > 0.0) {
+            return None;
+        }
+        // The pinhole direction (z = 1) of the focal-plane point on the line.
+        let pinhole = if self.lens_radius > 0.0 {
+            (aperture + d * (self.focus_distance / d.z)) / self.focus_distance
+        } else {
+            d / d.z
+        };
+        let aspect = self.film_size.x / self.film_size.y;
+        let tan = self.tan_half_fov_x;
+        let screen = Vec2::new(pinhole.x / tan, pinhole.y * aspect / tan);
+        let film = film_position(screen, self.film_size)?;
+        let lens = to_world.point(aperture);
+        let towards = lens - p;
+        let r2 = towards.length_squared();
+        if !(r2 > 0.0) {
+            return None;
+        }
+        let cos_theta = d.z / d.length();
+        let area = 4.0 * tan * tan / aspect;
+        Some(ImportanceSample {
+            film,
+            p: lens,
+            wi: towards / r2.sqrt(),
+            weight: 1.0 / (area * cos_theta * cos_theta * cos_theta * r2),
+        })
+    }
 }
 
 #[cfg(test)]

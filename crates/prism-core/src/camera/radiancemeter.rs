@@ -15,7 +15,7 @@
 
 use glam::{Vec2, Vec3};
 
-use super::{CameraModel, CameraRay};
+use super::{CameraModel, CameraRay, ImportanceSample};
 use crate::light::BoundingSphere;
 use crate::math::{AnimatedTransform, Ray};
 
@@ -39,6 +39,12 @@ impl CameraModel for RadianceMeter {
     }
 
     fn set_scene_bounds(&mut self, _bounds: BoundingSphere) {}
+
+    /// None: one ray from one point, a delta in position and direction, which no connection
+    /// from a scene point can find.
+    fn sample_importance(&self, _p: Vec3, _u: Vec2, _time: f32) -> Option<ImportanceSample> {
+        None
+    }
 }
 
 #[cfg(test)]

@@ -111,6 +111,26 @@ impl PixelSums {
         }
     }
 
+    /// Adds the total `xyz` that one sample index brings the pixel from everywhere on the film
+    /// (the particle tracer's splats): one sample of the pixel, whose mean over sample indices
+    /// is the image and whose spread gives its variance by batch means. A total that is not
+    /// finite is counted and dropped.
+    #[inline]
+    pub fn add_total(&mut self, xyz: [f64; 3]) {
+        self.samples += 1;
+        if !xyz
+            .iter()
+            .all(|v| v.is_finite() && v.abs() < LARGEST_SAMPLE)
+        {
+            self.rejected += 1;
+            return;
+        }
+        for (c, v) in xyz.into_iter().enumerate() {
+            self.xyz[c].add(v);
+            self.xyz_squared[c].add(v * v);
+        }
+    }
+
     /// Adds the total `xyz` of one sample index under filter MIS, with its weight's excess
     /// W − 1, to half A (`second_half` false) or B. Its sources were screened already
     /// ([`Self::count_rejected`]); a total that is still not finite is counted and dropped.

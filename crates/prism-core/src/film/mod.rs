@@ -1,4 +1,4 @@
-//! The film: reconstruction filters and their samplers, how samples become pixel values, per-pixel accumulation of XYZ, the
+//! The film: reconstruction filters and their samplers, how samples become pixel values, per-pixel accumulation of XYZ, splatting, the
 //! error estimated from the samples, a spectral film's channels, and the images written at the end (an EXR, and an 8-bit
 //! image tonemapped as the film asks).
 
@@ -8,6 +8,7 @@ pub mod ldr;
 pub mod output;
 pub mod reconstruction;
 pub mod spectral_bands;
+pub mod splat;
 pub mod stats;
 
 pub use accumulation::{CropWindow, Film, PixelSums, ValueSum};
@@ -22,3 +23,4 @@ pub use output::{
 };
 pub use reconstruction::{FilterMis, Reconstruction};
 pub use spectral_bands::SpectralBand;
+pub use splat::{SplatSums, SplatValue, Splatter};

@@ -110,6 +110,22 @@ impl Instance {
         })
     }
 
+    /// A point uniformly distributed over the surface at `time`, density per unit area: the
+    /// object-space density over the squared scale of the similarity that carries the shape
+    /// (the factory only lets such transforms carry emitters).
+    pub fn sample_area(&self, time: f32, u_choice: f32, u: Vec2) -> Option<SurfaceSample> {
+        let transform = self.to_world.at(time);
+        let scale = self.to_world.uniform_scale(time);
+        let s = self.shape().sample_area(u_choice, u)?;
+        Some(SurfaceSample {
+            p: transform.point(s.p),
+            n: transform.normal(s.n).normalize(),
+            shading_n: transform.normal(s.shading_n).normalize(),
+            pdf: s.pdf / (scale * scale),
+            ..s
+        })
+    }
+
     /// A point of the surface at `time` seen from `reference`, density per unit solid angle. The
     /// density is the object-space one, which is correct for similarities (solid angles do not
     /// change under rotation, translation and uniform scale); the factory only lets such

@@ -35,6 +35,16 @@ impl Primitive {
         }
     }
 
+    /// A point uniformly distributed over the surface at `time`, with its density per unit
+    /// area; None for a surface of zero area.
+    #[inline]
+    pub fn sample_area(&self, time: f32, u_choice: f32, u: Vec2) -> Option<SurfaceSample> {
+        match self {
+            Primitive::Shape(shape) => shape.sample_area(u_choice, u),
+            Primitive::Instance(instance) => instance.sample_area(time, u_choice, u),
+        }
+    }
+
     /// A point of the surface as seen from `reference` at `time`, with its density per unit
     /// solid angle (see [`Shape::sample_from`]).
     #[inline]

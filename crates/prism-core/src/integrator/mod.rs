@@ -23,6 +23,7 @@ pub mod distribution;
 pub mod mis;
 pub mod moment;
 pub mod path;
+pub mod ptracer;
 pub mod transmittance;
 pub mod vertex;
 pub mod volpath;
@@ -35,6 +36,7 @@ pub use direct::DirectIntegrator;
 pub use distribution::DistributionIntegrator;
 pub use moment::MomentIntegrator;
 pub use path::PathIntegrator;
+pub use ptracer::{LightPathSample, ParticleTracer, Splat};
 pub use volpath::{Tracking, VolPathIntegrator};
 
 use volpath::SpectralTracking;
@@ -79,6 +81,7 @@ integrator_enum! {
         Aov(AovIntegrator),
         VolPath(VolPathIntegrator),
         Depth(DepthIntegrator),
+        Particle(ParticleTracer),
     }
 }
 
@@ -102,9 +105,10 @@ impl Integrator {
             Integrator::Direct(_) => LightSelection::Exhaustive,
             Integrator::Distribution(distrib) => distrib.light_selection(),
             Integrator::VolPath(volpath) => volpath.light_selection,
-            Integrator::Moment(_) | Integrator::Aov(_) | Integrator::Depth(_) => {
-                LightSelection::Power
-            }
+            Integrator::Moment(_)
+            | Integrator::Aov(_)
+            | Integrator::Depth(_)
+            | Integrator::Particle(_) => LightSelection::Power,
         }
     }
 
@@ -117,7 +121,8 @@ impl Integrator {
             | Integrator::Direct(_)
             | Integrator::Distribution(_)
             | Integrator::VolPath(_)
-            | Integrator::Depth(_) => &[],
+            | Integrator::Depth(_)
+            | Integrator::Particle(_) => &[],
         };
         nested.iter().map(|(_, integrator)| integrator)
     }
@@ -130,6 +135,7 @@ impl Integrator {
             Integrator::Distribution(distrib) => distrib.hide_emitters,
             Integrator::VolPath(volpath) => volpath.hide_emitters,
             Integrator::Depth(_) => false,
+            Integrator::Particle(ptracer) => ptracer.hide_emitters,
             Integrator::Moment(_) | Integrator::Aov(_) => match self.nested().next() {
                 Some(first) => first.hides_emitters(),
                 None => true,
@@ -153,7 +159,8 @@ impl Integrator {
             | Integrator::Direct(_)
             | Integrator::Distribution(_)
             | Integrator::VolPath(_)
-            | Integrator::Depth(_) => Vec::new(),
+            | Integrator::Depth(_)
+            | Integrator::Particle(_) => Vec::new(),
             Integrator::Moment(moment) => moment.aov_names(),
             Integrator::Aov(aov) => aov.aov_names(),
         }
@@ -177,6 +184,33 @@ impl Integrator {
 }
 
 impl PreparedIntegrator<'_> {
+    /// The particle tracer, where the integrator is one: its samples are light subpaths
+    /// splatted onto the film rather than estimates along camera rays.
+    pub fn particle_tracer(&self) -> Option<&ParticleTracer> {
+        match self.integrator {
+            Integrator::Particle(ptracer) => Some(ptracer),
+            _ => None,
+        }
+    }
+
+    /// Traces one sample of the particle tracer `ptracer` (this integrator's), drawing random
+    /// numbers from `sampler` and handing its contributions to `out`.
+    pub fn trace_light_paths(
+        &self,
+        ptracer: &ParticleTracer,
+        sample: &LightPathSample,
+        sampler: &mut Sampler,
+        count: &mut RayCount,
+        out: &mut impl Splat,
+    ) {
+        let ctx = &mut SampleContext {
+            prepared: self,
+            sampler,
+            count,
+        };
+        ptracer.sample(ctx, sample, out);
+    }
+
     /// How many extra channels each sample writes.
     pub fn aov_count(&self) -> usize {
         self.aov_count
@@ -211,6 +245,9 @@ impl PreparedIntegrator<'_> {
             Integrator::Moment(_) => MomentIntegrator::radiance(ctx, ray, lambda, aovs),
             Integrator::Aov(integrator) => integrator.radiance(ctx, ray, lambda, aovs),
             Integrator::Depth(_) => DepthIntegrator::radiance(ctx, &ray),
+            // Light subpaths reach the film by splats, not along camera rays: the render driver
+            // runs them ([`Self::trace_light_paths`]).
+            Integrator::Particle(_) => SampledSpectrum::ZERO,
             Integrator::VolPath(integrator) => match integrator.tracking {
                 Tracking::Spectral => integrator.trace(SpectralTracking::new(), ctx, ray, lambda),
                 Tracking::HeroMis { spectral_mis } => {

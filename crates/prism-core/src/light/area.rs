@@ -37,11 +37,16 @@ use std::f32::consts::PI;
 
 use glam::{Vec2, Vec3};
 
-use super::{BoundingSphere, Environment, LightBounds, LightQuery, LightSample, LightSource};
+use super::{
+    BoundingSphere, EmissionQuery, EmissionSample, Environment, LightBounds, LightQuery,
+    LightSample, LightSource,
+};
 use crate::geometry::aggregate::AggregateElement;
 use crate::geometry::shape::area_to_solid_angle;
 use crate::geometry::{Primitive, Shape, ShapeGeometry, ShapeSampling, SurfaceSample};
+use crate::math::Frame;
 use crate::sampling::distribution::PiecewiseConstant2D;
+use crate::sampling::warp::sample_cosine_hemisphere;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths, Spectrum};
 use crate::texture::Texture;
 use crate::texture::TextureValues;
@@ -180,6 +185,19 @@ impl AreaLight {
         area_to_solid_angle(density.pdf(s.uv) / jacobian, reference, s.p, s.n).unwrap_or(0.0)
     }
 
+    /// A point uniformly distributed over the emitting shape at `time`, density per unit area
+    /// (for tracing light from the emitter, and for connecting its points to the camera).
+    pub fn sample_position(
+        &self,
+        shapes: &[Primitive],
+        time: f32,
+        u_choice: f32,
+        u: Vec2,
+    ) -> Option<SurfaceSample> {
+        let s = shapes[self.shape as usize].sample_area(time, u_choice, u)?;
+        (s.pdf > 0.0 && s.pdf.is_finite()).then_some(s)
+    }
+
     /// Density per unit solid angle with which [`Self::sample_incident`] from `reference` at
     /// `time` finds the surface point `s` (its position, geometric normal, uv and triangle, as
     /// a ray hit reports them).
@@ -264,6 +282,28 @@ impl LightSource for AreaLight {
             radiance,
             pdf: s.pdf,
             is_delta: false,
+        })
+    }
+
+    /// A point uniformly over the shape's area (density 1/A) and a cosine-distributed direction
+    /// about its shading normal (density cos θ / π): weight L_e · π · A. A textured radiance
+    /// is not importance sampled here; its value at the point enters the weight.
+    fn sample_emission(&self, query: EmissionQuery<'_>) -> Option<EmissionSample> {
+        let s = self.sample_position(query.shapes, query.time, query.u_choice, query.u_position)?;
+        let local = sample_cosine_hemisphere(query.u_direction);
+        if !(local.z > 0.0) {
+            return None;
+        }
+        let d = Frame::from_normal(s.shading_n).to_world(local);
+        let radiance = self.emitted(s.uv, s.shading_n, d, query.lambda);
+        if radiance.is_black() {
+            return None;
+        }
+        Some(EmissionSample {
+            p: s.p,
+            n: s.n,
+            d,
+            weight: radiance * (std::f32::consts::PI / s.pdf),
         })
     }
 

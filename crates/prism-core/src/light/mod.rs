@@ -17,6 +17,12 @@
 //! | `constant` | [`constant`] | uniform directions |
 //! | `envmap` | [`envmap`] | directions ∝ luminance · sin θ in the lat-long image |
 //! | `sunsky` | [`sunsky`] | the sky's luminance over (φ, cos θ), and the sun's cone |
+//!
+//! For tracing light from the lights' side (the particle tracer), every light also draws rays
+//! of its emission ([`LightSource::sample_emission`]): area lights a point by area and a
+//! cosine-distributed direction, point lights a uniform direction, spot lights a direction in
+//! their cone, projectors a point of their image, and lights at infinity a direction as for
+//! light sampling and a point on the disk of the scene's bounding sphere facing it.
 
 pub mod area;
 pub mod bounds;
@@ -33,6 +39,8 @@ use glam::{Vec2, Vec3};
 
 use crate::dispatch::plugin_class;
 use crate::geometry::Primitive;
+use crate::math::Frame;
+use crate::sampling::warp::sample_uniform_disk_concentric;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 pub use area::AreaLight;
 pub use bounds::{LightBounds, Receiver};
@@ -52,6 +60,11 @@ plugin_class! {
         /// Samples light arriving at the query's point from this light. None where the light
         /// sends nothing towards it.
         fn sample_incident(&self, query: LightQuery<'_>) -> Option<LightSample>;
+
+        /// Draws a ray of the light's emission, a point and a direction, for tracing light from
+        /// the lights' side (Mitsuba's `Emitter::sample_ray`). None where the draw finds no
+        /// emission.
+        fn sample_emission(&self, query: EmissionQuery<'_>) -> Option<EmissionSample>;
 
         /// Emitted power Φ, summarised as a luminance-weighted scalar (watts weighted by ȳ):
         /// the light sampler chooses lights in proportion to it. Lights at infinity count the
@@ -124,6 +137,39 @@ pub struct LightQuery<'a> {
     pub lambda: &'a SampledWavelengths,
 }
 
+/// What [`LightSource::sample_emission`] is asked: what the light may be made of, the
+/// instant, the wavelengths and the random numbers.
+#[derive(Clone, Copy, Debug)]
+pub struct EmissionQuery<'a> {
+    /// The world's primitives, which area lights are made of.
+    pub shapes: &'a [Primitive],
+    /// The instant, for shapes that move.
+    pub time: f32,
+    /// The random number that chooses among a light's parts (a mesh's triangle).
+    pub u_choice: f32,
+    /// The random numbers that draw the point.
+    pub u_position: Vec2,
+    /// The random numbers that draw the direction.
+    pub u_direction: Vec2,
+    /// The wavelengths the emission is sampled at.
+    pub lambda: &'a SampledWavelengths,
+}
+
+/// A ray of emitted light and its weight L_e |cos θ| / (p_A · p_ω): the radiance leaving the
+/// point along the ray over the densities of the point per unit area and of the direction per
+/// unit solid angle (Veach 1997, §10.2). For a point source it is I / p_ω; for a light at
+/// infinity, the radiance times the area of the disk the point is drawn on over p_ω.
+#[derive(Clone, Copy, Debug)]
+pub struct EmissionSample {
+    /// Where the ray starts.
+    pub p: Vec3,
+    /// The geometric normal there (zero for point sources and lights at infinity).
+    pub n: Vec3,
+    /// The unit direction the light travels in.
+    pub d: Vec3,
+    pub weight: SampledSpectrum,
+}
+
 /// A light at infinity (`directional`, `constant`, `envmap`, `sunsky`): it lights every point
 /// from directions alone, has no place for the light sampler to bound, and is told the scene's
 /// bounding sphere (Mitsuba's `Emitter::set_scene`), beyond which its shadow rays end and
@@ -170,6 +216,28 @@ impl<L: LightAtInfinity> LightSource for L {
             s.pdf,
             L::IS_DELTA,
         ))
+    }
+
+    /// The direction from [`LightAtInfinity::sample_direction`], and the point uniformly on
+    /// the disk of the scene's bounding sphere (radius R) facing it, outside the sphere:
+    /// weight L · πR² / p_ω (for `directional`, whose "radiance" is the irradiance and p_ω 1,
+    /// E · πR²), as Mitsuba's `sample_ray` of its lights at infinity.
+    fn sample_emission(&self, query: EmissionQuery<'_>) -> Option<EmissionSample> {
+        let s = self.sample_direction(query.u_direction, query.lambda)?;
+        if !(s.pdf > 0.0) || s.radiance.is_black() {
+            return None;
+        }
+        let scene = self.scene();
+        let disk = sample_uniform_disk_concentric(query.u_position) * scene.radius;
+        let frame = Frame::from_normal(s.wi);
+        let p = scene.center + scene.radius * s.wi + frame.to_world(Vec3::new(disk.x, disk.y, 0.0));
+        let area = std::f32::consts::PI * scene.radius * scene.radius;
+        Some(EmissionSample {
+            p,
+            n: Vec3::ZERO,
+            d: -s.wi,
+            weight: s.radiance * (area / s.pdf),
+        })
     }
 
     fn power(&self, _shapes: &[Primitive]) -> f32 {

@@ -16,9 +16,11 @@ use std::f32::consts::PI;
 use glam::Vec3;
 
 use super::{
-    BoundingSphere, Environment, LightBounds, LightQuery, LightSample, LightSource, towards_point,
+    BoundingSphere, EmissionQuery, EmissionSample, Environment, LightBounds, LightQuery,
+    LightSample, LightSource, towards_point,
 };
 use crate::geometry::Primitive;
+use crate::sampling::warp::{sample_uniform_sphere, uniform_sphere_pdf};
 use crate::spectrum::Spectrum;
 
 #[derive(Clone, Debug)]
@@ -32,6 +34,16 @@ impl LightSource for PointLight {
         let (wi, dist2) = towards_point(self.position, query.reference)?;
         let radiance = self.intensity.sample(query.lambda) * (1.0 / dist2);
         Some(LightSample::from_point(self.position, wi, radiance))
+    }
+
+    /// A uniform direction: weight I / (1/4π).
+    fn sample_emission(&self, query: EmissionQuery<'_>) -> Option<EmissionSample> {
+        Some(EmissionSample {
+            p: self.position,
+            n: Vec3::ZERO,
+            d: sample_uniform_sphere(query.u_direction),
+            weight: self.intensity.sample(query.lambda) * (1.0 / uniform_sphere_pdf()),
+        })
     }
 
     /// Φ = 4π I.

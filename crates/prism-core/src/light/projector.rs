@@ -36,7 +36,10 @@ use std::f32::consts::PI;
 
 use glam::{Vec2, Vec3};
 
-use super::{BoundingSphere, Environment, LightBounds, LightQuery, LightSample, LightSource};
+use super::{
+    BoundingSphere, EmissionQuery, EmissionSample, Environment, LightBounds, LightQuery,
+    LightSample, LightSource,
+};
 use crate::geometry::Primitive;
 use crate::math::Transform;
 use crate::texture::Texture;
@@ -119,6 +122,31 @@ impl LightSource for Projector {
         }
         let radiance = irradiance * (PI * self.scale / (local.z * local.z * cos_theta));
         Some(LightSample::from_point(self.position, wi, radiance))
+    }
+
+    /// A direction through a uniform point (x, y, 1) of the image's rectangle on the plane
+    /// z = 1, of area A = 4t²/a: its density per solid angle is 1/(A cos³θ), and the intensity
+    /// there is I = π · scale · E / cos³θ (the irradiance π · scale · E on that plane, at
+    /// distance 1/cos θ and tilted by θ), so the weight is π · scale · E · A.
+    fn sample_emission(&self, query: EmissionQuery<'_>) -> Option<EmissionSample> {
+        let uv = query.u_direction;
+        let t = self.tan_half_fov;
+        let local = Vec3::new(
+            (0.5 - uv.x) * 2.0 * t,
+            (0.5 - uv.y) * 2.0 * t / self.aspect,
+            1.0,
+        );
+        let irradiance = self.irradiance.eval(uv, query.lambda);
+        if irradiance.is_black() {
+            return None;
+        }
+        let area = 4.0 * t * t / self.aspect;
+        Some(EmissionSample {
+            p: self.position,
+            n: Vec3::ZERO,
+            d: self.to_world.vector(local).normalize(),
+            weight: irradiance * (PI * self.scale * area),
+        })
     }
 
     /// Φ = π · scale · Ē · 4 t² / a: the irradiance π · scale · E on the plane z = 1 over the

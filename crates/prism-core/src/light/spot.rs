@@ -25,10 +25,12 @@
 use glam::{Vec2, Vec3};
 
 use super::{
-    BoundingSphere, Environment, LightBounds, LightQuery, LightSample, LightSource, towards_point,
+    BoundingSphere, EmissionQuery, EmissionSample, Environment, LightBounds, LightQuery,
+    LightSample, LightSource, towards_point,
 };
 use crate::geometry::Primitive;
 use crate::math::Transform;
+use crate::sampling::warp::{sample_uniform_cone, uniform_cone_pdf};
 use crate::spectrum::Spectrum;
 use crate::texture::Texture;
 use crate::texture::TextureValues;
@@ -114,6 +116,27 @@ impl LightSource for SpotLight {
             }
         }
         Some(LightSample::from_point(self.position, wi, radiance))
+    }
+
+    /// A direction uniform in the cone of the cutoff angle (as Mitsuba's `sample_ray`):
+    /// weight I · falloff · texture / p_ω.
+    fn sample_emission(&self, query: EmissionQuery<'_>) -> Option<EmissionSample> {
+        let local = sample_uniform_cone(query.u_direction, self.cos_cutoff);
+        let pdf = uniform_cone_pdf(local, self.cos_cutoff);
+        let falloff = self.falloff(local);
+        if !(pdf > 0.0) || falloff == 0.0 {
+            return None;
+        }
+        let mut weight = self.intensity.sample(query.lambda) * (falloff / pdf);
+        if let Some(texture) = &self.texture {
+            weight *= texture.eval(self.texture_uv(local), query.lambda);
+        }
+        Some(EmissionSample {
+            p: self.position,
+            n: Vec3::ZERO,
+            d: self.to_world.vector(local).normalize(),
+            weight,
+        })
     }
 
     /// Φ = I ∫ falloff dω = 2π I [(1 − cos β) + ∫_β^c (c − θ)/(c − β) sin θ dθ]

@@ -8,7 +8,7 @@ use glam::{UVec2, Vec2};
 use crate::camera::{CameraModel, CameraRay};
 use crate::film::spectral_bands::band_values;
 use crate::film::{FilterMis, FilterSampler};
-use crate::integrator::{PreparedIntegrator, RayCount};
+use crate::integrator::{ParticleTracer, PreparedIntegrator, RayCount};
 use crate::math::Ray;
 use crate::sampling::sampler::Sampler;
 use crate::scene::Scene;
@@ -19,7 +19,7 @@ use crate::spectrum::SampledWavelengths;
 /// samples are shared between pixels.
 pub struct SampleEstimator<'a> {
     pub(super) scene: &'a Scene,
-    integrator: PreparedIntegrator<'a>,
+    pub(super) integrator: PreparedIntegrator<'a>,
     filter: FilterSampler,
     pub(super) shared: Option<FilterMis>,
     /// Whether each sample also writes its coverage alpha, after the integrator's channels.
@@ -39,6 +39,12 @@ impl<'a> SampleEstimator<'a> {
                 .then(|| FilterMis::new(film.filter, film.size.x, film.size.y)),
             alpha: scene.exr_output.pixel_format.has_alpha(),
         }
+    }
+
+    /// The particle tracer, where the scene's integrator is one: its samples are light
+    /// subpaths splatted onto the film, not camera samples.
+    pub fn particle_tracer(&self) -> Option<&ParticleTracer> {
+        self.integrator.particle_tracer()
     }
 
     /// How many extra channels each sample writes: the integrator's, the alpha, the bands.

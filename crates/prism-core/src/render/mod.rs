@@ -2,8 +2,10 @@
 //! within a pass the tiles of the crop window are rendered in parallel on a rayon pool.
 //!
 //! Every pixel sample draws its random numbers from the sampler's stream for (seed, pixel,
-//! sample index), and pixel sums are exact (order-free). Under the one-pixel reconstruction
-//! every sample lands in its own pixel; under filter MIS ([`crate::film::reconstruction`]) the
+//! sample index), and pixel sums are exact (order-free). The particle tracer's samples are
+//! light subpaths keyed the same way, splatted wherever they reach the film and gathered per
+//! sample index ([`particles`]). Under the one-pixel reconstruction every camera sample lands
+//! in its own pixel; under filter MIS ([`crate::film::reconstruction`]) the
 //! samples of a batch of indices are first traced for every pixel within the filter's reach of
 //! the crop window and kept, then every pixel gathers, index by index, what its neighbours'
 //! samples bring it, always in the same order. Either way the image is bit-identical whatever
@@ -22,6 +24,7 @@
 mod estimator;
 mod filter_mis;
 mod options;
+mod particles;
 mod pass;
 mod progress;
 pub mod resume;
@@ -125,6 +128,11 @@ pub fn render_with_preview(
 ) -> Result<RenderOutput> {
     let crop = scene.film.crop;
     let estimator = SampleEstimator::new(scene);
+    // The particle tracer's bound on a pass's sample indices.
+    let samples_per_pass = estimator
+        .particle_tracer()
+        .and_then(|ptracer| ptracer.samples_per_pass)
+        .unwrap_or(u32::MAX);
     let tiles = tiles(crop.size);
     let pixel_count = u64::from(crop.size.x) * u64::from(crop.size.y);
     let options = RenderOptions {
@@ -197,7 +205,8 @@ pub fn render_with_preview(
             break StopReason::Interrupted;
         }
         let left = stop.sample_end.map_or(u32::MAX - next, |end| end - next);
-        let count = next_pass(in_passes, next - first, left, &stop, start.elapsed(), error);
+        let count = next_pass(in_passes, next - first, left, &stop, start.elapsed(), error)
+            .min(samples_per_pass);
         let range = next..next + count;
         let pass_result = pool.install(|| pass.render(&sums, &mut spare, range.clone()));
         let Some(pass_rays) = pass_result.filter(|_| !abort.load(Ordering::Relaxed)) else {

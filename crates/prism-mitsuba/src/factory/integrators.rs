@@ -1,6 +1,6 @@
 //! Integrator plugins: `path` (with Prism's `emitter_sampling`, see
 //! [`prism_core::light::sampler`]), `direct`, `moment`, `aov`, the lecture's `distrib`, and
-//! `volpath` and `volpathmis` for media.
+//! `volpath` and `volpathmis` for media, and `ptracer`, the particle tracer.
 
 use crate::description::{PluginClass, PluginNode, Warning};
 use crate::params::Params;
@@ -12,7 +12,7 @@ use prism_core::integrator::aov::{Aov, AovKind};
 use prism_core::integrator::distribution::DirectLights;
 use prism_core::integrator::{
     AovIntegrator, DepthIntegrator, DirectIntegrator, DistributionIntegrator, Integrator,
-    MomentIntegrator, PathIntegrator, Tracking, VolPathIntegrator,
+    MomentIntegrator, ParticleTracer, PathIntegrator, Tracking, VolPathIntegrator,
 };
 use prism_core::light::{Light, LightSelection};
 
@@ -123,6 +123,17 @@ pub static INTEGRATORS: Registry<Build> = Registry {
             ],
             build: build_volpathmis,
         },
+        Plugin {
+            name: "ptracer",
+            origin: Origin::Mitsuba3,
+            summary: "The particle tracer: light subpaths from lights chosen by power, continued \
+                      by sampling the adjoint BSDF with Russian roulette, connected to the \
+                      camera at every surface and splatted through the reconstruction filter \
+                      (plus light-source points connected straight to the camera); no media. \
+                      Its error estimate is by batch means over sample indices.",
+            params: &[MAX_DEPTH, RR_DEPTH, HIDE_EMITTERS, SAMPLES_PER_PASS],
+            build: build_ptracer,
+        },
     ],
 };
 
@@ -142,6 +153,7 @@ params! {
     BOUNCE_SAMPLES = ParamSpec::new("bounce_samples", ParamKind::Integer, Default::Integer(4), "bounce samples at potential 1 (1 to 1024)");
     SHADOW_RAYS = ParamSpec::new("shadow_rays", ParamKind::Integer, Default::Integer(4), "shadow rays per light at potential 1 (1 to 1024)");
     LIGHTS = ParamSpec::new("lights", ParamKind::Choice(&[Choice::new("exhaustive", &DirectLights::One(LightSelection::Exhaustive)), Choice::new("power", &DirectLights::One(LightSelection::Power)), Choice::new("uniform", &DirectLights::One(LightSelection::Uniform)), Choice::new("all", &DirectLights::All)]), Default::Str("exhaustive"), "one light per vertex chosen ∝ its importance there, ∝ power or uniformly (as the path integrator's `emitter_sampling`), or every light");
+    SAMPLES_PER_PASS = ParamSpec::new("samples_per_pass", ParamKind::Integer, Default::Integer(-1), "the most samples per pixel a pass of the render takes (−1: as the render driver chooses)");
     RR_THRESHOLD = ParamSpec::new("rr_threshold", ParamKind::Float, Default::Float(0.1), "potential below which Russian roulette starts");
 }
 
@@ -185,6 +197,18 @@ fn max_depth(params: &Params) -> Result<i32> {
     Ok(max_depth as i32)
 }
 
+/// `rr_depth`: at least 1.
+fn rr_depth(params: &Params) -> Result<i32> {
+    let rr_depth = params.integer(&RR_DEPTH)?;
+    if rr_depth < 1 || rr_depth > i64::from(i32::MAX) {
+        return Err(Error::input(
+            params.location_of(&RR_DEPTH),
+            format!("rr_depth must be at least 1, not {rr_depth}"),
+        ));
+    }
+    Ok(rr_depth as i32)
+}
+
 /// A count that must be at least 1 (and sensible).
 fn count(params: &Params, spec: &ParamSpec) -> Result<u32> {
     let value = params.integer(spec)?;
@@ -207,21 +231,34 @@ fn build_path(params: &Params) -> Result<Integrator> {
 /// The settings `path` shares with `volpath` and `volpathmis`.
 fn path_settings(params: &Params) -> Result<PathIntegrator> {
     let max_depth = max_depth(params)?;
-    let rr_depth = params.integer(&RR_DEPTH)?;
-    if rr_depth < 1 || rr_depth > i64::from(i32::MAX) {
-        return Err(Error::input(
-            params.location_of(&RR_DEPTH),
-            format!("rr_depth must be at least 1, not {rr_depth}"),
-        ));
-    }
+    let rr_depth = rr_depth(params)?;
     let light_selection = params.choice(&EMITTER_SAMPLING)?;
     Ok(PathIntegrator {
         max_depth,
-        rr_depth: rr_depth as i32,
+        rr_depth,
         hide_emitters: params.boolean(&HIDE_EMITTERS)?,
         light_selection,
         strict_normals: false,
     })
+}
+
+fn build_ptracer(params: &Params) -> Result<Integrator> {
+    let samples_per_pass = match params.integer(&SAMPLES_PER_PASS)? {
+        -1 => None,
+        n if (1..=i64::from(u32::MAX)).contains(&n) => Some(n as u32),
+        n => {
+            return Err(Error::input(
+                params.location_of(&SAMPLES_PER_PASS),
+                format!("samples_per_pass must be -1 or at least 1, not {n}"),
+            ));
+        }
+    };
+    Ok(Integrator::Particle(ParticleTracer {
+        max_depth: max_depth(params)?,
+        rr_depth: rr_depth(params)?,
+        hide_emitters: params.boolean(&HIDE_EMITTERS)?,
+        samples_per_pass,
+    }))
 }
 
 /// A sample count of `direct`: 0 to 1024.

@@ -15,7 +15,7 @@ use crate::description::{NestedPlugin, PluginClass, PluginNode, Warning};
 use crate::params::Params;
 use crate::registry::{Default, ParamSpec, params};
 use prism_core::bsdf::Material;
-use prism_core::camera::CameraModel;
+use prism_core::camera::{Camera, CameraModel};
 use prism_core::error::{Error, Result, SourceLocation};
 use prism_core::geometry::{Geometry, Primitive, Shape};
 use prism_core::integrator::{Integrator, PathIntegrator};
@@ -92,6 +92,7 @@ pub fn build_scene_with_geometry(
     let integrator_location = integrator_child.map_or(&root.location, |c| &c.location);
     for (id, sensor) in sensors {
         check_band_names(&integrator, &sensor, integrator_location)?;
+        check_connectable(&integrator, &sensor, integrator_location)?;
         let medium = match &sensor.medium {
             Some(node) => Some(builder.media.index(&NestedPlugin {
                 name: None,
@@ -194,13 +195,40 @@ fn check_band_names(
     }
 }
 
-/// The distrib integrator estimates no participating media: a scene with media and distrib is
-/// an error at the first medium.
+/// The ptracer integrator connects light subpaths to a camera: a sensor of one ray or one
+/// direction (`radiancemeter`, `distant`), a surface's meter (`irradiancemeter`) or a `batch`
+/// cannot take it (an error at the integrator, `location`).
+fn check_connectable(
+    integrator: &Integrator,
+    sensor: &SensorSettings,
+    location: &SourceLocation,
+) -> Result<()> {
+    let kind = match (integrator, &sensor.camera) {
+        (Integrator::Particle(_), Camera::RadianceMeter(_)) => "radiancemeter",
+        (Integrator::Particle(_), Camera::IrradianceMeter(_)) => "irradiancemeter",
+        (Integrator::Particle(_), Camera::Distant(_)) => "distant",
+        (Integrator::Particle(_), Camera::Batch(_)) => "batch",
+        _ => return Ok(()),
+    };
+    Err(Error::input(
+        location,
+        format!("the ptracer integrator cannot connect light paths to a {kind} sensor"),
+    )
+    .with_help("render it with <integrator type=\"path\">, or use a perspective, thinlens or orthographic sensor"))
+}
+
+/// The distrib and ptracer integrators estimate no participating media: a scene with media
+/// and either is an error at the first medium.
 fn check_renders_media(integrator: &Integrator, media: &MediaCache) -> Result<()> {
-    if let (Integrator::Distribution(_), Some(location)) = (integrator, &media.first) {
+    let name = match integrator {
+        Integrator::Distribution(_) => "distrib",
+        Integrator::Particle(_) => "ptracer",
+        _ => return Ok(()),
+    };
+    if let Some(location) = &media.first {
         return Err(Error::input(
             location,
-            "the distrib integrator does not render participating media",
+            format!("the {name} integrator does not render participating media"),
         )
         .with_help(
             "render scenes with media with <integrator type=\"volpath\"> or \"volpathmis\"",
