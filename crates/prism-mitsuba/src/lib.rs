@@ -29,10 +29,17 @@ use std::path::Path;
 pub use factory::LoadedScene;
 use prism_core::error::{Error, Result};
 
-/// Reads a scene file and builds it: a pbrt-v4 scene when its name ends in `.pbrt` (see
-/// [`pbrt`]), else a Mitsuba XML scene (with `-D name=value` overrides); the reader's warnings
-/// come first.
+/// Reads a scene file and builds it (see [`read_scene`]); the reader's warnings come first.
 pub fn load_scene(path: &Path, defines: &[(String, String)]) -> Result<LoadedScene> {
+    let document = read_scene(path, defines)?;
+    let mut loaded = factory::build_scene(&document.root)?;
+    loaded.warnings.splice(0..0, document.warnings);
+    Ok(loaded)
+}
+
+/// Reads a scene file into its plugin tree: a pbrt-v4 scene when its name ends in `.pbrt` (see
+/// [`pbrt`]), else a Mitsuba XML scene (with `-D name=value` overrides).
+pub fn read_scene(path: &Path, defines: &[(String, String)]) -> Result<reader::SceneDocument> {
     if path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("pbrt"))
@@ -44,12 +51,10 @@ pub fn load_scene(path: &Path, defines: &[(String, String)]) -> Result<LoadedSce
             .with_help("-D sets the $name parameters of Mitsuba XML scenes"));
         }
         let scene = pbrt::read_pbrt_file(path)?;
-        let mut loaded = factory::build_scene(&scene.root)?;
-        loaded.warnings.splice(0..0, scene.warnings);
-        return Ok(loaded);
+        return Ok(reader::SceneDocument {
+            root: scene.root,
+            warnings: scene.warnings,
+        });
     }
-    let document = reader::read_scene_document(path, defines)?;
-    let mut loaded = factory::build_scene(&document.root)?;
-    loaded.warnings.splice(0..0, document.warnings);
-    Ok(loaded)
+    reader::read_scene_document(path, defines)
 }

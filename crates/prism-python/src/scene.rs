@@ -19,7 +19,8 @@ use prism_mitsuba::description::{PluginNode, Warning};
 use prism_mitsuba::factory::build_scene_with_geometry;
 use prism_mitsuba::file_cache::FileCache;
 use prism_mitsuba::fingerprint::{override_reconstruction, override_wavelengths};
-use prism_mitsuba::reader::{SceneDocument, read_scene_document, read_scene_str_document};
+use prism_mitsuba::read_scene;
+use prism_mitsuba::reader::{SceneDocument, read_scene_str_document};
 use prism_mitsuba::{LoadedScene, dict};
 
 /// A scene ready to render. Its settings that `prism render` can override from the command
@@ -207,13 +208,14 @@ impl Scene {
     }
 }
 
-/// Loads the Mitsuba XML scene at `path`, with `defines` as `(name, value)` pairs for its
-/// `$name` parameters (the command line's `-D name=value`).
+/// Loads the scene at `path` (Mitsuba XML, or pbrt-v4 when its name ends in `.pbrt`), with
+/// `defines` as `(name, value)` pairs for an XML scene's `$name` parameters (the command line's
+/// `-D name=value`).
 #[pyfunction]
 #[pyo3(signature = (path, defines = Vec::new()))]
 pub fn load_file(py: Python<'_>, path: PathBuf, defines: Vec<(String, String)>) -> PyResult<Scene> {
     let document = py
-        .detach(|| read_scene_document(&path, &defines))
+        .detach(|| read_scene(&path, &defines))
         .into_py_result(py)?;
     Scene::build(py, document)
 }

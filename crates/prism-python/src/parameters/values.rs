@@ -99,8 +99,8 @@ pub(super) fn to_python<'py>(
         PropertyValue::Transform(matrix) => {
             Transform { matrix: *matrix }.into_pyobject(py)?.into_any()
         }
-        PropertyValue::String(_) | PropertyValue::Animation(_) => {
-            unreachable!("strings and animations are not parameters")
+        PropertyValue::String(_) | PropertyValue::Animation(_) | PropertyValue::Numbers(_) => {
+            unreachable!("strings, animations and lists of numbers are not parameters")
         }
     })
 }
