@@ -87,15 +87,19 @@ pub fn read_scene_file(path: &Path, defines: &[(String, String)]) -> Result<Arc<
 
 /// As [`read_scene_file`], with the reader's warnings.
 pub fn read_scene_document(path: &Path, defines: &[(String, String)]) -> Result<SceneDocument> {
-    let text = std::fs::read_to_string(path).map_err(|err| {
+    read_scene_str_document(&scene_text(path)?, path, defines)
+}
+
+/// The text of the scene file at `path`, or the error a user sees for a missing one.
+pub(crate) fn scene_text(path: &Path) -> Result<String> {
+    std::fs::read_to_string(path).map_err(|err| {
         if err.kind() == std::io::ErrorKind::NotFound {
             Error::usage(format!("scene file \"{}\" not found", path.display()))
                 .with_help("check the path of the scene file")
         } else {
             Error::io(path, &err, "read the scene file")
         }
-    })?;
-    read_scene_str_document(&text, path, defines)
+    })
 }
 
 /// Same, from a string; `path` names the (possibly virtual) file for messages and relative lookups.

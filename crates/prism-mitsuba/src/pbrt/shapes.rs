@@ -150,22 +150,8 @@ impl Builder {
     /// `trianglemesh`: `P`, `indices` (optional for one triangle), `N`, `uv`.
     fn triangle_mesh(&mut self, list: &ParameterList) -> Result<PluginNode> {
         let location = &list.location;
-        let Some((_, positions)) = list.array("P", &["point3"], 3)? else {
-            return Err(list.directive_error("needs \"point3 P\""));
-        };
+        let (_, positions, indices) = positions_and_indices(list, 3)?;
         let vertex_count = positions.len() / 3;
-        let indices = match list.array("indices", &["integer"], 3)? {
-            Some((parameter, indices)) => {
-                check_indices(list, parameter, indices, vertex_count)?;
-                indices.to_vec()
-            }
-            None if vertex_count == 3 => vec![0.0, 1.0, 2.0],
-            None => {
-                return Err(
-                    list.directive_error("needs \"integer indices\" (more than 3 vertices)")
-                );
-            }
-        };
         let mut node = plugin(
             PluginClass::Shape,
             "trianglemesh",
@@ -229,22 +215,8 @@ impl Builder {
     /// `bilinearmesh`: each patch (p00, p10, p01, p11) a flat parallelogram, as two triangles.
     fn bilinear_mesh(&mut self, list: &ParameterList) -> Result<PluginNode> {
         let location = &list.location;
-        let Some((p_parameter, positions)) = list.array("P", &["point3"], 3)? else {
-            return Err(list.directive_error("needs \"point3 P\""));
-        };
+        let (p_parameter, positions, indices) = positions_and_indices(list, 4)?;
         let vertex_count = positions.len() / 3;
-        let indices = match list.array("indices", &["integer"], 4)? {
-            Some((parameter, indices)) => {
-                check_indices(list, parameter, indices, vertex_count)?;
-                indices.to_vec()
-            }
-            None if vertex_count == 4 => vec![0.0, 1.0, 2.0, 3.0],
-            None => {
-                return Err(
-                    list.directive_error("needs \"integer indices\" (more than 4 vertices)")
-                );
-            }
-        };
         let uv = match list.array("uv", &["point2"], 2)? {
             Some((parameter, uvs)) if uvs.len() != 2 * vertex_count => {
                 return Err(list.error(
@@ -342,6 +314,32 @@ fn whole(list: &ParameterList, name: &str, whole_value: f64) -> Result<()> {
         return Err(list.error(parameter, "cuts the shape; Prism's quadrics are whole"));
     }
     Ok(())
+}
+
+/// A mesh's `point3 P` and its `integer indices`, `per_face` to a face (optional when the mesh
+/// is one face of `per_face` vertices, which are then taken in order), checked against the
+/// vertices.
+fn positions_and_indices(
+    list: &ParameterList,
+    per_face: usize,
+) -> Result<(&Parameter, &[f64], Vec<f64>)> {
+    let Some((p_parameter, positions)) = list.array("P", &["point3"], 3)? else {
+        return Err(list.directive_error("needs \"point3 P\""));
+    };
+    let vertex_count = positions.len() / 3;
+    let indices = match list.array("indices", &["integer"], per_face)? {
+        Some((parameter, indices)) => {
+            check_indices(list, parameter, indices, vertex_count)?;
+            indices.to_vec()
+        }
+        None if vertex_count == per_face => (0..per_face).map(|i| i as f64).collect(),
+        None => {
+            return Err(list.directive_error(format!(
+                "needs \"integer indices\" (more than {per_face} vertices)"
+            )));
+        }
+    };
+    Ok((p_parameter, positions, indices))
 }
 
 /// Checks that every index names a vertex, before the mesh is built.
