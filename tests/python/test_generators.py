@@ -39,10 +39,15 @@ def test_conductor_tables_are_reproduced(tmp_path: Path) -> None:
     assert out.read_bytes() == (SPECTRUM / "conductors.rs").read_bytes()
 
 
+# Written by hand beside the generated scene: its pbrt-v4 transcription (docs/pbrt.md).
+HAND_WRITTEN = {Path("scene.pbrt")}
+
+
 def test_cornell_box_is_reproduced(tmp_path: Path) -> None:
     out = tmp_path / "cornell-box"
     run("gen_cornell_box.py", "--out", str(out))
-    written, committed = files_under(out), files_under(CORNELL)
+    written = files_under(out)
+    committed = {name: data for name, data in files_under(CORNELL).items() if name not in HAND_WRITTEN}
     assert sorted(written) == sorted(committed)
     for name, data in written.items():
         assert data == committed[name], f"{name} differs from scenes/cornell-box/{name}"
