@@ -91,7 +91,7 @@ pub fn read_scene_document(path: &Path, defines: &[(String, String)]) -> Result<
 }
 
 /// The text of the scene file at `path`, or the error a user sees for a missing one.
-pub(crate) fn scene_text(path: &Path) -> Result<String> {
+fn scene_text(path: &Path) -> Result<String> {
     std::fs::read_to_string(path).map_err(|err| {
         if err.kind() == std::io::ErrorKind::NotFound {
             Error::usage(format!("scene file \"{}\" not found", path.display()))

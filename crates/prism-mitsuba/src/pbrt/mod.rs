@@ -26,7 +26,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use crate::description::{NestedPlugin, PluginClass, PluginNode, Property, PropertyValue, Warning};
-use prism_core::error::{Result, SourceLocation};
+use prism_core::error::{Error, Result, SourceLocation};
 
 /// A pbrt-v4 scene read into a plugin tree, with the reader's warnings.
 pub struct PbrtScene {
@@ -36,7 +36,15 @@ pub struct PbrtScene {
 
 /// Reads the pbrt-v4 scene file at `path`.
 pub fn read_pbrt_file(path: &Path) -> Result<PbrtScene> {
-    read_pbrt_str(&crate::reader::scene_text(path)?, path)
+    let text = std::fs::read_to_string(path).map_err(|err| {
+        if err.kind() == std::io::ErrorKind::NotFound {
+            Error::usage(format!("scene file \"{}\" not found", path.display()))
+                .with_help("check the path of the scene file")
+        } else {
+            Error::io(path, &err, "read the scene file")
+        }
+    })?;
+    read_pbrt_str(&text, path)
 }
 
 /// Reads a pbrt-v4 scene given as text; `path` names it in messages, and relative file names
