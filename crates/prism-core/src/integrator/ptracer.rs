@@ -151,13 +151,11 @@ impl ParticleTracer {
         out: &mut impl Splat,
     ) {
         let world = ctx.world();
-        let u_light = ctx.sampler.next_1d();
-        let u_choice = ctx.sampler.next_1d();
-        let u = ctx.sampler.next_2d();
-        let anywhere = Receiver::point(Vec3::ZERO);
-        let Some((index, choice)) = ctx.light_sampler().sample(u_light, &anywhere) else {
+        let Some((index, choice)) = choose_light(ctx) else {
             return;
         };
+        let u_choice = ctx.sampler.next_1d();
+        let u = ctx.sampler.next_2d();
         let light = &world.lights[index];
         let (lambda, time) = (sample.lambda, sample.time);
         let shapes = &world.geometry.primitives;
@@ -216,14 +214,12 @@ impl ParticleTracer {
         out: &mut impl Splat,
     ) {
         let world = ctx.world();
-        let u_light = ctx.sampler.next_1d();
+        let Some((index, choice)) = choose_light(ctx) else {
+            return;
+        };
         let u_choice = ctx.sampler.next_1d();
         let u_position = ctx.sampler.next_2d();
         let u_direction = ctx.sampler.next_2d();
-        let anywhere = Receiver::point(Vec3::ZERO);
-        let Some((index, choice)) = ctx.light_sampler().sample(u_light, &anywhere) else {
-            return;
-        };
         let Some(emission) = world.lights[index].sample_emission(EmissionQuery {
             shapes: &world.geometry.primitives,
             time: sample.time,
@@ -318,4 +314,12 @@ impl ParticleTracer {
             }
         }
     }
+}
+
+/// A light for a light subpath or a visible emitter, and its probability: the particle tracer's
+/// light sampler chooses by power, the same wherever the receiver (here the origin) is.
+fn choose_light(ctx: &mut SampleContext) -> Option<(usize, f32)> {
+    let u_light = ctx.sampler.next_1d();
+    ctx.light_sampler()
+        .sample(u_light, &Receiver::point(Vec3::ZERO))
 }
