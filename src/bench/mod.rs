@@ -131,6 +131,9 @@ pub struct Measurement {
     /// The same with Embree.
     pub embree_shadow_rays_per_second: Option<f64>,
     pub samples_per_second: f64,
+    /// The mean share of the lanes that held a path per step, where the scene's paths run in
+    /// lanes (the path tracer's).
+    pub lane_occupancy: Option<f64>,
     /// Samples per pixel rendered in the budget.
     pub spp: u32,
     pub render_seconds: f64,
@@ -318,6 +321,7 @@ pub fn measure(bench: &BenchScene, options: &BenchOptions) -> Result<Measurement
         shadow_rays_per_second,
         embree_shadow_rays_per_second,
         samples_per_second: output.sample_count as f64 / render_seconds,
+        lane_occupancy: output.lane_occupancy,
         spp,
         render_seconds,
         rel_mse,

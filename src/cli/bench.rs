@@ -140,6 +140,14 @@ pub fn run(args: &BenchArgs) -> Result<()> {
                 "",
                 m.shadow_rays_per_second / 1e6
             );
+            if let Some(occupancy) = m.lane_occupancy {
+                println!(
+                    "{:<20} lanes: {:.1} of {} hold a path per step on average",
+                    "",
+                    occupancy * prism_core::render::LANES as f64,
+                    prism_core::render::LANES
+                );
+            }
             if let (Some(rate), Some(shadow_rate)) =
                 (m.embree_rays_per_second, m.embree_shadow_rays_per_second)
             {
@@ -170,6 +178,8 @@ fn json(m: &Measurement, threads: usize) -> String {
         "bytes_per_primitive": m.bytes_per_primitive(),
         "rays_per_second": m.rays_per_second,
         "samples_per_second": m.samples_per_second,
+        "lanes": prism_core::render::LANES,
+        "lane_occupancy": m.lane_occupancy,
         "spp": m.spp,
         "render_seconds": m.render_seconds,
         "rel_mse": m.rel_mse,

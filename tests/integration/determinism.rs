@@ -7,13 +7,18 @@ use prism_core::integrator::PathIntegrator;
 use prism_core::math::Transform;
 use prism_mitsuba::factory::shapes::{cube, transform_mesh};
 
+use prism_core::film::PixelSums;
+use prism_core::integrator::RayCount;
+use prism_core::render::{RenderOptions, SampleEstimator, render};
+use prism_core::sampling::sampler::Sampler;
+use prism_core::scene::Scene;
+
 use crate::common::scenes::{Object, build, camera, render_film};
 
-#[test]
-fn one_and_two_threads_give_identical_films() {
-    let size = UVec2::new(37, 23);
+/// A room lit by a glowing sphere, seen by a camera whose film is `size`, rendered by `path`.
+fn lit_room(size: UVec2, path: PathIntegrator) -> Scene {
     let room = Transform::new(DMat4::from_scale(DVec3::new(2.0, 1.5, 3.0))).unwrap();
-    let scene = build(
+    build(
         vec![
             Object {
                 shape: Shape::Mesh(transform_mesh(cube(), &room, true, true)).into(),
@@ -41,8 +46,13 @@ fn one_and_two_threads_give_identical_films() {
             size,
         ),
         size,
-        PathIntegrator::default(),
-    );
+        path,
+    )
+}
+
+#[test]
+fn one_and_two_threads_give_identical_films() {
+    let scene = lit_room(UVec2::new(37, 23), PathIntegrator::default());
     let one = render_film(&scene, 8, 42, Some(1));
     let two = render_film(&scene, 8, 42, Some(2));
     assert!(
@@ -52,4 +62,60 @@ fn one_and_two_threads_give_identical_films() {
     assert_eq!(one.pixels, two.pixels);
     let other_seed = render_film(&scene, 8, 43, Some(2));
     assert_ne!(one.pixels, other_seed.pixels);
+}
+
+/// The path tracer's paths run in lanes ([`prism_core::render::LANES`] per worker, each lane
+/// taking the next sample when its path ends); its film must be the one the same samples give
+/// traced one at a time, as a `--pixel` replay or any other integrator traces them, and the
+/// render reports how full the lanes were.
+#[test]
+fn paths_in_lanes_give_the_film_of_paths_one_at_a_time() {
+    let size = UVec2::new(21, 19);
+    for path in [
+        PathIntegrator::default(),
+        PathIntegrator {
+            rr_depth: 1,
+            ..PathIntegrator::default()
+        },
+        PathIntegrator {
+            max_depth: 0,
+            ..PathIntegrator::default()
+        },
+    ] {
+        let scene = lit_room(size, path.clone());
+        let (spp, seed) = (5, 9);
+        let output = render(&scene, &RenderOptions::fixed(spp, seed, Some(2))).unwrap();
+        // Paths of max_depth 0 end before their first step.
+        match output.lane_occupancy {
+            Some(occupancy) => assert!(
+                occupancy > 0.0 && occupancy <= 1.0 && path.max_depth != 0,
+                "occupancy {occupancy}"
+            ),
+            None => assert_eq!(path.max_depth, 0, "the path tracer runs in lanes"),
+        }
+
+        let estimator = SampleEstimator::new(&scene);
+        let mut sampler = Sampler::new(scene.sampler.kind, scene.strata(spp), seed);
+        let mut count = RayCount::default();
+        let mut one_at_a_time = Vec::new();
+        for y in 0..size.y {
+            for x in 0..size.x {
+                let mut sums = PixelSums::default();
+                for index in 0..spp {
+                    let xyz = estimator.estimate(
+                        &mut sampler,
+                        UVec2::new(x, y),
+                        index,
+                        &mut count,
+                        &mut [],
+                    );
+                    sums.add(xyz);
+                }
+                one_at_a_time.push(sums);
+            }
+        }
+        assert_eq!(output.film.pixels, one_at_a_time, "{path:?}");
+        let lit = one_at_a_time.iter().any(|p| p.sum(1) > 0.0);
+        assert_eq!(lit, path.max_depth != 0, "{path:?}");
+    }
 }

@@ -229,7 +229,13 @@ impl<P: AggregateElement> Aggregate<P> {
     /// The closest surface the ray meets in (0, t_max).
     pub fn intersect(&self, ray: &Ray) -> Option<SurfaceInteraction> {
         let hit = self.closest_hit(ray)?;
-        let mut si = self.primitives[hit.shape as usize].interaction(ray, &hit)?;
+        self.interaction(ray, &hit)
+    }
+
+    /// The surface interaction of `hit`, the closest hit of `ray` ([`Self::closest_hit`]).
+    #[inline]
+    pub fn interaction(&self, ray: &Ray, hit: &Hit) -> Option<SurfaceInteraction> {
+        let mut si = self.primitives[hit.shape as usize].interaction(ray, hit)?;
         si.time = ray.time;
         Some(si)
     }

@@ -216,6 +216,15 @@ impl PreparedIntegrator<'_> {
         self.aov_count
     }
 
+    /// The path tracer, where the scene's integrator is one: its camera paths run in lanes
+    /// (the render driver's `lanes`).
+    pub fn path_tracer(&self) -> Option<&PathIntegrator> {
+        match self.integrator {
+            Integrator::Path(path) => Some(path),
+            _ => None,
+        }
+    }
+
     /// The light sampler the integrator chooses lights with.
     pub fn light_sampler(&self) -> &LightSampler {
         &self.light_sampler

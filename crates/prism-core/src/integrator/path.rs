@@ -29,6 +29,7 @@
 //!   normals bend across the geometry, at the price of some energy.
 
 use crate::bsdf::BxdfTree;
+use crate::geometry::SurfaceInteraction;
 use crate::integrator::SampleContext;
 use crate::integrator::mis::{ScatterOrigin, Strategies, emission_found, sample_light_at_surface};
 use crate::integrator::vertex::{
@@ -65,92 +66,141 @@ impl Default for PathIntegrator {
     }
 }
 
+/// A path of the path tracer between two vertices: everything one step of it hands the next,
+/// so that a driver can hold many paths at once and advance each by one vertex at a time
+/// ([`PathIntegrator::step`]; docs/architecture.md, Paths in lanes).
+#[derive(Clone, Debug)]
+pub struct PathState {
+    /// The ray to the next vertex.
+    pub ray: Ray,
+    /// The wavelengths the path started with.
+    started: SampledWavelengths,
+    /// The path's own copy: a dispersive interface may drop the companion wavelengths.
+    lambda: SampledWavelengths,
+    result: SampledSpectrum,
+    throughput: SampledSpectrum,
+    /// Product of the relative indices of refraction crossed (Mitsuba's η).
+    eta_scale: f32,
+    previous: Option<ScatterOrigin>,
+    depth: i32,
+}
+
 impl PathIntegrator {
+    /// The path of the camera ray `ray` with `wavelengths`, before its first vertex; None when
+    /// `max_depth` is 0 (the estimate is then zero).
+    #[inline]
+    pub fn start(&self, ray: Ray, wavelengths: &SampledWavelengths) -> Option<PathState> {
+        (self.max_depth != 0).then_some(PathState {
+            ray,
+            started: *wavelengths,
+            lambda: *wavelengths,
+            result: SampledSpectrum::ZERO,
+            throughput: SampledSpectrum::ONE,
+            eta_scale: 1.0,
+            previous: None,
+            depth: 0,
+        })
+    }
+
+    /// One vertex of the path `state`, given `hit`, the nearest surface along `state.ray`: the
+    /// emission found there, a light sample and a BSDF sample for the next direction, and
+    /// Russian roulette. Returns whether the path goes on (along the new `state.ray`).
+    #[inline]
+    pub fn step(
+        &self,
+        ctx: &mut SampleContext,
+        state: &mut PathState,
+        hit: Option<SurfaceInteraction>,
+    ) -> bool {
+        let world = ctx.world();
+        let ray = &state.ray;
+        // Emission found by the previous BSDF sample (or by the camera ray), weighted against
+        // the light sample that could have found it.
+        if !(self.hide_emitters && state.depth == 0) {
+            state.result += state.throughput
+                * emission_found(
+                    ctx,
+                    ray,
+                    hit.as_ref(),
+                    state.previous.as_ref(),
+                    &state.lambda,
+                    Strategies::ONE_EACH,
+                );
+        }
+        let Some(si) = hit else {
+            return false;
+        };
+        let wo_world = -ray.d.normalize();
+
+        if !allows_next_vertex(self.max_depth, state.depth)
+            || (self.strict_normals && !normals_agree(&si, wo_world))
+        {
+            return false;
+        }
+
+        let mut lobes = BxdfTree::empty();
+        let scattering = surface_scattering(world, &si, wo_world, &mut state.lambda, &mut lobes);
+        if scattering.flags().has_smooth_lobe()
+            && let Some(light) =
+                sample_light_at_surface(ctx, &si, &scattering, &state.lambda, self.strict_normals)
+        {
+            state.result += state.throughput * light.weighted(Strategies::ONE_EACH);
+        }
+
+        // BSDF sampling for the next direction.
+        let u_lobe = ctx.sampler.next_1d();
+        let u = ctx.sampler.next_2d();
+        let Some(bs) = scattering.sample(u_lobe, u) else {
+            return false;
+        };
+        if self.strict_normals && !normals_agree(&si, bs.wi) {
+            return false;
+        }
+        state.lambda = wavelengths_after(&state.lambda, &bs);
+        state.throughput *= bs.weight;
+        state.eta_scale *= bs.eta;
+        if state.throughput.is_black() {
+            return false;
+        }
+        state.ray = si.spawn_ray(bs.wi);
+        state.previous = Some(ScatterOrigin {
+            receiver: Receiver::surface(si.p, si.shading.n),
+            pdf: bs.pdf,
+            specular: bs.flags.is_delta(),
+        });
+        state.depth += 1;
+
+        // Russian roulette on the path's potential, from depth `rr_depth` on.
+        if state.depth >= self.rr_depth {
+            let Some(factor) = russian_roulette(ctx, state.throughput, state.eta_scale) else {
+                return false;
+            };
+            state.throughput *= factor;
+        }
+        true
+    }
+
+    /// The estimate of a path that has ended, for the wavelengths it started with.
+    #[inline]
+    pub fn estimate(&self, state: &PathState) -> SampledSpectrum {
+        path_estimate(state.result, &state.started, &state.lambda)
+    }
+
+    /// The estimate along the camera ray `ray`, one vertex after another.
     pub(super) fn radiance(
         &self,
         ctx: &mut SampleContext,
-        mut ray: Ray,
+        ray: Ray,
         wavelengths: &SampledWavelengths,
     ) -> SampledSpectrum {
-        let world = ctx.world();
-        // The path's own copy: a dispersive interface may drop the companion wavelengths.
-        let mut lambda = *wavelengths;
-        let mut result = SampledSpectrum::ZERO;
-        let mut throughput = SampledSpectrum::ONE;
-        // Product of the relative indices of refraction crossed (Mitsuba's η).
-        let mut eta_scale = 1.0f32;
-        let mut previous: Option<ScatterOrigin> = None;
-        let mut depth = 0i32;
-        // The lobes of the vertex at hand, rewritten at every bounce.
-        let mut lobes = BxdfTree::empty();
-        if self.max_depth == 0 {
-            return result;
-        }
+        let Some(mut state) = self.start(ray, wavelengths) else {
+            return SampledSpectrum::ZERO;
+        };
         loop {
-            let hit = ctx.intersect(&ray);
-            // Emission found by the previous BSDF sample (or by the camera ray), weighted
-            // against the light sample that could have found it.
-            if !(self.hide_emitters && depth == 0) {
-                result += throughput
-                    * emission_found(
-                        ctx,
-                        &ray,
-                        hit.as_ref(),
-                        previous.as_ref(),
-                        &lambda,
-                        Strategies::ONE_EACH,
-                    );
-            }
-            let Some(si) = hit else {
-                break;
-            };
-            let wo_world = -ray.d.normalize();
-
-            if !allows_next_vertex(self.max_depth, depth)
-                || (self.strict_normals && !normals_agree(&si, wo_world))
-            {
-                break;
-            }
-
-            let scattering = surface_scattering(world, &si, wo_world, &mut lambda, &mut lobes);
-            if scattering.flags().has_smooth_lobe()
-                && let Some(light) =
-                    sample_light_at_surface(ctx, &si, &scattering, &lambda, self.strict_normals)
-            {
-                result += throughput * light.weighted(Strategies::ONE_EACH);
-            }
-
-            // BSDF sampling for the next direction.
-            let u_lobe = ctx.sampler.next_1d();
-            let u = ctx.sampler.next_2d();
-            let Some(bs) = scattering.sample(u_lobe, u) else {
-                break;
-            };
-            if self.strict_normals && !normals_agree(&si, bs.wi) {
-                break;
-            }
-            lambda = wavelengths_after(&lambda, &bs);
-            throughput *= bs.weight;
-            eta_scale *= bs.eta;
-            if throughput.is_black() {
-                break;
-            }
-            ray = si.spawn_ray(bs.wi);
-            previous = Some(ScatterOrigin {
-                receiver: Receiver::surface(si.p, si.shading.n),
-                pdf: bs.pdf,
-                specular: bs.flags.is_delta(),
-            });
-            depth += 1;
-
-            // Russian roulette on the path's potential, from depth `rr_depth` on.
-            if depth >= self.rr_depth {
-                let Some(factor) = russian_roulette(ctx, throughput, eta_scale) else {
-                    break;
-                };
-                throughput *= factor;
+            let hit = ctx.intersect(&state.ray);
+            if !self.step(ctx, &mut state, hit) {
+                return self.estimate(&state);
             }
         }
-        path_estimate(result, wavelengths, &lambda)
     }
 }

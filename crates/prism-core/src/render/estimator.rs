@@ -12,7 +12,22 @@ use crate::integrator::{ParticleTracer, PreparedIntegrator, RayCount};
 use crate::math::Ray;
 use crate::sampling::sampler::Sampler;
 use crate::scene::Scene;
-use crate::spectrum::SampledWavelengths;
+use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+
+/// A camera sample drawn, with its ray: what the film needs of it once the integrator has
+/// estimated the radiance along the ray.
+pub(super) struct CameraSampleRay {
+    pub(super) ray: Ray,
+    pub(super) lambda: SampledWavelengths,
+    /// Film offset from the pixel's centre.
+    offset: Vec2,
+    /// The weight the one-pixel estimator gives the sample.
+    filter_weight: f32,
+    /// The shutter's filter weight.
+    time_weight: f32,
+    /// The camera ray's weight (1 for most cameras).
+    ray_weight: f32,
+}
 
 /// What every camera sample of a render uses: the scene, its integrator prepared for the
 /// scene's world, the sampler of the reconstruction filter, and filter MIS's weights when the
@@ -64,6 +79,74 @@ impl<'a> SampleEstimator<'a> {
         f32::from(u8::from(world.geometry.occluded(ray)))
     }
 
+    /// Draws sample `index` of `pixel` (full-film coordinates): its wavelengths, film
+    /// position, time and lens position, and its camera ray; writes the coverage alpha, where
+    /// the film records it, to its place in `aovs`.
+    #[inline]
+    pub(super) fn camera_sample(
+        &self,
+        sampler: &mut Sampler,
+        pixel: UVec2,
+        index: u32,
+        count: &mut RayCount,
+        aovs: &mut [f32],
+    ) -> CameraSampleRay {
+        let scene = self.scene;
+        sampler.start_pixel_sample(pixel, index);
+        let primary = sampler.camera_sample();
+        let lambda = SampledWavelengths::sample(primary.wavelength, scene.film.wavelength_sampling);
+        let (offset, filter_weight) = self.filter.sample(primary.film);
+        let (time, time_weight) = scene.shutter.sample(primary.time);
+        let film_position = pixel.as_vec2() + Vec2::splat(0.5) + offset;
+        let CameraRay {
+            ray,
+            weight: ray_weight,
+        } = scene.camera.generate_ray(film_position, primary.lens, time);
+        if self.alpha {
+            aovs[self.integrator.aov_count()] = self.coverage(&ray, count);
+        }
+        CameraSampleRay {
+            ray,
+            lambda,
+            offset,
+            filter_weight,
+            time_weight,
+            ray_weight,
+        }
+    }
+
+    /// The sample `sample` with the integrator's `radiance` along its ray: the film offset from
+    /// the pixel's centre, the filter weight the one-pixel estimator gives it, and its CIE XYZ
+    /// weighted by the shutter's filter; its extra channels in `aovs` are weighted alike and
+    /// the spectral film's bands written after the alpha.
+    #[inline]
+    pub(super) fn film_sample(
+        &self,
+        sample: &CameraSampleRay,
+        mut radiance: SampledSpectrum,
+        aovs: &mut [f32],
+    ) -> (Vec2, f32, [f32; 3]) {
+        let scene = self.scene;
+        let lambda = &sample.lambda;
+        if let Some(response) = &scene.film.response {
+            radiance *= response.sample(lambda);
+        }
+        let bands = &mut aovs[self.integrator.aov_count() + usize::from(self.alpha)..];
+        if !bands.is_empty() {
+            band_values(&scene.film.bands, lambda, &radiance, bands);
+            for v in bands.iter_mut() {
+                *v *= sample.ray_weight;
+            }
+        }
+        for v in aovs.iter_mut() {
+            *v *= sample.time_weight;
+        }
+        let xyz = lambda
+            .to_xyz(&radiance)
+            .map(|v| v * sample.ray_weight * sample.time_weight);
+        (sample.offset, sample.filter_weight, xyz)
+    }
+
     /// Traces sample `index` of `pixel` (full-film coordinates): its film offset from the
     /// pixel's centre, the filter weight the one-pixel estimator gives it, and its CIE XYZ
     /// weighted by the shutter's filter; its extra channels, weighted alike, go to `aovs`.
@@ -76,41 +159,15 @@ impl<'a> SampleEstimator<'a> {
         count: &mut RayCount,
         aovs: &mut [f32],
     ) -> (Vec2, f32, [f32; 3]) {
-        let scene = self.scene;
-        sampler.start_pixel_sample(pixel, index);
-        let primary = sampler.camera_sample();
-        let lambda = SampledWavelengths::sample(primary.wavelength, scene.film.wavelength_sampling);
-        let (offset, filter_weight) = self.filter.sample(primary.film);
-        let (time, time_weight) = scene.shutter.sample(primary.time);
-        let film_position = pixel.as_vec2() + Vec2::splat(0.5) + offset;
-        let CameraRay {
-            ray,
-            weight: ray_weight,
-        } = scene.camera.generate_ray(film_position, primary.lens, time);
-        let (aovs_of_integrator, film_channels) = aovs.split_at_mut(self.integrator.aov_count());
-        let (alpha, bands) = film_channels.split_at_mut(usize::from(self.alpha));
-        if let Some(alpha) = alpha.first_mut() {
-            *alpha = self.coverage(&ray, count);
-        }
-        let mut radiance =
-            self.integrator
-                .radiance(ray, &lambda, sampler, count, aovs_of_integrator);
-        if let Some(response) = &scene.film.response {
-            radiance *= response.sample(&lambda);
-        }
-        if !bands.is_empty() {
-            band_values(&scene.film.bands, &lambda, &radiance, bands);
-            for v in bands.iter_mut() {
-                *v *= ray_weight;
-            }
-        }
-        for v in aovs.iter_mut() {
-            *v *= time_weight;
-        }
-        let xyz = lambda
-            .to_xyz(&radiance)
-            .map(|v| v * ray_weight * time_weight);
-        (offset, filter_weight, xyz)
+        let sample = self.camera_sample(sampler, pixel, index, count, aovs);
+        let radiance = self.integrator.radiance(
+            sample.ray,
+            &sample.lambda,
+            sampler,
+            count,
+            &mut aovs[..self.integrator.aov_count()],
+        );
+        self.film_sample(&sample, radiance, aovs)
     }
 
     /// The one-pixel estimate of sample `index` of `pixel` (full-film coordinates): its

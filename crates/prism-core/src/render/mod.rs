@@ -23,6 +23,7 @@
 
 mod estimator;
 mod filter_mis;
+mod lanes;
 mod options;
 mod particles;
 mod pass;
@@ -42,6 +43,8 @@ pub use crate::film::stats::relative_error;
 use crate::film::{Film, PixelSums, ValueSum};
 use crate::scene::Scene;
 pub use estimator::SampleEstimator;
+pub use lanes::LANES;
+use lanes::LaneCounter;
 pub use options::RenderOptions;
 use pass::Pass;
 use progress::Silent;
@@ -101,6 +104,9 @@ pub struct RenderOutput {
     pub stop: StopReason,
     /// The mean relative standard error of the image at the end.
     pub relative_error: f64,
+    /// The mean share of the lanes that held a path per step, where the integrator's paths
+    /// ran in lanes.
+    pub lane_occupancy: Option<f64>,
 }
 
 /// Renders the scene.
@@ -169,12 +175,14 @@ pub fn render_with_preview(
         external: options.interrupt.as_deref(),
         deadline: stop.time_limit.map(|limit| start + limit),
     };
+    let occupancy = LaneCounter::default();
     let pass = Pass {
         estimator: &estimator,
         tiles: &tiles,
         options: &options,
         cancel: &cancel,
         progress,
+        occupancy: &occupancy,
     };
     let mut last_checkpoint = start;
     let first = options.first_sample;
@@ -265,5 +273,6 @@ pub fn render_with_preview(
         rays: rays.into_inner(),
         stop: reason,
         relative_error: error,
+        lane_occupancy: occupancy.mean(),
     })
 }

@@ -10,6 +10,7 @@ use rayon::prelude::*;
 use super::RenderOptions;
 use super::estimator::SampleEstimator;
 use super::filter_mis::{SharedSamples, gather_tile};
+use super::lanes::{LaneCounter, render_tile_in_lanes};
 use super::progress::ProgressReport;
 use super::stop::Cancel;
 use super::tiles::{Tile, TileSums};
@@ -68,6 +69,8 @@ pub(super) struct Pass<'p, 's> {
     pub(super) options: &'p RenderOptions,
     pub(super) cancel: &'p Cancel<'p>,
     pub(super) progress: &'p dyn ProgressReport,
+    /// How full the lanes of the path tracer's tiles were.
+    pub(super) occupancy: &'p LaneCounter,
 }
 
 impl Pass<'_, '_> {
@@ -99,21 +102,27 @@ impl Pass<'_, '_> {
     ) -> Option<u64> {
         let pass = u64::from(range.end - range.start);
         let (estimator, options, cancel) = (self.estimator, self.options, self.cancel);
+        let path = estimator.integrator.path_tracer();
         let results: Vec<Option<u64>> = self
             .tiles
             .par_iter()
             .zip(sums)
             .zip(out)
             .map(|((&tile, tile_sums), tile_out)| {
-                let result = render_tile(
-                    estimator,
-                    tile,
-                    tile_sums,
-                    tile_out,
-                    range.clone(),
-                    options,
-                    cancel,
-                );
+                let result = match path {
+                    Some(path) => {
+                        render_tile_in_lanes(self, path, tile, tile_sums, tile_out, range.clone())
+                    }
+                    None => render_tile(
+                        estimator,
+                        tile,
+                        tile_sums,
+                        tile_out,
+                        range.clone(),
+                        options,
+                        cancel,
+                    ),
+                };
                 if result.is_some() {
                     self.progress
                         .advance(u64::from(tile.size.x * tile.size.y) * pass);
