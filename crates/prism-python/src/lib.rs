@@ -10,6 +10,7 @@ mod image;
 mod image_files;
 mod parameters;
 mod render;
+mod render_state;
 mod scene;
 mod transform;
 
@@ -25,10 +26,12 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<image::ChannelDifference>()?;
     m.add_class::<image::ZTest>()?;
     m.add_class::<parameters::SceneParameters>()?;
+    m.add_class::<render_state::RenderState>()?;
     m.add_function(wrap_pyfunction!(scene::load_file, m)?)?;
     m.add_function(wrap_pyfunction!(scene::load_dict, m)?)?;
     m.add_function(wrap_pyfunction!(scene::load_string, m)?)?;
     m.add_function(wrap_pyfunction!(render::render, m)?)?;
+    m.add_function(wrap_pyfunction!(render_state::merge, m)?)?;
     m.add_function(wrap_pyfunction!(parameters::traverse, m)?)?;
     m.add_function(wrap_pyfunction!(image::compare, m)?)?;
     m.add_function(wrap_pyfunction!(image_files::read_image, m)?)?;

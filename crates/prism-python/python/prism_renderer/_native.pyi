@@ -210,6 +210,40 @@ class Image:
     def _repr_png_(self) -> bytes:
         """The PNG that :meth:`write` writes, for Jupyter."""
 
+class RenderState:
+    """The exact pixel sums of a render over some sample ranges, from
+    ``render(..., sample_range=(start, end))``, :func:`merge` or a state file; what they belong
+    to (the scene, seed, sampler, samples per pixel, film and crop) travels with them. It
+    pickles as the bytes of its file, so task engines (dask, Ray, multiprocessing) carry it."""
+
+    @staticmethod
+    def read(path: Union[str, os.PathLike]) -> RenderState:
+        """Reads a state file (``prism render --checkpoint``'s or :meth:`write`'s)."""
+    @staticmethod
+    def from_bytes(data: bytes) -> RenderState:
+        """The state whose file holds ``data``; :class:`PrismError` when it is damaged."""
+    def to_bytes(self) -> bytes:
+        """The bytes of the state's file."""
+    def write(self, path: Union[str, os.PathLike]) -> None:
+        """Writes the state's file atomically, for ``prism merge`` or ``--resume``."""
+    @property
+    def ranges(self) -> List[Tuple[int, int]]:
+        """The sample index ranges ``(start, end)`` every pixel holds, sorted."""
+    @property
+    def spp(self) -> int:
+        """Samples per pixel the state holds."""
+    @property
+    def seed(self) -> int:
+        """The seed of the render's random numbers."""
+    def image(self) -> Image:
+        """The image of the sums, as ``prism merge`` writes it (``seconds`` is 0)."""
+
+def merge(states: Sequence[Union[RenderState, str, os.PathLike]]) -> RenderState:
+    """The state of one render of all the samples of ``states`` (each a :class:`RenderState`
+    or a state file's path), as ``prism merge``: their ranges must be disjoint and their renders
+    the same (scene, ``spp``, ``seed``, ``crop``), else :class:`PrismError`. The sums are exact,
+    so the merged image is the single render's bit for bit, in any order of merging."""
+
 class ChannelDifference:
     """How one channel of two images differs."""
 
@@ -293,15 +327,17 @@ class _RenderSettings(TypedDict):
     checkpoint: Optional[str]
     checkpoint_every: float
     resume: Optional[str]
+    sample_range: Optional[Tuple[int, int]]
 
 def render(
     scene: Scene,
     settings: _RenderSettings,
     progress: Optional[Callable[[int, Optional[int], float], object]] = None,
     preview: Optional[Callable[[Image], object]] = None,
-) -> Image:
+) -> Union[Image, RenderState]:
     """Renders ``scene`` (see :func:`prism_renderer.render`, whose keywords ``settings``
-    holds); ``progress`` and ``preview`` are callables or None."""
+    holds); ``progress`` and ``preview`` are callables or None. The image, or with a
+    ``sample_range`` the render's state."""
 
 def compare(
     test: Union[Image, str, os.PathLike],
