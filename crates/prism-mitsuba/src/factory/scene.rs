@@ -34,6 +34,9 @@ pub struct LoadedScene {
     /// Parameters of the file that Prism reads but ignores (Mitsuba 0.6 forms), and where
     /// Mitsuba would render the file otherwise, one warning each, in the order they were read.
     pub warnings: Vec<Warning>,
+    /// The `<shape>` (or `instance`) of the description that made each primitive of the
+    /// world's geometry, in the primitives' order.
+    pub shape_plugins: Vec<Arc<PluginNode>>,
     /// Every `<sensor>`, in document order (Mitsuba loads them all and renders the first unless
     /// told otherwise).
     pub(super) sensors: Vec<SceneSensor>,
@@ -244,6 +247,7 @@ struct SceneBuilder {
     textures: TextureCache,
     media: MediaCache,
     shapes: Vec<Primitive>,
+    shape_plugins: Vec<Arc<PluginNode>>,
     shape_info: Vec<ShapeInfo>,
     medium_interfaces: Vec<MediumInterface>,
     lights: Vec<Light>,
@@ -275,6 +279,7 @@ impl SceneBuilder {
                     let index = self.shapes.len();
                     if let Some(instance) = groups.instance(&child.node, index, &mut member)? {
                         self.shapes.push(instance.primitive);
+                        self.shape_plugins.push(child.node.clone());
                         self.shape_info.push(instance.info);
                         self.medium_interfaces.push(MediumInterface::default());
                     }
@@ -347,6 +352,7 @@ impl SceneBuilder {
             return Ok(());
         }
         self.shapes.push(shape);
+        self.shape_plugins.push(child.node.clone());
         self.shape_info.push(ShapeInfo { material, light });
         self.medium_interfaces.push(interface);
         Ok(())
@@ -503,6 +509,7 @@ impl SceneBuilder {
             scene,
             seed: first.seed,
             warnings,
+            shape_plugins: self.shape_plugins,
             sensors,
             selected: 0,
             description_fingerprint,

@@ -32,13 +32,19 @@ import numpy as np
 import numpy.typing as npt
 
 from ._native import (
+    BoundingBox3f,
     ChannelDifference,
     Comparison,
+    Emitter,
     Image,
     PrismError,
+    Ray3f,
     RenderState,
     Scene,
     SceneParameters,
+    Sensor,
+    Shape,
+    SurfaceInteraction,
     Transform,
     ZTest,
     load_dict,
@@ -54,14 +60,20 @@ ScalarTransform4f = Transform
 """Mitsuba's name of :class:`Transform`."""
 
 __all__ = [
+    "BoundingBox3f",
     "ChannelDifference",
     "Comparison",
+    "Emitter",
     "Image",
     "PrismError",
+    "Ray3f",
     "RenderState",
     "Scene",
     "SceneParameters",
     "ScalarTransform4f",
+    "Sensor",
+    "Shape",
+    "SurfaceInteraction",
     "Transform",
     "ZTest",
     "compare",

@@ -58,6 +58,16 @@ pub struct SceneParameters {
     changes: BTreeMap<String, PropertyValue>,
 }
 
+/// The name `traverse` gives `plugin`, a child of the scene `root` (its `id`, its key in a
+/// dictionary, or its class numbered among its siblings); its `id` or class if it is not one.
+pub fn top_level_name(root: &PluginNode, plugin: &Arc<PluginNode>) -> String {
+    let position = (root.children.iter()).position(|child| Arc::ptr_eq(&child.node, plugin));
+    match position {
+        Some(index) => listing::child_names(root, None).swap_remove(index),
+        None => (plugin.id.clone()).unwrap_or_else(|| plugin.class.tag().to_string()),
+    }
+}
+
 /// The parameters of `scene`, to read and change.
 #[pyfunction]
 pub fn traverse(scene: Bound<'_, Scene>) -> PyResult<SceneParameters> {
