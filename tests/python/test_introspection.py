@@ -65,8 +65,19 @@ def test_the_cornell_boxs_shapes_are_its_meshes(cornell, cornell_path):
     assert [shape.is_emitter() for shape in shapes] == [False] * 7 + [True]
     (light,) = cornell.emitters()
     assert light.shape() == 7 and not light.is_environment()
+    assert light.id() == "shape_7.emitter"
+    assert "shape_7.emitter.radiance.values" in pr.traverse(cornell).keys()
     (sensor,) = cornell.sensors()
     assert sensor.id() is None and sensor.film_size() == (cornell.width, cornell.height)
+
+
+def test_mitsubas_cornell_box_dictionary_names_its_shapes_by_their_keys():
+    scene = pr.load_dict(pr.cornell_box())
+    keys = [key for key in pr.cornell_box() if key not in ("type", "integrator", "sensor")]
+    shapes = [key for key in keys if pr.cornell_box()[key]["type"] in ("rectangle", "cube")]
+    assert [shape.id() for shape in scene.shapes()] == shapes
+    (light,) = scene.emitters()
+    assert light.id() == "light.emitter" and scene.shapes()[light.shape()].id() == "light"
 
 
 def test_named_shapes_analytic_shapes_and_every_sensor():
@@ -96,8 +107,9 @@ def test_named_shapes_analytic_shapes_and_every_sensor():
     with pytest.raises(TypeError, match="sphere.*not a triangle mesh"):
         ball.vertex_positions()
     area, environment = scene.emitters()
-    assert (area.shape(), area.is_environment()) == (2, False)
-    assert (environment.shape(), environment.is_environment()) == (None, True)
+    assert (area.id(), area.shape(), area.is_environment()) == ("shape_1.emitter", 2, False)
+    assert (environment.id(), environment.shape(), environment.is_environment()) == (
+        "emitter", None, True)
     front, second = scene.sensors()
     assert (front.id(), front.film_size()) == ("front", (8, 6))
     assert (second.id(), second.film_size()) == (None, (5, 4))

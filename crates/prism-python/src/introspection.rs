@@ -3,6 +3,8 @@
 //! refers to its scene and reads it when asked, so it follows the scene through
 //! `params.update()`.
 
+use std::sync::Arc;
+
 use numpy::IntoPyArray;
 use numpy::ndarray::Array2;
 use pyo3::exceptions::{PyIndexError, PyTypeError};
@@ -100,10 +102,7 @@ impl Shape {
         let plugin = scene.loaded.shape_plugins.get(self.index).ok_or_else(|| {
             PyIndexError::new_err(format!("the scene no longer has a shape {}", self.index))
         })?;
-        Ok(crate::parameters::top_level_name(
-            scene.description(),
-            plugin,
-        ))
+        Ok(name_of(&scene, plugin))
     }
 
     /// The plugin's type: `obj`, `ply`, `sphere`, `rectangle`, `instance`, ….
@@ -194,6 +193,21 @@ impl Emitter {
 
 #[pymethods]
 impl Emitter {
+    /// The emitter's name: its `id`, else the name `traverse` gives it (`light.emitter` for
+    /// the emitter of a shape `light`, `emitter` for the scene's one), so that
+    /// `f"{emitter.id()}.radiance.value"` is a key of `traverse(scene)`.
+    fn id(&self, py: Python<'_>) -> PyResult<String> {
+        let scene = self.scene.borrow(py);
+        let plugin = scene
+            .loaded
+            .emitter_plugins
+            .get(self.index)
+            .ok_or_else(|| {
+                PyIndexError::new_err(format!("the scene no longer has an emitter {}", self.index))
+            })?;
+        Ok(name_of(&scene, plugin))
+    }
+
     /// Whether the light is at infinity (`constant`, `envmap`, `sunsky`), seen by rays that
     /// leave the scene.
     fn is_environment(&self, py: Python<'_>) -> PyResult<bool> {
@@ -208,8 +222,8 @@ impl Emitter {
         Ok((infos.iter().take(shapes)).position(|info| info.light == Some(self.index as u32)))
     }
 
-    fn __repr__(&self) -> String {
-        format!("Emitter({})", self.index)
+    fn __repr__(&self, py: Python<'_>) -> PyResult<String> {
+        Ok(format!("Emitter({:?})", self.id(py)?))
     }
 }
 
@@ -242,6 +256,13 @@ impl Sensor {
     fn __repr__(&self, py: Python<'_>) -> String {
         format!("Sensor({}, id={:?})", self.index, self.id(py))
     }
+}
+
+/// The name `traverse` gives `plugin` of `scene`; its `id` or class if it is not found.
+fn name_of(scene: &Scene, plugin: &Arc<PluginNode>) -> String {
+    crate::parameters::plugin_name(scene.description(), plugin)
+        .or_else(|| plugin.id.clone())
+        .unwrap_or_else(|| plugin.class.tag().to_string())
 }
 
 /// The shapes of `scene`, in the order of its geometry's primitives (document order).

@@ -37,6 +37,9 @@ pub struct LoadedScene {
     /// The `<shape>` (or `instance`) of the description that made each primitive of the
     /// world's geometry, in the primitives' order.
     pub shape_plugins: Vec<Arc<PluginNode>>,
+    /// The `<emitter>` of the description that made each of the world's lights, in the
+    /// lights' order.
+    pub emitter_plugins: Vec<Arc<PluginNode>>,
     /// Every `<sensor>`, in document order (Mitsuba loads them all and renders the first unless
     /// told otherwise).
     pub(super) sensors: Vec<SceneSensor>,
@@ -251,6 +254,7 @@ struct SceneBuilder {
     shape_info: Vec<ShapeInfo>,
     medium_interfaces: Vec<MediumInterface>,
     lights: Vec<Light>,
+    emitter_plugins: Vec<Arc<PluginNode>>,
     sampling_weights: Vec<f32>,
     /// The area emitters attached to shapes, with where each was attached (an emitter declared
     /// at the top level with an id reaches its shape by a `<ref>`).
@@ -373,6 +377,7 @@ impl SceneBuilder {
         if lights::is_delta(&emitter.node) {
             let (light, weight) = lights::build_scene_light(&emitter.node, &mut self.textures)?;
             self.lights.push(light);
+            self.emitter_plugins.push(emitter.node.clone());
             self.sampling_weights.push(weight);
             return Ok(None);
         }
@@ -390,6 +395,7 @@ impl SceneBuilder {
         let (light, weight) =
             lights::build_area_light(&emitter.node, shape_index, &mut self.textures)?;
         self.lights.push(light);
+        self.emitter_plugins.push(emitter.node.clone());
         self.sampling_weights.push(weight);
         Ok(Some((self.lights.len() - 1) as u32))
     }
@@ -434,6 +440,7 @@ impl SceneBuilder {
             }
             let (light, weight) = lights::build_scene_light(&child.node, &mut self.textures)?;
             scene_lights.push((light, weight, child.location.clone()));
+            self.emitter_plugins.push(child.node.clone());
         }
         lights::check_single_environment(&scene_lights)?;
         for (light, weight, _) in scene_lights {
@@ -510,6 +517,7 @@ impl SceneBuilder {
             seed: first.seed,
             warnings,
             shape_plugins: self.shape_plugins,
+            emitter_plugins: self.emitter_plugins,
             sensors,
             selected: 0,
             description_fingerprint,

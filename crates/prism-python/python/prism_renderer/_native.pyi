@@ -205,6 +205,10 @@ class Emitter:
 
     @property
     def index(self) -> int: ...
+    def id(self) -> str:
+        """Its ``id``, else the name :func:`traverse` gives it (``light.emitter`` for the
+        emitter of a shape ``light``), so that ``f"{emitter.id()}.radiance.value"`` is a
+        parameter key."""
     def is_environment(self) -> bool:
         """Whether it is at infinity (``constant``, ``envmap``, ``sunsky``)."""
     def shape(self) -> Optional[int]:
