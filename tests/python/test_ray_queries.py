@@ -1,8 +1,11 @@
 """Ray queries: `scene.ray_intersect` and `scene.ray_test` against the closed forms of a sphere
 and a rectangle, the single-ray `Ray3f` form against the arrays, and the hits against the
-renderer's own (the `aov` integrator's shape index, normal and position per pixel)."""
+renderer's own (the `aov` integrator's shape index, normal and position per pixel), and
+other Python threads running while a batch is traced."""
 
 import math
+import threading
+import time
 
 import numpy as np
 import pytest
@@ -182,3 +185,35 @@ def test_the_hits_are_the_renderers():
     step = np.maximum(np.abs(np.gradient(centres, axis=0)), np.abs(np.gradient(centres, axis=1)))
     tolerance = 5 * np.sqrt(2) * step / math.sqrt(12) / math.sqrt(spp) + 1e-5
     assert (np.abs(position - centres)[wall] <= tolerance[wall]).all()
+
+
+def test_other_python_threads_run_while_rays_are_traced(cornell):
+    rng = np.random.default_rng(3)
+    n = 400_000
+    origins = np.tile([278.0, 273.0, -800.0], (n, 1))
+    directions = np.column_stack([rng.normal(0, 0.2, (n, 2)), np.ones(n)])
+    counts = []
+    stop = threading.Event()
+
+    def count():
+        k = 0
+        while not stop.is_set():
+            k += 1
+            if k % 1000 == 0:
+                counts.append(time.monotonic())
+
+    worker = threading.Thread(target=count)
+    worker.start()
+    try:
+        start = time.monotonic()
+        si = cornell.ray_intersect(origins, directions)
+        end = time.monotonic()
+    finally:
+        stop.set()
+        worker.join()
+    assert si.is_valid().mean() > 0.5
+    # The batch is the same traced again (each ray's answer is its own).
+    assert np.array_equal(si.t, cornell.ray_intersect(origins, directions).t)
+    during = [t for t in counts if start < t < end]
+    # A thread held off by the GIL while the rays are traced would count nothing then.
+    assert len(during) > 100
