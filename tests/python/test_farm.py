@@ -90,3 +90,15 @@ def test_states_that_do_not_merge_are_refused(scene):
         _part(scene, 3, 3)
     with pytest.raises(pr.PrismError, match="not a valid render state"):
         pr.RenderState.from_bytes(a.to_bytes()[:-1])
+
+
+def test_a_cropped_farm_merges_to_the_cropped_render(scene):
+    crop = (3, 2, 17, 11)
+    whole = pr.render(scene, spp=SPP, seed=SEED, crop=crop, progress=False)
+    parts = [_part(scene, 0, 4, crop=crop), _part(scene, 4, SPP, crop=crop)]
+    image = pr.merge(parts).image()
+    assert (image.width, image.height) == (14, 9)
+    assert_same_image(image, whole)
+    # A part of the whole film does not merge with a part of the crop.
+    with pytest.raises(pr.PrismError, match="crop"):
+        pr.merge([parts[0], _part(scene, 4, SPP)])

@@ -66,7 +66,7 @@ impl Shape {
         py: Python<'_>,
         read: impl FnOnce(&Primitive, &PluginNode) -> PyResult<T>,
     ) -> PyResult<T> {
-        let scene = self.scene.borrow(py);
+        let scene = self.scene.try_borrow(py)?;
         let primitives = &scene.loaded.scene.world.geometry.primitives;
         let (Some(primitive), Some(plugin)) = (
             primitives.get(self.index),
@@ -98,7 +98,7 @@ impl Shape {
     /// or `shape_0`, `shape_1`, … in document order), so that `f"{shape.id()}.to_world"` is a
     /// key of `traverse(scene)`.
     fn id(&self, py: Python<'_>) -> PyResult<String> {
-        let scene = self.scene.borrow(py);
+        let scene = self.scene.try_borrow(py)?;
         let plugin = scene.loaded.shape_plugins.get(self.index).ok_or_else(|| {
             PyIndexError::new_err(format!("the scene no longer has a shape {}", self.index))
         })?;
@@ -129,7 +129,7 @@ impl Shape {
 
     /// Whether an area light lies on the shape.
     fn is_emitter(&self, py: Python<'_>) -> PyResult<bool> {
-        let scene = self.scene.borrow(py);
+        let scene = self.scene.try_borrow(py)?;
         let info = scene.loaded.scene.world.shape_info.get(self.index);
         Ok(info.is_some_and(|info| info.light.is_some()))
     }
@@ -183,7 +183,7 @@ pub struct Emitter {
 
 impl Emitter {
     fn with<T>(&self, py: Python<'_>, read: impl FnOnce(&Light) -> T) -> PyResult<T> {
-        let scene = self.scene.borrow(py);
+        let scene = self.scene.try_borrow(py)?;
         let light = (scene.loaded.scene.world.lights.get(self.index)).ok_or_else(|| {
             PyIndexError::new_err(format!("the scene no longer has an emitter {}", self.index))
         })?;
@@ -197,7 +197,7 @@ impl Emitter {
     /// the emitter of a shape `light`, `emitter` for the scene's one), so that
     /// `f"{emitter.id()}.radiance.value"` is a key of `traverse(scene)`.
     fn id(&self, py: Python<'_>) -> PyResult<String> {
-        let scene = self.scene.borrow(py);
+        let scene = self.scene.try_borrow(py)?;
         let plugin = scene
             .loaded
             .emitter_plugins
@@ -216,7 +216,7 @@ impl Emitter {
 
     /// The index in `scene.shapes()` of the shape an area light lies on; None for other lights.
     fn shape(&self, py: Python<'_>) -> PyResult<Option<usize>> {
-        let scene = self.scene.borrow(py);
+        let scene = self.scene.try_borrow(py)?;
         let infos = &scene.loaded.scene.world.shape_info;
         let shapes = scene.loaded.scene.world.geometry.primitives.len();
         Ok((infos.iter().take(shapes)).position(|info| info.light == Some(self.index as u32)))
@@ -238,14 +238,14 @@ pub struct Sensor {
 #[pymethods]
 impl Sensor {
     /// The sensor's `id`, or None.
-    fn id(&self, py: Python<'_>) -> Option<String> {
-        let scene = self.scene.borrow(py);
-        (scene.loaded.sensors().get(self.index)).and_then(|sensor| sensor.id.clone())
+    fn id(&self, py: Python<'_>) -> PyResult<Option<String>> {
+        let scene = self.scene.try_borrow(py)?;
+        Ok((scene.loaded.sensors().get(self.index)).and_then(|sensor| sensor.id.clone()))
     }
 
     /// The film's size in pixels, (width, height), as Mitsuba's `sensor.film().size()`.
     fn film_size(&self, py: Python<'_>) -> PyResult<(u32, u32)> {
-        let scene = self.scene.borrow(py);
+        let scene = self.scene.try_borrow(py)?;
         let sensor = (scene.loaded.sensors().get(self.index)).ok_or_else(|| {
             PyIndexError::new_err(format!("the scene no longer has a sensor {}", self.index))
         })?;
@@ -253,8 +253,8 @@ impl Sensor {
         Ok((size.x, size.y))
     }
 
-    fn __repr__(&self, py: Python<'_>) -> String {
-        format!("Sensor({}, id={:?})", self.index, self.id(py))
+    fn __repr__(&self, py: Python<'_>) -> PyResult<String> {
+        Ok(format!("Sensor({}, id={:?})", self.index, self.id(py)?))
     }
 }
 

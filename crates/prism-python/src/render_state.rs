@@ -22,7 +22,7 @@ pub struct RenderState {
     pub state: State,
 }
 
-/// What a state was given by in messages: `bytes` for one decoded from memory.
+/// The name messages give a state decoded from memory.
 const FROM_BYTES: &str = "<bytes>";
 
 #[pymethods]
