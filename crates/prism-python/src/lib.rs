@@ -1,6 +1,6 @@
 //! The native module of the `prism_renderer` Python package: a thin layer over the renderer's
 //! Rust API (scene loading from files and dictionaries, rendering, the film's images and their
-//! comparison) with no rendering logic of its own. The Python package around it
+//! comparison, ray queries and what a scene is made of) with no rendering logic of its own. The Python package around it
 //! (`python/prism_renderer`) adds the keyword-argument forms and the progress bar; its `.pyi`
 //! stubs document every call.
 
@@ -8,8 +8,11 @@ mod dict;
 mod error;
 mod image;
 mod image_files;
+mod introspection;
 mod parameters;
+mod ray_queries;
 mod render;
+mod render_state;
 mod scene;
 mod transform;
 
@@ -25,10 +28,18 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<image::ChannelDifference>()?;
     m.add_class::<image::ZTest>()?;
     m.add_class::<parameters::SceneParameters>()?;
+    m.add_class::<render_state::RenderState>()?;
+    m.add_class::<ray_queries::Ray3f>()?;
+    m.add_class::<ray_queries::SurfaceInteraction>()?;
+    m.add_class::<introspection::BoundingBox3f>()?;
+    m.add_class::<introspection::Shape>()?;
+    m.add_class::<introspection::Emitter>()?;
+    m.add_class::<introspection::Sensor>()?;
     m.add_function(wrap_pyfunction!(scene::load_file, m)?)?;
     m.add_function(wrap_pyfunction!(scene::load_dict, m)?)?;
     m.add_function(wrap_pyfunction!(scene::load_string, m)?)?;
     m.add_function(wrap_pyfunction!(render::render, m)?)?;
+    m.add_function(wrap_pyfunction!(render_state::merge, m)?)?;
     m.add_function(wrap_pyfunction!(parameters::traverse, m)?)?;
     m.add_function(wrap_pyfunction!(image::compare, m)?)?;
     m.add_function(wrap_pyfunction!(image_files::read_image, m)?)?;

@@ -2,8 +2,9 @@
 //! only briefly, reports progress, hands the developing image to a preview callback and watches
 //! for Ctrl-C. An interruption (or an exception from a callback) raises the render's stop flag;
 //! the render finishes the tiles in flight, its threads are joined, and the exception is raised.
-//! A crop window, checkpoints and resuming work as `prism render --crop/--checkpoint/--resume`
-//! do, with the same state files.
+//! A crop window, checkpoints, resuming and sample ranges work as
+//! `prism render --crop/--checkpoint/--resume/--sample-range` do, with the same state files; a
+//! render of a sample range gives its [`RenderState`] for [`crate::render_state::merge`].
 
 use std::cell::Cell;
 use std::ops::Range;
@@ -17,6 +18,7 @@ use pyo3::prelude::*;
 
 use crate::error::{IntoPyResult, to_py};
 use crate::image::Image;
+use crate::render_state::RenderState;
 use crate::scene::Scene;
 use glam::UVec2;
 use prism_core::error::Error;
@@ -39,7 +41,8 @@ const POLL: Duration = Duration::from_millis(100);
 /// sensor to look through. `crop` (x0, y0, x1, y1) renders the pixels x0 ≤ x < x1,
 /// y0 ≤ y < y1 only; `checkpoint` saves the render state there every `checkpoint_every` seconds
 /// and at the end; `resume` continues the state saved there (and saves to it, without a
-/// `checkpoint`).
+/// `checkpoint`). `sample_range` (start, end) takes the sample indices start ≤ i < end of every
+/// pixel only, and the render gives their state rather than an image.
 #[derive(FromPyObject)]
 #[pyo3(from_item_all)]
 pub struct RenderSettings {
@@ -53,6 +56,7 @@ pub struct RenderSettings {
     checkpoint: Option<PathBuf>,
     checkpoint_every: f64,
     resume: Option<PathBuf>,
+    sample_range: Option<(u32, u32)>,
 }
 
 /// A sensor of the scene, by its index from 0 in document order or by its id.
@@ -75,7 +79,8 @@ struct Callbacks<'py> {
 /// `preview(image)` with the developing [`Image`] after passes (the newest, when several
 /// finished since the last call) and last with the image returned, unless the last pass's
 /// image, equal to it, was shown already. The image is the same for every number of threads.
-/// With a crop window the scene is held exclusively while it renders.
+/// With a crop window the scene is held exclusively while it renders. A render of a
+/// `sample_range` returns its [`RenderState`] in place of the image.
 #[pyfunction]
 #[pyo3(signature = (scene, settings, progress = None, preview = None))]
 pub fn render(
@@ -84,7 +89,7 @@ pub fn render(
     settings: RenderSettings,
     progress: Option<Bound<'_, PyAny>>,
     preview: Option<Bound<'_, PyAny>>,
-) -> PyResult<Py<Image>> {
+) -> PyResult<Py<PyAny>> {
     select_sensor(py, scene, &settings.sensor)?;
     let callbacks = Callbacks { progress, preview };
     let Some([x0, y0, x1, y1]) = settings.crop else {
@@ -119,7 +124,7 @@ fn render_loaded(
     loaded: &LoadedScene,
     settings: RenderSettings,
     callbacks: Callbacks<'_>,
-) -> PyResult<Py<Image>> {
+) -> PyResult<Py<PyAny>> {
     let RenderSettings {
         spp,
         seed,
@@ -131,6 +136,7 @@ fn render_loaded(
         checkpoint,
         checkpoint_every,
         resume,
+        sample_range,
     } = settings;
     let Callbacks { progress, preview } = callbacks;
     if threads == Some(0) {
@@ -152,19 +158,31 @@ fn render_loaded(
         time_limit: "time_limit",
         target_error: "target_error",
     };
-    let stop = StopRule::requested(spp, samples_per_pixel, time_limit, target_error, &names)
+    let mut stop = StopRule::requested(spp, samples_per_pixel, time_limit, target_error, &names)
         .into_py_result(py)?;
+    if let Some((start, end)) = sample_range {
+        if start >= end {
+            return Err(to_py(
+                py,
+                &Error::usage(format!(
+                    "the sample range ({start}, {end}) is empty: end must exceed start"
+                )),
+            ));
+        }
+        stop.sample_end = Some(end);
+    }
+    let range_start = sample_range.map_or(0, |(start, _)| start);
     let seed = seed.unwrap_or(loaded.seed);
     let strata = loaded.scene.strata(samples_per_pixel);
     let mut continuation = Continuation::new(&loaded.scene, seed, strata);
     let (first_sample, initial) = match &resume {
         Some(path) => {
             let (end, sums) = py
-                .detach(|| continuation.resume(path, 0))
+                .detach(|| continuation.resume(path, range_start))
                 .into_py_result(py)?;
             (end, Some(sums))
         }
-        None => (0, None),
+        None => (range_start, None),
     };
     if let Some(end) = stop.sample_end
         && first_sample >= end
@@ -270,6 +288,15 @@ fn render_loaded(
         .map_err(|_| PyRuntimeError::new_err("the render's thread panicked"))?
         .into_py_result(py)?;
     report()?;
+    if sample_range.is_some() {
+        let snapshot = Snapshot {
+            samples: output.samples,
+            pixels: &output.film.pixels,
+            aovs: &output.film.aovs,
+        };
+        let state = continuation.state(&snapshot);
+        return Ok(Py::new(py, RenderState { state })?.into_any());
+    }
     let image = Py::new(
         py,
         image_of(py, &output.film, seed, output.elapsed.as_secs_f64())?,
@@ -279,7 +306,7 @@ fn render_loaded(
     {
         callback.call1((image.clone_ref(py),))?;
     }
-    Ok(image)
+    Ok(image.into_any())
 }
 
 /// The image of `film`, rendered with the random streams of `seed` in `seconds`; its samples

@@ -11,6 +11,8 @@ use pyo3::types::PyDict;
 
 use crate::dict::dict_of;
 use crate::error::{IntoPyResult, to_py};
+use crate::introspection::{self, BoundingBox3f, Emitter, Sensor, Shape};
+use crate::ray_queries::{self, Rays, SurfaceInteraction};
 use prism_core::error::{Error, Result};
 use prism_core::film::Reconstruction;
 use prism_core::geometry::Geometry;
@@ -196,6 +198,56 @@ impl Scene {
         (self.loaded.sensors().iter())
             .map(|sensor| sensor.id.clone())
             .collect()
+    }
+
+    /// The closest surface each ray meets, as Mitsuba's `scene.ray_intersect`: for one
+    /// [`ray_queries::Ray3f`], or for N rays given as (N, 3) arrays of `origins` and
+    /// `directions` with `tmax` None, a number or N numbers.
+    #[pyo3(signature = (origins, directions = None, tmax = None))]
+    fn ray_intersect(
+        &self,
+        py: Python<'_>,
+        origins: &Bound<'_, PyAny>,
+        directions: Option<&Bound<'_, PyAny>>,
+        tmax: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<SurfaceInteraction> {
+        let rays = Rays::of(origins, directions, tmax)?;
+        ray_queries::intersect(py, &self.loaded.scene.world.geometry, rays)
+    }
+
+    /// Whether anything blocks each ray before its `tmax`, as Mitsuba's `scene.ray_test`
+    /// (shadow rays); the rays as for [`Scene::ray_intersect`].
+    #[pyo3(signature = (origins, directions = None, tmax = None))]
+    fn ray_test(
+        &self,
+        py: Python<'_>,
+        origins: &Bound<'_, PyAny>,
+        directions: Option<&Bound<'_, PyAny>>,
+        tmax: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Py<PyAny>> {
+        let rays = Rays::of(origins, directions, tmax)?;
+        ray_queries::occluded(py, &self.loaded.scene.world.geometry, rays)
+    }
+
+    /// The scene's shapes, in document order.
+    fn shapes(slf: &Bound<'_, Self>) -> Vec<Shape> {
+        introspection::shapes(slf)
+    }
+
+    /// The scene's lights.
+    fn emitters(slf: &Bound<'_, Self>) -> Vec<Emitter> {
+        introspection::emitters(slf)
+    }
+
+    /// The scene's sensors, in document order.
+    fn sensors(slf: &Bound<'_, Self>) -> Vec<Sensor> {
+        introspection::sensors(slf)
+    }
+
+    /// The box around the scene's shapes; an empty scene's is infinite and inverted.
+    fn bbox(&self) -> BoundingBox3f {
+        let bounds = self.loaded.scene.world.geometry.bounds();
+        BoundingBox3f::new(bounds.unwrap_or((glam::Vec3::INFINITY, glam::Vec3::NEG_INFINITY)))
     }
 
     fn __repr__(&self) -> String {

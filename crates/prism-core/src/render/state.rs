@@ -148,7 +148,8 @@ impl RenderState {
         self.ranges.iter().map(|r| r.end - r.start).sum()
     }
 
-    fn encode(&self) -> Vec<u8> {
+    /// The bytes of the state's file (the layout above); [`Self::decode`] reads them.
+    pub fn encode(&self) -> Vec<u8> {
         let id = &self.identity;
         let mut out = Vec::with_capacity(128 + self.pixels.len() * PIXEL_BYTES);
         out.extend_from_slice(MAGIC);

@@ -34,6 +34,12 @@ pub struct LoadedScene {
     /// Parameters of the file that Prism reads but ignores (Mitsuba 0.6 forms), and where
     /// Mitsuba would render the file otherwise, one warning each, in the order they were read.
     pub warnings: Vec<Warning>,
+    /// The `<shape>` (or `instance`) of the description that made each primitive of the
+    /// world's geometry, in the primitives' order.
+    pub shape_plugins: Vec<Arc<PluginNode>>,
+    /// The `<emitter>` of the description that made each of the world's lights, in the
+    /// lights' order.
+    pub emitter_plugins: Vec<Arc<PluginNode>>,
     /// Every `<sensor>`, in document order (Mitsuba loads them all and renders the first unless
     /// told otherwise).
     pub(super) sensors: Vec<SceneSensor>,
@@ -244,9 +250,11 @@ struct SceneBuilder {
     textures: TextureCache,
     media: MediaCache,
     shapes: Vec<Primitive>,
+    shape_plugins: Vec<Arc<PluginNode>>,
     shape_info: Vec<ShapeInfo>,
     medium_interfaces: Vec<MediumInterface>,
     lights: Vec<Light>,
+    emitter_plugins: Vec<Arc<PluginNode>>,
     sampling_weights: Vec<f32>,
     /// The area emitters attached to shapes, with where each was attached (an emitter declared
     /// at the top level with an id reaches its shape by a `<ref>`).
@@ -275,6 +283,7 @@ impl SceneBuilder {
                     let index = self.shapes.len();
                     if let Some(instance) = groups.instance(&child.node, index, &mut member)? {
                         self.shapes.push(instance.primitive);
+                        self.shape_plugins.push(child.node.clone());
                         self.shape_info.push(instance.info);
                         self.medium_interfaces.push(MediumInterface::default());
                     }
@@ -347,6 +356,7 @@ impl SceneBuilder {
             return Ok(());
         }
         self.shapes.push(shape);
+        self.shape_plugins.push(child.node.clone());
         self.shape_info.push(ShapeInfo { material, light });
         self.medium_interfaces.push(interface);
         Ok(())
@@ -367,6 +377,7 @@ impl SceneBuilder {
         if lights::is_delta(&emitter.node) {
             let (light, weight) = lights::build_scene_light(&emitter.node, &mut self.textures)?;
             self.lights.push(light);
+            self.emitter_plugins.push(emitter.node.clone());
             self.sampling_weights.push(weight);
             return Ok(None);
         }
@@ -384,6 +395,7 @@ impl SceneBuilder {
         let (light, weight) =
             lights::build_area_light(&emitter.node, shape_index, &mut self.textures)?;
         self.lights.push(light);
+        self.emitter_plugins.push(emitter.node.clone());
         self.sampling_weights.push(weight);
         Ok(Some((self.lights.len() - 1) as u32))
     }
@@ -428,6 +440,7 @@ impl SceneBuilder {
             }
             let (light, weight) = lights::build_scene_light(&child.node, &mut self.textures)?;
             scene_lights.push((light, weight, child.location.clone()));
+            self.emitter_plugins.push(child.node.clone());
         }
         lights::check_single_environment(&scene_lights)?;
         for (light, weight, _) in scene_lights {
@@ -503,6 +516,8 @@ impl SceneBuilder {
             scene,
             seed: first.seed,
             warnings,
+            shape_plugins: self.shape_plugins,
+            emitter_plugins: self.emitter_plugins,
             sensors,
             selected: 0,
             description_fingerprint,

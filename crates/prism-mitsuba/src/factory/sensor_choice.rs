@@ -24,6 +24,13 @@ pub struct SceneSensor {
     pub(super) medium: Option<u32>,
 }
 
+impl SceneSensor {
+    /// The sensor's film: its size, crop window and reconstruction.
+    pub fn film(&self) -> &FilmSettings {
+        &self.film
+    }
+}
+
 impl LoadedScene {
     /// The scene's sensors, in document order.
     pub fn sensors(&self) -> &[SceneSensor] {

@@ -10,6 +10,8 @@
     params.update()                            # rebuilt from the edited description
     pr.write_image("red.png", np.full((8, 8, 3), [1.0, 0.0, 0.0], np.float32))
     pixels = pr.read_image("mitsuba.exr")   # any EXR, PNG, JPEG or HDR as a float32 array
+    parts = [pr.render(scene, seed=1, sample_range=(s, s + 4)) for s in (0, 4, 8, 12)]
+    pr.merge(parts).image()                    # a farm's parts: the one render, bit for bit
 
 The API follows Mitsuba's (``load_file``, ``load_dict``, ``render``), and Mitsuba's own names
 (``set_variant``, ``load_string``, ``ScalarTransform4f``, ``util.write_bitmap``,
@@ -24,21 +26,29 @@ import math
 import os
 import sys
 import time
-from typing import Any, Callable, Optional, Sequence, Tuple, Union
+from typing import Any, Callable, Optional, Sequence, Tuple, Union, overload
 
 import numpy as np
 import numpy.typing as npt
 
 from ._native import (
+    BoundingBox3f,
     ChannelDifference,
     Comparison,
+    Emitter,
     Image,
     PrismError,
+    Ray3f,
+    RenderState,
     Scene,
     SceneParameters,
+    Sensor,
+    Shape,
+    SurfaceInteraction,
     Transform,
     ZTest,
     load_dict,
+    merge,
     traverse,
 )
 from . import _native, util
@@ -50,13 +60,20 @@ ScalarTransform4f = Transform
 """Mitsuba's name of :class:`Transform`."""
 
 __all__ = [
+    "BoundingBox3f",
     "ChannelDifference",
     "Comparison",
+    "Emitter",
     "Image",
     "PrismError",
+    "Ray3f",
+    "RenderState",
     "Scene",
     "SceneParameters",
     "ScalarTransform4f",
+    "Sensor",
+    "Shape",
+    "SurfaceInteraction",
     "Transform",
     "ZTest",
     "compare",
@@ -65,6 +82,7 @@ __all__ = [
     "load_dict",
     "load_file",
     "load_string",
+    "merge",
     "read_image",
     "render",
     "set_variant",
@@ -106,6 +124,45 @@ def _define_text(value: object) -> str:
     return str(value)
 
 
+@overload
+def render(
+    scene: Scene,
+    spp: Optional[int] = ...,
+    seed: Optional[int] = ...,
+    threads: Optional[int] = ...,
+    progress: Union[bool, ProgressCallback] = ...,
+    time_limit: Optional[float] = ...,
+    target_error: Optional[float] = ...,
+    preview: Optional[PreviewCallback] = ...,
+    sensor: Union[int, str] = ...,
+    crop: Optional[Tuple[int, int, int, int]] = ...,
+    checkpoint: Optional[Union[str, os.PathLike]] = ...,
+    checkpoint_every: float = ...,
+    resume: Optional[Union[str, os.PathLike]] = ...,
+    sample_range: None = ...,
+) -> Image: ...
+
+
+@overload
+def render(
+    scene: Scene,
+    spp: Optional[int] = ...,
+    seed: Optional[int] = ...,
+    threads: Optional[int] = ...,
+    progress: Union[bool, ProgressCallback] = ...,
+    time_limit: Optional[float] = ...,
+    target_error: Optional[float] = ...,
+    preview: Optional[PreviewCallback] = ...,
+    sensor: Union[int, str] = ...,
+    crop: Optional[Tuple[int, int, int, int]] = ...,
+    checkpoint: Optional[Union[str, os.PathLike]] = ...,
+    checkpoint_every: float = ...,
+    resume: Optional[Union[str, os.PathLike]] = ...,
+    *,
+    sample_range: Tuple[int, int],
+) -> RenderState: ...
+
+
 def render(
     scene: Scene,
     spp: Optional[int] = None,
@@ -120,7 +177,8 @@ def render(
     checkpoint: Optional[Union[str, os.PathLike]] = None,
     checkpoint_every: float = 60.0,
     resume: Optional[Union[str, os.PathLike]] = None,
-) -> Image:
+    sample_range: Optional[Tuple[int, int]] = None,
+) -> Union[Image, RenderState]:
     """Renders ``scene`` and returns its :class:`Image`.
 
     ``spp``: samples per pixel (default: the sampler's ``sample_count``). ``seed``: the seed of
@@ -139,6 +197,12 @@ def render(
     unless ``checkpoint`` names another file. These are ``prism render``'s ``--crop``,
     ``--checkpoint``, ``--checkpoint-every`` and ``--resume``: the state files are the same, and
     so is the image, bit for bit.
+
+    ``sample_range=(start, end)``: take only the samples start <= i < end of every pixel (of
+    the ``spp`` the stratification is made for) and return their :class:`RenderState` in place
+    of the image, as ``prism render --sample-range``: a render farm's task. :func:`merge` adds
+    the states of disjoint ranges into the state of one render of all their samples, whose
+    ``image()`` is bit for bit the single render's.
 
     ``progress``: True shows a progress bar (tqdm's, in a terminal or a notebook, if tqdm is
     installed; else a line on standard error), False none; a callable is called as
@@ -177,6 +241,7 @@ def render(
                 "checkpoint": None if checkpoint is None else os.fspath(checkpoint),
                 "checkpoint_every": float(checkpoint_every),
                 "resume": None if resume is None else os.fspath(resume),
+                "sample_range": sample_range,
             },
             callback,
             preview,

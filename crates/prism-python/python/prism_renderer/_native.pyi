@@ -74,6 +74,155 @@ class Scene:
     @property
     def sensor_ids(self) -> List[Optional[str]]:
         """The ``id`` of every ``<sensor>`` (None for one without), in document order."""
+    @overload
+    def ray_intersect(self, origins: Ray3f) -> SurfaceInteraction:
+        """The closest surface the ray meets before its ``maxt``; the interaction's fields
+        are those of this one ray."""
+    @overload
+    def ray_intersect(
+        self,
+        origins: npt.ArrayLike,
+        directions: npt.ArrayLike,
+        tmax: Union[None, float, npt.ArrayLike] = None,
+    ) -> SurfaceInteraction:
+        """The closest surface each ray ``origins[i] + t directions[i]``, 0 < t < ``tmax``,
+        meets: (N, 3) arrays (any numeric dtype, traced in float32), ``tmax`` None (no bound),
+        one number or N. As Mitsuba's ``scene.ray_intersect``; traced by the renderer's own
+        hierarchy on all cores without the GIL, each ray's answer the same for any number of
+        threads."""
+    @overload
+    def ray_test(self, origins: Ray3f) -> bool:
+        """Whether anything blocks the ray before its ``maxt`` (a shadow ray)."""
+    @overload
+    def ray_test(
+        self,
+        origins: npt.ArrayLike,
+        directions: npt.ArrayLike,
+        tmax: Union[None, float, npt.ArrayLike] = None,
+    ) -> npt.NDArray[np.bool_]:
+        """Whether anything blocks each ray before its ``tmax``, (N,) bool, as Mitsuba's
+        ``scene.ray_test``; the rays as for :meth:`ray_intersect`."""
+    def shapes(self) -> List[Shape]:
+        """The shapes (and ``instance``s of shape groups), in document order; a shape of zero
+        area, which is never hit, is left out."""
+    def emitters(self) -> List[Emitter]:
+        """The lights: those shapes carry, in the shapes' order, then the scene's
+        ``<emitter>``s."""
+    def sensors(self) -> List[Sensor]:
+        """The sensors, in document order."""
+    def bbox(self) -> BoundingBox3f:
+        """The box around the shapes (an empty scene's is infinite and inverted)."""
+
+class Ray3f:
+    """One ray, as Mitsuba's ``mi.Ray3f``: the points ``o + t d`` for 0 < t < ``maxt``, at
+    ``time``; ``d`` need not be of unit length (``t`` is in units of its length)."""
+
+    o: List[float]
+    d: List[float]
+    maxt: float
+    time: float
+    def __init__(
+        self,
+        o: Sequence[float],
+        d: Sequence[float],
+        maxt: float = ...,
+        time: float = 0.0,
+    ) -> None: ...
+    def __call__(self, t: float) -> List[float]:
+        """The point ``o + t d``."""
+
+class SurfaceInteraction:
+    """What :meth:`Scene.ray_intersect` found, as Mitsuba's ``SurfaceInteraction3f``: arrays
+    with one entry (row) per ray, or for one :class:`Ray3f` that entry alone. Where a ray hits
+    nothing, ``t`` is infinite, ``shape`` and ``prim_index`` are -1 and the rest 0."""
+
+    @property
+    def t(self) -> Any:
+        """(N,) float32: the distance along the ray, in units of its direction's length."""
+    @property
+    def p(self) -> Any:
+        """(N, 3) float32: the point hit."""
+    @property
+    def n(self) -> Any:
+        """(N, 3) float32: the unit geometric normal, on the side the shape calls outside."""
+    @property
+    def sh_n(self) -> Any:
+        """(N, 3) float32: the unit shading normal (interpolated on smooth meshes)."""
+    @property
+    def uv(self) -> Any:
+        """(N, 2) float32: the surface's texture coordinates."""
+    @property
+    def shape(self) -> Any:
+        """(N,) int64: the index of the shape hit in :meth:`Scene.shapes` (as the ``aov``
+        integrator's ``shape_index``; a shape group's members follow the scene's shapes)."""
+    @property
+    def prim_index(self) -> Any:
+        """(N,) int64: the triangle within a mesh (0 for other shapes)."""
+    def is_valid(self) -> Any:
+        """(N,) bool: whether each ray hit a surface."""
+
+class BoundingBox3f:
+    """An axis-aligned box, as Mitsuba's ``BoundingBox3f``."""
+
+    @property
+    def min(self) -> List[float]: ...
+    @property
+    def max(self) -> List[float]: ...
+    def center(self) -> List[float]: ...
+    def extents(self) -> List[float]:
+        """``max - min``."""
+
+class Shape:
+    """One shape of a scene (:meth:`Scene.shapes`); it reads its scene when asked, so it
+    follows :meth:`SceneParameters.update`."""
+
+    @property
+    def index(self) -> int:
+        """Its place in :meth:`Scene.shapes` (and ``SurfaceInteraction.shape``)."""
+    def id(self) -> str:
+        """Its ``id``, else the name :func:`traverse` gives it (its key in a dictionary,
+        or ``shape_0``, ``shape_1``, …), so that ``f"{shape.id()}.to_world"`` is a parameter
+        key."""
+    def plugin_type(self) -> str:
+        """``obj``, ``ply``, ``sphere``, ``rectangle``, ``instance``, …."""
+    def bbox(self) -> BoundingBox3f:
+        """The box around it in world space (around its motion, for a moving shape)."""
+    def surface_area(self) -> float:
+        """Its area in world units (0 for curves)."""
+    def is_mesh(self) -> bool: ...
+    def is_emitter(self) -> bool:
+        """Whether an area light lies on it."""
+    def vertex_positions(self) -> npt.NDArray[np.float32]:
+        """A mesh's vertices in world space, (V, 3); TypeError for other shapes."""
+    def faces(self) -> npt.NDArray[np.uint32]:
+        """A mesh's triangles as indices of :meth:`vertex_positions`, (F, 3); TypeError for
+        other shapes."""
+    def vertex_count(self) -> int: ...
+    def face_count(self) -> int: ...
+
+class Emitter:
+    """One light of a scene (:meth:`Scene.emitters`)."""
+
+    @property
+    def index(self) -> int: ...
+    def id(self) -> str:
+        """Its ``id``, else the name :func:`traverse` gives it (``light.emitter`` for the
+        emitter of a shape ``light``), so that ``f"{emitter.id()}.radiance.value"`` is a
+        parameter key."""
+    def is_environment(self) -> bool:
+        """Whether it is at infinity (``constant``, ``envmap``, ``sunsky``)."""
+    def shape(self) -> Optional[int]:
+        """The index in :meth:`Scene.shapes` of the shape an area light lies on; None for
+        other lights."""
+
+class Sensor:
+    """One sensor of a scene (:meth:`Scene.sensors`)."""
+
+    @property
+    def index(self) -> int: ...
+    def id(self) -> Optional[str]: ...
+    def film_size(self) -> Tuple[int, int]:
+        """The film's (width, height) in pixels, as Mitsuba's ``sensor.film().size()``."""
 
 ParameterValueIn = Union[float, int, bool, npt.ArrayLike, Transform]
 """A value :class:`SceneParameters` takes: a number, a bool, numbers (a list, tuple or numpy
@@ -210,6 +359,40 @@ class Image:
     def _repr_png_(self) -> bytes:
         """The PNG that :meth:`write` writes, for Jupyter."""
 
+class RenderState:
+    """The exact pixel sums of a render over some sample ranges, from
+    ``render(..., sample_range=(start, end))``, :func:`merge` or a state file; what they belong
+    to (the scene, seed, sampler, samples per pixel, film and crop) travels with them. It
+    pickles as the bytes of its file, so task engines (dask, Ray, multiprocessing) carry it."""
+
+    @staticmethod
+    def read(path: Union[str, os.PathLike]) -> RenderState:
+        """Reads a state file (``prism render --checkpoint``'s or :meth:`write`'s)."""
+    @staticmethod
+    def from_bytes(data: bytes) -> RenderState:
+        """The state whose file holds ``data``; :class:`PrismError` when it is damaged."""
+    def to_bytes(self) -> bytes:
+        """The bytes of the state's file."""
+    def write(self, path: Union[str, os.PathLike]) -> None:
+        """Writes the state's file atomically, for ``prism merge`` or ``--resume``."""
+    @property
+    def ranges(self) -> List[Tuple[int, int]]:
+        """The sample index ranges ``(start, end)`` every pixel holds, sorted."""
+    @property
+    def spp(self) -> int:
+        """Samples per pixel the state holds."""
+    @property
+    def seed(self) -> int:
+        """The seed of the render's random numbers."""
+    def image(self) -> Image:
+        """The image of the sums, as ``prism merge`` writes it (``seconds`` is 0)."""
+
+def merge(states: Sequence[Union[RenderState, str, os.PathLike]]) -> RenderState:
+    """The state of one render of all the samples of ``states`` (each a :class:`RenderState`
+    or a state file's path), as ``prism merge``: their ranges must be disjoint and their renders
+    the same (scene, ``spp``, ``seed``, ``crop``), else :class:`PrismError`. The sums are exact,
+    so the merged image is the single render's bit for bit, in any order of merging."""
+
 class ChannelDifference:
     """How one channel of two images differs."""
 
@@ -293,15 +476,17 @@ class _RenderSettings(TypedDict):
     checkpoint: Optional[str]
     checkpoint_every: float
     resume: Optional[str]
+    sample_range: Optional[Tuple[int, int]]
 
 def render(
     scene: Scene,
     settings: _RenderSettings,
     progress: Optional[Callable[[int, Optional[int], float], object]] = None,
     preview: Optional[Callable[[Image], object]] = None,
-) -> Image:
+) -> Union[Image, RenderState]:
     """Renders ``scene`` (see :func:`prism_renderer.render`, whose keywords ``settings``
-    holds); ``progress`` and ``preview`` are callables or None."""
+    holds); ``progress`` and ``preview`` are callables or None. The image, or with a
+    ``sample_range`` the render's state."""
 
 def compare(
     test: Union[Image, str, os.PathLike],

@@ -179,7 +179,7 @@ impl Listing {
 /// The names of the plugins `node` nests, `parent` being its own name (None for the scene):
 /// each one's `id`; else its `name` (a dictionary's key, an XML `name` attribute) or its
 /// class, numbered from 0 when several siblings share it, after the parent's name and a dot.
-fn child_names(node: &PluginNode, parent: Option<&str>) -> Vec<String> {
+pub(super) fn child_names(node: &PluginNode, parent: Option<&str>) -> Vec<String> {
     // Mitsuba's `twosided` calls the BSDFs it nests `brdf_0` and `brdf_1`.
     let twosided = node.class == PluginClass::Bsdf && node.plugin_type == "twosided";
     let slot = |child: &NestedPlugin| -> String {
