@@ -4,11 +4,12 @@
 
 use std::ops::Range;
 
-use glam::{UVec2, Vec4};
+use glam::{UVec2, Vec2, Vec4};
 use rayon::prelude::*;
 
 use super::RenderOptions;
 use super::estimator::SampleEstimator;
+use super::lanes::{LaneCounter, SampleSink, trace_in_lanes};
 use super::stop::Cancel;
 use super::tiles::{Tile, TileSums};
 use crate::film::FilterMis;
@@ -87,7 +88,8 @@ impl SharedSamples {
     }
 
     /// Traces the samples `range` (at most `self.indices` of them) of every pixel, in parallel
-    /// over rows. None when the pass was cancelled.
+    /// over rows (the path tracer's in lanes, adding their occupancy to `occupancy`). None
+    /// when the pass was cancelled.
     pub(super) fn trace(
         &mut self,
         estimator: &SampleEstimator,
@@ -95,10 +97,12 @@ impl SharedSamples {
         range: Range<u32>,
         options: &RenderOptions,
         cancel: &Cancel,
+        occupancy: &LaneCounter,
     ) -> Option<u64> {
         let (stride, origin, indices) = (self.stride, self.origin, self.indices as usize);
         let (k, reach) = (self.aovs, self.reach);
         let row_len = self.size.x as usize * indices * stride;
+        let path = estimator.integrator.path_tracer();
         let rays: Vec<Option<u64>> = self
             .values
             .par_chunks_mut(row_len)
@@ -106,6 +110,32 @@ impl SharedSamples {
             .map(|(row, values)| {
                 if cancel.raised() {
                     return None;
+                }
+                if let Some(path) = path {
+                    let columns = values.len() / (indices * stride);
+                    let pixels = (0..columns)
+                        .map(|column| (column, origin + UVec2::new(column as u32, row as u32)));
+                    let mut sink = RecordSink {
+                        values,
+                        row_start: origin + UVec2::new(0, row as u32),
+                        mis,
+                        first: range.start,
+                        per_pixel: indices * stride,
+                        stride,
+                        reach,
+                    };
+                    let (rays, lanes) = trace_in_lanes(
+                        estimator,
+                        path,
+                        pixels,
+                        range.clone(),
+                        options.samples_per_pixel,
+                        options.seed,
+                        cancel,
+                        &mut sink,
+                    )?;
+                    occupancy.add(lanes);
+                    return Some(rays);
                 }
                 let kind = estimator.scene.sampler.kind;
                 let mut sampler = Sampler::new(kind, options.samples_per_pixel, options.seed);
@@ -125,37 +155,85 @@ impl SharedSamples {
                     aovs.fill(0.0);
                     let (offset, _, xyz) =
                         estimator.trace(&mut sampler, pixel, index, &mut count, &mut aovs);
-                    if !acceptable_sample(&xyz) {
-                        record[Self::SCALE] = f32::NAN;
-                        continue;
-                    }
-                    // A point the density misses (none, for a sampled one) adds nothing.
-                    let scale = mis.sample_scale(pixel, offset);
-                    let scale = if scale.is_finite() { scale } else { 0.0 };
-                    record[Self::SCALE] = scale;
-                    for c in 0..3 {
-                        record[Self::XYZ + c] = xyz[c] * scale;
-                    }
-                    let (channels, kernels) = record[Self::AOVS..].split_at_mut(k);
-                    for (r, &v) in channels.iter_mut().zip(&aovs) {
-                        *r = if acceptable_sample(&[v]) {
-                            v * scale
-                        } else {
-                            0.0
-                        };
-                    }
-                    // The layout of kernel_x_at and kernel_y_at.
-                    let (kx, ky) = kernels.split_at_mut(2 * reach + 1);
-                    for j in 0..=2 * reach {
-                        let d = j as f32 - reach as f32;
-                        kx[j] = mis.kernel(offset.x - d);
-                        ky[j] = mis.kernel(offset.y - d);
-                    }
+                    write_record(record, mis, pixel, offset, xyz, &aovs, reach);
                 }
                 Some(count.rays)
             })
             .collect();
         rays.into_iter().sum()
+    }
+}
+
+/// Writes into `record` what filter MIS keeps of a sample of `pixel` drawn at `offset` from
+/// its centre, with its XYZ and extra channels `aovs`, for a filter reaching `reach` pixels
+/// (the layout of [`SharedSamples`]).
+fn write_record(
+    record: &mut [f32],
+    mis: &FilterMis,
+    pixel: UVec2,
+    offset: Vec2,
+    xyz: [f32; 3],
+    aovs: &[f32],
+    reach: usize,
+) {
+    if !acceptable_sample(&xyz) {
+        record[SharedSamples::SCALE] = f32::NAN;
+        return;
+    }
+    // A point the density misses (none, for a sampled one) adds nothing.
+    let scale = mis.sample_scale(pixel, offset);
+    let scale = if scale.is_finite() { scale } else { 0.0 };
+    record[SharedSamples::SCALE] = scale;
+    for c in 0..3 {
+        record[SharedSamples::XYZ + c] = xyz[c] * scale;
+    }
+    let (channels, kernels) = record[SharedSamples::AOVS..].split_at_mut(aovs.len());
+    for (r, &v) in channels.iter_mut().zip(aovs) {
+        *r = if acceptable_sample(&[v]) {
+            v * scale
+        } else {
+            0.0
+        };
+    }
+    // The layout of kernel_x_at and kernel_y_at.
+    let (kx, ky) = kernels.split_at_mut(2 * reach + 1);
+    for j in 0..=2 * reach {
+        let d = j as f32 - reach as f32;
+        kx[j] = mis.kernel(offset.x - d);
+        ky[j] = mis.kernel(offset.y - d);
+    }
+}
+
+/// The lanes' sink for a row of shared samples: each sample written to its record.
+struct RecordSink<'v, 'm> {
+    /// The row's records: per pixel, per sample index of the batch.
+    values: &'v mut [f32],
+    /// The film position of the row's first pixel (its slot 0).
+    row_start: UVec2,
+    mis: &'m FilterMis,
+    /// The batch's first sample index.
+    first: u32,
+    /// Floats per pixel of the row.
+    per_pixel: usize,
+    /// Floats per sample.
+    stride: usize,
+    reach: usize,
+}
+
+impl SampleSink for RecordSink<'_, '_> {
+    fn add(
+        &mut self,
+        slot: usize,
+        index: u32,
+        offset: Vec2,
+        _filter_weight: f32,
+        xyz: [f32; 3],
+        aovs: &[f32],
+    ) {
+        let start = slot * self.per_pixel + (index - self.first) as usize * self.stride;
+        let record = &mut self.values[start..start + self.stride];
+        let pixel = self.row_start + UVec2::new(slot as u32, 0);
+        write_record(record, self.mis, pixel, offset, xyz, aovs, self.reach);
     }
 }
 

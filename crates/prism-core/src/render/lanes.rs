@@ -9,6 +9,10 @@
 //! the tile that no lane has taken, so that a few long paths do not idle the others. A lane keeps its pixel's samples in order, which keeps its
 //! sampler's walk along the pixel's random stream one step per sample.
 //!
+//! Where the samples come from and go is the caller's: the one-pixel reconstruction hands
+//! the lanes a tile's pixels and adds each sample to its pixel's sums; filter MIS hands them a
+//! row of the pixels within the filter's reach and keeps each sample for the pixels around.
+//!
 //! The random numbers are keyed by (pixel, sample index, dimension) and the film's sums are
 //! exact, so the image is the same for any number of lanes, thread count and tile order, and
 //! the same as the one-path-at-a-time estimate ([`SampleEstimator::estimate`]) gives.
@@ -16,13 +20,10 @@
 use std::ops::Range;
 use std::sync::atomic::{AtomicU64, Ordering};
 
-use glam::UVec2;
+use glam::{UVec2, Vec2};
 
 use super::estimator::{CameraSampleRay, SampleEstimator};
-use super::pass::Pass;
 use super::stop::Cancel;
-use super::tiles::{Tile, TileSums};
-use crate::film::accumulation::{AOV_SUMS_PER_CHANNEL, add_aov_sample};
 use crate::geometry::aggregate::Hit;
 use crate::integrator::path::PathState;
 use crate::integrator::{PathIntegrator, RayCount, SampleContext};
@@ -35,7 +36,7 @@ pub const LANES: usize = F32s::LANES;
 
 /// How full a tile's lanes were: lane steps taken and, of them, those with a path.
 #[derive(Clone, Copy, Debug, Default)]
-struct Occupancy {
+pub(super) struct Occupancy {
     /// Steps times lanes.
     lane_steps: u64,
     /// Lane steps that advanced a path.
@@ -50,7 +51,7 @@ pub(super) struct LaneCounter {
 }
 
 impl LaneCounter {
-    fn add(&self, occupancy: Occupancy) {
+    pub(super) fn add(&self, occupancy: Occupancy) {
         self.lane_steps
             .fetch_add(occupancy.lane_steps, Ordering::Relaxed);
         self.active.fetch_add(occupancy.active, Ordering::Relaxed);
@@ -64,7 +65,23 @@ impl LaneCounter {
     }
 }
 
-/// One lane: the pixel it works on (its index in the tile and on the film), the sample index
+/// Where the lanes' finished samples go.
+pub(super) trait SampleSink {
+    /// Takes sample `index` of the pixel its source named `slot`: the film offset from the
+    /// pixel's centre, the weight the one-pixel estimator gives the sample, its CIE XYZ and its
+    /// extra channels (weighted by the shutter, not by the filter).
+    fn add(
+        &mut self,
+        slot: usize,
+        index: u32,
+        offset: Vec2,
+        filter_weight: f32,
+        xyz: [f32; 3],
+        aovs: &[f32],
+    );
+}
+
+/// One lane: the pixel it works on (as its source named it, and on the film), the sample index
 /// being traced, its random numbers, the camera sample and the path, None when the lane has
 /// no sample left.
 struct Lane {
@@ -76,55 +93,37 @@ struct Lane {
     path: Option<PathState>,
 }
 
-/// The tile's pixels not yet taken by a lane, in row-major order.
-struct PixelQueue {
-    tile: Tile,
-    crop_offset: UVec2,
-    next: u32,
-}
-
-impl PixelQueue {
-    fn take(&mut self) -> Option<(usize, UVec2)> {
-        let count = self.tile.size.x * self.tile.size.y;
-        (self.next < count).then(|| {
-            let i = self.next;
-            self.next += 1;
-            let local = UVec2::new(i % self.tile.size.x, i / self.tile.size.x);
-            (i as usize, self.crop_offset + self.tile.origin + local)
-        })
-    }
-}
-
-/// What a tile's lanes share: the estimator, the path tracer, the pass's sample indices, the
-/// tile's sums and the counts.
-struct TileRun<'e, 'a, 's> {
+/// What the lanes of one run share: the estimator, the path tracer, the sample indices of
+/// every pixel, where the pixels come from and the samples go, and the counts.
+struct LaneRun<'e, 'a, P, S> {
     estimator: &'e SampleEstimator<'a>,
     path: &'e PathIntegrator,
     range: Range<u32>,
-    sums: &'s mut TileSums,
+    pixels: P,
+    sink: &'e mut S,
     /// One sample's extra channels, reused.
     aovs: Vec<f32>,
     count: RayCount,
-    /// Whether the pass was cancelled before the tile was done.
+    /// Whether the pass was cancelled before the run was done.
     cancelled: bool,
 }
 
-impl TileRun<'_, '_, '_> {
-    /// Adds the finished sample `camera` of the tile's pixel `slot`, with the path's
-    /// `radiance`, to the pixel's sums.
-    fn add_to_film(&mut self, slot: usize, camera: &CameraSampleRay, radiance: SampledSpectrum) {
-        let k = self.aovs.len();
-        let (_, weight, xyz) = self.estimator.film_sample(camera, radiance, &mut self.aovs);
-        self.sums.pixels[slot].add(xyz.map(|v| v * weight));
-        for v in self.aovs.iter_mut() {
-            *v *= weight;
-        }
-        let start = slot * AOV_SUMS_PER_CHANNEL * k;
-        add_aov_sample(&mut self.sums.aovs[start..start + k], &self.aovs);
+impl<P: Iterator<Item = (usize, UVec2)>, S: SampleSink> LaneRun<'_, '_, P, S> {
+    /// Hands the finished sample `camera` of the lane's pixel, with the path's `radiance`, to
+    /// the sink.
+    fn add(
+        &mut self,
+        slot: usize,
+        index: u32,
+        camera: &CameraSampleRay,
+        radiance: SampledSpectrum,
+    ) {
+        let (offset, weight, xyz) = self.estimator.film_sample(camera, radiance, &mut self.aovs);
+        self.sink.add(slot, index, offset, weight, xyz, &self.aovs);
     }
 
     /// Starts the lane's sample, or the first of the following indices of its pixel whose
-    /// path does not end before its first vertex (`max_depth` 0: those go to the film at
+    /// path does not end before its first vertex (`max_depth` 0: those go to the sink at
     /// once); returns false when the pixel has no sample left.
     fn start(&mut self, lane: &mut Lane) -> bool {
         while lane.index < self.range.end {
@@ -141,21 +140,21 @@ impl TileRun<'_, '_, '_> {
                 lane.camera = Some(camera);
                 return true;
             }
-            self.add_to_film(lane.slot, &camera, SampledSpectrum::ZERO);
+            self.add(lane.slot, lane.index, &camera, SampledSpectrum::ZERO);
             lane.index += 1;
         }
         false
     }
 
-    /// Gives the lane the first sample of the queue's next pixel that has one; returns false
-    /// when the tile has no sample left or the pass is cancelled (then `cancelled` is set).
-    fn take_pixel(&mut self, lane: &mut Lane, queue: &mut PixelQueue, cancel: &Cancel) -> bool {
+    /// Gives the lane the first sample of the next pixel that has one; returns false when no
+    /// pixel is left or the pass is cancelled (then `cancelled` is set).
+    fn take_pixel(&mut self, lane: &mut Lane, cancel: &Cancel) -> bool {
         loop {
             if cancel.raised() {
                 self.cancelled = true;
                 return false;
             }
-            let Some((slot, pixel)) = queue.take() else {
+            let Some((slot, pixel)) = self.pixels.next() else {
                 return false;
             };
             (lane.slot, lane.pixel, lane.index) = (slot, pixel, self.range.start);
@@ -165,47 +164,45 @@ impl TileRun<'_, '_, '_> {
         }
     }
 
-    /// Adds the lane's finished sample to the film and gives the lane the next: its pixel's
+    /// Hands the lane's finished sample to the sink and gives the lane the next: its pixel's
     /// next index, else [`Self::take_pixel`].
-    fn finish(&mut self, lane: &mut Lane, queue: &mut PixelQueue, cancel: &Cancel) {
+    fn finish(&mut self, lane: &mut Lane, cancel: &Cancel) {
         if let (Some(path), Some(camera)) = (lane.path.take(), lane.camera.take()) {
-            self.add_to_film(lane.slot, &camera, self.path.estimate(&path));
+            self.add(lane.slot, lane.index, &camera, self.path.estimate(&path));
         }
         lane.index += 1;
         if !self.start(lane) {
-            self.take_pixel(lane, queue, cancel);
+            self.take_pixel(lane, cancel);
         }
     }
 }
 
-/// Writes into `out` the sums of a tile with the samples `range` of every pixel added, tracing
-/// the path tracer `path`'s camera paths [`LANES`] at a time and adding the lanes' occupancy
-/// to the pass's; returns the rays traced, or None when the pass was cancelled before the tile
-/// was done.
-pub(super) fn render_tile_in_lanes(
-    pass: &Pass,
+/// Traces the samples `range` of every pixel `pixels` yields (a slot the sink knows it by, and
+/// its film position), the path tracer `path`'s camera paths [`LANES`] at a time, handing each
+/// finished sample to `sink`; the random numbers are the sampler's for `samples_per_pixel`
+/// and `seed`. Returns the rays traced and the lanes' occupancy, or None when the pass was
+/// cancelled before the pixels were done.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn trace_in_lanes(
+    estimator: &SampleEstimator,
     path: &PathIntegrator,
-    tile: Tile,
-    sums: &TileSums,
-    out: &mut TileSums,
+    pixels: impl Iterator<Item = (usize, UVec2)>,
     range: Range<u32>,
-) -> Option<u64> {
-    let (estimator, options, cancel) = (pass.estimator, pass.options, pass.cancel);
+    samples_per_pixel: u32,
+    seed: u64,
+    cancel: &Cancel,
+    sink: &mut impl SampleSink,
+) -> Option<(u64, Occupancy)> {
     let scene = estimator.scene;
-    out.clone_from(sums);
-    let mut run = TileRun {
+    let mut run = LaneRun {
         estimator,
         path,
         range,
-        sums: out,
+        pixels,
+        sink,
         aovs: vec![0.0; estimator.aov_count()],
         count: RayCount::default(),
         cancelled: false,
-    };
-    let mut queue = PixelQueue {
-        tile,
-        crop_offset: scene.film.crop.offset,
-        next: 0,
     };
     let mut lanes: Vec<Lane> = (0..LANES)
         .map(|_| {
@@ -213,11 +210,11 @@ pub(super) fn render_tile_in_lanes(
                 slot: 0,
                 pixel: UVec2::ZERO,
                 index: 0,
-                sampler: Sampler::new(scene.sampler.kind, options.samples_per_pixel, options.seed),
+                sampler: Sampler::new(scene.sampler.kind, samples_per_pixel, seed),
                 camera: None,
                 path: None,
             };
-            run.take_pixel(&mut lane, &mut queue, cancel);
+            run.take_pixel(&mut lane, cancel);
             lane
         })
         .collect();
@@ -234,13 +231,12 @@ pub(super) fn render_tile_in_lanes(
             }
         }
         if active == 0 {
-            pass.occupancy.add(occupancy);
-            return Some(run.count.rays);
+            return Some((run.count.rays, occupancy));
         }
         occupancy.lane_steps += LANES as u64;
         occupancy.active += active;
         // The vertex stage: every active lane's hit as a surface interaction, and the path's
-        // vertex there; ended paths go to the film and their lanes take the next samples.
+        // vertex there; ended paths go to the sink and their lanes take the next samples.
         for (lane, hit) in lanes.iter_mut().zip(hits.iter_mut()) {
             let Some(state) = &mut lane.path else {
                 continue;
@@ -254,7 +250,7 @@ pub(super) fn render_tile_in_lanes(
                 count: &mut run.count,
             };
             if !path.step(ctx, state, si) {
-                run.finish(lane, &mut queue, cancel);
+                run.finish(lane, cancel);
             }
         }
     }

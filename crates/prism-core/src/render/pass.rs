@@ -4,13 +4,13 @@
 
 use std::ops::Range;
 
-use glam::UVec2;
+use glam::{UVec2, Vec2};
 use rayon::prelude::*;
 
 use super::RenderOptions;
 use super::estimator::SampleEstimator;
 use super::filter_mis::{SharedSamples, gather_tile};
-use super::lanes::{LaneCounter, render_tile_in_lanes};
+use super::lanes::{LaneCounter, SampleSink, trace_in_lanes};
 use super::progress::ProgressReport;
 use super::stop::Cancel;
 use super::tiles::{Tile, TileSums};
@@ -62,6 +62,44 @@ fn render_tile(
     Some(count.rays)
 }
 
+/// The pixels of `tile` (crop-window coordinates, the crop window at `crop_offset` on the
+/// film), row-major: each one's index in the tile and its film position.
+fn tile_pixels(tile: Tile, crop_offset: UVec2) -> impl Iterator<Item = (usize, UVec2)> {
+    (0..tile.size.y).flat_map(move |y| {
+        (0..tile.size.x).map(move |x| {
+            let i = (y * tile.size.x + x) as usize;
+            (i, crop_offset + tile.origin + UVec2::new(x, y))
+        })
+    })
+}
+
+/// The one-pixel reconstruction's sink for the lanes: a sample counts for its own pixel of
+/// the tile, weighted by the filter.
+struct PixelSink<'s> {
+    sums: &'s mut TileSums,
+    /// Extra channels per sample.
+    k: usize,
+}
+
+impl SampleSink for PixelSink<'_> {
+    fn add(
+        &mut self,
+        slot: usize,
+        _index: u32,
+        _offset: Vec2,
+        filter_weight: f32,
+        xyz: [f32; 3],
+        aovs: &[f32],
+    ) {
+        self.sums.pixels[slot].add(xyz.map(|v| v * filter_weight));
+        let start = slot * AOV_SUMS_PER_CHANNEL * self.k;
+        let sums = &mut self.sums.aovs[start..start + self.k];
+        for (sum, &v) in sums.iter_mut().zip(aovs) {
+            add_aov_sample(std::slice::from_mut(sum), &[v * filter_weight]);
+        }
+    }
+}
+
 /// What every pass of a render works with.
 pub(super) struct Pass<'p, 's> {
     pub(super) estimator: &'p SampleEstimator<'s>,
@@ -111,7 +149,21 @@ impl Pass<'_, '_> {
             .map(|((&tile, tile_sums), tile_out)| {
                 let result = match path {
                     Some(path) => {
-                        render_tile_in_lanes(self, path, tile, tile_sums, tile_out, range.clone())
+                        tile_out.clone_from(tile_sums);
+                        let k = estimator.aov_count();
+                        let mut sink = PixelSink { sums: tile_out, k };
+                        let (rays, occupancy) = trace_in_lanes(
+                            estimator,
+                            path,
+                            tile_pixels(tile, estimator.scene.film.crop.offset),
+                            range.clone(),
+                            options.samples_per_pixel,
+                            options.seed,
+                            cancel,
+                            &mut sink,
+                        )?;
+                        self.occupancy.add(occupancy);
+                        Some(rays)
                     }
                     None => render_tile(
                         estimator,
@@ -168,6 +220,7 @@ impl Pass<'_, '_> {
                 batch_range.clone(),
                 self.options,
                 self.cancel,
+                self.occupancy,
             )?;
             out.par_iter_mut()
                 .zip(self.tiles)
