@@ -457,6 +457,13 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             "prism: rendering took {:.3} s",
             output.elapsed.as_secs_f64()
         );
+        if let Some(occupancy) = output.lane_occupancy {
+            eprintln!(
+                "prism: paths in lanes: {:.1} of {} lanes held a path per step on average",
+                occupancy * prism_core::render::LANES as f64,
+                prism_core::render::LANES
+            );
+        }
     }
     let images = ImageOutput {
         exr: scene.exr_output,

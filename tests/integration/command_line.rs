@@ -120,6 +120,17 @@ fn a_verbose_render_gives_its_times() {
             "no line \"{line}...\" in:\n{text}"
         );
     }
+    // The Cornell box's path tracer runs its paths in lanes, nearly all of them busy.
+    let lanes = prism_core::render::LANES as f64;
+    let busy = text
+        .lines()
+        .find_map(|l| l.strip_prefix("prism: paths in lanes: "))
+        .and_then(|rest| rest.split(' ').next()?.parse::<f64>().ok())
+        .unwrap_or_else(|| panic!("no lane occupancy in:\n{text}"));
+    assert!(
+        busy > 0.5 * lanes && busy <= lanes,
+        "{busy} of {lanes} lanes busy"
+    );
 }
 
 /// A render takes the samples per pixel the scene's sampler asks for, whatever the
