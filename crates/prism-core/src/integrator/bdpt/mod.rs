@@ -12,7 +12,8 @@
 //! particle tracer's), at a point drawn uniformly over an area light's surface with a
 //! cosine-distributed direction about its normal, or at a point light with a uniform direction.
 //! Both go on by sampling the BSDF (the light subpath the adjoint BSDF, with the particle
-//! tracer's corrections for shading normals and refraction: [`super::ptracer`]), with Russian
+//! tracer's corrections for shading normals and refraction: [`super::ptracer`], but without
+//! ending where the geometric and shading normals disagree, as the camera subpath does not), with Russian
 //! roulette after `rr_depth` bounces; each vertex keeps its throughput β, its densities per
 //! unit area from either side (`pdf_fwd`, `pdf_rev`) and whether it scattered by a delta lobe.
 //!
@@ -66,7 +67,7 @@ use crate::camera::{Camera, CameraModel};
 use crate::geometry::SurfaceInteraction;
 use crate::geometry::offset::offset_ray_origin;
 use crate::integrator::vertex::{
-    hero_only, normals_agree, russian_roulette, surface_scattering, wavelengths_after,
+    hero_only, russian_roulette, surface_scattering, wavelengths_after,
 };
 use crate::integrator::{LightPathSample, SampleContext, Splat};
 use crate::light::{Light, LightQuery, LightSource, Receiver};
@@ -291,15 +292,12 @@ impl Connections<'_> {
 
     /// What the light-side vertex `v` (a surface whose light arrives from `v.wo`) sends along
     /// `w`: f(w, wo) |cos θ_wo| with the adjoint's shading-normal factor |cos_g θ_w| / |cos_g
-    /// θ_wo| (the particle tracer's, evaluated from the side the light leaves to, so that it
-    /// holds across refractions too); zero where the geometric and shading normals disagree.
+    /// θ_wo| (Veach's eq. 5.19, evaluated from the side the light leaves to, so that it holds
+    /// across refractions too).
     fn light_side(&self, v: &Vertex, w: Vec3) -> SampledSpectrum {
         let Point::Surface(si) = &v.point else {
             return self.emission_towards(v, w);
         };
-        if !normals_agree(si, v.wo) || !normals_agree(si, w) {
-            return SampledSpectrum::ZERO;
-        }
         let mut lobes = BxdfTree::empty();
         let scattering = self
             .world
@@ -408,14 +406,14 @@ impl Connections<'_> {
     }
 }
 
-/// The adjoint BSDF's shading-normal correction at `si` (the particle tracer's): None where the
-/// geometric and shading normals put either direction on different sides.
+/// The adjoint BSDF's shading-normal correction at `si` for light arriving from `w_light` and
+/// leaving along `w_out`, |cos_s θ_light| |cos_g θ_out| / (|cos_g θ_light| |cos_s θ_out|)
+/// (Veach's eq. 5.19, pbrt-v4's `CorrectShadingNormal`). Unlike the particle tracer, directions
+/// the geometric and shading normals put on different sides do not end the subpath: the camera
+/// subpath (the path tracer's) scatters there, and every strategy must see the same integrand.
 fn shading_correction(si: &SurfaceInteraction, w_light: Vec3, w_out: Vec3) -> Option<f32> {
     let (light_g, light_s) = (si.n.dot(w_light), si.shading.n.dot(w_light));
     let (out_g, out_s) = (si.n.dot(w_out), si.shading.n.dot(w_out));
-    if !(light_g * light_s > 0.0 && out_g * out_s > 0.0) {
-        return None;
-    }
     let correction = ((light_s * out_g) / (out_s * light_g)).abs();
     correction.is_finite().then_some(correction)
 }
