@@ -596,7 +596,9 @@ fn report(
         output.relative_error,
         match scene.integrator {
             // Light subpaths feed many pixels: the error is estimated from whole sample indices.
-            Integrator::Particle(_) => " (by batch means over sample indices)",
+            Integrator::Particle(_) | Integrator::Bdpt(_) => {
+                " (by batch means over sample indices)"
+            }
             _ => "",
         },
         exr.display(),
@@ -619,6 +621,13 @@ fn trace_pixel(
         return Err(Error::usage(
             "--pixel prints a pixel's camera samples, and ptracer takes none: its light \
              subpaths reach pixels anywhere on the film",
+        )
+        .with_help("render a --crop around the pixel instead"));
+    }
+    if let Integrator::Bdpt(_) = scene.integrator {
+        return Err(Error::usage(
+            "--pixel prints a pixel's camera samples, and bdpt's are not the pixel's whole \
+             estimate: its light subpaths reach pixels anywhere on the film",
         )
         .with_help("render a --crop around the pixel instead"));
     }

@@ -19,7 +19,7 @@ use crate::common::scenes::{
 };
 
 /// The inside of a unit sphere: normals point inwards, so the inner face is the front.
-fn inner_sphere() -> Shape {
+pub(super) fn inner_sphere() -> Shape {
     Shape::Sphere(Sphere {
         center: Vec3::ZERO,
         radius: 1.0,
@@ -48,7 +48,7 @@ fn furnace(
 }
 
 /// The scene of [`furnace`].
-fn furnace_scene(
+pub(super) fn furnace_scene(
     shape: Shape,
     rho: f32,
     le: f32,

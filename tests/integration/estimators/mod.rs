@@ -1,7 +1,8 @@
 //! The integrators' estimators against closed forms and against each other, their error, and
-//! the `aov` and `moment` integrators, and the particle tracer.
+//! the `aov` and `moment` integrators, the particle tracer and bidirectional path tracing.
 
 mod aov;
+mod bdpt;
 mod closed_form;
 mod convergence;
 mod depth;

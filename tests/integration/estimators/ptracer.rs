@@ -84,7 +84,7 @@ fn ptracer_reported_variance_predicts_the_spread_between_renders() {
     );
 }
 
-fn cornell_box(size: u32) -> Scene {
+pub(super) fn cornell_box(size: u32) -> Scene {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cornell-box/scene.xml");
     let defines = [
         ("resx".to_string(), size.to_string()),
@@ -108,7 +108,7 @@ fn ptracer_and_path_agree_on_the_cornell_box() {
 
 /// A small scene lit by `emitter` (XML), with a diffuse floor and back wall, a diffuse sphere
 /// and `extra` shapes, seen by `sensor` (XML, without film or sampler).
-fn lit_scene(sensor: &str, emitter: &str, extra: &str) -> Scene {
+pub(super) fn lit_scene(sensor: &str, emitter: &str, extra: &str) -> Scene {
     let folder = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/emitters");
     let xml = format!(
         r#"<scene version="3.0.0">
@@ -134,7 +134,7 @@ fn lit_scene(sensor: &str, emitter: &str, extra: &str) -> Scene {
     scene.unwrap()
 }
 
-const PINHOLE: &str = r#"<sensor type="perspective">
+pub(super) const PINHOLE: &str = r#"<sensor type="perspective">
         <float name="fov" value="60"/>
         <transform name="to_world"><lookat origin="0, -3, 1.6" target="0, 0, 0.5" up="0, 0, 1"/></transform>
         <sampler type="independent"/>
@@ -236,7 +236,7 @@ fn ptracer_and_path_agree_through_glass_and_shading_normals() {
 
 /// A unit sphere of `segments` × `rings` quads (the poles' as triangles) whose vertex normals
 /// are the smooth sphere's, far from its coarse faces' normals.
-fn coarse_sphere_obj(segments: u32, rings: u32) -> String {
+pub(super) fn coarse_sphere_obj(segments: u32, rings: u32) -> String {
     let mut obj = String::new();
     let index = |ring: u32, segment: u32| 1 + ring * segments + segment % segments;
     for ring in 0..=rings {

@@ -16,6 +16,7 @@
 //! weighed against it) and, for media, [`transmittance`].
 
 pub mod aov;
+pub mod bdpt;
 pub mod context;
 pub mod depth;
 pub mod direct;
@@ -30,6 +31,7 @@ pub mod volpath;
 pub mod volpathmis;
 
 pub use aov::AovIntegrator;
+pub use bdpt::BdptIntegrator;
 pub use context::{RayCount, SampleContext};
 pub use depth::DepthIntegrator;
 pub use direct::DirectIntegrator;
@@ -82,6 +84,7 @@ integrator_enum! {
         VolPath(VolPathIntegrator),
         Depth(DepthIntegrator),
         Particle(ParticleTracer),
+        Bdpt(BdptIntegrator),
     }
 }
 
@@ -108,7 +111,8 @@ impl Integrator {
             Integrator::Moment(_)
             | Integrator::Aov(_)
             | Integrator::Depth(_)
-            | Integrator::Particle(_) => LightSelection::Power,
+            | Integrator::Particle(_)
+            | Integrator::Bdpt(_) => LightSelection::Power,
         }
     }
 
@@ -122,7 +126,8 @@ impl Integrator {
             | Integrator::Distribution(_)
             | Integrator::VolPath(_)
             | Integrator::Depth(_)
-            | Integrator::Particle(_) => &[],
+            | Integrator::Particle(_)
+            | Integrator::Bdpt(_) => &[],
         };
         nested.iter().map(|(_, integrator)| integrator)
     }
@@ -136,6 +141,7 @@ impl Integrator {
             Integrator::VolPath(volpath) => volpath.hide_emitters,
             Integrator::Depth(_) => false,
             Integrator::Particle(ptracer) => ptracer.hide_emitters,
+            Integrator::Bdpt(bdpt) => bdpt.hide_emitters,
             Integrator::Moment(_) | Integrator::Aov(_) => match self.nested().next() {
                 Some(first) => first.hides_emitters(),
                 None => true,
@@ -160,7 +166,8 @@ impl Integrator {
             | Integrator::Distribution(_)
             | Integrator::VolPath(_)
             | Integrator::Depth(_)
-            | Integrator::Particle(_) => Vec::new(),
+            | Integrator::Particle(_)
+            | Integrator::Bdpt(_) => Vec::new(),
             Integrator::Moment(moment) => moment.aov_names(),
             Integrator::Aov(aov) => aov.aov_names(),
         }
@@ -211,6 +218,35 @@ impl PreparedIntegrator<'_> {
         ptracer.sample(ctx, sample, out);
     }
 
+    /// Bidirectional path tracing, where the integrator is it: its samples are a camera
+    /// subpath's estimate for its pixel and light subpaths' splats.
+    pub fn bidirectional(&self) -> Option<&BdptIntegrator> {
+        match self.integrator {
+            Integrator::Bdpt(bdpt) => Some(bdpt),
+            _ => None,
+        }
+    }
+
+    /// Traces one sample of bidirectional path tracing `bdpt` (this integrator's) from the
+    /// camera ray `ray`, drawing random numbers from `sampler`: returns the estimate for the
+    /// camera sample's pixel and hands the light subpaths' splats to `out`.
+    pub fn trace_bidirectional(
+        &self,
+        bdpt: &BdptIntegrator,
+        sample: &LightPathSample,
+        ray: Ray,
+        sampler: &mut Sampler,
+        count: &mut RayCount,
+        out: &mut impl Splat,
+    ) -> SampledSpectrum {
+        let ctx = &mut SampleContext {
+            prepared: self,
+            sampler,
+            count,
+        };
+        bdpt.sample(ctx, sample, ray, out)
+    }
+
     /// How many extra channels each sample writes.
     pub fn aov_count(&self) -> usize {
         self.aov_count
@@ -255,8 +291,8 @@ impl PreparedIntegrator<'_> {
             Integrator::Aov(integrator) => integrator.radiance(ctx, ray, lambda, aovs),
             Integrator::Depth(_) => DepthIntegrator::radiance(ctx, &ray),
             // Light subpaths reach the film by splats, not along camera rays: the render driver
-            // runs them ([`Self::trace_light_paths`]).
-            Integrator::Particle(_) => SampledSpectrum::ZERO,
+            // runs them ([`Self::trace_light_paths`], [`Self::trace_bidirectional`]).
+            Integrator::Particle(_) | Integrator::Bdpt(_) => SampledSpectrum::ZERO,
             Integrator::VolPath(integrator) => match integrator.tracking {
                 Tracking::Spectral => integrator.trace(SpectralTracking::new(), ctx, ray, lambda),
                 Tracking::HeroMis { spectral_mis } => {

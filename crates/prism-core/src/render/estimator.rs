@@ -5,6 +5,7 @@
 
 use glam::{UVec2, Vec2};
 
+use super::particles::Splatting;
 use crate::camera::{CameraModel, CameraRay};
 use crate::film::spectral_bands::band_values;
 use crate::film::{FilterMis, FilterSampler};
@@ -60,6 +61,25 @@ impl<'a> SampleEstimator<'a> {
     /// subpaths splatted onto the film, not camera samples.
     pub fn particle_tracer(&self) -> Option<&ParticleTracer> {
         self.integrator.particle_tracer()
+    }
+
+    /// The estimator whose samples are splatted, where the scene's integrator is one: the
+    /// particle tracer or bidirectional path tracing.
+    pub(super) fn splatting(&self) -> Option<Splatting<'_>> {
+        match (self.particle_tracer(), self.integrator.bidirectional()) {
+            (Some(ptracer), _) => Some(Splatting::Particle(ptracer)),
+            (None, Some(bdpt)) => Some(Splatting::Bidirectional(bdpt)),
+            (None, None) => None,
+        }
+    }
+
+    /// The film position (full film, pixels) of a camera sample of `pixel` drawn with `u`
+    /// through the reconstruction filter, and the filter weight the one-pixel estimator gives
+    /// it.
+    #[inline]
+    pub(super) fn film_position(&self, pixel: UVec2, u: Vec2) -> (Vec2, f32) {
+        let (offset, filter_weight) = self.filter.sample(u);
+        (pixel.as_vec2() + Vec2::splat(0.5) + offset, filter_weight)
     }
 
     /// How many extra channels each sample writes: the integrator's, the alpha, the bands.

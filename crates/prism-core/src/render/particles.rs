@@ -1,6 +1,8 @@
 //! A pass of the particle tracer: for each sample index, one light-subpath sample per pixel of
 //! the full film (keyed, as camera samples are, by the pixel and the index), splatted through
-//! the reconstruction filter onto the crop window ([`crate::film::splat`]).
+//! the reconstruction filter onto the crop window ([`crate::film::splat`]). Bidirectional path
+//! tracing runs the same way, each sample also tracing a camera subpath from its pixel, whose
+//! estimate adds to that pixel ([`Splatting`]).
 //!
 //! The light subpaths of one index are traced in parallel, a few hundred pixels' worth at a
 //! time, in batches that bound the memory their contributions take before they are gathered
@@ -24,9 +26,10 @@ use rayon::prelude::*;
 
 use super::pass::Pass;
 use super::tiles::TileSums;
+use crate::camera::{CameraModel, CameraRay};
 use crate::film::accumulation::{AOV_SUMS_PER_CHANNEL, acceptable_sample, add_aov_sample};
-use crate::film::{SplatSums, SplatValue, Splatter};
-use crate::integrator::{LightPathSample, ParticleTracer, RayCount, Splat};
+use crate::film::{CropWindow, SplatSums, SplatValue, Splatter};
+use crate::integrator::{BdptIntegrator, LightPathSample, ParticleTracer, RayCount, Splat};
 use crate::sampling::sampler::Sampler;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 
@@ -35,13 +38,47 @@ const PATHS_PER_TASK: u32 = 256;
 /// Tasks traced before their contributions are gathered.
 const TASKS_PER_BATCH: usize = 64;
 
+/// The estimators whose samples are splatted.
+#[derive(Clone, Copy, Debug)]
+pub(super) enum Splatting<'a> {
+    /// The particle tracer: light subpaths alone.
+    Particle(&'a ParticleTracer),
+    /// Bidirectional path tracing: a camera sample of the pixel the sample is keyed by, whose
+    /// estimate adds to that pixel alone (weighted by the reconstruction filter as the
+    /// one-pixel reconstruction weighs it), and a light subpath whose connections to the
+    /// camera are splatted.
+    Bidirectional(&'a BdptIntegrator),
+}
+
 /// Gathers one task's contributions in CIE XYZ, spread over the pixels they reach.
 struct Collector<'a> {
     splatter: &'a Splatter,
+    crop: CropWindow,
     /// The wavelengths of the sample at hand, and its shutter weight.
     lambda: SampledWavelengths,
     time_weight: f32,
     values: Vec<SplatValue>,
+}
+
+impl Collector<'_> {
+    /// Adds the CIE XYZ `xyz` to the full film's pixel `pixel` alone, if it is in the crop
+    /// window.
+    fn add_to_pixel(&mut self, pixel: UVec2, xyz: [f32; 3]) {
+        let (offset, size) = (self.crop.offset, self.crop.size);
+        if pixel.x < offset.x
+            || pixel.y < offset.y
+            || pixel.x >= offset.x + size.x
+            || pixel.y >= offset.y + size.y
+            || !acceptable_sample(&xyz)
+        {
+            return;
+        }
+        let local = pixel - offset;
+        self.values.push(SplatValue {
+            pixel: local.y * size.x + local.x,
+            xyz: xyz.map(f64::from),
+        });
+    }
 }
 
 impl Splat for Collector<'_> {
@@ -73,7 +110,7 @@ impl Pass<'_, '_> {
     /// was cancelled.
     pub(super) fn render_particles(
         &self,
-        ptracer: &ParticleTracer,
+        splatting: Splatting,
         sums: &[TileSums],
         out: &mut [TileSums],
         range: Range<u32>,
@@ -102,7 +139,7 @@ impl Pass<'_, '_> {
             for batch in tasks.chunks(TASKS_PER_BATCH) {
                 let traced: Vec<Option<(Vec<SplatValue>, u64)>> = batch
                     .par_iter()
-                    .map(|pixels| self.trace_task(ptracer, &splatter, pixels.clone(), index))
+                    .map(|pixels| self.trace_task(splatting, &splatter, pixels.clone(), index))
                     .collect();
                 for task in traced {
                     let (values, task_rays) = task?;
@@ -136,7 +173,7 @@ impl Pass<'_, '_> {
     /// pass was cancelled.
     fn trace_task(
         &self,
-        ptracer: &ParticleTracer,
+        splatting: Splatting,
         splatter: &Splatter,
         pixels: Range<u32>,
         index: u32,
@@ -154,6 +191,7 @@ impl Pass<'_, '_> {
         let mut count = RayCount::default();
         let mut collector = Collector {
             splatter,
+            crop: film.crop,
             lambda: SampledWavelengths::sample(0.5, film.wavelength_sampling),
             time_weight: 1.0,
             values: Vec::new(),
@@ -172,13 +210,33 @@ impl Pass<'_, '_> {
                 time,
                 u_lens: primary.lens,
             };
-            self.estimator.integrator.trace_light_paths(
-                ptracer,
-                &sample,
-                &mut sampler,
-                &mut count,
-                &mut collector,
-            );
+            let integrator = &self.estimator.integrator;
+            match splatting {
+                Splatting::Particle(ptracer) => integrator.trace_light_paths(
+                    ptracer,
+                    &sample,
+                    &mut sampler,
+                    &mut count,
+                    &mut collector,
+                ),
+                Splatting::Bidirectional(bdpt) => {
+                    let (film_position, filter_weight) =
+                        self.estimator.film_position(pixel, primary.film);
+                    let CameraRay { ray, weight } =
+                        scene.camera.generate_ray(film_position, primary.lens, time);
+                    let radiance = integrator.trace_bidirectional(
+                        bdpt,
+                        &sample,
+                        ray,
+                        &mut sampler,
+                        &mut count,
+                        &mut collector,
+                    );
+                    let scale = weight * time_weight * filter_weight;
+                    let xyz = lambda.to_xyz(&radiance).map(|v| v * scale);
+                    collector.add_to_pixel(pixel, xyz);
+                }
+            }
         }
         Some((collector.values, count.rays))
     }

@@ -1,6 +1,6 @@
 //! A pass of a render: the samples of a range of indices added to every pixel of the crop
 //! window, the tiles in parallel, by the one-pixel reconstruction or by filter MIS (or, for the
-//! particle tracer, by splatting: [`super::particles`]).
+//! particle tracer and bidirectional path tracing, by splatting: [`super::particles`]).
 
 use std::ops::Range;
 
@@ -122,8 +122,8 @@ impl Pass<'_, '_> {
         range: Range<u32>,
     ) -> Option<u64> {
         out.resize_with(sums.len(), TileSums::default);
-        if let Some(ptracer) = self.estimator.particle_tracer() {
-            return self.render_particles(ptracer, sums, out, range);
+        if let Some(splatting) = self.estimator.splatting() {
+            return self.render_particles(splatting, sums, out, range);
         }
         match &self.estimator.shared {
             Some(mis) => self.render_shared(mis, sums, out, range),

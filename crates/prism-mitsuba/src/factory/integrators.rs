@@ -1,6 +1,7 @@
 //! Integrator plugins: `path` (with Prism's `emitter_sampling`, see
 //! [`prism_core::light::sampler`]), `direct`, `moment`, `aov`, the lecture's `distrib`, and
-//! `volpath` and `volpathmis` for media, and `ptracer`, the particle tracer.
+//! `volpath` and `volpathmis` for media, `ptracer`, the particle tracer, and Mitsuba 0.6's
+//! `bdpt`, bidirectional path tracing.
 
 use crate::description::{PluginClass, PluginNode, Warning};
 use crate::params::Params;
@@ -11,8 +12,8 @@ use prism_core::film::output::IMAGE_CHANNELS;
 use prism_core::integrator::aov::{Aov, AovKind};
 use prism_core::integrator::distribution::DirectLights;
 use prism_core::integrator::{
-    AovIntegrator, DepthIntegrator, DirectIntegrator, DistributionIntegrator, Integrator,
-    MomentIntegrator, ParticleTracer, PathIntegrator, Tracking, VolPathIntegrator,
+    AovIntegrator, BdptIntegrator, DepthIntegrator, DirectIntegrator, DistributionIntegrator,
+    Integrator, MomentIntegrator, ParticleTracer, PathIntegrator, Tracking, VolPathIntegrator,
 };
 use prism_core::light::{Light, LightSelection};
 
@@ -134,6 +135,24 @@ pub static INTEGRATORS: Registry<Build> = Registry {
             params: &[MAX_DEPTH, RR_DEPTH, HIDE_EMITTERS, SAMPLES_PER_PASS],
             build: build_ptracer,
         },
+        Plugin {
+            name: "bdpt",
+            origin: Origin::Mitsuba06,
+            summary: "Bidirectional path tracing (Veach 1997, ch. 10): a camera subpath and a \
+                      light subpath per sample, every pair of their vertices connected, all \
+                      strategies weighted by the power heuristic; the light-tracing \
+                      connections (t = 1) splatted through the reconstruction filter. Surfaces, \
+                      area and point lights only; its error estimate is by batch means over \
+                      sample indices.",
+            params: &[
+                MAX_DEPTH,
+                RR_DEPTH,
+                HIDE_EMITTERS,
+                LIGHT_IMAGE,
+                SAMPLE_DIRECT,
+            ],
+            build: build_bdpt,
+        },
     ],
 };
 
@@ -154,6 +173,8 @@ params! {
     SHADOW_RAYS = ParamSpec::new("shadow_rays", ParamKind::Integer, Default::Integer(4), "shadow rays per light at potential 1 (1 to 1024)");
     LIGHTS = ParamSpec::new("lights", ParamKind::Choice(&[Choice::new("exhaustive", &DirectLights::One(LightSelection::Exhaustive)), Choice::new("power", &DirectLights::One(LightSelection::Power)), Choice::new("uniform", &DirectLights::One(LightSelection::Uniform)), Choice::new("all", &DirectLights::All)]), Default::Str("exhaustive"), "one light per vertex chosen ∝ its importance there, ∝ power or uniformly (as the path integrator's `emitter_sampling`), or every light");
     SAMPLES_PER_PASS = ParamSpec::new("samples_per_pass", ParamKind::Integer, Default::Integer(-1), "the most samples per pixel a pass of the render takes (−1: as the render driver chooses)");
+    LIGHT_IMAGE = ParamSpec::new("light_image", ParamKind::Boolean, Default::Boolean(true), "Mitsuba 0.6's `lightImage`: use the strategies that connect light subpaths to the camera (t = 1)");
+    SAMPLE_DIRECT = ParamSpec::new("sample_direct", ParamKind::Boolean, Default::Boolean(true), "Mitsuba 0.6's `sampleDirect`: connect each camera vertex to a point drawn by light sampling (s = 1) rather than to the light subpath's first vertex");
     RR_THRESHOLD = ParamSpec::new("rr_threshold", ParamKind::Float, Default::Float(0.1), "potential below which Russian roulette starts");
 }
 
@@ -258,6 +279,16 @@ fn build_ptracer(params: &Params) -> Result<Integrator> {
         rr_depth: rr_depth(params)?,
         hide_emitters: params.boolean(&HIDE_EMITTERS)?,
         samples_per_pass,
+    }))
+}
+
+fn build_bdpt(params: &Params) -> Result<Integrator> {
+    Ok(Integrator::Bdpt(BdptIntegrator {
+        max_depth: max_depth(params)?,
+        rr_depth: rr_depth(params)?,
+        hide_emitters: params.boolean(&HIDE_EMITTERS)?,
+        light_image: params.boolean(&LIGHT_IMAGE)?,
+        sample_direct: params.boolean(&SAMPLE_DIRECT)?,
     }))
 }
 

@@ -123,6 +123,7 @@ pub fn build_scene_with_geometry(
     builder.declared_media(&params)?;
     params.finish()?;
     check_renders_media(&integrator, &builder.media)?;
+    check_bdpt_lights(&integrator, &builder.lights, &builder.light_locations)?;
     let delta_light_warning = integrator_child.and_then(|child| {
         integrators::direct_delta_light_warning(&child.node, &integrator, &builder.lights)
     });
@@ -201,7 +202,7 @@ fn check_band_names(
     }
 }
 
-/// The ptracer integrator connects light subpaths to a camera: a sensor of one ray or one
+/// The ptracer and bdpt integrators connect light subpaths to a camera: a sensor of one ray or one
 /// direction (`radiancemeter`, `distant`), a surface's meter (`irradiancemeter`) or a `batch`
 /// cannot take it (an error at the integrator, `location`).
 fn check_connectable(
@@ -209,26 +210,32 @@ fn check_connectable(
     sensor: &SensorSettings,
     location: &SourceLocation,
 ) -> Result<()> {
-    let kind = match (integrator, &sensor.camera) {
-        (Integrator::Particle(_), Camera::RadianceMeter(_)) => "radiancemeter",
-        (Integrator::Particle(_), Camera::IrradianceMeter(_)) => "irradiancemeter",
-        (Integrator::Particle(_), Camera::Distant(_)) => "distant",
-        (Integrator::Particle(_), Camera::Batch(_)) => "batch",
+    let name = match integrator {
+        Integrator::Particle(_) => "ptracer",
+        Integrator::Bdpt(_) => "bdpt",
         _ => return Ok(()),
+    };
+    let kind = match &sensor.camera {
+        Camera::RadianceMeter(_) => "radiancemeter",
+        Camera::IrradianceMeter(_) => "irradiancemeter",
+        Camera::Distant(_) => "distant",
+        Camera::Batch(_) => "batch",
+        Camera::Perspective(_) | Camera::Orthographic(_) => return Ok(()),
     };
     Err(Error::input(
         location,
-        format!("the ptracer integrator cannot connect light paths to a {kind} sensor"),
+        format!("the {name} integrator cannot connect light paths to a {kind} sensor"),
     )
     .with_help("render it with <integrator type=\"path\">, or use a perspective, thinlens or orthographic sensor"))
 }
 
-/// The distrib and ptracer integrators estimate no participating media: a scene with media
-/// and either is an error at the first medium.
+/// The distrib, ptracer and bdpt integrators estimate no participating media: a scene with
+/// media and any of them is an error at the first medium.
 fn check_renders_media(integrator: &Integrator, media: &MediaCache) -> Result<()> {
     let name = match integrator {
         Integrator::Distribution(_) => "distrib",
         Integrator::Particle(_) => "ptracer",
+        Integrator::Bdpt(_) => "bdpt",
         _ => return Ok(()),
     };
     if let Some(location) = &media.first {
@@ -238,6 +245,37 @@ fn check_renders_media(integrator: &Integrator, media: &MediaCache) -> Result<()
         )
         .with_help(
             "render scenes with media with <integrator type=\"volpath\"> or \"volpathmis\"",
+        ));
+    }
+    Ok(())
+}
+
+/// The bdpt integrator starts light subpaths on area and point lights only: any other light is
+/// an error where it was declared.
+fn check_bdpt_lights(
+    integrator: &Integrator,
+    lights: &[Light],
+    locations: &[SourceLocation],
+) -> Result<()> {
+    if !matches!(integrator, Integrator::Bdpt(_)) {
+        return Ok(());
+    }
+    for (light, location) in lights.iter().zip(locations) {
+        let kind = match light {
+            Light::Area(_) | Light::Point(_) => continue,
+            Light::Spot(_) => "spot",
+            Light::Projector(_) => "projector",
+            Light::Directional(_) => "directional",
+            Light::Constant(_) => "constant",
+            Light::Envmap(_) => "envmap",
+            Light::Sunsky(_) => "sunsky",
+        };
+        return Err(Error::input(
+            location,
+            format!("the bdpt integrator does not start light paths on a {kind} emitter"),
+        )
+        .with_help(
+            "bdpt takes area and point emitters; render this scene with <integrator type=\"path\">",
         ));
     }
     Ok(())
@@ -255,6 +293,8 @@ struct SceneBuilder {
     medium_interfaces: Vec<MediumInterface>,
     lights: Vec<Light>,
     emitter_plugins: Vec<Arc<PluginNode>>,
+    /// Where each light was declared.
+    light_locations: Vec<SourceLocation>,
     sampling_weights: Vec<f32>,
     /// The area emitters attached to shapes, with where each was attached (an emitter declared
     /// at the top level with an id reaches its shape by a `<ref>`).
@@ -378,6 +418,7 @@ impl SceneBuilder {
             let (light, weight) = lights::build_scene_light(&emitter.node, &mut self.textures)?;
             self.lights.push(light);
             self.emitter_plugins.push(emitter.node.clone());
+            self.light_locations.push(emitter.location.clone());
             self.sampling_weights.push(weight);
             return Ok(None);
         }
@@ -396,6 +437,7 @@ impl SceneBuilder {
             lights::build_area_light(&emitter.node, shape_index, &mut self.textures)?;
         self.lights.push(light);
         self.emitter_plugins.push(emitter.node.clone());
+        self.light_locations.push(emitter.location.clone());
         self.sampling_weights.push(weight);
         Ok(Some((self.lights.len() - 1) as u32))
     }
@@ -443,8 +485,9 @@ impl SceneBuilder {
             self.emitter_plugins.push(child.node.clone());
         }
         lights::check_single_environment(&scene_lights)?;
-        for (light, weight, _) in scene_lights {
+        for (light, weight, location) in scene_lights {
             self.lights.push(light);
+            self.light_locations.push(location);
             self.sampling_weights.push(weight);
         }
         Ok(())
