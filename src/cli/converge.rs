@@ -90,6 +90,7 @@ fn integrator_named(name: &str, scene: &Scene) -> Result<Integrator> {
         Integrator::Distribution(d) => d.max_depth,
         Integrator::VolPath(v) => v.max_depth,
         Integrator::Particle(p) => p.max_depth,
+        Integrator::Sppm(s) => s.max_depth,
         Integrator::Moment(_) | Integrator::Aov(_) | Integrator::Depth(_) => -1,
     };
     let defaults: Integrator = match name {
@@ -157,6 +158,7 @@ fn integrator_label(integrator: &Integrator) -> &'static str {
         Integrator::Aov(_) => "aov",
         Integrator::Depth(_) => "depth",
         Integrator::Particle(_) => "ptracer",
+        Integrator::Sppm(_) => "sppm",
     }
 }
 

@@ -590,6 +590,8 @@ fn report(
         match scene.integrator {
             // Light subpaths feed many pixels: the error is estimated from whole sample indices.
             Integrator::Particle(_) => " (by batch means over sample indices)",
+            // A biased estimate with one value per pixel: there is no error to report.
+            Integrator::Sppm(_) => " (sppm: biased, no error estimate)",
             _ => "",
         },
         exr.display(),
@@ -612,6 +614,13 @@ fn trace_pixel(
         return Err(Error::usage(
             "--pixel prints a pixel's camera samples, and ptracer takes none: its light \
              subpaths reach pixels anywhere on the film",
+        )
+        .with_help("render a --crop around the pixel instead"));
+    }
+    if matches!(scene.integrator, Integrator::Sppm(_)) {
+        return Err(Error::usage(
+            "--pixel prints a pixel's camera samples, and sppm's passes depend on the photons \
+             of the whole scene",
         )
         .with_help("render a --crop around the pixel instead"));
     }

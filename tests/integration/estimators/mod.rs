@@ -8,4 +8,5 @@ mod depth;
 mod direct;
 mod moment;
 mod ptracer;
+mod sppm;
 mod strict_normals;

@@ -24,6 +24,7 @@ pub mod mis;
 pub mod moment;
 pub mod path;
 pub mod ptracer;
+pub mod sppm;
 pub mod transmittance;
 pub mod vertex;
 pub mod volpath;
@@ -37,6 +38,7 @@ pub use distribution::DistributionIntegrator;
 pub use moment::MomentIntegrator;
 pub use path::PathIntegrator;
 pub use ptracer::{LightPathSample, ParticleTracer, Splat};
+pub use sppm::SppmIntegrator;
 pub use volpath::{Tracking, VolPathIntegrator};
 
 use volpath::SpectralTracking;
@@ -82,6 +84,7 @@ integrator_enum! {
         VolPath(VolPathIntegrator),
         Depth(DepthIntegrator),
         Particle(ParticleTracer),
+        Sppm(SppmIntegrator),
     }
 }
 
@@ -108,7 +111,8 @@ impl Integrator {
             Integrator::Moment(_)
             | Integrator::Aov(_)
             | Integrator::Depth(_)
-            | Integrator::Particle(_) => LightSelection::Power,
+            | Integrator::Particle(_)
+            | Integrator::Sppm(_) => LightSelection::Power,
         }
     }
 
@@ -122,7 +126,8 @@ impl Integrator {
             | Integrator::Distribution(_)
             | Integrator::VolPath(_)
             | Integrator::Depth(_)
-            | Integrator::Particle(_) => &[],
+            | Integrator::Particle(_)
+            | Integrator::Sppm(_) => &[],
         };
         nested.iter().map(|(_, integrator)| integrator)
     }
@@ -136,6 +141,7 @@ impl Integrator {
             Integrator::VolPath(volpath) => volpath.hide_emitters,
             Integrator::Depth(_) => false,
             Integrator::Particle(ptracer) => ptracer.hide_emitters,
+            Integrator::Sppm(_) => false,
             Integrator::Moment(_) | Integrator::Aov(_) => match self.nested().next() {
                 Some(first) => first.hides_emitters(),
                 None => true,
@@ -160,7 +166,8 @@ impl Integrator {
             | Integrator::Distribution(_)
             | Integrator::VolPath(_)
             | Integrator::Depth(_)
-            | Integrator::Particle(_) => Vec::new(),
+            | Integrator::Particle(_)
+            | Integrator::Sppm(_) => Vec::new(),
             Integrator::Moment(moment) => moment.aov_names(),
             Integrator::Aov(aov) => aov.aov_names(),
         }
@@ -189,6 +196,15 @@ impl PreparedIntegrator<'_> {
     pub fn particle_tracer(&self) -> Option<&ParticleTracer> {
         match self.integrator {
             Integrator::Particle(ptracer) => Some(ptracer),
+            _ => None,
+        }
+    }
+
+    /// Stochastic progressive photon mapping, where the integrator is it: the render driver
+    /// runs its passes, which keep statistics per pixel from one pass to the next.
+    pub fn sppm(&self) -> Option<&SppmIntegrator> {
+        match self.integrator {
+            Integrator::Sppm(sppm) => Some(sppm),
             _ => None,
         }
     }
@@ -247,7 +263,8 @@ impl PreparedIntegrator<'_> {
             Integrator::Depth(_) => DepthIntegrator::radiance(ctx, &ray),
             // Light subpaths reach the film by splats, not along camera rays: the render driver
             // runs them ([`Self::trace_light_paths`]).
-            Integrator::Particle(_) => SampledSpectrum::ZERO,
+            // So do photon mapping's passes ([`Self::sppm`]).
+            Integrator::Particle(_) | Integrator::Sppm(_) => SampledSpectrum::ZERO,
             Integrator::VolPath(integrator) => match integrator.tracking {
                 Tracking::Spectral => integrator.trace(SpectralTracking::new(), ctx, ray, lambda),
                 Tracking::HeroMis { spectral_mis } => {

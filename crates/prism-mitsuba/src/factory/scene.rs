@@ -217,12 +217,13 @@ fn check_connectable(
     .with_help("render it with <integrator type=\"path\">, or use a perspective, thinlens or orthographic sensor"))
 }
 
-/// The distrib and ptracer integrators estimate no participating media: a scene with media
-/// and either is an error at the first medium.
+/// The distrib, ptracer and sppm integrators estimate no participating media: a scene with
+/// media and any of them is an error at the first medium.
 fn check_renders_media(integrator: &Integrator, media: &MediaCache) -> Result<()> {
     let name = match integrator {
         Integrator::Distribution(_) => "distrib",
         Integrator::Particle(_) => "ptracer",
+        Integrator::Sppm(_) => "sppm",
         _ => return Ok(()),
     };
     if let Some(location) = &media.first {
