@@ -573,12 +573,19 @@ fn report(
         StopReason::TargetError => ", target error reached",
         StopReason::Interrupted => ", interrupted",
     };
+    // sppm's pixels hold one estimate each: its count is the passes.
+    let (count, unit) = match scene.integrator {
+        Integrator::Sppm(_) => (
+            u64::from(output.samples.end - output.samples.start),
+            "passes",
+        ),
+        _ => (output.film.pixels.first().map_or(0, |p| p.samples), "spp"),
+    };
     eprintln!(
-        "prism: rendered {} ({}×{}, {} spp{stopped}{}) in {:.2} s: {:.3} M samples/s, {:.2} M rays/s, mean relative error {:.4}{} -> {}, {}",
+        "prism: rendered {} ({}×{}, {count} {unit}{stopped}{}) in {:.2} s: {:.3} M samples/s, {:.2} M rays/s, mean relative error {:.4}{} -> {}, {}",
         args.scene.display(),
         scene.film.crop.size.x,
         scene.film.crop.size.y,
-        output.film.pixels.first().map_or(0, |p| p.samples),
         match Accel::of(&scene.world.geometry) {
             Accel::Bvh => "",
             Accel::Embree => ", traced by Embree",

@@ -1,5 +1,5 @@
 //! The integrators' estimators against closed forms and against each other, their error, and
-//! the `aov` and `moment` integrators, and the particle tracer.
+//! the `aov` and `moment` integrators, the particle tracer and photon mapping.
 
 mod aov;
 mod closed_form;

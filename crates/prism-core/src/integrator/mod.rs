@@ -2,7 +2,8 @@
 //! illumination, the lecture's distribution ray tracer with splitting and the volumetric path
 //! tracers; `moment` runs nested integrators and writes their estimates and second moments as
 //! extra film channels, `aov` the albedo, normals, depth and other variables of the first hit
-//! beside nested integrators' images.
+//! beside nested integrators' images. `ptracer` and `sppm` start paths at the lights too; the
+//! render driver runs their passes.
 //!
 //! An [`Integrator`] is what a scene asks for: an estimator and its parameters. Before a render
 //! it is prepared for the world ([`Integrator::prepare`]), which builds the light sampler it

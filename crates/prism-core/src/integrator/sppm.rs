@@ -12,7 +12,7 @@
 //!   light chosen by power and a ray of its emission with weight β = L_e |cos θ| /
 //!   (P(light) p_A p_ω), continued by sampling the adjoint BSDF as the particle tracer does
 //!   (Veach's shading-normal factor, η² on refractions, Russian roulette after `rrDepth`
-//!   bounces). At the k-th surface it meets (k ≥ 2) where the BSDF has a smooth lobe, the
+//!   bounces on the weight relative to the emitted one). At the k-th surface it meets (k ≥ 2) where the BSDF has a smooth lobe, the
 //!   photon (position, incident direction, β, k) is stored; the first hits (k = 1) are direct
 //!   light, which the camera side estimates by light sampling, as in pbrt-v4. The photons of a
 //!   pass form a [`PhotonMap`], a hash grid with cells as wide as the largest search radius.
@@ -30,7 +30,7 @@
 //! The driver turns (Φ, M) into the pixel's progressive estimate: with N the pixel's
 //! accumulated photon count, N' = N + αM, r'² = r² N'/(N + M), τ' = (τ + Φ) r'²/r², and after
 //! P passes of `photonCount` photons each L = Σ L_direct / P + τ / (P · photonCount · π r²)
-//! (Hachisuka & Jensen 2009, eqs. 5–8; Knaus & Zwicker 2011 for the per-pixel radius schedule).
+//! (Hachisuka & Jensen 2009, eqs. 5–8, with one statistic per pixel as pbrt-v4 keeps them).
 //!
 //! **Wavelengths.** Every pass draws one set of wavelengths (a hero and its three rotations)
 //! that every pixel and every photon of the pass use. A photon's β and a camera path's weight
@@ -148,14 +148,6 @@ impl PhotonMap {
             starts,
             cell_size,
         }
-    }
-
-    pub fn len(&self) -> usize {
-        self.photons.len()
-    }
-
-    pub fn is_empty(&self) -> bool {
-        self.photons.is_empty()
     }
 
     /// Calls `f` for every photon within `radius` (at most the largest radius the map was
@@ -423,3 +415,44 @@ const LIGHT_SAMPLES_ONLY: Strategies = Strategies {
     light_samples: 1.0,
     bsdf_samples: 0.0,
 };
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sampling::rng::Pcg32;
+
+    /// A search of the map finds exactly the photons a search of every photon finds, in
+    /// searches of radii up to the largest, over photons spread across many cells (including
+    /// negative coordinates).
+    #[test]
+    fn photon_map_finds_what_a_brute_force_search_finds() {
+        let mut rng = Pcg32::seeded(3);
+        let point = |rng: &mut Pcg32| {
+            Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 4.0 - Vec3::splat(2.0)
+        };
+        let photons: Vec<Photon> = (0..5000)
+            .map(|i| Photon {
+                p: point(&mut rng),
+                wi: Vec3::Z,
+                beta: SampledSpectrum::splat(1.0),
+                depth: i,
+                hero_only: false,
+            })
+            .collect();
+        let largest = 0.3;
+        let map = PhotonMap::new(photons.clone(), largest);
+        for _ in 0..500 {
+            let p = point(&mut rng);
+            let radius = largest * rng.next_f32();
+            let mut found = Vec::new();
+            map.for_each_near(p, radius, |photon| found.push(photon.depth));
+            found.sort_unstable();
+            let expected: Vec<i32> = photons
+                .iter()
+                .filter(|photon| (photon.p - p).length_squared() <= radius * radius)
+                .map(|photon| photon.depth)
+                .collect();
+            assert_eq!(found, expected, "search at {p} within {radius}");
+        }
+    }
+}
