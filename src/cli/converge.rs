@@ -91,6 +91,7 @@ fn integrator_named(name: &str, scene: &Scene) -> Result<Integrator> {
         Integrator::VolPath(v) => v.max_depth,
         Integrator::Particle(p) => p.max_depth,
         Integrator::Bdpt(b) => b.max_depth,
+        Integrator::Sppm(s) => s.max_depth,
         Integrator::Moment(_) | Integrator::Aov(_) | Integrator::Depth(_) => -1,
     };
     let defaults: Integrator = match name {
@@ -159,6 +160,7 @@ fn integrator_label(integrator: &Integrator) -> &'static str {
         Integrator::Depth(_) => "depth",
         Integrator::Particle(_) => "ptracer",
         Integrator::Bdpt(_) => "bdpt",
+        Integrator::Sppm(_) => "sppm",
     }
 }
 

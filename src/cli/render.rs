@@ -580,12 +580,19 @@ fn report(
         StopReason::TargetError => ", target error reached",
         StopReason::Interrupted => ", interrupted",
     };
+    // sppm's pixels hold one estimate each: its count is the passes.
+    let (count, unit) = match scene.integrator {
+        Integrator::Sppm(_) => (
+            u64::from(output.samples.end - output.samples.start),
+            "passes",
+        ),
+        _ => (output.film.pixels.first().map_or(0, |p| p.samples), "spp"),
+    };
     eprintln!(
-        "prism: rendered {} ({}×{}, {} spp{stopped}{}) in {:.2} s: {:.3} M samples/s, {:.2} M rays/s, mean relative error {:.4}{} -> {}, {}",
+        "prism: rendered {} ({}×{}, {count} {unit}{stopped}{}) in {:.2} s: {:.3} M samples/s, {:.2} M rays/s, mean relative error {:.4}{} -> {}, {}",
         args.scene.display(),
         scene.film.crop.size.x,
         scene.film.crop.size.y,
-        output.film.pixels.first().map_or(0, |p| p.samples),
         match Accel::of(&scene.world.geometry) {
             Accel::Bvh => "",
             Accel::Embree => ", traced by Embree",
@@ -599,6 +606,8 @@ fn report(
             Integrator::Particle(_) | Integrator::Bdpt(_) => {
                 " (by batch means over sample indices)"
             }
+            // A biased estimate with one value per pixel: there is no error to report.
+            Integrator::Sppm(_) => " (sppm: biased, no error estimate)",
             _ => "",
         },
         exr.display(),
@@ -628,6 +637,13 @@ fn trace_pixel(
         return Err(Error::usage(
             "--pixel prints a pixel's camera samples, and bdpt's are not the pixel's whole \
              estimate: its light subpaths reach pixels anywhere on the film",
+        )
+        .with_help("render a --crop around the pixel instead"));
+    }
+    if matches!(scene.integrator, Integrator::Sppm(_)) {
+        return Err(Error::usage(
+            "--pixel prints a pixel's camera samples, and sppm's passes depend on the photons \
+             of the whole scene",
         )
         .with_help("render a --crop around the pixel instead"));
     }

@@ -1,5 +1,6 @@
 //! The integrators' estimators against closed forms and against each other, their error, and
-//! the `aov` and `moment` integrators, the particle tracer and bidirectional path tracing.
+//! the `aov` and `moment` integrators, the particle tracer, bidirectional path tracing and
+//! photon mapping.
 
 mod aov;
 mod bdpt;
@@ -9,4 +10,5 @@ mod depth;
 mod direct;
 mod moment;
 mod ptracer;
+mod sppm;
 mod strict_normals;

@@ -2,7 +2,8 @@
 //! illumination, the lecture's distribution ray tracer with splitting and the volumetric path
 //! tracers; `moment` runs nested integrators and writes their estimates and second moments as
 //! extra film channels, `aov` the albedo, normals, depth and other variables of the first hit
-//! beside nested integrators' images.
+//! beside nested integrators' images. `ptracer` and `sppm` start paths at the lights too; the
+//! render driver runs their passes.
 //!
 //! An [`Integrator`] is what a scene asks for: an estimator and its parameters. Before a render
 //! it is prepared for the world ([`Integrator::prepare`]), which builds the light sampler it
@@ -25,6 +26,7 @@ pub mod mis;
 pub mod moment;
 pub mod path;
 pub mod ptracer;
+pub mod sppm;
 pub mod transmittance;
 pub mod vertex;
 pub mod volpath;
@@ -39,6 +41,7 @@ pub use distribution::DistributionIntegrator;
 pub use moment::MomentIntegrator;
 pub use path::PathIntegrator;
 pub use ptracer::{LightPathSample, ParticleTracer, Splat};
+pub use sppm::SppmIntegrator;
 pub use volpath::{Tracking, VolPathIntegrator};
 
 use volpath::SpectralTracking;
@@ -85,6 +88,7 @@ integrator_enum! {
         Depth(DepthIntegrator),
         Particle(ParticleTracer),
         Bdpt(BdptIntegrator),
+        Sppm(SppmIntegrator),
     }
 }
 
@@ -112,7 +116,8 @@ impl Integrator {
             | Integrator::Aov(_)
             | Integrator::Depth(_)
             | Integrator::Particle(_)
-            | Integrator::Bdpt(_) => LightSelection::Power,
+            | Integrator::Bdpt(_)
+            | Integrator::Sppm(_) => LightSelection::Power,
         }
     }
 
@@ -127,7 +132,8 @@ impl Integrator {
             | Integrator::VolPath(_)
             | Integrator::Depth(_)
             | Integrator::Particle(_)
-            | Integrator::Bdpt(_) => &[],
+            | Integrator::Bdpt(_)
+            | Integrator::Sppm(_) => &[],
         };
         nested.iter().map(|(_, integrator)| integrator)
     }
@@ -142,6 +148,7 @@ impl Integrator {
             Integrator::Depth(_) => false,
             Integrator::Particle(ptracer) => ptracer.hide_emitters,
             Integrator::Bdpt(bdpt) => bdpt.hide_emitters,
+            Integrator::Sppm(_) => false,
             Integrator::Moment(_) | Integrator::Aov(_) => match self.nested().next() {
                 Some(first) => first.hides_emitters(),
                 None => true,
@@ -167,7 +174,8 @@ impl Integrator {
             | Integrator::VolPath(_)
             | Integrator::Depth(_)
             | Integrator::Particle(_)
-            | Integrator::Bdpt(_) => Vec::new(),
+            | Integrator::Bdpt(_)
+            | Integrator::Sppm(_) => Vec::new(),
             Integrator::Moment(moment) => moment.aov_names(),
             Integrator::Aov(aov) => aov.aov_names(),
         }
@@ -196,6 +204,15 @@ impl PreparedIntegrator<'_> {
     pub fn particle_tracer(&self) -> Option<&ParticleTracer> {
         match self.integrator {
             Integrator::Particle(ptracer) => Some(ptracer),
+            _ => None,
+        }
+    }
+
+    /// Stochastic progressive photon mapping, where the integrator is it: the render driver
+    /// runs its passes, which keep statistics per pixel from one pass to the next.
+    pub fn sppm(&self) -> Option<&SppmIntegrator> {
+        match self.integrator {
+            Integrator::Sppm(sppm) => Some(sppm),
             _ => None,
         }
     }
@@ -291,8 +308,11 @@ impl PreparedIntegrator<'_> {
             Integrator::Aov(integrator) => integrator.radiance(ctx, ray, lambda, aovs),
             Integrator::Depth(_) => DepthIntegrator::radiance(ctx, &ray),
             // Light subpaths reach the film by splats, not along camera rays: the render driver
-            // runs them ([`Self::trace_light_paths`], [`Self::trace_bidirectional`]).
-            Integrator::Particle(_) | Integrator::Bdpt(_) => SampledSpectrum::ZERO,
+            // runs them ([`Self::trace_light_paths`], [`Self::trace_bidirectional`]), and
+            // photon mapping's passes run apart ([`Self::sppm`]).
+            Integrator::Particle(_) | Integrator::Bdpt(_) | Integrator::Sppm(_) => {
+                SampledSpectrum::ZERO
+            }
             Integrator::VolPath(integrator) => match integrator.tracking {
                 Tracking::Spectral => integrator.trace(SpectralTracking::new(), ctx, ray, lambda),
                 Tracking::HeroMis { spectral_mis } => {

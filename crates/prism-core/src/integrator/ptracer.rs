@@ -53,7 +53,9 @@ use crate::integrator::SampleContext;
 use crate::integrator::vertex::{
     path_estimate, russian_roulette, surface_scattering, wavelengths_after,
 };
-use crate::light::{BoundingSphere, EmissionQuery, Light, LightQuery, LightSource, Receiver};
+use crate::light::{
+    BoundingSphere, EmissionQuery, EmissionSample, Light, LightQuery, LightSource, Receiver,
+};
 use crate::math::Ray;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 
@@ -114,7 +116,11 @@ fn shadow_ray(from: Vec3, n: Vec3, to: Vec3, time: f32) -> Ray {
 /// Veach's shading-normal factor for the adjoint BSDF at `si` (eq. 5.19), for light arriving
 /// from `w_light` and leaving along `w_out`: None where the geometric and shading normals put
 /// either direction on different sides.
-fn shading_correction(si: &SurfaceInteraction, w_light: Vec3, w_out: Vec3) -> Option<f32> {
+pub(super) fn shading_correction(
+    si: &SurfaceInteraction,
+    w_light: Vec3,
+    w_out: Vec3,
+) -> Option<f32> {
     let (light_g, light_s) = (si.n.dot(w_light), si.shading.n.dot(w_light));
     let (out_g, out_s) = (si.n.dot(w_out), si.shading.n.dot(w_out));
     if !(light_g * light_s > 0.0 && out_g * out_s > 0.0) {
@@ -234,17 +240,7 @@ impl ParticleTracer {
         if throughput.is_black() {
             return;
         }
-        let origin = if emission.n == Vec3::ZERO {
-            emission.p
-        } else {
-            let side = if emission.d.dot(emission.n) >= 0.0 {
-                emission.n
-            } else {
-                -emission.n
-            };
-            offset_ray_origin(emission.p, side)
-        };
-        let mut ray = Ray::new(origin, emission.d, f32::INFINITY, sample.time);
+        let mut ray = emission_ray(&emission, sample.time);
         let mut lambda = *sample.lambda;
         let mut eta_scale = 1.0f32;
         let mut lobes = BxdfTree::empty();
@@ -316,9 +312,24 @@ impl ParticleTracer {
     }
 }
 
+/// The ray of an emission sample, started off the light's surface where it has one.
+pub(super) fn emission_ray(emission: &EmissionSample, time: f32) -> Ray {
+    let origin = if emission.n == Vec3::ZERO {
+        emission.p
+    } else {
+        let side = if emission.d.dot(emission.n) >= 0.0 {
+            emission.n
+        } else {
+            -emission.n
+        };
+        offset_ray_origin(emission.p, side)
+    };
+    Ray::new(origin, emission.d, f32::INFINITY, time)
+}
+
 /// A light for a light subpath or a visible emitter, and its probability: the particle tracer's
 /// light sampler chooses by power, the same wherever the receiver (here the origin) is.
-fn choose_light(ctx: &mut SampleContext) -> Option<(usize, f32)> {
+pub(super) fn choose_light(ctx: &mut SampleContext) -> Option<(usize, f32)> {
     let u_light = ctx.sampler.next_1d();
     ctx.light_sampler()
         .sample(u_light, &Receiver::point(Vec3::ZERO))

@@ -29,6 +29,7 @@ mod particles;
 mod pass;
 mod progress;
 pub mod resume;
+mod sppm;
 pub mod state;
 mod stop;
 mod tiles;
@@ -156,6 +157,17 @@ pub fn render_with_preview(
         .build()
         .map_err(|e| Error::usage(format!("could not start the worker threads: {e}")))?;
 
+    if let Some(sppm) = estimator.integrator.sppm() {
+        return sppm::render(
+            scene,
+            sppm,
+            &estimator,
+            &options,
+            &pool,
+            checkpoints,
+            preview,
+        );
+    }
     // Sums of extra channels per pixel.
     let k = AOV_SUMS_PER_CHANNEL * estimator.aov_count();
     let mut sums = tile_major(&tiles, crop.size, k, options.initial.as_ref())?;

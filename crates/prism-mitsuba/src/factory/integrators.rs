@@ -1,7 +1,7 @@
 //! Integrator plugins: `path` (with Prism's `emitter_sampling`, see
 //! [`prism_core::light::sampler`]), `direct`, `moment`, `aov`, the lecture's `distrib`, and
-//! `volpath` and `volpathmis` for media, `ptracer`, the particle tracer, and Mitsuba 0.6's
-//! `bdpt`, bidirectional path tracing.
+//! `volpath` and `volpathmis` for media, `ptracer`, the particle tracer, Mitsuba 0.6's
+//! `bdpt`, bidirectional path tracing, and `sppm`, stochastic progressive photon mapping.
 
 use crate::description::{PluginClass, PluginNode, Warning};
 use crate::params::Params;
@@ -13,7 +13,8 @@ use prism_core::integrator::aov::{Aov, AovKind};
 use prism_core::integrator::distribution::DirectLights;
 use prism_core::integrator::{
     AovIntegrator, BdptIntegrator, DepthIntegrator, DirectIntegrator, DistributionIntegrator,
-    Integrator, MomentIntegrator, ParticleTracer, PathIntegrator, Tracking, VolPathIntegrator,
+    Integrator, MomentIntegrator, ParticleTracer, PathIntegrator, SppmIntegrator, Tracking,
+    VolPathIntegrator,
 };
 use prism_core::light::{Light, LightSelection};
 
@@ -153,6 +154,27 @@ pub static INTEGRATORS: Registry<Build> = Registry {
             ],
             build: build_bdpt,
         },
+        Plugin {
+            name: "sppm",
+            origin: Origin::Mitsuba06,
+            summary: "Stochastic progressive photon mapping (Hachisuka & Jensen 2009): per \
+                      pass, one camera path per pixel to its first diffuse vertex (direct light \
+                      by light sampling), photons from lights chosen by power gathered there \
+                      within the pixel's radius, and the radius and flux updated by the \
+                      progressive rule; one set of wavelengths per pass. Biased at any finite \
+                      pass count (consistent): the EXR's variance channels are infinite, not \
+                      an error bar; no checkpoints, resume or merge; no media.",
+            params: &[
+                INITIAL_RADIUS,
+                ALPHA,
+                PHOTON_COUNT,
+                MAX_PASSES,
+                GRANULARITY,
+                SPPM_MAX_DEPTH,
+                SPPM_RR_DEPTH,
+            ],
+            build: build_sppm,
+        },
     ],
 };
 
@@ -175,6 +197,13 @@ params! {
     SAMPLES_PER_PASS = ParamSpec::new("samples_per_pass", ParamKind::Integer, Default::Integer(-1), "the most samples per pixel a pass of the render takes (−1: as the render driver chooses)");
     LIGHT_IMAGE = ParamSpec::new("light_image", ParamKind::Boolean, Default::Boolean(true), "Mitsuba 0.6's `lightImage`: use the strategies that connect light subpaths to the camera (t = 1)");
     SAMPLE_DIRECT = ParamSpec::new("sample_direct", ParamKind::Boolean, Default::Boolean(true), "Mitsuba 0.6's `sampleDirect`: connect each camera vertex to a point drawn by light sampling (s = 1) rather than to the light subpath's first vertex");
+    INITIAL_RADIUS = ParamSpec::new("initial_radius", ParamKind::Float, Default::Float(0.0), "the search radius every pixel starts with, in world units (0: five times the scene's bounding radius over the film's larger side, as Mitsuba 0.6)");
+    ALPHA = ParamSpec::new("alpha", ParamKind::Float, Default::Float(0.7), "the fraction of a pass's photons a pixel keeps, which sets how fast its radius shrinks (0 < alpha < 1)");
+    PHOTON_COUNT = ParamSpec::new("photon_count", ParamKind::Integer, Default::Integer(250_000), "light subpaths traced per pass (Mitsuba 0.6 counts photons stored instead)");
+    MAX_PASSES = ParamSpec::new("max_passes", ParamKind::Integer, Default::Integer(-1), "passes to render, replacing the sample count (−1: the sample count, --spp, is the number of passes)");
+    GRANULARITY = ParamSpec::new("granularity", ParamKind::Integer, Default::Integer(0), "light subpaths per parallel task (0: 4096); the image does not depend on it");
+    SPPM_MAX_DEPTH = ParamSpec::new("max_depth", ParamKind::Integer, Default::Integer(-1), "longest path: −1 unbounded, 2 direct light, at least 2");
+    SPPM_RR_DEPTH = ParamSpec::new("rr_depth", ParamKind::Integer, Default::Integer(3), "bounces after which Russian roulette may end photons and camera paths (Mitsuba 0.6's code uses 3)");
     RR_THRESHOLD = ParamSpec::new("rr_threshold", ParamKind::Float, Default::Float(0.1), "potential below which Russian roulette starts");
 }
 
@@ -289,6 +318,77 @@ fn build_bdpt(params: &Params) -> Result<Integrator> {
         hide_emitters: params.boolean(&HIDE_EMITTERS)?,
         light_image: params.boolean(&LIGHT_IMAGE)?,
         sample_direct: params.boolean(&SAMPLE_DIRECT)?,
+    }))
+}
+
+fn build_sppm(params: &Params) -> Result<Integrator> {
+    let refuse =
+        |spec: &ParamSpec, message: String| Err(Error::input(params.location_of(spec), message));
+    let initial_radius = params.float(&INITIAL_RADIUS)?;
+    if !(initial_radius.is_finite() && initial_radius >= 0.0) {
+        return refuse(
+            &INITIAL_RADIUS,
+            format!(
+                "initial_radius must be 0 (automatic) or a positive length, not {initial_radius}"
+            ),
+        );
+    }
+    let alpha = params.float(&ALPHA)?;
+    if !(alpha > 0.0 && alpha < 1.0) {
+        return refuse(
+            &ALPHA,
+            format!("alpha must lie strictly between 0 and 1, not {alpha}"),
+        );
+    }
+    let photon_count = params.integer(&PHOTON_COUNT)?;
+    if !(1..=i64::from(u32::MAX)).contains(&photon_count) {
+        return refuse(
+            &PHOTON_COUNT,
+            format!("photon_count must be at least 1, not {photon_count}"),
+        );
+    }
+    let max_passes = match params.integer(&MAX_PASSES)? {
+        -1 => None,
+        n if (1..=i64::from(u32::MAX)).contains(&n) => Some(n as u32),
+        n => {
+            return refuse(
+                &MAX_PASSES,
+                format!("max_passes must be -1 or at least 1, not {n}"),
+            );
+        }
+    };
+    let granularity = match params.integer(&GRANULARITY)? {
+        0 => None,
+        n if (1..=i64::from(u32::MAX)).contains(&n) => Some(n as u32),
+        n => {
+            return refuse(
+                &GRANULARITY,
+                format!("granularity must be 0 (automatic) or at least 1, not {n}"),
+            );
+        }
+    };
+    let max_depth = params.integer(&SPPM_MAX_DEPTH)?;
+    if !(max_depth == -1 || (2..=i64::from(i32::MAX)).contains(&max_depth)) {
+        return refuse(
+            &SPPM_MAX_DEPTH,
+            format!("max_depth must be -1 (unbounded) or at least 2, not {max_depth}"),
+        );
+    }
+    let rr_depth = params.integer(&SPPM_RR_DEPTH)?;
+    if !(1..=i64::from(i32::MAX)).contains(&rr_depth) {
+        return refuse(
+            &SPPM_RR_DEPTH,
+            format!("rr_depth must be at least 1, not {rr_depth}"),
+        );
+    }
+    Ok(Integrator::Sppm(SppmIntegrator {
+        initial_radius: (initial_radius > 0.0).then_some(initial_radius as f32),
+        alpha: alpha as f32,
+        photon_count: photon_count as u32,
+        max_passes,
+        granularity,
+        max_depth: max_depth as i32,
+        rr_depth: rr_depth as i32,
     }))
 }
 
