@@ -93,6 +93,13 @@ fn directionalarea_matches_mitsuba() {
     assert_matches_reference_at("directionalarea", &scene, None, 1024);
 }
 
+/// `sggx`'s extinction: an absorbing medium whose coefficient is scaled by the flakes'
+/// projected area √(ωᵀSω) along each ray, for a skewed S.
+#[test]
+fn sggx_extinction_matches_mitsuba() {
+    assert_matches_reference("sggx");
+}
+
 #[test]
 fn ply_face_colours_match_mitsuba() {
     assert_matches_reference("face_color");
