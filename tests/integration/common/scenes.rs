@@ -34,6 +34,7 @@ pub fn camera(origin: DVec3, target: DVec3, up: DVec3, fov_degrees: f64, size: U
         far_clip: 1e4,
         lens_radius: 0.0,
         focus_distance: 1.0,
+        principal_point_offset: Vec2::ZERO,
     })
 }
 

@@ -887,8 +887,13 @@ const GRID_SCENE: &str = scene!(
     "    <shape type=\"sphere\"><bsdf type=\"null\"/><medium type=\"heterogeneous\" name=\"interior\"><volume type=\"gridvolume\" name=\"sigma_t\"><string name=\"filename\" value=\"density.vol\"/></volume></medium></shape>"
 );
 
+/// A scene whose medium scatters by `sggx` with the matrix grid `s.vol`.
+const SGGX_SCENE: &str = scene!(
+    "    <medium type=\"homogeneous\" id=\"fog\"><phase type=\"sggx\"><volume type=\"gridvolume\" name=\"S\"><string name=\"filename\" value=\"s.vol\"/></volume></phase></medium>"
+);
+
 /// Bad media: negative coefficients, albedos above 1, missing, truncated and foreign grids,
-/// phase functions out of range, misspelt parameters, and media where distrib or ptracer renders.
+/// phase functions out of range (SGGX matrices of the wrong size, varying or not positive definite), misspelt parameters, and media where distrib or ptracer renders.
 fn media_cases() -> Vec<Case> {
     let with_grid = |name: &'static str, bytes: &'static str, says: &'static str| Case {
         name,
@@ -896,6 +901,13 @@ fn media_cases() -> Vec<Case> {
             ("scene.xml", GRID_SCENE),
             ("density.vol", bytes),
         ])),
+        arguments: RENDER,
+        location: "scene.xml:3:",
+        says,
+    };
+    let with_sggx_grid = |name: &'static str, bytes: &'static str, says: &'static str| Case {
+        name,
+        files: Box::leak(Box::new([("scene.xml", SGGX_SCENE), ("s.vol", bytes)])),
         arguments: RENDER,
         location: "scene.xml:3:",
         says,
@@ -1046,6 +1058,42 @@ fn media_cases() -> Vec<Case> {
                 "\x00\x00\u{bf}"
             ),
             "at least 0",
+        ),
+        with_sggx_grid(
+            "sggx matrix of one channel",
+            concat!(
+                vol_header!("\x01", "\x01", "\x01", "\x01"),
+                "\x00\x00\x00\x00"
+            ),
+            "needs six",
+        ),
+        with_sggx_grid(
+            "sggx matrix of zeros",
+            concat!(
+                vol_header!("\x01", "\x01", "\x01", "\x06"),
+                "\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00",
+                "\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00"
+            ),
+            "not positive definite",
+        ),
+        with_sggx_grid(
+            "sggx matrix varying between voxels",
+            concat!(
+                vol_header!("\x02", "\x01", "\x01", "\x06"),
+                "\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00",
+                "\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00",
+                "\x00\x00\x00\x01\x00\x00\x00\x00\x00\x00\x00\x00",
+                "\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00"
+            ),
+            "varies from voxel to voxel",
+        ),
+        render_scene(
+            "sggx matrix as a constvolume",
+            scene!(
+                "    <medium type=\"homogeneous\" id=\"fog\"><phase type=\"sggx\"><volume type=\"constvolume\" name=\"S\"/></phase></medium>"
+            ),
+            "scene.xml:3:",
+            "not a gridvolume",
         ),
     ]
 }

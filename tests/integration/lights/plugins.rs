@@ -385,3 +385,33 @@ fn a_spot_nested_in_a_shape_lights_from_its_own_placement() {
         );
     }
 }
+
+/// A `directionalarea` nested in a shape, or declared with an id and referenced from one, is
+/// the shape's light but shows no emission on its surface (its radiance is a delta along the
+/// normal, as Mitsuba's `eval` returns zero), and light samples from any point find nothing.
+#[test]
+fn a_directional_area_emitter_is_found_by_no_ray() {
+    let nested = r#"<shape type="sphere"><emitter type="directionalarea"><rgb name="radiance" value="2"/></emitter></shape>"#;
+    let referenced = r#"<emitter type="directionalarea" id="beams"/>
+    <shape type="sphere"><ref id="beams"/></shape>"#;
+    for body in [nested, referenced] {
+        let scene = load(Path::new("."), body);
+        assert_eq!(scene.world.lights.len(), 1, "{body}");
+        assert!(
+            matches!(scene.world.lights[0], Light::DirectionalArea(_)),
+            "{body}"
+        );
+        assert_eq!(scene.world.shape_info[0].light, None, "{body}");
+        for reference in [Vec3::new(0.0, 0.0, 3.0), Vec3::new(2.0, -1.0, 0.5)] {
+            let sample = scene.world.lights[0].sample_incident(LightQuery {
+                shapes: &scene.world.geometry.primitives,
+                reference,
+                time: 0.0,
+                u_choice: 0.5,
+                u: Vec2::splat(0.3),
+                lambda: &SampledWavelengths::single(550.0),
+            });
+            assert!(sample.is_none(), "{body}");
+        }
+    }
+}

@@ -52,6 +52,11 @@ pub struct PerspectiveCamera {
     pub lens_radius: f32,
     /// Distance along the view axis of the plane in focus (irrelevant for a pinhole).
     pub focus_distance: f32,
+    /// Where the principal point (the foot of the view axis on the film) lies relative to the
+    /// film's centre, in units of the full film's width and height (Mitsuba's
+    /// `principal_point_offset_x/y`): film position u sees what u + offset · size would see
+    /// without it, as in Mitsuba's `sample_ray`, which shifts its sample so.
+    pub principal_point_offset: Vec2,
 }
 
 /// Converts a field of view given along `axis` into the horizontal one, for a film of aspect
@@ -108,7 +113,8 @@ impl CameraModel for PerspectiveCamera {
     /// the near plane and ends on the far plane, as in Mitsuba.
     #[inline]
     fn generate_ray(&self, film: Vec2, lens: Vec2, time: f32) -> CameraRay {
-        let (screen, aspect) = screen_position(film, self.film_size);
+        let shifted = film + self.principal_point_offset * self.film_size;
+        let (screen, aspect) = screen_position(shifted, self.film_size);
         // The pinhole direction, with z = 1.
         let pinhole = Vec3::new(
             screen.x * self.tan_half_fov_x,
@@ -166,7 +172,8 @@ impl CameraModel for PerspectiveCamera {
         let aspect = self.film_size.x / self.film_size.y;
         let tan = self.tan_half_fov_x;
         let screen = Vec2::new(pinhole.x / tan, pinhole.y * aspect / tan);
-        let film = film_position(screen, self.film_size)?;
+        let film =
+            film_position(screen, self.film_size)? - self.principal_point_offset * self.film_size;
         let lens = to_world.point(aperture);
         let towards = lens - p;
         let r2 = towards.length_squared();
@@ -215,6 +222,7 @@ mod tests {
             far_clip: 100.0,
             lens_radius: 0.0,
             focus_distance: 1.0,
+            principal_point_offset: Vec2::ZERO,
         };
         let lens = Vec2::splat(0.5);
         let center = camera.generate_ray(Vec2::new(100.0, 50.0), lens, 0.0).ray;
@@ -225,6 +233,41 @@ mod tests {
         let expected = Vec3::new(1.0, 0.5, 1.0).normalize();
         assert!((top_left.d - expected).length() < 1e-6);
         assert!((center.o - Vec3::new(0.0, 0.0, 0.01)).length() < 1e-7);
+    }
+
+    /// With a principal point offset, film position u sees what u + offset · size sees without
+    /// it, and the connection of a point back to the camera lands where its ray left.
+    #[test]
+    fn principal_point_offset_shifts_the_film_both_ways() {
+        let plain = PerspectiveCamera {
+            to_world: AnimatedTransform::fixed(Transform::IDENTITY),
+            film_size: Vec2::new(200.0, 100.0),
+            tan_half_fov_x: 1.0,
+            near_clip: 0.01,
+            far_clip: 100.0,
+            lens_radius: 0.0,
+            focus_distance: 1.0,
+            principal_point_offset: Vec2::ZERO,
+        };
+        let offset = Vec2::new(0.2, -0.15);
+        let shifted = PerspectiveCamera {
+            principal_point_offset: offset,
+            ..plain.clone()
+        };
+        let lens = Vec2::splat(0.5);
+        for film in [Vec2::new(10.0, 20.0), Vec2::new(150.0, 90.0)] {
+            let ray = shifted.generate_ray(film, lens, 0.0).ray;
+            let expected = plain
+                .generate_ray(film + offset * plain.film_size, lens, 0.0)
+                .ray;
+            assert!((ray.d - expected.d).length() < 1e-6);
+            let back = shifted.sample_importance(ray.at(3.0), lens, 0.0).unwrap();
+            assert!(
+                (back.film - film).length() < 1e-3,
+                "{} vs {film}",
+                back.film
+            );
+        }
     }
 
     /// Rays of one film position through different lens points meet on the focal plane.
@@ -238,6 +281,7 @@ mod tests {
             far_clip: 100.0,
             lens_radius: 0.2,
             focus_distance: 5.0,
+            principal_point_offset: Vec2::ZERO,
         };
         let film = Vec2::new(30.0, 70.0);
         let points: Vec<Vec3> = [(0.1, 0.2), (0.9, 0.5), (0.5, 0.95)]

@@ -264,11 +264,11 @@ fn spectral_tracking(
     sampler: &mut Sampler,
 ) -> Option<f32> {
     let (t0, t1) = medium.ray_extent(ray, t_surface)?;
-    let majorant = medium.majorant(lambda);
+    let majorant = medium.majorant(ray.d, lambda);
     let mut t = t0;
     loop {
         t = sample_free_flight(t, t1, majorant, sampler.next_1d())?;
-        let c = medium.coefficients(ray.at(t), lambda);
+        let c = medium.coefficients(ray.at(t), ray.d, lambda);
         match choose_collision(
             counted(*throughput, lambda),
             &c,

@@ -159,7 +159,7 @@ impl PathWeights for SpectralMis {
         sampler: &mut Sampler,
     ) -> Option<f32> {
         let (t0, t1) = medium.ray_extent(ray, t_surface)?;
-        let majorant = medium.majorants(lambda);
+        let majorant = medium.majorants(ray.d, lambda);
         let ratio_tracked = !medium.is_homogeneous();
         let mut t = t0;
         loop {
@@ -176,7 +176,7 @@ impl PathWeights for SpectralMis {
             };
             let reach = attenuation(majorant, collision - t);
             t = collision;
-            let c = medium.coefficients(ray.at(t), lambda);
+            let c = medium.coefficients(ray.at(t), ray.d, lambda);
             if !ratio_tracked || sampler.next_1d() * majorant[0] < c.sigma_t[0] {
                 self.event(c.sigma_s * reach, c.sigma_t * reach, SampledSpectrum::ZERO);
                 return Some(t);

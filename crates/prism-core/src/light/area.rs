@@ -73,6 +73,11 @@ pub struct AreaLight {
     pub sampling: ShapeSampling,
 }
 
+/// The mean luminance of `texture` over [0, 1]², from the cells of its sampling density.
+pub(super) fn mean_luminance(texture: &Texture) -> f32 {
+    luminance_density(texture).1
+}
+
 /// The density over [0, 1]² in proportion to the texture's luminance at cell centres, with the
 /// texture's image resolution (or [`PATTERN_RESOLUTION`]), and its mean.
 fn luminance_density(texture: &Texture) -> (PiecewiseConstant2D, f32) {

@@ -10,6 +10,7 @@
 //! | Mitsuba emitter | file | sampled by |
 //! | --- | --- | --- |
 //! | `area` | [`area`] | the shape: spheres by visible cone, other shapes by area; a textured radiance by the texture through the uv map |
+//! | `directionalarea` | [`directionalarea`] | not at all (a delta along the shape's normal, found by light traced from it only) |
 //! | `point` | [`point`] | its position (delta) |
 //! | `spot` | [`spot`] | its position (delta) |
 //! | `projector` | [`projector`] | its position (delta) |
@@ -20,14 +21,16 @@
 //!
 //! For tracing light from the lights' side (the particle tracer), every light also draws rays
 //! of its emission ([`LightSource::sample_emission`]): area lights a point by area and a
-//! cosine-distributed direction, point lights a uniform direction, spot lights a direction in
-//! their cone, projectors a point of their image, and lights at infinity a direction as for
-//! light sampling and a point on the disk of the scene's bounding sphere facing it.
+//! cosine-distributed direction, directional area lights a point by area and its normal, point
+//! lights a uniform direction, spot lights a direction in their cone, projectors a point of
+//! their image, and lights at infinity a direction as for light sampling and a point on the
+//! disk of the scene's bounding sphere facing it.
 
 pub mod area;
 pub mod bounds;
 pub mod constant;
 pub mod directional;
+pub mod directionalarea;
 pub mod envmap;
 pub mod point;
 pub mod projector;
@@ -46,6 +49,7 @@ pub use area::AreaLight;
 pub use bounds::{LightBounds, Receiver};
 pub use constant::ConstantLight;
 pub use directional::DirectionalLight;
+pub use directionalarea::DirectionalAreaLight;
 pub use envmap::EnvironmentMap;
 pub use point::PointLight;
 pub use projector::Projector;
@@ -108,6 +112,7 @@ plugin_class! {
     #[derive(Clone, Debug)]
     pub enum Light {
         Area(AreaLight),
+        DirectionalArea(DirectionalAreaLight),
         Point(PointLight),
         Spot(SpotLight),
         Projector(Projector),

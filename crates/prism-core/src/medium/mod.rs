@@ -7,6 +7,10 @@
 //! ray, light is attenuated by the transmittance T(t) = exp(−∫₀ᵗ σ_t) and gains in-scattered
 //! light σ_s ∫ p L at every point (the radiative transfer equation; pbrt-v4 §14.1).
 //!
+//! A microflake phase function (`sggx`) makes both coefficients depend on the direction of
+//! travel d as well, through the flakes' projected area σ(d) ([`PhaseFunction::projected_area`]),
+//! so [`Medium::coefficients`] and the majorants take d.
+//!
 //! # Tracking with one majorant for the four wavelengths
 //! A path carries four wavelengths, and σ_t may differ between them (a chromatic medium). The
 //! free-flight distances are drawn with a single majorant m ≥ σ_t(x, λᵢ) for all four (its
@@ -46,7 +50,7 @@ use glam::Vec3;
 
 pub use phase::{
     BlendPhase, HenyeyGreenstein, Isotropic, PhaseFunction, PhaseModel, PhaseSample, Rayleigh,
-    TabulatedPhase,
+    Sggx, TabulatedPhase,
 };
 pub use volume::{GridFilter, GridVolume, Volume};
 
@@ -237,10 +241,22 @@ pub enum Collision {
 }
 
 impl Medium {
-    /// The medium's coefficients at `p` for the wavelengths `lambda`.
+    /// The medium's coefficients at `p` for the wavelengths `lambda`, for light travelling
+    /// along `d` (unit): the medium's own, times the phase function's projected area along
+    /// `d` (1 unless the phase function is a microflake one, `sggx`).
     #[inline]
-    pub fn coefficients(&self, p: Vec3, lambda: &SampledWavelengths) -> MediumCoefficients {
-        self.kind.coefficients(p, lambda)
+    pub fn coefficients(
+        &self,
+        p: Vec3,
+        d: Vec3,
+        lambda: &SampledWavelengths,
+    ) -> MediumCoefficients {
+        let c = self.kind.coefficients(p, lambda);
+        let area = self.phase.projected_area(d);
+        MediumCoefficients {
+            sigma_t: c.sigma_t * area,
+            sigma_s: c.sigma_s * area,
+        }
     }
 
     /// Whether the coefficients are the same everywhere.
@@ -249,21 +265,27 @@ impl Medium {
         self.kind.is_homogeneous()
     }
 
-    /// A majorant m ≥ σ_t(x, λᵢ) for every point and each of the wavelengths `lambda`.
+    /// A majorant m ≥ σ_t(x, d, λᵢ) for every point along direction `d` (unit) and each of the
+    /// wavelengths `lambda`: a homogeneous medium's largest σ_t(d, λᵢ) (tight), a heterogeneous
+    /// one's bound times the largest projected area of its phase function.
     #[inline]
-    pub fn majorant(&self, lambda: &SampledWavelengths) -> f32 {
-        self.kind.majorant(lambda)
+    pub fn majorant(&self, d: Vec3, lambda: &SampledWavelengths) -> f32 {
+        if self.is_homogeneous() {
+            self.coefficients(Vec3::ZERO, d, lambda).sigma_t.max_value()
+        } else {
+            self.kind.majorant(lambda) * self.phase.max_projected_area()
+        }
     }
 
-    /// Each wavelength's own majorant m(λᵢ) ≥ σ_t(x, λᵢ) for every point: σ_t(λᵢ) itself for a
-    /// homogeneous medium (which then has no null collisions), the grid's maximum for all four
-    /// in a heterogeneous one.
+    /// Each wavelength's own majorant m(λᵢ) ≥ σ_t(x, d, λᵢ) for every point along direction
+    /// `d` (unit): σ_t(d, λᵢ) itself for a homogeneous medium (which then has no null
+    /// collisions), the bound of [`Self::majorant`] for all four in a heterogeneous one.
     #[inline]
-    pub fn majorants(&self, lambda: &SampledWavelengths) -> SampledSpectrum {
+    pub fn majorants(&self, d: Vec3, lambda: &SampledWavelengths) -> SampledSpectrum {
         if self.is_homogeneous() {
-            self.coefficients(Vec3::ZERO, lambda).sigma_t
+            self.coefficients(Vec3::ZERO, d, lambda).sigma_t
         } else {
-            SampledSpectrum::splat(self.majorant(lambda))
+            SampledSpectrum::splat(self.majorant(d, lambda))
         }
     }
 
@@ -285,18 +307,18 @@ impl Medium {
         mut u: impl FnMut() -> f32,
     ) -> SampledSpectrum {
         if self.is_homogeneous() {
-            let sigma_t = self.coefficients(ray.o, lambda).sigma_t;
+            let sigma_t = self.coefficients(ray.o, ray.d, lambda).sigma_t;
             return SampledSpectrum::from_fn(|i| (-sigma_t[i] * t_max).exp());
         }
         let Some((t0, t1)) = self.ray_extent(ray, t_max) else {
             return SampledSpectrum::ONE;
         };
-        let majorant = self.majorant(lambda);
+        let majorant = self.majorant(ray.d, lambda);
         let mut transmittance = SampledSpectrum::ONE;
         let mut t = t0;
         while let Some(next) = sample_free_flight(t, t1, majorant, u()) {
             t = next;
-            let sigma_t = self.coefficients(ray.at(t), lambda).sigma_t;
+            let sigma_t = self.coefficients(ray.at(t), ray.d, lambda).sigma_t;
             transmittance *= SampledSpectrum::from_fn(|i| (1.0 - sigma_t[i] / majorant).max(0.0));
             if transmittance.is_black() {
                 break;

@@ -475,7 +475,11 @@ fn delta_light_name(light: &Light) -> Option<&'static str> {
         Light::Spot(_) => Some("spot"),
         Light::Projector(_) => Some("projector"),
         Light::Directional(_) => Some("directional"),
-        Light::Area(_) | Light::Constant(_) | Light::Envmap(_) | Light::Sunsky(_) => None,
+        Light::Area(_)
+        | Light::DirectionalArea(_)
+        | Light::Constant(_)
+        | Light::Envmap(_)
+        | Light::Sunsky(_) => None,
     }
 }
 

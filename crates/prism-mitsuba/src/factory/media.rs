@@ -1,6 +1,6 @@
 //! Participating media, their phase functions and volumes: Mitsuba 3's `homogeneous` and
-//! `heterogeneous` media, `isotropic`, `hg`, `rayleigh`, `tabphase` and `blendphase` phase
-//! functions, and `constvolume`
+//! `heterogeneous` media, `isotropic`, `hg`, `rayleigh`, `tabphase`, `blendphase` and `sggx`
+//! phase functions, and `constvolume`
 //! and `gridvolume` volumes (Mitsuba's binary `.vol` files).
 
 use glam::DMat4;
@@ -13,10 +13,10 @@ use crate::registry::{
 };
 use prism_core::error::{Error, Result};
 use prism_core::math::Transform;
-use prism_core::medium::volume::parse_vol;
+use prism_core::medium::volume::{VolFile, parse_vol};
 use prism_core::medium::{
     BlendPhase, GridFilter, GridVolume, HenyeyGreenstein, Heterogeneous, Homogeneous,
-    HomogeneousAbsorbingScattering, Isotropic, Medium, MediumKind, PhaseFunction, Rayleigh,
+    HomogeneousAbsorbingScattering, Isotropic, Medium, MediumKind, PhaseFunction, Rayleigh, Sggx,
     TabulatedPhase, Volume,
 };
 use prism_core::spectrum::Spectrum;
@@ -100,6 +100,16 @@ pub static PHASES: Registry<BuildPhase> = Registry {
             params: &[PHASE_WEIGHT, BLENDED_PHASES],
             build: build_blendphase,
         },
+        Plugin {
+            name: "sggx",
+            origin: Origin::Mitsuba3,
+            summary: "The SGGX microflake phase function (Heitz et al. 2015): specular flakes \
+                      with the normals of an ellipsoid given by a positive-definite matrix S, \
+                      which also scales the medium's coefficients by the flakes' projected area \
+                      √(ωᵀSω) along the direction of travel; sampled by visible normals.",
+            params: &[SGGX_S],
+            build: build_sggx,
+        },
     ],
 };
 
@@ -138,6 +148,7 @@ params! {
     G = ParamSpec::new("g", ParamKind::Float, Default::Float(0.8), "mean cosine of the deflection, in (−1, 1): > 0 forward, < 0 backward");
     PHASE_VALUES = ParamSpec::new("values", ParamKind::String, Default::Required, "the phase function's values at equally spaced cosines from −1 to 1, separated by commas or spaces (at least two, not negative, not all zero)");
     PHASE_WEIGHT = ParamSpec::new("weight", ParamKind::FloatIn(Bounds::UNIT), Default::Float(0.5), "weight of the second phase function");
+    SGGX_S = ParamSpec::new("S", ParamKind::Volume(Range::Coefficient), Default::Required, "a `gridvolume` of six channels, S_xx, S_yy, S_zz, S_xy, S_xz, S_yz, the same in every voxel (Prism reads one matrix per medium; a grid of one voxel, as Mitsuba's tests write it)");
     BLENDED_PHASES = ParamSpec::nested(PluginClass::Phase, Default::Required, "the two phase functions");
     VALUE = ParamSpec::new("value", ParamKind::Spectrum { range: Range::Coefficient, textured: false, }, Default::Float(1.0), "the value");
     FILENAME = ParamSpec::new("filename", ParamKind::String, Default::Required, "the `.vol` file");
@@ -384,7 +395,8 @@ fn build_constvolume(params: &Params, range: Range) -> Result<Volume> {
     Ok(Volume::Constant(value))
 }
 
-fn build_gridvolume(params: &Params, range: Range) -> Result<Volume> {
+/// The `.vol` file a `gridvolume`'s `filename` names, read and parsed.
+fn read_grid(params: &Params) -> Result<(VolFile, std::path::PathBuf)> {
     let node = params.node();
     let filename = params.string_opt(&FILENAME)?.ok_or_else(|| {
         Error::input(
@@ -408,6 +420,13 @@ fn build_gridvolume(params: &Params, range: Range) -> Result<Volume> {
         )
         .with_help("write the grid in Mitsuba's .vol format (version 3, 32-bit floats)")
     })?;
+    Ok((file, path))
+}
+
+fn build_gridvolume(params: &Params, range: Range) -> Result<Volume> {
+    let node = params.node();
+    let (file, path) = read_grid(params)?;
+    let location = params.location_of(&FILENAME);
     if file.channels != 1 {
         return Err(Error::input(
             location,
@@ -460,4 +479,80 @@ fn build_gridvolume(params: &Params, range: Range) -> Result<Volume> {
         .with_help("use values between 0 and 1"));
     }
     Ok(Volume::Grid(Box::new(grid)))
+}
+
+/// Mitsuba's `sggx`: S from a six-channel `gridvolume` whose voxels all hold the same matrix.
+fn build_sggx(params: &Params) -> Result<PhaseFunction> {
+    let node = params.node();
+    let needs = || {
+        "give S as <volume type=\"gridvolume\" name=\"S\"> with a .vol file of six channels \
+         (S_xx, S_yy, S_zz, S_xy, S_xz, S_yz)"
+    };
+    let Some(child) = params.named_child(&SGGX_S) else {
+        return Err(Error::input(
+            &node.location,
+            format!("{} needs its matrix \"S\"", node.describe()),
+        )
+        .with_help(needs()));
+    };
+    if child.node.class != PluginClass::Volume || child.node.plugin_type != "gridvolume" {
+        return Err(Error::input(
+            &child.location,
+            format!(
+                "\"S\" of {} is {}, not a gridvolume",
+                node.describe(),
+                child.node.describe()
+            ),
+        )
+        .with_help(needs()));
+    }
+    let grid = Params::new(
+        &child.node,
+        &[FILENAME, FILTER_TYPE, VOLUME_TO_WORLD, USE_GRID_BBOX],
+    );
+    let (file, path) = read_grid(&grid)?;
+    // The placement and filtering of a grid that holds one value everywhere change nothing.
+    grid.choice::<GridFilter>(&FILTER_TYPE)?;
+    grid.transform(&VOLUME_TO_WORLD)?;
+    grid.boolean(&USE_GRID_BBOX)?;
+    let location = grid.location_of(&FILENAME);
+    if file.channels != 6 {
+        return Err(Error::input(
+            location,
+            format!(
+                "the grid \"{}\" has {} channel(s); the SGGX matrix needs six",
+                path.display(),
+                file.channels
+            ),
+        )
+        .with_help(needs()));
+    }
+    let mut voxels = file.data.chunks_exact(6);
+    let first: [f32; 6] = voxels
+        .next()
+        .expect("a parsed grid holds a voxel")
+        .try_into()
+        .expect("six channels");
+    if voxels.any(|voxel| voxel != first) {
+        return Err(Error::input(
+            location,
+            format!(
+                "the SGGX matrix in \"{}\" varies from voxel to voxel; Prism reads one matrix per medium",
+                path.display()
+            ),
+        )
+        .with_help("store the matrix in a grid of one voxel"));
+    }
+    let sggx = Sggx::new(first).ok_or_else(|| {
+        Error::input(
+            location,
+            format!(
+                "the SGGX matrix {first:?} in \"{}\" is not positive definite",
+                path.display()
+            ),
+        )
+        .with_help("S_xx, S_yy, S_zz, S_xy, S_xz, S_yz must form a symmetric positive-definite matrix, such as 1, 1, 1, 0, 0, 0")
+    })?;
+    grid.finish()?;
+    Ok(PhaseFunction::Sggx(sggx))
 }

@@ -404,7 +404,7 @@ impl SceneBuilder {
     }
 
     /// The emitter nested in the shape with index `shape_index`: the index of its area light,
-    /// or None for a delta emitter (`point`, `spot`, `projector`, `directional`). Mitsuba 3
+    /// or None for a `directionalarea` or a delta emitter (`point`, `spot`, `projector`, `directional`). Mitsuba 3
     /// lets a shape hold one of those: its radiance on the shape's surface is zero and it lights
     /// the scene from its own `to_world`, as if declared at the top level, while the shape
     /// takes the black default BSDF of emitting shapes; Prism does the same.
@@ -436,11 +436,14 @@ impl SceneBuilder {
         }
         let (light, weight) =
             lights::build_area_light(&emitter.node, shape_index, &mut self.textures)?;
+        // A `directionalarea` emits along the normal alone, a direction no ray finds, so its
+        // shape's surface shows no emission.
+        let seen_on_surface = matches!(light, Light::Area(_));
         self.lights.push(light);
         self.emitter_plugins.push(emitter.node.clone());
         self.light_locations.push(emitter.location.clone());
         self.sampling_weights.push(weight);
-        Ok(Some((self.lights.len() - 1) as u32))
+        Ok(seen_on_surface.then_some((self.lights.len() - 1) as u32))
     }
 
     /// Records that `emitter` is attached to a shape; an error if it already is to another.

@@ -1,4 +1,5 @@
-//! Emitter plugins: `area` (nested in a shape, or declared with an id and referenced from one),
+//! Emitter plugins: `area` and `directionalarea` (nested in a shape, or declared with an id and
+//! referenced from one),
 //! and at the top level of the scene `point`, `spot`, `projector` and `directional` (module
 //! `delta`), and `constant`, `envmap` and `sunsky` (module `environment`); see each light's
 //! module in [`prism_core::light`] for its parameters. Emission may be given as `<rgb>` (an
@@ -33,6 +34,7 @@ pub static EMITTERS: Registry<Build> = Registry {
     class: PluginClass::Emitter,
     plugins: &[
         area::AREA,
+        area::DIRECTIONAL_AREA,
         delta::POINT,
         delta::SPOT,
         delta::PROJECTOR,
@@ -56,14 +58,15 @@ params! {
     TO_WORLD = ParamSpec::new("to_world", ParamKind::Transform, Default::Text("identity"), "the emitter's placement");
 }
 
-/// Builds the area light nested in the shape with index `shape`, with its sampling weight.
+/// Builds the emitter nested in the shape with index `shape` (`area` or `directionalarea`),
+/// with its sampling weight.
 pub fn build_area_light(
     node: &PluginNode,
     shape: u32,
     textures: &mut TextureCache,
 ) -> Result<(Light, f32)> {
     let plugin = EMITTERS.find(node)?;
-    if plugin.name != "area" {
+    if !is_area(node) {
         return Err(Error::input(
             &node.location,
             format!(
@@ -72,7 +75,7 @@ pub fn build_area_light(
             ),
         )
         .with_help(
-            "a shape holds an \"area\" emitter, or a point, spot, projector or directional one that lights the scene from its own to_world; declare environment emitters at the top level of the scene",
+            "a shape holds an \"area\" or \"directionalarea\" emitter, or a point, spot, projector or directional one that lights the scene from its own to_world; declare environment emitters at the top level of the scene",
         ));
     }
     let params = Params::new(node, plugin.params);
@@ -103,13 +106,15 @@ pub fn is_delta(node: &PluginNode) -> bool {
         .contains(&node.plugin_type.as_str())
 }
 
-/// Whether `node` is an `area` emitter, which emits from the shape it is attached to.
+/// Whether `node` is an emitter that emits from the shape it is attached to (`area`,
+/// `directionalarea`).
 pub fn is_area(node: &PluginNode) -> bool {
-    node.class == PluginClass::Emitter && node.plugin_type == "area"
+    node.class == PluginClass::Emitter
+        && [area::AREA.name, area::DIRECTIONAL_AREA.name].contains(&node.plugin_type.as_str())
 }
 
-/// Builds an emitter declared at the top level of the scene, other than `area`, with its
-/// sampling weight.
+/// Builds an emitter declared at the top level of the scene, other than `area` and
+/// `directionalarea`, with its sampling weight.
 pub fn build_scene_light(node: &PluginNode, textures: &mut TextureCache) -> Result<(Light, f32)> {
     let plugin = EMITTERS.find(node)?;
     let params = Params::new(node, plugin.params);

@@ -15,7 +15,9 @@ use crate::description::{PluginClass, PluginNode, Warning};
 use crate::factory::fov::{FOCAL_LENGTH, FOV, FOV_AXIS, horizontal_fov_param};
 use crate::factory::spectra::spectrum_param;
 use crate::params::Params;
-use crate::registry::{Default, Origin, ParamKind, ParamSpec, Plugin, Range, Registry, params};
+use crate::registry::{
+    Bounds, Default, Origin, ParamKind, ParamSpec, Plugin, Range, Registry, params,
+};
 use film::{build_film, default_film};
 use glam::{DMat4, DVec3, Vec2};
 use prism_core::camera::{Camera, OrthographicCamera, PerspectiveCamera, RadianceMeter, Shutter};
@@ -61,7 +63,12 @@ pub static SENSORS: Registry<SensorBuild> = Registry {
             params: camera_params!(
                 [FOV, FOV_AXIS, FOCAL_LENGTH],
                 SENSOR_TO_WORLD,
-                [PINHOLE_FOCUS_DISTANCE, SENSOR_MEDIUM]
+                [
+                    PINHOLE_FOCUS_DISTANCE,
+                    SENSOR_MEDIUM,
+                    PRINCIPAL_POINT_OFFSET_X,
+                    PRINCIPAL_POINT_OFFSET_Y
+                ]
             ),
             build: build_sensor_of,
         },
@@ -183,6 +190,8 @@ params! {
     APERTURE_RADIUS = ParamSpec::new("aperture_radius", ParamKind::Float, Default::Required, "radius of the lens (or give `aperture_area`)");
     APERTURE_AREA = ParamSpec::new("aperture_area", ParamKind::Float, Default::None, "Prism only, the lecture's form: the lens's area a, radius √(a/π)");
     FOCUS_DISTANCE = ParamSpec::new("focus_distance", ParamKind::Float, Default::Text("`far_clip`"), "distance of the plane in focus");
+    PRINCIPAL_POINT_OFFSET_X = ParamSpec::new("principal_point_offset_x", ParamKind::FloatIn(Bounds::between(-f32::MAX, f32::MAX)), Default::Float(0.0), "shift of the principal point from the film's centre, in film widths (as the Mitsuba Blender add-on writes a lens shift); the image moves the other way");
+    PRINCIPAL_POINT_OFFSET_Y = ParamSpec::new("principal_point_offset_y", ParamKind::FloatIn(Bounds::between(-f32::MAX, f32::MAX)), Default::Float(0.0), "shift of the principal point from the film's centre, in film heights (down the image)");
     PINHOLE_FOCUS_DISTANCE = ParamSpec::new("focus_distance", ParamKind::Float, Default::Text("`far_clip`"), "read as Mitsuba 3 reads it on every projective camera; a pinhole has everything in focus");
     FOCAL_DISTANCE = ParamSpec::new("focal_distance", ParamKind::Float, Default::None, "Prism only, the lecture's name for `focus_distance`");
     METER_TO_WORLD = ParamSpec::new("to_world", ParamKind::AnimatedTransform, Default::Text("identity"), "sensor to world: the ray leaves its origin along its +z axis (wins over `origin` and `direction`)");
@@ -429,6 +438,14 @@ fn build_sensor_of(params: &Params, thinlens: bool) -> Result<SensorSettings> {
         .with_help("use only rotations and translations (lookat) for cameras"));
     }
     let shutter = shutter(params)?;
+    let principal_point_offset = if thinlens {
+        Vec2::ZERO
+    } else {
+        Vec2::new(
+            params.float_in(&PRINCIPAL_POINT_OFFSET_X)? as f32,
+            params.float_in(&PRINCIPAL_POINT_OFFSET_Y)? as f32,
+        )
+    };
 
     let camera = Camera::Perspective(PerspectiveCamera {
         to_world,
@@ -438,6 +455,7 @@ fn build_sensor_of(params: &Params, thinlens: bool) -> Result<SensorSettings> {
         far_clip: far_clip as f32,
         lens_radius: lens_radius as f32,
         focus_distance: focus_distance as f32,
+        principal_point_offset,
     });
     sensor_settings(params, parts, camera, shutter)
 }
