@@ -50,6 +50,7 @@
 //! | `ward` | [`ward`] | glossy and diffuse reflection |
 //! | `principled` | [`principled`] | diffuse, glossy reflection (two), glossy transmission |
 //! | `principledthin` | [`principledthin`] | diffuse and glossy reflection and transmission |
+//! | `coateddiffuse`, `coatedconductor` | [`layered`] | reflection by a random walk through a coating (pbrt-v4's) |
 //! | `twosided` | [`twosided`] | those of the nested BSDFs, on both sides |
 //! | `mask` | [`mask`] | the nested BSDF's, and null transmission |
 //! | `null` | [`null`] | null transmission only (a medium's boundary) |
@@ -64,6 +65,8 @@ pub mod dielectric;
 pub mod diffuse;
 pub mod fresnel;
 pub mod glossydiffuse;
+pub mod layer_interface;
+pub mod layered;
 pub mod mask;
 pub mod material;
 pub mod microfacet;
@@ -91,6 +94,7 @@ pub use bumpmap::BumpMap;
 pub use conductor::Conductor;
 pub use dielectric::Dielectric;
 pub use diffuse::Diffuse;
+pub use layered::{CoatedConductor, CoatedDiffuse, Coating};
 pub use mask::Mask;
 pub use material::{Material, Scattering};
 pub use normalmap::NormalMap;
@@ -636,6 +640,8 @@ bsdfs! {
         Ward(Ward),
         Principled(Principled),
         PrincipledThin(PrincipledThin),
+        CoatedDiffuse(CoatedDiffuse),
+        CoatedConductor(CoatedConductor),
         Null(Null),
     }
     adapters {
@@ -660,6 +666,7 @@ bsdfs! {
         Ward(ward::WardLobes),
         Principled(principled::PrincipledLobes),
         PrincipledThin(principledthin::PrincipledThinLobes),
+        Layered(layered::LayeredLobes),
         BackSide(twosided::BackSideLobes),
         Mask(mask::MaskLobes),
         Blend(blend::BlendLobes),

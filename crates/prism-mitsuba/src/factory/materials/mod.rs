@@ -26,6 +26,7 @@ mod dielectric;
 mod diffuse;
 mod glossy;
 mod ior;
+mod layered;
 mod microfacet;
 mod plastic;
 mod principled;
@@ -59,6 +60,8 @@ pub static BSDFS: Registry<Build> = Registry {
         glossy::WARD,
         principled::PRINCIPLED,
         principled::PRINCIPLEDTHIN,
+        layered::COATEDDIFFUSE,
+        layered::COATEDCONDUCTOR,
         adapters::TWOSIDED,
         adapters::MASK,
         adapters::NULL,
