@@ -67,14 +67,34 @@ impl Builder {
                 node
             }
             "diffusetransmission" => {
-                return Err(list.directive_error(
-                    "Prism has no diffuse transmitter (pbrt's diffusetransmission)",
-                ));
+                let mut node = plugin(
+                    PluginClass::Bsdf,
+                    "diffusetransmission",
+                    &location,
+                    &self.search_paths,
+                );
+                for name in ["reflectance", "transmittance"] {
+                    self.spectrum_property(
+                        &mut node,
+                        list,
+                        name,
+                        name,
+                        Some(PropertyValue::Float(0.25)),
+                    )?;
+                }
+                if list.float("scale", 1.0)? != 1.0 {
+                    let parameter = list.get("scale").expect("given");
+                    return Err(list.error(
+                        parameter,
+                        "is not read by Prism: scale the reflectance and transmittance instead",
+                    ));
+                }
+                node
             }
             _ => {
                 return Err(list
                     .directive_error("Prism has no material with this pbrt-v4 model")
-                    .with_help("Prism reads diffuse, conductor, dielectric, thindielectric, coateddiffuse, coatedconductor, mix and interface"));
+                    .with_help("Prism reads diffuse, conductor, dielectric, thindielectric, coateddiffuse, coatedconductor, diffusetransmission, mix and interface"));
             }
         };
         list.finish()?;

@@ -334,6 +334,24 @@ fn coated_materials_map_to_the_layered_bsdfs() {
 }
 
 #[test]
+fn diffuse_transmission_maps_to_its_bsdf() {
+    let root = root(
+        "WorldBegin\nMaterial \"diffusetransmission\" \"rgb transmittance\" [0.5 0.5 0.5]\nShape \"sphere\"",
+    );
+    let bsdf = &nodes(&root, PluginClass::Shape)[0].children[0].node;
+    assert_eq!(bsdf.plugin_type, "diffusetransmission");
+    assert_eq!(property(bsdf, "reflectance"), &PropertyValue::Float(0.25));
+    assert!(matches!(
+        property(bsdf, "transmittance"),
+        PropertyValue::Rgb(..)
+    ));
+    assert!(
+        error("WorldBegin\nMaterial \"diffusetransmission\" \"float scale\" 2")
+            .contains("test.pbrt:2:32: Material \"diffusetransmission\": parameter \"float scale\" is not read by Prism")
+    );
+}
+
+#[test]
 fn objects_become_shape_groups_and_instances() {
     let root = root(
         "WorldBegin\nObjectBegin \"pair\"\nShape \"sphere\"\nTranslate 2 0 0\nShape \"sphere\"\nObjectEnd\nTranslate 0 5 0\nObjectInstance \"pair\"\n",

@@ -48,6 +48,7 @@ pub static BSDFS: Registry<Build> = Registry {
     plugins: &[
         diffuse::DIFFUSE,
         diffuse::ROUGHDIFFUSE,
+        diffuse::DIFFUSETRANSMISSION,
         conductor::CONDUCTOR,
         conductor::ROUGHCONDUCTOR,
         dielectric::DIELECTRIC,
