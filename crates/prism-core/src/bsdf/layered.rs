@@ -83,10 +83,15 @@ pub struct Coating {
 }
 
 impl Coating {
+    /// The coating's index, 0 read as 1 (as pbrt reads it).
+    fn interface_eta(&self) -> f32 {
+        if self.eta == 0.0 { 1.0 } else { self.eta }
+    }
+
     fn lobes(&self, base: Base, at: TexturePoint, lambda: &SampledWavelengths) -> LayeredLobes {
         LayeredLobes {
             top: DielectricInterface {
-                eta: if self.eta == 0.0 { 1.0 } else { self.eta },
+                eta: self.interface_eta(),
                 distribution: trowbridge_reitz(self.alpha.0, self.alpha.1),
             },
             bottom: base,
@@ -103,7 +108,7 @@ impl Coating {
     /// scatters, glossy otherwise.
     fn flags(&self, base: BsdfFlags) -> BsdfFlags {
         let mut flags = BsdfFlags::REFLECTION;
-        if self.eta == 1.0 || trowbridge_reitz(self.alpha.0, self.alpha.1).is_none() {
+        if self.interface_eta() == 1.0 || trowbridge_reitz(self.alpha.0, self.alpha.1).is_none() {
             flags = flags.union(BsdfFlags::SPECULAR);
         }
         let scatters = self.albedo.max_value() > 0.0;
@@ -176,13 +181,8 @@ impl LeafBsdf for CoatedConductor {
 
     fn lobes(&self, at: TexturePoint, lambda: &SampledWavelengths) -> LayeredLobes {
         let (u, v) = self.conductor_alpha;
-        let coating_eta = if self.coating.eta == 0.0 {
-            1.0
-        } else {
-            self.coating.eta
-        };
         let base = Base::Conductor {
-            ior: ConductorIor::at(&self.eta, &self.k, coating_eta, at, lambda),
+            ior: ConductorIor::at(&self.eta, &self.k, self.coating.interface_eta(), at, lambda),
             distribution: trowbridge_reitz(u, v),
         };
         self.coating.lobes(base, at, lambda)
