@@ -183,6 +183,42 @@ fn instances_in_fog_render_as_the_xml() {
     );
 }
 
+/// A white coated sphere in a white furnace: pbrt-v4's `coateddiffuse` over a white base under
+/// a smooth coating loses no energy, so the sphere has the environment's radiance.
+const COATED_SPHERE_IN_A_FURNACE: &str = r#"
+LookAt 0 0 5  0 0 0  0 1 0
+Camera "perspective" "float fov" 20
+Film "rgb" "integer xresolution" 24 "integer yresolution" 24
+Sampler "independent" "integer pixelsamples" 64
+Integrator "path" "integer maxdepth" 200
+WorldBegin
+LightSource "infinite" "rgb L" [1 1 1]
+Material "coateddiffuse" "rgb reflectance" [1 1 1] "float thickness" 0.0001
+    "integer maxdepth" 100
+Shape "sphere" "float radius" 0.8
+"#;
+
+#[test]
+fn a_white_coated_sphere_vanishes_in_a_white_furnace() {
+    let root =
+        prism_mitsuba::pbrt::read_pbrt_str(COATED_SPHERE_IN_A_FURNACE, Path::new("furnace.pbrt"))
+            .unwrap()
+            .root;
+    let scene = prism_mitsuba::factory::build_scene(&root).unwrap().scene;
+    let film = render_film(&scene, 64, 3, None);
+    // Every ray from the corner escapes at once: the environment's radiance, without noise.
+    let (background, _) = block_mean(&film, 0, 0, 2, 1);
+    assert!(background > 0.5, "background {background}");
+    // The 8 × 8 pixels in the middle all see the sphere.
+    let (sphere, variance) = block_mean(&film, 8, 8, 8, 1);
+    let z = (sphere - background) / variance.sqrt();
+    assert!(
+        z.abs() < 4.5 && variance.sqrt() < 0.01 * background,
+        "the sphere's Y {sphere} ± {} against the environment's {background}",
+        variance.sqrt()
+    );
+}
+
 /// A folder of its own for a test's files.
 fn folder(name: &str) -> PathBuf {
     let folder = std::env::temp_dir().join(format!("prism-pbrt-{}-{name}", std::process::id()));
@@ -242,9 +278,14 @@ fn errors_name_the_file_line_and_column() {
             "unread_parameter.pbrt:2:20: Material \"diffuse\": parameter \"float sigma\" is not read by Prism",
         ),
         (
-            "coated",
-            "WorldBegin\nMaterial \"coateddiffuse\"\n",
-            "coated.pbrt:2:1: Material \"coateddiffuse\": pbrt-v4's coated materials are a random walk",
+            "dispersive_coating",
+            "WorldBegin\nMaterial \"coateddiffuse\" \"spectrum eta\" \"glass-BK7\"\n",
+            "dispersive_coating.pbrt:2:26: Material \"coateddiffuse\": parameter \"spectrum eta\" must be a number",
+        ),
+        (
+            "coated_conductor_by_reflectance",
+            "WorldBegin\nMaterial \"coatedconductor\" \"rgb reflectance\" [0.9 0.5 0.2]\n",
+            "coated_conductor_by_reflectance.pbrt:2:28: Material \"coatedconductor\": parameter \"rgb reflectance\" is not read by Prism",
         ),
     ];
     for (name, text, expected) in cases {

@@ -136,6 +136,14 @@ const CASES: &[Case] = &[
     )
     .reciprocal(),
     Case::new(
+        "diffusetransmission",
+        "diffusetransmission",
+        r#"<bsdf type="diffusetransmission"><rgb name="reflectance" value="0.7, 0.2, 0.1"/>
+        <rgb name="transmittance" value="0.2, 0.5, 0.8"/></bsdf>"#,
+        &BOTH_SIDES,
+        29,
+    ),
+    Case::new(
         "roughconductor_ggx",
         "roughconductor ggx",
         r#"<bsdf type="roughconductor"><string name="material" value="Au"/>
@@ -417,6 +425,27 @@ fn roughdiffuse() {
     let fast = r#"<bsdf type="roughdiffuse"><float name="alpha" value="0.6"/>
         <boolean name="use_fast_approx" value="true"/></bsdf>"#;
     assert_reciprocal("roughdiffuse (fast)", &bsdf_from_xml(fast), 3);
+}
+
+#[test]
+fn diffusetransmission() {
+    check("diffusetransmission");
+    // A white furnace: what is not reflected is transmitted.
+    let white = bsdf_from_xml(
+        r#"<bsdf type="diffusetransmission"><rgb name="reflectance" value="0.4"/>
+        <rgb name="transmittance" value="0.6"/></bsdf>"#,
+    );
+    for wo in BOTH_SIDES {
+        let stats = check_samples(&white, wo.direction(), 100_000, 31);
+        for c in 0..4 {
+            assert!(
+                (stats.albedo[c] - 1.0).abs() <= 4.0 * stats.albedo_se[c] + 1e-4,
+                "diffusetransmission from {wo:?}: albedo {} ± {}",
+                stats.albedo[c],
+                stats.albedo_se[c]
+            );
+        }
+    }
 }
 
 #[test]

@@ -4,6 +4,7 @@
 
 mod bsdfs;
 mod image_formation;
+mod layered;
 mod lights;
 mod media;
 mod sampling;

@@ -50,6 +50,8 @@
 //! | `ward` | [`ward`] | glossy and diffuse reflection |
 //! | `principled` | [`principled`] | diffuse, glossy reflection (two), glossy transmission |
 //! | `principledthin` | [`principledthin`] | diffuse and glossy reflection and transmission |
+//! | `diffusetransmission` | [`diffusetransmission`] | diffuse reflection and transmission (pbrt-v4's) |
+//! | `coateddiffuse`, `coatedconductor` | [`layered`] | reflection by a random walk through a coating (pbrt-v4's) |
 //! | `twosided` | [`twosided`] | those of the nested BSDFs, on both sides |
 //! | `mask` | [`mask`] | the nested BSDF's, and null transmission |
 //! | `null` | [`null`] | null transmission only (a medium's boundary) |
@@ -62,8 +64,11 @@ pub mod burley;
 pub mod conductor;
 pub mod dielectric;
 pub mod diffuse;
+pub mod diffusetransmission;
 pub mod fresnel;
 pub mod glossydiffuse;
+pub mod layer_interface;
+pub mod layered;
 pub mod mask;
 pub mod material;
 pub mod microfacet;
@@ -91,6 +96,8 @@ pub use bumpmap::BumpMap;
 pub use conductor::Conductor;
 pub use dielectric::Dielectric;
 pub use diffuse::Diffuse;
+pub use diffusetransmission::DiffuseTransmission;
+pub use layered::{CoatedConductor, CoatedDiffuse, Coating};
 pub use mask::Mask;
 pub use material::{Material, Scattering};
 pub use normalmap::NormalMap;
@@ -636,6 +643,9 @@ bsdfs! {
         Ward(Ward),
         Principled(Principled),
         PrincipledThin(PrincipledThin),
+        DiffuseTransmission(DiffuseTransmission),
+        CoatedDiffuse(CoatedDiffuse),
+        CoatedConductor(CoatedConductor),
         Null(Null),
     }
     adapters {
@@ -660,6 +670,8 @@ bsdfs! {
         Ward(ward::WardLobes),
         Principled(principled::PrincipledLobes),
         PrincipledThin(principledthin::PrincipledThinLobes),
+        DiffuseTransmission(diffusetransmission::DiffuseTransmissionLobes),
+        Layered(layered::LayeredLobes),
         BackSide(twosided::BackSideLobes),
         Mask(mask::MaskLobes),
         Blend(blend::BlendLobes),

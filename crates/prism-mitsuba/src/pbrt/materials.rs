@@ -48,22 +48,53 @@ impl Builder {
             "interface" | "" | "none" => {
                 plugin(PluginClass::Bsdf, "null", &location, &self.search_paths)
             }
-            "coateddiffuse" | "coatedconductor" => {
-                return Err(list
-                    .directive_error(
-                        "pbrt-v4's coated materials are a random walk through a layer; Prism has no such model",
-                    )
-                    .with_help("Prism's plastic and roughplastic (Mitsuba's) are other models; write the scene in Mitsuba XML to use them"));
+            "coateddiffuse" => {
+                let mut node = self.coating(ty, list, "eta", "")?;
+                self.spectrum_property(
+                    &mut node,
+                    list,
+                    "reflectance",
+                    "reflectance",
+                    Some(PropertyValue::Float(0.5)),
+                )?;
+                node
+            }
+            "coatedconductor" => {
+                let mut node = self.coating(ty, list, "interface.eta", "interface.")?;
+                self.conductor_index(&mut node, list, "conductor.eta", "conductor.k")?;
+                let (u, v) = self.roughness_values(list, "conductor.")?;
+                set_alpha(&mut node, list, "conductor_alpha", (u, v));
+                node
             }
             "diffusetransmission" => {
-                return Err(list.directive_error(
-                    "Prism has no diffuse transmitter (pbrt's diffusetransmission)",
-                ));
+                let mut node = plugin(
+                    PluginClass::Bsdf,
+                    "diffusetransmission",
+                    &location,
+                    &self.search_paths,
+                );
+                for name in ["reflectance", "transmittance"] {
+                    self.spectrum_property(
+                        &mut node,
+                        list,
+                        name,
+                        name,
+                        Some(PropertyValue::Float(0.25)),
+                    )?;
+                }
+                if list.float("scale", 1.0)? != 1.0 {
+                    let parameter = list.get("scale").expect("given");
+                    return Err(list.error(
+                        parameter,
+                        "is not read by Prism: scale the reflectance and transmittance instead",
+                    ));
+                }
+                node
             }
             _ => {
                 return Err(list
                     .directive_error("Prism has no material with this pbrt-v4 model")
-                    .with_help("Prism reads diffuse, conductor, dielectric, thindielectric, mix and interface"));
+                    .with_help("Prism reads diffuse, conductor, dielectric, thindielectric, coateddiffuse, coatedconductor, diffusetransmission, mix and interface"));
             }
         };
         list.finish()?;
@@ -143,6 +174,21 @@ impl Builder {
 
     /// pbrt's roughness as (αu, αv), or `None` for a smooth surface.
     fn roughness(&mut self, list: &ParameterList) -> Result<Option<(f64, f64)>> {
+        let (u, v) = self.roughness_values(list, "")?;
+        if u.max(v) < 1e-3 {
+            return Ok(None);
+        }
+        self.warn(
+            &list.location,
+            "pbrt-v4's rough surfaces (Trowbridge-Reitz with height-correlated masking) are \
+             rendered with Prism's GGX (Mitsuba's, with separable masking)",
+        );
+        Ok(Some((u, v)))
+    }
+
+    /// pbrt's `{prefix}roughness`, `{prefix}uroughness` and `{prefix}vroughness` as (αu, αv):
+    /// √roughness unless `remaproughness` is false (pbrt's `RoughnessToAlpha`).
+    fn roughness_values(&self, list: &ParameterList, prefix: &str) -> Result<(f64, f64)> {
         let value = |name: &str, default: f64| -> Result<f64> {
             match list.float_or_texture(name)? {
                 Some((FloatParam::Value(v), _)) => Ok(v),
@@ -153,23 +199,14 @@ impl Builder {
                 None => Ok(default),
             }
         };
-        let roughness = value("roughness", 0.0)?;
-        let u = value("uroughness", roughness)?;
-        let v = value("vroughness", roughness)?;
-        let (u, v) = if list.boolean("remaproughness", true)? {
+        let roughness = value(&format!("{prefix}roughness"), 0.0)?;
+        let u = value(&format!("{prefix}uroughness"), roughness)?;
+        let v = value(&format!("{prefix}vroughness"), roughness)?;
+        Ok(if list.boolean("remaproughness", true)? {
             (u.max(0.0).sqrt(), v.max(0.0).sqrt())
         } else {
-            (u, v)
-        };
-        if u.max(v) < 1e-3 {
-            return Ok(None);
-        }
-        self.warn(
-            &list.location,
-            "pbrt-v4's rough surfaces (Trowbridge-Reitz with height-correlated masking) are \
-             rendered with Prism's GGX (Mitsuba's, with separable masking)",
-        );
-        Ok(Some((u, v)))
+            (u.max(0.0), v.max(0.0))
+        })
     }
 
     fn set_roughness(node: &mut PluginNode, list: &ParameterList, (u, v): (f64, f64)) {
@@ -209,8 +246,24 @@ impl Builder {
             &list.location,
             &self.search_paths,
         );
-        let eta = list.spectrum("eta", false)?;
-        let k = list.spectrum("k", false)?;
+        self.conductor_index(&mut node, list, "eta", "k")?;
+        if let Some(alpha) = rough {
+            Self::set_roughness(&mut node, list, alpha);
+        }
+        Ok(node)
+    }
+
+    /// A conductor's index from the spectra `eta_name` and `k_name` (pbrt's default: copper):
+    /// the `material` of a metal Prism's table has, or both as spectra.
+    fn conductor_index(
+        &self,
+        node: &mut PluginNode,
+        list: &ParameterList,
+        eta_name: &str,
+        k_name: &str,
+    ) -> Result<()> {
+        let eta = list.spectrum(eta_name, false)?;
+        let k = list.spectrum(k_name, false)?;
         let metal = |value: &Option<(SpectrumParam, &super::parameters::Parameter)>, part: &str| {
             match value {
                 None => Some("Cu".to_string()),
@@ -223,24 +276,19 @@ impl Builder {
         };
         match (metal(&eta, "-eta"), metal(&k, "-k")) {
             (Some(a), Some(b)) if a == b && conductor_preset(&a).is_some() => {
-                set(
-                    &mut node,
-                    "material",
-                    PropertyValue::String(a),
-                    &list.location,
-                );
+                set(node, "material", PropertyValue::String(a), &list.location);
             }
             _ => {
                 for (value, name) in [(&eta, "eta"), (&k, "k")] {
                     let Some((value, parameter)) = value else {
-                        return Err(list.directive_error(
-                            "needs eta and k of the same metal (metal-*-eta and metal-*-k of a \
-                             metal Prism knows), or both as spectra",
-                        ));
+                        return Err(list.directive_error(format!(
+                            "needs {eta_name} and {k_name} of the same metal (metal-*-eta and \
+                             metal-*-k of a metal Prism knows), or both as spectra"
+                        )));
                     };
                     match spectra::spectrum(list, parameter, value, &self.search_paths)? {
                         spectrum @ PropertyValue::Spectrum(_) => {
-                            set(&mut node, name, spectrum, &parameter.location)
+                            set(node, name, spectrum, &parameter.location)
                         }
                         _ => {
                             return Err(list.error(
@@ -254,8 +302,76 @@ impl Builder {
                 }
             }
         }
-        if let Some(alpha) = rough {
-            Self::set_roughness(&mut node, list, alpha);
+        Ok(())
+    }
+
+    /// pbrt's coating and slab (`coateddiffuse`, `coatedconductor`): the index `eta_name`, the
+    /// roughness `{prefix}roughness`, and `thickness`, `albedo`, `g`, `maxdepth`, `nsamples`.
+    fn coating(
+        &self,
+        ty: &str,
+        list: &ParameterList,
+        eta_name: &str,
+        prefix: &str,
+    ) -> Result<PluginNode> {
+        let location = &list.location;
+        let mut node = plugin(PluginClass::Bsdf, ty, location, &self.search_paths);
+        let eta = match list.get(eta_name) {
+            None => 1.5,
+            Some(parameter) if parameter.is("float") => list.float(eta_name, 1.5)?,
+            Some(parameter) => {
+                return Err(list.error(
+                    parameter,
+                    "must be a number: Prism's coatings have a constant index (pbrt lets a \
+                     spectrum disperse)",
+                ));
+            }
+        };
+        let eta_prism = if ty == "coateddiffuse" {
+            "eta"
+        } else {
+            "interface_eta"
+        };
+        let alpha_prism = if ty == "coateddiffuse" {
+            "alpha"
+        } else {
+            "interface_alpha"
+        };
+        set(&mut node, eta_prism, PropertyValue::Float(eta), location);
+        let (u, v) = self.roughness_values(list, prefix)?;
+        set_alpha(&mut node, list, alpha_prism, (u, v));
+        for (name, default) in [("thickness", 0.01), ("g", 0.0)] {
+            let value = match list.float_or_texture(name)? {
+                Some((FloatParam::Value(v), _)) => v,
+                Some((FloatParam::Texture(_), parameter)) => {
+                    return Err(list.error(
+                        parameter,
+                        "is a texture; Prism's pbrt reader reads a constant",
+                    ));
+                }
+                None => default,
+            };
+            let value = if name == "g" {
+                value.clamp(-1.0, 1.0)
+            } else {
+                value.max(0.0)
+            };
+            set(&mut node, name, PropertyValue::Float(value), location);
+        }
+        self.spectrum_property(
+            &mut node,
+            list,
+            "albedo",
+            "albedo",
+            Some(PropertyValue::Float(0.0)),
+        )?;
+        for (pbrt, prism, default) in [("maxdepth", "max_depth", 10), ("nsamples", "samples", 1)] {
+            let value = list.integer(pbrt, default)?;
+            if !(1..=65536).contains(&value) {
+                let parameter = list.get(pbrt).expect("given");
+                return Err(list.error(parameter, "must be between 1 and 65536"));
+            }
+            set(&mut node, prism, PropertyValue::Integer(value), location);
         }
         Ok(node)
     }
@@ -514,6 +630,27 @@ impl Builder {
         let dv = list.float("vdelta", 0.0)?;
         Ok(DMat4::from_translation(DVec3::new(du, dv, 0.0))
             * DMat4::from_scale(DVec3::new(su, sv, 1.0)))
+    }
+}
+
+/// Sets the roughness `name` (or `{name}_u` and `{name}_v` where they differ).
+fn set_alpha(node: &mut PluginNode, list: &ParameterList, name: &str, (u, v): (f64, f64)) {
+    let location = &list.location;
+    if u == v {
+        set(node, name, PropertyValue::Float(u), location);
+    } else {
+        set(
+            node,
+            &format!("{name}_u"),
+            PropertyValue::Float(u),
+            location,
+        );
+        set(
+            node,
+            &format!("{name}_v"),
+            PropertyValue::Float(v),
+            location,
+        );
     }
 }
 

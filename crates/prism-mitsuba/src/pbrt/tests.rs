@@ -285,6 +285,73 @@ fn materials_map_to_mitsubas_bsdfs() {
 }
 
 #[test]
+fn coated_materials_map_to_the_layered_bsdfs() {
+    let root = root(
+        "WorldBegin\nMaterial \"coateddiffuse\" \"rgb reflectance\" [0.2 0.4 0.6] \"float roughness\" 0.09 \"float eta\" 1.33 \"rgb albedo\" [0.5 0.5 0.5] \"float g\" 0.3 \"integer nsamples\" 2\nShape \"sphere\"\nMaterial \"coatedconductor\" \"spectrum conductor.eta\" \"metal-Au-eta\" \"spectrum conductor.k\" \"metal-Au-k\" \"float conductor.uroughness\" 0.04 \"float conductor.vroughness\" 0.16 \"float thickness\" 0.2 \"integer maxdepth\" 20\nShape \"sphere\"",
+    );
+    let shapes = nodes(&root, PluginClass::Shape);
+    let diffuse = &shapes[0].children[0].node;
+    assert_eq!(diffuse.plugin_type, "coateddiffuse");
+    assert!(
+        (match property(diffuse, "alpha") {
+            PropertyValue::Float(a) => *a,
+            other => panic!("{other:?}"),
+        } - 0.3)
+            .abs()
+            < 1e-12
+    );
+    assert_eq!(property(diffuse, "eta"), &PropertyValue::Float(1.33));
+    assert_eq!(property(diffuse, "g"), &PropertyValue::Float(0.3));
+    assert_eq!(property(diffuse, "samples"), &PropertyValue::Integer(2));
+    assert_eq!(property(diffuse, "max_depth"), &PropertyValue::Integer(10));
+    let conductor = &shapes[1].children[0].node;
+    assert_eq!(conductor.plugin_type, "coatedconductor");
+    assert_eq!(
+        property(conductor, "material"),
+        &PropertyValue::String("Au".into())
+    );
+    assert_eq!(
+        property(conductor, "conductor_alpha_u"),
+        &PropertyValue::Float(0.2)
+    );
+    assert_eq!(
+        property(conductor, "conductor_alpha_v"),
+        &PropertyValue::Float(0.4)
+    );
+    assert_eq!(
+        property(conductor, "interface_alpha"),
+        &PropertyValue::Float(0.0)
+    );
+    assert_eq!(
+        property(conductor, "interface_eta"),
+        &PropertyValue::Float(1.5)
+    );
+    assert_eq!(property(conductor, "thickness"), &PropertyValue::Float(0.2));
+    assert!(
+        error("WorldBegin\nMaterial \"coateddiffuse\" \"integer maxdepth\" 0")
+            .contains("test.pbrt:2:26: Material \"coateddiffuse\": parameter \"integer maxdepth\" must be between 1 and 65536")
+    );
+}
+
+#[test]
+fn diffuse_transmission_maps_to_its_bsdf() {
+    let root = root(
+        "WorldBegin\nMaterial \"diffusetransmission\" \"rgb transmittance\" [0.5 0.5 0.5]\nShape \"sphere\"",
+    );
+    let bsdf = &nodes(&root, PluginClass::Shape)[0].children[0].node;
+    assert_eq!(bsdf.plugin_type, "diffusetransmission");
+    assert_eq!(property(bsdf, "reflectance"), &PropertyValue::Float(0.25));
+    assert!(matches!(
+        property(bsdf, "transmittance"),
+        PropertyValue::Rgb(..)
+    ));
+    assert!(
+        error("WorldBegin\nMaterial \"diffusetransmission\" \"float scale\" 2")
+            .contains("test.pbrt:2:32: Material \"diffusetransmission\": parameter \"float scale\" is not read by Prism")
+    );
+}
+
+#[test]
 fn objects_become_shape_groups_and_instances() {
     let root = root(
         "WorldBegin\nObjectBegin \"pair\"\nShape \"sphere\"\nTranslate 2 0 0\nShape \"sphere\"\nObjectEnd\nTranslate 0 5 0\nObjectInstance \"pair\"\n",

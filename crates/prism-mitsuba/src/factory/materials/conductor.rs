@@ -50,16 +50,19 @@ pub(super) const ROUGHCONDUCTOR: Plugin<Build> = Plugin {
 };
 
 params! {
-    MATERIAL = ParamSpec::new("material", ParamKind::String, Default::Str("none"), "a measured preset (`Au`, `Ag`, `Cu`, `Al`, `Cr`, … the 71 of Mitsuba's table), or `none`: a 100 % mirror");
-    ETA = colour("eta", Range::IndexPart, 0.0, "real part of the index (instead of `material`); an `<rgb>` is read as Mitsuba 3's spectral variants read it: components clamped to [0, 1], upsampled as a reflectance");
-    K = colour("k", Range::IndexPart, 1.0, "imaginary part of the index (instead of `material`); an `<rgb>` as for `eta`");
+    pub(super) MATERIAL = ParamSpec::new("material", ParamKind::String, Default::Str("none"), "a measured preset (`Au`, `Ag`, `Cu`, `Al`, `Cr`, … the 71 of Mitsuba's table), or `none`: a 100 % mirror");
+    pub(super) ETA = colour("eta", Range::IndexPart, 0.0, "real part of the index (instead of `material`); an `<rgb>` is read as Mitsuba 3's spectral variants read it: components clamped to [0, 1], upsampled as a reflectance");
+    pub(super) K = colour("k", Range::IndexPart, 1.0, "imaginary part of the index (instead of `material`); an `<rgb>` as for `eta`");
     CONDUCTOR_SPECULAR = colour("specular_reflectance", Range::Albedo, 1.0, "a factor on the reflectance");
     EXT_ETA = ParamSpec::new("ext_eta", ParamKind::Ior, Default::Text("1"), "(Mitsuba 0.6's `extEta`) index of the medium outside, a number or a name: η and k are divided by it. Mitsuba 3 reads no exterior index");
 }
 
 /// A conductor's η and k: `material` (a preset; "none", the default, is a perfect mirror with
 /// η = 0, k = 1), or `eta` and `k` as spectra, colours (upsampled without bounds) or textures.
-fn conductor_ior(params: &Params, textures: &mut TextureCache) -> Result<(Texture, Texture)> {
+pub(super) fn conductor_ior(
+    params: &Params,
+    textures: &mut TextureCache,
+) -> Result<(Texture, Texture)> {
     let material = params.string(&MATERIAL)?;
     if material == "none" {
         let eta = spectrum_texture(params, &ETA, textures)?;

@@ -26,6 +26,7 @@ mod dielectric;
 mod diffuse;
 mod glossy;
 mod ior;
+mod layered;
 mod microfacet;
 mod plastic;
 mod principled;
@@ -47,6 +48,7 @@ pub static BSDFS: Registry<Build> = Registry {
     plugins: &[
         diffuse::DIFFUSE,
         diffuse::ROUGHDIFFUSE,
+        diffuse::DIFFUSETRANSMISSION,
         conductor::CONDUCTOR,
         conductor::ROUGHCONDUCTOR,
         dielectric::DIELECTRIC,
@@ -59,6 +61,8 @@ pub static BSDFS: Registry<Build> = Registry {
         glossy::WARD,
         principled::PRINCIPLED,
         principled::PRINCIPLEDTHIN,
+        layered::COATEDDIFFUSE,
+        layered::COATEDCONDUCTOR,
         adapters::TWOSIDED,
         adapters::MASK,
         adapters::NULL,
