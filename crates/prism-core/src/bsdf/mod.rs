@@ -50,6 +50,7 @@
 //! | `ward` | [`ward`] | glossy and diffuse reflection |
 //! | `principled` | [`principled`] | diffuse, glossy reflection (two), glossy transmission |
 //! | `principledthin` | [`principledthin`] | diffuse and glossy reflection and transmission |
+//! | `hair` | [`hair`] | glossy scattering around a fibre (reflection and transmission) |
 //! | `twosided` | [`twosided`] | those of the nested BSDFs, on both sides |
 //! | `mask` | [`mask`] | the nested BSDF's, and null transmission |
 //! | `null` | [`null`] | null transmission only (a medium's boundary) |
@@ -64,6 +65,7 @@ pub mod dielectric;
 pub mod diffuse;
 pub mod fresnel;
 pub mod glossydiffuse;
+pub mod hair;
 pub mod mask;
 pub mod material;
 pub mod microfacet;
@@ -91,6 +93,7 @@ pub use bumpmap::BumpMap;
 pub use conductor::Conductor;
 pub use dielectric::Dielectric;
 pub use diffuse::Diffuse;
+pub use hair::{Hair, HairAbsorption, HairLobeShapes};
 pub use mask::Mask;
 pub use material::{Material, Scattering};
 pub use normalmap::NormalMap;
@@ -637,6 +640,7 @@ bsdfs! {
         Principled(Principled),
         PrincipledThin(PrincipledThin),
         Null(Null),
+        Hair(Hair),
     }
     adapters {
         TwoSided(TwoSided),
@@ -665,5 +669,6 @@ bsdfs! {
         Blend(blend::BlendLobes),
         Perturbed(perturbed::PerturbedLobes),
         Null(null::NullLobes),
+        Hair(hair::HairLobes<'a>),
     }
 }

@@ -25,6 +25,7 @@ mod conductor;
 mod dielectric;
 mod diffuse;
 mod glossy;
+mod hair;
 mod ior;
 mod microfacet;
 mod plastic;
@@ -59,6 +60,7 @@ pub static BSDFS: Registry<Build> = Registry {
         glossy::WARD,
         principled::PRINCIPLED,
         principled::PRINCIPLEDTHIN,
+        hair::HAIR,
         adapters::TWOSIDED,
         adapters::MASK,
         adapters::NULL,
