@@ -51,6 +51,7 @@
 //! | `principled` | [`principled`] | diffuse, glossy reflection (two), glossy transmission |
 //! | `principledthin` | [`principledthin`] | diffuse and glossy reflection and transmission |
 //! | `hair` | [`hair`] | glossy scattering around a fibre (reflection and transmission) |
+//! | `measured` | [`measured`] | glossy reflection, tabulated (RGL database) |
 //! | `twosided` | [`twosided`] | those of the nested BSDFs, on both sides |
 //! | `mask` | [`mask`] | the nested BSDF's, and null transmission |
 //! | `null` | [`null`] | null transmission only (a medium's boundary) |
@@ -68,6 +69,7 @@ pub mod glossydiffuse;
 pub mod hair;
 pub mod mask;
 pub mod material;
+pub mod measured;
 pub mod microfacet;
 pub mod normalmap;
 pub mod null;
@@ -96,6 +98,7 @@ pub use diffuse::Diffuse;
 pub use hair::{Hair, HairAbsorption, HairLobeShapes};
 pub use mask::Mask;
 pub use material::{Material, Scattering};
+pub use measured::{Measured, MeasuredData};
 pub use normalmap::NormalMap;
 pub use null::Null;
 pub use phong::Phong;
@@ -641,6 +644,7 @@ bsdfs! {
         PrincipledThin(PrincipledThin),
         Null(Null),
         Hair(Hair),
+        Measured(Measured),
     }
     adapters {
         TwoSided(TwoSided),
@@ -670,5 +674,6 @@ bsdfs! {
         Perturbed(perturbed::PerturbedLobes),
         Null(null::NullLobes),
         Hair(hair::HairLobes<'a>),
+        Measured(measured::MeasuredLobes<'a>),
     }
 }

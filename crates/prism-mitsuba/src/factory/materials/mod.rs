@@ -27,6 +27,7 @@ mod diffuse;
 mod glossy;
 mod hair;
 mod ior;
+mod measured;
 mod microfacet;
 mod plastic;
 mod principled;
@@ -61,6 +62,7 @@ pub static BSDFS: Registry<Build> = Registry {
         principled::PRINCIPLED,
         principled::PRINCIPLEDTHIN,
         hair::HAIR,
+        measured::MEASURED,
         adapters::TWOSIDED,
         adapters::MASK,
         adapters::NULL,
