@@ -110,6 +110,16 @@ fn principal_point_offset_matches_mitsuba() {
 }
 
 #[test]
+fn hair_matches_mitsuba() {
+    assert_matches_reference("hair");
+}
+
+#[test]
+fn hair_by_absorption_matches_mitsuba() {
+    assert_matches_reference("hair_sigma_a");
+}
+
+#[test]
 fn ply_face_colours_match_mitsuba() {
     assert_matches_reference("face_color");
 }

@@ -52,6 +52,8 @@
 //! | `principledthin` | [`principledthin`] | diffuse and glossy reflection and transmission |
 //! | `diffusetransmission` | [`diffusetransmission`] | diffuse reflection and transmission (pbrt-v4's) |
 //! | `coateddiffuse`, `coatedconductor` | [`layered`] | reflection by a random walk through a coating (pbrt-v4's) |
+//! | `hair` | [`hair`] | glossy scattering around a fibre (reflection and transmission) |
+//! | `measured` | [`measured`] | glossy reflection, tabulated (RGL database) |
 //! | `twosided` | [`twosided`] | those of the nested BSDFs, on both sides |
 //! | `mask` | [`mask`] | the nested BSDF's, and null transmission |
 //! | `null` | [`null`] | null transmission only (a medium's boundary) |
@@ -67,10 +69,12 @@ pub mod diffuse;
 pub mod diffusetransmission;
 pub mod fresnel;
 pub mod glossydiffuse;
+pub mod hair;
 pub mod layer_interface;
 pub mod layered;
 pub mod mask;
 pub mod material;
+pub mod measured;
 pub mod microfacet;
 pub mod normalmap;
 pub mod null;
@@ -97,9 +101,11 @@ pub use conductor::Conductor;
 pub use dielectric::Dielectric;
 pub use diffuse::Diffuse;
 pub use diffusetransmission::DiffuseTransmission;
+pub use hair::{Hair, HairAbsorption, HairLobeShapes};
 pub use layered::{CoatedConductor, CoatedDiffuse, Coating};
 pub use mask::Mask;
 pub use material::{Material, Scattering};
+pub use measured::{Measured, MeasuredData};
 pub use normalmap::NormalMap;
 pub use null::Null;
 pub use phong::Phong;
@@ -647,6 +653,8 @@ bsdfs! {
         CoatedDiffuse(CoatedDiffuse),
         CoatedConductor(CoatedConductor),
         Null(Null),
+        Hair(Hair),
+        Measured(Measured),
     }
     adapters {
         TwoSided(TwoSided),
@@ -677,5 +685,7 @@ bsdfs! {
         Blend(blend::BlendLobes),
         Perturbed(perturbed::PerturbedLobes),
         Null(null::NullLobes),
+        Hair(hair::HairLobes<'a>),
+        Measured(measured::MeasuredLobes<'a>),
     }
 }

@@ -270,6 +270,7 @@ fn check_bdpt_lights(
             Light::Constant(_) => "constant",
             Light::Envmap(_) => "envmap",
             Light::Sunsky(_) => "sunsky",
+            Light::DirectionalArea(_) => "directionalarea",
         };
         return Err(Error::input(
             location,

@@ -12,7 +12,7 @@
 //! u16               version (1)
 //! u32               number of fields
 //! per field:        u16 name length, the name (UTF-8), u16 number of dimensions,
-//!                   u8 element type (10 = f32, 11 = f64), u64 byte offset of the values
+//!                   u8 element type (1 = u8, 10 = f32, 11 = f64), u64 byte offset of the values
 //!                   from the start of the file, one u64 per dimension (the shape)
 //! ```
 //! The values of a field are stored contiguously, row-major (last dimension fastest). Every
@@ -27,6 +27,7 @@ pub struct TensorField {
 }
 
 const MAGIC: &[u8; 12] = b"tensor_file\0";
+const ELEMENT_U8: u8 = 1;
 const ELEMENT_F32: u8 = 10;
 const ELEMENT_F64: u8 = 11;
 /// More dimensions than any table here has; a bound so that a corrupt count cannot make the
@@ -117,11 +118,12 @@ pub fn parse_tensor_file(bytes: &[u8]) -> Result<Vec<TensorField>, String> {
         }
         let element = reader.u8(&format!("the element type of \"{name}\""))?;
         let element_size = match element {
+            ELEMENT_U8 => 1,
             ELEMENT_F32 => 4,
             ELEMENT_F64 => 8,
             other => {
                 return Err(format!(
-                    "field \"{name}\" has element type {other}; only 10 (f32) and 11 (f64) are read"
+                    "field \"{name}\" has element type {other}; only 1 (u8), 10 (f32) and 11 (f64) are read"
                 ));
             }
         };
@@ -154,7 +156,9 @@ pub fn parse_tensor_file(bytes: &[u8]) -> Result<Vec<TensorField>, String> {
             ));
         }
         let raw = &bytes[start..end];
-        let values: Vec<f64> = if element == ELEMENT_F32 {
+        let values: Vec<f64> = if element == ELEMENT_U8 {
+            raw.iter().map(|&b| f64::from(b)).collect()
+        } else if element == ELEMENT_F32 {
             raw.chunks_exact(4)
                 .map(|c| f64::from(f32::from_le_bytes(c.try_into().expect("4 bytes"))))
                 .collect()

@@ -25,8 +25,10 @@ mod conductor;
 mod dielectric;
 mod diffuse;
 mod glossy;
+mod hair;
 mod ior;
 mod layered;
+mod measured;
 mod microfacet;
 mod plastic;
 mod principled;
@@ -63,6 +65,8 @@ pub static BSDFS: Registry<Build> = Registry {
         principled::PRINCIPLEDTHIN,
         layered::COATEDDIFFUSE,
         layered::COATEDCONDUCTOR,
+        hair::HAIR,
+        measured::MEASURED,
         adapters::TWOSIDED,
         adapters::MASK,
         adapters::NULL,
