@@ -91,6 +91,9 @@ struct Lane {
     sampler: Sampler,
     camera: Option<CameraSampleRay>,
     path: Option<PathState>,
+    /// The sample's extra channels (the coverage alpha drawn with the camera sample, the
+    /// spectral film's bands written at the end).
+    aovs: Vec<f32>,
 }
 
 /// What the lanes of one run share: the estimator, the path tracer, the sample indices of
@@ -101,25 +104,17 @@ struct LaneRun<'e, 'a, P, S> {
     range: Range<u32>,
     pixels: P,
     sink: &'e mut S,
-    /// One sample's extra channels, reused.
-    aovs: Vec<f32>,
     count: RayCount,
     /// Whether the pass was cancelled before the run was done.
     cancelled: bool,
 }
 
 impl<P: Iterator<Item = (usize, UVec2)>, S: SampleSink> LaneRun<'_, '_, P, S> {
-    /// Hands the finished sample `camera` of the lane's pixel, with the path's `radiance`, to
-    /// the sink.
-    fn add(
-        &mut self,
-        slot: usize,
-        index: u32,
-        camera: &CameraSampleRay,
-        radiance: SampledSpectrum,
-    ) {
-        let (offset, weight, xyz) = self.estimator.film_sample(camera, radiance, &mut self.aovs);
-        self.sink.add(slot, index, offset, weight, xyz, &self.aovs);
+    /// Hands the lane's finished sample `camera`, with the path's `radiance`, to the sink.
+    fn add(&mut self, lane: &mut Lane, camera: &CameraSampleRay, radiance: SampledSpectrum) {
+        let (offset, weight, xyz) = self.estimator.film_sample(camera, radiance, &mut lane.aovs);
+        self.sink
+            .add(lane.slot, lane.index, offset, weight, xyz, &lane.aovs);
     }
 
     /// Starts the lane's sample, or the first of the following indices of its pixel whose
@@ -127,20 +122,20 @@ impl<P: Iterator<Item = (usize, UVec2)>, S: SampleSink> LaneRun<'_, '_, P, S> {
     /// once); returns false when the pixel has no sample left.
     fn start(&mut self, lane: &mut Lane) -> bool {
         while lane.index < self.range.end {
-            self.aovs.fill(0.0);
+            lane.aovs.fill(0.0);
             let camera = self.estimator.camera_sample(
                 &mut lane.sampler,
                 lane.pixel,
                 lane.index,
                 &mut self.count,
-                &mut self.aovs,
+                &mut lane.aovs,
             );
             lane.path = self.path.start(camera.ray, &camera.lambda);
             if lane.path.is_some() {
                 lane.camera = Some(camera);
                 return true;
             }
-            self.add(lane.slot, lane.index, &camera, SampledSpectrum::ZERO);
+            self.add(lane, &camera, SampledSpectrum::ZERO);
             lane.index += 1;
         }
         false
@@ -168,7 +163,7 @@ impl<P: Iterator<Item = (usize, UVec2)>, S: SampleSink> LaneRun<'_, '_, P, S> {
     /// next index, else [`Self::take_pixel`].
     fn finish(&mut self, lane: &mut Lane, cancel: &Cancel) {
         if let (Some(path), Some(camera)) = (lane.path.take(), lane.camera.take()) {
-            self.add(lane.slot, lane.index, &camera, self.path.estimate(&path));
+            self.add(lane, &camera, self.path.estimate(&path));
         }
         lane.index += 1;
         if !self.start(lane) {
@@ -200,7 +195,6 @@ pub(super) fn trace_in_lanes(
         range,
         pixels,
         sink,
-        aovs: vec![0.0; estimator.aov_count()],
         count: RayCount::default(),
         cancelled: false,
     };
@@ -213,6 +207,7 @@ pub(super) fn trace_in_lanes(
                 sampler: Sampler::new(scene.sampler.kind, samples_per_pixel, seed),
                 camera: None,
                 path: None,
+                aovs: vec![0.0; estimator.aov_count()],
             };
             run.take_pixel(&mut lane, cancel);
             lane
