@@ -7,7 +7,8 @@
 
 use glam::{Vec2, Vec3};
 use libfuzzer_sys::fuzz_target;
-use prism_core::light::sunsky::data::{DATASETS, SAMPLING_DATA, SunskyTables, parse_tensor_file};
+use prism_core::light::sunsky::data::{DATASETS, SAMPLING_DATA, SunskyTables};
+use prism_core::tensor_file::parse_tensor_file;
 use prism_core::light::{LightQuery, LightSource, Sunsky, SunskySettings};
 use prism_core::math::Transform;
 use prism_core::spectrum::SampledWavelengths;

@@ -52,5 +52,6 @@ pub mod render;
 pub mod sampling;
 pub mod scene;
 pub mod spectrum;
+pub mod tensor_file;
 pub mod texture;
 pub mod world;

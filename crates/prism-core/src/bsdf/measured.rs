@@ -8,7 +8,7 @@
 //! </bsdf>
 //! ```
 //!
-//! The file is a tensor file (`light::sunsky::data` describes the format) with the fields
+//! The file is a tensor file ([`crate::tensor_file`] describes the format) with the fields
 //! `theta_i`, `phi_i` (the incident angles measured), `ndf` and `sigma` (the microfacet
 //! distribution D and the projected area σ(ω) = ∫ D(m) ⟨ω·m⟩ dm, on grids over the unit square
 //! below), `vndf` (the visible normals' density for each incident direction), `luminance` (the
@@ -35,9 +35,9 @@ use std::sync::Arc;
 use glam::{Vec2, Vec3};
 
 use super::{BsdfEval, BsdfFlags, BsdfSample, Bxdf, BxdfTree, LeafBsdf, mixture_sample};
-use crate::light::sunsky::data::{TensorField, parse_tensor_file};
 use crate::sampling::marginal2d::Marginal2D;
 use crate::spectrum::{N_SPECTRUM_SAMPLES, SampledSpectrum, SampledWavelengths};
+use crate::tensor_file::{TensorField, parse_tensor_file};
 use crate::texture::TexturePoint;
 
 /// A measured material's tables, as its file gives them.
@@ -337,7 +337,7 @@ impl Bxdf for MeasuredLobes<'_> {
     }
 }
 
-/// Writes a tensor file (the format `light::sunsky::data` reads): named fields of u8 (type 1)
+/// Writes a tensor file (the format [`crate::tensor_file`] reads): named fields of u8 (type 1)
 /// or f32 (type 10) values with their shapes. For tests that need a `.bsdf` file.
 #[cfg(test)]
 pub(crate) fn write_tensor_file(fields: &[(&str, Vec<usize>, TensorValues)]) -> Vec<u8> {

@@ -273,3 +273,21 @@ fn horizontal_fov_kind(node: &PluginNode) -> Option<Kind> {
     let aspect = size(&film::WIDTH)? / size(&film::HEIGHT)?;
     Some(Kind::HorizontalFov { axis, aspect })
 }
+
+/// The name `traverse` gives `plugin`, a plugin of the scene `root` (where it first appears in
+/// document order, as `traverse` meets it); None when the scene does not hold it.
+pub fn plugin_name(root: &PluginNode, plugin: &Arc<PluginNode>) -> Option<String> {
+    fn search(node: &PluginNode, name: Option<&str>, plugin: &Arc<PluginNode>) -> Option<String> {
+        let names = child_names(node, name);
+        for (child, child_name) in node.children.iter().zip(names) {
+            if Arc::ptr_eq(&child.node, plugin) {
+                return Some(child_name);
+            }
+            if let Some(found) = search(&child.node, Some(&child_name), plugin) {
+                return Some(found);
+            }
+        }
+        None
+    }
+    search(root, None, plugin)
+}

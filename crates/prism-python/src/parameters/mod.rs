@@ -20,7 +20,7 @@
 //! horizontal field of view, and a BSDF with `int_ior` and `ext_ior` has `<bsdf>.eta`, their
 //! ratio.
 
-mod listing;
+pub mod listing;
 mod values;
 
 use std::collections::btree_map::Entry;
@@ -56,24 +56,6 @@ pub struct SceneParameters {
     keys: Vec<String>,
     /// The changed values, by key, as the description will hold them.
     changes: BTreeMap<String, PropertyValue>,
-}
-
-/// The name `traverse` gives `plugin`, a plugin of the scene `root` (where it first appears in
-/// document order, as `traverse` meets it); None when the scene does not hold it.
-pub fn plugin_name(root: &PluginNode, plugin: &Arc<PluginNode>) -> Option<String> {
-    fn search(node: &PluginNode, name: Option<&str>, plugin: &Arc<PluginNode>) -> Option<String> {
-        let names = listing::child_names(node, name);
-        for (child, child_name) in node.children.iter().zip(names) {
-            if Arc::ptr_eq(&child.node, plugin) {
-                return Some(child_name);
-            }
-            if let Some(found) = search(&child.node, Some(&child_name), plugin) {
-                return Some(found);
-            }
-        }
-        None
-    }
-    search(root, None, plugin)
 }
 
 /// The parameters of `scene`, to read and change.

@@ -260,7 +260,7 @@ impl Sensor {
 
 /// The name `traverse` gives `plugin` of `scene`; its `id` or class if it is not found.
 fn name_of(scene: &Scene, plugin: &Arc<PluginNode>) -> String {
-    crate::parameters::plugin_name(scene.description(), plugin)
+    crate::parameters::listing::plugin_name(scene.description(), plugin)
         .or_else(|| plugin.id.clone())
         .unwrap_or_else(|| plugin.class.tag().to_string())
 }

@@ -3,6 +3,9 @@
 //! A scene keeps its description and the files it read, to be built again when its
 //! parameters change ([`crate::parameters`]).
 
+pub mod introspection;
+pub mod ray_queries;
+
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -11,8 +14,7 @@ use pyo3::types::PyDict;
 
 use crate::dict::dict_of;
 use crate::error::{IntoPyResult, to_py};
-use crate::introspection::{self, BoundingBox3f, Emitter, Sensor, Shape};
-use crate::ray_queries::{self, Rays, SurfaceInteraction};
+use introspection::{BoundingBox3f, Emitter, Sensor, Shape};
 use prism_core::error::{Error, Result};
 use prism_core::film::Reconstruction;
 use prism_core::geometry::Geometry;
@@ -24,6 +26,7 @@ use prism_mitsuba::fingerprint::{override_reconstruction, override_wavelengths};
 use prism_mitsuba::read_scene;
 use prism_mitsuba::reader::{SceneDocument, read_scene_str_document};
 use prism_mitsuba::{LoadedScene, dict};
+use ray_queries::{Rays, SurfaceInteraction};
 
 /// A scene ready to render. Its settings that `prism render` can override from the command
 /// line are properties that may be set (not while the scene renders).
