@@ -44,7 +44,7 @@
 
 use glam::{Vec2, Vec3};
 
-use crate::bsdf::{BsdfFlags, BxdfTree};
+use crate::bsdf::{BsdfFlags, BsdfSample, BxdfTree, Scattering};
 use crate::camera::{Camera, CameraModel};
 use crate::geometry::SurfaceInteraction;
 use crate::geometry::interaction::SHADOW_EPSILON;
@@ -128,6 +128,24 @@ pub(super) fn shading_correction(
     }
     let correction = ((light_s * out_g) / (out_s * light_g)).abs();
     correction.is_finite().then_some(correction)
+}
+
+/// The next direction of a light subpath at `si`, reached by light from `w_light`: a sample of
+/// the BSDF `scattering` read as the adjoint, with the factor its weight f·cos/p takes on a
+/// light subpath, Veach's shading-normal correction times η² (radiance is compressed by η²
+/// across a refraction, importance is not; Veach 1997, §5.2). None where the subpath ends.
+pub(super) fn sample_adjoint(
+    ctx: &mut SampleContext,
+    si: &SurfaceInteraction,
+    scattering: &Scattering,
+    w_light: Vec3,
+) -> Option<(BsdfSample, f32)> {
+    let u_lobe = ctx.sampler.next_1d();
+    let u = ctx.sampler.next_2d();
+    let bs = scattering.sample(u_lobe, u)?;
+    let correction = shading_correction(si, w_light, bs.wi)?;
+    let factor = correction * bs.eta * bs.eta;
+    Some((bs, factor))
 }
 
 impl ParticleTracer {
@@ -286,16 +304,11 @@ impl ParticleTracer {
             }
 
             // The next vertex, by sampling the adjoint BSDF.
-            let u_lobe = ctx.sampler.next_1d();
-            let u = ctx.sampler.next_2d();
-            let Some(bs) = scattering.sample(u_lobe, u) else {
-                break;
-            };
-            let Some(correction) = shading_correction(&si, w_light, bs.wi) else {
+            let Some((bs, factor)) = sample_adjoint(ctx, &si, &scattering, w_light) else {
                 break;
             };
             lambda = wavelengths_after(&lambda, &bs);
-            throughput *= bs.weight * (correction * bs.eta * bs.eta);
+            throughput *= bs.weight * factor;
             eta_scale *= bs.eta;
             if throughput.is_black() {
                 break;

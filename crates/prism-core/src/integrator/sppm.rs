@@ -52,7 +52,7 @@ use glam::Vec3;
 
 use crate::bsdf::{BsdfFlags, BxdfTree};
 use crate::integrator::mis::{Strategies, emission_found, sample_light_at_surface};
-use crate::integrator::ptracer::{choose_light, emission_ray, shading_correction};
+use crate::integrator::ptracer::{choose_light, emission_ray, sample_adjoint};
 use crate::integrator::vertex::{
     allows_next_vertex, hero_only, path_estimate, russian_roulette, surface_scattering,
     wavelengths_after,
@@ -276,16 +276,11 @@ impl SppmIntegrator {
                     hero_only: !lambda.secondary_terminated() && path_lambda.secondary_terminated(),
                 });
             }
-            let u_lobe = ctx.sampler.next_1d();
-            let u = ctx.sampler.next_2d();
-            let Some(bs) = scattering.sample(u_lobe, u) else {
-                break;
-            };
-            let Some(correction) = shading_correction(&si, w_light, bs.wi) else {
+            let Some((bs, factor)) = sample_adjoint(ctx, &si, &scattering, w_light) else {
                 break;
             };
             path_lambda = wavelengths_after(&path_lambda, &bs);
-            beta *= bs.weight * (correction * bs.eta * bs.eta);
+            beta *= bs.weight * factor;
             eta_scale *= bs.eta;
             if beta.is_black() {
                 break;

@@ -160,7 +160,7 @@ mod tests {
         // The first field's element type follows its name ("sun_irradiance", 14 bytes) and
         // dimension count.
         let type_at = 12 + 2 + 4 + 2 + 14 + 2;
-        assert_eq!(wrong_type[type_at], ELEMENT_F32);
+        assert_eq!(wrong_type[type_at], 10, "f32");
         wrong_type[type_at] = 3;
         assert!(
             parse_tensor_file(&wrong_type)
