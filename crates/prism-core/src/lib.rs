@@ -21,6 +21,7 @@
 //! | [`sampling`] | random numbers, warps, tabulated distributions, the per-pixel sampler, chi-square tests of densities |
 //! | [`spectrum`] | wavelengths and spectral values along a path, CIE tables, RGB upsampling |
 //! | [`image`] | image files: decoding, EXR and PNG output, the sRGB curve, comparison |
+//! | [`tensor_file`] | Mitsuba's tensor files: the sun-and-sky tables, measured BSDFs |
 //! | [`geometry`] | shapes, intersection, the BVH, instances, the scene's primitives |
 //! | [`texture`] | values that vary over a surface |
 //! | [`bsdf`] | BSDFs, their lobes at a point, materials |
@@ -29,7 +30,7 @@
 //! | [`world`] | geometry, materials, lights and media together |
 //! | [`film`] | reconstruction filters, pixel sums and their error, the images written |
 //! | [`camera`] | perspective, thin-lens and orthographic cameras, the radiance, irradiance and distant meters, the batch of sensors, and the shutter |
-//! | [`integrator`] | the estimators: path, direct, distrib, volpath, volpathmis, moment, aov |
+//! | [`integrator`] | the estimators: path, direct, distrib, volpath, volpathmis, moment, aov, depth, ptracer, bdpt, sppm |
 //! | [`scene`] | the world with camera, film, sampler and integrator |
 //! | [`render`] | passes, tiles, threads, progress, render states |
 

@@ -105,7 +105,11 @@ fn unknown_plugin_lists_the_supported_ones() {
         &dir,
         &[],
         "scene.xml:9:9",
-        &["unknown bsdf type \"plastik\"", "diffuse, mask", "twosided"],
+        &[
+            "unknown bsdf type \"plastik\"",
+            "diffusetransmission, hair, mask",
+            "twosided",
+        ],
     );
     let dir = folder("unknown-shape");
     write(
