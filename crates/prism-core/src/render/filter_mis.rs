@@ -228,7 +228,7 @@ impl SampleSink for RecordSink<'_, '_> {
         offset: Vec2,
         _filter_weight: f32,
         xyz: [f32; 3],
-        aovs: &[f32],
+        aovs: &mut [f32],
     ) {
         let start = slot * self.per_pixel + (index - self.first) as usize * self.stride;
         let record = &mut self.values[start..start + self.stride];

@@ -69,7 +69,8 @@ impl LaneCounter {
 pub(super) trait SampleSink {
     /// Takes sample `index` of the pixel its source named `slot`: the film offset from the
     /// pixel's centre, the weight the one-pixel estimator gives the sample, its CIE XYZ and its
-    /// extra channels (weighted by the shutter, not by the filter).
+    /// extra channels (weighted by the shutter, not by the filter; the sink may scale them in
+    /// place).
     fn add(
         &mut self,
         slot: usize,
@@ -77,7 +78,7 @@ pub(super) trait SampleSink {
         offset: Vec2,
         filter_weight: f32,
         xyz: [f32; 3],
-        aovs: &[f32],
+        aovs: &mut [f32],
     );
 }
 
@@ -114,7 +115,7 @@ impl<P: Iterator<Item = (usize, UVec2)>, S: SampleSink> LaneRun<'_, '_, P, S> {
     fn add(&mut self, lane: &mut Lane, camera: &CameraSampleRay, radiance: SampledSpectrum) {
         let (offset, weight, xyz) = self.estimator.film_sample(camera, radiance, &mut lane.aovs);
         self.sink
-            .add(lane.slot, lane.index, offset, weight, xyz, &lane.aovs);
+            .add(lane.slot, lane.index, offset, weight, xyz, &mut lane.aovs);
     }
 
     /// Starts the lane's sample, or the first of the following indices of its pixel whose

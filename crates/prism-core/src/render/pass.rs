@@ -89,14 +89,14 @@ impl SampleSink for PixelSink<'_> {
         _offset: Vec2,
         filter_weight: f32,
         xyz: [f32; 3],
-        aovs: &[f32],
+        aovs: &mut [f32],
     ) {
         self.sums.pixels[slot].add(xyz.map(|v| v * filter_weight));
-        let start = slot * AOV_SUMS_PER_CHANNEL * self.k;
-        let sums = &mut self.sums.aovs[start..start + self.k];
-        for (sum, &v) in sums.iter_mut().zip(aovs) {
-            add_aov_sample(std::slice::from_mut(sum), &[v * filter_weight]);
+        for v in aovs.iter_mut() {
+            *v *= filter_weight;
         }
+        let start = slot * AOV_SUMS_PER_CHANNEL * self.k;
+        add_aov_sample(&mut self.sums.aovs[start..start + self.k], aovs);
     }
 }
 
