@@ -142,8 +142,24 @@ impl PiecewiseConstant1D {
         }
         let cell = self.cells[index];
         let offset = (u - cell.start) * cell.inverse_width;
-        let x = self.min + (index as u32 as f32 + offset) * self.cell_width;
-        (x.clamp(self.min, self.last), index)
+        let mut x = (self.min + (index as u32 as f32 + offset) * self.cell_width)
+            .clamp(self.min, self.last);
+        // Rounding may put x on the neighbouring cell's side of a border, where [`Self::pdf`]
+        // would give that cell's density: keep it in the cell drawn.
+        while self.cell_of(x) > index {
+            x = x.next_down();
+        }
+        while self.cell_of(x) < index {
+            x = x.next_up();
+        }
+        (x, index)
+    }
+
+    /// The cell [`Self::pdf`] finds `x` in, for `x` in the domain.
+    #[inline]
+    fn cell_of(&self, x: f32) -> usize {
+        let n = self.density.len();
+        (((x - self.min) / (self.max - self.min) * n as f32) as usize).min(n - 1)
     }
 
     /// Density of [`Self::sample`] at `x` (zero outside the domain).
@@ -151,9 +167,7 @@ impl PiecewiseConstant1D {
         if !(x >= self.min && x < self.max) {
             return 0.0;
         }
-        let n = self.density.len();
-        let index = (((x - self.min) / (self.max - self.min) * n as f32) as usize).min(n - 1);
-        self.cell_pdf(index)
+        self.cell_pdf(self.cell_of(x))
     }
 
     /// Density within cell `index`.

@@ -360,7 +360,7 @@ fn to_nanometre_coefficients([a, b, c]: [f64; 3]) -> RgbSigmoidPolynomial {
 }
 
 /// Quadrature for the colour of a reflectance under D65: wavelengths (as t in [0,1]) and the
-/// XYZ weights x̄·D65·Δλ / ∫ȳ at each (trapezoid rule on the 1 nm tables).
+/// XYZ weights x̄·D65·Δλ / ∫ȳ at each (trapezoid rule on a 1 nm grid).
 struct ColourQuadrature {
     t: Vec<f64>,
     weights: Vec<[f64; 3]>,

@@ -211,7 +211,7 @@ impl WavelengthSampling {
                 let [r, g, b] = mul3(&XYZ_TO_LINEAR_SRGB, xyz);
                 [xyz[1], r, g, b].map(f64::from)
             };
-            // I_c = ∫ c̄ D65 dλ by the trapezoidal rule on the 1 nm table.
+            // I_c = ∫ c̄ D65 dλ by the trapezoidal rule on a 1 nm grid.
             let mut means = [0.0f64; 4];
             for i in 0..=470 {
                 let lambda = LAMBDA_MIN + i as f32;
