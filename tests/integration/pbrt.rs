@@ -423,3 +423,60 @@ fn spectra_may_be_read_from_files() {
         "{message}"
     );
 }
+
+/// A grey square filling an orthographic view under a white sky, its reflectance a `mix` of
+/// 0.8 and 0.1 whose `amount` is a `scale` of 0.25 by a checkerboard of 1 and ½: the four
+/// quarters of the image reflect 0.75 · 0.8 + 0.25 · 0.1 = 0.625 and
+/// 0.875 · 0.8 + 0.125 · 0.1 = 0.7125, on the diagonals.
+const MIXED_SQUARE: &str = r#"
+LookAt 0 0 -5  0 0 0  0 1 0
+Camera "orthographic"
+Film "rgb" "integer xresolution" 16 "integer yresolution" 16
+PixelFilter "box"
+Sampler "independent" "integer pixelsamples" 64
+Integrator "path" "integer maxdepth" 1
+WorldBegin
+LightSource "infinite" "rgb L" [1 1 1]
+Texture "checks" "float" "checkerboard" "float tex1" 1 "float tex2" 0.5
+    "float uscale" 2 "float vscale" 2
+Texture "amount" "float" "scale" "float tex" 0.25 "texture scale" "checks"
+Texture "albedo" "spectrum" "mix" "rgb tex1" [0.8 0.8 0.8] "rgb tex2" [0.1 0.1 0.1]
+    "texture amount" "amount"
+Material "diffuse" "texture reflectance" "albedo"
+Shape "trianglemesh" "point3 P" [-1 -1 0  1 -1 0  1 1 0  -1 1 0]
+    "point2 uv" [0 0  1 0  1 1  0 1] "integer indices" [0 1 2  0 2 3]
+"#;
+
+#[test]
+fn scale_and_mix_textures_render_pbrts_values() {
+    let root = prism_mitsuba::pbrt::read_pbrt_str(MIXED_SQUARE, Path::new("mixed.pbrt"))
+        .unwrap()
+        .root;
+    let scene = prism_mitsuba::factory::build_scene(&root).unwrap().scene;
+    let film = render_film(&scene, 64, 4, None);
+    // A diffuse surface under a uniform sky of luminance 1 has the luminance of its
+    // reflectance; the sky is sampled over the whole sphere, so the estimate is noisy.
+    let quarter = |x0: usize, y0: usize| block_mean(&film, x0, y0, 8, 1);
+    let z = |(mean, variance): (f64, f64), expected: f64| (mean - expected) / variance.sqrt();
+    let (a, b) = (quarter(0, 0), quarter(8, 0));
+    let (first, second) = if a.0 < b.0 {
+        (0.625, 0.7125)
+    } else {
+        (0.7125, 0.625)
+    };
+    // 4 quarters: 4 standard errors fail a correct texture with probability 2.5·10⁻⁴; the
+    // two values differ by more than 20 standard errors.
+    for (value, expected) in [
+        (a, first),
+        (quarter(8, 8), first),
+        (b, second),
+        (quarter(0, 8), second),
+    ] {
+        assert!(
+            z(value, expected).abs() < 4.0 && z(value, 0.7125 + 0.625 - expected).abs() > 8.0,
+            "a quarter's Y {} ± {} where {expected} is expected",
+            value.0,
+            value.1.sqrt()
+        );
+    }
+}

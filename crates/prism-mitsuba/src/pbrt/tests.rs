@@ -489,3 +489,32 @@ fn the_samplers_seed_wins_over_the_option() {
         PropertyValue::Integer(3)
     );
 }
+
+#[test]
+fn scale_and_mix_textures_nest_their_operands() {
+    let root = root(
+        "WorldBegin\nTexture \"checks\" \"float\" \"checkerboard\"\nTexture \"amount\" \"float\" \"scale\" \"float tex\" 0.5 \"texture scale\" \"checks\"\nTexture \"blend\" \"spectrum\" \"mix\" \"rgb tex1\" [0.8 0.8 0.8] \"texture amount\" \"amount\"\nMaterial \"diffuse\" \"texture reflectance\" \"blend\"\nShape \"sphere\"",
+    );
+    let shape = nodes(&root, PluginClass::Shape)[0];
+    let diffuse = &shape.children[0].node.children[0].node;
+    let blend = &diffuse.children[0].node;
+    assert_eq!(blend.plugin_type, "mix");
+    assert_eq!(property(blend, "tex1"), &PropertyValue::Rgb([0.8; 3]));
+    // pbrt's defaults: tex2 = 1.
+    assert_eq!(property(blend, "tex2"), &PropertyValue::Float(1.0));
+    let amount = &blend.children[0];
+    assert_eq!(amount.name.as_deref(), Some("amount"));
+    assert_eq!(amount.node.plugin_type, "scale");
+    assert_eq!(property(&amount.node, "tex"), &PropertyValue::Float(0.5));
+    assert_eq!(amount.node.children[0].name.as_deref(), Some("scale"));
+    assert_eq!(amount.node.children[0].node.plugin_type, "checkerboard");
+    // A float texture's operand names a float texture; a spectrum texture is not one.
+    assert!(
+        error("WorldBegin\nTexture \"c\" \"spectrum\" \"checkerboard\"\nTexture \"s\" \"float\" \"scale\" \"texture tex\" \"c\"")
+            .contains("test.pbrt:3:29: Texture \"s\" \"float\" \"scale\": parameter \"texture tex\" names the unknown float texture \"c\"")
+    );
+    assert!(
+        error("WorldBegin\nTexture \"d\" \"float\" \"directionmix\" \"vector3 dir\" [0 1 0]")
+            .contains("test.pbrt:2:1: Texture \"d\" \"float\" \"directionmix\": blends by the surface normal's direction")
+    );
+}
