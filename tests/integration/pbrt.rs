@@ -480,3 +480,110 @@ fn scale_and_mix_textures_render_pbrts_values() {
         );
     }
 }
+
+/// A grey square (reflectance ½) in the plane x = 0, seen from +x, under pbrt's image infinite
+/// light `light` (an equal-area map, scale 2), in an orthographic view that it fills.
+fn square_under_sky(light: &str) -> String {
+    format!(
+        r#"
+LookAt 5 0 0  0 0 0  0 1 0
+Camera "orthographic"
+Film "rgb" "integer xresolution" 8 "integer yresolution" 8
+PixelFilter "box"
+Sampler "independent" "integer pixelsamples" 64
+Integrator "path" "integer maxdepth" 1
+WorldBegin
+AttributeBegin
+{light}
+AttributeEnd
+Material "diffuse" "rgb reflectance" [0.5 0.5 0.5]
+Shape "trianglemesh" "point3 P" [0 -2 -2  0 2 -2  0 2 2  0 -2 2] "integer indices" [0 1 2  0 2 3]
+"#
+    )
+}
+
+#[test]
+fn image_infinite_lights_are_equal_area_maps_in_pbrts_orientation() {
+    // White and black halves of a 16 × 16 map: the right half (u > ½) is the hemisphere
+    // x > 0 and the lower half (v > ½, the image's lower rows) y > 0; and a white map.
+    let folder = folder("sky");
+    let n = 16;
+    let write = |name: &str, white: &dyn Fn(usize, usize) -> bool| {
+        let rgb: Vec<f32> = (0..n * n)
+            .flat_map(|i| [if white(i % n, i / n) { 1.0 } else { 0.0 }; 3])
+            .collect();
+        prism_core::image::write_png_srgb(&folder.join(name), n, n, &rgb).unwrap();
+    };
+    write("right.png", &|x, _| x >= n / 2);
+    write("lower.png", &|_, y| y >= n / 2);
+    write("white.png", &|_, _| true);
+    let image = |name: &str, rotation: &str| {
+        format!(
+            "{rotation}\nLightSource \"infinite\" \"string filename\" \"{name}\" \"float scale\" 2"
+        )
+    };
+    // The square facing +x has the luminance ½ · 2 · (1/π) ∫ cos θ dω over its white
+    // directions: 1 for the whole hemisphere x > 0, ½ for its half with y > 0.
+    let cases = [
+        (image("right.png", ""), 1.0),
+        (image("right.png", "Rotate 180 0 1 0"), 0.0),
+        (image("right.png", "Rotate 90 0 0 1"), 0.5),
+        (image("lower.png", ""), 0.5),
+        (image("lower.png", "Rotate -90 0 0 1"), 1.0),
+        (image("white.png", "Rotate 30 1 1 0"), 1.0),
+        // The uniform light of the same colour: pbrt-v4's constant map.
+        (
+            "LightSource \"infinite\" \"rgb L\" [1 1 1] \"float scale\" 2".to_string(),
+            1.0,
+        ),
+    ];
+    let path = folder.join("sky.pbrt");
+    let renders: Vec<(f64, f64)> = cases
+        .iter()
+        .enumerate()
+        .map(|(k, (light, _))| {
+            let root = prism_mitsuba::pbrt::read_pbrt_str(&square_under_sky(light), &path)
+                .unwrap_or_else(|e| panic!("{light}: {e}"))
+                .root;
+            let scene = prism_mitsuba::factory::build_scene(&root).unwrap().scene;
+            let film = render_film(&scene, 64, 10 + k as u64, None);
+            block_mean(&film, 0, 0, 8, 1)
+        })
+        .collect();
+    let stretched = prism_mitsuba::pbrt::read_pbrt_str(
+        &square_under_sky(&image("white.png", "Scale 2 1 1")),
+        &path,
+    )
+    .map(|scene| prism_mitsuba::factory::build_scene(&scene.root).map(|_| ()));
+    let not_square = {
+        let rgb = vec![1.0; 3 * 2 * n * n];
+        prism_core::image::write_png_srgb(&folder.join("wide.png"), 2 * n, n, &rgb).unwrap();
+        prism_mitsuba::pbrt::read_pbrt_str(&square_under_sky(&image("wide.png", "")), &path)
+            .map(|scene| prism_mitsuba::factory::build_scene(&scene.root).map(|_| ()))
+    };
+    std::fs::remove_dir_all(&folder).unwrap();
+    // 6 noisy estimates: 4.5 standard errors fail a correct light with probability 4·10⁻⁵;
+    // the black hemisphere gives exactly nothing.
+    for ((light, expected), (mean, variance)) in cases.iter().zip(&renders) {
+        if *expected == 0.0 {
+            assert_eq!(*mean, 0.0, "{light}");
+            continue;
+        }
+        let z = (mean - expected) / variance.sqrt();
+        assert!(
+            z.abs() < 4.5 && variance.sqrt() < 0.05 * expected,
+            "{light}: Y {mean} ± {} where {expected} is expected",
+            variance.sqrt()
+        );
+    }
+    let message = stretched.unwrap().expect_err("refused").to_string();
+    assert!(
+        message.contains("sky.pbrt:11:1:") && message.contains("stretches directions"),
+        "{message}"
+    );
+    let message = not_square.unwrap().expect_err("refused").to_string();
+    assert!(
+        message.contains("sky.pbrt:11:") && message.contains("an equal-area map is square"),
+        "{message}"
+    );
+}

@@ -518,3 +518,29 @@ fn scale_and_mix_textures_nest_their_operands() {
             .contains("test.pbrt:2:1: Texture \"d\" \"float\" \"directionmix\": blends by the surface normal's direction")
     );
 }
+
+#[test]
+fn an_image_infinite_light_is_an_equal_area_map() {
+    let root = root(
+        "WorldBegin\nAttributeBegin\nRotate -90 1 0 0\nLightSource \"infinite\" \"string filename\" \"sky.exr\" \"float scale\" 3\nAttributeEnd",
+    );
+    let light = nodes(&root, PluginClass::Emitter)[0];
+    assert_eq!(light.plugin_type, "equal_area_envmap");
+    assert_eq!(
+        property(light, "filename"),
+        &PropertyValue::String("sky.exr".into())
+    );
+    assert_eq!(property(light, "scale"), &PropertyValue::Float(3.0));
+    assert_close(
+        transform(light),
+        DMat4::from_rotation_x(-std::f64::consts::FRAC_PI_2),
+    );
+    assert!(
+        error("WorldBegin\nLightSource \"infinite\" \"string filename\" \"sky.exr\" \"rgb L\" [1 1 1]")
+            .contains("test.pbrt:2:52: LightSource \"infinite\": parameter \"rgb L\" cannot be given with \"filename\"")
+    );
+    assert!(
+        error("WorldBegin\nLightSource \"infinite\" \"string filename\" \"sky.exr\" \"float illuminance\" 5")
+            .contains("test.pbrt:2:52: LightSource \"infinite\": parameter \"float illuminance\" sets the light by a photometric quantity")
+    );
+}
