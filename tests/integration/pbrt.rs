@@ -587,3 +587,60 @@ fn image_infinite_lights_are_equal_area_maps_in_pbrts_orientation() {
         "{message}"
     );
 }
+
+/// A ball of fog lit by a sky and a lamp, its medium given by `medium` (named "fog").
+fn fog_ball(medium: &str) -> String {
+    format!(
+        r#"
+LookAt 0 0 -4  0 0 0  0 1 0
+Camera "perspective" "float fov" 40
+Film "rgb" "integer xresolution" 24 "integer yresolution" 24
+PixelFilter "box"
+Sampler "independent" "integer pixelsamples" 128
+Integrator "volpath" "integer maxdepth" 8
+WorldBegin
+LightSource "infinite" "rgb L" [0.2 0.25 0.3]
+LightSource "point" "rgb I" [20 18 15] "point3 from" [2 3 -2]
+{medium}
+AttributeBegin
+    MediumInterface "fog" ""
+    Material "interface"
+    Shape "sphere" "float radius" 1
+AttributeEnd
+"#
+    )
+}
+
+#[test]
+fn a_constant_uniform_grid_renders_as_a_homogeneous_medium() {
+    // A grid of 8³ voxels over [−1.5, 1.5]³: the ball lies more than half a voxel inside its
+    // faces, where pbrt's density is the voxels' value.
+    let grid = |density: f64| {
+        let values = vec![density.to_string(); 512].join(" ");
+        format!(
+            "MakeNamedMedium \"fog\" \"string type\" \"uniformgrid\" \"integer nx\" 8 \"integer ny\" 8 \"integer nz\" 8 \"float density\" [{values}] \"point3 p0\" [-1.5 -1.5 -1.5] \"point3 p1\" [1.5 1.5 1.5] \"rgb sigma_a\" [0.5 0.5 0.5] \"rgb sigma_s\" [1 1 1] \"float scale\" 2 \"float g\" 0.3"
+        )
+    };
+    let homogeneous = "MakeNamedMedium \"fog\" \"string type\" \"homogeneous\" \"rgb sigma_a\" [0.5 0.5 0.5] \"rgb sigma_s\" [1 1 1] \"float scale\" 2 \"float g\" 0.3";
+    let render = |medium: &str, seed: u64| {
+        let root = prism_mitsuba::pbrt::read_pbrt_str(&fog_ball(medium), Path::new("fog.pbrt"))
+            .unwrap()
+            .root;
+        let scene = prism_mitsuba::factory::build_scene(&root).unwrap().scene;
+        render_film(&scene, 128, seed, None)
+    };
+    let reference = render(homogeneous, 1);
+    // 9 blocks × 3 channels: 4.5 standard errors fail a correct translation with probability
+    // 2·10⁻⁴.
+    let z = largest_block_z(&reference, &render(&grid(1.0), 2), 8);
+    assert!(
+        z < 4.5,
+        "the grid and the homogeneous medium differ by {z:.1} standard errors"
+    );
+    // The test can fail: a grid of half the density is told apart.
+    let z = largest_block_z(&reference, &render(&grid(0.5), 3), 8);
+    assert!(
+        z > 8.0,
+        "half the density differs by only {z:.1} standard errors"
+    );
+}

@@ -544,3 +544,60 @@ fn an_image_infinite_light_is_an_equal_area_map() {
             .contains("test.pbrt:2:52: LightSource \"infinite\": parameter \"float illuminance\" sets the light by a photometric quantity")
     );
 }
+
+#[test]
+fn a_uniform_grid_is_a_heterogeneous_medium_with_an_empty_border() {
+    let root = root(
+        "WorldBegin\nTranslate 1 0 0\nMakeNamedMedium \"smoke\" \"string type\" \"uniformgrid\" \"integer nx\" 2 \"float density\" [3 5] \"point3 p0\" [0 0 0] \"point3 p1\" [4 1 1] \"rgb sigma_a\" [1 1 1] \"rgb sigma_s\" [3 3 3] \"float scale\" 2 \"float g\" 0.5\nMediumInterface \"smoke\" \"\"\nMaterial \"interface\"\nShape \"sphere\"",
+    );
+    let shape = nodes(&root, PluginClass::Shape)[0];
+    let medium = &shape
+        .children
+        .iter()
+        .find(|c| c.name.as_deref() == Some("interior"))
+        .expect("an interior")
+        .node;
+    assert_eq!(medium.plugin_type, "heterogeneous");
+    // σ_t = 2 · (1 + 3) · d, albedo 3 / 4.
+    assert_eq!(property(medium, "scale"), &PropertyValue::Float(8.0));
+    assert_eq!(property(medium, "albedo"), &PropertyValue::Float(0.75));
+    let grid = &medium.children[0];
+    assert_eq!(grid.name.as_deref(), Some("sigma_t"));
+    assert_eq!(grid.node.plugin_type, "inlinegrid");
+    assert_eq!(medium.children[1].node.plugin_type, "hg");
+    // 2 × 1 × 1 voxels in a 4 × 3 × 3 grid of zeros, over the box grown by a voxel (2 × 1 × 1).
+    let PropertyValue::Numbers(values) = property(&grid.node, "values") else {
+        panic!("no values");
+    };
+    let mut expected = vec![0.0; 36];
+    expected[(3 + 1) * 4 + 1] = 3.0;
+    expected[(3 + 1) * 4 + 2] = 5.0;
+    assert_eq!(values, &expected);
+    assert_eq!(
+        property(&grid.node, "resolution_x"),
+        &PropertyValue::Integer(4)
+    );
+    assert_close(
+        transform(&grid.node),
+        DMat4::from_translation(DVec3::new(1.0 - 2.0, -1.0, -1.0))
+            * DMat4::from_scale(DVec3::new(8.0, 3.0, 3.0)),
+    );
+    let medium = |parameters: &str, expected: &str| {
+        let message = error(&format!(
+            "WorldBegin\nMakeNamedMedium \"m\" \"string type\" \"uniformgrid\" {parameters}"
+        ));
+        assert!(message.contains(expected), "{message}");
+    };
+    medium(
+        "\"integer nx\" 2 \"float density\" [1 2 3]",
+        "test.pbrt:2:64: MakeNamedMedium \"m\": parameter \"float density\" has 3 values, but nx × ny × nz = 2 × 1 × 1 = 2 are expected",
+    );
+    medium(
+        "\"float density\" [1] \"float temperature\" [900]",
+        "test.pbrt:2:69: MakeNamedMedium \"m\": parameter \"float temperature\" makes the medium glow",
+    );
+    medium(
+        "\"float density\" [1] \"rgb sigma_s\" [1 2 3]",
+        "test.pbrt:2:69: MakeNamedMedium \"m\": parameter \"rgb sigma_s\" must be grey",
+    );
+}
