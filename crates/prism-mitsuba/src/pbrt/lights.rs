@@ -4,7 +4,8 @@
 //! `point` → `point`, `spot` → `spot` (pbrt-v4's falloff is a smoothstep in cos θ, Mitsuba's
 //! linear in θ: a warning says so), `distant` → `directional`, `infinite` with a uniform `L` →
 //! `constant` and with an image (`filename`, pbrt's equal-area octahedral map) →
-//! `equal_area_envmap`; the area light `diffuse` → `area`. `power`, `illuminance`, portals and
+//! `equal_area_envmap`; the area light `diffuse` → `area`. A uniform infinite light's
+//! `illuminance` scales it as pbrt-v4 does; `power`, an image's `illuminance`, portals and
 //! two-sided area lights are refused.
 
 use glam::{DMat4, DVec3};
@@ -19,14 +20,27 @@ use prism_core::error::Result;
 impl Builder {
     /// The spectrum `name` (default: the colour space's illuminant) times `scale`.
     fn emission(&self, list: &ParameterList, name: &str) -> Result<PropertyValue> {
-        for refused in ["power", "illuminance"] {
-            if let Some(parameter) = list.get(refused) {
-                return Err(list
-                    .error(parameter, "sets the light by a photometric quantity, which Prism's pbrt reader does not read")
-                    .with_help("give \"scale\" instead"));
-            }
+        if let Some(parameter) = list.get("illuminance") {
+            return Err(list
+                .error(parameter, "sets the light by a photometric quantity, which Prism's pbrt reader does not read")
+                .with_help("give \"scale\" instead"));
         }
-        let scale = list.float("scale", 1.0)?;
+        self.scaled_emission(list, name, 1.0)
+    }
+
+    /// The spectrum `name` (default: the colour space's illuminant) times `scale` and `factor`.
+    fn scaled_emission(
+        &self,
+        list: &ParameterList,
+        name: &str,
+        factor: f64,
+    ) -> Result<PropertyValue> {
+        if let Some(parameter) = list.get("power") {
+            return Err(list
+                .error(parameter, "sets the light by a photometric quantity, which Prism's pbrt reader does not read")
+                .with_help("give \"scale\" instead"));
+        }
+        let scale = list.float("scale", 1.0)? * factor;
         let value = list.spectrum(name, false)?;
         spectra::illuminant(
             list,
@@ -124,7 +138,13 @@ impl Builder {
                 if let Some((parameter, files)) = list.strings("filename", "string")? {
                     return self.image_infinite_light(list, parameter, &files[0], ctm);
                 }
-                let radiance = self.emission(list, "L")?;
+                // pbrt-v4 scales a uniform light of `illuminance` E (if positive) by E / π, the
+                // illuminance of unit radiance on a surface facing the whole hemisphere.
+                let factor = match list.float_opt("illuminance")? {
+                    Some(illuminance) if illuminance > 0.0 => illuminance / std::f64::consts::PI,
+                    _ => 1.0,
+                };
+                let radiance = self.scaled_emission(list, "L", factor)?;
                 let mut node = plugin(
                     PluginClass::Emitter,
                     "constant",

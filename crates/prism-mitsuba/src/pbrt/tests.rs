@@ -250,6 +250,21 @@ fn lights_are_scaled_to_pbrts_luminance() {
     assert!(
         error("WorldBegin\nLightSource \"point\" \"float power\" 10").contains("test.pbrt:2:21:")
     );
+    assert!(
+        error("WorldBegin\nLightSource \"point\" \"float illuminance\" 10")
+            .contains("test.pbrt:2:21:")
+    );
+    // A uniform sky of illuminance E has the radiance E / π (times `scale`).
+    let sky = super::read_pbrt_str(
+        "WorldBegin\nLightSource \"infinite\" \"rgb L\" [1 2 3] \"float scale\" 2 \"float illuminance\" 6.283185307179586\n",
+        Path::new("test.pbrt"),
+    )
+    .unwrap()
+    .root;
+    assert_eq!(
+        property(nodes(&sky, PluginClass::Emitter)[0], "radiance"),
+        &PropertyValue::Rgb([4.0, 8.0, 12.0])
+    );
 }
 
 #[test]
