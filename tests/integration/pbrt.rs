@@ -423,3 +423,224 @@ fn spectra_may_be_read_from_files() {
         "{message}"
     );
 }
+
+/// A grey square filling an orthographic view under a white sky, its reflectance a `mix` of
+/// 0.8 and 0.1 whose `amount` is a `scale` of 0.25 by a checkerboard of 1 and ½: the four
+/// quarters of the image reflect 0.75 · 0.8 + 0.25 · 0.1 = 0.625 and
+/// 0.875 · 0.8 + 0.125 · 0.1 = 0.7125, on the diagonals.
+const MIXED_SQUARE: &str = r#"
+LookAt 0 0 -5  0 0 0  0 1 0
+Camera "orthographic"
+Film "rgb" "integer xresolution" 16 "integer yresolution" 16
+PixelFilter "box"
+Sampler "independent" "integer pixelsamples" 64
+Integrator "path" "integer maxdepth" 1
+WorldBegin
+LightSource "infinite" "rgb L" [1 1 1]
+Texture "checks" "float" "checkerboard" "float tex1" 1 "float tex2" 0.5
+    "float uscale" 2 "float vscale" 2
+Texture "amount" "float" "scale" "float tex" 0.25 "texture scale" "checks"
+Texture "albedo" "spectrum" "mix" "rgb tex1" [0.8 0.8 0.8] "rgb tex2" [0.1 0.1 0.1]
+    "texture amount" "amount"
+Material "diffuse" "texture reflectance" "albedo"
+Shape "trianglemesh" "point3 P" [-1 -1 0  1 -1 0  1 1 0  -1 1 0]
+    "point2 uv" [0 0  1 0  1 1  0 1] "integer indices" [0 1 2  0 2 3]
+"#;
+
+#[test]
+fn scale_and_mix_textures_render_pbrts_values() {
+    let root = prism_mitsuba::pbrt::read_pbrt_str(MIXED_SQUARE, Path::new("mixed.pbrt"))
+        .unwrap()
+        .root;
+    let scene = prism_mitsuba::factory::build_scene(&root).unwrap().scene;
+    let film = render_film(&scene, 64, 4, None);
+    // A diffuse surface under a uniform sky of luminance 1 has the luminance of its
+    // reflectance; the sky is sampled over the whole sphere, so the estimate is noisy.
+    let quarter = |x0: usize, y0: usize| block_mean(&film, x0, y0, 8, 1);
+    let z = |(mean, variance): (f64, f64), expected: f64| (mean - expected) / variance.sqrt();
+    let (a, b) = (quarter(0, 0), quarter(8, 0));
+    let (first, second) = if a.0 < b.0 {
+        (0.625, 0.7125)
+    } else {
+        (0.7125, 0.625)
+    };
+    // 4 quarters: 4 standard errors fail a correct texture with probability 2.5·10⁻⁴; the
+    // two values differ by more than 20 standard errors.
+    for (value, expected) in [
+        (a, first),
+        (quarter(8, 8), first),
+        (b, second),
+        (quarter(0, 8), second),
+    ] {
+        assert!(
+            z(value, expected).abs() < 4.0 && z(value, 0.7125 + 0.625 - expected).abs() > 8.0,
+            "a quarter's Y {} ± {} where {expected} is expected",
+            value.0,
+            value.1.sqrt()
+        );
+    }
+}
+
+/// A grey square (reflectance ½) in the plane x = 0, seen from +x, under pbrt's image infinite
+/// light `light` (an equal-area map, scale 2), in an orthographic view that it fills.
+fn square_under_sky(light: &str) -> String {
+    format!(
+        r#"
+LookAt 5 0 0  0 0 0  0 1 0
+Camera "orthographic"
+Film "rgb" "integer xresolution" 8 "integer yresolution" 8
+PixelFilter "box"
+Sampler "independent" "integer pixelsamples" 64
+Integrator "path" "integer maxdepth" 1
+WorldBegin
+AttributeBegin
+{light}
+AttributeEnd
+Material "diffuse" "rgb reflectance" [0.5 0.5 0.5]
+Shape "trianglemesh" "point3 P" [0 -2 -2  0 2 -2  0 2 2  0 -2 2] "integer indices" [0 1 2  0 2 3]
+"#
+    )
+}
+
+#[test]
+fn image_infinite_lights_are_equal_area_maps_in_pbrts_orientation() {
+    // White and black halves of a 16 × 16 map: the right half (u > ½) is the hemisphere
+    // x > 0 and the lower half (v > ½, the image's lower rows) y > 0; and a white map.
+    let folder = folder("sky");
+    let n = 16;
+    let write = |name: &str, white: &dyn Fn(usize, usize) -> bool| {
+        let rgb: Vec<f32> = (0..n * n)
+            .flat_map(|i| [if white(i % n, i / n) { 1.0 } else { 0.0 }; 3])
+            .collect();
+        prism_core::image::write_png_srgb(&folder.join(name), n, n, &rgb).unwrap();
+    };
+    write("right.png", &|x, _| x >= n / 2);
+    write("lower.png", &|_, y| y >= n / 2);
+    write("white.png", &|_, _| true);
+    let image = |name: &str, rotation: &str| {
+        format!(
+            "{rotation}\nLightSource \"infinite\" \"string filename\" \"{name}\" \"float scale\" 2"
+        )
+    };
+    // The square facing +x has the luminance ½ · 2 · (1/π) ∫ cos θ dω over its white
+    // directions: 1 for the whole hemisphere x > 0, ½ for its half with y > 0.
+    let cases = [
+        (image("right.png", ""), 1.0),
+        (image("right.png", "Rotate 180 0 1 0"), 0.0),
+        (image("right.png", "Rotate 90 0 0 1"), 0.5),
+        (image("lower.png", ""), 0.5),
+        (image("lower.png", "Rotate -90 0 0 1"), 1.0),
+        (image("white.png", "Rotate 30 1 1 0"), 1.0),
+        // The uniform light of the same colour: pbrt-v4's constant map.
+        (
+            "LightSource \"infinite\" \"rgb L\" [1 1 1] \"float scale\" 2".to_string(),
+            1.0,
+        ),
+    ];
+    let path = folder.join("sky.pbrt");
+    let renders: Vec<(f64, f64)> = cases
+        .iter()
+        .enumerate()
+        .map(|(k, (light, _))| {
+            let root = prism_mitsuba::pbrt::read_pbrt_str(&square_under_sky(light), &path)
+                .unwrap_or_else(|e| panic!("{light}: {e}"))
+                .root;
+            let scene = prism_mitsuba::factory::build_scene(&root).unwrap().scene;
+            let film = render_film(&scene, 64, 10 + k as u64, None);
+            block_mean(&film, 0, 0, 8, 1)
+        })
+        .collect();
+    let stretched = prism_mitsuba::pbrt::read_pbrt_str(
+        &square_under_sky(&image("white.png", "Scale 2 1 1")),
+        &path,
+    )
+    .map(|scene| prism_mitsuba::factory::build_scene(&scene.root).map(|_| ()));
+    let not_square = {
+        let rgb = vec![1.0; 3 * 2 * n * n];
+        prism_core::image::write_png_srgb(&folder.join("wide.png"), 2 * n, n, &rgb).unwrap();
+        prism_mitsuba::pbrt::read_pbrt_str(&square_under_sky(&image("wide.png", "")), &path)
+            .map(|scene| prism_mitsuba::factory::build_scene(&scene.root).map(|_| ()))
+    };
+    std::fs::remove_dir_all(&folder).unwrap();
+    // 6 noisy estimates: 4.5 standard errors fail a correct light with probability 4·10⁻⁵;
+    // the black hemisphere gives exactly nothing.
+    for ((light, expected), (mean, variance)) in cases.iter().zip(&renders) {
+        if *expected == 0.0 {
+            assert_eq!(*mean, 0.0, "{light}");
+            continue;
+        }
+        let z = (mean - expected) / variance.sqrt();
+        assert!(
+            z.abs() < 4.5 && variance.sqrt() < 0.05 * expected,
+            "{light}: Y {mean} ± {} where {expected} is expected",
+            variance.sqrt()
+        );
+    }
+    let message = stretched.unwrap().expect_err("refused").to_string();
+    assert!(
+        message.contains("sky.pbrt:11:1:") && message.contains("stretches directions"),
+        "{message}"
+    );
+    let message = not_square.unwrap().expect_err("refused").to_string();
+    assert!(
+        message.contains("sky.pbrt:11:") && message.contains("an equal-area map is square"),
+        "{message}"
+    );
+}
+
+/// A ball of fog lit by a sky and a lamp, its medium given by `medium` (named "fog").
+fn fog_ball(medium: &str) -> String {
+    format!(
+        r#"
+LookAt 0 0 -4  0 0 0  0 1 0
+Camera "perspective" "float fov" 40
+Film "rgb" "integer xresolution" 24 "integer yresolution" 24
+PixelFilter "box"
+Sampler "independent" "integer pixelsamples" 128
+Integrator "volpath" "integer maxdepth" 8
+WorldBegin
+LightSource "infinite" "rgb L" [0.2 0.25 0.3]
+LightSource "point" "rgb I" [20 18 15] "point3 from" [2 3 -2]
+{medium}
+AttributeBegin
+    MediumInterface "fog" ""
+    Material "interface"
+    Shape "sphere" "float radius" 1
+AttributeEnd
+"#
+    )
+}
+
+#[test]
+fn a_constant_uniform_grid_renders_as_a_homogeneous_medium() {
+    // A grid of 8³ voxels over [−1.5, 1.5]³: the ball lies more than half a voxel inside its
+    // faces, where pbrt's density is the voxels' value.
+    let grid = |density: f64| {
+        let values = vec![density.to_string(); 512].join(" ");
+        format!(
+            "MakeNamedMedium \"fog\" \"string type\" \"uniformgrid\" \"integer nx\" 8 \"integer ny\" 8 \"integer nz\" 8 \"float density\" [{values}] \"point3 p0\" [-1.5 -1.5 -1.5] \"point3 p1\" [1.5 1.5 1.5] \"rgb sigma_a\" [0.5 0.5 0.5] \"rgb sigma_s\" [1 1 1] \"float scale\" 2 \"float g\" 0.3"
+        )
+    };
+    let homogeneous = "MakeNamedMedium \"fog\" \"string type\" \"homogeneous\" \"rgb sigma_a\" [0.5 0.5 0.5] \"rgb sigma_s\" [1 1 1] \"float scale\" 2 \"float g\" 0.3";
+    let render = |medium: &str, seed: u64| {
+        let root = prism_mitsuba::pbrt::read_pbrt_str(&fog_ball(medium), Path::new("fog.pbrt"))
+            .unwrap()
+            .root;
+        let scene = prism_mitsuba::factory::build_scene(&root).unwrap().scene;
+        render_film(&scene, 128, seed, None)
+    };
+    let reference = render(homogeneous, 1);
+    // 9 blocks × 3 channels: 4.5 standard errors fail a correct translation with probability
+    // 2·10⁻⁴.
+    let z = largest_block_z(&reference, &render(&grid(1.0), 2), 8);
+    assert!(
+        z < 4.5,
+        "the grid and the homogeneous medium differ by {z:.1} standard errors"
+    );
+    // The test can fail: a grid of half the density is told apart.
+    let z = largest_block_z(&reference, &render(&grid(0.5), 3), 8);
+    assert!(
+        z > 8.0,
+        "half the density differs by only {z:.1} standard errors"
+    );
+}

@@ -86,9 +86,11 @@ fn luminance_density(texture: &Texture) -> (PiecewiseConstant2D, f32) {
             bitmap.width.clamp(1, MAX_RESOLUTION),
             bitmap.height.clamp(1, MAX_RESOLUTION),
         ),
-        Texture::Constant(_) | Texture::Checkerboard(_) | Texture::MeshAttribute(_) => {
-            (PATTERN_RESOLUTION, PATTERN_RESOLUTION)
-        }
+        Texture::Constant(_)
+        | Texture::Checkerboard(_)
+        | Texture::MeshAttribute(_)
+        | Texture::Scale(_)
+        | Texture::Mix(_) => (PATTERN_RESOLUTION, PATTERN_RESOLUTION),
     };
     let weights: Vec<f32> = (0..nx * ny)
         .map(|cell| {

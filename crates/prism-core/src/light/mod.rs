@@ -17,6 +17,7 @@
 //! | `directional` | [`directional`] | its direction (delta) |
 //! | `constant` | [`constant`] | uniform directions |
 //! | `envmap` | [`envmap`] | directions ∝ luminance · sin θ in the lat-long image |
+//! | `equal_area_envmap` (pbrt-v4's image `infinite`) | [`equal_area_envmap`] | directions ∝ luminance in the equal-area image |
 //! | `sunsky` | [`sunsky`] | the sky's luminance over (φ, cos θ), and the sun's cone |
 //!
 //! For tracing light from the lights' side (the particle tracer), every light also draws rays
@@ -32,6 +33,7 @@ pub mod constant;
 pub mod directional;
 pub mod directionalarea;
 pub mod envmap;
+pub mod equal_area_envmap;
 pub mod point;
 pub mod projector;
 pub mod sampler;
@@ -51,6 +53,7 @@ pub use constant::ConstantLight;
 pub use directional::DirectionalLight;
 pub use directionalarea::DirectionalAreaLight;
 pub use envmap::EnvironmentMap;
+pub use equal_area_envmap::EqualAreaEnvmap;
 pub use point::PointLight;
 pub use projector::Projector;
 pub use sampler::{LightSampler, LightSelection};
@@ -119,6 +122,7 @@ plugin_class! {
         Directional(DirectionalLight),
         Constant(ConstantLight),
         Envmap(EnvironmentMap),
+        EqualAreaEnvmap(EqualAreaEnvmap),
         Sunsky(Box<Sunsky>),
     }
 }
@@ -267,6 +271,7 @@ impl<L: LightAtInfinity> LightSource for L {
 pub enum Environment<'a> {
     Constant(&'a ConstantLight),
     Envmap(&'a EnvironmentMap),
+    EqualAreaEnvmap(&'a EqualAreaEnvmap),
     Sunsky(&'a Sunsky),
 }
 
@@ -277,6 +282,7 @@ impl Environment<'_> {
         match self {
             Environment::Constant(light) => light.radiance(lambda),
             Environment::Envmap(light) => light.radiance(d, lambda),
+            Environment::EqualAreaEnvmap(light) => light.radiance(d, lambda),
             Environment::Sunsky(light) => light.radiance(d, lambda),
         }
     }
@@ -287,6 +293,7 @@ impl Environment<'_> {
         match self {
             Environment::Constant(light) => light.pdf(),
             Environment::Envmap(light) => light.pdf(d),
+            Environment::EqualAreaEnvmap(light) => light.pdf(d),
             Environment::Sunsky(light) => light.pdf(d),
         }
     }

@@ -14,6 +14,8 @@ pub mod bitmap;
 pub mod checkerboard;
 pub mod constant;
 pub mod mesh_attribute;
+pub mod mix;
+pub mod scale;
 
 use std::sync::Arc;
 
@@ -22,6 +24,8 @@ use glam::{DMat4, Vec2, Vec3};
 pub use bitmap::{BitmapTexture, FilterType, TextureUse, WrapMode};
 pub use checkerboard::Checkerboard;
 pub use mesh_attribute::MeshAttributeTexture;
+pub use mix::MixTexture;
+pub use scale::ScaledTexture;
 
 use crate::dispatch::plugin_class;
 use crate::geometry::interaction::AttributeValues;
@@ -73,6 +77,10 @@ plugin_class! {
         Checkerboard(Box<Checkerboard>),
         /// A colour the mesh carries per vertex or per face (Mitsuba's `mesh_attribute`).
         MeshAttribute(MeshAttributeTexture),
+        /// A texture times a number-valued texture (pbrt-v4's `scale`).
+        Scale(Box<ScaledTexture>),
+        /// Two textures blended by a number-valued texture (pbrt-v4's `mix`).
+        Mix(Box<MixTexture>),
     }
 }
 

@@ -479,6 +479,7 @@ fn delta_light_name(light: &Light) -> Option<&'static str> {
         | Light::DirectionalArea(_)
         | Light::Constant(_)
         | Light::Envmap(_)
+        | Light::EqualAreaEnvmap(_)
         | Light::Sunsky(_) => None,
     }
 }

@@ -132,6 +132,7 @@ pub static VOLUMES: Registry<BuildVolume> = Registry {
             params: &[FILENAME, FILTER_TYPE, VOLUME_TO_WORLD, USE_GRID_BBOX],
             build: build_gridvolume,
         },
+        super::inline_grid::INLINE_GRID,
     ],
 };
 

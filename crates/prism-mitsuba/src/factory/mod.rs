@@ -9,6 +9,7 @@
 //! once.
 
 pub mod fov;
+mod inline_grid;
 mod instancing;
 pub mod integrators;
 pub mod lights;

@@ -269,6 +269,7 @@ fn check_bdpt_lights(
             Light::Directional(_) => "directional",
             Light::Constant(_) => "constant",
             Light::Envmap(_) => "envmap",
+            Light::EqualAreaEnvmap(_) => "equal_area_envmap",
             Light::Sunsky(_) => "sunsky",
             Light::DirectionalArea(_) => "directionalarea",
         };

@@ -1,4 +1,5 @@
-//! Texture plugins (`bitmap`, `checkerboard`, `mesh_attribute`, `rawconstant`) and texture-valued parameters: any colour or
+//! Texture plugins (`bitmap`, `checkerboard`, `mesh_attribute`, `rawconstant`, and pbrt-v4's
+//! `scale` and `mix`) and texture-valued parameters: any colour or
 //! number a BSDF takes may be given as a value (`<rgb>`, `<spectrum>`, `<float>`) or as a nested
 //! `<texture>` (inline or a `<ref name="..." id="..."/>` to a texture declared at the top level).
 //!
@@ -25,7 +26,7 @@ use prism_core::spectrum::{LAMBDA_MAX, LAMBDA_MIN, RgbIntent, Spectrum};
 use prism_core::texture::{
     BitmapTexture, Checkerboard, FilterType, TextureUse, UvTransform, WrapMode,
 };
-use prism_core::texture::{MeshAttributeTexture, Texture};
+use prism_core::texture::{MeshAttributeTexture, MixTexture, ScaledTexture, Texture};
 
 type Build = fn(&Params, TextureUse, &mut TextureCache) -> Result<Texture>;
 
@@ -72,6 +73,22 @@ pub static TEXTURES: Registry<Build> = Registry {
             params: &[RAW_VALUE],
             build: |params, usage, _| build_rawconstant(params, usage),
         },
+        Plugin {
+            name: "scale",
+            origin: Origin::Prism,
+            summary: "pbrt-v4's `scale` texture: `tex` · `scale`, a texture (a colour, or a number \
+                      where the texture is read as one) times a number-valued texture.",
+            params: &[SCALED_TEX, SCALE_FACTOR],
+            build: build_scale,
+        },
+        Plugin {
+            name: "mix",
+            origin: Origin::Prism,
+            summary: "pbrt-v4's `mix` texture: (1 − `amount`) · `tex1` + `amount` · `tex2`, two \
+                      textures blended by a number-valued texture.",
+            params: &[TEX1, TEX2, AMOUNT],
+            build: build_mix,
+        },
     ],
 };
 
@@ -88,6 +105,11 @@ params! {
     COLOR0 = ParamSpec::new("color0", ParamKind::Spectrum { range: Range::Albedo, textured: true, }, Default::Float(0.4), "the first colour (a number when the texture is read as one)");
     COLOR1 = ParamSpec::new("color1", ParamKind::Spectrum { range: Range::Albedo, textured: true, }, Default::Float(0.2), "the second colour");
     RAW_VALUE = ParamSpec::new("value", ParamKind::FloatOrVector, Default::Required, "the value: one number, or three");
+    SCALED_TEX = ParamSpec::new("tex", ParamKind::Spectrum { range: Range::Coefficient, textured: true, }, Default::Float(1.0), "the texture scaled (a number when the texture is read as one)");
+    SCALE_FACTOR = ParamSpec::new("scale", ParamKind::FloatTexture(Bounds::FINITE_NON_NEGATIVE), Default::Float(1.0), "the factor, a number or a texture read as numbers");
+    TEX1 = ParamSpec::new("tex1", ParamKind::Spectrum { range: Range::Coefficient, textured: true, }, Default::Float(0.0), "the texture where `amount` is 0 (a number when the texture is read as one)");
+    TEX2 = ParamSpec::new("tex2", ParamKind::Spectrum { range: Range::Coefficient, textured: true, }, Default::Float(1.0), "the texture where `amount` is 1");
+    AMOUNT = ParamSpec::new("amount", ParamKind::FloatTexture(Bounds::UNIT), Default::Float(0.5), "the weight of `tex2`, a number or a texture read as numbers");
 }
 
 /// Textures built so far, by element and use.
@@ -419,6 +441,44 @@ fn build_checkerboard(
         color0,
         color1,
         to_uv: UvTransform::from_matrix(&params.transform(&TO_UV)?),
+    })))
+}
+
+params! {
+    /// Read as a number, the textures `scale` and `mix` combine are numbers too.
+    SCALAR_SCALED_TEX = ParamSpec::new("tex", ParamKind::FloatTexture(Bounds::FINITE_NON_NEGATIVE), Default::Float(1.0), "");
+    SCALAR_TEX1 = ParamSpec::new("tex1", ParamKind::FloatTexture(Bounds::FINITE_NON_NEGATIVE), Default::Float(0.0), "");
+    SCALAR_TEX2 = ParamSpec::new("tex2", ParamKind::FloatTexture(Bounds::FINITE_NON_NEGATIVE), Default::Float(1.0), "");
+}
+
+/// The texture `spec` (a colour, or `scalar` where the texture is read as a number) of a
+/// texture built for `usage`.
+fn operand(
+    params: &Params,
+    spec: &ParamSpec,
+    scalar: &ParamSpec,
+    usage: TextureUse,
+    cache: &mut TextureCache,
+) -> Result<Texture> {
+    match usage {
+        TextureUse::Scalar => float_texture(params, scalar, cache),
+        TextureUse::Spectral | TextureUse::Rgb => spectrum_texture(params, spec, cache),
+        TextureUse::Emission => emission_texture(params, spec, cache),
+    }
+}
+
+fn build_scale(params: &Params, usage: TextureUse, cache: &mut TextureCache) -> Result<Texture> {
+    Ok(Texture::Scale(Box::new(ScaledTexture {
+        texture: operand(params, &SCALED_TEX, &SCALAR_SCALED_TEX, usage, cache)?,
+        scale: float_texture(params, &SCALE_FACTOR, cache)?,
+    })))
+}
+
+fn build_mix(params: &Params, usage: TextureUse, cache: &mut TextureCache) -> Result<Texture> {
+    Ok(Texture::Mix(Box::new(MixTexture {
+        tex1: operand(params, &TEX1, &SCALAR_TEX1, usage, cache)?,
+        tex2: operand(params, &TEX2, &SCALAR_TEX2, usage, cache)?,
+        amount: float_texture(params, &AMOUNT, cache)?,
     })))
 }
 

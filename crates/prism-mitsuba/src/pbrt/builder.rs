@@ -594,7 +594,7 @@ impl Builder {
                 let name = stream.string(token)?;
                 let list =
                     stream.parameters(format!("MakeNamedMedium \"{}\"", name.text), location)?;
-                let medium = self.medium(&list)?;
+                let medium = self.medium(&list, self.state.ctm)?;
                 self.media.insert(name.text, Arc::new(medium));
                 Ok(())
             }

@@ -3,14 +3,15 @@
 //!
 //! `point` → `point`, `spot` → `spot` (pbrt-v4's falloff is a smoothstep in cos θ, Mitsuba's
 //! linear in θ: a warning says so), `distant` → `directional`, `infinite` with a uniform `L` →
-//! `constant`; the area light `diffuse` → `area`. pbrt's image infinite light reads an
-//! equal-area octahedral map, which Prism's `envmap` (latitude-longitude) is not, so it is
-//! refused, as are `power`, `illuminance` and two-sided area lights.
+//! `constant` and with an image (`filename`, pbrt's equal-area octahedral map) →
+//! `equal_area_envmap`; the area light `diffuse` → `area`. A uniform infinite light's
+//! `illuminance` scales it as pbrt-v4 does; `power`, an image's `illuminance`, portals and
+//! two-sided area lights are refused.
 
 use glam::{DMat4, DVec3};
 
 use super::builder::Builder;
-use super::parameters::ParameterList;
+use super::parameters::{Parameter, ParameterList};
 use super::spectra;
 use super::{plugin, set};
 use crate::description::{PluginClass, PluginNode, PropertyValue};
@@ -19,14 +20,27 @@ use prism_core::error::Result;
 impl Builder {
     /// The spectrum `name` (default: the colour space's illuminant) times `scale`.
     fn emission(&self, list: &ParameterList, name: &str) -> Result<PropertyValue> {
-        for refused in ["power", "illuminance"] {
-            if let Some(parameter) = list.get(refused) {
-                return Err(list
-                    .error(parameter, "sets the light by a photometric quantity, which Prism's pbrt reader does not read")
-                    .with_help("give \"scale\" instead"));
-            }
+        if let Some(parameter) = list.get("illuminance") {
+            return Err(list
+                .error(parameter, "sets the light by a photometric quantity, which Prism's pbrt reader does not read")
+                .with_help("give \"scale\" instead"));
         }
-        let scale = list.float("scale", 1.0)?;
+        self.scaled_emission(list, name, 1.0)
+    }
+
+    /// The spectrum `name` (default: the colour space's illuminant) times `scale` and `factor`.
+    fn scaled_emission(
+        &self,
+        list: &ParameterList,
+        name: &str,
+        factor: f64,
+    ) -> Result<PropertyValue> {
+        if let Some(parameter) = list.get("power") {
+            return Err(list
+                .error(parameter, "sets the light by a photometric quantity, which Prism's pbrt reader does not read")
+                .with_help("give \"scale\" instead"));
+        }
+        let scale = list.float("scale", 1.0)? * factor;
         let value = list.spectrum(name, false)?;
         spectra::illuminant(
             list,
@@ -118,15 +132,19 @@ impl Builder {
                 node
             }
             "infinite" => {
-                if let Some(parameter) = list.get("filename") {
-                    return Err(list
-                        .error(parameter, "is an equal-area octahedral environment map, which Prism does not read")
-                        .with_help("give a uniform \"L\", or write the scene in Mitsuba XML with an envmap (latitude-longitude)"));
-                }
                 if let Some(parameter) = list.get("portal") {
                     return Err(list.error(parameter, "is not read by Prism"));
                 }
-                let radiance = self.emission(list, "L")?;
+                if let Some((parameter, files)) = list.strings("filename", "string")? {
+                    return self.image_infinite_light(list, parameter, &files[0], ctm);
+                }
+                // pbrt-v4 scales a uniform light of `illuminance` E (if positive) by E / π, the
+                // illuminance of unit radiance on a surface facing the whole hemisphere.
+                let factor = match list.float_opt("illuminance")? {
+                    Some(illuminance) if illuminance > 0.0 => illuminance / std::f64::consts::PI,
+                    _ => 1.0,
+                };
+                let radiance = self.scaled_emission(list, "L", factor)?;
                 let mut node = plugin(
                     PluginClass::Emitter,
                     "constant",
@@ -144,6 +162,57 @@ impl Builder {
         };
         list.finish()?;
         node.location = location;
+        Ok(node)
+    }
+
+    /// pbrt's image infinite light: `equal_area_envmap` with the image `filename`, `scale`
+    /// (the image's RGB as illuminants of luminance 1, as for `<rgb>` emission), placed by
+    /// `ctm`.
+    fn image_infinite_light(
+        &mut self,
+        list: &ParameterList,
+        parameter: &Parameter,
+        filename: &str,
+        ctm: DMat4,
+    ) -> Result<PluginNode> {
+        let location = list.location.clone();
+        if let Some(radiance) = list.get("L") {
+            return Err(list
+                .error(radiance, "cannot be given with \"filename\"")
+                .with_help("give either a uniform \"L\" or an image, as pbrt-v4 requires"));
+        }
+        for refused in ["power", "illuminance"] {
+            if let Some(parameter) = list.get(refused) {
+                return Err(list
+                    .error(parameter, "sets the light by a photometric quantity, which Prism's pbrt reader does not read for an image")
+                    .with_help("give \"scale\" instead"));
+            }
+        }
+        let mut node = plugin(
+            PluginClass::Emitter,
+            "equal_area_envmap",
+            &location,
+            &self.search_paths,
+        );
+        set(
+            &mut node,
+            "filename",
+            PropertyValue::String(filename.to_string()),
+            &parameter.location,
+        );
+        set(
+            &mut node,
+            "scale",
+            PropertyValue::Float(list.float("scale", 1.0)?),
+            &location,
+        );
+        set(
+            &mut node,
+            "to_world",
+            PropertyValue::Transform(ctm),
+            &location,
+        );
+        list.finish()?;
         Ok(node)
     }
 

@@ -7,7 +7,8 @@
 //! as pbrt's `EffectivelySmooth`. pbrt's `mix` picks one material per hit with probability
 //! `amount` for the second: in expectation `blendbsdf`'s (1 − w) f₀ + w f₁. `interface` is
 //! `null`. pbrt's image textures look up (s, 1 − t) with the image's first row at the top, so
-//! the texture's `to_uv` flips v.
+//! the texture's `to_uv` flips v. The textures `scale` and `mix` are Prism's of the same names,
+//! which implement pbrt-v4's.
 
 use std::sync::Arc;
 
@@ -598,10 +599,30 @@ impl Builder {
                 );
                 node
             }
+            "scale" => {
+                let mut node = plugin(PluginClass::Texture, "scale", &location, &self.search_paths);
+                self.texture_operand(&mut node, list, float, "tex", 1.0)?;
+                self.float_property(&mut node, list, "scale", "scale", 1.0)?;
+                node
+            }
+            "mix" => {
+                let mut node = plugin(PluginClass::Texture, "mix", &location, &self.search_paths);
+                self.texture_operand(&mut node, list, float, "tex1", 0.0)?;
+                self.texture_operand(&mut node, list, float, "tex2", 1.0)?;
+                self.float_property(&mut node, list, "amount", "amount", 0.5)?;
+                node
+            }
+            "directionmix" => {
+                return Err(list
+                    .directive_error(
+                        "blends by the surface normal's direction, which Prism's textures do not see",
+                    )
+                    .with_help("use \"mix\" with an \"amount\""));
+            }
             _ => {
                 return Err(list
                     .directive_error("Prism has no texture with this pbrt-v4 model")
-                    .with_help("Prism reads imagemap and checkerboard"));
+                    .with_help("Prism reads imagemap, checkerboard, scale and mix"));
             }
         };
         list.finish()?;
@@ -612,6 +633,23 @@ impl Builder {
         };
         textures.insert(name.text.clone(), Arc::new(node));
         Ok(())
+    }
+
+    /// The operand `name` of a `scale` or `mix` texture: a number or float texture in a float
+    /// texture, a spectrum or spectrum texture in a spectrum texture; `default` when absent.
+    fn texture_operand(
+        &self,
+        node: &mut PluginNode,
+        list: &ParameterList,
+        float: bool,
+        name: &str,
+        default: f64,
+    ) -> Result<()> {
+        if float {
+            self.float_property(node, list, name, name, default)
+        } else {
+            self.spectrum_property(node, list, name, name, Some(PropertyValue::Float(default)))
+        }
     }
 
     /// pbrt's `uv` mapping: (s, t) = (su·u + du, sv·v + dv).

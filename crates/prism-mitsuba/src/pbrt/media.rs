@@ -1,39 +1,59 @@
 //! `MakeNamedMedium`: pbrt-v4's `homogeneous` medium as Mitsuba's, σ_a and σ_s times `scale`,
-//! with a Henyey-Greenstein phase function of parameter `g`. pbrt's emissive media (`Le`) and
-//! its measured presets are refused.
+//! and its `uniformgrid` as a `heterogeneous` medium whose extinction is an `inlinegrid`
+//! volume; both with a Henyey-Greenstein phase function of parameter `g`. pbrt's emissive
+//! media (`Le`, `temperature`) and its measured presets are refused.
+//!
+//! pbrt's grid medium scales σ_a and σ_s by a density d(p) over the box `p0`–`p1`:
+//! σ_t(p) = scale (σ_a + σ_s) d(p) with a constant albedo σ_s / (σ_a + σ_s). d is interpolated
+//! trilinearly between voxel centres, and a lookup beyond the outermost centres reads 0
+//! (pbrt-v4's `SampledGrid::Lookup`), so the density fades to half its value at the box's faces.
+//! The translation surrounds the grid with a layer of empty voxels, so that Prism's grid,
+//! clamped at its faces, has pbrt's density everywhere inside the box.
 
 use std::sync::Arc;
 
+use glam::{DMat4, DVec3};
+
 use super::builder::Builder;
-use super::parameters::ParameterList;
+use super::parameters::{ParameterList, SpectrumParam};
 use super::spectra;
 use super::{nest, plugin, set};
 use crate::description::{PluginClass, PluginNode, PropertyValue};
 use prism_core::error::Result;
 
 impl Builder {
-    /// The medium of `MakeNamedMedium`'s parameters.
-    pub(super) fn medium(&mut self, list: &ParameterList) -> Result<PluginNode> {
+    /// The medium of `MakeNamedMedium`'s parameters, in the space `ctm` places.
+    pub(super) fn medium(&mut self, list: &ParameterList, ctm: DMat4) -> Result<PluginNode> {
         let ty = match list.strings("type", "string")? {
             Some((_, types)) => types[0].clone(),
             None => return Err(list.directive_error("needs a \"string type\" parameter")),
         };
-        if ty != "homogeneous" {
-            return Err(list
-                .directive_error(format!("Prism has no medium like pbrt-v4's \"{ty}\""))
-                .with_help("Prism reads \"homogeneous\""));
-        }
+        let mut node = match ty.as_str() {
+            "homogeneous" => self.homogeneous(list)?,
+            "uniformgrid" => self.uniform_grid(list, ctm)?,
+            _ => {
+                return Err(list
+                    .directive_error(format!("Prism has no medium like pbrt-v4's \"{ty}\""))
+                    .with_help("Prism reads \"homogeneous\" and \"uniformgrid\""));
+            }
+        };
         let location = list.location.clone();
-        if let Some(parameter) = list.get("preset") {
-            return Err(list.error(
-                parameter,
-                "names pbrt's measured media, which Prism does not have",
-            ));
+        let g = list.float("g", 0.0)?;
+        if g != 0.0 {
+            let mut phase = plugin(PluginClass::Phase, "hg", &location, &self.search_paths);
+            set(&mut phase, "g", PropertyValue::Float(g), &location);
+            nest(&mut node, None, Arc::new(phase), &location);
         }
+        list.finish()?;
+        Ok(node)
+    }
+
+    /// Refuses an emitting medium (a non-zero `Le`).
+    fn refuse_emission(list: &ParameterList) -> Result<()> {
         if let Some((value, parameter)) = list.spectrum("Le", false)? {
             let is_zero = match &value {
-                super::parameters::SpectrumParam::Rgb(rgb) => rgb.iter().all(|&c| c == 0.0),
-                super::parameters::SpectrumParam::Samples(s) => s.iter().all(|&(_, v)| v == 0.0),
+                SpectrumParam::Rgb(rgb) => rgb.iter().all(|&c| c == 0.0),
+                SpectrumParam::Samples(s) => s.iter().all(|&(_, v)| v == 0.0),
                 _ => false,
             };
             if !is_zero {
@@ -44,6 +64,18 @@ impl Builder {
             }
         }
         list.ignore(&["Lescale"]);
+        Ok(())
+    }
+
+    fn homogeneous(&mut self, list: &ParameterList) -> Result<PluginNode> {
+        let location = list.location.clone();
+        if let Some(parameter) = list.get("preset") {
+            return Err(list.error(
+                parameter,
+                "names pbrt's measured media, which Prism does not have",
+            ));
+        }
+        Self::refuse_emission(list)?;
         let mut node = plugin(
             PluginClass::Medium,
             "homogeneous",
@@ -65,13 +97,148 @@ impl Builder {
             PropertyValue::Float(list.float("scale", 1.0)?),
             &location,
         );
-        let g = list.float("g", 0.0)?;
-        if g != 0.0 {
-            let mut phase = plugin(PluginClass::Phase, "hg", &location, &self.search_paths);
-            set(&mut phase, "g", PropertyValue::Float(g), &location);
-            nest(&mut node, None, Arc::new(phase), &location);
-        }
-        list.finish()?;
         Ok(node)
+    }
+
+    /// pbrt's `uniformgrid`: `density` (`nx` × `ny` × `nz` values, x fastest) over `p0`–`p1`
+    /// in the medium's space (the current transformation), `sigma_a`, `sigma_s` (grey: Prism's
+    /// grid media have one extinction at every wavelength) and `scale`.
+    fn uniform_grid(&mut self, list: &ParameterList, ctm: DMat4) -> Result<PluginNode> {
+        let location = list.location.clone();
+        Self::refuse_emission(list)?;
+        if let Some(parameter) = list.get("temperature") {
+            return Err(list.error(
+                parameter,
+                "makes the medium glow as a blackbody, which Prism's media do not",
+            ));
+        }
+        list.ignore(&["temperaturescale", "temperatureoffset", "temperaturecutoff"]);
+        let Some((density_parameter, density)) = list.array("density", &["float"], 1)? else {
+            return Err(list.directive_error("needs the grid's \"float density\" values"));
+        };
+        let mut resolution = [0usize; 3];
+        for (axis, name) in ["nx", "ny", "nz"].into_iter().enumerate() {
+            let count = list.integer(name, 1)?;
+            resolution[axis] = match usize::try_from(count) {
+                Ok(n) if (1..=65536).contains(&n) => n,
+                _ => {
+                    let parameter = list.get(name).expect("given");
+                    return Err(list.error(parameter, "must be between 1 and 65536"));
+                }
+            };
+        }
+        let [nx, ny, nz] = resolution;
+        if nx * ny * nz != density.len() {
+            return Err(list.error(
+                density_parameter,
+                format!(
+                    "has {} values, but nx × ny × nz = {nx} × {ny} × {nz} = {} are expected",
+                    density.len(),
+                    nx * ny * nz
+                ),
+            ));
+        }
+        if let Some(bad) = density.iter().find(|v| !(**v >= 0.0)) {
+            return Err(list.error(
+                density_parameter,
+                format!("holds {bad}; densities must be at least 0"),
+            ));
+        }
+        let p0 = list.point3("p0", DVec3::ZERO)?;
+        let p1 = list.point3("p1", DVec3::ONE)?;
+        if !(p1.cmpgt(p0).all()) {
+            return Err(list.directive_error("\"p1\" must exceed \"p0\" along every axis"));
+        }
+        let sigma_a = self.grey(list, "sigma_a")?;
+        let sigma_s = self.grey(list, "sigma_s")?;
+        let sigma_t = sigma_a + sigma_s;
+        let scale = list.float("scale", 1.0)?;
+
+        // The grid with a layer of empty voxels around it, over the box grown by one voxel.
+        let padded = [nx + 2, ny + 2, nz + 2];
+        let mut values = vec![0.0; padded[0] * padded[1] * padded[2]];
+        for z in 0..nz {
+            for y in 0..ny {
+                let from = (z * ny + y) * nx;
+                let to = ((z + 1) * padded[1] + y + 1) * padded[0] + 1;
+                values[to..to + nx].copy_from_slice(&density[from..from + nx]);
+            }
+        }
+        let voxel = (p1 - p0) / DVec3::new(nx as f64, ny as f64, nz as f64);
+        let (lo, hi) = (p0 - voxel, p1 + voxel);
+        let to_world = ctm * DMat4::from_translation(lo) * DMat4::from_scale(hi - lo);
+        let mut grid = plugin(
+            PluginClass::Volume,
+            "inlinegrid",
+            &location,
+            &self.search_paths,
+        );
+        set(
+            &mut grid,
+            "values",
+            PropertyValue::Numbers(values),
+            &density_parameter.location,
+        );
+        for (name, count) in ["resolution_x", "resolution_y", "resolution_z"]
+            .into_iter()
+            .zip(padded)
+        {
+            set(
+                &mut grid,
+                name,
+                PropertyValue::Integer(count as i64),
+                &location,
+            );
+        }
+        set(
+            &mut grid,
+            "to_world",
+            PropertyValue::Transform(to_world),
+            &location,
+        );
+        self.warn(
+            &location,
+            "pbrt-v4's grid medium is empty outside p0–p1; Prism's keeps the grid's faded border \
+             for half a voxel beyond them: the same image where the medium's shapes lie within \
+             p0–p1",
+        );
+
+        let mut node = plugin(
+            PluginClass::Medium,
+            "heterogeneous",
+            &location,
+            &self.search_paths,
+        );
+        nest(&mut node, Some("sigma_t"), Arc::new(grid), &location);
+        let albedo = if sigma_t > 0.0 {
+            sigma_s / sigma_t
+        } else {
+            0.0
+        };
+        set(&mut node, "albedo", PropertyValue::Float(albedo), &location);
+        set(
+            &mut node,
+            "scale",
+            PropertyValue::Float(scale * sigma_t),
+            &location,
+        );
+        Ok(node)
+    }
+
+    /// The grey coefficient `name` (1 when absent): an `rgb` of three equal values.
+    fn grey(&self, list: &ParameterList, name: &str) -> Result<f64> {
+        let Some((value, parameter)) = list.spectrum(name, false)? else {
+            return Ok(1.0);
+        };
+        match value {
+            SpectrumParam::Rgb([r, g, b]) if r == g && g == b && r >= 0.0 => Ok(r),
+            _ => Err(list
+                .error(
+                    parameter,
+                    "must be grey (the same at every wavelength): Prism's grid media have one \
+                     extinction at every wavelength",
+                )
+                .with_help("give it as \"rgb\" with three equal values")),
+        }
     }
 }

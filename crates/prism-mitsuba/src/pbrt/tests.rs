@@ -250,6 +250,21 @@ fn lights_are_scaled_to_pbrts_luminance() {
     assert!(
         error("WorldBegin\nLightSource \"point\" \"float power\" 10").contains("test.pbrt:2:21:")
     );
+    assert!(
+        error("WorldBegin\nLightSource \"point\" \"float illuminance\" 10")
+            .contains("test.pbrt:2:21:")
+    );
+    // A uniform sky of illuminance E has the radiance E / π (times `scale`).
+    let sky = super::read_pbrt_str(
+        "WorldBegin\nLightSource \"infinite\" \"rgb L\" [1 2 3] \"float scale\" 2 \"float illuminance\" 6.283185307179586\n",
+        Path::new("test.pbrt"),
+    )
+    .unwrap()
+    .root;
+    assert_eq!(
+        property(nodes(&sky, PluginClass::Emitter)[0], "radiance"),
+        &PropertyValue::Rgb([4.0, 8.0, 12.0])
+    );
 }
 
 #[test]
@@ -487,5 +502,117 @@ fn the_samplers_seed_wins_over_the_option() {
     assert_eq!(
         seed("Option \"integer seed\" 7\nSampler \"independent\" \"integer seed\" 3\nWorldBegin"),
         PropertyValue::Integer(3)
+    );
+}
+
+#[test]
+fn scale_and_mix_textures_nest_their_operands() {
+    let root = root(
+        "WorldBegin\nTexture \"checks\" \"float\" \"checkerboard\"\nTexture \"amount\" \"float\" \"scale\" \"float tex\" 0.5 \"texture scale\" \"checks\"\nTexture \"blend\" \"spectrum\" \"mix\" \"rgb tex1\" [0.8 0.8 0.8] \"texture amount\" \"amount\"\nMaterial \"diffuse\" \"texture reflectance\" \"blend\"\nShape \"sphere\"",
+    );
+    let shape = nodes(&root, PluginClass::Shape)[0];
+    let diffuse = &shape.children[0].node.children[0].node;
+    let blend = &diffuse.children[0].node;
+    assert_eq!(blend.plugin_type, "mix");
+    assert_eq!(property(blend, "tex1"), &PropertyValue::Rgb([0.8; 3]));
+    // pbrt's defaults: tex2 = 1.
+    assert_eq!(property(blend, "tex2"), &PropertyValue::Float(1.0));
+    let amount = &blend.children[0];
+    assert_eq!(amount.name.as_deref(), Some("amount"));
+    assert_eq!(amount.node.plugin_type, "scale");
+    assert_eq!(property(&amount.node, "tex"), &PropertyValue::Float(0.5));
+    assert_eq!(amount.node.children[0].name.as_deref(), Some("scale"));
+    assert_eq!(amount.node.children[0].node.plugin_type, "checkerboard");
+    // A float texture's operand names a float texture; a spectrum texture is not one.
+    assert!(
+        error("WorldBegin\nTexture \"c\" \"spectrum\" \"checkerboard\"\nTexture \"s\" \"float\" \"scale\" \"texture tex\" \"c\"")
+            .contains("test.pbrt:3:29: Texture \"s\" \"float\" \"scale\": parameter \"texture tex\" names the unknown float texture \"c\"")
+    );
+    assert!(
+        error("WorldBegin\nTexture \"d\" \"float\" \"directionmix\" \"vector3 dir\" [0 1 0]")
+            .contains("test.pbrt:2:1: Texture \"d\" \"float\" \"directionmix\": blends by the surface normal's direction")
+    );
+}
+
+#[test]
+fn an_image_infinite_light_is_an_equal_area_map() {
+    let root = root(
+        "WorldBegin\nAttributeBegin\nRotate -90 1 0 0\nLightSource \"infinite\" \"string filename\" \"sky.exr\" \"float scale\" 3\nAttributeEnd",
+    );
+    let light = nodes(&root, PluginClass::Emitter)[0];
+    assert_eq!(light.plugin_type, "equal_area_envmap");
+    assert_eq!(
+        property(light, "filename"),
+        &PropertyValue::String("sky.exr".into())
+    );
+    assert_eq!(property(light, "scale"), &PropertyValue::Float(3.0));
+    assert_close(
+        transform(light),
+        DMat4::from_rotation_x(-std::f64::consts::FRAC_PI_2),
+    );
+    assert!(
+        error("WorldBegin\nLightSource \"infinite\" \"string filename\" \"sky.exr\" \"rgb L\" [1 1 1]")
+            .contains("test.pbrt:2:52: LightSource \"infinite\": parameter \"rgb L\" cannot be given with \"filename\"")
+    );
+    assert!(
+        error("WorldBegin\nLightSource \"infinite\" \"string filename\" \"sky.exr\" \"float illuminance\" 5")
+            .contains("test.pbrt:2:52: LightSource \"infinite\": parameter \"float illuminance\" sets the light by a photometric quantity")
+    );
+}
+
+#[test]
+fn a_uniform_grid_is_a_heterogeneous_medium_with_an_empty_border() {
+    let root = root(
+        "WorldBegin\nTranslate 1 0 0\nMakeNamedMedium \"smoke\" \"string type\" \"uniformgrid\" \"integer nx\" 2 \"float density\" [3 5] \"point3 p0\" [0 0 0] \"point3 p1\" [4 1 1] \"rgb sigma_a\" [1 1 1] \"rgb sigma_s\" [3 3 3] \"float scale\" 2 \"float g\" 0.5\nMediumInterface \"smoke\" \"\"\nMaterial \"interface\"\nShape \"sphere\"",
+    );
+    let shape = nodes(&root, PluginClass::Shape)[0];
+    let medium = &shape
+        .children
+        .iter()
+        .find(|c| c.name.as_deref() == Some("interior"))
+        .expect("an interior")
+        .node;
+    assert_eq!(medium.plugin_type, "heterogeneous");
+    // σ_t = 2 · (1 + 3) · d, albedo 3 / 4.
+    assert_eq!(property(medium, "scale"), &PropertyValue::Float(8.0));
+    assert_eq!(property(medium, "albedo"), &PropertyValue::Float(0.75));
+    let grid = &medium.children[0];
+    assert_eq!(grid.name.as_deref(), Some("sigma_t"));
+    assert_eq!(grid.node.plugin_type, "inlinegrid");
+    assert_eq!(medium.children[1].node.plugin_type, "hg");
+    // 2 × 1 × 1 voxels in a 4 × 3 × 3 grid of zeros, over the box grown by a voxel (2 × 1 × 1).
+    let PropertyValue::Numbers(values) = property(&grid.node, "values") else {
+        panic!("no values");
+    };
+    let mut expected = vec![0.0; 36];
+    expected[(3 + 1) * 4 + 1] = 3.0;
+    expected[(3 + 1) * 4 + 2] = 5.0;
+    assert_eq!(values, &expected);
+    assert_eq!(
+        property(&grid.node, "resolution_x"),
+        &PropertyValue::Integer(4)
+    );
+    assert_close(
+        transform(&grid.node),
+        DMat4::from_translation(DVec3::new(1.0 - 2.0, -1.0, -1.0))
+            * DMat4::from_scale(DVec3::new(8.0, 3.0, 3.0)),
+    );
+    let medium = |parameters: &str, expected: &str| {
+        let message = error(&format!(
+            "WorldBegin\nMakeNamedMedium \"m\" \"string type\" \"uniformgrid\" {parameters}"
+        ));
+        assert!(message.contains(expected), "{message}");
+    };
+    medium(
+        "\"integer nx\" 2 \"float density\" [1 2 3]",
+        "test.pbrt:2:64: MakeNamedMedium \"m\": parameter \"float density\" has 3 values, but nx × ny × nz = 2 × 1 × 1 = 2 are expected",
+    );
+    medium(
+        "\"float density\" [1] \"float temperature\" [900]",
+        "test.pbrt:2:69: MakeNamedMedium \"m\": parameter \"float temperature\" makes the medium glow",
+    );
+    medium(
+        "\"float density\" [1] \"rgb sigma_s\" [1 2 3]",
+        "test.pbrt:2:69: MakeNamedMedium \"m\": parameter \"rgb sigma_s\" must be grey",
     );
 }

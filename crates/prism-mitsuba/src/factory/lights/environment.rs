@@ -1,4 +1,5 @@
-//! Emitters at infinity that surround the scene: `constant`, `envmap` and `sunsky`.
+//! Emitters at infinity that surround the scene: `constant`, `envmap`, `equal_area_envmap`
+//! (pbrt-v4's image `infinite` light) and `sunsky`.
 
 use super::{Build, D65, SAMPLING_WEIGHT, TO_WORLD, emission_param, invertible};
 use crate::factory::spectra::spectrum_param;
@@ -8,7 +9,9 @@ use crate::registry::{Bounds, Default, Origin, ParamKind, ParamSpec, Plugin, Ran
 use glam::Vec3;
 use prism_core::error::{Error, Result};
 use prism_core::light::sunsky::sun_position::{DateTime, Location, sun_angles};
-use prism_core::light::{ConstantLight, EnvironmentMap, Light, Sunsky, SunskySettings};
+use prism_core::light::{
+    ConstantLight, EnvironmentMap, EqualAreaEnvmap, Light, Sunsky, SunskySettings,
+};
 
 pub(super) const CONSTANT: Plugin<Build> = Plugin {
     name: "constant",
@@ -30,6 +33,17 @@ pub(super) const ENVMAP: Plugin<Build> = Plugin {
               upsampling; importance sampled ∝ luminance · sin θ.",
     params: &[ENVMAP_FILENAME, ENVMAP_SCALE, TO_WORLD, SAMPLING_WEIGHT],
     build: |params, _, _| build_envmap(params),
+};
+
+pub(super) const EQUAL_AREA_ENVMAP: Plugin<Build> = Plugin {
+    name: "equal_area_envmap",
+    origin: Origin::Prism,
+    summary: "pbrt-v4's image infinite light: a square image in the equal-area octahedral \
+              projection (+z at its centre, +x at the middle of its right edge, +y at the \
+              middle of its bottom edge), each direction the colour of the pixel it falls in, \
+              upsampled as an illuminant; importance sampled ∝ luminance.",
+    params: &[EQUAL_AREA_FILENAME, ENVMAP_SCALE, ROTATION, SAMPLING_WEIGHT],
+    build: |params, _, _| build_equal_area_envmap(params),
 };
 
 pub(super) const SUNSKY: Plugin<Build> = Plugin {
@@ -65,6 +79,8 @@ pub(super) const SUNSKY: Plugin<Build> = Plugin {
 params! {
     RADIANCE = ParamSpec::new("radiance", ParamKind::Spectrum { range: Range::Emission, textured: false, }, D65, "emitted radiance; or a nested `<spectrum type=\"blackbody\">`");
     ENVMAP_FILENAME = ParamSpec::new("filename", ParamKind::String, Default::Required, "the image: OpenEXR, Radiance HDR, PFM, PNG, JPEG, BMP, TGA or PPM/PGM, at least 2 × 3 pixels");
+    EQUAL_AREA_FILENAME = ParamSpec::new("filename", ParamKind::String, Default::Required, "the square image: OpenEXR, Radiance HDR, PFM, PNG, JPEG, BMP, TGA or PPM/PGM");
+    ROTATION = ParamSpec::new("to_world", ParamKind::Transform, Default::Text("identity"), "the map's rotation (or reflection): it must keep lengths and angles");
     ENVMAP_SCALE = ParamSpec::new("scale", ParamKind::Float, Default::Float(1.0), "factor on the image's values");
     SUN_DIRECTION = ParamSpec::new("sun_direction", ParamKind::Vector, Default::Text("from the place and time"), "the sun's direction (world space); not together with the place and time");
     LATITUDE = ParamSpec::new("latitude", ParamKind::Float, Default::Float(35.6894), "degrees north (Tokyo by default)");
@@ -127,6 +143,75 @@ fn build_envmap(params: &Params) -> Result<Light> {
     }
     let to_world = invertible(params, &TO_WORLD)?;
     Ok(Light::Envmap(EnvironmentMap::new(
+        bitmap,
+        scale as f32,
+        to_world,
+    )))
+}
+
+/// pbrt-v4's image infinite light.
+fn build_equal_area_envmap(params: &Params) -> Result<Light> {
+    let node = params.node();
+    let Some(filename) = params.string_opt(&EQUAL_AREA_FILENAME)? else {
+        return Err(Error::input(
+            &node.location,
+            format!("{} needs a \"filename\"", node.describe()),
+        )
+        .with_help("add <string name=\"filename\" value=\"sky.exr\"/>"));
+    };
+    let location = params.location_of(&EQUAL_AREA_FILENAME);
+    let path = node.resolve_file(filename, location)?;
+    let bitmap = read_image_file(&path).map_err(|e| e.at(location))?;
+    if bitmap.width != bitmap.height {
+        return Err(Error::input(
+            location,
+            format!(
+                "the environment map \"{filename}\" has {} × {} pixels; an equal-area map is square",
+                bitmap.width, bitmap.height
+            ),
+        )
+        .with_help("a latitude-longitude map (twice as wide as high) is read by \"envmap\""));
+    }
+    if let Some(index) = bitmap
+        .data
+        .iter()
+        .position(|v| !(*v >= 0.0 && v.is_finite()))
+    {
+        let pixel = index / bitmap.channels;
+        return Err(Error::input(
+            location,
+            format!(
+                "pixel ({}, {}) of the environment map \"{filename}\" is {}",
+                pixel % bitmap.width,
+                pixel / bitmap.width,
+                bitmap.data[index]
+            ),
+        )
+        .with_help("radiance must be finite and at least 0"));
+    }
+    let scale = params.float(&ENVMAP_SCALE)?;
+    if !(scale >= 0.0 && scale.is_finite() && scale <= f64::from(f32::MAX)) {
+        return Err(Error::input(
+            params.location_of(&ENVMAP_SCALE),
+            format!("the environment map's scale must be finite and at least 0, not {scale}"),
+        ));
+    }
+    let matrix = params.transform(&ROTATION)?;
+    let linear = glam::DMat3::from_mat4(matrix);
+    let gram = linear.transpose() * linear;
+    if !gram.abs_diff_eq(glam::DMat3::IDENTITY, 1e-6) {
+        return Err(Error::input(
+            params.location_of(&ROTATION),
+            format!(
+                "the \"to_world\" transform of {} stretches directions; an equal-area map is \
+                 only rotated (or reflected)",
+                node.describe()
+            ),
+        )
+        .with_help("remove the scale from the transform"));
+    }
+    let to_world = invertible(params, &ROTATION)?;
+    Ok(Light::EqualAreaEnvmap(EqualAreaEnvmap::new(
         bitmap,
         scale as f32,
         to_world,

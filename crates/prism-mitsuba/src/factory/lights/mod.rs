@@ -1,7 +1,7 @@
 //! Emitter plugins: `area` and `directionalarea` (nested in a shape, or declared with an id and
 //! referenced from one),
 //! and at the top level of the scene `point`, `spot`, `projector` and `directional` (module
-//! `delta`), and `constant`, `envmap` and `sunsky` (module `environment`); see each light's
+//! `delta`), and `constant`, `envmap`, `equal_area_envmap` and `sunsky` (module `environment`); see each light's
 //! module in [`prism_core::light`] for its parameters. Emission may be given as `<rgb>` (an
 //! illuminant: the upsampled colour times D65), `<float>` (D65 scaled), `<spectrum>` (as
 //! written) or a nested `<spectrum type="blackbody">` with a `temperature` in kelvin; an area
@@ -41,6 +41,7 @@ pub static EMITTERS: Registry<Build> = Registry {
         delta::DIRECTIONAL,
         environment::CONSTANT,
         environment::ENVMAP,
+        environment::EQUAL_AREA_ENVMAP,
         environment::SUNSKY,
     ],
 };
