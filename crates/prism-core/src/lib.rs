@@ -22,6 +22,7 @@
 //! | [`spectrum`] | wavelengths and spectral values along a path, CIE tables, RGB upsampling |
 //! | [`image`] | image files: decoding, EXR and PNG output, the sRGB curve, comparison |
 //! | [`tensor_file`] | Mitsuba's tensor files: the sun-and-sky tables, measured BSDFs |
+//! | [`polarization`] | Stokes vectors, Mueller matrices, the Fresnel equations for polarized light |
 //! | [`geometry`] | shapes, intersection, the BVH, instances, the scene's primitives |
 //! | [`texture`] | values that vary over a surface |
 //! | [`bsdf`] | BSDFs, their lobes at a point, materials |
@@ -49,6 +50,7 @@ pub mod integrator;
 pub mod light;
 pub mod math;
 pub mod medium;
+pub mod polarization;
 pub mod render;
 pub mod sampling;
 pub mod scene;
