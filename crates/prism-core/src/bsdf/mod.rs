@@ -54,6 +54,9 @@
 //! | `coateddiffuse`, `coatedconductor` | [`layered`] | reflection by a random walk through a coating (pbrt-v4's) |
 //! | `hair` | [`hair`] | glossy scattering around a fibre (reflection and transmission) |
 //! | `measured` | [`measured`] | glossy reflection, tabulated (RGL database) |
+//! | `polarizer` | [`polarizer`] | null transmission through a linear polarizer |
+//! | `retarder` | [`retarder`] | null transmission through a linear retarder (a wave plate) |
+//! | `circular` | [`circular`] | null transmission through a circular polarizer |
 //! | `twosided` | [`twosided`] | those of the nested BSDFs, on both sides |
 //! | `mask` | [`mask`] | the nested BSDF's, and null transmission |
 //! | `null` | [`null`] | null transmission only (a medium's boundary) |
@@ -63,6 +66,7 @@
 pub mod blend;
 pub mod bumpmap;
 pub mod burley;
+pub mod circular;
 pub mod conductor;
 pub mod dielectric;
 pub mod diffuse;
@@ -81,9 +85,11 @@ pub mod null;
 pub mod perturbed;
 pub mod phong;
 pub mod plastic;
+pub mod polarizer;
 pub mod pplastic;
 pub mod principled;
 pub mod principledthin;
+pub mod retarder;
 pub mod roughconductor;
 pub mod roughdielectric;
 pub mod roughdiffuse;
@@ -97,6 +103,7 @@ use glam::{Vec2, Vec3};
 
 pub use blend::Blend;
 pub use bumpmap::BumpMap;
+pub use circular::Circular;
 pub use conductor::Conductor;
 pub use dielectric::Dielectric;
 pub use diffuse::Diffuse;
@@ -110,9 +117,11 @@ pub use normalmap::NormalMap;
 pub use null::Null;
 pub use phong::Phong;
 pub use plastic::Plastic;
+pub use polarizer::Polarizer;
 pub use pplastic::PolarizedPlastic;
 pub use principled::Principled;
 pub use principledthin::PrincipledThin;
+pub use retarder::Retarder;
 pub use roughconductor::RoughConductor;
 pub use roughdielectric::RoughDielectric;
 pub use roughdiffuse::RoughDiffuse;
@@ -655,6 +664,9 @@ bsdfs! {
         Null(Null),
         Hair(Hair),
         Measured(Measured),
+        Polarizer(Polarizer),
+        Retarder(Retarder),
+        Circular(Circular),
     }
     adapters {
         TwoSided(TwoSided),
@@ -687,5 +699,8 @@ bsdfs! {
         Null(null::NullLobes),
         Hair(hair::HairLobes<'a>),
         Measured(measured::MeasuredLobes<'a>),
+        Polarizer(polarizer::PolarizerLobes),
+        Retarder(retarder::RetarderLobes),
+        Circular(circular::CircularLobes),
     }
 }
