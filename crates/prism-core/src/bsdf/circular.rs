@@ -36,7 +36,7 @@ pub struct Circular {
 
 impl LeafBsdf for Circular {
     type Lobes<'a> = CircularLobes;
-    const FLAGS: BsdfFlags = BsdfFlags::NULL;
+    const FLAGS: BsdfFlags = BsdfFlags::NULL.union(BsdfFlags::POLARIZING);
 
     #[inline]
     fn lobes(&self, at: TexturePoint, lambda: &SampledWavelengths) -> CircularLobes {
@@ -63,7 +63,7 @@ impl CircularLobes {
 
     /// The Mueller matrix for light passing along `forward` (local, the direction of travel),
     /// from and to the implicit Stokes bases of `forward`.
-    pub fn mueller(&self, forward: Vec3) -> SampledMueller {
+    pub fn mueller_along(&self, forward: Vec3) -> SampledMueller {
         let m = if self.left_handed {
             left_circular_polarizer()
         } else {
@@ -87,6 +87,17 @@ impl Bxdf for CircularLobes {
     fn null_transmission(&self, _tree: &BxdfTree, _wo: Vec3) -> SampledSpectrum {
         self.unpolarized()
     }
+
+    /// Light passes along `wo`.
+    fn mueller(
+        &self,
+        _tree: &BxdfTree,
+        wo: Vec3,
+        _wi: Vec3,
+        _lobe: BsdfFlags,
+    ) -> Option<SampledMueller> {
+        Some(self.mueller_along(wo))
+    }
 }
 
 #[cfg(test)]
@@ -107,7 +118,7 @@ mod tests {
                     left_handed,
                     transmittance,
                 };
-                let m = lobes.mueller(forward);
+                let m = lobes.mueller_along(forward);
                 assert_eq!(m.m00(), transmittance * 0.5);
                 let tree = BxdfTree::empty();
                 assert_eq!(lobes.null_transmission(&tree, forward), transmittance * 0.5);

@@ -132,6 +132,7 @@ pub use ward::{Ward, WardVariant};
 
 use crate::geometry::interaction::AttributeValues;
 use crate::math::Frame;
+use crate::polarization::SampledMueller;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use crate::texture::TexturePoint;
 
@@ -151,6 +152,9 @@ impl BsdfFlags {
     /// BSDF, the transparent part of `mask`, the transmission of `thindielectric`); a delta lobe
     /// too.
     pub const NULL: BsdfFlags = BsdfFlags(32);
+    /// The BSDF changes the polarization of light in a way an unpolarized render cannot show
+    /// (`polarizer`, `retarder`, `circular`): a scene with one renders polarized.
+    pub const POLARIZING: BsdfFlags = BsdfFlags(64);
     pub const REFLECTION: BsdfFlags = BsdfFlags(8);
     pub const TRANSMISSION: BsdfFlags = BsdfFlags(16);
 
@@ -417,6 +421,23 @@ pub trait Bxdf {
         let _ = (tree, wo);
         SampledSpectrum::ZERO
     }
+    /// For polarized rendering: the Mueller matrix of f(wo, wi)·|cos θi| of the lobe `lobe`
+    /// (a sample's flags, or [`BsdfFlags::NONE`] for the smooth lobes that light sampling
+    /// evaluates), up to a positive factor per wavelength, from the implicit Stokes basis of the
+    /// incident beam (travelling along −wi) to that of the outgoing one (along wo), local
+    /// directions, as Mitsuba 3's polarized BSDFs return it; the integrator scales its M₀₀ to
+    /// the unpolarized value. A BSDF without a polarized model keeps this default, None: it
+    /// depolarizes, as Mitsuba's do.
+    fn mueller(
+        &self,
+        tree: &BxdfTree,
+        wo: Vec3,
+        wi: Vec3,
+        lobe: BsdfFlags,
+    ) -> Option<SampledMueller> {
+        let _ = (tree, wo, wi, lobe);
+        None
+    }
 }
 
 /// Index of a node in a [`BxdfTree`].
@@ -472,6 +493,18 @@ impl<'a> BxdfTree<'a> {
     #[inline]
     pub fn null_transmission(&self, id: NodeId, wo: Vec3) -> SampledSpectrum {
         self.nodes[id as usize].null_transmission(self, wo)
+    }
+
+    /// [`Bxdf::mueller`] of node `id`.
+    #[inline]
+    pub fn mueller(
+        &self,
+        id: NodeId,
+        wo: Vec3,
+        wi: Vec3,
+        lobe: BsdfFlags,
+    ) -> Option<SampledMueller> {
+        self.nodes[id as usize].mueller(self, wo, wi, lobe)
     }
 }
 
@@ -575,6 +608,13 @@ macro_rules! bsdfs {
             fn null_transmission(&self, tree: &BxdfTree, wo: Vec3) -> SampledSpectrum {
                 match self {
                     $(Node::$node(b) => b.null_transmission(tree, wo),)+
+                }
+            }
+
+            #[inline]
+            fn mueller(&self, tree: &BxdfTree, wo: Vec3, wi: Vec3, lobe: BsdfFlags) -> Option<SampledMueller> {
+                match self {
+                    $(Node::$node(b) => b.mueller(tree, wo, wi, lobe),)+
                 }
             }
         }

@@ -40,7 +40,7 @@ pub struct Polarizer {
 
 impl LeafBsdf for Polarizer {
     type Lobes<'a> = PolarizerLobes;
-    const FLAGS: BsdfFlags = BsdfFlags::NULL;
+    const FLAGS: BsdfFlags = BsdfFlags::NULL.union(BsdfFlags::POLARIZING);
 
     #[inline]
     fn lobes(&self, at: TexturePoint, lambda: &SampledWavelengths) -> PolarizerLobes {
@@ -69,7 +69,7 @@ impl PolarizerLobes {
 
     /// The Mueller matrix for light passing along `forward` (local, the direction of travel),
     /// from and to the implicit Stokes bases of `forward`.
-    pub fn mueller(&self, forward: Vec3) -> SampledMueller {
+    pub fn mueller_along(&self, forward: Vec3) -> SampledMueller {
         if !self.polarizing {
             return SampledMueller::absorber(self.unpolarized());
         }
@@ -96,6 +96,17 @@ impl Bxdf for PolarizerLobes {
 
     fn null_transmission(&self, _tree: &BxdfTree, _wo: Vec3) -> SampledSpectrum {
         self.unpolarized()
+    }
+
+    /// Light passes along `wo`.
+    fn mueller(
+        &self,
+        _tree: &BxdfTree,
+        wo: Vec3,
+        _wi: Vec3,
+        _lobe: BsdfFlags,
+    ) -> Option<SampledMueller> {
+        Some(self.mueller_along(wo))
     }
 }
 
@@ -125,7 +136,7 @@ mod tests {
                 let l = lobes(360.0 * rng.next_f32(), polarizing);
                 let tree = BxdfTree::empty();
                 let weight = l.sample(&tree, forward, 0.5, Vec2::ZERO).unwrap().weight;
-                let m00 = l.mueller(forward).m00();
+                let m00 = l.mueller_along(forward).m00();
                 for i in 0..4 {
                     assert!((m00[i] - weight[i]).abs() < 1e-6);
                 }
@@ -141,14 +152,14 @@ mod tests {
     fn two_sheets_follow_malus_law() {
         for forward in [Vec3::Z, -Vec3::Z] {
             for degrees in [0.0f32, 30.0, 45.0, 80.0, 90.0] {
-                let first = lobes(10.0, true).mueller(forward).0[0];
-                let second = lobes(10.0 + degrees, true).mueller(forward).0[0];
+                let first = lobes(10.0, true).mueller_along(forward).0[0];
+                let second = lobes(10.0 + degrees, true).mueller_along(forward).0[0];
                 let out = second * first * Vec4::X;
                 let expected = 0.5 * degrees.to_radians().cos().powi(2);
                 assert!((out.x - expected).abs() < 1e-5, "{degrees}°: {out}");
             }
-            let neutral = lobes(37.0, false).mueller(forward).0[0];
-            let out = neutral * lobes(0.0, true).mueller(forward).0[0] * Vec4::X;
+            let neutral = lobes(37.0, false).mueller_along(forward).0[0];
+            let out = neutral * lobes(0.0, true).mueller_along(forward).0[0] * Vec4::X;
             assert!((out.x - 0.25).abs() < 1e-6);
         }
     }

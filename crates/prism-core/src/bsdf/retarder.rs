@@ -37,7 +37,7 @@ pub struct Retarder {
 
 impl LeafBsdf for Retarder {
     type Lobes<'a> = RetarderLobes;
-    const FLAGS: BsdfFlags = BsdfFlags::NULL;
+    const FLAGS: BsdfFlags = BsdfFlags::NULL.union(BsdfFlags::POLARIZING);
 
     #[inline]
     fn lobes(&self, at: TexturePoint, lambda: &SampledWavelengths) -> RetarderLobes {
@@ -60,7 +60,7 @@ pub struct RetarderLobes {
 impl RetarderLobes {
     /// The Mueller matrix for light passing along `forward` (local, the direction of travel),
     /// from and to the implicit Stokes bases of `forward`.
-    pub fn mueller(&self, forward: Vec3) -> SampledMueller {
+    pub fn mueller_along(&self, forward: Vec3) -> SampledMueller {
         let cos_theta = forward.z;
         let retarder = linear_retarder(self.delta * cos_theta.abs());
         let side = if cos_theta >= 0.0 { 1.0 } else { -1.0 };
@@ -83,6 +83,17 @@ impl Bxdf for RetarderLobes {
     fn null_transmission(&self, _tree: &BxdfTree, _wo: Vec3) -> SampledSpectrum {
         self.transmittance
     }
+
+    /// Light passes along `wo`.
+    fn mueller(
+        &self,
+        _tree: &BxdfTree,
+        wo: Vec3,
+        _wi: Vec3,
+        _lobe: BsdfFlags,
+    ) -> Option<SampledMueller> {
+        Some(self.mueller_along(wo))
+    }
 }
 
 #[cfg(test)]
@@ -101,7 +112,7 @@ mod tests {
             delta: 90f32.to_radians(),
             transmittance,
         };
-        let front = plate.mueller(Vec3::Z);
+        let front = plate.mueller_along(Vec3::Z);
         assert_eq!(front.m00(), transmittance);
         let tree = BxdfTree::empty();
         assert_eq!(plate.null_transmission(&tree, Vec3::Z), transmittance);
@@ -118,7 +129,7 @@ mod tests {
         } else {
             Vec4::new(1.0, -1.0, 0.0, 0.0)
         };
-        let out = plate.mueller(-Vec3::Z).0[0] * along_s;
+        let out = plate.mueller_along(-Vec3::Z).0[0] * along_s;
         assert!((out.w - -1.0).abs() < 1e-5, "{out}");
     }
 }

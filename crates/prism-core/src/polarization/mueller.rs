@@ -172,6 +172,49 @@ impl FrameChange {
         FrameChange { r_in: r, r_out: r }
     }
 
+    /// For a matrix whose reference directions are the normals of the plane of incidence (the
+    /// s directions of the Fresnel equations) about `normal`, on the incident beam travelling
+    /// along `in_forward` and the outgoing one along `out_forward`: the change to the implicit
+    /// bases of the two beams (the rotation Mitsuba's pBSDFs apply). A beam along the normal
+    /// has no plane of incidence; (1, 0, 0) stands for it.
+    #[inline]
+    pub fn from_plane_of_incidence(
+        normal: Vec3,
+        in_forward: Vec3,
+        out_forward: Vec3,
+    ) -> FrameChange {
+        let s_in = normal.cross(in_forward);
+        let (s_in, s_out) = if s_in == Vec3::ZERO {
+            (Vec3::X, Vec3::X)
+        } else {
+            (s_in.normalize(), normal.cross(out_forward).normalize())
+        };
+        FrameChange::new(
+            in_forward,
+            s_in,
+            stokes_basis(in_forward),
+            out_forward,
+            s_out,
+            stokes_basis(out_forward),
+        )
+    }
+
+    /// For a matrix between the implicit bases of the local directions `in_forward` and
+    /// `out_forward` (local to `frame`): the change to the implicit bases of the same beams in
+    /// world space (Mitsuba's `to_world_mueller`).
+    #[inline]
+    pub fn local_to_world(frame: &Frame, in_forward: Vec3, out_forward: Vec3) -> FrameChange {
+        let (in_world, out_world) = (frame.to_world(in_forward), frame.to_world(out_forward));
+        FrameChange::new(
+            in_world,
+            frame.to_world(stokes_basis(in_forward)),
+            stokes_basis(in_world),
+            out_world,
+            frame.to_world(stokes_basis(out_forward)),
+            stokes_basis(out_world),
+        )
+    }
+
     /// R_out M R_inᵀ.
     #[inline]
     pub fn apply(&self, m: Mat4) -> Mat4 {
