@@ -1,8 +1,9 @@
 //! Polarized rendering against Mitsuba 3 and against closed forms, on the scenes of
 //! `tests/data/polarization/` (its README says how the references were made): an area light
 //! seen through two linear polarizers 60° apart (Malus's law), through two aligned ones and a
-//! quarter-wave plate at 45° (circular light), and a glass plane seen near Brewster's angle
-//! beside a gold sphere, all through the `stokes` integrator.
+//! quarter-wave plate at 45° (circular light), a glass plane seen near Brewster's angle beside
+//! a gold sphere, and a `pplastic` plane at the same angle, all through the `stokes`
+//! integrator.
 //!
 //! Each of the twelve channels S0.R … S3.B is compared by its image mean, Prism's from eight
 //! renders with different seeds (their spread gives its standard error), with the mean of
@@ -65,6 +66,18 @@ const REFERENCES: &[Reference] = &[
         standard_error: [
             3.17e-04, 2.37e-04, 4.01e-04, 3.47e-04, 2.97e-04, 4.01e-04, 6.72e-05, 5.02e-05,
             6.71e-05, 2.55e-05, 1.61e-05, 8.27e-06,
+        ],
+    },
+    Reference {
+        scene: "pplastic",
+        defines: &[],
+        mean: [
+            0.2177895, 0.3110890, 0.5293539, 0.0754009, 0.0477179, 0.0266272, -0.0000822,
+            -0.0000794, -0.0001025, 0.0, 0.0, 0.0,
+        ],
+        standard_error: [
+            2.38e-04, 4.95e-04, 1.14e-03, 8.22e-05, 9.09e-05, 1.31e-04, 2.31e-05, 2.33e-05,
+            4.03e-05, 0.0, 0.0, 0.0,
         ],
     },
 ];

@@ -361,6 +361,38 @@ mod tests {
         }
     }
 
+    /// Energy is never above the unpolarized case's bound: whatever the polarization of the
+    /// incident light, reflected plus refracted intensity is at most the incident one (exactly
+    /// it for a dielectric), and each beam stays physical (S₀ ≥ |(S₁, S₂, S₃)|).
+    #[test]
+    fn no_polarization_gains_energy() {
+        let mut rng = crate::sampling::rng::Pcg32::seeded(12);
+        for _ in 0..2000 {
+            let direction = crate::sampling::warp::sample_uniform_sphere(glam::Vec2::new(
+                rng.next_f32(),
+                rng.next_f32(),
+            ));
+            let incident = glam::Vec4::new(1.0, direction.x, direction.y, direction.z);
+            let cos = 2.0 * rng.next_f32() - 1.0;
+            let eta = 1.0 + 2.0 * rng.next_f32();
+            let reflected = specular_reflection(cos, Complex::real(eta)) * incident;
+            let refracted = specular_transmission(cos, eta) * incident;
+            assert!(
+                (reflected.x + refracted.x - 1.0).abs() < 1e-4,
+                "{cos} {eta}"
+            );
+            let conductor = specular_reflection(
+                cos.abs(),
+                Complex::new(3.0 * rng.next_f32(), 5.0 * rng.next_f32()),
+            ) * incident;
+            assert!(conductor.x <= 1.0 + 1e-5);
+            for s in [reflected, refracted, conductor] {
+                let polarized = glam::Vec3::new(s.y, s.z, s.w).length();
+                assert!(polarized <= s.x + 1e-4, "{s}");
+            }
+        }
+    }
+
     #[test]
     fn complex_square_roots_are_principal() {
         for (re, im) in [
