@@ -85,6 +85,8 @@ fn integrator_named(name: &str, scene: &Scene) -> Result<Integrator> {
     let image = scene.integrator.image_integrator();
     let max_depth = match image {
         Integrator::Path(p) => p.max_depth,
+        Integrator::PolarizedPath(p) => p.path.max_depth,
+        Integrator::Stokes(s) => s.nested.path.max_depth,
         // Direct illumination is the path tracer's estimate of paths of two vertices.
         Integrator::Direct(_) => 2,
         Integrator::Distribution(d) => d.max_depth,
@@ -150,7 +152,8 @@ fn sampler_named(name: &str) -> Result<SamplerKind> {
 
 fn integrator_label(integrator: &Integrator) -> &'static str {
     match integrator {
-        Integrator::Path(_) => "path",
+        Integrator::Path(_) | Integrator::PolarizedPath(_) => "path",
+        Integrator::Stokes(_) => "stokes",
         Integrator::Direct(_) => "direct",
         Integrator::Distribution(_) => "distrib",
         Integrator::VolPath(v) if v.tracking == Tracking::Spectral => "volpath",

@@ -21,6 +21,7 @@ mod materials;
 mod media;
 mod output_formats;
 mod pbrt;
+mod polarization;
 mod preview;
 mod references;
 mod reliability;

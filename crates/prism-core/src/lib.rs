@@ -22,6 +22,7 @@
 //! | [`spectrum`] | wavelengths and spectral values along a path, CIE tables, RGB upsampling |
 //! | [`image`] | image files: decoding, EXR and PNG output, the sRGB curve, comparison |
 //! | [`tensor_file`] | Mitsuba's tensor files: the sun-and-sky tables, measured BSDFs |
+//! | [`polarization`] | Stokes vectors, Mueller matrices, the Fresnel equations for polarized light |
 //! | [`geometry`] | shapes, intersection, the BVH, instances, the scene's primitives |
 //! | [`texture`] | values that vary over a surface |
 //! | [`bsdf`] | BSDFs, their lobes at a point, materials |
@@ -30,7 +31,7 @@
 //! | [`world`] | geometry, materials, lights and media together |
 //! | [`film`] | reconstruction filters, pixel sums and their error, the images written |
 //! | [`camera`] | perspective, thin-lens and orthographic cameras, the radiance, irradiance and distant meters, the batch of sensors, and the shutter |
-//! | [`integrator`] | the estimators: path, direct, distrib, volpath, volpathmis, moment, aov, depth, ptracer, bdpt, sppm |
+//! | [`integrator`] | the estimators: path, direct, distrib, volpath, volpathmis, moment, aov, depth, ptracer, bdpt, sppm, the polarized path tracer and stokes |
 //! | [`scene`] | the world with camera, film, sampler and integrator |
 //! | [`render`] | passes, tiles, threads, progress, render states |
 
@@ -49,6 +50,7 @@ pub mod integrator;
 pub mod light;
 pub mod math;
 pub mod medium;
+pub mod polarization;
 pub mod render;
 pub mod sampling;
 pub mod scene;

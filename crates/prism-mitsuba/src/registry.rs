@@ -191,6 +191,8 @@ impl Bounds {
         min_exclusive: false,
         max: 1.0,
     };
+    /// Any finite number.
+    pub const FINITE: Bounds = Bounds::between(f32::MIN, f32::MAX);
     /// At least 0 and finite.
     pub const FINITE_NON_NEGATIVE: Bounds = Bounds::between(0.0, f32::MAX);
 
@@ -206,6 +208,9 @@ impl Bounds {
     /// "in [0, 1]", "greater than 0", ...
     pub fn describe(&self) -> String {
         let (min, max) = (self.min, self.max);
+        if *self == Bounds::FINITE {
+            return "finite".into();
+        }
         match (self.min_exclusive, max < f32::MAX) {
             (true, true) => format!("in ({min}, {max}]"),
             (true, false) => format!("greater than {min}"),

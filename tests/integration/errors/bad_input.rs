@@ -269,6 +269,14 @@ fn cases() -> Vec<Case> {
             "finite",
         ),
         render_scene(
+            "NaN polarizer angle",
+            scene!(
+                "    <shape type=\"sphere\"><bsdf type=\"polarizer\"><float name=\"theta\" value=\"nan\"/></bsdf></shape>"
+            ),
+            "scene.xml:3:",
+            "not a finite number",
+        ),
+        render_scene(
             "degenerate lookat",
             scene!(
                 "    <shape type=\"sphere\"><transform name=\"to_world\"><lookat origin=\"1,1,1\" target=\"1,1,1\"/></transform></shape>"

@@ -12,13 +12,17 @@
 //! Its parameters and their defaults are listed in docs/plugins.md.
 //!
 //! A single specular lobe: `sample` returns the mirror direction with weight
-//! F(cos θ, η(λ), k(λ)) · specular_reflectance; nothing to evaluate. One-sided.
+//! F(cos θ, η(λ), k(λ)) · specular_reflectance; nothing to evaluate. One-sided. Rendered
+//! polarized, its Mueller matrix is that of Fresnel reflection
+//! ([`crate::polarization::fresnel::specular_reflection`]).
 
 use glam::{Vec2, Vec3};
 use wide::f32x4;
 
 use super::fresnel::{fresnel_conductor4, reflect_z};
 use super::{BsdfFlags, BsdfSample, Bxdf, BxdfTree, LeafBsdf};
+use crate::polarization::fresnel::{Complex, specular_reflection};
+use crate::polarization::{FrameChange, SampledMueller};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use crate::texture::TextureValues;
 use crate::texture::{Texture, TexturePoint};
@@ -57,6 +61,20 @@ impl ConductorIor {
             eta: eta.eval(at, lambda) * inv_ext,
             k: k.eval(at, lambda) * inv_ext,
         }
+    }
+
+    /// The Mueller matrix of reflection about the (micro)normal `m` at each wavelength, for
+    /// light arriving from `wi` and leaving along `wo` (local), between the implicit Stokes
+    /// bases of the two beams (Mitsuba's `conductor` and `roughconductor`).
+    pub fn mueller_reflection(&self, m: Vec3, wo: Vec3, wi: Vec3) -> SampledMueller {
+        let cos_theta = wi.dot(m);
+        let change = FrameChange::from_plane_of_incidence(m, -wi, wo);
+        SampledMueller::from_fn(|i| {
+            change.apply(specular_reflection(
+                cos_theta,
+                Complex::new(self.eta[i], self.k[i]),
+            ))
+        })
     }
 
     /// The Fresnel reflectance at cos θ for each wavelength.
@@ -100,5 +118,15 @@ impl Bxdf for ConductorLobes {
             1.0,
             Conductor::FLAGS,
         ))
+    }
+
+    fn mueller(
+        &self,
+        _tree: &BxdfTree,
+        wo: Vec3,
+        wi: Vec3,
+        _lobe: BsdfFlags,
+    ) -> Option<SampledMueller> {
+        Some(self.ior.mueller_reflection(Vec3::Z, wo, wi))
     }
 }

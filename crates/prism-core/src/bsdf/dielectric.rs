@@ -25,6 +25,8 @@ use glam::{Vec2, Vec3};
 
 use super::fresnel::{fresnel_dielectric, reflect_z, refract_z};
 use super::{BsdfFlags, BsdfSample, Bxdf, BxdfTree, LeafBsdf};
+use crate::polarization::fresnel::{Complex, specular_reflection, specular_transmission};
+use crate::polarization::{FrameChange, SampledMueller};
 use crate::spectrum::ior::RelativeIor;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use crate::texture::TextureValues;
@@ -196,5 +198,32 @@ impl Bxdf for DielectricLobes {
             eta: hero.eta_it,
             terminates_secondary: dispersive,
         })
+    }
+
+    /// Fresnel reflection or refraction, whichever takes light from `wi` to `wo` (Mitsuba's
+    /// `dielectric`).
+    fn mueller(
+        &self,
+        _tree: &BxdfTree,
+        wo: Vec3,
+        wi: Vec3,
+        _lobe: BsdfFlags,
+    ) -> Option<SampledMueller> {
+        let eta = &self.interface.eta;
+        let reflected = wi.z * wo.z > 0.0;
+        let change = FrameChange::from_plane_of_incidence(Vec3::Z, -wi, wo);
+        Some(SampledMueller::from_fn(|i| {
+            let eta = if eta.dispersive {
+                eta.eta[i]
+            } else {
+                eta.hero()
+            };
+            let m = if reflected {
+                specular_reflection(wi.z, Complex::real(eta))
+            } else {
+                specular_transmission(wi.z, eta)
+            };
+            change.apply(m)
+        }))
     }
 }

@@ -6,6 +6,7 @@
 use glam::{Vec2, Vec3};
 
 use super::{BsdfEval, BsdfFlags, BsdfSample, Bxdf, BxdfTree, choice_probability, mixture_sample};
+use crate::polarization::SampledMueller;
 use crate::sampling::warp::{cosine_hemisphere_pdf, sample_cosine_hemisphere};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use crate::texture::{Texture, TexturePoint, TextureValues};
@@ -64,6 +65,12 @@ pub trait GlossyDiffuseLobes {
     fn sample_glossy(&self, wo: Vec3, u: Vec2) -> Vec3;
     /// The density with which [`Self::sample_glossy`] draws wi.
     fn glossy_pdf(&self, wo: Vec3, wi: Vec3) -> f32;
+    /// [`Bxdf::mueller`] of both lobes, for wo and wi above the surface: None, a depolarizer,
+    /// unless the BSDF has a polarized model (`pplastic`).
+    fn mueller(&self, wo: Vec3, wi: Vec3) -> Option<SampledMueller> {
+        let _ = (wo, wi);
+        None
+    }
 }
 
 /// The density of wi when the glossy lobe is chosen with probability `p_glossy`.
@@ -110,5 +117,16 @@ impl<L: GlossyDiffuseLobes> Bxdf for L {
             mixture_pdf(self, wo, wi, p_glossy),
             flags,
         )
+    }
+
+    #[inline]
+    fn mueller(
+        &self,
+        _tree: &BxdfTree,
+        wo: Vec3,
+        wi: Vec3,
+        _lobe: BsdfFlags,
+    ) -> Option<SampledMueller> {
+        GlossyDiffuseLobes::mueller(self, wo, wi)
     }
 }

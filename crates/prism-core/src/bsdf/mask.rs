@@ -20,6 +20,7 @@ use super::{
     Adapter, Bsdf, BsdfEval, BsdfFlags, BsdfModel, BsdfSample, Bxdf, BxdfTree, NodeId,
     ResolveContext,
 };
+use crate::polarization::SampledMueller;
 use crate::spectrum::SampledSpectrum;
 use crate::texture::Texture;
 use crate::texture::TextureValues;
@@ -87,5 +88,20 @@ impl Bxdf for MaskLobes {
     fn null_transmission(&self, tree: &BxdfTree, wo: Vec3) -> SampledSpectrum {
         let nested = tree.null_transmission(self.nested, wo);
         SampledSpectrum::ONE - (SampledSpectrum::ONE - nested) * self.opacity
+    }
+
+    /// The pass-through keeps the polarization; the nested lobes give theirs.
+    fn mueller(
+        &self,
+        tree: &BxdfTree,
+        wo: Vec3,
+        wi: Vec3,
+        lobe: BsdfFlags,
+    ) -> Option<SampledMueller> {
+        if lobe.contains(BsdfFlags::NULL) && wi == -wo {
+            Some(SampledMueller::IDENTITY)
+        } else {
+            tree.mueller(self.nested, wo, wi, lobe)
+        }
     }
 }

@@ -1,6 +1,6 @@
 //! Materials, and the scattering at a path vertex that both integrators use.
 
-use glam::{Vec2, Vec3};
+use glam::{Mat4, Vec2, Vec3};
 
 use super::{
     Bsdf, BsdfEval, BsdfFlags, BsdfModel, BsdfSample, BxdfTree, NodeId, ResolveContext,
@@ -8,6 +8,7 @@ use super::{
 };
 use crate::geometry::SurfaceInteraction;
 use crate::math::Frame;
+use crate::polarization::{FrameChange, SampledMueller};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 
 /// What a surface is made of: a BSDF for the front (the side of the shading normal) and, for
@@ -115,6 +116,13 @@ impl Material {
             .null_transmission()
     }
 
+    /// Whether a BSDF of either side, or one nested in it, is a polarizing element
+    /// ([`BsdfFlags::POLARIZING`]).
+    pub fn is_polarizing(&self) -> bool {
+        let polarizing = |bsdf: &Bsdf| bsdf.flags().contains(BsdfFlags::POLARIZING);
+        polarizing(&self.front) || self.back.as_ref().is_some_and(polarizing)
+    }
+
     /// The most [`BxdfTree`] nodes either side takes.
     pub fn node_count(&self) -> usize {
         let back = self.back.as_ref().map_or(0, Bsdf::node_count);
@@ -185,6 +193,27 @@ impl<'t, 'm> Scattering<'t, 'm> {
     #[inline]
     pub fn null_transmission(&self) -> SampledSpectrum {
         self.tree.null_transmission(self.root, self.wo)
+    }
+
+    /// For polarized rendering: the Mueller matrix of the lobe `lobe` (a sample's flags, or
+    /// [`BsdfFlags::NONE`] for the smooth lobes) for light arriving from `wi` (world space),
+    /// from the implicit Stokes basis of the incident beam to that of the outgoing one, world
+    /// directions, with M₀₀ equal to `value`, the unpolarized value that eval or sample gave
+    /// (a depolarizer for BSDFs without a polarized model; see [`super::Bxdf::mueller`]).
+    pub fn polarized(&self, wi: Vec3, lobe: BsdfFlags, value: SampledSpectrum) -> SampledMueller {
+        let wi = self.frame.to_local(wi);
+        let Some(local) = self.tree.mueller(self.root, self.wo, wi, lobe) else {
+            return SampledMueller::depolarizer(value);
+        };
+        let change = FrameChange::local_to_world(&self.frame, -wi, self.wo);
+        SampledMueller::from_fn(|i| {
+            let m00 = local.0[i].x_axis.x;
+            if m00 > 0.0 && m00.is_finite() {
+                change.apply(local.0[i]) * (value[i] / m00)
+            } else {
+                Mat4::ZERO
+            }
+        })
     }
 
     /// Draws an incident direction: `u_lobe` chooses a lobe, `u` the direction within it; the

@@ -54,6 +54,9 @@
 //! | `coateddiffuse`, `coatedconductor` | [`layered`] | reflection by a random walk through a coating (pbrt-v4's) |
 //! | `hair` | [`hair`] | glossy scattering around a fibre (reflection and transmission) |
 //! | `measured` | [`measured`] | glossy reflection, tabulated (RGL database) |
+//! | `polarizer` | [`polarizer`] | null transmission through a linear polarizer |
+//! | `retarder` | [`retarder`] | null transmission through a linear retarder (a wave plate) |
+//! | `circular` | [`circular`] | null transmission through a circular polarizer |
 //! | `twosided` | [`twosided`] | those of the nested BSDFs, on both sides |
 //! | `mask` | [`mask`] | the nested BSDF's, and null transmission |
 //! | `null` | [`null`] | null transmission only (a medium's boundary) |
@@ -63,6 +66,7 @@
 pub mod blend;
 pub mod bumpmap;
 pub mod burley;
+pub mod circular;
 pub mod conductor;
 pub mod dielectric;
 pub mod diffuse;
@@ -81,9 +85,11 @@ pub mod null;
 pub mod perturbed;
 pub mod phong;
 pub mod plastic;
+pub mod polarizer;
 pub mod pplastic;
 pub mod principled;
 pub mod principledthin;
+pub mod retarder;
 pub mod roughconductor;
 pub mod roughdielectric;
 pub mod roughdiffuse;
@@ -97,6 +103,7 @@ use glam::{Vec2, Vec3};
 
 pub use blend::Blend;
 pub use bumpmap::BumpMap;
+pub use circular::Circular;
 pub use conductor::Conductor;
 pub use dielectric::Dielectric;
 pub use diffuse::Diffuse;
@@ -110,9 +117,11 @@ pub use normalmap::NormalMap;
 pub use null::Null;
 pub use phong::Phong;
 pub use plastic::Plastic;
+pub use polarizer::Polarizer;
 pub use pplastic::PolarizedPlastic;
 pub use principled::Principled;
 pub use principledthin::PrincipledThin;
+pub use retarder::Retarder;
 pub use roughconductor::RoughConductor;
 pub use roughdielectric::RoughDielectric;
 pub use roughdiffuse::RoughDiffuse;
@@ -123,6 +132,7 @@ pub use ward::{Ward, WardVariant};
 
 use crate::geometry::interaction::AttributeValues;
 use crate::math::Frame;
+use crate::polarization::SampledMueller;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use crate::texture::TexturePoint;
 
@@ -142,6 +152,9 @@ impl BsdfFlags {
     /// BSDF, the transparent part of `mask`, the transmission of `thindielectric`); a delta lobe
     /// too.
     pub const NULL: BsdfFlags = BsdfFlags(32);
+    /// The BSDF changes the polarization of light in a way an unpolarized render cannot show
+    /// (`polarizer`, `retarder`, `circular`): a scene with one renders polarized.
+    pub const POLARIZING: BsdfFlags = BsdfFlags(64);
     pub const REFLECTION: BsdfFlags = BsdfFlags(8);
     pub const TRANSMISSION: BsdfFlags = BsdfFlags(16);
 
@@ -408,6 +421,23 @@ pub trait Bxdf {
         let _ = (tree, wo);
         SampledSpectrum::ZERO
     }
+    /// For polarized rendering: the Mueller matrix of f(wo, wi)·|cos θi| of the lobe `lobe`
+    /// (a sample's flags, or [`BsdfFlags::NONE`] for the smooth lobes that light sampling
+    /// evaluates), up to a positive factor per wavelength, from the implicit Stokes basis of the
+    /// incident beam (travelling along −wi) to that of the outgoing one (along wo), local
+    /// directions, as Mitsuba 3's polarized BSDFs return it; the integrator scales its M₀₀ to
+    /// the unpolarized value. A BSDF without a polarized model keeps this default, None: it
+    /// depolarizes, as Mitsuba's do.
+    fn mueller(
+        &self,
+        tree: &BxdfTree,
+        wo: Vec3,
+        wi: Vec3,
+        lobe: BsdfFlags,
+    ) -> Option<SampledMueller> {
+        let _ = (tree, wo, wi, lobe);
+        None
+    }
 }
 
 /// Index of a node in a [`BxdfTree`].
@@ -463,6 +493,18 @@ impl<'a> BxdfTree<'a> {
     #[inline]
     pub fn null_transmission(&self, id: NodeId, wo: Vec3) -> SampledSpectrum {
         self.nodes[id as usize].null_transmission(self, wo)
+    }
+
+    /// [`Bxdf::mueller`] of node `id`.
+    #[inline]
+    pub fn mueller(
+        &self,
+        id: NodeId,
+        wo: Vec3,
+        wi: Vec3,
+        lobe: BsdfFlags,
+    ) -> Option<SampledMueller> {
+        self.nodes[id as usize].mueller(self, wo, wi, lobe)
     }
 }
 
@@ -568,6 +610,13 @@ macro_rules! bsdfs {
                     $(Node::$node(b) => b.null_transmission(tree, wo),)+
                 }
             }
+
+            #[inline]
+            fn mueller(&self, tree: &BxdfTree, wo: Vec3, wi: Vec3, lobe: BsdfFlags) -> Option<SampledMueller> {
+                match self {
+                    $(Node::$node(b) => b.mueller(tree, wo, wi, lobe),)+
+                }
+            }
         }
 
         $(impl<'a> From<$lobes> for Node<'a> {
@@ -655,6 +704,9 @@ bsdfs! {
         Null(Null),
         Hair(Hair),
         Measured(Measured),
+        Polarizer(Polarizer),
+        Retarder(Retarder),
+        Circular(Circular),
     }
     adapters {
         TwoSided(TwoSided),
@@ -687,5 +739,8 @@ bsdfs! {
         Null(null::NullLobes),
         Hair(hair::HairLobes<'a>),
         Measured(measured::MeasuredLobes<'a>),
+        Polarizer(polarizer::PolarizerLobes),
+        Retarder(retarder::RetarderLobes),
+        Circular(circular::CircularLobes),
     }
 }

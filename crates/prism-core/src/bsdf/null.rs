@@ -14,6 +14,7 @@
 use glam::{Vec2, Vec3};
 
 use super::{BsdfFlags, BsdfSample, Bxdf, BxdfTree, LeafBsdf};
+use crate::polarization::SampledMueller;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use crate::texture::TexturePoint;
 
@@ -43,5 +44,16 @@ impl Bxdf for NullLobes {
     /// All light passes.
     fn null_transmission(&self, _tree: &BxdfTree, _wo: Vec3) -> SampledSpectrum {
         SampledSpectrum::ONE
+    }
+
+    /// Polarization passes unchanged too (Mitsuba's `null` is the identity, not a depolarizer).
+    fn mueller(
+        &self,
+        _tree: &BxdfTree,
+        _wo: Vec3,
+        _wi: Vec3,
+        _lobe: BsdfFlags,
+    ) -> Option<SampledMueller> {
+        Some(SampledMueller::IDENTITY)
     }
 }

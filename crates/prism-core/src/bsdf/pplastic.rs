@@ -1,7 +1,8 @@
-//! Mitsuba 3's `pplastic` BSDF in its unpolarised form: a rough specular reflection added to a
-//! diffuse base seen through two smooth refractions (after Baek et al. 2018, "Simultaneous
-//! Acquisition of Polarimetric SVBRDF and Normals", as Mitsuba's `pplastic.cpp` evaluates it
-//! for unpolarised light).
+//! Mitsuba 3's `pplastic` BSDF: a rough specular reflection added to a diffuse base seen
+//! through two smooth refractions (after Baek et al. 2018, "Simultaneous Acquisition of
+//! Polarimetric SVBRDF and Normals", as Mitsuba's `pplastic.cpp` evaluates it). Below its
+//! unpolarised form; rendered polarized, its Mueller matrix is Mitsuba's polarized one
+//! ([`GlossyDiffuseLobes::mueller`]).
 //!
 //! ```xml
 //! <bsdf type="pplastic">
@@ -27,13 +28,16 @@
 
 use std::f32::consts::FRAC_1_PI;
 
-use glam::{Vec2, Vec3};
+use glam::{Mat4, Vec2, Vec3};
 
 use super::dielectric::optional_factor;
 use super::fresnel::{fresnel_dielectric, reflect};
 use super::glossydiffuse::{GLOSSY_OVER_DIFFUSE, GlossyDiffuseLobes};
 use super::microfacet::{Microfacet, MicrofacetRoughness};
 use super::{BsdfFlags, LeafBsdf, choice_probability};
+use crate::polarization::fresnel::{Complex, specular_reflection, specular_transmission};
+use crate::polarization::mueller::depolarizer;
+use crate::polarization::{FrameChange, SampledMueller};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use crate::texture::Texture;
 use crate::texture::TexturePoint;
@@ -99,6 +103,30 @@ impl GlossyDiffuseLobes for PolarizedPlasticLobes {
         specular + self.diffuse * (t_o * t_i * wi.z * FRAC_1_PI)
     }
 
+    /// Mitsuba's polarized `pplastic`: the specular part Fresnel reflection about the half
+    /// vector; the base, light refracted in (T at wi), depolarized by ρ and refracted out (T at
+    /// the inner angle of wo, with 1/η), in the frame of the plane of incidence.
+    fn mueller(&self, wo: Vec3, wi: Vec3) -> Option<SampledMueller> {
+        let h = (wo + wi).normalize();
+        let d = self.distribution.d(h);
+        let glossy = if d > 0.0 && h.is_finite() {
+            let scale = d * self.distribution.g(wo, wi, h) / (4.0 * wo.z);
+            let change = FrameChange::from_plane_of_incidence(h, -wi, wo);
+            change.apply(specular_reflection(wi.dot(h), Complex::real(self.eta))) * scale
+        } else {
+            Mat4::ZERO
+        };
+        let inward = specular_transmission(wi.z.abs(), self.eta);
+        let cos_inner = fresnel_dielectric(wo.z, self.eta).cos_theta_t.abs();
+        let outward = specular_transmission(cos_inner, 1.0 / self.eta);
+        let base = FrameChange::from_plane_of_incidence(Vec3::Z, -wi, wo)
+            .apply(outward * depolarizer(1.0) * inward)
+            * (wi.z * FRAC_1_PI);
+        Some(SampledMueller::from_fn(|i| {
+            glossy * self.specular[i] + base * self.diffuse[i]
+        }))
+    }
+
     #[inline]
     fn glossy_probability(&self, _wo: Vec3) -> f32 {
         self.p_specular
@@ -117,6 +145,48 @@ impl GlossyDiffuseLobes for PolarizedPlasticLobes {
             self.distribution.pdf_visible(wo, h) / (4.0 * cos_oh)
         } else {
             0.0
+        }
+    }
+}
+
+#[cfg(test)]
+mod polarized_tests {
+    use super::*;
+    use crate::bsdf::microfacet::MicrofacetKind;
+    use crate::sampling::rng::Pcg32;
+    use crate::sampling::warp::sample_cosine_hemisphere;
+
+    /// The polarized model's M₀₀ is the unpolarized value, so that a polarized render's S₀
+    /// carries the same energy; and it never turns unpolarized light into more than fully
+    /// polarized light.
+    #[test]
+    fn the_first_element_is_the_unpolarized_value() {
+        let lobes = PolarizedPlasticLobes {
+            eta: 1.49,
+            distribution: Microfacet::new(MicrofacetKind::Ggx, 0.2, 0.2),
+            diffuse: SampledSpectrum([0.1, 0.4, 0.7, 0.9]),
+            specular: SampledSpectrum([1.0, 0.8, 1.0, 0.6]),
+            p_specular: 0.5,
+        };
+        let mut rng = Pcg32::seeded(5);
+        for _ in 0..500 {
+            let wo = sample_cosine_hemisphere(Vec2::new(rng.next_f32(), rng.next_f32()));
+            let wi = sample_cosine_hemisphere(Vec2::new(rng.next_f32(), rng.next_f32()));
+            let value = GlossyDiffuseLobes::value(&lobes, wo, wi);
+            let m = GlossyDiffuseLobes::mueller(&lobes, wo, wi).unwrap();
+            for i in 0..4 {
+                let m00 = m.0[i].x_axis.x;
+                assert!(
+                    (m00 - value[i]).abs() <= 1e-4 * value[i].max(1e-3),
+                    "{m00} {}",
+                    value[i]
+                );
+                let s = m.0[i].x_axis;
+                assert!(
+                    Vec3::new(s.y, s.z, s.w).length() <= s.x * (1.0 + 1e-4),
+                    "{s}"
+                );
+            }
         }
     }
 }

@@ -24,6 +24,7 @@ use super::conductor::ConductorIor;
 use super::fresnel::reflect;
 use super::microfacet::{Microfacet, MicrofacetRoughness};
 use super::{BsdfEval, BsdfFlags, BsdfSample, Bxdf, BxdfTree, LeafBsdf};
+use crate::polarization::SampledMueller;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use crate::texture::Texture;
 use crate::texture::TexturePoint;
@@ -103,5 +104,18 @@ impl Bxdf for RoughConductorLobes {
         let f = self.ior.reflectance(cos_om);
         let weight = f * self.specular_reflectance * self.distribution.g1(wi, m);
         Some(BsdfSample::new(wi, weight, pdf, RoughConductor::FLAGS))
+    }
+
+    /// Fresnel reflection about the half vector (Mitsuba's `roughconductor`).
+    fn mueller(
+        &self,
+        _tree: &BxdfTree,
+        wo: Vec3,
+        wi: Vec3,
+        _lobe: BsdfFlags,
+    ) -> Option<SampledMueller> {
+        let h = (wo + wi).normalize();
+        h.is_finite()
+            .then(|| self.ior.mueller_reflection(h, wo, wi))
     }
 }

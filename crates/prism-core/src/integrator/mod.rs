@@ -15,6 +15,10 @@
 //! dispersion rule, the depth limit, Russian roulette, hero-only estimates), [`mis`] (light
 //! sampling with a hook for what shadow rays cross, and the emission a sampled direction finds,
 //! weighed against it) and, for media, [`transmittance`].
+//!
+//! A scene with a polarizing element or the `stokes` integrator gets [`polarized_path`] in place
+//! of `path`: the same estimator with a Mueller matrix per wavelength for a throughput, in its
+//! own file, so that unpolarized scenes run the path tracer's code unchanged.
 
 pub mod aov;
 pub mod bdpt;
@@ -25,8 +29,10 @@ pub mod distribution;
 pub mod mis;
 pub mod moment;
 pub mod path;
+pub mod polarized_path;
 pub mod ptracer;
 pub mod sppm;
+pub mod stokes;
 pub mod transmittance;
 pub mod vertex;
 pub mod volpath;
@@ -40,8 +46,10 @@ pub use direct::DirectIntegrator;
 pub use distribution::DistributionIntegrator;
 pub use moment::MomentIntegrator;
 pub use path::PathIntegrator;
+pub use polarized_path::PolarizedPathIntegrator;
 pub use ptracer::{LightPathSample, ParticleTracer, Splat};
 pub use sppm::SppmIntegrator;
+pub use stokes::StokesIntegrator;
 pub use volpath::{Tracking, VolPathIntegrator};
 
 use volpath::SpectralTracking;
@@ -89,6 +97,8 @@ integrator_enum! {
         Particle(ParticleTracer),
         Bdpt(BdptIntegrator),
         Sppm(SppmIntegrator),
+        PolarizedPath(PolarizedPathIntegrator),
+        Stokes(StokesIntegrator),
     }
 }
 
@@ -112,6 +122,8 @@ impl Integrator {
             Integrator::Direct(_) => LightSelection::Exhaustive,
             Integrator::Distribution(distrib) => distrib.light_selection(),
             Integrator::VolPath(volpath) => volpath.light_selection,
+            Integrator::PolarizedPath(polarized) => polarized.light_selection(),
+            Integrator::Stokes(stokes) => stokes.nested.light_selection(),
             Integrator::Moment(_)
             | Integrator::Aov(_)
             | Integrator::Depth(_)
@@ -133,7 +145,9 @@ impl Integrator {
             | Integrator::Depth(_)
             | Integrator::Particle(_)
             | Integrator::Bdpt(_)
-            | Integrator::Sppm(_) => &[],
+            | Integrator::Sppm(_)
+            | Integrator::PolarizedPath(_)
+            | Integrator::Stokes(_) => &[],
         };
         nested.iter().map(|(_, integrator)| integrator)
     }
@@ -149,6 +163,8 @@ impl Integrator {
             Integrator::Particle(ptracer) => ptracer.hide_emitters,
             Integrator::Bdpt(bdpt) => bdpt.hide_emitters,
             Integrator::Sppm(_) => false,
+            Integrator::PolarizedPath(polarized) => polarized.path.hide_emitters,
+            Integrator::Stokes(stokes) => stokes.nested.path.hide_emitters,
             Integrator::Moment(_) | Integrator::Aov(_) => match self.nested().next() {
                 Some(first) => first.hides_emitters(),
                 None => true,
@@ -175,8 +191,10 @@ impl Integrator {
             | Integrator::Depth(_)
             | Integrator::Particle(_)
             | Integrator::Bdpt(_)
-            | Integrator::Sppm(_) => Vec::new(),
+            | Integrator::Sppm(_)
+            | Integrator::PolarizedPath(_) => Vec::new(),
             Integrator::Moment(moment) => moment.aov_names(),
+            Integrator::Stokes(stokes) => stokes.aov_names(),
             Integrator::Aov(aov) => aov.aov_names(),
         }
     }
@@ -307,6 +325,8 @@ impl PreparedIntegrator<'_> {
             Integrator::Moment(_) => MomentIntegrator::radiance(ctx, ray, lambda, aovs),
             Integrator::Aov(integrator) => integrator.radiance(ctx, ray, lambda, aovs),
             Integrator::Depth(_) => DepthIntegrator::radiance(ctx, &ray),
+            Integrator::PolarizedPath(integrator) => integrator.radiance(ctx, ray, lambda),
+            Integrator::Stokes(integrator) => integrator.radiance(ctx, ray, lambda, aovs),
             // Light subpaths reach the film by splats, not along camera rays: the render driver
             // runs them ([`Self::trace_light_paths`], [`Self::trace_bidirectional`]), and
             // photon mapping's passes run apart ([`Self::sppm`]).

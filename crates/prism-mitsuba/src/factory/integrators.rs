@@ -1,20 +1,25 @@
 //! Integrator plugins: `path` (with Prism's `emitter_sampling`, see
 //! [`prism_core::light::sampler`]), `direct`, `moment`, `aov`, the lecture's `distrib`, and
 //! `volpath` and `volpathmis` for media, `ptracer`, the particle tracer, Mitsuba 0.6's
-//! `bdpt`, bidirectional path tracing, and `sppm`, stochastic progressive photon mapping.
+//! `bdpt`, bidirectional path tracing, `sppm`, stochastic progressive photon mapping, and
+//! `stokes`, the polarized path tracer's Stokes vectors (a scene with a polarizing BSDF gets
+//! the polarized path tracer in place of `path`: [`polarized_where_needed`]).
+
+use glam::Vec3;
 
 use crate::description::{PluginClass, PluginNode, Warning};
 use crate::params::Params;
 use crate::registry::{Choice, Default, Origin, ParamKind, ParamSpec, Plugin, Registry, params};
 use crate::suggest::closest_match;
+use prism_core::camera::Camera;
 use prism_core::error::{Error, Result, SourceLocation};
 use prism_core::film::output::IMAGE_CHANNELS;
 use prism_core::integrator::aov::{Aov, AovKind};
 use prism_core::integrator::distribution::DirectLights;
 use prism_core::integrator::{
     AovIntegrator, BdptIntegrator, DepthIntegrator, DirectIntegrator, DistributionIntegrator,
-    Integrator, MomentIntegrator, ParticleTracer, PathIntegrator, SppmIntegrator, Tracking,
-    VolPathIntegrator,
+    Integrator, MomentIntegrator, ParticleTracer, PathIntegrator, PolarizedPathIntegrator,
+    SppmIntegrator, StokesIntegrator, Tracking, VolPathIntegrator,
 };
 use prism_core::light::{Light, LightSelection};
 
@@ -78,6 +83,16 @@ pub static INTEGRATORS: Registry<Build> = Registry {
                       (0 where it leaves the scene), as a constant spectrum.",
             params: &[],
             build: |_| Ok(Integrator::Depth(DepthIntegrator)),
+        },
+        Plugin {
+            name: "stokes",
+            origin: Origin::Mitsuba3,
+            summary: "Renders its nested `path` integrator polarized and writes the Stokes \
+                      vector at the sensor as the EXR channels S0.R, S0.G, S0.B, … S3.B (each \
+                      component as linear sRGB, in the sensor's frame, as Mitsuba 3); the \
+                      image is S0, the intensity.",
+            params: &[NESTED_POLARIZED],
+            build: build_stokes,
         },
         Plugin {
             name: "distrib",
@@ -189,6 +204,7 @@ params! {
     EMITTER_SAMPLES = ParamSpec::new("emitter_samples", ParamKind::Integer, Default::Text("shading_samples"), "light samples per camera ray");
     BSDF_SAMPLES = ParamSpec::new("bsdf_samples", ParamKind::Integer, Default::Text("shading_samples"), "BSDF samples per camera ray");
     NESTED_INTEGRATORS = ParamSpec::nested(PluginClass::Integrator, Default::Required, "the integrators whose moments are recorded (at least one), in order");
+    NESTED_POLARIZED = ParamSpec::nested(PluginClass::Integrator, Default::Required, "the integrator rendered polarized: `path` (Prism's only polarized estimator)");
     NESTED_IMAGE_INTEGRATORS = ParamSpec::nested(PluginClass::Integrator, Default::Text("none (a black image)"), "the integrators whose images are written beside the variables, in order");
     AOVS = ParamSpec::new("aovs", ParamKind::String, Default::Required, "comma-separated name:type pairs, e.g. \"dd.y:depth,nn:sh_normal,alb:albedo\"");
     BOUNCE_SAMPLES = ParamSpec::new("bounce_samples", ParamKind::Integer, Default::Integer(4), "bounce samples at potential 1 (1 to 1024)");
@@ -233,6 +249,66 @@ pub fn check_channel_names(integrator: &Integrator, location: &SourceLocation) -
         ))),
         None => Ok(()),
     }
+}
+
+/// `stokes`: its one nested integrator, which must be `path`, rendered polarized.
+fn build_stokes(params: &Params) -> Result<Integrator> {
+    let nested = params.children(&NESTED_POLARIZED);
+    let [child] = nested.as_slice() else {
+        return Err(Error::input(
+            params.location(),
+            format!(
+                "the stokes integrator needs exactly one nested integrator, found {}",
+                nested.len()
+            ),
+        )
+        .with_help("nest the integrator to render polarized: <integrator type=\"path\"/>"));
+    };
+    let Integrator::Path(path) = build_integrator(&child.node)? else {
+        return Err(Error::input(
+            &child.location,
+            format!(
+                "Prism renders only `path` polarized, so {} cannot be nested in \"stokes\"",
+                child.node.describe()
+            ),
+        )
+        .with_help("nest <integrator type=\"path\"/> (volpath without media renders the same)"));
+    };
+    Ok(Integrator::Stokes(StokesIntegrator {
+        nested: PolarizedPathIntegrator { path },
+        sensor_up: Vec3::Y,
+    }))
+}
+
+/// The integrator a scene renders with: `path` becomes the polarized path tracer where the
+/// scene holds a polarizing BSDF (`polarizing`), as Mitsuba's polarized variants render it;
+/// any other integrator is kept.
+pub fn polarized_where_needed(integrator: Integrator, polarizing: bool) -> Integrator {
+    match integrator {
+        Integrator::Path(path) if polarizing => {
+            Integrator::PolarizedPath(PolarizedPathIntegrator { path })
+        }
+        other => other,
+    }
+}
+
+/// Gives the `stokes` integrator the up direction of the sensor it renders through, which
+/// its Stokes frame follows.
+pub fn aim_stokes(integrator: &mut Integrator, camera: &Camera) {
+    let Integrator::Stokes(stokes) = integrator else {
+        return;
+    };
+    let to_world = match camera {
+        Camera::Perspective(c) => c.to_world.at(0.0),
+        Camera::Orthographic(c) => c.to_world.at(0.0),
+        Camera::RadianceMeter(c) => c.to_world.at(0.0),
+        Camera::Distant(c) => c.to_world,
+        Camera::IrradianceMeter(_) | Camera::Batch(_) => {
+            stokes.sensor_up = Vec3::Y;
+            return;
+        }
+    };
+    stokes.sensor_up = to_world.vector(Vec3::Y).normalize();
 }
 
 /// `max_depth`: −1 (unbounded) or at least 0.

@@ -555,6 +555,9 @@ impl SceneBuilder {
         }
         let first = sensors[0].clone();
         world.camera_medium = first.medium;
+        let polarizing = world.materials.iter().any(|m| m.is_polarizing());
+        let mut integrator = integrators::polarized_where_needed(integrator, polarizing);
+        integrators::aim_stokes(&mut integrator, &first.camera);
         let mut scene = Scene::new(world, first.camera, first.film, first.sampler, integrator);
         scene.shutter = first.shutter;
         scene.exr_output = first.exr_output;

@@ -102,6 +102,7 @@ impl LoadedScene {
         let reconstruction =
             (film.reconstruction != previous.reconstruction).then_some(film.reconstruction);
         let sensor = self.sensors[index].clone();
+        super::integrators::aim_stokes(&mut self.scene.integrator, &sensor.camera);
         self.scene.camera = sensor.camera;
         self.scene.shutter = sensor.shutter;
         self.scene.film = sensor.film;

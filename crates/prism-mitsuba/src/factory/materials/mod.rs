@@ -31,6 +31,7 @@ mod layered;
 mod measured;
 mod microfacet;
 mod plastic;
+mod polarizing;
 mod principled;
 
 use crate::description::{PluginClass, PluginNode};
@@ -67,6 +68,9 @@ pub static BSDFS: Registry<Build> = Registry {
         layered::COATEDCONDUCTOR,
         hair::HAIR,
         measured::MEASURED,
+        polarizing::POLARIZER,
+        polarizing::RETARDER,
+        polarizing::CIRCULAR,
         adapters::TWOSIDED,
         adapters::MASK,
         adapters::NULL,
