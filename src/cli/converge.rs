@@ -94,6 +94,7 @@ fn integrator_named(name: &str, scene: &Scene) -> Result<Integrator> {
         Integrator::Particle(p) => p.max_depth,
         Integrator::Bdpt(b) => b.max_depth,
         Integrator::Sppm(s) => s.max_depth,
+        Integrator::Guided(g) => g.max_depth,
         Integrator::Moment(_) | Integrator::Aov(_) | Integrator::Depth(_) => -1,
     };
     let defaults: Integrator = match name {
@@ -164,6 +165,7 @@ fn integrator_label(integrator: &Integrator) -> &'static str {
         Integrator::Particle(_) => "ptracer",
         Integrator::Bdpt(_) => "bdpt",
         Integrator::Sppm(_) => "sppm",
+        Integrator::Guided(_) => "guided_path",
     }
 }
 

@@ -647,6 +647,13 @@ fn trace_pixel(
         )
         .with_help("render a --crop around the pixel instead"));
     }
+    if matches!(scene.integrator, Integrator::Guided(_)) {
+        return Err(Error::usage(
+            "--pixel prints a pixel's camera samples, and guided_path's depend on what the \
+             whole image taught its SD-tree",
+        )
+        .with_help("render a --crop around the pixel instead"));
+    }
     let mut sampler = Sampler::new(scene.sampler.kind, strata, seed);
     let mut count = RayCount::default();
     let mut sums = PixelSums::default();

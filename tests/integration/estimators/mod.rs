@@ -1,6 +1,6 @@
 //! The integrators' estimators against closed forms and against each other, their error, and
-//! the `aov` and `moment` integrators, the particle tracer, bidirectional path tracing and
-//! photon mapping.
+//! the `aov` and `moment` integrators, the particle tracer, bidirectional path tracing, photon
+//! mapping and path guiding.
 
 mod aov;
 mod bdpt;
@@ -8,6 +8,7 @@ mod closed_form;
 mod convergence;
 mod depth;
 mod direct;
+mod guided;
 mod moment;
 mod ptracer;
 mod sppm;

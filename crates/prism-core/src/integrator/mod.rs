@@ -3,7 +3,8 @@
 //! tracers; `moment` runs nested integrators and writes their estimates and second moments as
 //! extra film channels, `aov` the albedo, normals, depth and other variables of the first hit
 //! beside nested integrators' images. `ptracer` and `sppm` start paths at the lights too; the
-//! render driver runs their passes.
+//! render driver runs their passes, and the iterations of `guided_path`, the path tracer that
+//! learns where light comes from.
 //!
 //! An [`Integrator`] is what a scene asks for: an estimator and its parameters. Before a render
 //! it is prepared for the world ([`Integrator::prepare`]), which builds the light sampler it
@@ -26,6 +27,7 @@ pub mod context;
 pub mod depth;
 pub mod direct;
 pub mod distribution;
+pub mod guided;
 pub mod mis;
 pub mod moment;
 pub mod path;
@@ -44,6 +46,7 @@ pub use context::{RayCount, SampleContext};
 pub use depth::DepthIntegrator;
 pub use direct::DirectIntegrator;
 pub use distribution::DistributionIntegrator;
+pub use guided::GuidedPathIntegrator;
 pub use moment::MomentIntegrator;
 pub use path::PathIntegrator;
 pub use polarized_path::PolarizedPathIntegrator;
@@ -99,6 +102,7 @@ integrator_enum! {
         Sppm(SppmIntegrator),
         PolarizedPath(PolarizedPathIntegrator),
         Stokes(StokesIntegrator),
+        Guided(GuidedPathIntegrator),
     }
 }
 
@@ -130,6 +134,7 @@ impl Integrator {
             | Integrator::Particle(_)
             | Integrator::Bdpt(_)
             | Integrator::Sppm(_) => LightSelection::Power,
+            Integrator::Guided(_) => LightSelection::Exhaustive,
         }
     }
 
@@ -147,7 +152,9 @@ impl Integrator {
             | Integrator::Bdpt(_)
             | Integrator::Sppm(_)
             | Integrator::PolarizedPath(_)
-            | Integrator::Stokes(_) => &[],
+            | Integrator::Stokes(_)
+
+            | Integrator::Guided(_) => &[],
         };
         nested.iter().map(|(_, integrator)| integrator)
     }
@@ -165,6 +172,7 @@ impl Integrator {
             Integrator::Sppm(_) => false,
             Integrator::PolarizedPath(polarized) => polarized.path.hide_emitters,
             Integrator::Stokes(stokes) => stokes.nested.path.hide_emitters,
+            Integrator::Guided(guided) => guided.hide_emitters,
             Integrator::Moment(_) | Integrator::Aov(_) => match self.nested().next() {
                 Some(first) => first.hides_emitters(),
                 None => true,
@@ -192,7 +200,9 @@ impl Integrator {
             | Integrator::Particle(_)
             | Integrator::Bdpt(_)
             | Integrator::Sppm(_)
-            | Integrator::PolarizedPath(_) => Vec::new(),
+            | Integrator::PolarizedPath(_)
+
+            | Integrator::Guided(_) => Vec::new(),
             Integrator::Moment(moment) => moment.aov_names(),
             Integrator::Stokes(stokes) => stokes.aov_names(),
             Integrator::Aov(aov) => aov.aov_names(),
@@ -231,6 +241,15 @@ impl PreparedIntegrator<'_> {
     pub fn sppm(&self) -> Option<&SppmIntegrator> {
         match self.integrator {
             Integrator::Sppm(sppm) => Some(sppm),
+            _ => None,
+        }
+    }
+
+    /// The guided path tracer, where the integrator is it: the render driver runs its
+    /// iterations, which learn the SD-tree its paths sample from.
+    pub fn guided(&self) -> Option<&GuidedPathIntegrator> {
+        match self.integrator {
+            Integrator::Guided(guided) => Some(guided),
             _ => None,
         }
     }
@@ -329,10 +348,12 @@ impl PreparedIntegrator<'_> {
             Integrator::Stokes(integrator) => integrator.radiance(ctx, ray, lambda, aovs),
             // Light subpaths reach the film by splats, not along camera rays: the render driver
             // runs them ([`Self::trace_light_paths`], [`Self::trace_bidirectional`]), and
-            // photon mapping's passes run apart ([`Self::sppm`]).
-            Integrator::Particle(_) | Integrator::Bdpt(_) | Integrator::Sppm(_) => {
-                SampledSpectrum::ZERO
-            }
+            // photon mapping's passes and path guiding's iterations run apart ([`Self::sppm`],
+            // [`Self::guided`]).
+            Integrator::Particle(_)
+            | Integrator::Bdpt(_)
+            | Integrator::Sppm(_)
+            | Integrator::Guided(_) => SampledSpectrum::ZERO,
             Integrator::VolPath(integrator) => match integrator.tracking {
                 Tracking::Spectral => integrator.trace(SpectralTracking::new(), ctx, ray, lambda),
                 Tracking::HeroMis { spectral_mis } => {

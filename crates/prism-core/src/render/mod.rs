@@ -23,6 +23,7 @@
 
 mod estimator;
 mod filter_mis;
+mod guided;
 mod lanes;
 mod options;
 mod particles;
@@ -161,6 +162,17 @@ pub fn render_with_preview(
         return sppm::render(
             scene,
             sppm,
+            &estimator,
+            &options,
+            &pool,
+            checkpoints,
+            preview,
+        );
+    }
+    if let Some(guided) = estimator.integrator.guided() {
+        return guided::render(
+            scene,
+            guided,
             &estimator,
             &options,
             &pool,

@@ -1,7 +1,8 @@
 //! Integrator plugins: `path` (with Prism's `emitter_sampling`, see
 //! [`prism_core::light::sampler`]), `direct`, `moment`, `aov`, the lecture's `distrib`, and
 //! `volpath` and `volpathmis` for media, `ptracer`, the particle tracer, Mitsuba 0.6's
-//! `bdpt`, bidirectional path tracing, `sppm`, stochastic progressive photon mapping, and
+//! `bdpt`, bidirectional path tracing, `sppm`, stochastic progressive photon mapping,
+//! `guided_path`, Müller et al.'s practical path guiding (their Mitsuba 0.6 plugin), and
 //! `stokes`, the polarized path tracer's Stokes vectors (a scene with a polarizing BSDF gets
 //! the polarized path tracer in place of `path`: [`polarized_where_needed`]).
 
@@ -16,10 +17,11 @@ use prism_core::error::{Error, Result, SourceLocation};
 use prism_core::film::output::IMAGE_CHANNELS;
 use prism_core::integrator::aov::{Aov, AovKind};
 use prism_core::integrator::distribution::DirectLights;
+use prism_core::integrator::guided::{Budget, NextEvent, SampleCombination, SpatialFilter};
 use prism_core::integrator::{
     AovIntegrator, BdptIntegrator, DepthIntegrator, DirectIntegrator, DistributionIntegrator,
-    Integrator, MomentIntegrator, ParticleTracer, PathIntegrator, PolarizedPathIntegrator,
-    SppmIntegrator, StokesIntegrator, Tracking, VolPathIntegrator,
+    GuidedPathIntegrator, Integrator, MomentIntegrator, ParticleTracer, PathIntegrator,
+    PolarizedPathIntegrator, SppmIntegrator, StokesIntegrator, Tracking, VolPathIntegrator,
 };
 use prism_core::light::{Light, LightSelection};
 
@@ -190,8 +192,48 @@ pub static INTEGRATORS: Registry<Build> = Registry {
             ],
             build: build_sppm,
         },
+        Plugin {
+            name: "guided_path",
+            origin: Origin::Mitsuba06,
+            summary: "Practical path guiding (Müller, Gross & Novák 2017; the authors' Mitsuba \
+                      0.6 plugin): path tracing whose directions are drawn by one-sample MIS \
+                      from the BSDF and from an SD-tree of incident radiance (a spatial binary \
+                      tree of directional quadtrees) learned in iterations of doubling sample \
+                      counts; next-event estimation and Russian roulette as `path`. The image \
+                      is the last iteration's (or an inverse-variance mix of the last four); \
+                      bit-identical for any thread count; one-pixel reconstruction; no \
+                      checkpoints, resume or merge; no media.",
+            params: &[
+                MAX_DEPTH,
+                RR_DEPTH,
+                HIDE_EMITTERS,
+                STRICT_NORMALS,
+                SPP_PER_PASS,
+                BUDGET_TYPE,
+                BUDGET,
+                SAMPLE_COMBINATION,
+                S_TREE_THRESHOLD,
+                D_TREE_THRESHOLD,
+                BSDF_SAMPLING_FRACTION,
+                NEE,
+                SPATIAL_FILTER,
+                DO_FILTERED_SPLATTING,
+                DIRECTIONAL_FILTER,
+                BSDF_SAMPLING_FRACTION_LOSS,
+                SD_TREE_MAX_MEMORY,
+                DUMP_SD_TREE,
+            ],
+            build: build_guided,
+        },
     ],
 };
+
+/// The units of `guided_path`'s `budget`.
+#[derive(Clone, Copy, Debug)]
+enum BudgetType {
+    Samples,
+    Seconds,
+}
 
 params! {
     MAX_DEPTH = ParamSpec::new("max_depth", ParamKind::Integer, Default::Integer(-1), "longest path: −1 unbounded, 1 emitters only, 2 direct light");
@@ -220,6 +262,20 @@ params! {
     GRANULARITY = ParamSpec::new("granularity", ParamKind::Integer, Default::Integer(0), "light subpaths per parallel task (0: 4096); the image does not depend on it");
     SPPM_MAX_DEPTH = ParamSpec::new("max_depth", ParamKind::Integer, Default::Integer(-1), "longest path: −1 unbounded, 2 direct light, at least 2");
     SPPM_RR_DEPTH = ParamSpec::new("rr_depth", ParamKind::Integer, Default::Integer(3), "bounces after which Russian roulette may end photons and camera paths (Mitsuba 0.6's code uses 3)");
+    SPP_PER_PASS = ParamSpec::new("spp_per_pass", ParamKind::Integer, Default::Integer(4), "samples per pixel of a pass; iteration k renders 2^k passes");
+    BUDGET_TYPE = ParamSpec::new("budget_type", ParamKind::Choice(&[Choice::new("spp", &BudgetType::Samples), Choice::new("seconds", &BudgetType::Seconds)]), Default::Str("spp"), "what `budget` counts: samples per pixel or seconds, over all iterations (the authors' default is seconds)");
+    BUDGET = ParamSpec::new("budget", ParamKind::Float, Default::Float(-1.0), "samples per pixel or seconds over all iterations (−1: the render's sample count, or its time limit; the authors' default is 300 seconds)");
+    SAMPLE_COMBINATION = ParamSpec::new("sample_combination", ParamKind::Choice(&[Choice::new("discard", &SampleCombination::Discard), Choice::new("automatic", &SampleCombination::Automatic), Choice::new("inversevar", &SampleCombination::InverseVariance)]), Default::Str("automatic"), "the image: the last iteration's (`discard`), the same with training stopped where the extrapolated variance grows (`automatic`), or the last four iterations' weighted by their inverse variance (`inversevar`, one estimate per pixel: no error bar)");
+    S_TREE_THRESHOLD = ParamSpec::new("s_tree_threshold", ParamKind::Float, Default::Float(12_000.0), "c: a spatial leaf splits where its recorded samples exceed c·√(2^k · spp_per_pass / 4) at iteration k");
+    D_TREE_THRESHOLD = ParamSpec::new("d_tree_threshold", ParamKind::Float, Default::Float(0.01), "ρ: a quadrant splits where it holds more than this share of its quadtree's flux (0 < ρ < 1)");
+    BSDF_SAMPLING_FRACTION = ParamSpec::new("bsdf_sampling_fraction", ParamKind::Float, Default::Float(0.5), "α: the probability of sampling the BSDF rather than the guide (0 < α ≤ 1; 0 would leave directions the guide has not seen unsampled)");
+    NEE = ParamSpec::new("nee", ParamKind::Choice(&[Choice::new("never", &NextEvent::Never), Choice::new("kickstart", &NextEvent::Kickstart), Choice::new("always", &NextEvent::Always)]), Default::Str("always"), "light samples at every vertex (`always`, as `path`), while fewer than 128 spp have been rendered (`kickstart`), or none (`never`, the authors' default)");
+    SPATIAL_FILTER = ParamSpec::new("spatial_filter", ParamKind::Choice(&[Choice::new("nearest", &SpatialFilter::Nearest), Choice::new("stochastic", &SpatialFilter::StochasticBox)]), Default::Str("nearest"), "where a record is filed: the vertex's leaf, or the leaf of a point jittered within a box of that leaf's size (`box`, the deterministic box filter, is not supported)");
+    DO_FILTERED_SPLATTING = ParamSpec::new("do_filtered_splatting", ParamKind::Boolean, Default::Boolean(false), "the authors' earlier switch: true files records by the stochastic box filter (as spatial_filter = stochastic)");
+    DIRECTIONAL_FILTER = ParamSpec::new("directional_filter", ParamKind::Choice(&[Choice::new("nearest", &())]), Default::Str("nearest"), "records go to the quadrant of their direction (`box` is not supported)");
+    BSDF_SAMPLING_FRACTION_LOSS = ParamSpec::new("bsdf_sampling_fraction_loss", ParamKind::Choice(&[Choice::new("none", &())]), Default::Str("none"), "α is fixed (learning it, `kl` or `var`, is not supported)");
+    SD_TREE_MAX_MEMORY = ParamSpec::new("sd_tree_max_memory", ParamKind::Integer, Default::Integer(-1), "megabytes of quadtrees beyond which spatial leaves stop splitting (−1: no limit)");
+    DUMP_SD_TREE = ParamSpec::new("dump_sd_tree", ParamKind::Boolean, Default::Boolean(false), "must be false: Prism writes no SD-tree files");
     RR_THRESHOLD = ParamSpec::new("rr_threshold", ParamKind::Float, Default::Float(0.1), "potential below which Russian roulette starts");
 }
 
@@ -465,6 +521,131 @@ fn build_sppm(params: &Params) -> Result<Integrator> {
         granularity,
         max_depth: max_depth as i32,
         rr_depth: rr_depth as i32,
+    }))
+}
+
+/// The parameters of `guided_path`'s that name a value Prism does not implement, with why.
+const UNSUPPORTED_GUIDING: [(&ParamSpec, &str, &str); 5] = [
+    (
+        &SPATIAL_FILTER,
+        "box",
+        "the box filter files each record into every leaf it overlaps; use \"stochastic\"",
+    ),
+    (
+        &DIRECTIONAL_FILTER,
+        "box",
+        "records go to the quadrant of their direction only",
+    ),
+    (
+        &BSDF_SAMPLING_FRACTION_LOSS,
+        "kl",
+        "bsdf_sampling_fraction is fixed, not learned",
+    ),
+    (
+        &BSDF_SAMPLING_FRACTION_LOSS,
+        "var",
+        "bsdf_sampling_fraction is fixed, not learned",
+    ),
+    (&DUMP_SD_TREE, "true", "Prism writes no SD-tree files"),
+];
+
+fn build_guided(params: &Params) -> Result<Integrator> {
+    let refuse =
+        |spec: &ParamSpec, message: String| Err(Error::input(params.location_of(spec), message));
+    for (spec, value, why) in UNSUPPORTED_GUIDING {
+        let given = match spec.kind {
+            ParamKind::Boolean => params.boolean(spec)?.then_some("true"),
+            _ => params.string_opt(spec)?,
+        };
+        if given.is_some_and(|v| v.eq_ignore_ascii_case(value)) {
+            return refuse(
+                spec,
+                format!("{} = \"{value}\" is not supported: {why}", spec.name),
+            );
+        }
+    }
+    params.choice::<()>(&DIRECTIONAL_FILTER)?;
+    params.choice::<()>(&BSDF_SAMPLING_FRACTION_LOSS)?;
+    let spp_per_pass = params.integer(&SPP_PER_PASS)?;
+    if !(1..=1 << 16).contains(&spp_per_pass) {
+        return refuse(
+            &SPP_PER_PASS,
+            format!("spp_per_pass must be between 1 and 65536, not {spp_per_pass}"),
+        );
+    }
+    let budget = params.float(&BUDGET)?;
+    if !(budget == -1.0 || (budget > 0.0 && budget.is_finite())) {
+        return refuse(
+            &BUDGET,
+            format!("budget must be -1 (the render's) or positive, not {budget}"),
+        );
+    }
+    let budget = match params.choice::<BudgetType>(&BUDGET_TYPE)? {
+        BudgetType::Samples => {
+            if budget > 0.0 && !(budget >= 1.0 && budget <= f64::from(u32::MAX / 2)) {
+                return refuse(
+                    &BUDGET,
+                    format!("a budget of samples per pixel must be at least 1, not {budget}"),
+                );
+            }
+            Budget::Samples((budget > 0.0).then_some(budget.round() as u32))
+        }
+        BudgetType::Seconds => Budget::Seconds((budget > 0.0).then_some(budget)),
+    };
+    let s_tree_threshold = params.float(&S_TREE_THRESHOLD)?;
+    if !(s_tree_threshold > 0.0 && s_tree_threshold.is_finite()) {
+        return refuse(
+            &S_TREE_THRESHOLD,
+            format!("s_tree_threshold must be positive, not {s_tree_threshold}"),
+        );
+    }
+    let d_tree_threshold = params.float(&D_TREE_THRESHOLD)?;
+    if !(d_tree_threshold > 0.0 && d_tree_threshold < 1.0) {
+        return refuse(
+            &D_TREE_THRESHOLD,
+            format!("d_tree_threshold must lie strictly between 0 and 1, not {d_tree_threshold}"),
+        );
+    }
+    let bsdf_sampling_fraction = params.float(&BSDF_SAMPLING_FRACTION)?;
+    if !(bsdf_sampling_fraction > 0.0 && bsdf_sampling_fraction <= 1.0) {
+        return refuse(
+            &BSDF_SAMPLING_FRACTION,
+            format!(
+                "bsdf_sampling_fraction must be in (0, 1], not {bsdf_sampling_fraction}: without \
+                 BSDF samples the directions the guide has not learned would never be sampled"
+            ),
+        );
+    }
+    let sd_tree_max_memory = match params.integer(&SD_TREE_MAX_MEMORY)? {
+        -1 => None,
+        n if (1..=i64::from(u32::MAX)).contains(&n) => Some(n as u32),
+        n => {
+            return refuse(
+                &SD_TREE_MAX_MEMORY,
+                format!("sd_tree_max_memory must be -1 (no limit) or at least 1, not {n}"),
+            );
+        }
+    };
+    let spatial_filter =
+        if !params.has(&SPATIAL_FILTER) && params.boolean(&DO_FILTERED_SPLATTING)? {
+            SpatialFilter::StochasticBox
+        } else {
+            params.choice(&SPATIAL_FILTER)?
+        };
+    Ok(Integrator::Guided(GuidedPathIntegrator {
+        max_depth: max_depth(params)?,
+        rr_depth: rr_depth(params)?,
+        hide_emitters: params.boolean(&HIDE_EMITTERS)?,
+        strict_normals: params.boolean(&STRICT_NORMALS)?,
+        spp_per_pass: spp_per_pass as u32,
+        budget,
+        sample_combination: params.choice(&SAMPLE_COMBINATION)?,
+        s_tree_threshold: s_tree_threshold as f32,
+        d_tree_threshold: d_tree_threshold as f32,
+        bsdf_sampling_fraction: bsdf_sampling_fraction as f32,
+        nee: params.choice(&NEE)?,
+        spatial_filter,
+        sd_tree_max_memory,
     }))
 }
 

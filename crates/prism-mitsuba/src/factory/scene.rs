@@ -229,14 +229,15 @@ fn check_connectable(
     .with_help("render it with <integrator type=\"path\">, or use a perspective, thinlens or orthographic sensor"))
 }
 
-/// The distrib, ptracer, bdpt and sppm integrators estimate no participating media: a scene with
-/// media and any of them is an error at the first medium.
+/// The distrib, ptracer, bdpt, sppm and guided_path integrators estimate no participating
+/// media: a scene with media and any of them is an error at the first medium.
 fn check_renders_media(integrator: &Integrator, media: &MediaCache) -> Result<()> {
     let name = match integrator {
         Integrator::Distribution(_) => "distrib",
         Integrator::Particle(_) => "ptracer",
         Integrator::Bdpt(_) => "bdpt",
         Integrator::Sppm(_) => "sppm",
+        Integrator::Guided(_) => "guided_path",
         _ => return Ok(()),
     };
     if let Some(location) = &media.first {

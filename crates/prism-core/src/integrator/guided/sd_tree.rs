@@ -1,0 +1,207 @@
+//! The spatial half of the SD-tree (Müller, Gross & Novák 2017, §3.1): a binary tree over a
+//! cube around the scene, each node split at its middle along x, y, z in turn, each leaf holding
+//! two directional quadtrees ([`DirectionalTree`]): the one paths sample from (learned in the
+//! previous iteration) and the one they record into.
+//!
+//! Between iterations ([`SdTree::refine`]) a leaf is split in two where the statistical weight
+//! recorded in it exceeds c·√(2ᵏ) (§3.1; with the authors' code's scale, c = `sTreeThreshold`
+//! × √(`sppPerPass` / 4) at iteration k, so the leaves' sample counts grow as the square root
+//! of the iteration's samples); each half starts with a copy of the leaf's trees and half its
+//! weight, and splits again while its weight exceeds the threshold. Then every leaf's recording
+//! tree is rebuilt from its sampling tree's flux ([`DirectionalTree::refined`]), and at the end
+//! of the iteration ([`SdTree::build`]) it becomes the sampling tree.
+
+use glam::{Vec2, Vec3};
+
+use super::quadtree::{self, DirectionalTree};
+
+/// A node of the spatial tree.
+#[derive(Clone, Copy, Debug)]
+enum SpatialNode {
+    /// A leaf: the index of its trees, and the axis it would be split along.
+    Leaf { trees: u32, axis: u8 },
+    /// Split at the middle of `axis` into the lower and the upper half.
+    Split { axis: u8, children: [u32; 2] },
+}
+
+/// The directional trees of a spatial leaf.
+#[derive(Clone, Debug, Default)]
+pub struct LeafTrees {
+    /// Learned in the previous iteration: what paths sample from.
+    pub sampling: DirectionalTree,
+    /// What this iteration's paths record into.
+    pub building: DirectionalTree,
+}
+
+/// A spatial leaf found for a point: its index and its extent.
+#[derive(Clone, Copy, Debug)]
+pub struct SpatialLeaf {
+    pub index: u32,
+    pub size: Vec3,
+}
+
+/// The SD-tree.
+#[derive(Clone, Debug)]
+pub struct SdTree {
+    /// The lowest corner of the cube the tree covers.
+    origin: Vec3,
+    /// The cube's edge length.
+    extent: f32,
+    nodes: Vec<SpatialNode>,
+    leaves: Vec<LeafTrees>,
+}
+
+impl SdTree {
+    /// A tree of one leaf over the cube with lowest corner `lo` whose edge is the longest of
+    /// the box (`lo`, `hi`) (the authors enlarge the scene's box to a cube, so the splits stay
+    /// even).
+    pub fn new(lo: Vec3, hi: Vec3) -> SdTree {
+        let extent = (hi - lo).max_element().max(f32::MIN_POSITIVE);
+        SdTree {
+            origin: lo,
+            extent,
+            nodes: vec![SpatialNode::Leaf { trees: 0, axis: 0 }],
+            leaves: vec![LeafTrees::default()],
+        }
+    }
+
+    /// The leaf holding the point `p` (clamped into the cube).
+    #[inline]
+    pub fn leaf_at(&self, p: Vec3) -> SpatialLeaf {
+        let mut q = ((p - self.origin) / self.extent).clamp(Vec3::ZERO, Vec3::ONE);
+        let mut size = Vec3::splat(self.extent);
+        let mut node = 0usize;
+        loop {
+            match self.nodes[node] {
+                SpatialNode::Leaf { trees, .. } => {
+                    return SpatialLeaf { index: trees, size };
+                }
+                SpatialNode::Split { axis, children } => {
+                    let axis = axis as usize;
+                    size[axis] *= 0.5;
+                    let upper = q[axis] >= 0.5;
+                    q[axis] = (q[axis] * 2.0 - if upper { 1.0 } else { 0.0 }).clamp(0.0, 1.0);
+                    node = children[usize::from(upper)] as usize;
+                }
+            }
+        }
+    }
+
+    /// The point `p` clamped into the cube the tree covers.
+    pub fn clamp(&self, p: Vec3) -> Vec3 {
+        p.clamp(self.origin, self.origin + Vec3::splat(self.extent))
+    }
+
+    /// The trees of leaf `index`.
+    #[inline]
+    pub fn leaf(&self, index: u32) -> &LeafTrees {
+        &self.leaves[index as usize]
+    }
+
+    /// Records into the building tree of leaf `index` a sample at `p` (unit square) with value
+    /// `flux` and statistical weight `weight`.
+    #[inline]
+    pub fn record(&mut self, index: u32, p: Vec2, flux: f32, weight: f32) {
+        self.leaves[index as usize].building.record(p, flux, weight);
+    }
+
+    /// Spatial leaves.
+    pub fn leaf_count(&self) -> usize {
+        self.leaves.len()
+    }
+
+    /// About how many bytes the directional trees take.
+    fn footprint(&self) -> usize {
+        let per_node = 48;
+        self.leaves
+            .iter()
+            .map(|l| (l.sampling.node_count() + l.building.node_count()) * per_node)
+            .sum()
+    }
+
+    /// Prepares the tree for an iteration (see the module's text): splits the leaves whose
+    /// recorded weight exceeds `threshold` (unless the trees already take `max_bytes`), then
+    /// rebuilds every leaf's recording tree from its sampling tree, refined at the flux
+    /// fraction `flux_fraction`.
+    pub fn refine(&mut self, threshold: f64, flux_fraction: f32, max_bytes: Option<usize>) {
+        if max_bytes.is_none_or(|max| self.footprint() < max) {
+            let mut stack = vec![0usize];
+            while let Some(node) = stack.pop() {
+                if let SpatialNode::Leaf { trees, axis } = self.nodes[node]
+                    && self.leaves[trees as usize].building.weight() > threshold
+                {
+                    self.split(node, trees, axis);
+                }
+                if let SpatialNode::Split { children, .. } = self.nodes[node] {
+                    stack.extend(children.map(|c| c as usize));
+                }
+            }
+        }
+        for leaf in &mut self.leaves {
+            leaf.building =
+                DirectionalTree::refined(&leaf.sampling, flux_fraction, quadtree::MAX_DEPTH);
+        }
+    }
+
+    /// Splits leaf node `node` (holding the trees `index`) in two along `axis`: both halves
+    /// get its trees with half the recorded weight, and split along the next axis.
+    fn split(&mut self, node: usize, index: u32, axis: u8) {
+        let trees = &mut self.leaves[index as usize];
+        let weight = trees.building.weight() * 0.5;
+        trees.building.set_weight(weight);
+        let copy = trees.clone();
+        let upper = self.leaves.len() as u32;
+        self.leaves.push(copy);
+        let lower_node = self.nodes.len() as u32;
+        let next = (axis + 1) % 3;
+        self.nodes.push(SpatialNode::Leaf {
+            trees: index,
+            axis: next,
+        });
+        self.nodes.push(SpatialNode::Leaf {
+            trees: upper,
+            axis: next,
+        });
+        self.nodes[node] = SpatialNode::Split {
+            axis,
+            children: [lower_node, lower_node + 1],
+        };
+    }
+
+    /// Ends an iteration: every leaf's recorded tree, its sums built, becomes the tree paths
+    /// sample from.
+    pub fn build(&mut self) {
+        for leaf in &mut self.leaves {
+            leaf.building.build();
+            leaf.sampling = leaf.building.clone();
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A leaf with more recorded weight than the threshold splits, and its halves split again
+    /// while half the weight still exceeds it; points find the leaf of their octant.
+    #[test]
+    fn leaves_split_by_recorded_weight() {
+        let mut tree = SdTree::new(Vec3::ZERO, Vec3::new(2.0, 1.0, 1.0));
+        tree.refine(0.0, 0.01, None);
+        for _ in 0..100 {
+            tree.record(0, Vec2::splat(0.5), 1.0, 1.0);
+        }
+        tree.build();
+        // 100 > 30: split in x (50 each), again in y (25 each), then no more.
+        tree.refine(30.0, 0.01, None);
+        assert_eq!(tree.leaf_count(), 4);
+        let a = tree.leaf_at(Vec3::new(0.1, 0.1, 0.1));
+        let b = tree.leaf_at(Vec3::new(1.9, 0.1, 0.1));
+        let c = tree.leaf_at(Vec3::new(0.1, 1.9, 1.9));
+        assert_ne!(a.index, b.index);
+        assert_ne!(a.index, c.index);
+        assert_eq!(a.size, Vec3::new(1.0, 1.0, 2.0));
+        // The sampling trees are the parent's.
+        assert!(tree.leaf(a.index).sampling.pdf(Vec2::splat(0.5)) > 1.0);
+    }
+}
