@@ -1,6 +1,7 @@
 //! Participating media: Mitsuba 3's `homogeneous` and `heterogeneous` media with their phase
 //! functions ([`phase`]) and the volumes that give a heterogeneous medium's coefficients
-//! ([`volume`]), and the three operations a volumetric path tracer needs from them.
+//! ([`volume`], grids looked up as [`lattice`] describes), and the three operations a
+//! volumetric path tracer needs from them.
 //!
 //! A medium has an extinction coefficient σ_t (per unit length, `scale` times the given
 //! `sigma_t`) and a single-scattering albedo α, so σ_s = α σ_t and σ_a = σ_t − σ_s. Along a
@@ -43,6 +44,7 @@
 //! collisions with the majorant, each multiplying the estimate by 1 − σ_t(x, λᵢ)/m, whose
 //! expectation is exp(−∫σ_t) for every wavelength.
 
+pub mod lattice;
 pub mod phase;
 pub mod volume;
 
@@ -52,7 +54,7 @@ pub use phase::{
     BlendPhase, HenyeyGreenstein, Isotropic, PhaseFunction, PhaseModel, PhaseSample, Rayleigh,
     Sggx, TabulatedPhase,
 };
-pub use volume::{GridFilter, GridVolume, Volume};
+pub use volume::{GridFilter, GridVolume, GridWrap, SpectralGridVolume, Volume};
 
 use crate::dispatch::plugin_class;
 use crate::math::Ray;

@@ -15,9 +15,9 @@ use prism_core::error::{Error, Result};
 use prism_core::math::Transform;
 use prism_core::medium::volume::{VolFile, parse_vol};
 use prism_core::medium::{
-    BlendPhase, GridFilter, GridVolume, HenyeyGreenstein, Heterogeneous, Homogeneous,
+    BlendPhase, GridFilter, GridVolume, GridWrap, HenyeyGreenstein, Heterogeneous, Homogeneous,
     HomogeneousAbsorbingScattering, Isotropic, Medium, MediumKind, PhaseFunction, Rayleigh, Sggx,
-    TabulatedPhase, Volume,
+    SpectralGridVolume, TabulatedPhase, Volume,
 };
 use prism_core::spectrum::Spectrum;
 
@@ -126,10 +126,19 @@ pub static VOLUMES: Registry<BuildVolume> = Registry {
         Plugin {
             name: "gridvolume",
             origin: Origin::Mitsuba3,
-            summary: "A single-channel grid from a Mitsuba `.vol` file (32-bit floats) over the \
-                      unit cube placed by `to_world`, interpolated trilinearly between voxel \
-                      centres and clamped at its faces.",
-            params: &[FILENAME, FILTER_TYPE, VOLUME_TO_WORLD, USE_GRID_BBOX],
+            summary: "A grid from a Mitsuba `.vol` file (32-bit floats) over the unit cube placed \
+                      by `to_world`, interpolated trilinearly between voxel centres, clamped, \
+                      repeated or mirrored outside. One channel gives a number; three give a \
+                      colour, upsampled to a spectrum per voxel as Mitsuba 3's spectral \
+                      variants do (2·max(rgb) times the spectrum of rgb/(2·max(rgb)); the \
+                      spectra and the scales are interpolated separately and multiplied).",
+            params: &[
+                FILENAME,
+                FILTER_TYPE,
+                WRAP_MODE,
+                VOLUME_TO_WORLD,
+                USE_GRID_BBOX,
+            ],
             build: build_gridvolume,
         },
     ],
@@ -152,7 +161,8 @@ params! {
     BLENDED_PHASES = ParamSpec::nested(PluginClass::Phase, Default::Required, "the two phase functions");
     VALUE = ParamSpec::new("value", ParamKind::Spectrum { range: Range::Coefficient, textured: false, }, Default::Float(1.0), "the value");
     FILENAME = ParamSpec::new("filename", ParamKind::String, Default::Required, "the `.vol` file");
-    FILTER_TYPE = ParamSpec::new("filter_type", ParamKind::Choice(&[Choice::new("bilinear", &GridFilter::Trilinear), Choice::new("nearest", &GridFilter::Nearest)]), Default::Str("bilinear"), "interpolation between voxels: `bilinear` (trilinear in 3D, Mitsuba's name) or `nearest`");
+    FILTER_TYPE = ParamSpec::new("filter_type", ParamKind::Choice(&[Choice::new("trilinear", &GridFilter::Trilinear), Choice::new("bilinear", &GridFilter::Trilinear), Choice::new("nearest", &GridFilter::Nearest)]), Default::Str("trilinear"), "interpolation between voxels: `trilinear` (Mitsuba 3's name; `bilinear` is read the same) or `nearest`");
+    WRAP_MODE = ParamSpec::new("wrap_mode", ParamKind::Choice(&[Choice::new("clamp", &GridWrap::Clamp), Choice::new("repeat", &GridWrap::Repeat), Choice::new("mirror", &GridWrap::Mirror)]), Default::Str("clamp"), "lookups outside the unit cube: `clamp` (the border voxels extend), `repeat` (the grid tiles space) or `mirror` (tiles, every other one mirrored)");
     VOLUME_TO_WORLD = ParamSpec::new("to_world", ParamKind::Transform, Default::Text("identity"), "from the unit cube [0, 1]³ to the world");
     USE_GRID_BBOX = ParamSpec::new("use_grid_bbox", ParamKind::Boolean, Default::Boolean(false), "place the grid in the box its file gives (then transformed by `to_world`)");
 }
@@ -427,16 +437,16 @@ fn build_gridvolume(params: &Params, range: Range) -> Result<Volume> {
     let node = params.node();
     let (file, path) = read_grid(params)?;
     let location = params.location_of(&FILENAME);
-    if file.channels != 1 {
+    if file.channels != 1 && file.channels != 3 {
         return Err(Error::input(
             location,
             format!(
-                "the grid \"{}\" has {} channels; Prism reads single-channel grids",
+                "the grid \"{}\" has {} channels; a gridvolume holds one (a number) or three (a colour)",
                 path.display(),
                 file.channels
             ),
         )
-        .with_help("store one quantity (a density or an albedo) per grid"));
+        .with_help("store a density or a scalar albedo in one channel, an RGB colour in three"));
     }
     if let Some(bad) = file.data.iter().find(|v| !(v.is_finite() && **v >= 0.0)) {
         return Err(Error::input(
@@ -465,20 +475,31 @@ fn build_gridvolume(params: &Params, range: Range) -> Result<Volume> {
     };
     let to_world = Transform::new(to_world).ok_or_else(singular)?;
     let filter = params.choice(&FILTER_TYPE)?;
-    let grid = GridVolume::new(file.resolution, file.data, to_world, filter)
-        .expect("a parsed grid holds its voxels");
-    if range == Range::Albedo && grid.max_value() > 1.0 {
+    let wrap = params.choice(&WRAP_MODE)?;
+    let (volume, largest) = if file.channels == 3 {
+        let grid = SpectralGridVolume::new(file.resolution, &file.data, to_world, filter)
+            .expect("a parsed grid holds its voxels")
+            .with_wrap(wrap);
+        let largest = grid.max_component();
+        (Volume::SpectralGrid(Box::new(grid)), largest)
+    } else {
+        let grid = GridVolume::new(file.resolution, file.data, to_world, filter)
+            .expect("a parsed grid holds its voxels")
+            .with_wrap(wrap);
+        let largest = grid.max_value();
+        (Volume::Grid(Box::new(grid)), largest)
+    };
+    if range == Range::Albedo && largest > 1.0 {
         return Err(Error::input(
             location,
             format!(
-                "the albedo grid \"{}\" reaches {}, above 1: the medium would scatter more light than it removes",
+                "the albedo grid \"{}\" reaches {largest}, above 1: the medium would scatter more light than it removes",
                 path.display(),
-                grid.max_value()
             ),
         )
         .with_help("use values between 0 and 1"));
     }
-    Ok(Volume::Grid(Box::new(grid)))
+    Ok(volume)
 }
 
 /// Mitsuba's `sggx`: S from a six-channel `gridvolume` whose voxels all hold the same matrix.
@@ -508,11 +529,18 @@ fn build_sggx(params: &Params) -> Result<PhaseFunction> {
     }
     let grid = Params::new(
         &child.node,
-        &[FILENAME, FILTER_TYPE, VOLUME_TO_WORLD, USE_GRID_BBOX],
+        &[
+            FILENAME,
+            FILTER_TYPE,
+            WRAP_MODE,
+            VOLUME_TO_WORLD,
+            USE_GRID_BBOX,
+        ],
     );
     let (file, path) = read_grid(&grid)?;
     // The placement and filtering of a grid that holds one value everywhere change nothing.
     grid.choice::<GridFilter>(&FILTER_TYPE)?;
+    grid.choice::<GridWrap>(&WRAP_MODE)?;
     grid.transform(&VOLUME_TO_WORLD)?;
     grid.boolean(&USE_GRID_BBOX)?;
     let location = grid.location_of(&FILENAME);
