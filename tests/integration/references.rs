@@ -118,6 +118,15 @@ fn colour_grids_match_mitsuba() {
     assert_matches_reference_at("rgb_grid", &scene, None, 1024);
 }
 
+/// A `homogeneous` medium whose albedo is a colour `gridvolume` tiled by `wrap_mode` repeat
+/// (1024 spp, for the medium's noise).
+#[test]
+fn homogeneous_medium_with_an_albedo_grid_matches_mitsuba() {
+    let scene =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/references/homogeneous_albedo_grid.xml");
+    assert_matches_reference_at("homogeneous_albedo_grid", &scene, None, 1024);
+}
+
 #[test]
 fn hair_matches_mitsuba() {
     assert_matches_reference("hair");

@@ -16,8 +16,8 @@ use prism_core::math::Transform;
 use prism_core::medium::volume::{VolFile, parse_vol};
 use prism_core::medium::{
     BlendPhase, GridFilter, GridVolume, GridWrap, HenyeyGreenstein, Heterogeneous, Homogeneous,
-    HomogeneousAbsorbingScattering, Isotropic, Medium, MediumKind, PhaseFunction, Rayleigh, Sggx,
-    SpectralGridVolume, TabulatedPhase, Volume,
+    HomogeneousAbsorbingScattering, HomogeneousExtinction, Isotropic, Medium, MediumKind,
+    PhaseFunction, Rayleigh, Sggx, SpectralGridVolume, TabulatedPhase, Volume,
 };
 use prism_core::spectrum::Spectrum;
 
@@ -31,13 +31,14 @@ pub static MEDIA: Registry<BuildMedium> = Registry {
         Plugin {
             name: "homogeneous",
             origin: Origin::Mitsuba3,
-            summary: "The same extinction σ_t = scale · sigma_t and albedo everywhere; or, in \
-                      Mitsuba 0.6's form, σ_a = scale · sigma_a and σ_s = scale · sigma_s \
-                      (which Mitsuba 3 refuses). A shape takes it as its `interior` or \
-                      `exterior`, the sensor as the medium it sits in.",
+            summary: "The same extinction σ_t = scale · sigma_t everywhere, with an albedo \
+                      that is a value or, as in Mitsuba 3, a volume (so that only the \
+                      scattering varies); or, in Mitsuba 0.6's form, σ_a = scale · sigma_a and \
+                      σ_s = scale · sigma_s (which Mitsuba 3 refuses). A shape takes it as its \
+                      `interior` or `exterior`, the sensor as the medium it sits in.",
             params: &[
                 SIGMA_T,
-                ALBEDO,
+                ALBEDO_VOLUME,
                 SIGMA_A,
                 SIGMA_S,
                 SCALE,
@@ -146,7 +147,6 @@ pub static VOLUMES: Registry<BuildVolume> = Registry {
 
 params! {
     SIGMA_T = ParamSpec::new("sigma_t", ParamKind::Spectrum { range: Range::Coefficient, textured: false, }, Default::Float(1.0), "extinction coefficient per scene unit");
-    ALBEDO = ParamSpec::new("albedo", ParamKind::Spectrum { range: Range::Albedo, textured: false, }, Default::Float(0.75), "single-scattering albedo σ_s/σ_t, in [0, 1]");
     SIGMA_A = ParamSpec::new("sigma_a", ParamKind::Spectrum { range: Range::Coefficient, textured: false, }, Default::None, "Mitsuba 0.6: absorption coefficient, with `sigma_s` in place of `sigma_t` and `albedo`");
     SIGMA_S = ParamSpec::new("sigma_s", ParamKind::Spectrum { range: Range::Coefficient, textured: false, }, Default::None, "Mitsuba 0.6: scattering coefficient, with `sigma_a`");
     SIGMA_T_VOLUME = ParamSpec::new("sigma_t", ParamKind::Volume(Range::Coefficient), Default::Float(1.0), "extinction coefficient per scene unit");
@@ -231,7 +231,7 @@ fn given_max(params: &Params, spec: &ParamSpec, spectrum: &Spectrum) -> f32 {
 fn build_homogeneous(params: &Params) -> Result<Medium> {
     let scale = scale(params)?;
     let kind = if params.has(&SIGMA_A) || params.has(&SIGMA_S) {
-        for spec in [&SIGMA_T, &ALBEDO] {
+        for spec in [&SIGMA_T, &ALBEDO_VOLUME] {
             if params.has(spec) {
                 return Err(Error::input(
                     params.location_of(spec),
@@ -264,13 +264,19 @@ fn build_homogeneous(params: &Params) -> Result<Medium> {
             scale,
         })
     } else {
-        let albedo = spectrum_param(params, &ALBEDO)?;
-        check_albedo(params, &ALBEDO, given_max(params, &ALBEDO, &albedo))?;
-        MediumKind::Homogeneous(Homogeneous {
-            sigma_t: spectrum_param(params, &SIGMA_T)?,
-            albedo,
-            scale,
-        })
+        let sigma_t = spectrum_param(params, &SIGMA_T)?;
+        match volume_param(params, &ALBEDO_VOLUME)? {
+            Volume::Constant(albedo) => MediumKind::Homogeneous(Homogeneous {
+                sigma_t,
+                albedo,
+                scale,
+            }),
+            albedo => MediumKind::HomogeneousExtinction(HomogeneousExtinction {
+                sigma_t,
+                albedo,
+                scale,
+            }),
+        }
     };
     Ok(Medium {
         kind,
