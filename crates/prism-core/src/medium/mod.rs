@@ -54,7 +54,7 @@ pub use phase::{
     BlendPhase, HenyeyGreenstein, Isotropic, PhaseFunction, PhaseModel, PhaseSample, Rayleigh,
     Sggx, TabulatedPhase,
 };
-pub use volume::{GridFilter, GridVolume, GridWrap, SpectralGridVolume, Volume};
+pub use volume::{ConstantInBox, GridFilter, GridVolume, GridWrap, SpectralGridVolume, Volume};
 
 use crate::dispatch::plugin_class;
 use crate::math::Ray;

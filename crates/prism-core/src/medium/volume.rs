@@ -13,8 +13,11 @@ use crate::spectrum::{SampledSpectrum, SampledWavelengths, Spectrum};
 /// A quantity over space.
 #[derive(Clone, Debug)]
 pub enum Volume {
-    /// The same spectrum everywhere (`constvolume`, or a plain value given for a volume).
+    /// The same spectrum everywhere, without bounds (a plain value given for a volume).
     Constant(Spectrum),
+    /// The same spectrum everywhere, with a box that bounds a heterogeneous medium whose
+    /// extinction it gives (`constvolume`).
+    ConstantInBox(Box<ConstantInBox>),
     /// A grid of numbers over a box (`gridvolume`), boxed to keep media small.
     Grid(Box<GridVolume>),
     /// A grid of colours over a box, upsampled to spectra (a three-channel `gridvolume`).
@@ -27,6 +30,7 @@ impl Volume {
     pub fn eval(&self, p: Vec3, lambda: &SampledWavelengths) -> SampledSpectrum {
         match self {
             Volume::Constant(spectrum) => spectrum.sample(lambda),
+            Volume::ConstantInBox(constant) => constant.value.sample(lambda),
             Volume::Grid(grid) => SampledSpectrum::splat(grid.eval(p)),
             Volume::SpectralGrid(grid) => grid.eval(p, lambda),
         }
@@ -37,20 +41,52 @@ impl Volume {
     pub fn max_value(&self) -> f32 {
         match self {
             Volume::Constant(spectrum) => spectrum.max_value(),
+            Volume::ConstantInBox(constant) => constant.value.max_value(),
             Volume::Grid(grid) => grid.max_value,
             Volume::SpectralGrid(grid) => grid.max_value,
         }
     }
 
     /// The parameter interval of `ray` (unit direction) inside the volume's box, clipped to
-    /// [0, t_max]; a constant volume fills all space.
+    /// [0, t_max]; an unbounded constant fills all space.
     #[inline]
     pub fn ray_extent(&self, ray: &Ray, t_max: f32) -> Option<(f32, f32)> {
         match self {
             Volume::Constant(_) => Some((0.0, t_max)),
+            Volume::ConstantInBox(constant) => constant.ray_extent(ray, t_max),
             Volume::Grid(grid) => grid.ray_extent(ray, t_max),
             Volume::SpectralGrid(grid) => grid.ray_extent(ray, t_max),
         }
+    }
+}
+
+/// Mitsuba 3's `constvolume`: a value everywhere, and a box, the axis-aligned bounds of the
+/// unit cube placed by the volume's `to_world` (the unit cube itself by default). Mitsuba's
+/// `heterogeneous` medium is empty outside its extinction volume's box, so the box matters there.
+#[derive(Clone, Debug)]
+pub struct ConstantInBox {
+    pub value: Spectrum,
+    pub min: Vec3,
+    pub max: Vec3,
+}
+
+impl ConstantInBox {
+    /// The value in the bounds of the unit cube placed by `to_world`.
+    pub fn new(value: Spectrum, to_world: &Transform) -> ConstantInBox {
+        let corners = (0..8).map(|i| {
+            let corner = Vec3::new((i & 1) as f32, ((i >> 1) & 1) as f32, (i >> 2) as f32);
+            to_world.point(corner)
+        });
+        let (min, max) = corners.fold(
+            (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+            |(min, max), p| (min.min(p), max.max(p)),
+        );
+        ConstantInBox { value, min, max }
+    }
+
+    /// The parameter interval of `ray` inside the box, clipped to [0, t_max].
+    pub fn ray_extent(&self, ray: &Ray, t_max: f32) -> Option<(f32, f32)> {
+        slab_extent(ray.o, ray.d, self.min, self.max, t_max)
     }
 }
 
@@ -252,10 +288,17 @@ impl SpectralGridVolume {
 fn unit_cube_extent(to_world: &Transform, ray: &Ray, t_max: f32) -> Option<(f32, f32)> {
     let o = to_world.inverse_point(ray.o);
     let d = to_world.inverse_vector(ray.d);
+    slab_extent(o, d, Vec3::ZERO, Vec3::ONE, t_max)
+}
+
+/// The parameter interval of the ray o + t d inside the box [min, max], clipped to [0, t_max]
+/// (the slab test).
+#[inline]
+fn slab_extent(o: Vec3, d: Vec3, min: Vec3, max: Vec3, t_max: f32) -> Option<(f32, f32)> {
     let (mut t0, mut t1) = (0.0f32, t_max);
     for axis in 0..3 {
         let inv = 1.0 / d[axis];
-        let (mut near, mut far) = ((0.0 - o[axis]) * inv, (1.0 - o[axis]) * inv);
+        let (mut near, mut far) = ((min[axis] - o[axis]) * inv, (max[axis] - o[axis]) * inv);
         if near > far {
             std::mem::swap(&mut near, &mut far);
         }
@@ -383,6 +426,35 @@ mod tests {
             }
             assert_eq!(grid.max_value(), 1.6);
         }
+    }
+
+    /// A `constvolume`'s box is the bounds of the placed unit cube (Mitsuba's `test_constant.py`:
+    /// scale (2, 0.2, 1) gives [0, 0, 0]–[2, 0.2, 1]), axis-aligned around a rotated one.
+    #[test]
+    fn a_constant_volumes_box_bounds_the_placed_unit_cube() {
+        let scaled = Transform::new(glam::DMat4::from_scale(glam::DVec3::new(2.0, 0.2, 1.0)))
+            .expect("invertible");
+        let constant = ConstantInBox::new(Spectrum::Constant(3.0), &scaled);
+        assert_eq!(
+            (constant.min, constant.max),
+            (Vec3::ZERO, Vec3::new(2.0, 0.2, 1.0))
+        );
+        let rotated = Transform::new(glam::DMat4::from_rotation_z(std::f64::consts::FRAC_PI_4))
+            .expect("invertible");
+        let constant = ConstantInBox::new(Spectrum::Constant(3.0), &rotated);
+        let h = std::f32::consts::FRAC_1_SQRT_2;
+        assert!((constant.min - Vec3::new(-h, 0.0, 0.0)).abs().max_element() < 1e-6);
+        assert!(
+            (constant.max - Vec3::new(h, 2.0 * h, 1.0))
+                .abs()
+                .max_element()
+                < 1e-6
+        );
+        let ray = Ray::new(Vec3::new(-1.0, 0.1, 0.5), Vec3::X, f32::INFINITY, 0.0);
+        let (t0, t1) = constant
+            .ray_extent(&ray, 10.0)
+            .expect("the ray crosses the box");
+        assert!((t0 - (1.0 - h)).abs() < 1e-6 && (t1 - (1.0 + h)).abs() < 1e-6);
     }
 
     /// Between two voxels of colours a and b, a quarter of the way: the spectra and the scales

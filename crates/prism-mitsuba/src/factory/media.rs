@@ -15,9 +15,9 @@ use prism_core::error::{Error, Result};
 use prism_core::math::Transform;
 use prism_core::medium::volume::{VolFile, parse_vol};
 use prism_core::medium::{
-    BlendPhase, GridFilter, GridVolume, GridWrap, HenyeyGreenstein, Heterogeneous, Homogeneous,
-    HomogeneousAbsorbingScattering, HomogeneousExtinction, Isotropic, Medium, MediumKind,
-    PhaseFunction, Rayleigh, Sggx, SpectralGridVolume, TabulatedPhase, Volume,
+    BlendPhase, ConstantInBox, GridFilter, GridVolume, GridWrap, HenyeyGreenstein, Heterogeneous,
+    Homogeneous, HomogeneousAbsorbingScattering, HomogeneousExtinction, Isotropic, Medium,
+    MediumKind, PhaseFunction, Rayleigh, Sggx, SpectralGridVolume, TabulatedPhase, Volume,
 };
 use prism_core::spectrum::Spectrum;
 
@@ -120,8 +120,11 @@ pub static VOLUMES: Registry<BuildVolume> = Registry {
         Plugin {
             name: "constvolume",
             origin: Origin::Mitsuba3,
-            summary: "The same value everywhere.",
-            params: &[VALUE],
+            summary: "The same value everywhere. As a `heterogeneous` medium's `sigma_t`, it \
+                      also bounds the medium, as in Mitsuba 3: the medium is empty outside the \
+                      axis-aligned box around the unit cube placed by `to_world` (a plain \
+                      `sigma_t` value is the unit cube's).",
+            params: &[VALUE, VOLUME_TO_WORLD],
             build: build_constvolume,
         },
         Plugin {
@@ -149,7 +152,7 @@ params! {
     SIGMA_T = ParamSpec::new("sigma_t", ParamKind::Spectrum { range: Range::Coefficient, textured: false, }, Default::Float(1.0), "extinction coefficient per scene unit");
     SIGMA_A = ParamSpec::new("sigma_a", ParamKind::Spectrum { range: Range::Coefficient, textured: false, }, Default::None, "Mitsuba 0.6: absorption coefficient, with `sigma_s` in place of `sigma_t` and `albedo`");
     SIGMA_S = ParamSpec::new("sigma_s", ParamKind::Spectrum { range: Range::Coefficient, textured: false, }, Default::None, "Mitsuba 0.6: scattering coefficient, with `sigma_a`");
-    SIGMA_T_VOLUME = ParamSpec::new("sigma_t", ParamKind::Volume(Range::Coefficient), Default::Float(1.0), "extinction coefficient per scene unit");
+    SIGMA_T_VOLUME = ParamSpec::new("sigma_t", ParamKind::Volume(Range::Coefficient), Default::Float(1.0), "extinction coefficient per scene unit; the medium is empty outside its box (a plain value's is the unit cube, as in Mitsuba 3)");
     ALBEDO_VOLUME = ParamSpec::new("albedo", ParamKind::Volume(Range::Albedo), Default::Float(0.75), "single-scattering albedo σ_s/σ_t, in [0, 1]");
     SCALE = ParamSpec::new("scale", ParamKind::Float, Default::Float(1.0), "factor on the coefficients (a change of units)");
     SAMPLE_EMITTERS = ParamSpec::new("sample_emitters", ParamKind::Boolean, Default::Boolean(true), "sample lights at scattering points in the medium (next-event estimation)");
@@ -271,6 +274,11 @@ fn build_homogeneous(params: &Params) -> Result<Medium> {
                 albedo,
                 scale,
             }),
+            Volume::ConstantInBox(constant) => MediumKind::Homogeneous(Homogeneous {
+                sigma_t,
+                albedo: constant.value,
+                scale,
+            }),
             albedo => MediumKind::HomogeneousExtinction(HomogeneousExtinction {
                 sigma_t,
                 albedo,
@@ -317,7 +325,14 @@ fn volume_param(params: &Params, spec: &ParamSpec) -> Result<Volume> {
 }
 
 fn build_heterogeneous(params: &Params) -> Result<Medium> {
-    let sigma_t = volume_param(params, &SIGMA_T_VOLUME)?;
+    // Mitsuba reads a plain value as a `constvolume` over the unit cube, outside which the
+    // medium is empty.
+    let sigma_t = match volume_param(params, &SIGMA_T_VOLUME)? {
+        Volume::Constant(value) => {
+            Volume::ConstantInBox(Box::new(ConstantInBox::new(value, &Transform::IDENTITY)))
+        }
+        volume => volume,
+    };
     let albedo = volume_param(params, &ALBEDO_VOLUME)?;
     Ok(Medium {
         kind: MediumKind::Heterogeneous(Heterogeneous {
@@ -408,7 +423,19 @@ fn build_constvolume(params: &Params, range: Range) -> Result<Volume> {
     if range == Range::Albedo {
         check_albedo(params, &VALUE, given_max(params, &VALUE, &value))?;
     }
-    Ok(Volume::Constant(value))
+    let to_world = Transform::new(params.transform(&VOLUME_TO_WORLD)?).ok_or_else(|| {
+        Error::input(
+            params.location_of(&VOLUME_TO_WORLD),
+            format!(
+                "{} is placed by a singular transform",
+                params.node().describe()
+            ),
+        )
+        .with_help("give to_world a non-zero scale on every axis")
+    })?;
+    Ok(Volume::ConstantInBox(Box::new(ConstantInBox::new(
+        value, &to_world,
+    ))))
 }
 
 /// The `.vol` file a `gridvolume`'s `filename` names, read and parsed.
