@@ -1,4 +1,4 @@
-//! Renders of new BSDFs, shapes, emitters and PLY face colours against Mitsuba 3's images of the same scenes
+//! Renders of new BSDFs, shapes, emitters, volumes and PLY face colours against Mitsuba 3's images of the same scenes
 //! (`tests/references/README.md`): the image means of X, Y and Z agree within four standard
 //! errors of their difference. Prism's standard error comes from its pixels' sample variances;
 //! the reference's, rendered with the same estimator at 2048 spp, is taken as Prism's scaled
@@ -107,6 +107,24 @@ fn sggx_extinction_matches_mitsuba() {
 fn principal_point_offset_matches_mitsuba() {
     let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/references/principal_point.xml");
     assert_matches_reference_at("principal_point", &scene, None, 1024);
+}
+
+/// Three-channel `gridvolume`s: a colour albedo grid tiled by `wrap_mode` repeat over a
+/// density grid, and a colour extinction grid read by its nearest voxels (1024 spp, for the
+/// media's noise).
+#[test]
+fn colour_grids_match_mitsuba() {
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/references/rgb_grid.xml");
+    assert_matches_reference_at("rgb_grid", &scene, None, 1024);
+}
+
+/// A `homogeneous` medium whose albedo is a colour `gridvolume` tiled by `wrap_mode` repeat
+/// (1024 spp, for the medium's noise).
+#[test]
+fn homogeneous_medium_with_an_albedo_grid_matches_mitsuba() {
+    let scene =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/references/homogeneous_albedo_grid.xml");
+    assert_matches_reference_at("homogeneous_albedo_grid", &scene, None, 1024);
 }
 
 #[test]

@@ -1052,13 +1052,53 @@ fn media_cases() -> Vec<Case> {
             "header",
         ),
         with_grid(
-            "three-channel grid",
+            "two-channel grid",
+            concat!(
+                vol_header!("\x01", "\x01", "\x01", "\x02"),
+                "\x00\x00\x00\x00\x00\x00\x00\x00"
+            ),
+            "one (a number) or three (a colour)",
+        ),
+        with_grid(
+            "three-channel grid with a voxel's colour cut short",
+            concat!(
+                vol_header!("\x02", "\x01", "\x01", "\x03"),
+                "\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00",
+                "\x00\x00\x00\x00\x00\x00\x00\x00"
+            ),
+            "2 × 1 × 1 voxels of 3 channel(s), but the file is truncated",
+        ),
+        with_grid(
+            "three-channel grid with a colour too many",
             concat!(
                 vol_header!("\x01", "\x01", "\x01", "\x03"),
+                "\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00",
                 "\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00"
             ),
-            "single-channel",
+            "1 × 1 × 1 voxels of 3 channel(s), but the file has 12 bytes more",
         ),
+        Case {
+            name: "colour albedo grid above 1",
+            files: Box::leak(Box::new([
+                (
+                    "scene.xml",
+                    scene!(
+                        "    <shape type=\"sphere\"><bsdf type=\"null\"/><medium type=\"heterogeneous\" name=\"interior\"><volume type=\"gridvolume\" name=\"albedo\"><string name=\"filename\" value=\"albedo.vol\"/></volume></medium></shape>"
+                    ),
+                ),
+                (
+                    "albedo.vol",
+                    // One voxel of colour (3, 0, 0).
+                    concat!(
+                        vol_header!("\x01", "\x01", "\x01", "\x03"),
+                        "\x00\x00\x40\x40\x00\x00\x00\x00\x00\x00\x00\x00"
+                    ),
+                ),
+            ])),
+            arguments: RENDER,
+            location: "scene.xml:3:",
+            says: "reaches 3, above 1",
+        },
         with_grid(
             "negative value in a grid",
             concat!(

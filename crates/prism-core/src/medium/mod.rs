@@ -1,6 +1,7 @@
 //! Participating media: Mitsuba 3's `homogeneous` and `heterogeneous` media with their phase
 //! functions ([`phase`]) and the volumes that give a heterogeneous medium's coefficients
-//! ([`volume`]), and the three operations a volumetric path tracer needs from them.
+//! ([`volume`], grids looked up as [`lattice`] describes), and the three operations a
+//! volumetric path tracer needs from them.
 //!
 //! A medium has an extinction coefficient σ_t (per unit length, `scale` times the given
 //! `sigma_t`) and a single-scattering albedo α, so σ_s = α σ_t and σ_a = σ_t − σ_s. Along a
@@ -43,6 +44,7 @@
 //! collisions with the majorant, each multiplying the estimate by 1 − σ_t(x, λᵢ)/m, whose
 //! expectation is exp(−∫σ_t) for every wavelength.
 
+pub mod lattice;
 pub mod phase;
 pub mod volume;
 
@@ -52,7 +54,7 @@ pub use phase::{
     BlendPhase, HenyeyGreenstein, Isotropic, PhaseFunction, PhaseModel, PhaseSample, Rayleigh,
     Sggx, TabulatedPhase,
 };
-pub use volume::{GridFilter, GridVolume, Volume};
+pub use volume::{ConstantInBox, GridFilter, GridVolume, GridWrap, SpectralGridVolume, Volume};
 
 use crate::dispatch::plugin_class;
 use crate::math::Ray;
@@ -76,7 +78,8 @@ plugin_class! {
         /// The coefficients at `p` for the wavelengths `lambda`.
         fn coefficients(&self, p: Vec3, lambda: &SampledWavelengths) -> MediumCoefficients;
 
-        /// Whether the coefficients are the same everywhere.
+        /// Whether σ_t is the same everywhere (σ_s may vary with the albedo, as in
+        /// [`HomogeneousExtinction`]).
         fn is_homogeneous(&self) -> bool;
 
         /// A majorant m ≥ σ_t(x, λᵢ) for every point and each of the wavelengths `lambda`.
@@ -92,6 +95,7 @@ plugin_class! {
     pub enum MediumKind {
         Homogeneous(Homogeneous),
         HomogeneousAbsorbingScattering(HomogeneousAbsorbingScattering),
+        HomogeneousExtinction(HomogeneousExtinction),
         Heterogeneous(Heterogeneous),
     }
 }
@@ -160,6 +164,41 @@ impl HomogeneousModel for HomogeneousAbsorbingScattering {
             sigma_t: self.sigma_a.sample(lambda) * self.scale + sigma_s,
             sigma_s,
         }
+    }
+}
+
+/// The same σ_t = scale·sigma_t everywhere with an albedo that varies, α(x) from a volume
+/// (Mitsuba 3's `homogeneous` medium given a `gridvolume` albedo): the extinction, and so the
+/// free flights, majorant and transmittance, are a homogeneous medium's; only the scattering
+/// σ_s(x) = α(x) σ_t varies.
+#[derive(Clone, Debug)]
+pub struct HomogeneousExtinction {
+    pub sigma_t: Spectrum,
+    pub albedo: Volume,
+    pub scale: f32,
+}
+
+impl MediumModel for HomogeneousExtinction {
+    #[inline]
+    fn coefficients(&self, p: Vec3, lambda: &SampledWavelengths) -> MediumCoefficients {
+        let sigma_t = self.sigma_t.sample(lambda) * self.scale;
+        MediumCoefficients {
+            sigma_s: sigma_t * self.albedo.eval(p, lambda),
+            sigma_t,
+        }
+    }
+
+    fn is_homogeneous(&self) -> bool {
+        true
+    }
+
+    #[inline]
+    fn majorant(&self, lambda: &SampledWavelengths) -> f32 {
+        (self.sigma_t.sample(lambda) * self.scale).max_value()
+    }
+
+    fn ray_extent(&self, _ray: &Ray, t_max: f32) -> Option<(f32, f32)> {
+        Some((0.0, t_max))
     }
 }
 
@@ -259,7 +298,7 @@ impl Medium {
         }
     }
 
-    /// Whether the coefficients are the same everywhere.
+    /// Whether σ_t is the same everywhere (the albedo may still vary).
     #[inline]
     pub fn is_homogeneous(&self) -> bool {
         self.kind.is_homogeneous()

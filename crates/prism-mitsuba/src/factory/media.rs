@@ -15,9 +15,9 @@ use prism_core::error::{Error, Result};
 use prism_core::math::Transform;
 use prism_core::medium::volume::{VolFile, parse_vol};
 use prism_core::medium::{
-    BlendPhase, GridFilter, GridVolume, HenyeyGreenstein, Heterogeneous, Homogeneous,
-    HomogeneousAbsorbingScattering, Isotropic, Medium, MediumKind, PhaseFunction, Rayleigh, Sggx,
-    TabulatedPhase, Volume,
+    BlendPhase, ConstantInBox, GridFilter, GridVolume, GridWrap, HenyeyGreenstein, Heterogeneous,
+    Homogeneous, HomogeneousAbsorbingScattering, HomogeneousExtinction, Isotropic, Medium,
+    MediumKind, PhaseFunction, Rayleigh, Sggx, SpectralGridVolume, TabulatedPhase, Volume,
 };
 use prism_core::spectrum::Spectrum;
 
@@ -31,13 +31,14 @@ pub static MEDIA: Registry<BuildMedium> = Registry {
         Plugin {
             name: "homogeneous",
             origin: Origin::Mitsuba3,
-            summary: "The same extinction σ_t = scale · sigma_t and albedo everywhere; or, in \
-                      Mitsuba 0.6's form, σ_a = scale · sigma_a and σ_s = scale · sigma_s \
-                      (which Mitsuba 3 refuses). A shape takes it as its `interior` or \
-                      `exterior`, the sensor as the medium it sits in.",
+            summary: "The same extinction σ_t = scale · sigma_t everywhere, with an albedo \
+                      that is a value or, as in Mitsuba 3, a volume (so that only the \
+                      scattering varies); or, in Mitsuba 0.6's form, σ_a = scale · sigma_a and \
+                      σ_s = scale · sigma_s (which Mitsuba 3 refuses). A shape takes it as its \
+                      `interior` or `exterior`, the sensor as the medium it sits in.",
             params: &[
                 SIGMA_T,
-                ALBEDO,
+                ALBEDO_VOLUME,
                 SIGMA_A,
                 SIGMA_S,
                 SCALE,
@@ -119,17 +120,29 @@ pub static VOLUMES: Registry<BuildVolume> = Registry {
         Plugin {
             name: "constvolume",
             origin: Origin::Mitsuba3,
-            summary: "The same value everywhere.",
-            params: &[VALUE],
+            summary: "The same value everywhere. As a `heterogeneous` medium's `sigma_t`, it \
+                      also bounds the medium, as in Mitsuba 3: the medium is empty outside the \
+                      axis-aligned box around the unit cube placed by `to_world` (a plain \
+                      `sigma_t` value is the unit cube's).",
+            params: &[VALUE, VOLUME_TO_WORLD],
             build: build_constvolume,
         },
         Plugin {
             name: "gridvolume",
             origin: Origin::Mitsuba3,
-            summary: "A single-channel grid from a Mitsuba `.vol` file (32-bit floats) over the \
-                      unit cube placed by `to_world`, interpolated trilinearly between voxel \
-                      centres and clamped at its faces.",
-            params: &[FILENAME, FILTER_TYPE, VOLUME_TO_WORLD, USE_GRID_BBOX],
+            summary: "A grid from a Mitsuba `.vol` file (32-bit floats) over the unit cube placed \
+                      by `to_world`, interpolated trilinearly between voxel centres, clamped, \
+                      repeated or mirrored outside. One channel gives a number; three give a \
+                      colour, upsampled to a spectrum per voxel as Mitsuba 3's spectral \
+                      variants do (2·max(rgb) times the spectrum of rgb/(2·max(rgb)); the \
+                      spectra and the scales are interpolated separately and multiplied).",
+            params: &[
+                FILENAME,
+                FILTER_TYPE,
+                WRAP_MODE,
+                VOLUME_TO_WORLD,
+                USE_GRID_BBOX,
+            ],
             build: build_gridvolume,
         },
         super::inline_grid::INLINE_GRID,
@@ -138,10 +151,9 @@ pub static VOLUMES: Registry<BuildVolume> = Registry {
 
 params! {
     SIGMA_T = ParamSpec::new("sigma_t", ParamKind::Spectrum { range: Range::Coefficient, textured: false, }, Default::Float(1.0), "extinction coefficient per scene unit");
-    ALBEDO = ParamSpec::new("albedo", ParamKind::Spectrum { range: Range::Albedo, textured: false, }, Default::Float(0.75), "single-scattering albedo σ_s/σ_t, in [0, 1]");
     SIGMA_A = ParamSpec::new("sigma_a", ParamKind::Spectrum { range: Range::Coefficient, textured: false, }, Default::None, "Mitsuba 0.6: absorption coefficient, with `sigma_s` in place of `sigma_t` and `albedo`");
     SIGMA_S = ParamSpec::new("sigma_s", ParamKind::Spectrum { range: Range::Coefficient, textured: false, }, Default::None, "Mitsuba 0.6: scattering coefficient, with `sigma_a`");
-    SIGMA_T_VOLUME = ParamSpec::new("sigma_t", ParamKind::Volume(Range::Coefficient), Default::Float(1.0), "extinction coefficient per scene unit");
+    SIGMA_T_VOLUME = ParamSpec::new("sigma_t", ParamKind::Volume(Range::Coefficient), Default::Float(1.0), "extinction coefficient per scene unit; the medium is empty outside its box (a plain value's is the unit cube, as in Mitsuba 3)");
     ALBEDO_VOLUME = ParamSpec::new("albedo", ParamKind::Volume(Range::Albedo), Default::Float(0.75), "single-scattering albedo σ_s/σ_t, in [0, 1]");
     SCALE = ParamSpec::new("scale", ParamKind::Float, Default::Float(1.0), "factor on the coefficients (a change of units)");
     SAMPLE_EMITTERS = ParamSpec::new("sample_emitters", ParamKind::Boolean, Default::Boolean(true), "sample lights at scattering points in the medium (next-event estimation)");
@@ -153,7 +165,8 @@ params! {
     BLENDED_PHASES = ParamSpec::nested(PluginClass::Phase, Default::Required, "the two phase functions");
     VALUE = ParamSpec::new("value", ParamKind::Spectrum { range: Range::Coefficient, textured: false, }, Default::Float(1.0), "the value");
     FILENAME = ParamSpec::new("filename", ParamKind::String, Default::Required, "the `.vol` file");
-    FILTER_TYPE = ParamSpec::new("filter_type", ParamKind::Choice(&[Choice::new("bilinear", &GridFilter::Trilinear), Choice::new("nearest", &GridFilter::Nearest)]), Default::Str("bilinear"), "interpolation between voxels: `bilinear` (trilinear in 3D, Mitsuba's name) or `nearest`");
+    FILTER_TYPE = ParamSpec::new("filter_type", ParamKind::Choice(&[Choice::new("trilinear", &GridFilter::Trilinear), Choice::new("bilinear", &GridFilter::Trilinear), Choice::new("nearest", &GridFilter::Nearest)]), Default::Str("trilinear"), "interpolation between voxels: `trilinear` (Mitsuba 3's name; `bilinear` is read the same) or `nearest`");
+    WRAP_MODE = ParamSpec::new("wrap_mode", ParamKind::Choice(&[Choice::new("clamp", &GridWrap::Clamp), Choice::new("repeat", &GridWrap::Repeat), Choice::new("mirror", &GridWrap::Mirror)]), Default::Str("clamp"), "lookups outside the unit cube: `clamp` (the border voxels extend), `repeat` (the grid tiles space) or `mirror` (tiles, every other one mirrored)");
     VOLUME_TO_WORLD = ParamSpec::new("to_world", ParamKind::Transform, Default::Text("identity"), "from the unit cube [0, 1]³ to the world");
     USE_GRID_BBOX = ParamSpec::new("use_grid_bbox", ParamKind::Boolean, Default::Boolean(false), "place the grid in the box its file gives (then transformed by `to_world`)");
 }
@@ -222,7 +235,7 @@ fn given_max(params: &Params, spec: &ParamSpec, spectrum: &Spectrum) -> f32 {
 fn build_homogeneous(params: &Params) -> Result<Medium> {
     let scale = scale(params)?;
     let kind = if params.has(&SIGMA_A) || params.has(&SIGMA_S) {
-        for spec in [&SIGMA_T, &ALBEDO] {
+        for spec in [&SIGMA_T, &ALBEDO_VOLUME] {
             if params.has(spec) {
                 return Err(Error::input(
                     params.location_of(spec),
@@ -255,13 +268,24 @@ fn build_homogeneous(params: &Params) -> Result<Medium> {
             scale,
         })
     } else {
-        let albedo = spectrum_param(params, &ALBEDO)?;
-        check_albedo(params, &ALBEDO, given_max(params, &ALBEDO, &albedo))?;
-        MediumKind::Homogeneous(Homogeneous {
-            sigma_t: spectrum_param(params, &SIGMA_T)?,
-            albedo,
-            scale,
-        })
+        let sigma_t = spectrum_param(params, &SIGMA_T)?;
+        match volume_param(params, &ALBEDO_VOLUME)? {
+            Volume::Constant(albedo) => MediumKind::Homogeneous(Homogeneous {
+                sigma_t,
+                albedo,
+                scale,
+            }),
+            Volume::ConstantInBox(constant) => MediumKind::Homogeneous(Homogeneous {
+                sigma_t,
+                albedo: constant.value,
+                scale,
+            }),
+            albedo => MediumKind::HomogeneousExtinction(HomogeneousExtinction {
+                sigma_t,
+                albedo,
+                scale,
+            }),
+        }
     };
     Ok(Medium {
         kind,
@@ -302,7 +326,14 @@ fn volume_param(params: &Params, spec: &ParamSpec) -> Result<Volume> {
 }
 
 fn build_heterogeneous(params: &Params) -> Result<Medium> {
-    let sigma_t = volume_param(params, &SIGMA_T_VOLUME)?;
+    // Mitsuba reads a plain value as a `constvolume` over the unit cube, outside which the
+    // medium is empty.
+    let sigma_t = match volume_param(params, &SIGMA_T_VOLUME)? {
+        Volume::Constant(value) => {
+            Volume::ConstantInBox(Box::new(ConstantInBox::new(value, &Transform::IDENTITY)))
+        }
+        volume => volume,
+    };
     let albedo = volume_param(params, &ALBEDO_VOLUME)?;
     Ok(Medium {
         kind: MediumKind::Heterogeneous(Heterogeneous {
@@ -393,7 +424,19 @@ fn build_constvolume(params: &Params, range: Range) -> Result<Volume> {
     if range == Range::Albedo {
         check_albedo(params, &VALUE, given_max(params, &VALUE, &value))?;
     }
-    Ok(Volume::Constant(value))
+    let to_world = Transform::new(params.transform(&VOLUME_TO_WORLD)?).ok_or_else(|| {
+        Error::input(
+            params.location_of(&VOLUME_TO_WORLD),
+            format!(
+                "{} is placed by a singular transform",
+                params.node().describe()
+            ),
+        )
+        .with_help("give to_world a non-zero scale on every axis")
+    })?;
+    Ok(Volume::ConstantInBox(Box::new(ConstantInBox::new(
+        value, &to_world,
+    ))))
 }
 
 /// The `.vol` file a `gridvolume`'s `filename` names, read and parsed.
@@ -428,16 +471,16 @@ fn build_gridvolume(params: &Params, range: Range) -> Result<Volume> {
     let node = params.node();
     let (file, path) = read_grid(params)?;
     let location = params.location_of(&FILENAME);
-    if file.channels != 1 {
+    if file.channels != 1 && file.channels != 3 {
         return Err(Error::input(
             location,
             format!(
-                "the grid \"{}\" has {} channels; Prism reads single-channel grids",
+                "the grid \"{}\" has {} channels; a gridvolume holds one (a number) or three (a colour)",
                 path.display(),
                 file.channels
             ),
         )
-        .with_help("store one quantity (a density or an albedo) per grid"));
+        .with_help("store a density or a scalar albedo in one channel, an RGB colour in three"));
     }
     if let Some(bad) = file.data.iter().find(|v| !(v.is_finite() && **v >= 0.0)) {
         return Err(Error::input(
@@ -466,20 +509,31 @@ fn build_gridvolume(params: &Params, range: Range) -> Result<Volume> {
     };
     let to_world = Transform::new(to_world).ok_or_else(singular)?;
     let filter = params.choice(&FILTER_TYPE)?;
-    let grid = GridVolume::new(file.resolution, file.data, to_world, filter)
-        .expect("a parsed grid holds its voxels");
-    if range == Range::Albedo && grid.max_value() > 1.0 {
+    let wrap = params.choice(&WRAP_MODE)?;
+    let (volume, largest) = if file.channels == 3 {
+        let grid = SpectralGridVolume::new(file.resolution, &file.data, to_world, filter)
+            .expect("a parsed grid holds its voxels")
+            .with_wrap(wrap);
+        let largest = grid.max_component();
+        (Volume::SpectralGrid(Box::new(grid)), largest)
+    } else {
+        let grid = GridVolume::new(file.resolution, file.data, to_world, filter)
+            .expect("a parsed grid holds its voxels")
+            .with_wrap(wrap);
+        let largest = grid.max_value();
+        (Volume::Grid(Box::new(grid)), largest)
+    };
+    if range == Range::Albedo && largest > 1.0 {
         return Err(Error::input(
             location,
             format!(
-                "the albedo grid \"{}\" reaches {}, above 1: the medium would scatter more light than it removes",
+                "the albedo grid \"{}\" reaches {largest}, above 1: the medium would scatter more light than it removes",
                 path.display(),
-                grid.max_value()
             ),
         )
         .with_help("use values between 0 and 1"));
     }
-    Ok(Volume::Grid(Box::new(grid)))
+    Ok(volume)
 }
 
 /// Mitsuba's `sggx`: S from a six-channel `gridvolume` whose voxels all hold the same matrix.
@@ -509,11 +563,18 @@ fn build_sggx(params: &Params) -> Result<PhaseFunction> {
     }
     let grid = Params::new(
         &child.node,
-        &[FILENAME, FILTER_TYPE, VOLUME_TO_WORLD, USE_GRID_BBOX],
+        &[
+            FILENAME,
+            FILTER_TYPE,
+            WRAP_MODE,
+            VOLUME_TO_WORLD,
+            USE_GRID_BBOX,
+        ],
     );
     let (file, path) = read_grid(&grid)?;
     // The placement and filtering of a grid that holds one value everywhere change nothing.
     grid.choice::<GridFilter>(&FILTER_TYPE)?;
+    grid.choice::<GridWrap>(&WRAP_MODE)?;
     grid.transform(&VOLUME_TO_WORLD)?;
     grid.boolean(&USE_GRID_BBOX)?;
     let location = grid.location_of(&FILENAME);
