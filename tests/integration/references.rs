@@ -76,6 +76,11 @@ fn principledthin_matches_mitsuba() {
 }
 
 #[test]
+fn ellipsoids_match_mitsuba() {
+    assert_matches_reference("ellipsoids");
+}
+
+#[test]
 fn linearcurve_matches_mitsuba() {
     assert_matches_reference("linearcurve");
 }
