@@ -81,6 +81,16 @@ fn ellipsoids_match_mitsuba() {
 }
 
 #[test]
+fn sdfgrid_with_smooth_normals_matches_mitsuba() {
+    assert_matches_reference("sdfgrid_smooth");
+}
+
+#[test]
+fn sdfgrid_with_analytic_normals_matches_mitsuba() {
+    assert_matches_reference("sdfgrid_analytic");
+}
+
+#[test]
 fn linearcurve_matches_mitsuba() {
     assert_matches_reference("linearcurve");
 }

@@ -1,4 +1,4 @@
-//! Shapes and meshes: curves, the cylinder, ellipsoids, instancing, mesh attributes and serialized meshes.
+//! Shapes and meshes: curves, the cylinder, ellipsoids, SDF grids, instancing, mesh attributes and serialized meshes.
 
 mod bspline_curve;
 mod cylinder;
@@ -6,4 +6,5 @@ mod ellipsoids;
 mod instancing;
 mod linear_curve;
 mod mesh_attribute;
+mod sdf_grid;
 mod serialized;

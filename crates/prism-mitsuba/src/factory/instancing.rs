@@ -83,7 +83,7 @@ impl ShapeGroups {
             let (material, interface) = member(&shape_params)?;
             shape_params.finish()?;
             // A shape of zero area is never hit: read, as at the top level, and left out
-            // (curves and ellipsoids, which have no area, excepted).
+            // (curves, ellipsoids and SDF grids, which have no area, excepted).
             if shape.area() == 0.0 && !shapes::is_hit_without_area(plugin) {
                 continue;
             }

@@ -349,8 +349,9 @@ impl SceneBuilder {
         shapes::check_area(area, child)?;
         let shape_index = self.shapes.len() as u32;
         let emitter = shape_params.single_child(&shapes::EMITTER)?;
-        // Curves and ellipsoids are hit but have no area sampling in Mitsuba, which refuses to
-        // make curves emit (and never samples an emitter on ellipsoids); Prism refuses both.
+        // Curves, ellipsoids and SDF grids are hit but have no area sampling in Mitsuba, which
+        // refuses to make curves emit (and never samples an emitter on the others); Prism
+        // refuses them all.
         let no_area = shapes::is_hit_without_area(plugin);
         if no_area && let Some(emitter) = &emitter {
             return Err(Error::input(

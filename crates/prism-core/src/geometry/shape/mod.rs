@@ -1,4 +1,4 @@
-//! The shapes a scene is made of: triangle meshes, spheres, disks, cylinders, linear and B-spline curves, ellipsoids, in world space (or in the
+//! The shapes a scene is made of: triangle meshes, spheres, disks, cylinders, linear and B-spline curves, ellipsoids, SDF grids, in world space (or in the
 //! object space of an [`super::instance::Instance`]). Every shape answers the
 //! [`ShapeGeometry`] interface, and the enum [`Shape`] dispatches to it by an exhaustive `match`
 //! ([`crate::dispatch`]).
@@ -12,6 +12,7 @@ pub mod disk;
 pub mod ellipsoids;
 pub mod linear_curve;
 pub mod mesh;
+pub mod sdf_grid;
 pub mod sphere;
 pub mod uv_grid;
 
@@ -24,6 +25,7 @@ pub use disk::Disk;
 pub use ellipsoids::{Ellipsoid, Ellipsoids};
 pub use linear_curve::LinearCurve;
 pub use mesh::{MeshAttribute, RectangleView, SurfaceSample, TriangleMesh};
+pub use sdf_grid::{SdfGrid, SdfNormals};
 pub use sphere::{Sphere, SphereCone, area_to_solid_angle};
 
 use crate::dispatch::plugin_class;
@@ -156,6 +158,9 @@ plugin_class! {
         BSplineCurve(BSplineCurve),
         /// A cloud of ellipsoids; each is one primitive of the hierarchy.
         Ellipsoids(Ellipsoids),
+        /// A signed distance function on a grid; each voxel the surface crosses is one
+        /// primitive of the hierarchy.
+        SdfGrid(SdfGrid),
     }
 }
 
@@ -186,17 +191,19 @@ impl Shape {
             Shape::LinearCurve(curve) => curve.sample_area(0.0, u),
             Shape::BSplineCurve(curve) => curve.sample_area(0.0, u),
             Shape::Ellipsoids(ellipsoids) => ellipsoids.sample_area(0.0, u),
+            Shape::SdfGrid(grid) => grid.sample_area(0.0, u),
         }
     }
 }
 
-/// The parts of a shape made of them (the segments of a curve, the ellipsoids of a cloud),
-/// each a primitive of the hierarchy.
+/// The parts of a shape made of them (the segments of a curve, the ellipsoids of a cloud, the
+/// occupied voxels of an SDF grid), each a primitive of the hierarchy.
 #[derive(Clone, Copy, Debug)]
 pub enum Segments<'a> {
     Linear(&'a LinearCurve),
     BSpline(&'a BSplineCurve),
     Ellipsoids(&'a Ellipsoids),
+    SdfVoxels(&'a SdfGrid),
 }
 
 impl Segments<'_> {
@@ -207,6 +214,7 @@ impl Segments<'_> {
             Segments::Linear(curve) => curve.segment_count(),
             Segments::BSpline(curve) => curve.segment_count(),
             Segments::Ellipsoids(ellipsoids) => ellipsoids.count(),
+            Segments::SdfVoxels(grid) => grid.voxel_count(),
         }
     }
 
@@ -217,6 +225,7 @@ impl Segments<'_> {
             Segments::Linear(curve) => curve.segment_bounds(i as usize),
             Segments::BSpline(curve) => curve.segment_bounds(i as usize),
             Segments::Ellipsoids(ellipsoids) => ellipsoids.ellipsoid_bounds(i as usize),
+            Segments::SdfVoxels(grid) => grid.voxel_bounds(i as usize),
         }
     }
 
@@ -230,6 +239,7 @@ impl Segments<'_> {
                 curve.intersect_segment(i, ray.o, ray.d, t_max).map(|h| h.t)
             }
             Segments::Ellipsoids(ellipsoids) => ellipsoids.intersect_ellipsoid(i, ray, t_max),
+            Segments::SdfVoxels(grid) => grid.intersect_voxel(i, ray, t_max),
         }
     }
 }
