@@ -76,6 +76,21 @@ fn principledthin_matches_mitsuba() {
 }
 
 #[test]
+fn ellipsoids_match_mitsuba() {
+    assert_matches_reference("ellipsoids");
+}
+
+#[test]
+fn sdfgrid_with_smooth_normals_matches_mitsuba() {
+    assert_matches_reference("sdfgrid_smooth");
+}
+
+#[test]
+fn sdfgrid_with_analytic_normals_matches_mitsuba() {
+    assert_matches_reference("sdfgrid_analytic");
+}
+
+#[test]
 fn linearcurve_matches_mitsuba() {
     assert_matches_reference("linearcurve");
 }

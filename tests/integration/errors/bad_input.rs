@@ -664,7 +664,7 @@ fn cases() -> Vec<Case> {
             ])),
             arguments: RENDER,
             location: "scene.xml:3:",
-            says: "curves have no area sampling",
+            says: "has no area sampling",
         },
         // B-spline curves.
         Case {
@@ -713,7 +713,152 @@ fn cases() -> Vec<Case> {
             ])),
             arguments: RENDER,
             location: "scene.xml:3:",
-            says: "curves have no area sampling",
+            says: "has no area sampling",
+        },
+        // Ellipsoids.
+        Case {
+            name: "ellipsoids: a centre that is not a number",
+            files: Box::leak(Box::new([
+                (
+                    "scene.xml",
+                    scene!(
+                        "    <shape type=\"ellipsoids\"><string name=\"filename\" value=\"e.ply\"/></shape>"
+                    ),
+                ),
+                (
+                    "e.ply",
+                    "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\nproperty float nx\nproperty float ny\nproperty float nz\nproperty float scale_0\nproperty float scale_1\nproperty float scale_2\nproperty float rot_0\nproperty float rot_1\nproperty float rot_2\nproperty float rot_3\nend_header\n0 nan 0 0 0 0 -1 -1 -1 1 0 0 0\n",
+                ),
+            ])),
+            arguments: RENDER,
+            location: "e.ply:18:3",
+            says: "ellipsoid 0: its centre is not finite",
+        },
+        Case {
+            name: "ellipsoids: a zero quaternion",
+            files: Box::leak(Box::new([
+                (
+                    "scene.xml",
+                    scene!(
+                        "    <shape type=\"ellipsoids\"><string name=\"filename\" value=\"e.ply\"/></shape>"
+                    ),
+                ),
+                (
+                    "e.ply",
+                    "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\nproperty float nx\nproperty float ny\nproperty float nz\nproperty float scale_0\nproperty float scale_1\nproperty float scale_2\nproperty float rot_0\nproperty float rot_1\nproperty float rot_2\nproperty float rot_3\nend_header\n0 0 0 0 0 0 -1 -1 -1 0 0 0 0\n",
+                ),
+            ])),
+            arguments: RENDER,
+            location: "e.ply:18:28",
+            says: "its quaternion is zero",
+        },
+        Case {
+            name: "ellipsoids: more ellipsoids than the file holds",
+            files: Box::leak(Box::new([
+                (
+                    "scene.xml",
+                    scene!(
+                        "    <shape type=\"ellipsoids\"><string name=\"filename\" value=\"e.ply\"/></shape>"
+                    ),
+                ),
+                (
+                    "e.ply",
+                    "ply\nformat ascii 1.0\nelement vertex 1000\nproperty float x\nproperty float y\nproperty float z\nproperty float nx\nproperty float ny\nproperty float nz\nproperty float scale_0\nproperty float scale_1\nproperty float scale_2\nproperty float rot_0\nproperty float rot_1\nproperty float rot_2\nproperty float rot_3\nend_header\n0 0 0 0 0 0 -1 -1 -1 1 0 0 0\n",
+                ),
+            ])),
+            arguments: RENDER,
+            location: "e.ply:3:1",
+            says: "too short",
+        },
+        Case {
+            name: "ellipsoids: a property of type double",
+            files: Box::leak(Box::new([
+                (
+                    "scene.xml",
+                    scene!(
+                        "    <shape type=\"ellipsoids\"><string name=\"filename\" value=\"e.ply\"/></shape>"
+                    ),
+                ),
+                (
+                    "e.ply",
+                    "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty double y\nproperty float z\nproperty float nx\nproperty float ny\nproperty float nz\nproperty float scale_0\nproperty float scale_1\nproperty float scale_2\nproperty float rot_0\nproperty float rot_1\nproperty float rot_2\nproperty float rot_3\nend_header\n0 0 0 0 0 0 -1 -1 -1 1 0 0 0\n",
+                ),
+            ])),
+            arguments: RENDER,
+            location: "e.ply:5:1",
+            says: "32-bit floats",
+        },
+        Case {
+            name: "ellipsoids: no rotation",
+            files: Box::leak(Box::new([
+                (
+                    "scene.xml",
+                    scene!(
+                        "    <shape type=\"ellipsoids\"><string name=\"filename\" value=\"e.ply\"/></shape>"
+                    ),
+                ),
+                (
+                    "e.ply",
+                    "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\nproperty float nx\nproperty float ny\nproperty float nz\nproperty float scale_0\nproperty float scale_1\nproperty float scale_2\nproperty float rot_0\nproperty float rot_1\nproperty float rot_2\nend_header\n0 0 0 0 0 0 -1 -1 -1 1 0 0\n",
+                ),
+            ])),
+            arguments: RENDER,
+            location: "e.ply:3:1",
+            says: "Mitsuba's layout",
+        },
+        Case {
+            name: "ellipsoids: a text where a number belongs",
+            files: Box::leak(Box::new([
+                (
+                    "scene.xml",
+                    scene!(
+                        "    <shape type=\"ellipsoids\"><string name=\"filename\" value=\"e.ply\"/></shape>"
+                    ),
+                ),
+                (
+                    "e.ply",
+                    "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\nproperty float nx\nproperty float ny\nproperty float nz\nproperty float scale_0\nproperty float scale_1\nproperty float scale_2\nproperty float rot_0\nproperty float rot_1\nproperty float rot_2\nproperty float rot_3\nend_header\n0 0 0 0 0 0 -1 one -1 1 0 0 0\n",
+                ),
+            ])),
+            arguments: RENDER,
+            location: "e.ply:18:16",
+            says: "\"one\" is not a number",
+        },
+        Case {
+            name: "ellipsoids: an area emitter",
+            files: Box::leak(Box::new([
+                (
+                    "scene.xml",
+                    scene!(
+                        "    <shape type=\"ellipsoids\"><string name=\"filename\" value=\"e.ply\"/><emitter type=\"area\"/></shape>"
+                    ),
+                ),
+                (
+                    "e.ply",
+                    "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\nproperty float nx\nproperty float ny\nproperty float nz\nproperty float scale_0\nproperty float scale_1\nproperty float scale_2\nproperty float rot_0\nproperty float rot_1\nproperty float rot_2\nproperty float rot_3\nend_header\n0 0 0 0 0 0 -1 -1 -1 1 0 0 0\n",
+                ),
+            ])),
+            arguments: RENDER,
+            location: "scene.xml:3:",
+            says: "has no area sampling",
+        },
+        Case {
+            name: "ellipsoids: an extent of zero",
+            files: Box::leak(Box::new([
+                (
+                    "scene.xml",
+                    scene!(
+                        "    <shape type=\"ellipsoids\"><string name=\"filename\" value=\"e.ply\"/><float name=\"extent\" value=\"0\"/></shape>"
+                    ),
+                ),
+                (
+                    "e.ply",
+                    "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\nproperty float nx\nproperty float ny\nproperty float nz\nproperty float scale_0\nproperty float scale_1\nproperty float scale_2\nproperty float rot_0\nproperty float rot_1\nproperty float rot_2\nproperty float rot_3\nend_header\n0 0 0 0 0 0 -1 -1 -1 1 0 0 0\n",
+                ),
+            ])),
+            arguments: RENDER,
+            location: "scene.xml:3:",
+            says: "must be a positive number",
         },
         // Cylinders.
         render_scene(

@@ -1,8 +1,10 @@
-//! Shapes and meshes: curves, the cylinder, instancing, mesh attributes and serialized meshes.
+//! Shapes and meshes: curves, the cylinder, ellipsoids, SDF grids, instancing, mesh attributes and serialized meshes.
 
 mod bspline_curve;
 mod cylinder;
+mod ellipsoids;
 mod instancing;
 mod linear_curve;
 mod mesh_attribute;
+mod sdf_grid;
 mod serialized;

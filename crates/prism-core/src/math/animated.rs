@@ -40,7 +40,7 @@ pub enum AnimationError {
 /// Polar decomposition of the linear part A = R S (R a rotation, S symmetric), by the iteration
 /// R ← (R + R⁻ᵀ)/2, which converges quadratically to the orthogonal factor. A mirroring matrix
 /// (det A < 0) gets R = −Q, S = −Qᵀ A, so that R is a proper rotation.
-fn polar_decomposition(a: DMat3) -> (DMat3, DMat3) {
+pub fn polar_decomposition(a: DMat3) -> (DMat3, DMat3) {
     let mut r = a;
     for _ in 0..100 {
         let next = (r + r.inverse().transpose()) * 0.5;

@@ -83,8 +83,8 @@ impl ShapeGroups {
             let (material, interface) = member(&shape_params)?;
             shape_params.finish()?;
             // A shape of zero area is never hit: read, as at the top level, and left out
-            // (curves, which have no area, excepted).
-            if shape.area() == 0.0 && !shapes::is_curve(plugin) {
+            // (curves, ellipsoids and SDF grids, which have no area, excepted).
+            if shape.area() == 0.0 && !shapes::is_hit_without_area(plugin) {
                 continue;
             }
             object.push(shape);

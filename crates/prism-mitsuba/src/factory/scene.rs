@@ -351,18 +351,19 @@ impl SceneBuilder {
         shapes::check_area(area, child)?;
         let shape_index = self.shapes.len() as u32;
         let emitter = shape_params.single_child(&shapes::EMITTER)?;
-        // Curves are hit but have no area sampling in Mitsuba, which refuses to make them
-        // emit; so does Prism.
-        let curve = shapes::is_curve(plugin);
-        if curve && let Some(emitter) = &emitter {
+        // Curves, ellipsoids and SDF grids are hit but have no area sampling in Mitsuba, which
+        // refuses to make curves emit (and never samples an emitter on the others); Prism
+        // refuses them all.
+        let no_area = shapes::is_hit_without_area(plugin);
+        if no_area && let Some(emitter) = &emitter {
             return Err(Error::input(
                 &emitter.location,
                 format!(
-                    "{} cannot emit: curves have no area sampling (as in Mitsuba 3)",
+                    "{} cannot emit: it has no area sampling (as in Mitsuba 3)",
                     child.node.describe()
                 ),
             )
-            .with_help("remove the emitter, or light the curves with another shape"));
+            .with_help("remove the emitter, or light the scene with another shape"));
         }
         // A shape of zero area is never hit, so it contributes nothing; like Mitsuba, Prism
         // reads it (its BSDF included) and renders without it, but an emitter needs an area
@@ -396,7 +397,7 @@ impl SceneBuilder {
             });
         }
         shape_params.finish()?;
-        if area == 0.0 && !curve {
+        if area == 0.0 && !no_area {
             return Ok(());
         }
         self.shapes.push(shape);

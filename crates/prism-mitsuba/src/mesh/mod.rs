@@ -1,6 +1,6 @@
 //! Triangle meshes read from files: Wavefront OBJ ([`obj`]), Stanford PLY ([`ply`]) and
-//! Mitsuba's compressed format ([`serialized`]); and the control points of curve files
-//! ([`curves`]).
+//! Mitsuba's compressed format ([`serialized`]); the control points of curve files
+//! ([`curves`]) and the PLY files of ellipsoids ([`ellipsoids`]).
 //!
 //! A reader turns a file into a [`MeshData`] in object space: positions, optional per-vertex
 //! normals, texture coordinates and colours, and triangles indexing them. Polygons are triangulated as a
@@ -14,6 +14,7 @@
 //! `face_normals="true"`).
 
 pub mod curves;
+pub mod ellipsoids;
 pub mod obj;
 pub mod ply;
 pub mod serialized;

@@ -1,4 +1,4 @@
-//! The shapes a scene is made of: triangle meshes, spheres, disks, cylinders, linear and B-spline curves, in world space (or in the
+//! The shapes a scene is made of: triangle meshes, spheres, disks, cylinders, linear and B-spline curves, ellipsoids, SDF grids, in world space (or in the
 //! object space of an [`super::instance::Instance`]). Every shape answers the
 //! [`ShapeGeometry`] interface, and the enum [`Shape`] dispatches to it by an exhaustive `match`
 //! ([`crate::dispatch`]).
@@ -9,8 +9,10 @@ pub mod bspline_curve;
 pub mod curve;
 pub mod cylinder;
 pub mod disk;
+pub mod ellipsoids;
 pub mod linear_curve;
 pub mod mesh;
+pub mod sdf_grid;
 pub mod sphere;
 pub mod uv_grid;
 
@@ -20,8 +22,10 @@ pub use bspline_curve::BSplineCurve;
 pub use curve::Curve;
 pub use cylinder::Cylinder;
 pub use disk::Disk;
+pub use ellipsoids::{Ellipsoid, Ellipsoids};
 pub use linear_curve::LinearCurve;
 pub use mesh::{MeshAttribute, RectangleView, SurfaceSample, TriangleMesh};
+pub use sdf_grid::{SdfGrid, SdfNormals};
 pub use sphere::{Sphere, SphereCone, area_to_solid_angle};
 
 use crate::dispatch::plugin_class;
@@ -152,6 +156,11 @@ plugin_class! {
         LinearCurve(LinearCurve),
         /// Round uniform cubic B-spline curves; each segment is one primitive of the hierarchy.
         BSplineCurve(BSplineCurve),
+        /// A cloud of ellipsoids; each is one primitive of the hierarchy.
+        Ellipsoids(Ellipsoids),
+        /// A signed distance function on a grid; each voxel the surface crosses is one
+        /// primitive of the hierarchy.
+        SdfGrid(SdfGrid),
     }
 }
 
@@ -181,15 +190,20 @@ impl Shape {
             Shape::Cylinder(cylinder) => cylinder.sample_area(0.0, u),
             Shape::LinearCurve(curve) => curve.sample_area(0.0, u),
             Shape::BSplineCurve(curve) => curve.sample_area(0.0, u),
+            Shape::Ellipsoids(ellipsoids) => ellipsoids.sample_area(0.0, u),
+            Shape::SdfGrid(grid) => grid.sample_area(0.0, u),
         }
     }
 }
 
-/// The segments of a curve, each a primitive of the hierarchy.
+/// The parts of a shape made of them (the segments of a curve, the ellipsoids of a cloud, the
+/// occupied voxels of an SDF grid), each a primitive of the hierarchy.
 #[derive(Clone, Copy, Debug)]
 pub enum Segments<'a> {
     Linear(&'a LinearCurve),
     BSpline(&'a BSplineCurve),
+    Ellipsoids(&'a Ellipsoids),
+    SdfVoxels(&'a SdfGrid),
 }
 
 impl Segments<'_> {
@@ -199,6 +213,8 @@ impl Segments<'_> {
         match self {
             Segments::Linear(curve) => curve.segment_count(),
             Segments::BSpline(curve) => curve.segment_count(),
+            Segments::Ellipsoids(ellipsoids) => ellipsoids.count(),
+            Segments::SdfVoxels(grid) => grid.voxel_count(),
         }
     }
 
@@ -208,6 +224,8 @@ impl Segments<'_> {
         match self {
             Segments::Linear(curve) => curve.segment_bounds(i as usize),
             Segments::BSpline(curve) => curve.segment_bounds(i as usize),
+            Segments::Ellipsoids(ellipsoids) => ellipsoids.ellipsoid_bounds(i as usize),
+            Segments::SdfVoxels(grid) => grid.voxel_bounds(i as usize),
         }
     }
 
@@ -220,6 +238,8 @@ impl Segments<'_> {
             Segments::BSpline(curve) => {
                 curve.intersect_segment(i, ray.o, ray.d, t_max).map(|h| h.t)
             }
+            Segments::Ellipsoids(ellipsoids) => ellipsoids.intersect_ellipsoid(i, ray, t_max),
+            Segments::SdfVoxels(grid) => grid.intersect_voxel(i, ray, t_max),
         }
     }
 }

@@ -1,5 +1,6 @@
 //! Shape plugins: triangle meshes (`obj`, `ply`, `serialized`, `trianglemesh`, `rectangle`,
 //! `cube`), quadrics (`sphere`, `disk`, `cylinder`), curves (`linearcurve`, `bsplinecurve`),
+//! clouds of ellipsoids (`ellipsoids`), signed distance grids (`sdfgrid`),
 //! and the entries of the instancing plugins `shapegroup` and `instance`, which the scene builds
 //! ([`super::instancing`]). Any shape whose `to_world` is an `<animation>` moves while the
 //! shutter is open: it is built in object space and placed by an [`Instance`].
@@ -21,9 +22,11 @@ macro_rules! shape_params {
 }
 
 mod curves;
+mod ellipsoids;
 mod groups;
 mod meshes;
 mod quadrics;
+mod sdfgrid;
 
 use crate::description::{NestedPlugin, PluginClass, PluginNode};
 use crate::params::Params;
@@ -52,6 +55,8 @@ pub static SHAPES: Registry<Build> = Registry {
         quadrics::CYLINDER,
         curves::LINEARCURVE,
         curves::BSPLINECURVE,
+        ellipsoids::ELLIPSOIDS,
+        sdfgrid::SDFGRID,
         groups::SHAPEGROUP,
         groups::INSTANCE,
     ],
@@ -74,9 +79,13 @@ params! {
     pub SENSOR = ParamSpec::nested(PluginClass::Sensor, Default::None, "an `irradiancemeter` measuring the irradiance on the shape");
 }
 
-/// Whether `plugin` makes curves: shapes that are hit but have no area (nor area sampling).
-pub fn is_curve(plugin: &Plugin<Build>) -> bool {
-    matches!(plugin.name, "linearcurve" | "bsplinecurve")
+/// Whether `plugin` makes shapes that are hit but have no area (nor area sampling): curves,
+/// ellipsoids and SDF grids, which Mitsuba 3 gives no surface sampling.
+pub fn is_hit_without_area(plugin: &Plugin<Build>) -> bool {
+    matches!(
+        plugin.name,
+        "linearcurve" | "bsplinecurve" | "ellipsoids" | "sdfgrid"
+    )
 }
 
 /// The plugin a `<shape>` names, and its parameters.
