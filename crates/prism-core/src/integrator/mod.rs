@@ -153,7 +153,6 @@ impl Integrator {
             | Integrator::Sppm(_)
             | Integrator::PolarizedPath(_)
             | Integrator::Stokes(_)
-
             | Integrator::Guided(_) => &[],
         };
         nested.iter().map(|(_, integrator)| integrator)
@@ -201,7 +200,6 @@ impl Integrator {
             | Integrator::Bdpt(_)
             | Integrator::Sppm(_)
             | Integrator::PolarizedPath(_)
-
             | Integrator::Guided(_) => Vec::new(),
             Integrator::Moment(moment) => moment.aov_names(),
             Integrator::Stokes(stokes) => stokes.aov_names(),
