@@ -23,6 +23,8 @@ pub struct PiecewiseConstant1D {
     max: f32,
     /// The width of a cell, (max − min) / n.
     cell_width: f32,
+    /// Cells per unit of the domain, n / (max − min).
+    cells_per_unit: f32,
     /// The largest f32 below `max`, the largest point a sample may return.
     last: f32,
 }
@@ -108,6 +110,7 @@ impl PiecewiseConstant1D {
             min,
             max,
             cell_width: (max - min) / n as f32,
+            cells_per_unit: n as f32 / (max - min),
             last: max.next_down(),
         }
     }
@@ -146,11 +149,14 @@ impl PiecewiseConstant1D {
             .clamp(self.min, self.last);
         // Rounding may put x on the neighbouring cell's side of a border, where [`Self::pdf`]
         // would give that cell's density: keep it in the cell drawn.
-        while self.cell_of(x) > index {
-            x = x.next_down();
-        }
-        while self.cell_of(x) < index {
-            x = x.next_up();
+        let mut cell = self.cell_of(x);
+        while cell != index {
+            x = if cell > index {
+                x.next_down()
+            } else {
+                x.next_up()
+            };
+            cell = self.cell_of(x);
         }
         (x, index)
     }
@@ -158,8 +164,7 @@ impl PiecewiseConstant1D {
     /// The cell [`Self::pdf`] finds `x` in, for `x` in the domain.
     #[inline]
     fn cell_of(&self, x: f32) -> usize {
-        let n = self.density.len();
-        (((x - self.min) / (self.max - self.min) * n as f32) as usize).min(n - 1)
+        (((x - self.min) * self.cells_per_unit) as usize).min(self.density.len() - 1)
     }
 
     /// Density of [`Self::sample`] at `x` (zero outside the domain).
