@@ -15,7 +15,7 @@ use std::time::{Duration, Instant};
 
 use glam::Vec3;
 
-use super::bvh::{BuildPrimitive, Bvh, PrimitiveKind};
+use super::bvh::{BuildPrimitive, Bvh, MAX_INTERLEAVED, PrimitiveKind};
 use super::interaction::SurfaceInteraction;
 use super::shape::{Shape, ShapeGeometry, TriangleMesh};
 use super::triangle::{TriangleHit, WatertightRay};
@@ -211,6 +211,57 @@ impl<P: AggregateElement> Aggregate<P> {
             return external.closest_hit(&self.primitives, ray);
         }
         self.bvh_closest_hit(ray)
+    }
+
+    /// The closest hits in (0, t_max) of `rays` (at most [`MAX_INTERLEAVED`], None where
+    /// there is no ray), written to `hits`: each the one [`Self::closest_hit`] gives, our
+    /// BVH's traversals interleaved ([`Bvh::closest_hits`]).
+    pub fn closest_hits(&self, rays: &[Option<&Ray>], hits: &mut [Option<Hit>]) {
+        let Some(bvh) = self.bvh.as_ref().filter(|_| self.external.is_none()) else {
+            for (ray, hit) in rays.iter().zip(hits) {
+                *hit = ray.and_then(|ray| self.closest_hit(ray));
+            }
+            return;
+        };
+        let mut found = [None; MAX_INTERLEAVED];
+        let found = &mut found[..rays.len()];
+        bvh.closest_hits(
+            rays,
+            |i, id, t_max| rays[i].and_then(|ray| self.whole_hit(ray, id, t_max)),
+            found,
+        );
+        for (hit, found) in hits.iter_mut().zip(found) {
+            *hit = found.map(|(id, triangle)| {
+                let (shape, primitive) = self.element_of(id);
+                Hit {
+                    shape,
+                    primitive,
+                    triangle,
+                }
+            });
+        }
+    }
+
+    /// Whether anything blocks each of `rays` (at most [`MAX_INTERLEAVED`], None where there
+    /// is no ray) in (0, t_max), written to `blocked`: each what [`Self::occluded`] says, our
+    /// BVH's traversals interleaved ([`Bvh::occluded_each`]).
+    pub fn occluded_each(&self, rays: &[Option<&Ray>], blocked: &mut [bool]) {
+        let Some(bvh) = self.bvh.as_ref().filter(|_| self.external.is_none()) else {
+            for (ray, blocked) in rays.iter().zip(blocked) {
+                *blocked = ray.is_some_and(|ray| self.occluded(ray));
+            }
+            return;
+        };
+        let mut found = [None; MAX_INTERLEAVED];
+        let found = &mut found[..rays.len()];
+        bvh.occluded_each(
+            rays,
+            |i, id, t_max| rays[i].and_then(|ray| self.whole_hit(ray, id, t_max)),
+            found,
+        );
+        for (blocked, found) in blocked.iter_mut().zip(found) {
+            *blocked = found.is_some();
+        }
     }
 
     fn bvh_closest_hit(&self, ray: &Ray) -> Option<Hit> {

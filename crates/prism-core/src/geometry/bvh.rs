@@ -153,6 +153,34 @@ struct SlabRay {
     far: [usize; 3],
 }
 
+/// A query in progress ([`Bvh::visit`]): the ray prepared for the box and triangle tests, the
+/// nearest hit so far, the node to visit next and how many entries its stack holds.
+struct Walk {
+    slab: SlabRay,
+    pack_ray: PackRay,
+    t_max: f32,
+    nearest: Option<(u32, TriangleHit)>,
+    node: NodeRef,
+    depth: usize,
+}
+
+impl Walk {
+    #[inline(always)]
+    fn new(root: NodeRef, ray: &Ray, watertight: &WatertightRay) -> Walk {
+        Walk {
+            slab: SlabRay::new(ray),
+            pack_ray: PackRay::new(watertight),
+            t_max: ray.t_max,
+            nearest: None,
+            node: root,
+            depth: 0,
+        }
+    }
+}
+
+/// The most rays [`Bvh::closest_hits`] traces together.
+pub const MAX_INTERLEAVED: usize = 16;
+
 /// The exit distances are enlarged by this factor (pbrt-v4 §6.8.2).
 const ROBUST_EXIT: f32 = 1.0 + 2.0 * gamma(3);
 
@@ -342,28 +370,136 @@ impl Bvh {
         watertight: &WatertightRay,
         mut analytic: impl FnMut(u32, f32) -> Option<f32>,
     ) -> Option<(u32, TriangleHit)> {
-        let slab = SlabRay::new(ray);
-        let pack_ray = PackRay::new(watertight);
-        let mut t_max = ray.t_max;
-        let mut nearest = None;
-        let mut depth = 0usize;
-        let mut node = self.root;
-        loop {
-            // Down the tree to a leaf, nearest child first.
-            'descend: while node.is_inner() {
-                let n = &self.nodes[node.0 as usize];
-                let (t_near, mut mask) = slab.test::<AVX>(n, t_max);
-                if mask == 0 {
-                    break 'descend;
+        let mut walk = Walk::new(self.root, ray, watertight);
+        while self.visit::<AVX, ANY_HIT>(&mut walk, stack, &mut analytic) {}
+        walk.nearest
+    }
+
+    /// The nearest hits of `rays` (at most [`MAX_INTERLEAVED`]; None where there is no ray,
+    /// whose hit is None), written to `hits`, their traversals interleaved: each ray visits
+    /// one node and asks for the next node it will visit to be loaded, then the next ray takes
+    /// its turn, so that the rays' cache misses overlap instead of following one another.
+    /// `analytic(i, id, t_max)` intersects analytic primitive `id` with ray i. Each ray's
+    /// result is the one [`Self::closest_hit`] gives.
+    pub fn closest_hits(
+        &self,
+        rays: &[Option<&Ray>],
+        analytic: impl FnMut(usize, u32, f32) -> Option<f32>,
+        hits: &mut [Option<(u32, TriangleHit)>],
+    ) {
+        self.traverse_interleaved::<false>(rays, analytic, hits);
+    }
+
+    /// Whether anything blocks each of `rays` in (0, ray.t_max), written to `hits` (Some
+    /// where something does), the traversals interleaved as in [`Self::closest_hits`].
+    pub fn occluded_each(
+        &self,
+        rays: &[Option<&Ray>],
+        analytic: impl FnMut(usize, u32, f32) -> Option<f32>,
+        hits: &mut [Option<(u32, TriangleHit)>],
+    ) {
+        self.traverse_interleaved::<true>(rays, analytic, hits);
+    }
+
+    /// [`Self::interleaved`] in AVX where the processor has it, with stacks on the machine
+    /// stack; hierarchies deeper than that allows are traversed one ray after another.
+    #[inline(always)]
+    fn traverse_interleaved<const ANY_HIT: bool>(
+        &self,
+        rays: &[Option<&Ray>],
+        mut analytic: impl FnMut(usize, u32, f32) -> Option<f32>,
+        hits: &mut [Option<(u32, TriangleHit)>],
+    ) {
+        assert!(rays.len() <= MAX_INTERLEAVED && hits.len() == rays.len());
+        if self.stack_size > INLINE_STACK {
+            for (i, (ray, hit)) in rays.iter().zip(hits.iter_mut()).enumerate() {
+                *hit = ray.and_then(|ray| {
+                    let watertight = WatertightRay::new(ray.o, ray.d);
+                    self.traverse::<ANY_HIT>(ray, &watertight, |id, t| analytic(i, id, t))
+                });
+            }
+            return;
+        }
+        #[cfg(target_arch = "x86_64")]
+        if self.avx {
+            // SAFETY: `avx` is set only where the processor has AVX.
+            return unsafe { self.interleaved_avx::<ANY_HIT>(rays, analytic, hits) };
+        }
+        self.interleaved::<false, ANY_HIT>(rays, analytic, hits);
+    }
+
+    /// [`Self::interleaved`] compiled for AVX; the processor must have it.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx")]
+    unsafe fn interleaved_avx<const ANY_HIT: bool>(
+        &self,
+        rays: &[Option<&Ray>],
+        analytic: impl FnMut(usize, u32, f32) -> Option<f32>,
+        hits: &mut [Option<(u32, TriangleHit)>],
+    ) {
+        self.interleaved::<true, ANY_HIT>(rays, analytic, hits);
+    }
+
+    /// The rays' walks taking turns, one node per ray per turn, until every ray is done.
+    #[inline(always)]
+    fn interleaved<const AVX: bool, const ANY_HIT: bool>(
+        &self,
+        rays: &[Option<&Ray>],
+        mut analytic: impl FnMut(usize, u32, f32) -> Option<f32>,
+        hits: &mut [Option<(u32, TriangleHit)>],
+    ) {
+        let mut stacks = [[MaybeUninit::uninit(); INLINE_STACK]; MAX_INTERLEAVED];
+        let mut walks: [MaybeUninit<Walk>; MAX_INTERLEAVED] =
+            [const { MaybeUninit::uninit() }; MAX_INTERLEAVED];
+        let mut pending = 0u32;
+        for (i, (walk, ray)) in walks.iter_mut().zip(rays).enumerate() {
+            hits[i] = None;
+            if let Some(ray) = ray {
+                walk.write(Walk::new(self.root, ray, &WatertightRay::new(ray.o, ray.d)));
+                pending |= 1 << i;
+            }
+        }
+        while pending != 0 {
+            let mut turn = pending;
+            while turn != 0 {
+                let i = turn.trailing_zeros() as usize;
+                turn &= turn - 1;
+                // SAFETY: the walks of the rays in `pending` were written above.
+                let walk = unsafe { walks[i].assume_init_mut() };
+                let goes_on = self
+                    .visit::<AVX, ANY_HIT>(walk, &mut stacks[i], &mut |id, t| analytic(i, id, t));
+                if !goes_on {
+                    hits[i] = walk.nearest;
+                    pending &= !(1 << i);
                 }
+            }
+        }
+    }
+
+    /// One step of a query's front-to-back walk: visits the walk's node (an inner node's
+    /// children the ray enters within its nearest hit so far, the nearest one next and the
+    /// others pushed onto `stack`, farthest first; a leaf's primitives) and moves on to the
+    /// next node, popping pending children the ray can no longer reach first. Returns false
+    /// when the query is done (no node left, or with `ANY_HIT` a hit found).
+    #[inline(always)]
+    fn visit<const AVX: bool, const ANY_HIT: bool>(
+        &self,
+        walk: &mut Walk,
+        stack: &mut [MaybeUninit<(NodeRef, f32)>],
+        analytic: &mut impl FnMut(u32, f32) -> Option<f32>,
+    ) -> bool {
+        if walk.node.is_inner() {
+            let n = &self.nodes[walk.node.0 as usize];
+            let (t_near, mut mask) = walk.slab.test::<AVX>(n, walk.t_max);
+            if mask != 0 {
                 let first = mask.trailing_zeros() as usize;
                 mask &= mask - 1;
                 if mask == 0 {
-                    node = n.children[first];
-                    self.prefetch(node);
-                    continue;
+                    walk.node = n.children[first];
+                    self.prefetch(walk.node);
+                    return true;
                 }
-                // Two or more children: sorted by entry distance, the nearest visited now.
+                // Two or more children: sorted by entry distance, the nearest visited next.
                 let mut hits = [(NodeRef(0), 0.0f32); NODE_WIDTH];
                 hits[0] = (n.children[first], t_near[first]);
                 let mut count = 1;
@@ -379,41 +515,39 @@ impl Bvh {
                     hits[j] = entry;
                     count += 1;
                 }
-                // `hits` is farthest first: push all but the last, descend into the last. The
-                // pushed nodes are fetched into the cache meanwhile.
+                // `hits` is farthest first: push all but the last, visit the last. The pushed
+                // nodes are fetched into the cache meanwhile.
                 for &(pending, _) in &hits[..count - 1] {
                     self.prefetch(pending);
                 }
-                for (slot, &entry) in stack[depth..].iter_mut().zip(&hits[..count - 1]) {
+                for (slot, &entry) in stack[walk.depth..].iter_mut().zip(&hits[..count - 1]) {
                     slot.write(entry);
                 }
-                depth += count - 1;
-                node = hits[count - 1].0;
-                self.prefetch(node);
+                walk.depth += count - 1;
+                walk.node = hits[count - 1].0;
+                self.prefetch(walk.node);
+                return true;
             }
-            if !node.is_inner()
-                && let Some((id, hit)) = self.leaf_hit(node, &pack_ray, t_max, &mut analytic)
-            {
-                t_max = hit.t;
-                nearest = Some((id, hit));
-                if ANY_HIT {
-                    return nearest;
-                }
-            }
-            // Back up to the nearest pending child the ray can still reach first.
-            loop {
-                if depth == 0 {
-                    return nearest;
-                }
-                depth -= 1;
-                // SAFETY: the entries below `depth` have all been written.
-                let (pending, t_entry) = unsafe { stack[depth].assume_init() };
-                if t_entry <= t_max {
-                    node = pending;
-                    break;
-                }
+        } else if let Some((id, hit)) =
+            self.leaf_hit(walk.node, &walk.pack_ray, walk.t_max, analytic)
+        {
+            walk.t_max = hit.t;
+            walk.nearest = Some((id, hit));
+            if ANY_HIT {
+                return false;
             }
         }
+        // Back up to the nearest pending child the ray can still reach first.
+        while walk.depth > 0 {
+            walk.depth -= 1;
+            // SAFETY: the entries below `depth` have all been written.
+            let (pending, t_entry) = unsafe { stack[walk.depth].assume_init() };
+            if t_entry <= walk.t_max {
+                walk.node = pending;
+                return true;
+            }
+        }
+        false
     }
 
     /// Asks the processor to start loading a child: an inner node or a leaf's triangle pack.
@@ -1131,6 +1265,67 @@ mod tests {
                 portable.occluded(&ray, &watertight, none),
                 avx.occluded(&ray, &watertight, none)
             );
+        }
+    }
+
+    /// Interleaved queries of up to [`MAX_INTERLEAVED`] rays, some lanes empty, give each ray
+    /// what its query alone gives, bit for bit, with analytic primitives and both node tests.
+    #[test]
+    fn interleaved_queries_agree_with_one_ray_queries() {
+        let mut rng = Pcg32::seeded(23);
+        for triangles in [1, 17, 3000] {
+            let (primitives, spheres) = scene(&mut rng, triangles);
+            let mut bvh = Bvh::build(&primitives).unwrap();
+            for avx in [false, has_avx()] {
+                bvh.avx = avx;
+                let mut hits = 0;
+                for group in 0..400 {
+                    let width = 1 + group % MAX_INTERLEAVED;
+                    let rays: Vec<Option<Ray>> = (0..width)
+                        .map(|k| {
+                            // Most rays aim at a primitive, some go anywhere.
+                            let o = random_unit(&mut rng) * 2.0;
+                            let aim = match primitives[(group + k) % primitives.len()].kind {
+                                PrimitiveKind::Triangle(v) => (v[0] + v[1] + v[2]) / 3.0,
+                                PrimitiveKind::Analytic { lo, hi } => (lo + hi) / 2.0,
+                            };
+                            let d = if k % 4 == 1 {
+                                random_unit(&mut rng)
+                            } else {
+                                aim + random_unit(&mut rng) * 0.02 - o
+                            };
+                            let t_max = if k % 3 == 0 { 1.5 } else { f32::INFINITY };
+                            (k % 5 != 4).then(|| Ray::new(o, d, t_max, 0.0))
+                        })
+                        .collect();
+                    let refs: Vec<Option<&Ray>> = rays.iter().map(Option::as_ref).collect();
+                    let analytic = |i: usize, id: u32, t_max: f32| {
+                        sphere_hit(rays[i].as_ref()?, spheres[id as usize - triangles], t_max)
+                    };
+                    let stale = TriangleHit {
+                        t: -1.0,
+                        b0: 0.0,
+                        b1: 0.0,
+                        b2: 0.0,
+                    };
+                    let mut nearest = vec![Some((u32::MAX, stale)); width];
+                    let mut blocking = nearest.clone();
+                    bvh.closest_hits(&refs, analytic, &mut nearest);
+                    bvh.occluded_each(&refs, analytic, &mut blocking);
+                    for (i, ray) in rays.iter().enumerate() {
+                        let Some(ray) = ray else {
+                            assert_eq!((nearest[i], blocking[i]), (None, None));
+                            continue;
+                        };
+                        let watertight = WatertightRay::new(ray.o, ray.d);
+                        let one = |id: u32, t: f32| analytic(i, id, t);
+                        assert_eq!(nearest[i], bvh.closest_hit(ray, &watertight, one));
+                        assert_eq!(blocking[i].is_some(), bvh.occluded(ray, &watertight, one));
+                        hits += usize::from(nearest[i].is_some());
+                    }
+                }
+                assert!(hits > 500, "{triangles} triangles: only {hits} hits");
+            }
         }
     }
 

@@ -2,12 +2,16 @@
 //! together, one vertex per step, each stage run for every active lane before the next stage
 //! begins (docs/architecture.md, Paths in lanes).
 //!
-//! A step traces the ray of every active lane to its closest hit, then turns each hit into
-//! its surface interaction and runs the path tracer's vertex ([`PathIntegrator::step`]) on
-//! it. A lane whose path ends writes its sample to the film and regenerates: it takes its
-//! pixel's next sample index, or, when its pixel has all the pass's samples, the next pixel of
-//! the tile that no lane has taken, so that a few long paths do not idle the others. A lane keeps its pixel's samples in order, which keeps its
-//! sampler's walk along the pixel's random stream one step per sample.
+//! A step traces the ray of every active lane to its closest hit (the trace stage), turns
+//! each hit into its surface interaction and runs the path tracer's vertex
+//! ([`PathIntegrator::step`]) on it (the vertex stage), then traces the shadow rays of the
+//! vertices' light samples (the shadow stage). Both ray stages interleave the lanes' BVH
+//! traversals ([`crate::geometry::Aggregate::closest_hits`]), so that one ray's cache misses
+//! overlap another's. A lane whose path ends writes its sample to the film and regenerates:
+//! it takes its pixel's next sample index, or, when its pixel has all the pass's samples, the
+//! next pixel of the tile that no lane has taken, so that a few long paths do not idle the
+//! others. A lane keeps its pixel's samples in order, which keeps its sampler's walk along the
+//! pixel's random stream one step per sample.
 //!
 //! Where the samples come from and go is the caller's: the one-pixel reconstruction hands
 //! the lanes a tile's pixels and adds each sample to its pixel's sums; filter MIS hands them a
@@ -27,6 +31,7 @@ use super::stop::Cancel;
 use crate::geometry::aggregate::Hit;
 use crate::integrator::path::PathState;
 use crate::integrator::{PathIntegrator, RayCount, SampleContext};
+use crate::math::Ray;
 use crate::math::lanes::{F32s, Real};
 use crate::sampling::sampler::Sampler;
 use crate::spectrum::SampledSpectrum;
@@ -215,25 +220,25 @@ pub(super) fn trace_in_lanes(
         })
         .collect();
     let mut hits: Vec<Option<Hit>> = vec![None; LANES];
+    let mut going_on = [false; LANES];
+    let mut blocked = [false; LANES];
     let mut occupancy = Occupancy::default();
     while !run.cancelled {
-        // The trace stage: every active lane's ray to its closest hit.
-        let mut active = 0;
-        for (lane, hit) in lanes.iter().zip(hits.iter_mut()) {
-            if let Some(path) = &lane.path {
-                active += 1;
-                run.count.rays += 1;
-                *hit = scene.world.geometry.closest_hit(&path.ray);
-            }
-        }
+        // The trace stage: every active lane's ray to its closest hit, the traversals
+        // interleaved.
+        let rays: [Option<&Ray>; LANES] =
+            std::array::from_fn(|i| lanes[i].path.as_ref().map(|path| &path.ray));
+        let active = rays.iter().flatten().count() as u64;
         if active == 0 {
             return Some((run.count.rays, occupancy));
         }
+        scene.world.geometry.closest_hits(&rays, &mut hits);
+        run.count.rays += active;
         occupancy.lane_steps += LANES as u64;
         occupancy.active += active;
         // The vertex stage: every active lane's hit as a surface interaction, and the path's
-        // vertex there; ended paths go to the sink and their lanes take the next samples.
-        for (lane, hit) in lanes.iter_mut().zip(hits.iter_mut()) {
+        // vertex there.
+        for ((lane, hit), goes_on) in lanes.iter_mut().zip(&mut hits).zip(&mut going_on) {
             let Some(state) = &mut lane.path else {
                 continue;
             };
@@ -245,7 +250,25 @@ pub(super) fn trace_in_lanes(
                 sampler: &mut lane.sampler,
                 count: &mut run.count,
             };
-            if !path.step(ctx, state, si) {
+            *goes_on = path.step(ctx, state, si);
+        }
+        // The shadow stage: the light samples' shadow rays, the traversals interleaved.
+        let shadow_rays: [Option<&Ray>; LANES] = std::array::from_fn(|i| {
+            let test = lanes[i].path.as_ref()?.shadow_test()?;
+            Some(&test.ray)
+        });
+        scene
+            .world
+            .geometry
+            .occluded_each(&shadow_rays, &mut blocked);
+        run.count.rays += shadow_rays.iter().flatten().count() as u64;
+        // Ended paths go to the sink and their lanes take the next samples.
+        for ((lane, &blocked), &goes_on) in lanes.iter_mut().zip(&blocked).zip(&going_on) {
+            let Some(state) = &mut lane.path else {
+                continue;
+            };
+            state.resolve_shadow(blocked);
+            if !goes_on {
                 run.finish(lane, cancel);
             }
         }
