@@ -14,6 +14,11 @@
 //! - `shadow_occluded`: from the same points to a point on a light chosen by power (the
 //!   integrator's next-event estimation rays), finite segments.
 //!
+//! The bounce and shadow rays are also traced without the surface interaction, one at a time
+//! (`bounce_closest_hit`, `shadow_occluded`) and [`MAX_INTERLEAVED`] at a time with their
+//! traversals interleaved, as the path tracer's lanes trace them (`bounce_closest_hits_lanes`,
+//! `shadow_occluded_lanes`; [`prism_core::geometry::Aggregate::closest_hits`]).
+//!
 //! Criterion reports the throughput in rays (elements) per second. The large scene is written
 //! (once; it is kept in `target/bench-scenes`) and loaded only when one of its benchmarks runs,
 //! so `cargo bench --bench traversal -- cornell` is quick.
@@ -29,6 +34,7 @@ use criterion::{BatchSize, Criterion, SamplingMode, Throughput, criterion_group,
 use glam::{UVec2, Vec2};
 use prism_core::camera::CameraModel;
 use prism_core::geometry::Geometry;
+use prism_core::geometry::bvh::MAX_INTERLEAVED;
 use prism_core::light::{LightQuery, LightSource, Receiver};
 use prism_core::math::{Frame, Ray};
 use prism_core::sampling::rng::Pcg32;
@@ -146,6 +152,37 @@ fn occluded_all(geometry: &Geometry, rays: &[Ray]) -> usize {
     rays.iter().filter(|ray| geometry.occluded(ray)).count()
 }
 
+/// Closest-hit queries over `rays`, without the surface interaction; returns the number of hits.
+fn closest_hit_all(geometry: &Geometry, rays: &[Ray]) -> usize {
+    rays.iter()
+        .filter(|ray| black_box(geometry.closest_hit(ray)).is_some())
+        .count()
+}
+
+/// [`closest_hit_all`] with [`MAX_INTERLEAVED`] rays at a time, their traversals interleaved.
+fn closest_hits_interleaved(geometry: &Geometry, rays: &[Ray]) -> usize {
+    let mut hits = [None; MAX_INTERLEAVED];
+    let mut count = 0;
+    for group in rays.chunks(MAX_INTERLEAVED) {
+        let group: [Option<&Ray>; MAX_INTERLEAVED] = std::array::from_fn(|i| group.get(i));
+        geometry.closest_hits(&group, &mut hits);
+        count += black_box(&hits).iter().flatten().count();
+    }
+    count
+}
+
+/// [`occluded_all`] with [`MAX_INTERLEAVED`] rays at a time, their traversals interleaved.
+fn occluded_interleaved(geometry: &Geometry, rays: &[Ray]) -> usize {
+    let mut blocked = [false; MAX_INTERLEAVED];
+    let mut count = 0;
+    for group in rays.chunks(MAX_INTERLEAVED) {
+        let group: [Option<&Ray>; MAX_INTERLEAVED] = std::array::from_fn(|i| group.get(i));
+        geometry.occluded_each(&group, &mut blocked);
+        count += blocked.iter().filter(|&&b| b).count();
+    }
+    count
+}
+
 /// One of a fixture's ray sets.
 type RaySet = fn(&Fixture) -> &[Ray];
 /// A query over a ray set.
@@ -158,10 +195,13 @@ fn traversal(c: &mut Criterion) {
         // the same iteration count.
         group.sample_size(10).sampling_mode(SamplingMode::Flat);
         group.throughput(Throughput::Elements(u64::from(GRID * GRID)));
-        let cases: [(&str, RaySet, Query); 3] = [
+        let cases: [(&str, RaySet, Query); 6] = [
             ("camera_intersect", |f| &f.camera, intersect_all),
             ("bounce_intersect", |f| &f.bounce, intersect_all),
             ("shadow_occluded", |f| &f.shadow, occluded_all),
+            ("bounce_closest_hit", |f| &f.bounce, closest_hit_all),
+            ("bounce_closest_hits_lanes", |f| &f.bounce, closest_hits_interleaved),
+            ("shadow_occluded_lanes", |f| &f.shadow, occluded_interleaved),
         ];
         for (id, rays_of, query) in cases {
             group.bench_function(id, |b| {
