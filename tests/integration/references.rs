@@ -157,6 +157,14 @@ fn ply_face_colours_match_mitsuba() {
     assert_matches_reference("face_color");
 }
 
+/// `volume` textures in the form of Mitsuba's lego tutorial scene: a `principled` sphere whose
+/// base colour and roughness are grids read at the surface point's world position, on a floor
+/// whose reflectance is a `constvolume`.
+#[test]
+fn volume_textures_match_mitsuba() {
+    assert_matches_reference("volume_texture");
+}
+
 /// `scenes/emitters/sunsky.xml`: sky and sun over a diffuse ground and sphere in a +y-up world.
 /// Mitsuba's own samples of this emitter are noisier than Prism's (about 38 times the variance
 /// per sample on the ground), so the reference's standard errors are measured: from the
