@@ -7,6 +7,7 @@
 * rgb_sigma_t.vol: 4 x 4 x 4 voxels of three channels, a chromatic extinction,
   (0.5 + 2 x, 1.5 - y, 0.3 + 1.2 z x).
 * density.vol: 8 x 8 x 8 voxels of one channel, a smooth blob, 0.2 + 1.8 exp(-6 |p - c|^2).
+* roughness.vol: 5 x 5 x 5 voxels of one channel, a roughness, 0.1 + 0.6 y (1 - 0.5 z) + 0.2 x.
 """
 import math
 import struct
@@ -33,3 +34,5 @@ write("tests/references/rgb_sigma_t.vol", (4, 4, 4), 3,
       lambda x, y, z: [0.5 + 2 * x, 1.5 - y, 0.3 + 1.2 * z * x])
 write("tests/references/density.vol", (8, 8, 8), 1,
       lambda x, y, z: 0.2 + 1.8 * math.exp(-6 * ((x - 0.5) ** 2 + (y - 0.5) ** 2 + (z - 0.5) ** 2)))
+write("tests/references/roughness.vol", (5, 5, 5), 1,
+      lambda x, y, z: 0.1 + 0.6 * y * (1 - 0.5 * z) + 0.2 * x)

@@ -934,6 +934,30 @@ fn cases() -> Vec<Case> {
             says: "is a colour of three channels, which its BSDF reads as a number",
         },
         render_scene(
+            "volume texture as an emitter's radiance",
+            scene!(
+                "    <shape type=\"sphere\"><emitter type=\"area\"><texture type=\"volume\" name=\"radiance\"><float name=\"volume\" value=\"1\"/></texture></emitter></shape>"
+            ),
+            "scene.xml:3:",
+            "an emitter looks its textures up by (u, v) alone",
+        ),
+        render_scene(
+            "volume texture as a bump map's heights",
+            scene!(
+                "    <shape type=\"sphere\"><bsdf type=\"bumpmap\"><texture type=\"volume\"><float name=\"volume\" value=\"0.5\"/></texture><bsdf type=\"diffuse\"/></bsdf></shape>"
+            ),
+            "scene.xml:3:",
+            "which gives them no (u, v) gradient",
+        ),
+        render_scene(
+            "volume texture as a normal map",
+            scene!(
+                "    <shape type=\"sphere\"><bsdf type=\"normalmap\"><texture type=\"volume\" name=\"normalmap\"><float name=\"volume\" value=\"0.5\"/></texture><bsdf type=\"diffuse\"/></bsdf></shape>"
+            ),
+            "scene.xml:3:",
+            "is read here as a raw RGB triple (a normal map)",
+        ),
+        render_scene(
             "mesh_attribute: no name",
             scene!(
                 "    <shape type=\"sphere\"><bsdf type=\"diffuse\"><texture type=\"mesh_attribute\" name=\"reflectance\"/></bsdf></shape>"
@@ -1066,6 +1090,28 @@ fn media_cases() -> Vec<Case> {
         says,
     };
     vec![
+        Case {
+            name: "volume texture of a colour grid read as a number",
+            files: Box::leak(Box::new([
+                (
+                    "scene.xml",
+                    scene!(
+                        "    <shape type=\"sphere\"><bsdf type=\"roughconductor\"><texture type=\"volume\" name=\"alpha\"><volume type=\"gridvolume\" name=\"volume\"><string name=\"filename\" value=\"colour.vol\"/></volume></texture></bsdf></shape>"
+                    ),
+                ),
+                (
+                    "colour.vol",
+                    // One voxel of colour (0.5, 0, 0).
+                    concat!(
+                        vol_header!("\x01", "\x01", "\x01", "\x03"),
+                        "\x00\x00\x00\x3f\x00\x00\x00\x00\x00\x00\x00\x00"
+                    ),
+                ),
+            ])),
+            arguments: RENDER,
+            location: "scene.xml:3:",
+            says: "holds a three-channel grid, a colour, where a number is wanted",
+        },
         render_scene(
             "negative extinction",
             scene!(

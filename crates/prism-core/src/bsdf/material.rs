@@ -79,6 +79,7 @@ impl Material {
         let point = ShadingPoint {
             uv: si.uv,
             attributes: si.attributes,
+            p: si.p,
             frame,
             ng: if si.n.dot(frame.n) < 0.0 { -si.n } else { si.n },
             dp_du: si.dp_du,

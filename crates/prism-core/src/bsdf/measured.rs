@@ -529,13 +529,7 @@ mod tests {
     }
 
     fn lobes<'a>(measured: &'a Measured, lambda: &SampledWavelengths) -> MeasuredLobes<'a> {
-        measured.lobes(
-            TexturePoint {
-                uv: Vec2::ZERO,
-                attributes: Default::default(),
-            },
-            lambda,
-        )
+        measured.lobes(TexturePoint::from(Vec2::ZERO), lambda)
     }
 
     /// The tabulated material reproduces the analytic one: f cos θi within 3 % of its peak

@@ -268,6 +268,8 @@ pub struct ShadingPoint {
     pub uv: Vec2,
     /// The hit mesh's attributes at the point (for `mesh_attribute` textures).
     pub attributes: AttributeValues,
+    /// The point's world position (for `volume` textures).
+    pub p: Vec3,
     /// The shading frame that the local directions refer to (world space).
     pub frame: Frame,
     /// The geometric normal, on the side of `frame.n`.
@@ -284,6 +286,7 @@ impl ShadingPoint {
         TexturePoint {
             uv: self.uv,
             attributes: self.attributes,
+            p: self.p,
         }
     }
 
@@ -293,6 +296,7 @@ impl ShadingPoint {
         ShadingPoint {
             uv,
             attributes: AttributeValues::default(),
+            p: Vec3::ZERO,
             frame: Frame {
                 s: Vec3::X,
                 t: Vec3::Y,

@@ -90,7 +90,8 @@ fn luminance_density(texture: &Texture) -> (PiecewiseConstant2D, f32) {
         | Texture::Checkerboard(_)
         | Texture::MeshAttribute(_)
         | Texture::Scale(_)
-        | Texture::Mix(_) => (PATTERN_RESOLUTION, PATTERN_RESOLUTION),
+        | Texture::Mix(_)
+        | Texture::Volume(_) => (PATTERN_RESOLUTION, PATTERN_RESOLUTION),
     };
     let weights: Vec<f32> = (0..nx * ny)
         .map(|cell| {

@@ -173,6 +173,11 @@ impl GridVolume {
         self.max_value
     }
 
+    /// The smallest voxel value.
+    pub fn min_value(&self) -> f32 {
+        self.data.iter().copied().fold(f32::INFINITY, f32::min)
+    }
+
     pub fn resolution(&self) -> [usize; 3] {
         self.lattice.resolution
     }

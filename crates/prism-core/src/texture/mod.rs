@@ -1,4 +1,5 @@
-//! Textures: values that vary over a surface with its (u, v) coordinates. Any BSDF parameter
+//! Textures: values that vary over a surface with its (u, v) coordinates (or, for a `volume`
+//! texture, with its position). Any BSDF parameter
 //! that Mitsuba lets vary (reflectances, roughness, opacity, blend weights, η and k, bump heights,
 //! normal maps) is a [`Texture`]; a constant is the common case.
 //!
@@ -7,8 +8,9 @@
 //! * as a number ([`Texture::eval_1`]): roughness, opacity, weights, heights;
 //! * as a raw RGB triple ([`Texture::eval_3`]): normal maps.
 //!
-//! A texture is looked up at a [`TexturePoint`]: the surface's (u, v) and the mesh attributes
-//! interpolated there (for `mesh_attribute`); a bare `Vec2` is a point without attributes.
+//! A texture is looked up at a [`TexturePoint`]: the surface's (u, v), the mesh attributes
+//! interpolated there (for `mesh_attribute`) and its world position (for `volume`); a bare
+//! `Vec2` is a point without attributes or position, as emitters look their textures up.
 
 pub mod bitmap;
 pub mod checkerboard;
@@ -16,6 +18,7 @@ pub mod constant;
 pub mod mesh_attribute;
 pub mod mix;
 pub mod scale;
+pub mod volume;
 
 use std::sync::Arc;
 
@@ -26,6 +29,7 @@ pub use checkerboard::Checkerboard;
 pub use mesh_attribute::MeshAttributeTexture;
 pub use mix::MixTexture;
 pub use scale::ScaledTexture;
+pub use volume::VolumeTexture;
 
 use crate::dispatch::plugin_class;
 use crate::geometry::interaction::AttributeValues;
@@ -81,6 +85,8 @@ plugin_class! {
         Scale(Box<ScaledTexture>),
         /// Two textures blended by a number-valued texture (pbrt-v4's `mix`).
         Mix(Box<MixTexture>),
+        /// A volume read at the surface point's world position (Mitsuba's `volume`).
+        Volume(Arc<VolumeTexture>),
     }
 }
 
@@ -90,14 +96,18 @@ pub struct TexturePoint {
     pub uv: Vec2,
     /// The hit mesh's attributes, interpolated at the point (zero where the mesh has none).
     pub attributes: AttributeValues,
+    /// The point's world position (the origin for a lookup by (u, v) alone, which the scene
+    /// reader never gives a `volume` texture).
+    pub p: Vec3,
 }
 
 impl From<Vec2> for TexturePoint {
-    /// A point of a surface without mesh attributes.
+    /// A point of a surface without mesh attributes or position.
     fn from(uv: Vec2) -> TexturePoint {
         TexturePoint {
             uv,
             attributes: AttributeValues::default(),
+            p: Vec3::ZERO,
         }
     }
 }
@@ -106,6 +116,20 @@ impl Texture {
     /// The constant `v` everywhere.
     pub fn constant(v: f32) -> Texture {
         Texture::Constant(Spectrum::Constant(v))
+    }
+
+    /// Whether the texture, or one it combines, is a [`VolumeTexture`], read at the surface
+    /// point's position and without a (u, v) gradient.
+    pub fn reads_position(&self) -> bool {
+        match self {
+            Texture::Volume(_) => true,
+            Texture::Constant(_) | Texture::Bitmap(_) | Texture::MeshAttribute(_) => false,
+            Texture::Checkerboard(c) => c.color0.reads_position() || c.color1.reads_position(),
+            Texture::Scale(s) => s.texture.reads_position() || s.scale.reads_position(),
+            Texture::Mix(m) => {
+                m.tex1.reads_position() || m.tex2.reads_position() || m.amount.reads_position()
+            }
+        }
     }
 }
 

@@ -295,7 +295,7 @@ fn build_homogeneous(params: &Params) -> Result<Medium> {
 }
 
 /// A volume parameter: a nested `<volume name="...">` or a plain value.
-fn volume_param(params: &Params, spec: &ParamSpec) -> Result<Volume> {
+pub(super) fn volume_param(params: &Params, spec: &ParamSpec) -> Result<Volume> {
     let ParamKind::Volume(range) = spec.kind else {
         panic!("\"{}\" is not a volume", spec.name);
     };

@@ -1,5 +1,5 @@
-//! Texture plugins (`bitmap`, `checkerboard`, `mesh_attribute`, `rawconstant`, and pbrt-v4's
-//! `scale` and `mix`) and texture-valued parameters: any colour or
+//! Texture plugins (`bitmap`, `checkerboard`, `mesh_attribute`, `rawconstant`, `volume`, and
+//! pbrt-v4's `scale` and `mix`) and texture-valued parameters: any colour or
 //! number a BSDF takes may be given as a value (`<rgb>`, `<spectrum>`, `<float>`) or as a nested
 //! `<texture>` (inline or a `<ref name="..." id="..."/>` to a texture declared at the top level).
 //!
@@ -11,6 +11,7 @@ use std::collections::HashMap;
 use std::path::Path;
 use std::sync::Arc;
 
+use super::media::volume_param;
 use super::spectra::spectrum_param;
 use crate::description::{PluginClass, PluginNode, PropertyValue, SpectrumValue};
 use crate::file_cache;
@@ -22,11 +23,14 @@ use crate::registry::{
 use prism_core::error::{Error, Result};
 use prism_core::geometry::interaction::MAX_MESH_ATTRIBUTES;
 use prism_core::image::{Bitmap, Encoding, decode_bitmap_file};
+use prism_core::medium::Volume;
 use prism_core::spectrum::{LAMBDA_MAX, LAMBDA_MIN, RgbIntent, Spectrum};
 use prism_core::texture::{
     BitmapTexture, Checkerboard, FilterType, TextureUse, UvTransform, WrapMode,
 };
-use prism_core::texture::{MeshAttributeTexture, MixTexture, ScaledTexture, Texture};
+use prism_core::texture::{
+    MeshAttributeTexture, MixTexture, ScaledTexture, Texture, VolumeTexture,
+};
 
 type Build = fn(&Params, TextureUse, &mut TextureCache) -> Result<Texture>;
 
@@ -74,6 +78,17 @@ pub static TEXTURES: Registry<Build> = Registry {
             build: |params, usage, _| build_rawconstant(params, usage),
         },
         Plugin {
+            name: "volume",
+            origin: Origin::Mitsuba3,
+            summary: "A volume (`constvolume`, `gridvolume`, or a plain value) looked up at the \
+                      surface point's world position, for solid textures and surfaces without \
+                      a (u, v) map. A three-channel grid gives a colour only, as in Mitsuba 3's \
+                      spectral variants; emitters, which look textures up by (u, v) alone, \
+                      normal maps and bump maps refuse it.",
+            params: &[VOLUME],
+            build: build_volume,
+        },
+        Plugin {
             name: "scale",
             origin: Origin::Prism,
             summary: "pbrt-v4's `scale` texture: `tex` · `scale`, a texture (a colour, or a number \
@@ -109,6 +124,7 @@ params! {
     SCALE_FACTOR = ParamSpec::new("scale", ParamKind::FloatTexture(Bounds::FINITE_NON_NEGATIVE), Default::Float(1.0), "the factor, a number or a texture read as numbers");
     TEX1 = ParamSpec::new("tex1", ParamKind::Spectrum { range: Range::Coefficient, textured: true, }, Default::Float(0.0), "the texture where `amount` is 0 (a number when the texture is read as one)");
     TEX2 = ParamSpec::new("tex2", ParamKind::Spectrum { range: Range::Coefficient, textured: true, }, Default::Float(1.0), "the texture where `amount` is 1");
+    VOLUME = ParamSpec::new("volume", ParamKind::Volume(Range::Coefficient), Default::Float(0.75), "the volume, placed in the world by its own `to_world`");
     AMOUNT = ParamSpec::new("amount", ParamKind::FloatTexture(Bounds::UNIT), Default::Float(0.5), "the weight of `tex2`, a number or a texture read as numbers");
 }
 
@@ -480,6 +496,35 @@ fn build_mix(params: &Params, usage: TextureUse, cache: &mut TextureCache) -> Re
         tex2: operand(params, &TEX2, &SCALAR_TEX2, usage, cache)?,
         amount: float_texture(params, &AMOUNT, cache)?,
     })))
+}
+
+/// Mitsuba's `volume` texture, refused where it would be read without a surface point
+/// (emissions) or as what Mitsuba's spectral variants cannot read a volume as: a colour grid as
+/// a number, any volume as raw RGB.
+fn build_volume(params: &Params, usage: TextureUse, _: &mut TextureCache) -> Result<Texture> {
+    let node = params.node();
+    let refuse = |message: &str, help: &str| {
+        Err(Error::input(&node.location, format!("{} {message}", node.describe())).with_help(help))
+    };
+    let volume = volume_param(params, &VOLUME)?;
+    match (usage, &volume) {
+        (TextureUse::Emission, _) => refuse(
+            "is looked up at a surface point's position, but an emitter looks its textures up \
+             by (u, v) alone",
+            "give the emitter a bitmap, a pattern or a value",
+        ),
+        (TextureUse::Rgb, _) => refuse(
+            "is read here as a raw RGB triple (a normal map); Prism reads a volume texture only \
+             as a colour or a number",
+            "give the normal map a bitmap with raw=\"true\"",
+        ),
+        (TextureUse::Scalar, Volume::SpectralGrid(_)) => refuse(
+            "holds a three-channel grid, a colour, where a number is wanted (Mitsuba 3's spectral \
+             variants refuse it too)",
+            "store the number in a one-channel grid",
+        ),
+        _ => Ok(Texture::Volume(Arc::new(VolumeTexture { volume }))),
+    }
 }
 
 fn build_rawconstant(params: &Params, usage: TextureUse) -> Result<Texture> {

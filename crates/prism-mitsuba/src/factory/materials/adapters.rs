@@ -205,8 +205,17 @@ fn build_bumpmap(params: &Params, t: &mut TextureCache) -> Result<Bsdf> {
             "the bump map's scale must be a finite number",
         ));
     }
+    let heights = build_texture(&height.node, TextureUse::Scalar, t)?;
+    if heights.reads_position() {
+        return Err(Error::input(
+            &height.location,
+            "the bump map's heights are read at the surface point's position (a volume \
+             texture), which gives them no (u, v) gradient",
+        )
+        .with_help("give the heights as a bitmap or a pattern in (u, v)"));
+    }
     Ok(Bsdf::BumpMap(BumpMap {
-        height: build_texture(&height.node, TextureUse::Scalar, t)?,
+        height: heights,
         scale,
         perturbed: perturbed(params, t)?,
     }))
