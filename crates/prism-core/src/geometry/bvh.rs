@@ -32,7 +32,7 @@
 //! docs/performance.md has the measurements behind these choices.
 //!
 //! **Refit.** When primitives move but stay the same primitives (a shape's transform changed),
-//! [`Bvh::refit`] keeps the tree and recomputes its boxes ([`refit`]), unless the tree got too
+//! [`Bvh::refit`] keeps the tree and recomputes its boxes (module `refit`), unless the tree got too
 //! costly for the new places.
 
 use std::mem::MaybeUninit;

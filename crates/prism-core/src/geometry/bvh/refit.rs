@@ -24,8 +24,8 @@ use super::{
 };
 use crate::geometry::triangle_pack::PACK_WIDTH;
 
-/// A refit tree may cost this many times its cost when built (per ray, by the surface area
-/// heuristic) before a new one is built instead.
+/// A refit tree may cost this many times what it cost when built (by the surface area
+/// heuristic; see [`Bvh::refit`]) before a new one is built instead.
 pub const REFIT_COST_LIMIT: f32 = 1.25;
 
 /// Where the primitives of a hierarchy are now, by the ids they were built with.
