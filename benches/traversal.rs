@@ -200,7 +200,11 @@ fn traversal(c: &mut Criterion) {
             ("bounce_intersect", |f| &f.bounce, intersect_all),
             ("shadow_occluded", |f| &f.shadow, occluded_all),
             ("bounce_closest_hit", |f| &f.bounce, closest_hit_all),
-            ("bounce_closest_hits_lanes", |f| &f.bounce, closest_hits_interleaved),
+            (
+                "bounce_closest_hits_lanes",
+                |f| &f.bounce,
+                closest_hits_interleaved,
+            ),
             ("shadow_occluded_lanes", |f| &f.shadow, occluded_interleaved),
         ];
         for (id, rays_of, query) in cases {

@@ -15,7 +15,7 @@ use std::time::{Duration, Instant};
 
 use glam::Vec3;
 
-use super::bvh::{BuildPrimitive, Bvh, MAX_INTERLEAVED, PrimitiveKind};
+use super::bvh::{BuildPrimitive, Bvh, MAX_INTERLEAVED, PrimitiveKind, PrimitivePlaces};
 use super::interaction::SurfaceInteraction;
 use super::shape::{Shape, ShapeGeometry, TriangleMesh};
 use super::triangle::{TriangleHit, WatertightRay};
@@ -83,8 +83,11 @@ pub struct Aggregate<P> {
     primitive_count: usize,
     /// Another structure that answers the queries instead of `bvh`.
     external: Option<Arc<dyn ExternalRayQueries<P>>>,
-    /// How long [`Aggregate::new`] took.
+    /// How long building (or refitting) the hierarchy took.
     build_time: Duration,
+    /// Whether the hierarchy was refit to moved elements ([`Aggregate::refit`]) rather than
+    /// built.
+    refit: bool,
 }
 
 impl<P: AggregateElement> Aggregate<P> {
@@ -146,14 +149,69 @@ impl<P: AggregateElement> Aggregate<P> {
             primitive_count: build.len(),
             external: None,
             build_time: start.elapsed(),
+            refit: false,
+        }
+    }
+
+    /// The aggregate over `primitives`, this aggregate's elements moved or reshaped in place
+    /// (a shape's transform or radius changed): its hierarchy refit ([`Bvh::refit`]) when the
+    /// elements give the same primitives as before (the same meshes' triangles, the same ones
+    /// degenerate, as many parts) and the refit tree is not too costly; otherwise built anew,
+    /// as [`Self::new`] builds it. The structure set by [`Self::set_external`] is dropped.
+    pub fn refit(self, primitives: Vec<P>) -> Aggregate<P>
+    where
+        P: Sync,
+    {
+        let start = Instant::now();
+        let mut first_id = Vec::with_capacity(primitives.len() + 1);
+        let mut next_id = 0u64;
+        for element in &primitives {
+            first_id.push(next_id as u32);
+            next_id += id_count(element);
+        }
+        first_id.push(next_id as u32);
+        let Some(bvh) = self.bvh.filter(|_| first_id == self.first_id) else {
+            return Aggregate::new(primitives);
+        };
+        let primitive_count: usize = (primitives.iter())
+            .map(|element| match element.mesh() {
+                Some(mesh) => (0..mesh.triangles().len())
+                    .filter(|&i| mesh.triangle_area(i) != 0.0)
+                    .count(),
+                None => id_count(element) as usize,
+            })
+            .sum();
+        if primitive_count != self.primitive_count {
+            return Aggregate::new(primitives);
+        }
+        let places = MovedElements {
+            elements: &primitives,
+            first_id: &first_id,
+        };
+        let Some(bvh) = bvh.refit(&places) else {
+            return Aggregate::new(primitives);
+        };
+        Aggregate {
+            primitives,
+            bvh: Some(bvh),
+            first_id,
+            primitive_count,
+            external: None,
+            build_time: start.elapsed(),
+            refit: true,
         }
     }
 
     /// The element and, for a mesh, the triangle of primitive `id`.
     #[inline]
     fn element_of(&self, id: u32) -> (u32, u32) {
-        let element = self.first_id.partition_point(|&first| first <= id) - 1;
-        (element as u32, id - self.first_id[element])
+        element_of(&self.first_id, id)
+    }
+
+    /// Whether the hierarchy was refit to moved elements rather than built
+    /// ([`Self::refit`]).
+    pub fn is_refit(&self) -> bool {
+        self.refit
     }
 
     /// Lets another structure answer the queries (the BVH is kept, so that both can be
@@ -167,8 +225,8 @@ impl<P: AggregateElement> Aggregate<P> {
         self.external.as_ref().map(|e| e.name())
     }
 
-    /// How long building the hierarchy took (an instanced shape's own hierarchy, built with
-    /// the shape, not included).
+    /// How long building or refitting the hierarchy took (an instanced shape's own hierarchy,
+    /// built with the shape, not included).
     pub fn build_time(&self) -> Duration {
         self.build_time
     }
@@ -301,6 +359,48 @@ impl<P: AggregateElement> Aggregate<P> {
         };
         let watertight = WatertightRay::new(ray.o, ray.d);
         bvh.occluded(ray, &watertight, |id, t_max| self.whole_hit(ray, id, t_max))
+    }
+}
+
+/// The element owning primitive `id` and the primitive's index in it, `first_id` holding each
+/// element's first id.
+#[inline]
+fn element_of(first_id: &[u32], id: u32) -> (u32, u32) {
+    let element = first_id.partition_point(|&first| first <= id) - 1;
+    (element as u32, id - first_id[element])
+}
+
+/// The ids an element takes: one per triangle of a mesh, one per part, else one.
+fn id_count(element: &impl AggregateElement) -> u64 {
+    match element.mesh() {
+        Some(mesh) => mesh.triangles().len() as u64,
+        None => element.part_count().unwrap_or(1) as u64,
+    }
+}
+
+/// Elements at their new places, as a refit reads them by primitive id.
+struct MovedElements<'a, P> {
+    elements: &'a [P],
+    first_id: &'a [u32],
+}
+
+impl<P: AggregateElement + Sync> PrimitivePlaces for MovedElements<'_, P> {
+    fn triangle(&self, id: u32) -> Option<[Vec3; 3]> {
+        let (element, triangle) = element_of(self.first_id, id);
+        let mesh = self.elements[element as usize].mesh()?;
+        (mesh.triangle_area(triangle as usize) != 0.0).then(|| mesh.vertices(triangle as usize))
+    }
+
+    fn analytic_bounds(&self, id: u32) -> Option<(Vec3, Vec3)> {
+        let (element, part) = element_of(self.first_id, id);
+        let element = &self.elements[element as usize];
+        if element.mesh().is_some() {
+            return None;
+        }
+        match element.part_count() {
+            Some(parts) => (part < parts as u32).then(|| element.part_bounds(part)),
+            None => (part == 0).then(|| element.bounds()),
+        }
     }
 }
 

@@ -30,6 +30,10 @@
 //! into the traversal (so that it, too, runs in AVX's three-operand instructions) with the
 //! ray's constants prepared once per ray ([`PackRay`]). Child boxes are f32 (not quantised).
 //! docs/performance.md has the measurements behind these choices.
+//!
+//! **Refit.** When primitives move but stay the same primitives (a shape's transform changed),
+//! [`Bvh::refit`] keeps the tree and recomputes its boxes (module `refit`), unless the tree got too
+//! costly for the new places.
 
 use std::mem::MaybeUninit;
 
@@ -45,6 +49,10 @@ use wide::{CmpLe, f32x8};
 use super::triangle::{TriangleHit, WatertightRay, gamma};
 use super::triangle_pack::{PACK_WIDTH, PackRay, TrianglePack};
 use crate::math::Ray;
+
+mod refit;
+
+pub use refit::{PrimitivePlaces, REFIT_COST_LIMIT};
 
 /// A primitive to build the hierarchy over: a triangle, or an analytic shape given by its box.
 #[derive(Clone, Copy, Debug)]
@@ -141,6 +149,8 @@ pub struct Bvh {
     stack_size: usize,
     /// Whether the processor has AVX, so that queries test eight boxes per instruction.
     avx: bool,
+    /// The tree's cost by the surface area heuristic when it was built (see [`Bvh::refit`]).
+    built_cost: f32,
 }
 
 /// A ray prepared for the slab tests: origin, reciprocal direction, and which bound of each
@@ -937,7 +947,7 @@ impl<'a> Collapse<'a> {
                 (NodeRef::inner(0), tree.nodes, tree.packs, tree.max_depth)
             }
         };
-        Bvh {
+        let mut bvh = Bvh {
             nodes,
             packs,
             root,
@@ -945,7 +955,10 @@ impl<'a> Collapse<'a> {
             hi: Vec3::from(root_box.max),
             stack_size: (NODE_WIDTH - 1) * max_depth + 1,
             avx: has_avx(),
-        }
+            built_cost: 0.0,
+        };
+        bvh.built_cost = bvh.sah_cost();
+        bvh
     }
 
     /// The binary nodes that become the children of binary node `i` when it is an inner node
@@ -1114,17 +1127,20 @@ impl WideTree {
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
     use crate::sampling::rng::Pcg32;
     use std::collections::HashMap;
 
-    fn random_unit(rng: &mut Pcg32) -> Vec3 {
+    pub(super) fn random_unit(rng: &mut Pcg32) -> Vec3 {
         Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 2.0 - 1.0
     }
 
     /// Random small triangles in a cube, and some analytic "spheres" given by their boxes.
-    fn scene(rng: &mut Pcg32, triangles: usize) -> (Vec<BuildPrimitive>, Vec<(Vec3, f32)>) {
+    pub(super) fn scene(
+        rng: &mut Pcg32,
+        triangles: usize,
+    ) -> (Vec<BuildPrimitive>, Vec<(Vec3, f32)>) {
         let mut primitives = Vec::new();
         for id in 0..triangles {
             let c = random_unit(rng);
@@ -1150,7 +1166,7 @@ mod tests {
         (primitives, spheres)
     }
 
-    fn sphere_hit(ray: &Ray, (c, r): (Vec3, f32), t_max: f32) -> Option<f32> {
+    pub(super) fn sphere_hit(ray: &Ray, (c, r): (Vec3, f32), t_max: f32) -> Option<f32> {
         let oc = ray.o - c;
         let a = ray.d.length_squared();
         let b = oc.dot(ray.d);

@@ -22,5 +22,5 @@ pub mod shapes;
 pub mod spectra;
 pub mod textures;
 
-pub use scene::{LoadedScene, build_scene, build_scene_with_geometry};
+pub use scene::{KeptGeometry, LoadedScene, build_scene, build_scene_with_geometry};
 pub use sensor_choice::SceneSensor;

@@ -70,13 +70,32 @@ pub fn build_scene(root: &PluginNode) -> Result<LoadedScene> {
     build_scene_with_geometry(root, &mut None)
 }
 
-/// Builds the scene as [`build_scene`] does, but with the hierarchy `geometry` holds in place of
-/// one built over the shapes, taken from it when the build succeeds (and left there when it
-/// fails). The caller vouches that `geometry` was built from the same shapes: those of a
-/// description whose `<shape>` plugins, shape groups and instances are all unchanged.
+/// The hierarchy of a scene built before from the description being built, or from an edit of
+/// it with the same plugins.
+#[derive(Debug)]
+pub enum KeptGeometry {
+    /// Built from the same shapes (no parameter of a `<shape>`, shape group or instance
+    /// changed): used as it is.
+    Unchanged(Geometry),
+    /// Built from the shapes before a shape's parameters changed: refit to the shapes read
+    /// where they are the same primitives moved, else built again ([`Geometry::refit`]).
+    Moved(Geometry),
+}
+
+impl KeptGeometry {
+    pub fn into_geometry(self) -> Geometry {
+        match self {
+            KeptGeometry::Unchanged(geometry) | KeptGeometry::Moved(geometry) => geometry,
+        }
+    }
+}
+
+/// Builds the scene as [`build_scene`] does, but from the hierarchy `geometry` holds rather
+/// than one built from scratch over the shapes, taken from it when the build succeeds (and
+/// left there when it fails).
 pub fn build_scene_with_geometry(
     root: &PluginNode,
-    geometry: &mut Option<Geometry>,
+    geometry: &mut Option<KeptGeometry>,
 ) -> Result<LoadedScene> {
     let params = Params::new(root, SCENE);
     let integrator_child = params.single_child(&INTEGRATOR)?;
@@ -531,17 +550,22 @@ impl SceneBuilder {
     }
 
     /// The scene, from the parts read, seen through the first sensor; `geometry`, when given,
-    /// is the hierarchy over the shapes read.
+    /// is the hierarchy kept from a scene built before (see [`KeptGeometry`]).
     fn finish(
         self,
         root: &PluginNode,
         integrator: Integrator,
         mut sensors: Vec<SceneSensor>,
         warnings: Vec<Warning>,
-        geometry: Option<Geometry>,
+        geometry: Option<KeptGeometry>,
     ) -> LoadedScene {
+        let geometry = match geometry {
+            None => Geometry::new(self.shapes),
+            Some(KeptGeometry::Unchanged(geometry)) => geometry,
+            Some(KeptGeometry::Moved(geometry)) => geometry.refit(self.shapes),
+        };
         let mut world = World::new(
-            geometry.unwrap_or_else(|| Geometry::new(self.shapes)),
+            geometry,
             self.shape_info,
             self.materials.materials,
             self.lights,

@@ -72,6 +72,11 @@ class Scene:
         """The index of the sensor the scene is seen through: 0 after loading, then the one the
         last :func:`render` used. ``width``, ``height``, ``spp`` and ``seed`` are its."""
     @property
+    def bvh_refit(self) -> bool:
+        """Whether the bounding volume hierarchy over the shapes was refit to shapes an update
+        moved (True) or built for the shapes where they are (False), as
+        :meth:`SceneParameters.update` chooses."""
+    @property
     def sensor_ids(self) -> List[Optional[str]]:
         """The ``id`` of every ``<sensor>`` (None for one without), in document order."""
     @overload

@@ -20,7 +20,7 @@ use prism_core::film::Reconstruction;
 use prism_core::geometry::Geometry;
 use prism_core::spectrum::WavelengthSampling;
 use prism_mitsuba::description::{PluginNode, Warning};
-use prism_mitsuba::factory::build_scene_with_geometry;
+use prism_mitsuba::factory::{KeptGeometry, build_scene_with_geometry};
 use prism_mitsuba::file_cache::FileCache;
 use prism_mitsuba::fingerprint::{override_reconstruction, override_wavelengths};
 use prism_mitsuba::read_scene;
@@ -69,17 +69,21 @@ impl Scene {
 
     /// Builds the scene again from `description`, an edit of its own with the same plugins,
     /// reading no file again. With `same_shapes` (no parameter of a `<shape>` changed) the
-    /// hierarchy over the shapes is kept rather than built again. The scene is seen through
-    /// the same sensor, with the same overrides; on an error it is left as it was.
+    /// hierarchy over the shapes is kept as it is, else refit to the moved shapes where it can
+    /// be ([`KeptGeometry`]). The scene is seen through the same sensor, with the same
+    /// overrides; on an error it is left as it was.
     pub fn rebuild(
         &mut self,
         py: Python<'_>,
         description: Arc<PluginNode>,
         same_shapes: bool,
     ) -> PyResult<()> {
-        let mut geometry = same_shapes.then(|| {
-            let world = &mut self.loaded.scene.world;
-            std::mem::replace(&mut world.geometry, Geometry::new(Vec::new()))
+        let world = &mut self.loaded.scene.world;
+        let kept = std::mem::replace(&mut world.geometry, Geometry::new(Vec::new()));
+        let mut geometry = Some(if same_shapes {
+            KeptGeometry::Unchanged(kept)
+        } else {
+            KeptGeometry::Moved(kept)
         });
         let files = &self.files;
         let warnings = &self.reader_warnings;
@@ -88,7 +92,7 @@ impl Scene {
             Ok(loaded) => loaded,
             Err(error) => {
                 if let Some(geometry) = geometry {
-                    self.loaded.scene.world.geometry = geometry;
+                    self.loaded.scene.world.geometry = geometry.into_geometry();
                 }
                 return Err(to_py(py, &error));
             }
@@ -110,7 +114,7 @@ impl Scene {
 /// warnings led by the reader's.
 fn build(
     description: &PluginNode,
-    geometry: &mut Option<Geometry>,
+    geometry: &mut Option<KeptGeometry>,
     reader_warnings: &[Warning],
 ) -> Result<LoadedScene> {
     let mut loaded = build_scene_with_geometry(description, geometry)?;
@@ -193,6 +197,13 @@ impl Scene {
     #[getter]
     fn sensor(&self) -> usize {
         self.loaded.selected_sensor()
+    }
+
+    /// Whether the hierarchy over the shapes is one refit to moved shapes by an update rather
+    /// than one built for them (see `SceneParameters.update`).
+    #[getter]
+    fn bvh_refit(&self) -> bool {
+        self.loaded.scene.world.geometry.is_refit()
     }
 
     /// The `id` of every sensor (None for one without), in document order.
