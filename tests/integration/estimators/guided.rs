@@ -9,6 +9,7 @@ use std::path::Path;
 use glam::{DVec3, Mat3, UVec2, Vec3};
 use prism_core::film::Film;
 use prism_core::geometry::{Shape, Sphere};
+use prism_core::integrator::guided::selection::SelectionLoss;
 use prism_core::integrator::guided::{NextEvent, SampleCombination, SpatialFilter};
 use prism_core::integrator::{GuidedPathIntegrator, Integrator};
 use prism_core::render::{RenderOptions, StopRule, render};
@@ -31,10 +32,16 @@ fn guided() -> GuidedPathIntegrator {
 
 /// Inside a sphere of reflectance rho that emits le everywhere, the radiance is
 /// le / (1 − rho) = 2 in every direction: the image's mean Y is 2 within 4 standard errors, with
-/// light samples (`always`) and without (`never`).
+/// light samples (`always`) and without (`never`), with α fixed and learned (`kl`, `var`).
 #[test]
 fn guided_sphere_furnace_gives_le_over_one_minus_rho() {
-    for nee in [NextEvent::Always, NextEvent::Never] {
+    let cases = [
+        (NextEvent::Always, SelectionLoss::None),
+        (NextEvent::Never, SelectionLoss::None),
+        (NextEvent::Always, SelectionLoss::KullbackLeibler),
+        (NextEvent::Never, SelectionLoss::Variance),
+    ];
+    for (nee, loss) in cases {
         let size = UVec2::new(16, 16);
         let camera = camera(
             DVec3::new(0.1, 0.2, -0.3),
@@ -54,10 +61,14 @@ fn guided_sphere_furnace_gives_le_over_one_minus_rho() {
             reflectance: 0.5,
             emission: Some(1.0),
         };
-        let integrator = GuidedPathIntegrator { nee, ..guided() };
+        let integrator = GuidedPathIntegrator {
+            nee,
+            bsdf_sampling_fraction_loss: loss,
+            ..guided()
+        };
         let scene = build(vec![object], vec![], camera, size, integrator);
         let film = render_film(&scene, 512, 1, None);
-        assert_mean_luminance(&format!("{nee:?}"), &film, 2.0);
+        assert_mean_luminance(&format!("{nee:?}, {loss:?}"), &film, 2.0);
     }
 }
 
@@ -92,7 +103,8 @@ fn guided_and_path_agree_on_the_cornell_box() {
 }
 
 /// The same image, bit for bit, on one thread and on two: with the nearest and the stochastic
-/// spatial filter and with `kickstart` light samples, and with the inverse-variance mix.
+/// spatial filter and with `kickstart` light samples, with the inverse-variance mix, and with α
+/// learned.
 #[test]
 fn guided_is_deterministic_for_any_thread_count() {
     let variants = [
@@ -104,6 +116,10 @@ fn guided_is_deterministic_for_any_thread_count() {
         },
         GuidedPathIntegrator {
             sample_combination: SampleCombination::InverseVariance,
+            ..guided()
+        },
+        GuidedPathIntegrator {
+            bsdf_sampling_fraction_loss: SelectionLoss::KullbackLeibler,
             ..guided()
         },
     ];
@@ -212,7 +228,7 @@ fn guided_refuses_bad_parameters() {
             "directional_filter",
         ),
         (
-            r#"<string name="bsdf_sampling_fraction_loss" value="kl"/>"#,
+            r#"<string name="bsdf_sampling_fraction_loss" value="kld"/>"#,
             "bsdf_sampling_fraction_loss",
         ),
         (

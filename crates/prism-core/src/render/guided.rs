@@ -358,8 +358,8 @@ impl Driver<'_> {
             image.passes += 1;
             state.passes_done += 1;
             state.rays += rays;
-            for r in records.into_iter().flatten() {
-                tree.record(r.leaf, r.point, r.flux, r.weight);
+            for r in records.iter().flatten() {
+                tree.file(r, self.guided.bsdf_sampling_fraction_loss);
             }
             self.progress
                 .pass_done(state.passes_done * spp, f64::INFINITY);

@@ -17,6 +17,7 @@ use prism_core::error::{Error, Result, SourceLocation};
 use prism_core::film::output::IMAGE_CHANNELS;
 use prism_core::integrator::aov::{Aov, AovKind};
 use prism_core::integrator::distribution::DirectLights;
+use prism_core::integrator::guided::selection::SelectionLoss;
 use prism_core::integrator::guided::{Budget, NextEvent, SampleCombination, SpatialFilter};
 use prism_core::integrator::{
     AovIntegrator, BdptIntegrator, DepthIntegrator, DirectIntegrator, DistributionIntegrator,
@@ -273,7 +274,7 @@ params! {
     SPATIAL_FILTER = ParamSpec::new("spatial_filter", ParamKind::Choice(&[Choice::new("nearest", &SpatialFilter::Nearest), Choice::new("stochastic", &SpatialFilter::StochasticBox)]), Default::Str("nearest"), "where a record is filed: the vertex's leaf, or the leaf of a point jittered within a box of that leaf's size (`box`, the deterministic box filter, is not supported)");
     DO_FILTERED_SPLATTING = ParamSpec::new("do_filtered_splatting", ParamKind::Boolean, Default::Boolean(false), "the authors' earlier switch: true files records by the stochastic box filter (as spatial_filter = stochastic)");
     DIRECTIONAL_FILTER = ParamSpec::new("directional_filter", ParamKind::Choice(&[Choice::new("nearest", &())]), Default::Str("nearest"), "records go to the quadrant of their direction (`box` is not supported)");
-    BSDF_SAMPLING_FRACTION_LOSS = ParamSpec::new("bsdf_sampling_fraction_loss", ParamKind::Choice(&[Choice::new("none", &())]), Default::Str("none"), "α is fixed (learning it, `kl` or `var`, is not supported)");
+    BSDF_SAMPLING_FRACTION_LOSS = ParamSpec::new("bsdf_sampling_fraction_loss", ParamKind::Choice(&[Choice::new("none", &SelectionLoss::None), Choice::new("kl", &SelectionLoss::KullbackLeibler), Choice::new("var", &SelectionLoss::Variance)]), Default::Str("none"), "α fixed at bsdf_sampling_fraction (`none`), or learned per spatial leaf by Adam on the KL divergence from the integrand to the mixture (`kl`) or on the estimate's variance (`var`)");
     SD_TREE_MAX_MEMORY = ParamSpec::new("sd_tree_max_memory", ParamKind::Integer, Default::Integer(-1), "megabytes of quadtrees beyond which spatial leaves stop splitting (−1: no limit)");
     DUMP_SD_TREE = ParamSpec::new("dump_sd_tree", ParamKind::Boolean, Default::Boolean(false), "must be false: Prism writes no SD-tree files");
     RR_THRESHOLD = ParamSpec::new("rr_threshold", ParamKind::Float, Default::Float(0.1), "potential below which Russian roulette starts");
@@ -525,7 +526,7 @@ fn build_sppm(params: &Params) -> Result<Integrator> {
 }
 
 /// The parameters of `guided_path`'s that name a value Prism does not implement, with why.
-const UNSUPPORTED_GUIDING: [(&ParamSpec, &str, &str); 5] = [
+const UNSUPPORTED_GUIDING: [(&ParamSpec, &str, &str); 3] = [
     (
         &SPATIAL_FILTER,
         "box",
@@ -535,16 +536,6 @@ const UNSUPPORTED_GUIDING: [(&ParamSpec, &str, &str); 5] = [
         &DIRECTIONAL_FILTER,
         "box",
         "records go to the quadrant of their direction only",
-    ),
-    (
-        &BSDF_SAMPLING_FRACTION_LOSS,
-        "kl",
-        "bsdf_sampling_fraction is fixed, not learned",
-    ),
-    (
-        &BSDF_SAMPLING_FRACTION_LOSS,
-        "var",
-        "bsdf_sampling_fraction is fixed, not learned",
     ),
     (&DUMP_SD_TREE, "true", "Prism writes no SD-tree files"),
 ];
@@ -565,7 +556,6 @@ fn build_guided(params: &Params) -> Result<Integrator> {
         }
     }
     params.choice::<()>(&DIRECTIONAL_FILTER)?;
-    params.choice::<()>(&BSDF_SAMPLING_FRACTION_LOSS)?;
     let spp_per_pass = params.integer(&SPP_PER_PASS)?;
     if !(1..=1 << 16).contains(&spp_per_pass) {
         return refuse(
@@ -643,6 +633,7 @@ fn build_guided(params: &Params) -> Result<Integrator> {
         s_tree_threshold: s_tree_threshold as f32,
         d_tree_threshold: d_tree_threshold as f32,
         bsdf_sampling_fraction: bsdf_sampling_fraction as f32,
+        bsdf_sampling_fraction_loss: params.choice(&BSDF_SAMPLING_FRACTION_LOSS)?,
         nee: params.choice(&NEE)?,
         spatial_filter,
         sd_tree_max_memory,

@@ -18,11 +18,15 @@
 //! (`inversevar`). The first iteration has nothing to learn from and samples the BSDF alone.
 //!
 //! **A vertex** with a smooth lobe draws its direction by one-sample MIS between the BSDF,
-//! with probability α = `bsdfSamplingFraction`, and the quadtree of the spatial leaf holding
-//! the vertex, with probability 1 − α, and weighs the sample by the mixture's density
-//! p(ω) = α p_bsdf(ω) + (1 − α) p_guide(ω), so the estimator f cos θ L / p is unbiased for
-//! any learned distribution (α > 0 keeps p > 0 wherever the BSDF scatters). A delta lobe
-//! drawn from the BSDF keeps its own weight divided by α; BSDFs without smooth lobes are
+//! with probability α, and the quadtree of the spatial leaf holding the vertex (of the
+//! orientation class of its surface's front side, [`sd_tree`]), with probability 1 − α
+//! (folded onto the side of the surface the path arrived from where the BSDF only reflects,
+//! [`vertex_guide`]), and weighs the sample by the mixture's density
+//! p(ω) = α p_bsdf(ω) + (1 − α) p_guide(ω), so the estimator f cos θ L / p is unbiased for any
+//! learned distribution (α > 0 keeps p > 0 wherever the BSDF scatters). α is
+//! `bsdfSamplingFraction`, or, with a `bsdfSamplingFractionLoss`, learned per spatial leaf and
+//! orientation class from the records filed there ([`selection`]). A delta lobe drawn from
+//! the BSDF keeps its own weight divided by α; BSDFs without smooth lobes are
 //! sampled as the path tracer samples them. Next-event estimation (`nee`, by default
 //! `always`) takes one light sample per vertex as `path` does, weighed against the mixture's
 //! density by the power heuristic, as is the emission a sampled direction finds; Russian
@@ -48,12 +52,14 @@
 
 pub mod quadtree;
 pub mod sd_tree;
+pub mod selection;
+pub mod vertex_guide;
 
 use std::f32::consts::PI;
 
 use glam::{Vec2, Vec3};
 
-use crate::bsdf::BxdfTree;
+use crate::bsdf::{BsdfFlags, BxdfTree};
 use crate::integrator::SampleContext;
 use crate::integrator::mis::{
     ScatterOrigin, Strategies, emission_found, power_heuristic, sample_light, unoccluded,
@@ -66,8 +72,9 @@ use crate::integrator::vertex::{
 use crate::light::Receiver;
 use crate::math::Ray;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
-use quadtree::DirectionalTree;
-use sd_tree::{SdTree, SpatialLeaf};
+use sd_tree::{SdTree, SpatialLeaf, orientation};
+use selection::{SelectionLoss, SelectionSample};
+use vertex_guide::VertexGuide;
 
 /// How the iterations' images make the final one.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -126,8 +133,10 @@ pub struct GuidedPathIntegrator {
     pub s_tree_threshold: f32,
     /// ρ, the share of a quadtree's flux above which a quadrant is split.
     pub d_tree_threshold: f32,
-    /// α, the probability of sampling the BSDF rather than the guide.
+    /// α, the probability of sampling the BSDF rather than the guide, where it is not learned.
     pub bsdf_sampling_fraction: f32,
+    /// The loss α is learned by per spatial leaf (`bsdfSamplingFractionLoss`, [`selection`]).
+    pub bsdf_sampling_fraction_loss: SelectionLoss,
     pub nee: NextEvent,
     pub spatial_filter: SpatialFilter,
     /// Megabytes beyond which the spatial tree stops splitting (None: no limit).
@@ -147,6 +156,7 @@ impl Default for GuidedPathIntegrator {
             s_tree_threshold: 12_000.0,
             d_tree_threshold: 0.01,
             bsdf_sampling_fraction: 0.5,
+            bsdf_sampling_fraction_loss: SelectionLoss::None,
             nee: NextEvent::Always,
             spatial_filter: SpatialFilter::Nearest,
             sd_tree_max_memory: None,
@@ -174,6 +184,8 @@ pub struct Record {
     /// L_i / p(ω).
     pub flux: f32,
     pub weight: f32,
+    /// What the record brings to the leaf's learned α, where it is learned.
+    pub selection: Option<SelectionSample>,
 }
 
 /// The point of the unit square (cylindrical coordinates) of the unit direction `d`.
@@ -199,12 +211,6 @@ pub fn square_to_direction(p: Vec2) -> Vec3 {
     Vec3::new(sin_theta * cos_phi, sin_theta * sin_phi, cos_theta)
 }
 
-/// The solid-angle density of direction `d` under the quadtree `tree`.
-#[inline]
-fn guide_pdf(tree: &DirectionalTree, d: Vec3) -> f32 {
-    tree.pdf(direction_to_square(d)) / (4.0 * PI)
-}
-
 /// Vertices a path records at most (the authors' limit).
 const MAX_RECORDED_VERTICES: usize = 32;
 
@@ -212,6 +218,8 @@ const MAX_RECORDED_VERTICES: usize = 32;
 #[derive(Clone, Copy, Debug)]
 struct RecordingVertex {
     leaf: SpatialLeaf,
+    /// The orientation class of the surface's front side.
+    class: u32,
     p: Vec3,
     point: Vec2,
     /// The path's throughput once the vertex's sample is taken.
@@ -219,6 +227,9 @@ struct RecordingVertex {
     /// The radiance the path has brought back through the vertex.
     radiance: SampledSpectrum,
     pdf: f32,
+    /// f cos θ at the sampled direction, and the BSDF's and the guide's densities there, where
+    /// the vertex trains its leaf's α.
+    selection: Option<(SampledSpectrum, f32, f32)>,
 }
 
 /// The recording vertices of a path.
@@ -263,17 +274,20 @@ impl RecordingVertices {
     }
 }
 
-/// The mean over the wavelengths of `radiance` / `throughput`, where the throughput is not
-/// negligible.
-fn incident_radiance(radiance: SampledSpectrum, throughput: SampledSpectrum, pdf: f32) -> f32 {
-    let local = SampledSpectrum::from_fn(|i| {
+/// `radiance` / `throughput` per wavelength, where the throughput is not negligible: the
+/// incident radiance a recording vertex brings.
+fn incident_radiance(
+    radiance: SampledSpectrum,
+    throughput: SampledSpectrum,
+    pdf: f32,
+) -> SampledSpectrum {
+    SampledSpectrum::from_fn(|i| {
         if throughput[i] * pdf > 1e-4 {
             radiance[i] / throughput[i]
         } else {
             0.0
         }
-    });
-    local.average()
+    })
 }
 
 impl GuidedPathIntegrator {
@@ -291,7 +305,7 @@ impl GuidedPathIntegrator {
             return SampledSpectrum::ZERO;
         }
         let world = ctx.world();
-        let alpha = self.bsdf_sampling_fraction;
+        let learns_alpha = self.bsdf_sampling_fraction_loss != SelectionLoss::None;
         let strategies = Strategies {
             light_samples: if guide.light_samples { 1.0 } else { 0.0 },
             bsdf_samples: 1.0,
@@ -335,12 +349,31 @@ impl GuidedPathIntegrator {
             }
             let scattering = surface_scattering(world, &si, wo, &mut lambda, &mut lobes);
             let smooth = scattering.flags().has_smooth_lobe();
-            let leaf = smooth.then(|| guide.tree.leaf_at(si.p));
-            let trees = leaf
-                .filter(|_| guide.trained)
-                .map(|l| &guide.tree.leaf(l.index).sampling);
+            let side = wo.dot(si.shading.n);
+            let front = if side < 0.0 {
+                -si.shading.n
+            } else {
+                si.shading.n
+            };
+            let class = orientation(front);
+            let leaf = smooth.then(|| guide.tree.leaf_at(si.p, class));
+            let reflects_only = !scattering.flags().contains(BsdfFlags::TRANSMISSION);
+            let trees = leaf.filter(|_| guide.trained).map(|l| {
+                let tree = &guide.tree.leaf(l.index).sampling;
+                if reflects_only && side != 0.0 {
+                    VertexGuide::folded(tree, front)
+                } else {
+                    VertexGuide::sphere(tree)
+                }
+            });
+            let alpha = match leaf {
+                Some(l) if learns_alpha && guide.trained => {
+                    guide.tree.leaf(l.index).selection.fraction()
+                }
+                _ => self.bsdf_sampling_fraction,
+            };
             let mixture = |bsdf_pdf: f32, wi: Vec3| match trees {
-                Some(tree) => alpha * bsdf_pdf + (1.0 - alpha) * guide_pdf(tree, wi),
+                Some(tree) => alpha * bsdf_pdf + (1.0 - alpha) * tree.pdf(wi),
                 None => bsdf_pdf,
             };
 
@@ -370,6 +403,7 @@ impl GuidedPathIntegrator {
                             point: direction_to_square(light_direction),
                             flux: (light.radiance * w).average() / light.light_pdf,
                             weight: weight * 0.5,
+                            selection: None,
                         });
                     }
                 }
@@ -383,16 +417,25 @@ impl GuidedPathIntegrator {
             };
             let u_lobe = ctx.sampler.next_1d();
             let u = ctx.sampler.next_2d();
-            let (wi, weight, pdf, delta, eta, next_lambda) = match trees {
+            let (wi, weight, pdf, delta, eta, next_lambda, selection) = match trees {
                 Some(tree) if u_choice >= alpha => {
-                    let point = tree.sample(u);
-                    let wi = square_to_direction(point);
+                    let wi = tree.sample(u);
                     let f = scattering.eval(wi);
-                    let pdf = alpha * f.pdf + (1.0 - alpha) * tree.pdf(point) / (4.0 * PI);
+                    let guide_pdf = tree.pdf(wi);
+                    let pdf = alpha * f.pdf + (1.0 - alpha) * guide_pdf;
                     if !(pdf > 0.0) {
                         break;
                     }
-                    (wi, f.value * (1.0 / pdf), pdf, false, 1.0, lambda)
+                    let selection = learns_alpha.then_some((f.value, f.pdf, guide_pdf));
+                    (
+                        wi,
+                        f.value * (1.0 / pdf),
+                        pdf,
+                        false,
+                        1.0,
+                        lambda,
+                        selection,
+                    )
                 }
                 _ => {
                     let Some(bs) = scattering.sample(u_lobe, u) else {
@@ -400,15 +443,18 @@ impl GuidedPathIntegrator {
                     };
                     let next_lambda = wavelengths_after(&lambda, &bs);
                     let delta = bs.flags.is_delta();
-                    let (weight, pdf) = match trees {
-                        Some(_) if delta => (bs.weight * (1.0 / alpha), bs.pdf * alpha),
-                        Some(_) => {
-                            let pdf = mixture(bs.pdf, bs.wi);
-                            (bs.weight * (bs.pdf / pdf), pdf)
+                    let (weight, pdf, selection) = match trees {
+                        Some(_) if delta => (bs.weight * (1.0 / alpha), bs.pdf * alpha, None),
+                        Some(tree) => {
+                            let guide_pdf = tree.pdf(bs.wi);
+                            let pdf = alpha * bs.pdf + (1.0 - alpha) * guide_pdf;
+                            let selection =
+                                learns_alpha.then_some((bs.weight * bs.pdf, bs.pdf, guide_pdf));
+                            (bs.weight * (bs.pdf / pdf), pdf, selection)
                         }
-                        None => (bs.weight, bs.pdf),
+                        None => (bs.weight, bs.pdf, None),
                     };
-                    (bs.wi, weight, pdf, delta, bs.eta, next_lambda)
+                    (bs.wi, weight, pdf, delta, bs.eta, next_lambda, selection)
                 }
             };
             if self.strict_normals && !normals_agree(&si, wi) {
@@ -424,11 +470,13 @@ impl GuidedPathIntegrator {
                 leaf.filter(|_| guide.record_weight.is_some() && !delta)
                     .map(|leaf| RecordingVertex {
                         leaf,
+                        class,
                         p: si.p,
                         point: direction_to_square(wi),
                         throughput,
                         radiance: SampledSpectrum::ZERO,
                         pdf,
+                        selection,
                     }),
             );
             ray = si.spawn_ray(wi);
@@ -463,15 +511,24 @@ impl GuidedPathIntegrator {
                         ) - Vec3::splat(0.5);
                         guide
                             .tree
-                            .leaf_at(guide.tree.clamp(v.p + jitter * v.leaf.size))
+                            .leaf_at(guide.tree.clamp(v.p + jitter * v.leaf.size), v.class)
                             .index
                     }
                 };
+                let incident = incident_radiance(v.radiance, v.throughput, v.pdf);
                 records.push(Record {
                     leaf,
                     point: v.point,
-                    flux: incident_radiance(v.radiance, v.throughput, v.pdf) / v.pdf,
+                    flux: incident.average() / v.pdf,
                     weight,
+                    selection: v.selection.map(|(bsdf_value, bsdf_pdf, guide_pdf)| {
+                        SelectionSample {
+                            integrand: (incident * bsdf_value).average(),
+                            pdf: v.pdf,
+                            bsdf_pdf,
+                            guide_pdf,
+                        }
+                    }),
                 });
             }
         }

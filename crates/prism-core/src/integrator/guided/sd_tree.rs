@@ -3,37 +3,70 @@
 //! two directional quadtrees ([`DirectionalTree`]): the one paths sample from (learned in the
 //! previous iteration) and the one they record into.
 //!
+//! Unlike the authors' tree, a leaf holds such a pair for each of six orientation classes of
+//! the surface's front side (the normal turned towards the outgoing direction, classed by its
+//! dominant axis and that axis's sign, [`orientation`]): a vertex samples from and records into
+//! its class's trees. A leaf holding surfaces that face apart (both sides of a thin panel, a
+//! wall and the floor it meets) then learns their incident light apart; with one pair the
+//! brighter side's light decides the trees, and the other side's guided samples go where its
+//! BSDF is zero or its light is not.
+//!
 //! Between iterations ([`SdTree::refine`]) a leaf is split in two where the statistical weight
-//! recorded in it exceeds c·√(2ᵏ) (§3.1; with the authors' code's scale, c = `sTreeThreshold`
+//! recorded in it (over its classes) exceeds c·√(2ᵏ) (§3.1; with the authors' code's scale, c = `sTreeThreshold`
 //! × √(`sppPerPass` / 4) at iteration k, so the leaves' sample counts grow as the square root
 //! of the iteration's samples); each half starts with a copy of the leaf's trees and half its
 //! weight, and splits again while its weight exceeds the threshold. Then every leaf's recording
 //! tree is rebuilt from its sampling tree's flux ([`DirectionalTree::refined`]), and at the end
 //! of the iteration ([`SdTree::build`]) it becomes the sampling tree.
 
-use glam::{Vec2, Vec3};
+use glam::Vec3;
 
+use super::Record;
 use super::quadtree::{self, DirectionalTree};
+use super::selection::{LearnedSelection, SelectionLoss};
+
+/// The orientation classes a spatial leaf keeps apart: the dominant axis of the normal of the
+/// surface's front side, and its sign.
+pub const ORIENTATIONS: u32 = 6;
+
+/// The orientation class of the unit normal `n`: 2 × the axis of its largest component, plus
+/// 1 where that component is negative.
+#[inline]
+pub fn orientation(n: Vec3) -> u32 {
+    let a = n.abs();
+    let axis = if a.x >= a.y && a.x >= a.z {
+        0
+    } else if a.y >= a.z {
+        1
+    } else {
+        2
+    };
+    2 * axis + u32::from(n[axis as usize] < 0.0)
+}
 
 /// A node of the spatial tree.
 #[derive(Clone, Copy, Debug)]
 enum SpatialNode {
-    /// A leaf: the index of its trees, and the axis it would be split along.
+    /// A leaf: the index of its first trees (one per orientation class follow), and the axis
+    /// it would be split along.
     Leaf { trees: u32, axis: u8 },
     /// Split at the middle of `axis` into the lower and the upper half.
     Split { axis: u8, children: [u32; 2] },
 }
 
-/// The directional trees of a spatial leaf.
+/// The directional trees of a spatial leaf and its learned BSDF sampling fraction.
 #[derive(Clone, Debug, Default)]
 pub struct LeafTrees {
     /// Learned in the previous iteration: what paths sample from.
     pub sampling: DirectionalTree,
     /// What this iteration's paths record into.
     pub building: DirectionalTree,
+    /// α where it is learned (`bsdfSamplingFractionLoss`).
+    pub selection: LearnedSelection,
 }
 
-/// A spatial leaf found for a point: its index and its extent.
+/// The trees found for a point and orientation: their index and the extent of their spatial
+/// leaf.
 #[derive(Clone, Copy, Debug)]
 pub struct SpatialLeaf {
     pub index: u32,
@@ -48,6 +81,7 @@ pub struct SdTree {
     /// The cube's edge length.
     extent: f32,
     nodes: Vec<SpatialNode>,
+    /// The trees of every spatial leaf, [`ORIENTATIONS`] consecutive ones per leaf.
     leaves: Vec<LeafTrees>,
 }
 
@@ -61,20 +95,24 @@ impl SdTree {
             origin: lo,
             extent,
             nodes: vec![SpatialNode::Leaf { trees: 0, axis: 0 }],
-            leaves: vec![LeafTrees::default()],
+            leaves: vec![LeafTrees::default(); ORIENTATIONS as usize],
         }
     }
 
-    /// The leaf holding the point `p` (clamped into the cube).
+    /// The trees of orientation class `class` ([`orientation`]) in the leaf holding the point
+    /// `p` (clamped into the cube).
     #[inline]
-    pub fn leaf_at(&self, p: Vec3) -> SpatialLeaf {
+    pub fn leaf_at(&self, p: Vec3, class: u32) -> SpatialLeaf {
         let mut q = ((p - self.origin) / self.extent).clamp(Vec3::ZERO, Vec3::ONE);
         let mut size = Vec3::splat(self.extent);
         let mut node = 0usize;
         loop {
             match self.nodes[node] {
                 SpatialNode::Leaf { trees, .. } => {
-                    return SpatialLeaf { index: trees, size };
+                    return SpatialLeaf {
+                        index: trees + class,
+                        size,
+                    };
                 }
                 SpatialNode::Split { axis, children } => {
                     let axis = axis as usize;
@@ -98,16 +136,30 @@ impl SdTree {
         &self.leaves[index as usize]
     }
 
-    /// Records into the building tree of leaf `index` a sample at `p` (unit square) with value
-    /// `flux` and statistical weight `weight`.
-    #[inline]
-    pub fn record(&mut self, index: u32, p: Vec2, flux: f32, weight: f32) {
-        self.leaves[index as usize].building.record(p, flux, weight);
+    /// Files `record` into its leaf: its flux into the building tree and, under `loss`, its
+    /// gradient into the leaf's learned α.
+    pub fn file(&mut self, record: &Record, loss: SelectionLoss) {
+        let leaf = &mut self.leaves[record.leaf as usize];
+        leaf.building
+            .record(record.point, record.flux, record.weight);
+        if let Some(sample) = &record.selection {
+            leaf.selection.train(sample, loss);
+        }
     }
 
     /// Spatial leaves.
     pub fn leaf_count(&self) -> usize {
-        self.leaves.len()
+        self.leaves.len() / ORIENTATIONS as usize
+    }
+
+    /// The statistical weight recorded in the leaf whose trees start at `trees`, over its
+    /// orientation classes.
+    fn recorded_weight(&self, trees: u32) -> f64 {
+        let first = trees as usize;
+        self.leaves[first..first + ORIENTATIONS as usize]
+            .iter()
+            .map(|t| t.building.weight())
+            .sum()
     }
 
     /// About how many bytes the directional trees take.
@@ -128,7 +180,7 @@ impl SdTree {
             let mut stack = vec![0usize];
             while let Some(node) = stack.pop() {
                 if let SpatialNode::Leaf { trees, axis } = self.nodes[node]
-                    && self.leaves[trees as usize].building.weight() > threshold
+                    && self.recorded_weight(trees) > threshold
                 {
                     self.split(node, trees, axis);
                 }
@@ -143,15 +195,17 @@ impl SdTree {
         }
     }
 
-    /// Splits leaf node `node` (holding the trees `index`) in two along `axis`: both halves
-    /// get its trees with half the recorded weight, and split along the next axis.
+    /// Splits leaf node `node` (holding the trees from `index`) in two along `axis`: both
+    /// halves get its trees with half the recorded weight, and split along the next axis.
     fn split(&mut self, node: usize, index: u32, axis: u8) {
-        let trees = &mut self.leaves[index as usize];
-        let weight = trees.building.weight() * 0.5;
-        trees.building.set_weight(weight);
-        let copy = trees.clone();
         let upper = self.leaves.len() as u32;
-        self.leaves.push(copy);
+        for class in 0..ORIENTATIONS {
+            let trees = &mut self.leaves[(index + class) as usize];
+            let weight = trees.building.weight() * 0.5;
+            trees.building.set_weight(weight);
+            let copy = trees.clone();
+            self.leaves.push(copy);
+        }
         let lower_node = self.nodes.len() as u32;
         let next = (axis + 1) % 3;
         self.nodes.push(SpatialNode::Leaf {
@@ -181,6 +235,7 @@ impl SdTree {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use glam::Vec2;
 
     /// A leaf with more recorded weight than the threshold splits, and its halves split again
     /// while half the weight still exceeds it; points find the leaf of their octant.
@@ -188,20 +243,68 @@ mod tests {
     fn leaves_split_by_recorded_weight() {
         let mut tree = SdTree::new(Vec3::ZERO, Vec3::new(2.0, 1.0, 1.0));
         tree.refine(0.0, 0.01, None);
+        let record = Record {
+            leaf: 0,
+            point: Vec2::splat(0.5),
+            flux: 1.0,
+            weight: 1.0,
+            selection: None,
+        };
         for _ in 0..100 {
-            tree.record(0, Vec2::splat(0.5), 1.0, 1.0);
+            tree.file(&record, SelectionLoss::None);
         }
         tree.build();
         // 100 > 30: split in x (50 each), again in y (25 each), then no more.
         tree.refine(30.0, 0.01, None);
         assert_eq!(tree.leaf_count(), 4);
-        let a = tree.leaf_at(Vec3::new(0.1, 0.1, 0.1));
-        let b = tree.leaf_at(Vec3::new(1.9, 0.1, 0.1));
-        let c = tree.leaf_at(Vec3::new(0.1, 1.9, 1.9));
+        let a = tree.leaf_at(Vec3::new(0.1, 0.1, 0.1), 0);
+        let b = tree.leaf_at(Vec3::new(1.9, 0.1, 0.1), 0);
+        let c = tree.leaf_at(Vec3::new(0.1, 1.9, 1.9), 0);
         assert_ne!(a.index, b.index);
         assert_ne!(a.index, c.index);
         assert_eq!(a.size, Vec3::new(1.0, 1.0, 2.0));
         // The sampling trees are the parent's.
         assert!(tree.leaf(a.index).sampling.pdf(Vec2::splat(0.5)) > 1.0);
+    }
+
+    /// Records of the two sides of a surface go to trees of their own in the same leaf, and
+    /// the leaf splits by the weight of both; the classes are the normal's dominant axis and
+    /// sign.
+    #[test]
+    fn orientation_classes_keep_apart_in_a_leaf() {
+        assert_eq!(orientation(Vec3::X), 0);
+        assert_eq!(orientation(Vec3::new(-0.8, 0.6, 0.0)), 1);
+        assert_eq!(orientation(Vec3::new(0.1, 0.9, -0.4)), 2);
+        assert_eq!(orientation(Vec3::NEG_Y), 3);
+        assert_eq!(orientation(Vec3::new(0.5, 0.4, 0.76)), 4);
+        assert_eq!(orientation(Vec3::NEG_Z), 5);
+        let mut tree = SdTree::new(Vec3::ZERO, Vec3::ONE);
+        tree.refine(0.0, 0.01, None);
+        let p = Vec3::splat(0.25);
+        let (up, down) = (tree.leaf_at(p, 2), tree.leaf_at(p, 3));
+        assert_ne!(up.index, down.index);
+        for (leaf, point) in [(up, Vec2::new(0.9, 0.5)), (down, Vec2::new(0.1, 0.5))] {
+            let record = Record {
+                leaf: leaf.index,
+                point,
+                flux: 1.0,
+                weight: 1.0,
+                selection: None,
+            };
+            for _ in 0..20 {
+                tree.file(&record, SelectionLoss::None);
+            }
+        }
+        tree.build();
+        assert!(tree.leaf(up.index).sampling.pdf(Vec2::new(0.9, 0.5)) > 10.0);
+        assert_eq!(tree.leaf(up.index).sampling.pdf(Vec2::new(0.1, 0.5)), 0.0);
+        assert!(tree.leaf(down.index).sampling.pdf(Vec2::new(0.1, 0.5)) > 10.0);
+        // 40 records exceed 30 where 20 would not: the leaf splits, its classes together.
+        tree.refine(30.0, 0.01, None);
+        assert_eq!(tree.leaf_count(), 2);
+        let lower = tree.leaf_at(p, 3);
+        let upper = tree.leaf_at(Vec3::new(0.75, 0.25, 0.25), 3);
+        assert_ne!(lower.index, upper.index);
+        assert!(tree.leaf(upper.index).sampling.pdf(Vec2::new(0.1, 0.5)) > 10.0);
     }
 }
