@@ -4,7 +4,8 @@
 //! quarter-wave plate at 45° (circular light), a glass plane seen near Brewster's angle beside
 //! a gold sphere, a `pplastic` plane at the same angle, a `twosided` polarizer seen from
 //! either side behind a plain one, and a `blendbsdf` of a `twosided` polarizer and a diffuse
-//! BSDF under a uniform sky, from either side, all through the `stokes` integrator.
+//! BSDF under a uniform sky, from either side, and a `measured_polarized` plane with a
+//! synthetic table (`synthetic.pbsdf`), all through the `stokes` integrator.
 //!
 //! Each of the twelve channels S0.R … S3.B is compared by its image mean, Prism's from eight
 //! renders with different seeds (their spread gives its standard error), with the mean of
@@ -127,6 +128,18 @@ const REFERENCES: &[Reference] = &[
         standard_error: [
             2.62e-04, 2.07e-04, 2.25e-04, 1.51e-04, 1.18e-04, 1.30e-04, 2.63e-04, 2.04e-04,
             2.29e-04, 0.00e+00, 0.00e+00, 0.00e+00,
+        ],
+    },
+    Reference {
+        scene: "measured_polarized",
+        defines: &[],
+        mean: [
+            0.4501475, 0.3267578, 0.2859972, 0.0131809, 0.0095663, 0.0083068, -0.0000428,
+            -0.0000774, -0.0001053, 0.0000000, 0.0000000, 0.0000000,
+        ],
+        standard_error: [
+            9.64e-04, 6.64e-04, 5.49e-04, 2.55e-04, 1.76e-04, 1.76e-04, 3.79e-04, 2.78e-04,
+            3.64e-04, 0.00e+00, 0.00e+00, 0.00e+00,
         ],
     },
 ];

@@ -68,6 +68,7 @@ pub static BSDFS: Registry<Build> = Registry {
         layered::COATEDCONDUCTOR,
         hair::HAIR,
         measured::MEASURED,
+        measured::MEASURED_POLARIZED,
         polarizing::POLARIZER,
         polarizing::RETARDER,
         polarizing::CIRCULAR,
