@@ -2,8 +2,10 @@
 //! `tests/data/polarization/` (its README says how the references were made): an area light
 //! seen through two linear polarizers 60° apart (Malus's law), through two aligned ones and a
 //! quarter-wave plate at 45° (circular light), a glass plane seen near Brewster's angle beside
-//! a gold sphere, and a `pplastic` plane at the same angle, all through the `stokes`
-//! integrator.
+//! a gold sphere, a `pplastic` plane at the same angle, a `twosided` polarizer seen from
+//! either side behind a plain one, and a `blendbsdf` of a `twosided` polarizer and a diffuse
+//! BSDF under a uniform sky, from either side, and a `measured_polarized` plane with a
+//! synthetic table (`synthetic.pbsdf`), all through the `stokes` integrator.
 //!
 //! Each of the twelve channels S0.R … S3.B is compared by its image mean, Prism's from eight
 //! renders with different seeds (their spread gives its standard error), with the mean of
@@ -80,6 +82,66 @@ const REFERENCES: &[Reference] = &[
             4.03e-05, 0.0, 0.0, 0.0,
         ],
     },
+    Reference {
+        scene: "twosided",
+        defines: &[],
+        mean: [
+            0.1507988, 0.1186561, 0.1137992, -0.0753316, -0.0592747, -0.0568492, -0.1306117,
+            -0.1027719, -0.0985647, 0.0000000, 0.0000000, 0.0000000,
+        ],
+        standard_error: [
+            3.13e-05, 2.52e-06, 7.55e-05, 1.62e-05, 1.37e-06, 3.76e-05, 2.68e-05, 2.23e-06,
+            6.55e-05, 0.00e+00, 0.00e+00, 0.00e+00,
+        ],
+    },
+    Reference {
+        scene: "twosided",
+        defines: &[("turn", "180")],
+        mean: [
+            0.1507839, 0.1186444, 0.1137884, -0.0753785, -0.0593116, -0.0568847, -0.1305854,
+            -0.1027512, -0.0985453, 0.0000000, 0.0000000, 0.0000000,
+        ],
+        standard_error: [
+            3.17e-05, 2.47e-06, 7.53e-05, 1.62e-05, 1.38e-06, 3.76e-05, 2.72e-05, 2.09e-06,
+            6.52e-05, 0.00e+00, 0.00e+00, 0.00e+00,
+        ],
+    },
+    Reference {
+        scene: "blend",
+        defines: &[],
+        mean: [
+            0.5730250, 0.4510178, 0.4329230, 0.2262134, 0.1780489, 0.1708257, -0.3918015,
+            -0.3083817, -0.2958674, 0.0000000, 0.0000000, 0.0000000,
+        ],
+        standard_error: [
+            2.62e-04, 2.07e-04, 2.25e-04, 1.52e-04, 1.18e-04, 1.31e-04, 2.63e-04, 2.04e-04,
+            2.29e-04, 0.00e+00, 0.00e+00, 0.00e+00,
+        ],
+    },
+    Reference {
+        scene: "blend",
+        defines: &[("turn", "180")],
+        mean: [
+            0.5730250, 0.4510178, 0.4329230, 0.2261897, 0.1780297, 0.1708075, -0.3917611,
+            -0.3083503, -0.2958368, 0.0000000, 0.0000000, 0.0000000,
+        ],
+        standard_error: [
+            2.62e-04, 2.07e-04, 2.25e-04, 1.51e-04, 1.18e-04, 1.30e-04, 2.63e-04, 2.04e-04,
+            2.29e-04, 0.00e+00, 0.00e+00, 0.00e+00,
+        ],
+    },
+    Reference {
+        scene: "measured_polarized",
+        defines: &[],
+        mean: [
+            0.4501475, 0.3267578, 0.2859972, 0.0131809, 0.0095663, 0.0083068, -0.0000428,
+            -0.0000774, -0.0001053, 0.0000000, 0.0000000, 0.0000000,
+        ],
+        standard_error: [
+            9.64e-04, 6.64e-04, 5.49e-04, 2.55e-04, 1.76e-04, 1.76e-04, 3.79e-04, 2.78e-04,
+            3.64e-04, 0.00e+00, 0.00e+00, 0.00e+00,
+        ],
+    },
 ];
 
 fn scene_path(name: &str) -> PathBuf {
@@ -103,7 +165,13 @@ fn load(name: &str, defines: &[(&str, &str)]) -> Scene {
 /// The image means of the twelve Stokes channels over `renders` renders of `spp` samples
 /// with seeds 11, 12, …, and their standard errors from the spread of the renders.
 fn stokes_means(scene: &Scene, spp: u32, renders: u64) -> ([f64; 12], [f64; 12]) {
-    let per_render: Vec<[f64; 12]> = (0..renders)
+    mean_and_standard_error(&stokes_renders(scene, spp, renders))
+}
+
+/// The image means of the twelve Stokes channels of `renders` renders of `spp` samples with
+/// seeds 11, 12, …
+fn stokes_renders(scene: &Scene, spp: u32, renders: u64) -> Vec<[f64; 12]> {
+    (0..renders)
         .map(|i| {
             let film = render_film(scene, spp, 11 + i, None);
             assert_eq!(film.aov_names, CHANNELS, "the stokes integrator's channels");
@@ -112,15 +180,15 @@ fn stokes_means(scene: &Scene, spp: u32, renders: u64) -> ([f64; 12], [f64; 12])
                 values.iter().map(|&v| f64::from(v)).sum::<f64>() / values.len() as f64
             })
         })
-        .collect();
-    let n = renders as f64;
-    let mean: [f64; 12] = std::array::from_fn(|c| per_render.iter().map(|m| m[c]).sum::<f64>() / n);
+        .collect()
+}
+
+/// The mean of each column of `rows` and its standard error from their spread.
+fn mean_and_standard_error<const N: usize>(rows: &[[f64; N]]) -> ([f64; N], [f64; N]) {
+    let n = rows.len() as f64;
+    let mean: [f64; N] = std::array::from_fn(|c| rows.iter().map(|m| m[c]).sum::<f64>() / n);
     let standard_error = std::array::from_fn(|c| {
-        let variance = per_render
-            .iter()
-            .map(|m| (m[c] - mean[c]).powi(2))
-            .sum::<f64>()
-            / (n - 1.0);
+        let variance = rows.iter().map(|m| (m[c] - mean[c]).powi(2)).sum::<f64>() / (n - 1.0);
         (variance / n).sqrt()
     });
     (mean, standard_error)
@@ -173,6 +241,68 @@ fn two_polarizers_follow_malus_law() {
                 "{degrees}°: not fully polarized"
             );
             assert!(mean[9 + c].abs() <= 1e-6, "{degrees}°: S3 {}", mean[9 + c]);
+        }
+    }
+}
+
+/// Malus's law through a `twosided` polarizer, seen from its front and from its back: S₀
+/// behind a plain polarizer and the two-sided one θ apart is cos²θ times S₀ with the two
+/// aligned, and the light that passes is fully linearly polarized.
+#[test]
+fn a_twosided_polarizer_follows_malus_law_from_both_sides() {
+    for turn in ["0", "180"] {
+        let aligned = stokes_means(&load("twosided", &[("theta", "0"), ("turn", turn)]), 64, 2).0;
+        for degrees in [30.0f64, 60.0, 90.0] {
+            let theta = degrees.to_string();
+            let scene = load("twosided", &[("theta", &theta), ("turn", turn)]);
+            let (mean, _) = stokes_means(&scene, 64, 2);
+            let expected = degrees.to_radians().cos().powi(2);
+            for c in 0..3 {
+                let ratio = mean[c] / aligned[c];
+                assert!(
+                    (ratio - expected).abs() < 2e-3,
+                    "turned {turn}°, {degrees}° {}: {ratio} against cos²θ = {expected}",
+                    CHANNELS[c]
+                );
+                let linear = (mean[3 + c].powi(2) + mean[6 + c].powi(2)).sqrt();
+                assert!(
+                    (linear - mean[c]).abs() <= 2e-3 * aligned[c],
+                    "turned {turn}°, {degrees}°: not fully polarized"
+                );
+                assert!(mean[9 + c].abs() <= 1e-6, "{degrees}°: S3 {}", mean[9 + c]);
+            }
+        }
+    }
+}
+
+/// A sheet blending a polarizer (share 1 − w) and a diffuse BSDF of reflectance ρ (share w)
+/// under a uniform sky of radiance L, seen from either side: the polarizer passes ½ (1 − w) L,
+/// fully linearly polarized, the diffuse BSDF reflects w ρ L, unpolarized, so the degree of
+/// linear polarization √(S₁² + S₂²) / S₀ is ½ (1 − w) / (½ (1 − w) + w ρ), whatever the colour
+/// of L; nothing is circular. Each render's ratio gives one value; their spread the tolerance.
+#[test]
+fn a_blend_of_a_polarizer_and_a_diffuse_bsdf_has_the_closed_form_polarization() {
+    let (weight, reflectance) = (0.25, 0.4);
+    let polarized = 0.5 * (1.0 - weight);
+    let expected = polarized / (polarized + weight * reflectance);
+    for turn in ["0", "180"] {
+        let renders = stokes_renders(&load("blend", &[("turn", turn)]), 256, 8);
+        let degrees: Vec<[f64; 3]> = renders
+            .iter()
+            .map(|m| std::array::from_fn(|c| (m[3 + c].powi(2) + m[6 + c].powi(2)).sqrt() / m[c]))
+            .collect();
+        let (mean, se) = mean_and_standard_error(&degrees);
+        for c in 0..3 {
+            assert!(
+                se[c] < 5e-3 && (mean[c] - expected).abs() < 4.0 * se[c] + 1e-4,
+                "turned {turn}°, {}: degree of polarization {} ± {:.1e}, expected {expected}",
+                CHANNELS[c],
+                mean[c],
+                se[c]
+            );
+            for r in &renders {
+                assert!(r[9 + c].abs() <= 1e-6, "turned {turn}°: S3 {}", r[9 + c]);
+            }
         }
     }
 }

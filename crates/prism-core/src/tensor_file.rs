@@ -7,11 +7,13 @@
 //! u16               version (1)
 //! u32               number of fields
 //! per field:        u16 name length, the name (UTF-8), u16 number of dimensions,
-//!                   u8 element type (1 = u8, 10 = f32, 11 = f64), u64 byte offset of the values
+//!                   u8 element type (1 = u8, 3 = u16, 10 = f32, 11 = f64), u64 byte offset of the values
 //!                   from the start of the file, one u64 per dimension (the shape)
 //! ```
 //! The values of a field are stored contiguously, row-major (last dimension fastest). Every
-//! size is checked against the file's length before anything is allocated.
+//! size is checked against the file's length before anything is allocated. Non-finite values
+//! are refused, except by [`parse_tensor_file_with_nans`] for tables that mark missing
+//! measurements with NaN.
 
 /// One field of a tensor file: its shape and values (widened to f64).
 #[derive(Clone, Debug, PartialEq)]
@@ -23,6 +25,7 @@ pub struct TensorField {
 
 const MAGIC: &[u8; 12] = b"tensor_file\0";
 const ELEMENT_U8: u8 = 1;
+const ELEMENT_U16: u8 = 3;
 const ELEMENT_F32: u8 = 10;
 const ELEMENT_F64: u8 = 11;
 /// More dimensions than any table here has; a bound so that a corrupt count cannot make the
@@ -75,6 +78,16 @@ impl<'a> Reader<'a> {
 
 /// Reads every field of a tensor file; the error says what is wrong and where.
 pub fn parse_tensor_file(bytes: &[u8]) -> Result<Vec<TensorField>, String> {
+    parse(bytes, false)
+}
+
+/// [`parse_tensor_file`] for a file whose values may be NaN (missing measurements); infinite
+/// values are still refused.
+pub fn parse_tensor_file_with_nans(bytes: &[u8]) -> Result<Vec<TensorField>, String> {
+    parse(bytes, true)
+}
+
+fn parse(bytes: &[u8], nans: bool) -> Result<Vec<TensorField>, String> {
     if bytes.len() < MAGIC.len() || &bytes[..MAGIC.len()] != MAGIC {
         return Err("not a Mitsuba tensor file (it does not start with \"tensor_file\")".into());
     }
@@ -114,11 +127,12 @@ pub fn parse_tensor_file(bytes: &[u8]) -> Result<Vec<TensorField>, String> {
         let element = reader.u8(&format!("the element type of \"{name}\""))?;
         let element_size = match element {
             ELEMENT_U8 => 1,
+            ELEMENT_U16 => 2,
             ELEMENT_F32 => 4,
             ELEMENT_F64 => 8,
             other => {
                 return Err(format!(
-                    "field \"{name}\" has element type {other}; only 1 (u8), 10 (f32) and 11 (f64) are read"
+                    "field \"{name}\" has element type {other}; only 1 (u8), 3 (u16), 10 (f32) and 11 (f64) are read"
                 ));
             }
         };
@@ -153,6 +167,10 @@ pub fn parse_tensor_file(bytes: &[u8]) -> Result<Vec<TensorField>, String> {
         let raw = &bytes[start..end];
         let values: Vec<f64> = if element == ELEMENT_U8 {
             raw.iter().map(|&b| f64::from(b)).collect()
+        } else if element == ELEMENT_U16 {
+            raw.chunks_exact(2)
+                .map(|c| f64::from(u16::from_le_bytes([c[0], c[1]])))
+                .collect()
         } else if element == ELEMENT_F32 {
             raw.chunks_exact(4)
                 .map(|c| f64::from(f32::from_le_bytes(c.try_into().expect("4 bytes"))))
@@ -163,7 +181,8 @@ pub fn parse_tensor_file(bytes: &[u8]) -> Result<Vec<TensorField>, String> {
                 .collect()
         };
         debug_assert_eq!(values.len(), length);
-        if let Some(position) = values.iter().position(|v| !v.is_finite()) {
+        let refused = |v: &f64| !(v.is_finite() || nans && v.is_nan());
+        if let Some(position) = values.iter().position(refused) {
             return Err(format!(
                 "field \"{name}\" holds a non-finite value at index {position}"
             ));

@@ -277,6 +277,14 @@ fn cases() -> Vec<Case> {
             "not a finite number",
         ),
         render_scene(
+            "polarizer under volpath",
+            scene!(
+                "    <integrator type=\"volpath\"/>\n    <shape type=\"sphere\"><bsdf type=\"polarizer\"/></shape>"
+            ),
+            "scene.xml:3:",
+            "does not render polarized light",
+        ),
+        render_scene(
             "degenerate lookat",
             scene!(
                 "    <shape type=\"sphere\"><transform name=\"to_world\"><lookat origin=\"1,1,1\" target=\"1,1,1\"/></transform></shape>"

@@ -1,6 +1,6 @@
 //! Materials, and the scattering at a path vertex that both integrators use.
 
-use glam::{Mat4, Vec2, Vec3};
+use glam::{Vec2, Vec3};
 
 use super::{
     Bsdf, BsdfEval, BsdfFlags, BsdfModel, BsdfSample, BxdfTree, NodeId, ResolveContext,
@@ -207,14 +207,7 @@ impl<'t, 'm> Scattering<'t, 'm> {
             return SampledMueller::depolarizer(value);
         };
         let change = FrameChange::local_to_world(&self.frame, -wi, self.wo);
-        SampledMueller::from_fn(|i| {
-            let m00 = local.0[i].x_axis.x;
-            if m00 > 0.0 && m00.is_finite() {
-                change.apply(local.0[i]) * (value[i] / m00)
-            } else {
-                Mat4::ZERO
-            }
-        })
+        local.in_frames(&change).with_m00(value)
     }
 
     /// Draws an incident direction: `u_lobe` chooses a lobe, `u` the direction within it; the

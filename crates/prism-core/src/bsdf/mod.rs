@@ -54,6 +54,7 @@
 //! | `coateddiffuse`, `coatedconductor` | [`layered`] | reflection by a random walk through a coating (pbrt-v4's) |
 //! | `hair` | [`hair`] | glossy scattering around a fibre (reflection and transmission) |
 //! | `measured` | [`measured`] | glossy reflection, tabulated (RGL database) |
+//! | `measured_polarized` | [`measured_polarized`] | glossy reflection, a tabulated Mueller matrix (KAIST pBRDF database) |
 //! | `polarizer` | [`polarizer`] | null transmission through a linear polarizer |
 //! | `retarder` | [`retarder`] | null transmission through a linear retarder (a wave plate) |
 //! | `circular` | [`circular`] | null transmission through a circular polarizer |
@@ -79,6 +80,7 @@ pub mod layered;
 pub mod mask;
 pub mod material;
 pub mod measured;
+pub mod measured_polarized;
 pub mod microfacet;
 pub mod normalmap;
 pub mod null;
@@ -113,6 +115,7 @@ pub use layered::{CoatedConductor, CoatedDiffuse, Coating};
 pub use mask::Mask;
 pub use material::{Material, Scattering};
 pub use measured::{Measured, MeasuredData};
+pub use measured_polarized::{MeasuredPolarized, MeasuredPolarizedData};
 pub use normalmap::NormalMap;
 pub use null::Null;
 pub use phong::Phong;
@@ -708,6 +711,7 @@ bsdfs! {
         Null(Null),
         Hair(Hair),
         Measured(Measured),
+        MeasuredPolarized(MeasuredPolarized),
         Polarizer(Polarizer),
         Retarder(Retarder),
         Circular(Circular),
@@ -743,6 +747,7 @@ bsdfs! {
         Null(null::NullLobes),
         Hair(hair::HairLobes<'a>),
         Measured(measured::MeasuredLobes<'a>),
+        MeasuredPolarized(measured_polarized::MeasuredPolarizedLobes<'a>),
         Polarizer(polarizer::PolarizerLobes),
         Retarder(retarder::RetarderLobes),
         Circular(circular::CircularLobes),

@@ -17,6 +17,7 @@ use super::{
     ResolveContext, ShadingPoint,
 };
 use crate::math::Frame;
+use crate::polarization::SampledMueller;
 use crate::spectrum::SampledSpectrum;
 
 /// The BSDF a bump or normal map nests, and how its frame is tilted.
@@ -149,5 +150,20 @@ impl Bxdf for PerturbedLobes {
             return SampledSpectrum::ZERO;
         }
         tree.null_transmission(self.nested, wo_p) * self.shadowing(-wo)
+    }
+
+    /// The nested BSDF's matrix for the directions in the tilted frame, passed on as it is:
+    /// its reference directions are the implicit Stokes bases of the tilted frame's local
+    /// directions, taken for those of the original frame (as Mitsuba 3's `bumpmap` and
+    /// `normalmap` pass the nested matrix on, unrotated).
+    fn mueller(
+        &self,
+        tree: &BxdfTree,
+        wo: Vec3,
+        wi: Vec3,
+        lobe: BsdfFlags,
+    ) -> Option<SampledMueller> {
+        let (wo_p, wi_p) = (self.local.to_local(wo), self.local.to_local(wi));
+        tree.mueller(self.nested, wo_p, wi_p, lobe)
     }
 }

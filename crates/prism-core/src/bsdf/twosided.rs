@@ -16,6 +16,7 @@ use super::{
     ResolveContext, ShadingPoint,
 };
 use crate::math::Frame;
+use crate::polarization::SampledMueller;
 use crate::spectrum::SampledSpectrum;
 
 #[derive(Clone, Debug)]
@@ -113,5 +114,25 @@ impl Bxdf for BackSideLobes {
         let mut s = tree.sample(self.nested, flip(wo), u_lobe, u)?;
         s.wi = flip(s.wi);
         Some(s)
+    }
+
+    /// The back BSDF's, seen from the mirrored direction.
+    #[inline]
+    fn null_transmission(&self, tree: &BxdfTree, wo: Vec3) -> SampledSpectrum {
+        tree.null_transmission(self.nested, flip(wo))
+    }
+
+    /// The back BSDF's matrix for the mirrored directions, passed on in the implicit bases of
+    /// the directions as they are (Mitsuba 3's `twosided`, which mirrors the directions and
+    /// keeps the nested BSDF's matrix).
+    #[inline]
+    fn mueller(
+        &self,
+        tree: &BxdfTree,
+        wo: Vec3,
+        wi: Vec3,
+        lobe: BsdfFlags,
+    ) -> Option<SampledMueller> {
+        tree.mueller(self.nested, flip(wo), flip(wi), lobe)
     }
 }

@@ -11,7 +11,7 @@
 //! Goldstein, "Polarized Light", 3rd ed., 2011, ch. 6); [`SampledMueller`] holds one matrix per
 //! wavelength of a path.
 
-use std::ops::Mul;
+use std::ops::{Add, Mul};
 
 use glam::{Mat4, Vec3, Vec4};
 
@@ -305,8 +305,32 @@ impl SampledMueller {
         std::array::from_fn(|i| self.0[i].x_axis * intensity[i])
     }
 
+    /// Each matrix scaled so that its M₀₀ is `value` at its wavelength: the polarization of an
+    /// element whose matrix is known up to a positive factor, with the intensity an unpolarized
+    /// evaluation gave. Zero where M₀₀ is not a positive number.
+    #[inline]
+    pub fn with_m00(&self, value: SampledSpectrum) -> SampledMueller {
+        SampledMueller::from_fn(|i| {
+            let m00 = self.0[i].x_axis.x;
+            if m00 > 0.0 && m00.is_finite() {
+                self.0[i] * (value[i] / m00)
+            } else {
+                Mat4::ZERO
+            }
+        })
+    }
+
     pub fn is_finite(&self) -> bool {
         self.0.iter().all(|m| m.is_finite())
+    }
+}
+
+impl Add for SampledMueller {
+    type Output = SampledMueller;
+
+    #[inline]
+    fn add(self, rhs: SampledMueller) -> SampledMueller {
+        SampledMueller::from_fn(|i| self.0[i] + rhs.0[i])
     }
 }
 

@@ -142,6 +142,11 @@ pub fn build_scene_with_geometry(
     builder.declared_media(&params)?;
     params.finish()?;
     check_renders_media(&integrator, &builder.media)?;
+    check_renders_polarization(
+        &integrator,
+        &builder.materials.materials,
+        integrator_location,
+    )?;
     check_bdpt_lights(&integrator, &builder.lights, &builder.light_locations)?;
     let delta_light_warning = integrator_child.and_then(|child| {
         integrators::direct_delta_light_warning(&child.node, &integrator, &builder.lights)
@@ -269,6 +274,42 @@ fn check_renders_media(integrator: &Integrator, media: &MediaCache) -> Result<()
         ));
     }
     Ok(())
+}
+
+/// A scene with a polarizing BSDF renders polarized with `path` (and `stokes`); `direct`, whose
+/// light from unpolarized emitters scatters once, gives the polarized intensity exactly
+/// (S₀ = M₀₀ L), and `depth` and `aov` trace no light. The integrators that follow light over
+/// several vertices carry no polarization, so that light through two polarizers would come out
+/// wrong: such a scene is an error at the integrator.
+fn check_renders_polarization(
+    integrator: &Integrator,
+    materials: &[Material],
+    location: &SourceLocation,
+) -> Result<()> {
+    let name = match integrator {
+        Integrator::VolPath(_) => "volpath (and volpathmis)",
+        Integrator::Distribution(_) => "distrib",
+        Integrator::Particle(_) => "ptracer",
+        Integrator::Bdpt(_) => "bdpt",
+        Integrator::Sppm(_) => "sppm",
+        Integrator::Guided(_) => "guided_path",
+        Integrator::Moment(_) => "moment",
+        _ => return Ok(()),
+    };
+    if !materials.iter().any(Material::is_polarizing) {
+        return Ok(());
+    }
+    Err(Error::input(
+        location,
+        format!(
+            "the {name} integrator does not render polarized light, and the scene has a \
+             polarizing BSDF (polarizer, retarder, circular or measured_polarized)"
+        ),
+    )
+    .with_help(
+        "render it with <integrator type=\"path\"> (polarized, as Mitsuba's *_polarized \
+         variants render it; nested in <integrator type=\"stokes\"> for the Stokes vector)",
+    ))
 }
 
 /// The bdpt integrator starts light subpaths on area and point lights only: any other light is

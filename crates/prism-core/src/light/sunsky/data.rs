@@ -161,11 +161,11 @@ mod tests {
         // dimension count.
         let type_at = 12 + 2 + 4 + 2 + 14 + 2;
         assert_eq!(wrong_type[type_at], 10, "f32");
-        wrong_type[type_at] = 3;
+        wrong_type[type_at] = 2;
         assert!(
             parse_tensor_file(&wrong_type)
                 .unwrap_err()
-                .contains("element type 3")
+                .contains("element type 2")
         );
     }
 }

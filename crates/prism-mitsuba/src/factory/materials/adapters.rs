@@ -18,7 +18,7 @@ pub(super) const TWOSIDED: Plugin<Build> = Plugin {
     origin: Origin::Mitsuba3,
     summary: "A reflecting BSDF on both sides of the surface, or one for the front and one \
               for the back.",
-    params: &[TWOSIDED_BSDFS],
+    params: &[TWOSIDED_BSDFS, ALLOW_TRANSMISSION],
     build: |params, t| {
         let (front, back) = twosided_pair(params, t)?;
         Ok(Bsdf::TwoSided(TwoSided {
@@ -93,6 +93,7 @@ pub(super) const NORMALMAP: Plugin<Build> = Plugin {
 
 params! {
     pub(super) TWOSIDED_BSDFS = ParamSpec::nested(PluginClass::Bsdf, Default::Required, "one reflecting BSDF for both sides, or two: front, then back");
+    pub(super) ALLOW_TRANSMISSION = ParamSpec::new("allow_transmission", ParamKind::Boolean, Default::Boolean(false), "accept nested BSDFs that transmit light (a `polarizer`), as Mitsuba 3 does with this flag");
     NESTED_BSDF = ParamSpec::nested(PluginClass::Bsdf, Default::Required, "the BSDF adapted");
     OPACITY = ParamSpec::new("opacity", ParamKind::FloatTexture(Bounds::UNIT), Default::Float(0.5), "the opacity α");
     WEIGHT = ParamSpec::new("weight", ParamKind::FloatTexture(Bounds::UNIT), Default::Required, "the share w of the second BSDF");
@@ -108,6 +109,7 @@ params! {
 pub(super) fn twosided_pair(params: &Params, textures: &mut TextureCache) -> Result<(Bsdf, Bsdf)> {
     let node = params.node();
     let nested = params.children(&TWOSIDED_BSDFS);
+    let allow_transmission = params.boolean(&ALLOW_TRANSMISSION)?;
     let one_sided = |child: &PluginNode, textures: &mut TextureCache| -> Result<Bsdf> {
         if child.plugin_type == "twosided" {
             return Err(Error::input(
@@ -118,7 +120,8 @@ pub(super) fn twosided_pair(params: &Params, textures: &mut TextureCache) -> Res
         }
         let bsdf = build_bsdf(child, textures)?;
         let flags = bsdf.flags();
-        if flags.contains(BsdfFlags::TRANSMISSION) || flags.contains(BsdfFlags::NULL) {
+        let transmits = flags.contains(BsdfFlags::TRANSMISSION) || flags.contains(BsdfFlags::NULL);
+        if transmits && !allow_transmission {
             return Err(Error::input(
                 &child.location,
                 format!(
@@ -128,7 +131,8 @@ pub(super) fn twosided_pair(params: &Params, textures: &mut TextureCache) -> Res
             )
             .with_help(
                 "dielectrics and masks already work from both sides; as in Mitsuba 3, only \
-                 reflecting BSDFs can be made two-sided (put a mask around the twosided BSDF)",
+                 reflecting BSDFs can be made two-sided (put a mask around the twosided BSDF), \
+                 unless <boolean name=\"allow_transmission\" value=\"true\"/> is given",
             ));
         }
         Ok(bsdf)

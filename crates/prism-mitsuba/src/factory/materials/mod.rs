@@ -38,7 +38,7 @@ use crate::description::{PluginClass, PluginNode};
 use crate::factory::textures::TextureCache;
 use crate::params::Params;
 use crate::registry::{Default, ParamKind, ParamSpec, Range, Registry, params};
-use adapters::{TWOSIDED_BSDFS, twosided_pair};
+use adapters::{ALLOW_TRANSMISSION, TWOSIDED_BSDFS, twosided_pair};
 use prism_core::bsdf::{Bsdf, Diffuse, MAX_NODES, Material};
 use prism_core::error::{Error, Result};
 use prism_core::texture::Texture;
@@ -68,6 +68,7 @@ pub static BSDFS: Registry<Build> = Registry {
         layered::COATEDCONDUCTOR,
         hair::HAIR,
         measured::MEASURED,
+        measured::MEASURED_POLARIZED,
         polarizing::POLARIZER,
         polarizing::RETARDER,
         polarizing::CIRCULAR,
@@ -111,7 +112,7 @@ pub fn default_material() -> Material {
 /// and back BSDFs, anything else the front one.
 pub fn build_material(node: &PluginNode, textures: &mut TextureCache) -> Result<Material> {
     let material = if node.plugin_type == "twosided" {
-        let params = Params::new(node, &[TWOSIDED_BSDFS]);
+        let params = Params::new(node, &[TWOSIDED_BSDFS, ALLOW_TRANSMISSION]);
         let (front, back) = twosided_pair(&params, textures)?;
         params.finish()?;
         Material {
