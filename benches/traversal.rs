@@ -14,10 +14,10 @@
 //! - `shadow_occluded`: from the same points to a point on a light chosen by power (the
 //!   integrator's next-event estimation rays), finite segments.
 //!
-//! The bounce and shadow rays are also traced without the surface interaction, one at a time
-//! (`bounce_closest_hit`, `shadow_occluded`) and [`MAX_INTERLEAVED`] at a time with their
-//! traversals interleaved, as the path tracer's lanes trace them (`bounce_closest_hits_lanes`,
-//! `shadow_occluded_lanes`; [`prism_core::geometry::Aggregate::closest_hits`]).
+//! The bounce rays are also traced without the surface interaction, one at a time
+//! (`bounce_closest_hit`) and [`MAX_INTERLEAVED`] at a time with their traversals interleaved,
+//! as the path tracer's lanes trace them (`bounce_closest_hits_lanes`;
+//! [`prism_core::geometry::Aggregate::closest_hits`]).
 //!
 //! Criterion reports the throughput in rays (elements) per second. The large scene is written
 //! (once; it is kept in `target/bench-scenes`) and loaded only when one of its benchmarks runs,
@@ -171,18 +171,6 @@ fn closest_hits_interleaved(geometry: &Geometry, rays: &[Ray]) -> usize {
     count
 }
 
-/// [`occluded_all`] with [`MAX_INTERLEAVED`] rays at a time, their traversals interleaved.
-fn occluded_interleaved(geometry: &Geometry, rays: &[Ray]) -> usize {
-    let mut blocked = [false; MAX_INTERLEAVED];
-    let mut count = 0;
-    for group in rays.chunks(MAX_INTERLEAVED) {
-        let group: [Option<&Ray>; MAX_INTERLEAVED] = std::array::from_fn(|i| group.get(i));
-        geometry.occluded_each(&group, &mut blocked);
-        count += blocked.iter().filter(|&&b| b).count();
-    }
-    count
-}
-
 /// One of a fixture's ray sets.
 type RaySet = fn(&Fixture) -> &[Ray];
 /// A query over a ray set.
@@ -195,7 +183,7 @@ fn traversal(c: &mut Criterion) {
         // the same iteration count.
         group.sample_size(10).sampling_mode(SamplingMode::Flat);
         group.throughput(Throughput::Elements(u64::from(GRID * GRID)));
-        let cases: [(&str, RaySet, Query); 6] = [
+        let cases: [(&str, RaySet, Query); 5] = [
             ("camera_intersect", |f| &f.camera, intersect_all),
             ("bounce_intersect", |f| &f.bounce, intersect_all),
             ("shadow_occluded", |f| &f.shadow, occluded_all),
@@ -205,7 +193,6 @@ fn traversal(c: &mut Criterion) {
                 |f| &f.bounce,
                 closest_hits_interleaved,
             ),
-            ("shadow_occluded_lanes", |f| &f.shadow, occluded_interleaved),
         ];
         for (id, rays_of, query) in cases {
             group.bench_function(id, |b| {

@@ -300,28 +300,6 @@ impl<P: AggregateElement> Aggregate<P> {
         }
     }
 
-    /// Whether anything blocks each of `rays` (at most [`MAX_INTERLEAVED`], None where there
-    /// is no ray) in (0, t_max), written to `blocked`: each what [`Self::occluded`] says, our
-    /// BVH's traversals interleaved ([`Bvh::occluded_each`]).
-    pub fn occluded_each(&self, rays: &[Option<&Ray>], blocked: &mut [bool]) {
-        let Some(bvh) = self.bvh.as_ref().filter(|_| self.external.is_none()) else {
-            for (ray, blocked) in rays.iter().zip(blocked) {
-                *blocked = ray.is_some_and(|ray| self.occluded(ray));
-            }
-            return;
-        };
-        let mut found = [None; MAX_INTERLEAVED];
-        let found = &mut found[..rays.len()];
-        bvh.occluded_each(
-            rays,
-            |i, id, t_max| rays[i].and_then(|ray| self.whole_hit(ray, id, t_max)),
-            found,
-        );
-        for (blocked, found) in blocked.iter_mut().zip(found) {
-            *blocked = found.is_some();
-        }
-    }
-
     fn bvh_closest_hit(&self, ray: &Ray) -> Option<Hit> {
         let bvh = self.bvh.as_ref()?;
         let watertight = WatertightRay::new(ray.o, ray.d);

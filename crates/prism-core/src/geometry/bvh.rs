@@ -390,31 +390,9 @@ impl Bvh {
     /// one node and asks for the next node it will visit to be loaded, then the next ray takes
     /// its turn, so that the rays' cache misses overlap instead of following one another.
     /// `analytic(i, id, t_max)` intersects analytic primitive `id` with ray i. Each ray's
-    /// result is the one [`Self::closest_hit`] gives.
+    /// result is the one [`Self::closest_hit`] gives. Hierarchies too deep for the stacks on
+    /// the machine stack are traversed one ray after another.
     pub fn closest_hits(
-        &self,
-        rays: &[Option<&Ray>],
-        analytic: impl FnMut(usize, u32, f32) -> Option<f32>,
-        hits: &mut [Option<(u32, TriangleHit)>],
-    ) {
-        self.traverse_interleaved::<false>(rays, analytic, hits);
-    }
-
-    /// Whether anything blocks each of `rays` in (0, ray.t_max), written to `hits` (Some
-    /// where something does), the traversals interleaved as in [`Self::closest_hits`].
-    pub fn occluded_each(
-        &self,
-        rays: &[Option<&Ray>],
-        analytic: impl FnMut(usize, u32, f32) -> Option<f32>,
-        hits: &mut [Option<(u32, TriangleHit)>],
-    ) {
-        self.traverse_interleaved::<true>(rays, analytic, hits);
-    }
-
-    /// [`Self::interleaved`] in AVX where the processor has it, with stacks on the machine
-    /// stack; hierarchies deeper than that allows are traversed one ray after another.
-    #[inline(always)]
-    fn traverse_interleaved<const ANY_HIT: bool>(
         &self,
         rays: &[Option<&Ray>],
         mut analytic: impl FnMut(usize, u32, f32) -> Option<f32>,
@@ -425,7 +403,7 @@ impl Bvh {
             for (i, (ray, hit)) in rays.iter().zip(hits.iter_mut()).enumerate() {
                 *hit = ray.and_then(|ray| {
                     let watertight = WatertightRay::new(ray.o, ray.d);
-                    self.traverse::<ANY_HIT>(ray, &watertight, |id, t| analytic(i, id, t))
+                    self.closest_hit(ray, &watertight, |id, t| analytic(i, id, t))
                 });
             }
             return;
@@ -433,26 +411,26 @@ impl Bvh {
         #[cfg(target_arch = "x86_64")]
         if self.avx {
             // SAFETY: `avx` is set only where the processor has AVX.
-            return unsafe { self.interleaved_avx::<ANY_HIT>(rays, analytic, hits) };
+            return unsafe { self.interleaved_avx(rays, analytic, hits) };
         }
-        self.interleaved::<false, ANY_HIT>(rays, analytic, hits);
+        self.interleaved::<false>(rays, analytic, hits);
     }
 
     /// [`Self::interleaved`] compiled for AVX; the processor must have it.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx")]
-    unsafe fn interleaved_avx<const ANY_HIT: bool>(
+    unsafe fn interleaved_avx(
         &self,
         rays: &[Option<&Ray>],
         analytic: impl FnMut(usize, u32, f32) -> Option<f32>,
         hits: &mut [Option<(u32, TriangleHit)>],
     ) {
-        self.interleaved::<true, ANY_HIT>(rays, analytic, hits);
+        self.interleaved::<true>(rays, analytic, hits);
     }
 
     /// The rays' walks taking turns, one node per ray per turn, until every ray is done.
     #[inline(always)]
-    fn interleaved<const AVX: bool, const ANY_HIT: bool>(
+    fn interleaved<const AVX: bool>(
         &self,
         rays: &[Option<&Ray>],
         mut analytic: impl FnMut(usize, u32, f32) -> Option<f32>,
@@ -476,8 +454,8 @@ impl Bvh {
                 turn &= turn - 1;
                 // SAFETY: the walks of the rays in `pending` were written above.
                 let walk = unsafe { walks[i].assume_init_mut() };
-                let goes_on = self
-                    .visit::<AVX, ANY_HIT>(walk, &mut stacks[i], &mut |id, t| analytic(i, id, t));
+                let goes_on =
+                    self.visit::<AVX, false>(walk, &mut stacks[i], &mut |id, t| analytic(i, id, t));
                 if !goes_on {
                     hits[i] = walk.nearest;
                     pending &= !(1 << i);
@@ -1284,8 +1262,9 @@ pub(super) mod tests {
         }
     }
 
-    /// Interleaved queries of up to [`MAX_INTERLEAVED`] rays, some lanes empty, give each ray
-    /// what its query alone gives, bit for bit, with analytic primitives and both node tests.
+    /// Interleaved closest-hit queries of up to [`MAX_INTERLEAVED`] rays, some lanes empty, give
+    /// each ray what its query alone gives, bit for bit, with analytic primitives and both node
+    /// tests.
     #[test]
     fn interleaved_queries_agree_with_one_ray_queries() {
         let mut rng = Pcg32::seeded(23);
@@ -1325,18 +1304,15 @@ pub(super) mod tests {
                         b2: 0.0,
                     };
                     let mut nearest = vec![Some((u32::MAX, stale)); width];
-                    let mut blocking = nearest.clone();
                     bvh.closest_hits(&refs, analytic, &mut nearest);
-                    bvh.occluded_each(&refs, analytic, &mut blocking);
                     for (i, ray) in rays.iter().enumerate() {
                         let Some(ray) = ray else {
-                            assert_eq!((nearest[i], blocking[i]), (None, None));
+                            assert_eq!(nearest[i], None);
                             continue;
                         };
                         let watertight = WatertightRay::new(ray.o, ray.d);
                         let one = |id: u32, t: f32| analytic(i, id, t);
                         assert_eq!(nearest[i], bvh.closest_hit(ray, &watertight, one));
-                        assert_eq!(blocking[i].is_some(), bvh.occluded(ray, &watertight, one));
                         hits += usize::from(nearest[i].is_some());
                     }
                 }

@@ -288,33 +288,11 @@ pub fn sample_light_at_surface(
     lambda: &SampledWavelengths,
     strict_normals: bool,
 ) -> Option<LightSampleTerms> {
-    let (terms, shadow_ray) = light_sample_to_test(ctx, si, scattering, lambda, strict_normals)?;
-    (!ctx.occluded(&shadow_ray)).then_some(terms)
-}
-
-/// [`sample_light_at_surface`] without its shadow ray traced: the sample's terms and the shadow
-/// ray, which the caller traces (the lanes trace theirs together); the terms count only if
-/// nothing blocks the ray. None where the sample adds nothing whatever the ray meets.
-#[inline]
-pub fn light_sample_to_test(
-    ctx: &mut SampleContext,
-    si: &SurfaceInteraction,
-    scattering: &Scattering,
-    lambda: &SampledWavelengths,
-    strict_normals: bool,
-) -> Option<(LightSampleTerms, Ray)> {
     let receiver = Receiver::surface(si.p, si.shading.n);
-    let mut shadow_ray = None;
-    let terms = sample_light(ctx, &receiver, si.time, lambda, |_, ls| {
+    sample_light(ctx, &receiver, si.time, lambda, |ctx, ls| {
         if strict_normals && !normals_agree(si, ls.wi) {
             return None;
         }
-        let f = scattering.eval(ls.wi);
-        if f.value.is_black() {
-            return None;
-        }
-        shadow_ray = Some(si.spawn_ray_to(ls.p, ls.n));
-        Some((f, ShadowTransmittance::ONE))
-    })?;
-    Some((terms, shadow_ray?))
+        unoccluded(ctx, si, scattering, ls).map(|f| (f, ShadowTransmittance::ONE))
+    })
 }

@@ -31,7 +31,7 @@
 use crate::bsdf::BxdfTree;
 use crate::geometry::SurfaceInteraction;
 use crate::integrator::SampleContext;
-use crate::integrator::mis::{ScatterOrigin, Strategies, emission_found, light_sample_to_test};
+use crate::integrator::mis::{ScatterOrigin, Strategies, emission_found, sample_light_at_surface};
 use crate::integrator::vertex::{
     allows_next_vertex, normals_agree, path_estimate, russian_roulette, surface_scattering,
     wavelengths_after,
@@ -83,35 +83,6 @@ pub struct PathState {
     eta_scale: f32,
     previous: Option<ScatterOrigin>,
     depth: i32,
-    /// The last vertex's light sample, waiting for its shadow ray ([`Self::shadow_test`]).
-    shadow: Option<ShadowTest>,
-}
-
-/// A light sample's contribution and the shadow ray that decides it: it counts only if nothing
-/// blocks the ray.
-#[derive(Clone, Copy, Debug)]
-pub struct ShadowTest {
-    pub ray: Ray,
-    contribution: SampledSpectrum,
-}
-
-impl PathState {
-    /// The shadow ray of the last vertex's light sample, if it has one to trace; its answer
-    /// goes to [`Self::resolve_shadow`] before the path's next step.
-    #[inline]
-    pub fn shadow_test(&self) -> Option<&ShadowTest> {
-        self.shadow.as_ref()
-    }
-
-    /// Adds the last vertex's light sample to the estimate unless its shadow ray is `blocked`.
-    #[inline]
-    pub fn resolve_shadow(&mut self, blocked: bool) {
-        if let Some(test) = self.shadow.take()
-            && !blocked
-        {
-            self.result += test.contribution;
-        }
-    }
 }
 
 impl PathIntegrator {
@@ -128,15 +99,12 @@ impl PathIntegrator {
             eta_scale: 1.0,
             previous: None,
             depth: 0,
-            shadow: None,
         })
     }
 
     /// One vertex of the path `state`, given `hit`, the nearest surface along `state.ray`: the
     /// emission found there, a light sample and a BSDF sample for the next direction, and
-    /// Russian roulette. Returns whether the path goes on (along the new `state.ray`). The
-    /// light sample's shadow ray is left to the caller ([`PathState::shadow_test`]), which
-    /// resolves it before the next step or the estimate.
+    /// Russian roulette. Returns whether the path goes on (along the new `state.ray`).
     #[inline]
     pub fn step(
         &self,
@@ -173,13 +141,10 @@ impl PathIntegrator {
         let mut lobes = BxdfTree::empty();
         let scattering = surface_scattering(world, &si, wo_world, &mut state.lambda, &mut lobes);
         if scattering.flags().has_smooth_lobe()
-            && let Some((light, ray)) =
-                light_sample_to_test(ctx, &si, &scattering, &state.lambda, self.strict_normals)
+            && let Some(light) =
+                sample_light_at_surface(ctx, &si, &scattering, &state.lambda, self.strict_normals)
         {
-            state.shadow = Some(ShadowTest {
-                ray,
-                contribution: state.throughput * light.weighted(Strategies::ONE_EACH),
-            });
+            state.result += state.throughput * light.weighted(Strategies::ONE_EACH);
         }
 
         // BSDF sampling for the next direction.
@@ -215,11 +180,9 @@ impl PathIntegrator {
         true
     }
 
-    /// The estimate of a path that has ended, for the wavelengths it started with (its last
-    /// shadow ray resolved).
+    /// The estimate of a path that has ended, for the wavelengths it started with.
     #[inline]
     pub fn estimate(&self, state: &PathState) -> SampledSpectrum {
-        debug_assert!(state.shadow.is_none(), "a shadow ray left unresolved");
         path_estimate(state.result, &state.started, &state.lambda)
     }
 
@@ -235,12 +198,7 @@ impl PathIntegrator {
         };
         loop {
             let hit = ctx.intersect(&state.ray);
-            let goes_on = self.step(ctx, &mut state, hit);
-            if let Some(test) = state.shadow_test() {
-                let blocked = ctx.occluded(&test.ray);
-                state.resolve_shadow(blocked);
-            }
-            if !goes_on {
+            if !self.step(ctx, &mut state, hit) {
                 return self.estimate(&state);
             }
         }

@@ -2,12 +2,11 @@
 //! together, one vertex per step, each stage run for every active lane before the next stage
 //! begins (docs/architecture.md, Paths in lanes).
 //!
-//! A step traces the ray of every active lane to its closest hit (the trace stage), turns
-//! each hit into its surface interaction and runs the path tracer's vertex
-//! ([`PathIntegrator::step`]) on it (the vertex stage), then traces the shadow rays of the
-//! vertices' light samples (the shadow stage). Both ray stages interleave the lanes' BVH
-//! traversals ([`crate::geometry::Aggregate::closest_hits`]), so that one ray's cache misses
-//! overlap another's. A lane whose path ends writes its sample to the film and regenerates:
+//! A step traces the ray of every active lane to its closest hit (the trace stage, the lanes'
+//! BVH traversals interleaved so that one ray's cache misses overlap another's:
+//! [`crate::geometry::Aggregate::closest_hits`]), then turns each hit into its surface
+//! interaction and runs the path tracer's vertex ([`PathIntegrator::step`]) on it (the vertex
+//! stage). A lane whose path ends writes its sample to the film and regenerates:
 //! it takes its pixel's next sample index, or, when its pixel has all the pass's samples, the
 //! next pixel of the tile that no lane has taken, so that a few long paths do not idle the
 //! others. A lane keeps its pixel's samples in order, which keeps its sampler's walk along the
@@ -220,8 +219,6 @@ pub(super) fn trace_in_lanes(
         })
         .collect();
     let mut hits: Vec<Option<Hit>> = vec![None; LANES];
-    let mut going_on = [false; LANES];
-    let mut blocked = [false; LANES];
     let mut occupancy = Occupancy::default();
     while !run.cancelled {
         // The trace stage: every active lane's ray to its closest hit, the traversals
@@ -237,8 +234,8 @@ pub(super) fn trace_in_lanes(
         occupancy.lane_steps += LANES as u64;
         occupancy.active += active;
         // The vertex stage: every active lane's hit as a surface interaction, and the path's
-        // vertex there.
-        for ((lane, hit), goes_on) in lanes.iter_mut().zip(&mut hits).zip(&mut going_on) {
+        // vertex there; ended paths go to the sink and their lanes take the next samples.
+        for (lane, hit) in lanes.iter_mut().zip(hits.iter_mut()) {
             let Some(state) = &mut lane.path else {
                 continue;
             };
@@ -250,25 +247,7 @@ pub(super) fn trace_in_lanes(
                 sampler: &mut lane.sampler,
                 count: &mut run.count,
             };
-            *goes_on = path.step(ctx, state, si);
-        }
-        // The shadow stage: the light samples' shadow rays, the traversals interleaved.
-        let shadow_rays: [Option<&Ray>; LANES] = std::array::from_fn(|i| {
-            let test = lanes[i].path.as_ref()?.shadow_test()?;
-            Some(&test.ray)
-        });
-        scene
-            .world
-            .geometry
-            .occluded_each(&shadow_rays, &mut blocked);
-        run.count.rays += shadow_rays.iter().flatten().count() as u64;
-        // Ended paths go to the sink and their lanes take the next samples.
-        for ((lane, &blocked), &goes_on) in lanes.iter_mut().zip(&blocked).zip(&going_on) {
-            let Some(state) = &mut lane.path else {
-                continue;
-            };
-            state.resolve_shadow(blocked);
-            if !goes_on {
+            if !path.step(ctx, state, si) {
                 run.finish(lane, cancel);
             }
         }
