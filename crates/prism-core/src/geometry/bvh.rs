@@ -150,7 +150,7 @@ pub struct Bvh {
     /// Whether the processor has AVX, so that queries test eight boxes per instruction.
     avx: bool,
     /// The tree's cost by the surface area heuristic when it was built (see [`Bvh::refit`]).
-    built_cost: f32,
+    built_cost: f64,
 }
 
 /// A ray prepared for the slab tests: origin, reciprocal direction, and which bound of each
@@ -1105,7 +1105,7 @@ impl WideTree {
 }
 
 #[cfg(test)]
-pub(super) mod tests {
+mod tests {
     use super::*;
     use crate::sampling::rng::Pcg32;
     use std::collections::HashMap;
@@ -1321,27 +1321,6 @@ pub(super) mod tests {
         }
     }
 
-    /// The SAH cost of a wide tree: its root's box area times NODE_COST (or LEAF_COST where the
-    /// root is a leaf), and every child's box area times NODE_COST for an inner node and
-    /// LEAF_COST for a leaf.
-    fn sah_cost(bvh: &Bvh) -> f64 {
-        let area = |lo: Vec3, hi: Vec3| Aabb::new(lo.into(), hi.into()).half_area() as f64;
-        let cost_of = |r: NodeRef| f64::from(if r.is_inner() { NODE_COST } else { LEAF_COST });
-        let mut total = area(bvh.lo, bvh.hi) * cost_of(bvh.root);
-        for node in &bvh.nodes {
-            let bounds = node.bounds.map(|lanes| lanes.to_array());
-            for (slot, &child) in node.children.iter().enumerate() {
-                if bounds[0][slot] > bounds[3][slot] {
-                    continue; // an empty slot
-                }
-                let lo = Vec3::new(bounds[0][slot], bounds[1][slot], bounds[2][slot]);
-                let hi = Vec3::new(bounds[3][slot], bounds[4][slot], bounds[5][slot]);
-                total += area(lo, hi) * cost_of(child);
-            }
-        }
-        total
-    }
-
     /// Every way to cover the binary subtree under `i` with at most `slots` of its nodes (each
     /// leaf of the subtree below exactly one of them).
     fn covers(binary: &Bvh2, i: usize, slots: usize) -> Vec<Vec<usize>> {
@@ -1419,7 +1398,7 @@ pub(super) mod tests {
             for primitives in [&primitives[..triangles], &primitives[..]] {
                 let binary = binary_hierarchy(primitives);
                 let least = least_sah_cost(&binary, primitives, 0, &mut HashMap::new());
-                let built = sah_cost(&Bvh::build(primitives).unwrap());
+                let built = Bvh::build(primitives).unwrap().sah_cost();
                 // The plan sums its costs in f32: n terms (a few hundred here) rounded by
                 // 6·10⁻⁸ relative each err by about √n · 6·10⁻⁸ < 2·10⁻⁶, so it may pick a tree
                 // whose f64 cost is that much above the least; 10⁻⁵ leaves a factor five.

@@ -26,7 +26,7 @@ use crate::geometry::triangle_pack::PACK_WIDTH;
 
 /// A refit tree may cost this many times what it cost when built (by the surface area
 /// heuristic; see [`Bvh::refit`]) before a new one is built instead.
-pub const REFIT_COST_LIMIT: f32 = 1.25;
+pub const REFIT_COST_LIMIT: f64 = 1.25;
 
 /// Where the primitives of a hierarchy are now, by the ids they were built with.
 pub trait PrimitivePlaces: Sync {
@@ -117,7 +117,7 @@ impl Bvh {
     /// The tree's cost by the surface area heuristic: A(root)·c(root) + Σ A(child)·c(child)
     /// over every child of every node, A being half a box's surface area and c [`NODE_COST`]
     /// for inner nodes and [`LEAF_COST`] for leaves.
-    pub(super) fn sah_cost(&self) -> f32 {
+    pub(super) fn sah_cost(&self) -> f64 {
         let half_area = |lo: Vec3, hi: Vec3| f64::from(Aabb::new(lo.into(), hi.into()).half_area());
         let cost_of = |r: NodeRef| f64::from(if r.is_inner() { NODE_COST } else { LEAF_COST });
         let mut children = 0.0;
@@ -132,7 +132,7 @@ impl Bvh {
                 children += half_area(lo, hi) * cost_of(child);
             }
         }
-        (half_area(self.lo, self.hi) * cost_of(self.root) + children) as f32
+        half_area(self.lo, self.hi) * cost_of(self.root) + children
     }
 }
 
