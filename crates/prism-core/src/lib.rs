@@ -24,10 +24,10 @@
 //! | [`tensor_file`] | Mitsuba's tensor files: the sun-and-sky tables, measured BSDFs |
 //! | [`polarization`] | Stokes vectors, Mueller matrices, the Fresnel equations for polarized light |
 //! | [`geometry`] | shapes, intersection, the BVH, instances, the scene's primitives |
+//! | [`medium`] | participating media and phase functions |
 //! | [`texture`] | values that vary over a surface |
 //! | [`bsdf`] | BSDFs, their lobes at a point, materials |
 //! | [`light`] | light sources and the light sampler |
-//! | [`medium`] | participating media and phase functions |
 //! | [`world`] | geometry, materials, lights and media together |
 //! | [`film`] | reconstruction filters, pixel sums and their error, the images written |
 //! | [`camera`] | perspective, thin-lens and orthographic cameras, the radiance, irradiance and distant meters, the batch of sensors, and the shutter |
