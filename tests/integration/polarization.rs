@@ -223,26 +223,7 @@ fn stokes_vectors_match_mitsuba() {
 /// up to the frame's orientation, so S₁² + S₂² = S₀² and S₃ = 0.
 #[test]
 fn two_polarizers_follow_malus_law() {
-    let aligned = stokes_means(&load("polarizers", &[("theta", "0")]), 64, 2).0;
-    for degrees in [30.0f64, 60.0, 90.0] {
-        let theta = degrees.to_string();
-        let (mean, _) = stokes_means(&load("polarizers", &[("theta", &theta)]), 64, 2);
-        let expected = degrees.to_radians().cos().powi(2);
-        for c in 0..3 {
-            let ratio = mean[c] / aligned[c];
-            assert!(
-                (ratio - expected).abs() < 2e-3,
-                "{degrees}° {}: {ratio} against cos²θ = {expected}",
-                CHANNELS[c]
-            );
-            let linear = (mean[3 + c].powi(2) + mean[6 + c].powi(2)).sqrt();
-            assert!(
-                (linear - mean[c]).abs() <= 2e-3 * aligned[c],
-                "{degrees}°: not fully polarized"
-            );
-            assert!(mean[9 + c].abs() <= 1e-6, "{degrees}°: S3 {}", mean[9 + c]);
-        }
-    }
+    assert_malus_law("polarizers", &[]);
 }
 
 /// Malus's law through a `twosided` polarizer, seen from its front and from its back: S₀
@@ -251,26 +232,39 @@ fn two_polarizers_follow_malus_law() {
 #[test]
 fn a_twosided_polarizer_follows_malus_law_from_both_sides() {
     for turn in ["0", "180"] {
-        let aligned = stokes_means(&load("twosided", &[("theta", "0"), ("turn", turn)]), 64, 2).0;
-        for degrees in [30.0f64, 60.0, 90.0] {
-            let theta = degrees.to_string();
-            let scene = load("twosided", &[("theta", &theta), ("turn", turn)]);
-            let (mean, _) = stokes_means(&scene, 64, 2);
-            let expected = degrees.to_radians().cos().powi(2);
-            for c in 0..3 {
-                let ratio = mean[c] / aligned[c];
-                assert!(
-                    (ratio - expected).abs() < 2e-3,
-                    "turned {turn}°, {degrees}° {}: {ratio} against cos²θ = {expected}",
-                    CHANNELS[c]
-                );
-                let linear = (mean[3 + c].powi(2) + mean[6 + c].powi(2)).sqrt();
-                assert!(
-                    (linear - mean[c]).abs() <= 2e-3 * aligned[c],
-                    "turned {turn}°, {degrees}°: not fully polarized"
-                );
-                assert!(mean[9 + c].abs() <= 1e-6, "{degrees}°: S3 {}", mean[9 + c]);
-            }
+        assert_malus_law("twosided", &[("turn", turn)]);
+    }
+}
+
+/// Scene `name` with `defines` and its second polarizer at `theta` = 30°, 60° and 90° from the
+/// first: S₀ is cos²θ times S₀ at 0°, the light fully linearly polarized, none of it circular.
+fn assert_malus_law(name: &str, defines: &[(&str, &str)]) {
+    let with_theta = |theta: &str| {
+        let mut all = defines.to_vec();
+        all.push(("theta", theta));
+        stokes_means(&load(name, &all), 64, 2).0
+    };
+    let aligned = with_theta("0");
+    for degrees in [30.0f64, 60.0, 90.0] {
+        let mean = with_theta(&degrees.to_string());
+        let expected = degrees.to_radians().cos().powi(2);
+        for c in 0..3 {
+            let ratio = mean[c] / aligned[c];
+            assert!(
+                (ratio - expected).abs() < 2e-3,
+                "{name} {defines:?}, {degrees}° {}: {ratio} against cos²θ = {expected}",
+                CHANNELS[c]
+            );
+            let linear = (mean[3 + c].powi(2) + mean[6 + c].powi(2)).sqrt();
+            assert!(
+                (linear - mean[c]).abs() <= 2e-3 * aligned[c],
+                "{name} {defines:?}, {degrees}°: not fully polarized"
+            );
+            assert!(
+                mean[9 + c].abs() <= 1e-6,
+                "{name} {defines:?}, {degrees}°: S3 {}",
+                mean[9 + c]
+            );
         }
     }
 }
