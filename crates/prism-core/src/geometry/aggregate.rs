@@ -289,14 +289,7 @@ impl<P: AggregateElement> Aggregate<P> {
             found,
         );
         for (hit, found) in hits.iter_mut().zip(found) {
-            *hit = found.map(|(id, triangle)| {
-                let (shape, primitive) = self.element_of(id);
-                Hit {
-                    shape,
-                    primitive,
-                    triangle,
-                }
-            });
+            *hit = found.map(|(id, triangle)| self.hit_of(id, triangle));
         }
     }
 
@@ -305,12 +298,18 @@ impl<P: AggregateElement> Aggregate<P> {
         let watertight = WatertightRay::new(ray.o, ray.d);
         let (id, triangle) =
             bvh.closest_hit(ray, &watertight, |id, t_max| self.whole_hit(ray, id, t_max))?;
+        Some(self.hit_of(id, triangle))
+    }
+
+    /// The hit of the BVH's primitive `id`: its element and part.
+    #[inline]
+    fn hit_of(&self, id: u32, triangle: TriangleHit) -> Hit {
         let (shape, primitive) = self.element_of(id);
-        Some(Hit {
+        Hit {
             shape,
             primitive,
             triangle,
-        })
+        }
     }
 
     /// The closest surface the ray meets in (0, t_max).
