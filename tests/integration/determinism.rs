@@ -3,7 +3,7 @@
 use glam::{DMat4, DVec3, Mat3, UVec2, Vec3};
 use prism_core::geometry::Shape;
 use prism_core::geometry::Sphere;
-use prism_core::integrator::PathIntegrator;
+use prism_core::integrator::{PathIntegrator, Tracking, VolPathIntegrator};
 use prism_core::math::Transform;
 use prism_mitsuba::factory::shapes::{cube, transform_mesh};
 
@@ -64,9 +64,37 @@ fn one_and_two_threads_give_identical_films() {
     assert_ne!(one.pixels, other_seed.pixels);
 }
 
-/// The path tracer's paths run in lanes ([`prism_core::render::LANES`] per worker, each lane
-/// taking the next sample when its path ends); its film must be the one the same samples give
-/// traced one at a time, as a `--pixel` replay or any other integrator traces them, and the
+/// Renders `scene` with `spp` samples per pixel and `seed` on two threads, where a stepped
+/// estimator's paths run in lanes ([`prism_core::render::LANES`] per worker, each lane taking
+/// the next sample when its path ends), and traces the same samples one at a time, as a
+/// `--pixel` replay or any other integrator traces them. Returns the two films and the lanes'
+/// occupancy.
+fn in_lanes_and_one_at_a_time(
+    scene: &Scene,
+    spp: u32,
+    seed: u64,
+) -> (Vec<PixelSums>, Vec<PixelSums>, Option<f64>) {
+    let output = render(scene, &RenderOptions::fixed(spp, seed, Some(2))).unwrap();
+    let estimator = SampleEstimator::new(scene);
+    let mut sampler = Sampler::new(scene.sampler.kind, scene.strata(spp), seed);
+    let mut count = RayCount::default();
+    let mut one_at_a_time = Vec::new();
+    let size = scene.film.size;
+    for y in 0..size.y {
+        for x in 0..size.x {
+            let mut sums = PixelSums::default();
+            for index in 0..spp {
+                let xyz =
+                    estimator.estimate(&mut sampler, UVec2::new(x, y), index, &mut count, &mut []);
+                sums.add(xyz);
+            }
+            one_at_a_time.push(sums);
+        }
+    }
+    (output.film.pixels, one_at_a_time, output.lane_occupancy)
+}
+
+/// The path tracer's film in lanes is the one its samples give traced one at a time, and the
 /// render reports how full the lanes were.
 #[test]
 fn paths_in_lanes_give_the_film_of_paths_one_at_a_time() {
@@ -83,39 +111,53 @@ fn paths_in_lanes_give_the_film_of_paths_one_at_a_time() {
         },
     ] {
         let scene = lit_room(size, path.clone());
-        let (spp, seed) = (5, 9);
-        let output = render(&scene, &RenderOptions::fixed(spp, seed, Some(2))).unwrap();
+        let (in_lanes, one_at_a_time, occupancy) = in_lanes_and_one_at_a_time(&scene, 5, 9);
         // Paths of max_depth 0 end before their first step.
-        match output.lane_occupancy {
+        match occupancy {
             Some(occupancy) => assert!(
                 occupancy > 0.0 && occupancy <= 1.0 && path.max_depth != 0,
                 "occupancy {occupancy}"
             ),
             None => assert_eq!(path.max_depth, 0, "the path tracer runs in lanes"),
         }
-
-        let estimator = SampleEstimator::new(&scene);
-        let mut sampler = Sampler::new(scene.sampler.kind, scene.strata(spp), seed);
-        let mut count = RayCount::default();
-        let mut one_at_a_time = Vec::new();
-        for y in 0..size.y {
-            for x in 0..size.x {
-                let mut sums = PixelSums::default();
-                for index in 0..spp {
-                    let xyz = estimator.estimate(
-                        &mut sampler,
-                        UVec2::new(x, y),
-                        index,
-                        &mut count,
-                        &mut [],
-                    );
-                    sums.add(xyz);
-                }
-                one_at_a_time.push(sums);
-            }
-        }
-        assert_eq!(output.film.pixels, one_at_a_time, "{path:?}");
+        assert_eq!(in_lanes, one_at_a_time, "{path:?}");
         let lit = one_at_a_time.iter().any(|p| p.sum(1) > 0.0);
         assert_eq!(lit, path.max_depth != 0, "{path:?}");
+    }
+}
+
+/// The same for the volumetric path tracers (`volpath`, `volpathmis` with and without spectral
+/// MIS) on the bundled smoke box: a heterogeneous medium behind `null` boundaries over a floor,
+/// at several depths (a real collision, a null crossing and a surface each take a step).
+#[test]
+fn volumetric_paths_in_lanes_give_the_film_of_paths_one_at_a_time() {
+    let path = std::path::Path::new("scenes/media/smoke-box.xml");
+    let defines = [("resx", "23"), ("resy", "17")].map(|(k, v)| (k.to_string(), v.to_string()));
+    let root = prism_mitsuba::reader::read_scene_file(path, &defines).unwrap();
+    let mut scene = prism_mitsuba::factory::build_scene(&root).unwrap().scene;
+    for tracking in [
+        Tracking::Spectral,
+        Tracking::HeroMis { spectral_mis: true },
+        Tracking::HeroMis {
+            spectral_mis: false,
+        },
+    ] {
+        for max_depth in [-1, 1, 3] {
+            let volpath = VolPathIntegrator {
+                tracking,
+                max_depth,
+                rr_depth: 2,
+                ..VolPathIntegrator::default()
+            };
+            scene.integrator = volpath.clone().into();
+            let (in_lanes, one_at_a_time, occupancy) = in_lanes_and_one_at_a_time(&scene, 4, 3);
+            let occupancy = occupancy.expect("the volumetric path tracers run in lanes");
+            assert!(occupancy > 0.0 && occupancy <= 1.0, "occupancy {occupancy}");
+            assert_eq!(in_lanes, one_at_a_time, "{volpath:?}");
+            assert!(
+                one_at_a_time.iter().any(|p| p.sum(1) > 0.0),
+                "{volpath:?}: the image is black"
+            );
+        }
     }
 }

@@ -34,6 +34,7 @@ pub mod path;
 pub mod polarized_path;
 pub mod ptracer;
 pub mod sppm;
+pub mod stepped;
 pub mod stokes;
 pub mod transmittance;
 pub mod vertex;
@@ -52,10 +53,12 @@ pub use path::PathIntegrator;
 pub use polarized_path::PolarizedPathIntegrator;
 pub use ptracer::{LightPathSample, ParticleTracer, Splat};
 pub use sppm::SppmIntegrator;
+pub use stepped::SteppedPath;
 pub use stokes::StokesIntegrator;
 pub use volpath::{Tracking, VolPathIntegrator};
 
-use volpath::SpectralTracking;
+use stepped::SteppedIntegrator;
+use volpath::{SpectralTracking, VolPathWith};
 use volpathmis::SpectralMis;
 
 use crate::light::{LightSampler, LightSelection};
@@ -304,11 +307,21 @@ impl PreparedIntegrator<'_> {
         self.aov_count
     }
 
-    /// The path tracer, where the scene's integrator is one: its camera paths run in lanes
-    /// (the render driver's `lanes`).
-    pub fn path_tracer(&self) -> Option<&PathIntegrator> {
+    /// The integrator as a [`SteppedPath`], where it is one: its camera paths run in lanes (the
+    /// render driver's `lanes`).
+    pub(crate) fn stepped(&self) -> Option<SteppedIntegrator<'_>> {
         match self.integrator {
-            Integrator::Path(path) => Some(path),
+            Integrator::Path(path) => Some(SteppedIntegrator::Path(path)),
+            Integrator::VolPath(integrator) => Some(match integrator.tracking {
+                Tracking::Spectral => SteppedIntegrator::VolPath(VolPathWith {
+                    integrator,
+                    weights: SpectralTracking::new(),
+                }),
+                Tracking::HeroMis { spectral_mis } => SteppedIntegrator::VolPathMis(VolPathWith {
+                    integrator,
+                    weights: SpectralMis::new(spectral_mis),
+                }),
+            }),
             _ => None,
         }
     }
@@ -336,7 +349,10 @@ impl PreparedIntegrator<'_> {
             count,
         };
         match self.integrator {
-            Integrator::Path(integrator) => integrator.radiance(ctx, ray, lambda),
+            Integrator::Path(_) | Integrator::VolPath(_) => match self.stepped() {
+                Some(stepped) => stepped.radiance(ctx, ray, lambda),
+                None => unreachable!("the path tracers are stepped"),
+            },
             Integrator::Direct(integrator) => integrator.radiance(ctx, ray, lambda),
             Integrator::Distribution(integrator) => integrator.radiance(ctx, ray, lambda),
             Integrator::Moment(_) => MomentIntegrator::radiance(ctx, ray, lambda, aovs),
@@ -352,12 +368,6 @@ impl PreparedIntegrator<'_> {
             | Integrator::Bdpt(_)
             | Integrator::Sppm(_)
             | Integrator::Guided(_) => SampledSpectrum::ZERO,
-            Integrator::VolPath(integrator) => match integrator.tracking {
-                Tracking::Spectral => integrator.trace(SpectralTracking::new(), ctx, ray, lambda),
-                Tracking::HeroMis { spectral_mis } => {
-                    integrator.trace(SpectralMis::new(spectral_mis), ctx, ray, lambda)
-                }
-            },
         }
     }
 }

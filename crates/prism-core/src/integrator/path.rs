@@ -32,6 +32,7 @@ use crate::bsdf::BxdfTree;
 use crate::geometry::SurfaceInteraction;
 use crate::integrator::SampleContext;
 use crate::integrator::mis::{ScatterOrigin, Strategies, emission_found, sample_light_at_surface};
+use crate::integrator::stepped::SteppedPath;
 use crate::integrator::vertex::{
     allows_next_vertex, normals_agree, path_estimate, russian_roulette, surface_scattering,
     wavelengths_after,
@@ -39,6 +40,7 @@ use crate::integrator::vertex::{
 use crate::light::{LightSelection, Receiver};
 use crate::math::Ray;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+use crate::world::World;
 
 #[derive(Clone, Debug)]
 pub struct PathIntegrator {
@@ -68,11 +70,11 @@ impl Default for PathIntegrator {
 
 /// A path of the path tracer between two vertices: everything one step of it hands the next,
 /// so that a driver can hold many paths at once and advance each by one vertex at a time
-/// ([`PathIntegrator::step`]; docs/architecture.md, Paths in lanes).
+/// ([`SteppedPath`]; docs/architecture.md, Paths in lanes).
 #[derive(Clone, Debug)]
 pub struct PathState {
     /// The ray to the next vertex.
-    pub ray: Ray,
+    ray: Ray,
     /// The wavelengths the path started with.
     started: SampledWavelengths,
     /// The path's own copy: a dispersive interface may drop the companion wavelengths.
@@ -85,11 +87,17 @@ pub struct PathState {
     depth: i32,
 }
 
-impl PathIntegrator {
-    /// The path of the camera ray `ray` with `wavelengths`, before its first vertex; None when
-    /// `max_depth` is 0 (the estimate is then zero).
+impl SteppedPath for PathIntegrator {
+    type State = PathState;
+
+    /// The path before its first vertex; None when `max_depth` is 0.
     #[inline]
-    pub fn start(&self, ray: Ray, wavelengths: &SampledWavelengths) -> Option<PathState> {
+    fn start(
+        &self,
+        _world: &World,
+        ray: Ray,
+        wavelengths: &SampledWavelengths,
+    ) -> Option<PathState> {
         (self.max_depth != 0).then_some(PathState {
             ray,
             started: *wavelengths,
@@ -102,11 +110,15 @@ impl PathIntegrator {
         })
     }
 
-    /// One vertex of the path `state`, given `hit`, the nearest surface along `state.ray`: the
-    /// emission found there, a light sample and a BSDF sample for the next direction, and
-    /// Russian roulette. Returns whether the path goes on (along the new `state.ray`).
     #[inline]
-    pub fn step(
+    fn ray(state: &PathState) -> &Ray {
+        &state.ray
+    }
+
+    /// One vertex of the path: the emission found at `hit`, a light sample and a BSDF sample
+    /// for the next direction, and Russian roulette.
+    #[inline]
+    fn step(
         &self,
         ctx: &mut SampleContext,
         state: &mut PathState,
@@ -180,27 +192,8 @@ impl PathIntegrator {
         true
     }
 
-    /// The estimate of a path that has ended, for the wavelengths it started with.
     #[inline]
-    pub fn estimate(&self, state: &PathState) -> SampledSpectrum {
+    fn estimate(&self, state: &PathState) -> SampledSpectrum {
         path_estimate(state.result, &state.started, &state.lambda)
-    }
-
-    /// The estimate along the camera ray `ray`, one vertex after another.
-    pub(super) fn radiance(
-        &self,
-        ctx: &mut SampleContext,
-        ray: Ray,
-        wavelengths: &SampledWavelengths,
-    ) -> SampledSpectrum {
-        let Some(mut state) = self.start(ray, wavelengths) else {
-            return SampledSpectrum::ZERO;
-        };
-        loop {
-            let hit = ctx.intersect(&state.ray);
-            if !self.step(ctx, &mut state, hit) {
-                return self.estimate(&state);
-            }
-        }
     }
 }

@@ -30,15 +30,17 @@
 //! * Chromatic media keep all four wavelengths unbiased (see [`crate::medium`] for why one
 //!   majorant over the four rather than hero-wavelength tracking).
 //!
-//! The path loop below is shared with `volpathmis` ([`super::volpathmis`]): what differs is how
+//! The path's step below is shared with `volpathmis` ([`super::volpathmis`]): what differs is how
 //! free flights are drawn and how the path's weights and its estimate are kept, the
 //! [`PathWeights`] of each ([`SpectralTracking`] here).
 
 use glam::Vec3;
 
 use crate::bsdf::{BsdfEval, BxdfTree};
+use crate::geometry::SurfaceInteraction;
 use crate::integrator::SampleContext;
 use crate::integrator::mis::{LightSampleTerms, emission_along, power_heuristic, sample_light};
+use crate::integrator::stepped::SteppedPath;
 use crate::integrator::transmittance::{medium_after, shadow_end, shadow_transmittance};
 use crate::integrator::vertex::{
     allows_next_vertex, hero_only, russian_roulette, surface_scattering, wavelengths_after,
@@ -48,6 +50,7 @@ use crate::math::Ray;
 use crate::medium::{Collision, Medium, PhaseModel, choose_collision, sample_free_flight};
 use crate::sampling::sampler::Sampler;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+use crate::world::World;
 
 #[derive(Clone, Debug)]
 pub struct VolPathIntegrator {
@@ -88,8 +91,8 @@ pub enum Tracking {
 }
 
 /// What a volumetric path keeps besides its geometry: its weights, the state its MIS weights
-/// need, and the estimate it sums. The loop in [`VolPathIntegrator`] calls these at each event.
-pub(super) trait PathWeights {
+/// need, and the estimate it sums. The step of [`VolPathWith`] calls these at each event.
+pub(crate) trait PathWeights {
     /// The factor by which the path's further contributions are weighted (before MIS against
     /// light samples): Russian roulette and termination look at it.
     fn throughput(&self) -> SampledSpectrum;
@@ -137,7 +140,8 @@ pub(super) trait PathWeights {
 
 /// `volpath`'s weights: the throughput of spectral tracking and the density of the last
 /// directional sample, for the power heuristic against light samples.
-pub(super) struct SpectralTracking {
+#[derive(Clone)]
+pub(crate) struct SpectralTracking {
     throughput: SampledSpectrum,
     /// Solid-angle density of the last directional sample.
     pdf: f32,
@@ -146,7 +150,7 @@ pub(super) struct SpectralTracking {
 }
 
 impl SpectralTracking {
-    pub(super) fn new() -> Self {
+    pub(crate) fn new() -> Self {
         SpectralTracking {
             throughput: SampledSpectrum::ONE,
             pdf: 0.0,
@@ -289,154 +293,207 @@ fn spectral_tracking(
     }
 }
 
-impl VolPathIntegrator {
-    /// The path loop of both volumetric path tracers, keeping the path's weights in `weights`.
-    pub(super) fn trace<W: PathWeights>(
+/// `volpath` or `volpathmis`: the volumetric path tracer with the weights `W` of one of them,
+/// `weights` being those a path starts with.
+pub(crate) struct VolPathWith<'a, W> {
+    pub(crate) integrator: &'a VolPathIntegrator,
+    pub(crate) weights: W,
+}
+
+/// A volumetric path between two ray queries: everything one step of it hands the next.
+pub(crate) struct VolPathState<W> {
+    /// The ray to the next surface (unit direction), through `medium`.
+    ray: Ray,
+    medium: Option<u32>,
+    weights: W,
+    /// The path's own copy of the wavelengths: a dispersive interface may drop the companions.
+    lambda: SampledWavelengths,
+    /// Whether the path started with all four wavelengths.
+    lambda_was_whole: bool,
+    /// Product of the relative indices of refraction crossed (Mitsuba's η).
+    eta_scale: f32,
+    /// The last scattering vertex, which light sampling would have started from.
+    previous: Receiver,
+    depth: i32,
+}
+
+impl<W: PathWeights + Clone> SteppedPath for VolPathWith<'_, W> {
+    type State = VolPathState<W>;
+
+    /// The path before its first query, in the camera's medium; None when `max_depth` is 0.
+    #[inline]
+    fn start(
         &self,
-        mut weights: W,
-        ctx: &mut SampleContext,
-        camera_ray: Ray,
+        world: &World,
+        ray: Ray,
         wavelengths: &SampledWavelengths,
-    ) -> SampledSpectrum {
-        let world = ctx.world();
-        let mut lambda = *wavelengths;
-        let lambda_was_whole = !wavelengths.secondary_terminated();
-        let mut eta_scale = 1.0f32;
-        // The last scattering vertex, which light sampling would have started from.
-        let mut previous = Receiver::point(Vec3::ZERO);
-        let mut depth = 0i32;
-        let mut medium = world.camera_medium;
-        let mut ray = Ray {
-            d: camera_ray.d.normalize(),
-            ..camera_ray
-        };
-        let mut lobes = BxdfTree::empty();
-        if self.max_depth == 0 {
-            return SampledSpectrum::ZERO;
-        }
-        loop {
-            let hit = ctx.intersect(&ray);
-
-            // The medium between here and the surface: a real collision scatters.
-            if let Some(m) = medium {
-                let med = &world.media[m as usize];
-                let t_surface = hit.map_or(f32::INFINITY, |si| si.t);
-                let collision = weights.free_flight(med, &ray, t_surface, &lambda, ctx.sampler);
-                if weights.throughput().is_black() {
-                    break;
-                }
-                if let Some(t) = collision {
-                    if !allows_next_vertex(self.max_depth, depth) {
-                        break;
-                    }
-                    let p = ray.at(t);
-                    let wo = -ray.d;
-                    if med.sample_emitters
-                        && let Some(terms) =
-                            Self::light_sample_in_medium(ctx, p, wo, ray.time, med, medium, &lambda)
-                    {
-                        weights.add_light_sample(&terms);
-                    }
-                    let ps = med.phase.sample(wo, ctx.sampler.next_2d());
-                    if !(ps.pdf > 0.0) {
-                        break;
-                    }
-                    ray = Ray::new(p, ps.wi, f32::INFINITY, ray.time);
-                    weights.scatter(SampledSpectrum::ONE, ps.pdf, !med.sample_emitters);
-                    previous = Receiver::point(p);
-                    depth += 1;
-                    if !self.survives_roulette(ctx, depth, &mut weights, eta_scale) {
-                        break;
-                    }
-                    continue;
-                }
-            }
-
-            // Emission found by the previous directional sample (or by the camera ray).
-            if !(self.hide_emitters && depth == 0)
-                && let Some(found) = emission_along(world, ray.d, hit.as_ref(), &lambda)
-                && !found.radiance.is_black()
-            {
-                let light_pdf = if weights.weights_emission() {
-                    found.light_pdf(ctx, &previous)
-                } else {
-                    0.0
-                };
-                weights.add_emission(found.radiance, light_pdf);
-            }
-            let Some(si) = hit else {
-                break;
-            };
-            let wo = -ray.d;
-
-            // An index-matched boundary: cross it without a bounce.
-            let material = world.material(&si);
-            if material.is_null() {
-                medium = medium_after(world, &si, ray.d, medium);
-                ray = si.spawn_ray(ray.d);
-                continue;
-            }
-            // Without a bounce left, only a null lobe lets the path go on.
-            let may_bounce = allows_next_vertex(self.max_depth, depth);
-            if !may_bounce && !material.has_null_lobe() {
-                break;
-            }
-
-            let scattering = surface_scattering(world, &si, wo, &mut lambda, &mut lobes);
-            if may_bounce && scattering.flags().has_smooth_lobe() {
-                let receiver = Receiver::surface(si.p, si.shading.n);
-                let terms = sample_light(ctx, &receiver, si.time, &lambda, |ctx, ls| {
-                    let f = scattering.eval(ls.wi);
-                    if f.value.is_black() {
-                        return None;
-                    }
-                    let shadow = si.spawn_ray_to(ls.p, ls.n);
-                    let end = shadow.o + shadow.d * shadow.t_max;
-                    let shadow_medium = medium_after(world, &si, ls.wi, medium);
-                    let tr =
-                        shadow_transmittance(ctx, shadow.o, end, si.time, shadow_medium, &lambda);
-                    (!tr.is_black()).then_some((f, tr))
-                });
-                if let Some(terms) = terms {
-                    weights.add_light_sample(&terms);
-                }
-            }
-
-            let u_lobe = ctx.sampler.next_1d();
-            let u = ctx.sampler.next_2d();
-            let Some(bs) = scattering.sample(u_lobe, u) else {
-                break;
-            };
-            if bs.flags.has_null_lobe() {
-                weights.pass_through(bs.weight);
-                if weights.throughput().is_black() {
-                    break;
-                }
-                medium = medium_after(world, &si, ray.d, medium);
-                ray = si.spawn_ray(ray.d);
-                continue;
-            }
-            if !may_bounce {
-                break;
-            }
-            lambda = wavelengths_after(&lambda, &bs);
-            weights.scatter(bs.weight, bs.pdf, bs.flags.is_delta());
-            eta_scale *= bs.eta;
-            if weights.throughput().is_black() {
-                break;
-            }
-            let wi = bs.wi.normalize();
-            medium = medium_after(world, &si, wi, medium);
-            ray = si.spawn_ray(wi);
-            previous = Receiver::surface(si.p, si.shading.n);
-            depth += 1;
-            if !self.survives_roulette(ctx, depth, &mut weights, eta_scale) {
-                break;
-            }
-        }
-        weights.estimate(&lambda, lambda_was_whole)
+    ) -> Option<VolPathState<W>> {
+        (self.integrator.max_depth != 0).then(|| VolPathState {
+            ray: Ray {
+                d: ray.d.normalize(),
+                ..ray
+            },
+            medium: world.camera_medium,
+            weights: self.weights.clone(),
+            lambda: *wavelengths,
+            lambda_was_whole: !wavelengths.secondary_terminated(),
+            eta_scale: 1.0,
+            previous: Receiver::point(Vec3::ZERO),
+            depth: 0,
+        })
     }
 
+    #[inline]
+    fn ray(state: &VolPathState<W>) -> &Ray {
+        &state.ray
+    }
+
+    /// One event of the path: a real collision in the medium before `hit` (a light sample and
+    /// a phase function sample), or the surface `hit` (the emission found there, a null
+    /// crossing, or a light sample and a BSDF sample), and Russian roulette after a bounce.
+    fn step(
+        &self,
+        ctx: &mut SampleContext,
+        state: &mut VolPathState<W>,
+        hit: Option<SurfaceInteraction>,
+    ) -> bool {
+        let integrator = self.integrator;
+        let world = ctx.world();
+        let VolPathState {
+            ray,
+            medium,
+            weights,
+            lambda,
+            eta_scale,
+            previous,
+            depth,
+            ..
+        } = state;
+
+        // The medium between here and the surface: a real collision scatters.
+        if let Some(m) = *medium {
+            let med = &world.media[m as usize];
+            let t_surface = hit.as_ref().map_or(f32::INFINITY, |si| si.t);
+            let collision = weights.free_flight(med, ray, t_surface, lambda, ctx.sampler);
+            if weights.throughput().is_black() {
+                return false;
+            }
+            if let Some(t) = collision {
+                if !allows_next_vertex(integrator.max_depth, *depth) {
+                    return false;
+                }
+                let p = ray.at(t);
+                let wo = -ray.d;
+                if med.sample_emitters
+                    && let Some(terms) = VolPathIntegrator::light_sample_in_medium(
+                        ctx, p, wo, ray.time, med, *medium, lambda,
+                    )
+                {
+                    weights.add_light_sample(&terms);
+                }
+                let ps = med.phase.sample(wo, ctx.sampler.next_2d());
+                if !(ps.pdf > 0.0) {
+                    return false;
+                }
+                *ray = Ray::new(p, ps.wi, f32::INFINITY, ray.time);
+                weights.scatter(SampledSpectrum::ONE, ps.pdf, !med.sample_emitters);
+                *previous = Receiver::point(p);
+                *depth += 1;
+                return integrator.survives_roulette(ctx, *depth, weights, *eta_scale);
+            }
+        }
+
+        // Emission found by the previous directional sample (or by the camera ray).
+        if !(integrator.hide_emitters && *depth == 0)
+            && let Some(found) = emission_along(world, ray.d, hit.as_ref(), lambda)
+            && !found.radiance.is_black()
+        {
+            let light_pdf = if weights.weights_emission() {
+                found.light_pdf(ctx, previous)
+            } else {
+                0.0
+            };
+            weights.add_emission(found.radiance, light_pdf);
+        }
+        let Some(si) = hit else {
+            return false;
+        };
+        let wo = -ray.d;
+
+        // An index-matched boundary: cross it without a bounce.
+        let material = world.material(&si);
+        if material.is_null() {
+            *medium = medium_after(world, &si, ray.d, *medium);
+            *ray = si.spawn_ray(ray.d);
+            return true;
+        }
+        // Without a bounce left, only a null lobe lets the path go on.
+        let may_bounce = allows_next_vertex(integrator.max_depth, *depth);
+        if !may_bounce && !material.has_null_lobe() {
+            return false;
+        }
+
+        let mut lobes = BxdfTree::empty();
+        let scattering = surface_scattering(world, &si, wo, lambda, &mut lobes);
+        if may_bounce && scattering.flags().has_smooth_lobe() {
+            let receiver = Receiver::surface(si.p, si.shading.n);
+            let current = *medium;
+            let terms = sample_light(ctx, &receiver, si.time, lambda, |ctx, ls| {
+                let f = scattering.eval(ls.wi);
+                if f.value.is_black() {
+                    return None;
+                }
+                let shadow = si.spawn_ray_to(ls.p, ls.n);
+                let end = shadow.o + shadow.d * shadow.t_max;
+                let shadow_medium = medium_after(world, &si, ls.wi, current);
+                let tr = shadow_transmittance(ctx, shadow.o, end, si.time, shadow_medium, lambda);
+                (!tr.is_black()).then_some((f, tr))
+            });
+            if let Some(terms) = terms {
+                weights.add_light_sample(&terms);
+            }
+        }
+
+        let u_lobe = ctx.sampler.next_1d();
+        let u = ctx.sampler.next_2d();
+        let Some(bs) = scattering.sample(u_lobe, u) else {
+            return false;
+        };
+        if bs.flags.has_null_lobe() {
+            weights.pass_through(bs.weight);
+            if weights.throughput().is_black() {
+                return false;
+            }
+            *medium = medium_after(world, &si, ray.d, *medium);
+            *ray = si.spawn_ray(ray.d);
+            return true;
+        }
+        if !may_bounce {
+            return false;
+        }
+        *lambda = wavelengths_after(lambda, &bs);
+        weights.scatter(bs.weight, bs.pdf, bs.flags.is_delta());
+        *eta_scale *= bs.eta;
+        if weights.throughput().is_black() {
+            return false;
+        }
+        let wi = bs.wi.normalize();
+        *medium = medium_after(world, &si, wi, *medium);
+        *ray = si.spawn_ray(wi);
+        *previous = Receiver::surface(si.p, si.shading.n);
+        *depth += 1;
+        integrator.survives_roulette(ctx, *depth, weights, *eta_scale)
+    }
+
+    #[inline]
+    fn estimate(&self, state: &VolPathState<W>) -> SampledSpectrum {
+        state
+            .weights
+            .estimate(&state.lambda, state.lambda_was_whole)
+    }
+}
+
+impl VolPathIntegrator {
     /// Russian roulette ([`russian_roulette`]) after `rr_depth` bounces (depth > rr_depth, as
     /// Mitsuba's volpath counts them).
     #[inline]

@@ -1,5 +1,5 @@
 //! The volumetric path tracer with spectral MIS (Mitsuba 3's `volpathmis`): `volpath`'s path
-//! loop ([`super::volpath`]) with the hero wavelength's free flights combined over the path's
+//! step ([`super::volpath`]) with the hero wavelength's free flights combined over the path's
 //! four wavelengths by multiple importance sampling (Miller, Georgiev and Jarosz 2019, "A
 //! Null-Scattering Path Integral Formulation of Light Transport", §5–6).
 //!
@@ -69,7 +69,8 @@ use crate::sampling::sampler::Sampler;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 
 /// `volpathmis`'s weights (see the module's documentation for the symbols).
-pub(super) struct SpectralMis {
+#[derive(Clone)]
+pub(crate) struct SpectralMis {
     spectral_mis: bool,
     /// βᵢ = fᵢ / D.
     beta: SampledSpectrum,
@@ -108,7 +109,7 @@ fn over(value: SampledSpectrum, denominator: f32) -> SampledSpectrum {
 }
 
 impl SpectralMis {
-    pub(super) fn new(spectral_mis: bool) -> Self {
+    pub(crate) fn new(spectral_mis: bool) -> Self {
         SpectralMis {
             spectral_mis,
             beta: SampledSpectrum::ONE,

@@ -102,7 +102,7 @@ impl SharedSamples {
         let (stride, origin, indices) = (self.stride, self.origin, self.indices as usize);
         let (k, reach) = (self.aovs, self.reach);
         let row_len = self.size.x as usize * indices * stride;
-        let path = estimator.integrator.path_tracer();
+        let path = estimator.integrator.stepped();
         let rays: Vec<Option<u64>> = self
             .values
             .par_chunks_mut(row_len)
@@ -111,7 +111,7 @@ impl SharedSamples {
                 if cancel.raised() {
                     return None;
                 }
-                if let Some(path) = path {
+                if let Some(path) = &path {
                     let columns = values.len() / (indices * stride);
                     let pixels = (0..columns)
                         .map(|column| (column, origin + UVec2::new(column as u32, row as u32)));

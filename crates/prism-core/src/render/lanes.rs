@@ -5,8 +5,8 @@
 //! A step traces the ray of every active lane to its closest hit (the trace stage, the lanes'
 //! BVH traversals interleaved so that one ray's cache misses overlap another's:
 //! [`crate::geometry::Aggregate::closest_hits`]), then turns each hit into its surface
-//! interaction and runs the path tracer's vertex ([`PathIntegrator::step`]) on it (the vertex
-//! stage). A lane whose path ends writes its sample to the film and regenerates:
+//! interaction and runs the path's step ([`SteppedPath::step`]: the path tracer's vertex, the
+//! volumetric path tracers' next event) on it (the vertex stage). A lane whose path ends writes its sample to the film and regenerates:
 //! it takes its pixel's next sample index, or, when its pixel has all the pass's samples, the
 //! next pixel of the tile that no lane has taken, so that a few long paths do not idle the
 //! others. A lane keeps its pixel's samples in order, which keeps its sampler's walk along the
@@ -28,8 +28,8 @@ use glam::{UVec2, Vec2};
 use super::estimator::{CameraSampleRay, SampleEstimator};
 use super::stop::Cancel;
 use crate::geometry::aggregate::Hit;
-use crate::integrator::path::PathState;
-use crate::integrator::{PathIntegrator, RayCount, SampleContext};
+use crate::integrator::stepped::SteppedIntegrator;
+use crate::integrator::{RayCount, SampleContext, SteppedPath};
 use crate::math::Ray;
 use crate::math::lanes::{F32s, Real};
 use crate::sampling::sampler::Sampler;
@@ -87,25 +87,25 @@ pub(super) trait SampleSink {
 }
 
 /// One lane: the pixel it works on (as its source named it, and on the film), the sample index
-/// being traced, its random numbers, the camera sample and the path, None when the lane has
-/// no sample left.
-struct Lane {
+/// being traced, its random numbers, the camera sample and the path (of state `S`), None when
+/// the lane has no sample left.
+struct Lane<S> {
     slot: usize,
     pixel: UVec2,
     index: u32,
     sampler: Sampler,
     camera: Option<CameraSampleRay>,
-    path: Option<PathState>,
+    path: Option<S>,
     /// The sample's extra channels (the coverage alpha drawn with the camera sample, the
     /// spectral film's bands written at the end).
     aovs: Vec<f32>,
 }
 
-/// What the lanes of one run share: the estimator, the path tracer, the sample indices of
-/// every pixel, where the pixels come from and the samples go, and the counts.
-struct LaneRun<'e, 'a, P, S> {
+/// What the lanes of one run share: the estimator, the stepped estimator `T`, the sample
+/// indices of every pixel, where the pixels come from and the samples go, and the counts.
+struct LaneRun<'e, 'a, T, P, S> {
     estimator: &'e SampleEstimator<'a>,
-    path: &'e PathIntegrator,
+    path: &'e T,
     range: Range<u32>,
     pixels: P,
     sink: &'e mut S,
@@ -114,9 +114,14 @@ struct LaneRun<'e, 'a, P, S> {
     cancelled: bool,
 }
 
-impl<P: Iterator<Item = (usize, UVec2)>, S: SampleSink> LaneRun<'_, '_, P, S> {
+impl<T: SteppedPath, P: Iterator<Item = (usize, UVec2)>, S: SampleSink> LaneRun<'_, '_, T, P, S> {
     /// Hands the lane's finished sample `camera`, with the path's `radiance`, to the sink.
-    fn add(&mut self, lane: &mut Lane, camera: &CameraSampleRay, radiance: SampledSpectrum) {
+    fn add(
+        &mut self,
+        lane: &mut Lane<T::State>,
+        camera: &CameraSampleRay,
+        radiance: SampledSpectrum,
+    ) {
         let (offset, weight, xyz) = self.estimator.film_sample(camera, radiance, &mut lane.aovs);
         self.sink
             .add(lane.slot, lane.index, offset, weight, xyz, &mut lane.aovs);
@@ -125,7 +130,7 @@ impl<P: Iterator<Item = (usize, UVec2)>, S: SampleSink> LaneRun<'_, '_, P, S> {
     /// Starts the lane's sample, or the first of the following indices of its pixel whose
     /// path does not end before its first vertex (`max_depth` 0: those go to the sink at
     /// once); returns false when the pixel has no sample left.
-    fn start(&mut self, lane: &mut Lane) -> bool {
+    fn start(&mut self, lane: &mut Lane<T::State>) -> bool {
         while lane.index < self.range.end {
             lane.aovs.fill(0.0);
             let camera = self.estimator.camera_sample(
@@ -135,7 +140,9 @@ impl<P: Iterator<Item = (usize, UVec2)>, S: SampleSink> LaneRun<'_, '_, P, S> {
                 &mut self.count,
                 &mut lane.aovs,
             );
-            lane.path = self.path.start(camera.ray, &camera.lambda);
+            lane.path = self
+                .path
+                .start(&self.estimator.scene.world, camera.ray, &camera.lambda);
             if lane.path.is_some() {
                 lane.camera = Some(camera);
                 return true;
@@ -148,7 +155,7 @@ impl<P: Iterator<Item = (usize, UVec2)>, S: SampleSink> LaneRun<'_, '_, P, S> {
 
     /// Gives the lane the first sample of the next pixel that has one; returns false when no
     /// pixel is left or the pass is cancelled (then `cancelled` is set).
-    fn take_pixel(&mut self, lane: &mut Lane, cancel: &Cancel) -> bool {
+    fn take_pixel(&mut self, lane: &mut Lane<T::State>, cancel: &Cancel) -> bool {
         loop {
             if cancel.raised() {
                 self.cancelled = true;
@@ -166,7 +173,7 @@ impl<P: Iterator<Item = (usize, UVec2)>, S: SampleSink> LaneRun<'_, '_, P, S> {
 
     /// Hands the lane's finished sample to the sink and gives the lane the next: its pixel's
     /// next index, else [`Self::take_pixel`].
-    fn finish(&mut self, lane: &mut Lane, cancel: &Cancel) {
+    fn finish(&mut self, lane: &mut Lane<T::State>, cancel: &Cancel) {
         if let (Some(path), Some(camera)) = (lane.path.take(), lane.camera.take()) {
             self.add(lane, &camera, self.path.estimate(&path));
         }
@@ -178,20 +185,42 @@ impl<P: Iterator<Item = (usize, UVec2)>, S: SampleSink> LaneRun<'_, '_, P, S> {
 }
 
 /// Traces the samples `range` of every pixel `pixels` yields (a slot the sink knows it by, and
-/// its film position), the path tracer `path`'s camera paths [`LANES`] at a time, handing each
-/// finished sample to `sink`; the random numbers are the sampler's for `samples_per_pixel`
-/// and `seed`. Returns the rays traced and the lanes' occupancy, or None when the pass was
-/// cancelled before the pixels were done.
+/// its film position), the camera paths of `paths` [`LANES`] at a time, handing each finished
+/// sample to `sink`; the random numbers are the sampler's for `samples_per_pixel` and `seed`.
+/// Returns the rays traced and the lanes' occupancy, or None when the pass was cancelled
+/// before the pixels were done.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn trace_in_lanes(
     estimator: &SampleEstimator,
-    path: &PathIntegrator,
+    paths: &SteppedIntegrator,
     pixels: impl Iterator<Item = (usize, UVec2)>,
     range: Range<u32>,
     samples_per_pixel: u32,
     seed: u64,
     cancel: &Cancel,
     sink: &mut impl SampleSink,
+) -> Option<(u64, Occupancy)> {
+    let run = (pixels, range, samples_per_pixel, seed, cancel, sink);
+    match paths {
+        SteppedIntegrator::Path(path) => trace_stepped(estimator, *path, run),
+        SteppedIntegrator::VolPath(volpath) => trace_stepped(estimator, volpath, run),
+        SteppedIntegrator::VolPathMis(volpath) => trace_stepped(estimator, volpath, run),
+    }
+}
+
+/// [`trace_in_lanes`] for the stepped estimator `path`.
+#[allow(clippy::type_complexity)]
+fn trace_stepped<T: SteppedPath>(
+    estimator: &SampleEstimator,
+    path: &T,
+    (pixels, range, samples_per_pixel, seed, cancel, sink): (
+        impl Iterator<Item = (usize, UVec2)>,
+        Range<u32>,
+        u32,
+        u64,
+        &Cancel,
+        &mut impl SampleSink,
+    ),
 ) -> Option<(u64, Occupancy)> {
     let scene = estimator.scene;
     let mut run = LaneRun {
@@ -203,7 +232,7 @@ pub(super) fn trace_in_lanes(
         count: RayCount::default(),
         cancelled: false,
     };
-    let mut lanes: Vec<Lane> = (0..LANES)
+    let mut lanes: Vec<Lane<T::State>> = (0..LANES)
         .map(|_| {
             let mut lane = Lane {
                 slot: 0,
@@ -224,7 +253,7 @@ pub(super) fn trace_in_lanes(
         // The trace stage: every active lane's ray to its closest hit, the traversals
         // interleaved.
         let rays: [Option<&Ray>; LANES] =
-            std::array::from_fn(|i| lanes[i].path.as_ref().map(|path| &path.ray));
+            std::array::from_fn(|i| lanes[i].path.as_ref().map(T::ray));
         let active = rays.iter().flatten().count() as u64;
         if active == 0 {
             return Some((run.count.rays, occupancy));
@@ -241,7 +270,7 @@ pub(super) fn trace_in_lanes(
             };
             let si = hit
                 .take()
-                .and_then(|hit| scene.world.geometry.interaction(&state.ray, &hit));
+                .and_then(|hit| scene.world.geometry.interaction(T::ray(state), &hit));
             let ctx = &mut SampleContext {
                 prepared: &estimator.integrator,
                 sampler: &mut lane.sampler,

@@ -140,14 +140,14 @@ impl Pass<'_, '_> {
     ) -> Option<u64> {
         let pass = u64::from(range.end - range.start);
         let (estimator, options, cancel) = (self.estimator, self.options, self.cancel);
-        let path = estimator.integrator.path_tracer();
+        let path = estimator.integrator.stepped();
         let results: Vec<Option<u64>> = self
             .tiles
             .par_iter()
             .zip(sums)
             .zip(out)
             .map(|((&tile, tile_sums), tile_out)| {
-                let result = match path {
+                let result = match &path {
                     Some(path) => {
                         tile_out.clone_from(tile_sums);
                         let k = estimator.aov_count();
