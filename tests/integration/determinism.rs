@@ -3,7 +3,10 @@
 use glam::{DMat4, DVec3, Mat3, UVec2, Vec3};
 use prism_core::geometry::Shape;
 use prism_core::geometry::Sphere;
-use prism_core::integrator::{PathIntegrator, Tracking, VolPathIntegrator};
+use prism_core::integrator::distribution::DirectLights;
+use prism_core::integrator::{
+    DistributionIntegrator, Integrator, PathIntegrator, Tracking, VolPathIntegrator,
+};
 use prism_core::math::Transform;
 use prism_mitsuba::factory::shapes::{cube, transform_mesh};
 
@@ -15,8 +18,9 @@ use prism_core::scene::Scene;
 
 use crate::common::scenes::{Object, build, camera, render_film};
 
-/// A room lit by a glowing sphere, seen by a camera whose film is `size`, rendered by `path`.
-fn lit_room(size: UVec2, path: PathIntegrator) -> Scene {
+/// A room lit by a glowing sphere, seen by a camera whose film is `size`, rendered by
+/// `integrator`.
+fn lit_room(size: UVec2, integrator: impl Into<Integrator>) -> Scene {
     let room = Transform::new(DMat4::from_scale(DVec3::new(2.0, 1.5, 3.0))).unwrap();
     build(
         vec![
@@ -46,7 +50,7 @@ fn lit_room(size: UVec2, path: PathIntegrator) -> Scene {
             size,
         ),
         size,
-        path,
+        integrator,
     )
 }
 
@@ -123,6 +127,37 @@ fn paths_in_lanes_give_the_film_of_paths_one_at_a_time() {
         assert_eq!(in_lanes, one_at_a_time, "{path:?}");
         let lit = one_at_a_time.iter().any(|p| p.sum(1) > 0.0);
         assert_eq!(lit, path.max_depth != 0, "{path:?}");
+    }
+}
+
+/// The same for the lecture's distribution ray tracer, whose tree of rays a lane traces one
+/// ray per step: with its splitting (bounces and shadow rays by the potential), with every
+/// light sampled, and without splitting (a path tracer without MIS).
+#[test]
+fn distribution_trees_in_lanes_give_the_film_of_trees_one_at_a_time() {
+    let size = UVec2::new(13, 11);
+    for distrib in [
+        DistributionIntegrator::default(),
+        DistributionIntegrator {
+            lights: DirectLights::All,
+            max_depth: 3,
+            ..DistributionIntegrator::default()
+        },
+        DistributionIntegrator {
+            bounce_samples: 1,
+            shadow_rays: 1,
+            ..DistributionIntegrator::default()
+        },
+    ] {
+        let scene = lit_room(size, distrib.clone());
+        let (in_lanes, one_at_a_time, occupancy) = in_lanes_and_one_at_a_time(&scene, 3, 5);
+        let occupancy = occupancy.expect("distrib runs in lanes");
+        assert!(occupancy > 0.0 && occupancy <= 1.0, "occupancy {occupancy}");
+        assert_eq!(in_lanes, one_at_a_time, "{distrib:?}");
+        assert!(
+            one_at_a_time.iter().any(|p| p.sum(1) > 0.0),
+            "{distrib:?}: the image is black"
+        );
     }
 }
 

@@ -32,6 +32,14 @@
 //! (the hero-only estimator of the same integral), so each branch of the split decides for
 //! itself.
 //!
+//! The recursion is traced as a tree of rays, depth first and one ray per step
+//! ([`SteppedPath`]), so that the estimator's camera samples run in the render driver's lanes:
+//! at a vertex, after its shadow rays, the N bounce directions are drawn, and each bounce's
+//! subtree is traced before the next, as the slides' recursion orders the rays. The factors
+//! along a branch (the weights, 1/s, 1/N and the hero-only factor of a dispersive vertex or
+//! bounce) are all per wavelength, so they multiply into the branch's weight instead of being
+//! applied on the way back up.
+//!
 //! Its parameters (`bounce_samples` N and `shadow_rays` N_l at potential 1, `rr_threshold`, the
 //! choice of `lights`, `max_depth`, `hide_emitters`) and their defaults are listed in
 //! docs/plugins.md.
@@ -42,10 +50,12 @@ use crate::bsdf::{BxdfTree, Scattering};
 use crate::geometry::SurfaceInteraction;
 use crate::integrator::SampleContext;
 use crate::integrator::mis::{emission_along, sample_point_on, unoccluded};
+use crate::integrator::stepped::SteppedPath;
 use crate::integrator::vertex::{allows_next_vertex, hero_only, surface_scattering};
 use crate::light::{Light, LightSelection, Receiver};
 use crate::math::Ray;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+use crate::world::World;
 
 /// Which lights a vertex sends shadow rays to.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -121,118 +131,62 @@ impl DistributionIntegrator {
         }
     }
 
-    pub(super) fn radiance(
-        &self,
-        ctx: &mut SampleContext,
-        ray: Ray,
-        lambda: &SampledWavelengths,
-    ) -> SampledSpectrum {
-        if self.max_depth == 0 {
-            return SampledSpectrum::ZERO;
-        }
-        let camera = Level {
-            depth: 0,
-            potential: 1.0,
-        };
-        self.incoming(ctx, ray, camera, !self.hide_emitters, lambda)
-    }
-
-    /// Radiance arriving along `ray` at a vertex of `level` (the slides' `incoming_radiance`);
-    /// emission at the hit is counted only when `with_emission`.
-    fn incoming(
-        &self,
-        ctx: &mut SampleContext,
-        ray: Ray,
-        level: Level,
-        with_emission: bool,
-        lambda: &SampledWavelengths,
-    ) -> SampledSpectrum {
-        let hit = ctx.intersect(&ray);
-        let d = ray.d.normalize();
-        let mut result = SampledSpectrum::ZERO;
-        // Emission (the environment's when the ray leaves the scene) is counted only where no
-        // shadow ray could have found it: camera rays and specular bounces.
-        if with_emission && let Some(found) = emission_along(ctx.world(), d, hit.as_ref(), lambda) {
-            result += found.radiance;
-        }
-        let Some(si) = hit else {
-            return result;
-        };
-        if allows_next_vertex(self.max_depth, level.depth) {
-            result += self.reflected(ctx, &si, -d, level, lambda);
-        }
-        result
-    }
-
-    /// Reflected radiance at `si` towards `wo_world` (the slides' `reflected_radiance`).
+    /// The reflected radiance at the hit `si` of `branch`, seen from `wo_world` (the slides'
+    /// `reflected_radiance`): its direct part by shadow rays is added to `result`, and its split
+    /// indirect part becomes bounce branches, pushed on `pending` so that the first is traced
+    /// next.
     fn reflected(
         &self,
         ctx: &mut SampleContext,
+        branch: &Branch,
         si: &SurfaceInteraction,
         wo_world: Vec3,
-        level: Level,
-        lambda: &SampledWavelengths,
-    ) -> SampledSpectrum {
+        result: &mut SampledSpectrum,
+        pending: &mut Vec<Branch>,
+    ) {
+        let level = branch.level;
         let survival = self.choose_s(level.potential, level.depth);
         if !(ctx.sampler.next_1d() < survival) {
-            return SampledSpectrum::ZERO;
+            return;
         }
-        // This level's lobes, alive while the levels below it are estimated.
         let mut lobes = BxdfTree::empty();
-        let mut vertex_lambda = *lambda;
-        let scattering =
-            surface_scattering(ctx.world(), si, wo_world, &mut vertex_lambda, &mut lobes);
-        let estimate = self.scatter(ctx, si, &scattering, level, survival, &vertex_lambda);
+        let mut lambda = branch.lambda;
+        let scattering = surface_scattering(ctx.world(), si, wo_world, &mut lambda, &mut lobes);
+        let mut weight = branch.weight * (1.0 / survival);
         // A vertex whose BSDF keeps only the hero continues with it alone.
-        if vertex_lambda.secondary_terminated() && !lambda.secondary_terminated() {
-            hero_only(estimate)
-        } else {
-            estimate
+        if lambda.secondary_terminated() && !branch.lambda.secondary_terminated() {
+            weight = hero_only(weight);
         }
-    }
-
-    /// The direct and split indirect estimate at a vertex that survived roulette with
-    /// probability `survival`.
-    fn scatter(
-        &self,
-        ctx: &mut SampleContext,
-        si: &SurfaceInteraction,
-        scattering: &Scattering,
-        level: Level,
-        survival: f32,
-        lambda: &SampledWavelengths,
-    ) -> SampledSpectrum {
-        let mut result = SampledSpectrum::ZERO;
         if scattering.flags().has_smooth_lobe() {
-            result += self.direct(ctx, si, scattering, level.potential, lambda);
+            *result += weight * self.direct(ctx, si, &scattering, level.potential, &lambda);
         }
 
         let n = self.choose_n(level.potential);
-        let mut indirect = SampledSpectrum::ZERO;
+        let first = pending.len();
         for _ in 0..n {
             let u_lobe = ctx.sampler.next_1d();
             let u = ctx.sampler.next_2d();
             let Some(bs) = scattering.sample(u_lobe, u) else {
                 continue;
             };
-            let specular = bs.flags.is_delta();
-            let next = Level {
-                depth: level.depth + 1,
-                potential: level.potential * bs.weight.max_value() / (n as f32 * survival),
+            let mut bounce = Branch {
+                ray: si.spawn_ray(bs.wi),
+                weight: weight * bs.weight * (1.0 / n as f32),
+                level: Level {
+                    depth: level.depth + 1,
+                    potential: level.potential * bs.weight.max_value() / (n as f32 * survival),
+                },
+                with_emission: bs.flags.is_delta(),
+                lambda,
             };
-            let ray = si.spawn_ray(bs.wi);
-            let arriving = if bs.terminates_secondary && !lambda.secondary_terminated() {
+            if bs.terminates_secondary && !lambda.secondary_terminated() {
                 // This direction is the hero's alone: so is what arrives along it.
-                let mut hero = *lambda;
-                hero.terminate_secondary();
-                hero_only(self.incoming(ctx, ray, next, specular, &hero))
-            } else {
-                self.incoming(ctx, ray, next, specular, lambda)
-            };
-            indirect += bs.weight * arriving;
+                bounce.lambda.terminate_secondary();
+                bounce.weight = hero_only(bounce.weight);
+            }
+            pending.push(bounce);
         }
-        result += indirect * (1.0 / n as f32);
-        result * (1.0 / survival)
+        pending[first..].reverse();
     }
 
     /// Direct light by shadow rays: N_l per light, over every light or one drawn by the light
@@ -276,6 +230,99 @@ impl DistributionIntegrator {
                 estimate_light(ctx, &world.lights[index]) * (1.0 / pmf)
             }
         }
+    }
+}
+
+/// A ray of the estimator's tree of rays, with the factor the radiance arriving along it
+/// enters the pixel's estimate with.
+#[derive(Clone, Copy, Debug)]
+struct Branch {
+    ray: Ray,
+    /// The product of the weights (f cos / p)/(N s) from the camera to this ray, with the
+    /// hero-only factors of the dispersive vertices on the way.
+    weight: SampledSpectrum,
+    level: Level,
+    /// Whether emission found along the ray counts: camera rays and specular bounces, which
+    /// no shadow ray could have found.
+    with_emission: bool,
+    lambda: SampledWavelengths,
+}
+
+/// The estimator's tree of rays for one camera sample, traced depth first, one ray per step,
+/// in the order of the slides' recursion: the branch being traced, those waiting, and the sum
+/// of the tree's contributions so far.
+#[derive(Clone, Debug)]
+pub struct DistributionState {
+    current: Branch,
+    /// Branches waiting, the next on top.
+    pending: Vec<Branch>,
+    result: SampledSpectrum,
+}
+
+impl SteppedPath for DistributionIntegrator {
+    type State = DistributionState;
+
+    /// The tree of the camera ray; None when `max_depth` is 0.
+    fn start(
+        &self,
+        _world: &World,
+        ray: Ray,
+        wavelengths: &SampledWavelengths,
+    ) -> Option<DistributionState> {
+        (self.max_depth != 0).then(|| DistributionState {
+            current: Branch {
+                ray,
+                weight: SampledSpectrum::ONE,
+                level: Level {
+                    depth: 0,
+                    potential: 1.0,
+                },
+                with_emission: !self.hide_emitters,
+                lambda: *wavelengths,
+            },
+            pending: Vec::new(),
+            result: SampledSpectrum::ZERO,
+        })
+    }
+
+    #[inline]
+    fn ray(state: &DistributionState) -> &Ray {
+        &state.current.ray
+    }
+
+    /// The radiance arriving along the current branch's ray at `hit` (the slides'
+    /// `incoming_radiance`): the emission found there where it counts, the direct part of the
+    /// reflected radiance, and the bounce branches; then the next branch waiting.
+    fn step(
+        &self,
+        ctx: &mut SampleContext,
+        state: &mut DistributionState,
+        hit: Option<SurfaceInteraction>,
+    ) -> bool {
+        let branch = state.current;
+        let d = branch.ray.d.normalize();
+        if branch.with_emission
+            && let Some(found) = emission_along(ctx.world(), d, hit.as_ref(), &branch.lambda)
+        {
+            state.result += branch.weight * found.radiance;
+        }
+        if let Some(si) = hit
+            && allows_next_vertex(self.max_depth, branch.level.depth)
+        {
+            self.reflected(ctx, &branch, &si, -d, &mut state.result, &mut state.pending);
+        }
+        match state.pending.pop() {
+            Some(next) => {
+                state.current = next;
+                true
+            }
+            None => false,
+        }
+    }
+
+    #[inline]
+    fn estimate(&self, state: &DistributionState) -> SampledSpectrum {
+        state.result
     }
 }
 
