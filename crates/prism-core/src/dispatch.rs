@@ -1,8 +1,9 @@
 //! How a plugin class is declared: its interface, a trait whose required methods every plugin of
-//! the class must answer, and the enum of its plugins, one variant per plugin type, which
-//! implements the same trait by an exhaustive `match` (no wildcard arm, no dynamic dispatch in
-//! the hot path). Adding a plugin is then adding a variant: the compiler asks for each method,
-//! and no method can fall through to a default meant for other plugins.
+//! the class must answer and whose provided methods have a default body a plugin may override,
+//! and the enum of its plugins, one variant per plugin type, which implements the same trait by
+//! an exhaustive `match` (no wildcard arm, no dynamic dispatch in the hot path). Adding a plugin
+//! is then adding a variant: the compiler asks for each required method, and the enum answers
+//! every method, required or provided, with the plugin's own.
 //!
 //! [`plugin_class!`] writes the trait, the enum, a `From` conversion per plugin type and the
 //! enum's forwarding implementation from one declaration:
@@ -13,7 +14,8 @@
 //!     pub trait Kernel {
 //!         /// A required method, answered by every plugin.
 //!         fn radius(&self) -> f32;
-//!         /// A provided method, written once in terms of the required ones.
+//!         /// A provided method: a default in terms of the required ones, which a plugin may
+//!         /// override.
 //!         fn diameter(&self) -> f32 {
 //!             2.0 * self.radius()
 //!         }
@@ -27,8 +29,9 @@
 //! }
 //! ```
 //!
-//! Required methods take `&self` or `&mut self` and arguments written `name: Type`; provided
-//! methods have a body and are not forwarded (the enum's use the forwarded required ones).
+//! Methods take `&self` or `&mut self` and arguments written `name: Type`. The enum forwards
+//! each of them, provided ones included, to the plugin of the variant: a plugin's override is
+//! what the enum answers, and a plugin that keeps the default answers with the default.
 
 macro_rules! plugin_class {
     (
@@ -111,7 +114,9 @@ macro_rules! plugin_class {
         $(#[$m:meta])* fn $name:ident($($params:tt)*) $(-> $ret:ty)? $body:block
         $($rest:tt)*
     ) => {
-        $crate::dispatch::plugin_class!(@forward $enum [$($variant)+] $($rest)*);
+        $crate::dispatch::plugin_class!(
+            @forward $enum [$($variant)+] fn $name($($params)*) $(-> $ret)?; $($rest)*
+        );
     };
 
     (@match $receiver:ident, $enum:ident, [$($variant:ident)+], $name:ident, $args:tt) => {
@@ -138,6 +143,7 @@ mod tests {
         pub enum Number {
             Whole(Whole),
             Half(Half),
+            Capped(Capped),
         }
     }
 
@@ -145,6 +151,9 @@ mod tests {
     pub struct Whole(f32);
     #[derive(Debug, PartialEq)]
     pub struct Half(f32);
+    /// A number whose double stops at 10.
+    #[derive(Debug, PartialEq)]
+    pub struct Capped(f32);
 
     impl Doubled for Whole {
         fn value(&self) -> f32 {
@@ -164,11 +173,30 @@ mod tests {
         }
     }
 
+    impl Doubled for Capped {
+        fn value(&self) -> f32 {
+            self.0
+        }
+        fn scale(&mut self, factor: f32) {
+            self.0 *= factor;
+        }
+        fn double(&self) -> f32 {
+            (2.0 * self.0).min(10.0)
+        }
+    }
+
+    /// The enum answers a provided method with the default where a plugin keeps it and with
+    /// the plugin's override where it has one.
     #[test]
-    fn the_enum_forwards_required_methods_and_provides_the_others() {
-        let mut numbers = [Number::from(Whole(3.0)), Number::from(Half(3.0))];
+    fn the_enum_forwards_every_method_to_the_plugin() {
+        let mut numbers = [
+            Number::from(Whole(3.0)),
+            Number::from(Half(3.0)),
+            Number::from(Capped(8.0)),
+        ];
         assert_eq!(numbers[0].double(), 6.0);
         assert_eq!(numbers[1].double(), 3.0);
+        assert_eq!(numbers[2].double(), 10.0);
         numbers[1].scale(2.0);
         assert_eq!(numbers[1], Number::Half(Half(6.0)));
     }

@@ -148,6 +148,7 @@ mod tests {
     use super::*;
     use crate::bsdf::null::NullLobes;
     use crate::bsdf::polarizer::PolarizerLobes;
+    use crate::bsdf::polarizing_sheet::PolarizingSheet;
     use crate::bsdf::{Diffuse, ShadingPoint};
     use crate::polarization::mueller::depolarizer;
     use crate::spectrum::{SampledWavelengths, WavelengthSampling};

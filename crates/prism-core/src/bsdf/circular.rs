@@ -10,21 +10,21 @@
 //! Its parameters and their defaults are listed in docs/plugins.md. Like Mitsuba's, it has no
 //! angle: a circular polarizer looks the same turned about the beam.
 //!
-//! A null lobe δ(wi + wo) on both sides. Unpolarized light keeps half its intensity, so an
-//! unpolarized render sees a grey filter of ½ · transmittance. In a polarized render its
-//! Mueller matrix is the [`right_circular_polarizer`] or [`left_circular_polarizer`], as
-//! Mitsuba's `circular.cpp` gives it.
+//! A [polarizing sheet](super::polarizing_sheet), a null lobe δ(wi + wo) on both sides. Unpolarized
+//! light keeps half its intensity, so an unpolarized render sees a grey filter of
+//! ½ · transmittance. In a polarized render its Mueller matrix is the
+//! [`right_circular_polarizer`] or [`left_circular_polarizer`], as Mitsuba's `circular.cpp`
+//! gives it.
 //!
 //! [`right_circular_polarizer`]: crate::polarization::mueller::right_circular_polarizer
 //! [`left_circular_polarizer`]: crate::polarization::mueller::left_circular_polarizer
 
-use glam::{Vec2, Vec3};
+use glam::Vec3;
 
-use super::{BsdfFlags, BsdfSample, Bxdf, BxdfTree, LeafBsdf};
-use crate::polarization::mueller::{
-    left_circular_polarizer, right_circular_polarizer, stokes_basis,
-};
-use crate::polarization::{FrameChange, SampledMueller};
+use super::polarizing_sheet::{PolarizingSheet, in_beam_basis};
+use super::{BsdfFlags, LeafBsdf};
+use crate::polarization::SampledMueller;
+use crate::polarization::mueller::{left_circular_polarizer, right_circular_polarizer};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use crate::texture::{Texture, TexturePoint, TextureValues};
 
@@ -54,55 +54,28 @@ pub struct CircularLobes {
     pub transmittance: SampledSpectrum,
 }
 
-impl CircularLobes {
-    /// ½ · transmittance: what passes of unpolarized light.
+impl PolarizingSheet for CircularLobes {
+    /// ½ · transmittance.
     #[inline]
     fn unpolarized(&self) -> SampledSpectrum {
         self.transmittance * 0.5
     }
 
-    /// The Mueller matrix for light passing along `forward` (local, the direction of travel),
-    /// from and to the implicit Stokes bases of `forward`.
-    pub fn mueller_along(&self, forward: Vec3) -> SampledMueller {
+    /// The right or left circular polarizer, the same about any axis.
+    fn mueller_along(&self, forward: Vec3) -> SampledMueller {
         let m = if self.left_handed {
             left_circular_polarizer()
         } else {
             right_circular_polarizer()
         };
-        let change = FrameChange::collinear(forward, Vec3::X, stokes_basis(forward));
-        SampledMueller::splat(change.apply(m)).scaled(self.transmittance)
-    }
-}
-
-impl Bxdf for CircularLobes {
-    fn sample(&self, _tree: &BxdfTree, wo: Vec3, _u_lobe: f32, _u: Vec2) -> Option<BsdfSample> {
-        Some(BsdfSample::new(
-            -wo,
-            self.unpolarized(),
-            1.0,
-            BsdfFlags::NULL,
-        ))
-    }
-
-    fn null_transmission(&self, _tree: &BxdfTree, _wo: Vec3) -> SampledSpectrum {
-        self.unpolarized()
-    }
-
-    /// Light passes along `wo`.
-    fn mueller(
-        &self,
-        _tree: &BxdfTree,
-        wo: Vec3,
-        _wi: Vec3,
-        _lobe: BsdfFlags,
-    ) -> Option<SampledMueller> {
-        Some(self.mueller_along(wo))
+        in_beam_basis(m, Vec3::X, forward, self.transmittance)
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::bsdf::{Bxdf, BxdfTree};
     use glam::Vec4;
 
     /// M₀₀ is the unpolarized value ½ · transmittance; each handedness passes its own light,

@@ -88,6 +88,7 @@ pub mod perturbed;
 pub mod phong;
 pub mod plastic;
 pub mod polarizer;
+pub mod polarizing_sheet;
 pub mod pplastic;
 pub mod principled;
 pub mod principledthin;

@@ -10,22 +10,23 @@
 //! ```
 //! Its parameters and their defaults are listed in docs/plugins.md.
 //!
-//! A null lobe δ(wi + wo) on both sides. Unpolarized light keeps half its intensity, so an
-//! unpolarized render sees a grey filter of ½ · transmittance (as Mitsuba 3's unpolarized
-//! variants do). In a polarized render its Mueller matrix is the [`linear_polarizer`] whose
-//! absorbing axis is the shading frame's t direction (the surface's v direction) turned by
-//! `theta` towards s, projected orthogonally to the beam for light that crosses the sheet
-//! obliquely (Korger et al. 2013, "The polarization properties of a tilted polarizer"), and
-//! whose transmission axis is orthogonal to it and the beam, as Mitsuba's `polarizer.cpp`
-//! builds it.
+//! A [polarizing sheet](super::polarizing_sheet), a null lobe δ(wi + wo) on both sides. Unpolarized
+//! light keeps half its intensity, so an unpolarized render sees a grey filter of ½ · transmittance
+//! (as Mitsuba 3's unpolarized variants do). In a polarized render its Mueller matrix is the
+//! [`linear_polarizer`] whose absorbing axis is the shading frame's t direction (the surface's v
+//! direction) turned by `theta` towards s, projected orthogonally to the beam for light that
+//! crosses the sheet obliquely (Korger et al. 2013, "The polarization properties of a tilted
+//! polarizer"), and whose transmission axis is orthogonal to it and the beam, as Mitsuba's
+//! `polarizer.cpp` builds it.
 //!
 //! [`linear_polarizer`]: crate::polarization::mueller::linear_polarizer
 
-use glam::{Mat4, Vec2, Vec3};
+use glam::Vec3;
 
-use super::{BsdfFlags, BsdfSample, Bxdf, BxdfTree, LeafBsdf};
-use crate::polarization::mueller::{linear_polarizer, stokes_basis};
-use crate::polarization::{FrameChange, SampledMueller};
+use super::polarizing_sheet::{PolarizingSheet, in_beam_basis};
+use super::{BsdfFlags, LeafBsdf};
+use crate::polarization::SampledMueller;
+use crate::polarization::mueller::linear_polarizer;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use crate::texture::{Texture, TexturePoint, TextureValues};
 
@@ -60,16 +61,16 @@ pub struct PolarizerLobes {
     pub polarizing: bool,
 }
 
-impl PolarizerLobes {
-    /// ½ · transmittance: what passes of unpolarized light.
+impl PolarizingSheet for PolarizerLobes {
+    /// ½ · transmittance.
     #[inline]
     fn unpolarized(&self) -> SampledSpectrum {
         self.transmittance * 0.5
     }
 
-    /// The Mueller matrix for light passing along `forward` (local, the direction of travel),
-    /// from and to the implicit Stokes bases of `forward`.
-    pub fn mueller_along(&self, forward: Vec3) -> SampledMueller {
+    /// The linear polarizer whose absorbing axis is t turned by `theta` towards s, projected
+    /// orthogonally to `forward`; where it does not polarize, an absorber of ½ · transmittance.
+    fn mueller_along(&self, forward: Vec3) -> SampledMueller {
         if !self.polarizing {
             return SampledMueller::absorber(self.unpolarized());
         }
@@ -78,42 +79,20 @@ impl PolarizerLobes {
         let effective_absorbing =
             (absorbing_axis - absorbing_axis.dot(forward) * forward).normalize();
         let effective_transmitting = forward.cross(effective_absorbing);
-        let change = FrameChange::collinear(forward, effective_transmitting, stokes_basis(forward));
-        let m: Mat4 = change.apply(linear_polarizer(1.0));
-        SampledMueller::splat(m).scaled(self.transmittance)
-    }
-}
-
-impl Bxdf for PolarizerLobes {
-    fn sample(&self, _tree: &BxdfTree, wo: Vec3, _u_lobe: f32, _u: Vec2) -> Option<BsdfSample> {
-        Some(BsdfSample::new(
-            -wo,
-            self.unpolarized(),
-            1.0,
-            BsdfFlags::NULL,
-        ))
-    }
-
-    fn null_transmission(&self, _tree: &BxdfTree, _wo: Vec3) -> SampledSpectrum {
-        self.unpolarized()
-    }
-
-    /// Light passes along `wo`.
-    fn mueller(
-        &self,
-        _tree: &BxdfTree,
-        wo: Vec3,
-        _wi: Vec3,
-        _lobe: BsdfFlags,
-    ) -> Option<SampledMueller> {
-        Some(self.mueller_along(wo))
+        in_beam_basis(
+            linear_polarizer(1.0),
+            effective_transmitting,
+            forward,
+            self.transmittance,
+        )
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use glam::Vec4;
+    use crate::bsdf::{Bxdf, BxdfTree};
+    use glam::{Vec2, Vec4};
 
     fn lobes(degrees: f32, polarizing: bool) -> PolarizerLobes {
         PolarizerLobes {

@@ -10,19 +10,20 @@
 //! ```
 //! Its parameters and their defaults are listed in docs/plugins.md.
 //!
-//! A null lobe δ(wi + wo) on both sides; unpolarized light passes whole, so an unpolarized
-//! render sees a filter of `transmittance`. In a polarized render its Mueller matrix is the
+//! A [polarizing sheet](super::polarizing_sheet), a null lobe δ(wi + wo) on both sides;
+//! unpolarized light passes whole, so an unpolarized render sees a filter of `transmittance`. In a polarized render its Mueller matrix is the
 //! [`linear_retarder`] of retardance δ |cos θ| (Mitsuba's approximation of the change with the
 //! angle of incidence), turned by `theta` (by −`theta` seen from the back) from the shading
 //! frame's s direction, as Mitsuba's `retarder.cpp` builds it.
 //!
 //! [`linear_retarder`]: crate::polarization::mueller::linear_retarder
 
-use glam::{Vec2, Vec3};
+use glam::Vec3;
 
-use super::{BsdfFlags, BsdfSample, Bxdf, BxdfTree, LeafBsdf};
-use crate::polarization::mueller::{linear_retarder, rotated_element, stokes_basis};
-use crate::polarization::{FrameChange, SampledMueller};
+use super::polarizing_sheet::{PolarizingSheet, in_beam_basis};
+use super::{BsdfFlags, LeafBsdf};
+use crate::polarization::SampledMueller;
+use crate::polarization::mueller::{linear_retarder, rotated_element};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use crate::texture::{Texture, TexturePoint, TextureValues};
 
@@ -57,48 +58,29 @@ pub struct RetarderLobes {
     pub transmittance: SampledSpectrum,
 }
 
-impl RetarderLobes {
-    /// The Mueller matrix for light passing along `forward` (local, the direction of travel),
-    /// from and to the implicit Stokes bases of `forward`.
-    pub fn mueller_along(&self, forward: Vec3) -> SampledMueller {
+impl PolarizingSheet for RetarderLobes {
+    /// The transmittance: a retarder passes unpolarized light whole.
+    #[inline]
+    fn unpolarized(&self) -> SampledSpectrum {
+        self.transmittance
+    }
+
+    /// The linear retarder of retardance δ |cos θᵢ| (θᵢ the angle of incidence), its fast axis
+    /// turned by `theta` from s (by −`theta` for light crossing from the back).
+    fn mueller_along(&self, forward: Vec3) -> SampledMueller {
         let cos_theta = forward.z;
         let retarder = linear_retarder(self.delta * cos_theta.abs());
         let side = if cos_theta >= 0.0 { 1.0 } else { -1.0 };
         let m = rotated_element(side * self.theta, retarder);
-        let change = FrameChange::collinear(forward, Vec3::X, stokes_basis(forward));
-        SampledMueller::splat(change.apply(m)).scaled(self.transmittance)
-    }
-}
-
-impl Bxdf for RetarderLobes {
-    fn sample(&self, _tree: &BxdfTree, wo: Vec3, _u_lobe: f32, _u: Vec2) -> Option<BsdfSample> {
-        Some(BsdfSample::new(
-            -wo,
-            self.transmittance,
-            1.0,
-            BsdfFlags::NULL,
-        ))
-    }
-
-    fn null_transmission(&self, _tree: &BxdfTree, _wo: Vec3) -> SampledSpectrum {
-        self.transmittance
-    }
-
-    /// Light passes along `wo`.
-    fn mueller(
-        &self,
-        _tree: &BxdfTree,
-        wo: Vec3,
-        _wi: Vec3,
-        _lobe: BsdfFlags,
-    ) -> Option<SampledMueller> {
-        Some(self.mueller_along(wo))
+        in_beam_basis(m, Vec3::X, forward, self.transmittance)
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::bsdf::{Bxdf, BxdfTree};
+    use crate::polarization::mueller::stokes_basis;
     use glam::Vec4;
 
     /// M₀₀ is the transmittance; a quarter-wave plate at 45° to the s direction turns light

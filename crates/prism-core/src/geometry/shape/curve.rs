@@ -2,9 +2,9 @@
 //! answer as shapes, written once: each segment is a primitive of the hierarchy, and, as in
 //! Mitsuba, a curve has no area and no sampling, so it cannot be an area light.
 
-use glam::{Vec2, Vec3};
+use glam::Vec3;
 
-use super::{Segments, ShapeGeometry, SolidAngleSampler, SurfaceSample};
+use super::{Segments, ShapeGeometry};
 use crate::geometry::interaction::SurfaceInteraction;
 use crate::geometry::triangle::TriangleHit;
 use crate::math::Ray;
@@ -85,22 +85,6 @@ impl<C: Curve> ShapeGeometry for C {
         index: u32,
     ) -> SurfaceInteraction {
         self.hit_interaction(ray, segment, hit.t, index)
-    }
-
-    fn sample_area(&self, _u_choice: f32, _u: Vec2) -> Option<SurfaceSample> {
-        None
-    }
-
-    fn solid_angle_sampler(&self, _reference: Vec3) -> Option<SolidAngleSampler<'_>> {
-        None
-    }
-
-    fn at_uv(&self, _uv: Vec2) -> Option<(SurfaceSample, f32)> {
-        None
-    }
-
-    fn uv_jacobian_at(&self, _primitive: u32, _uv: Vec2) -> Option<f32> {
-        None
     }
 
     fn heap_bytes(&self) -> usize {

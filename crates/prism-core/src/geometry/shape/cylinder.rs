@@ -12,7 +12,7 @@ use std::f32::consts::PI;
 use glam::{DVec3, Vec2, Vec3};
 
 use super::mesh::SurfaceSample;
-use super::{Segments, ShapeGeometry, SolidAngleSampler};
+use super::{Segments, ShapeGeometry};
 use crate::geometry::interaction::{AttributeValues, SurfaceInteraction};
 use crate::geometry::triangle::TriangleHit;
 use crate::math::{Frame, Ray, Transform};
@@ -177,10 +177,6 @@ impl ShapeGeometry for Cylinder {
     /// pdf 1/(2π r L) per unit area.
     fn sample_area(&self, _u_choice: f32, u: Vec2) -> Option<SurfaceSample> {
         Some(self.point_at_uv(u, 1.0 / self.area))
-    }
-
-    fn solid_angle_sampler(&self, _reference: Vec3) -> Option<SolidAngleSampler<'_>> {
-        None
     }
 
     /// The point at `uv` in [0, 1]² and |∂p/∂u × ∂p/∂v| = 2π r L there (Mitsuba's

@@ -5,7 +5,7 @@ use std::f32::consts::PI;
 use glam::{Vec2, Vec3};
 
 use super::mesh::SurfaceSample;
-use super::{Segments, ShapeGeometry, SolidAngleSampler};
+use super::{Segments, ShapeGeometry};
 use crate::geometry::interaction::{AttributeValues, SurfaceInteraction};
 use crate::geometry::triangle::TriangleHit;
 use crate::math::{Frame, Ray, Transform};
@@ -135,10 +135,6 @@ impl ShapeGeometry for Disk {
             primitive: 0,
             pdf: 1.0 / self.area,
         })
-    }
-
-    fn solid_angle_sampler(&self, _reference: Vec3) -> Option<SolidAngleSampler<'_>> {
-        None
     }
 
     /// The surface point with texture coordinates `uv` = (r, φ/2π) in [0, 1]², with its

@@ -63,24 +63,39 @@ plugin_class! {
         ) -> SurfaceInteraction;
 
         /// A point uniformly distributed over the surface, pdf per unit area; None for a shape
-        /// of zero area. `u_choice` picks the triangle of a mesh.
-        fn sample_area(&self, u_choice: f32, u: Vec2) -> Option<SurfaceSample>;
+        /// of zero area. `u_choice` picks the triangle of a mesh. By default None: a shape
+        /// that cannot be sampled (curves, ellipsoids, SDF grids) cannot be an area light.
+        fn sample_area(&self, u_choice: f32, u: Vec2) -> Option<SurfaceSample> {
+            let _ = (u_choice, u);
+            None
+        }
 
         /// How the shape is sampled by the solid angle it subtends at `reference`, where it
         /// has a way (spheres from outside: their cone; rectangles from near by: the spherical
-        /// rectangle); None where it is sampled by area. The one choice that
+        /// rectangle); None, the default, where it is sampled by area. The one choice that
         /// [`Self::sample_from`] and [`Self::pdf_from`] both follow.
-        fn solid_angle_sampler(&self, reference: Vec3) -> Option<SolidAngleSampler<'_>>;
+        fn solid_angle_sampler(&self, reference: Vec3) -> Option<SolidAngleSampler<'_>> {
+            let _ = reference;
+            None
+        }
 
         /// The surface point with texture coordinates `uv` in [0, 1]² (Mitsuba's
         /// `eval_parameterization`) and |∂p/∂u × ∂p/∂v| there, the area per unit uv area;
         /// None where the uv map does not reach `uv`. A point several mesh triangles share in
-        /// uv space lies on the lowest-numbered of them. The sample's pdf is 0.
-        fn at_uv(&self, uv: Vec2) -> Option<(SurfaceSample, f32)>;
+        /// uv space lies on the lowest-numbered of them. The sample's pdf is 0. By default
+        /// None: a shape without a uv map (curves, ellipsoids, SDF grids) reaches no `uv`.
+        fn at_uv(&self, uv: Vec2) -> Option<(SurfaceSample, f32)> {
+            let _ = uv;
+            None
+        }
 
         /// |∂p/∂u × ∂p/∂v| at the point with texture coordinates `uv` on triangle `primitive`
-        /// (0 for other shapes), if [`Self::at_uv`] maps `uv` to that point; None otherwise.
-        fn uv_jacobian_at(&self, primitive: u32, uv: Vec2) -> Option<f32>;
+        /// (0 for other shapes), if [`Self::at_uv`] maps `uv` to that point; None otherwise,
+        /// and by default, with the default [`Self::at_uv`].
+        fn uv_jacobian_at(&self, primitive: u32, uv: Vec2) -> Option<f32> {
+            let _ = (primitive, uv);
+            None
+        }
 
         /// Bytes of heap memory the shape holds (a mesh's vertex attributes and indices).
         fn heap_bytes(&self) -> usize;

@@ -22,8 +22,7 @@
 
 use glam::{DVec3, UVec3, Vec2, Vec3};
 
-use super::mesh::SurfaceSample;
-use super::{Segments, ShapeGeometry, SolidAngleSampler};
+use super::{Segments, ShapeGeometry};
 use crate::geometry::interaction::{AttributeValues, SurfaceInteraction};
 use crate::geometry::triangle::TriangleHit;
 use crate::math::{Frame, Ray, Transform};
@@ -423,22 +422,6 @@ impl ShapeGeometry for SdfGrid {
     ) -> SurfaceInteraction {
         let primitive = primitive.min(self.voxels.len() as u32 - 1);
         self.interaction_on(ray, primitive, hit.t, index)
-    }
-
-    fn sample_area(&self, _u_choice: f32, _u: Vec2) -> Option<SurfaceSample> {
-        None
-    }
-
-    fn solid_angle_sampler(&self, _reference: Vec3) -> Option<SolidAngleSampler<'_>> {
-        None
-    }
-
-    fn at_uv(&self, _uv: Vec2) -> Option<(SurfaceSample, f32)> {
-        None
-    }
-
-    fn uv_jacobian_at(&self, _primitive: u32, _uv: Vec2) -> Option<f32> {
-        None
     }
 
     fn heap_bytes(&self) -> usize {
