@@ -481,6 +481,72 @@ fn scale_and_mix_textures_render_pbrts_values() {
     }
 }
 
+/// A diffuse square in the plane x = 0 (normal ±x), seen from +x under a uniform sky of
+/// luminance 1, whose reflectance is the spectrum texture `texture` (named "r") defined after
+/// `transform`.
+fn textured_square(transform: &str, texture: &str) -> String {
+    format!(
+        r#"
+LookAt 5 0 0  0 0 0  0 1 0
+Camera "orthographic"
+Film "rgb" "integer xresolution" 8 "integer yresolution" 8
+PixelFilter "box"
+Sampler "independent" "integer pixelsamples" 64
+Integrator "path" "integer maxdepth" 1
+WorldBegin
+LightSource "infinite" "rgb L" [1 1 1]
+AttributeBegin
+{transform}
+{texture}
+AttributeEnd
+Material "diffuse" "texture reflectance" "r"
+Shape "trianglemesh" "point3 P" [0 -2 -2  0 2 -2  0 2 2  0 -2 2] "integer indices" [0 1 2  0 2 3]
+"#
+    )
+}
+
+#[test]
+fn a_direction_mix_renders_the_blend_of_the_normals_angle() {
+    // Under a uniform sky of luminance 1 a diffuse surface has the luminance of its
+    // reflectance, here a · 0.8 + (1 − a) · 0.2 with a = |n · dir| and n = ±x.
+    let mix = |dir: &str| {
+        format!(
+            "Texture \"r\" \"spectrum\" \"directionmix\" \"rgb tex1\" [0.8 0.8 0.8] \"rgb tex2\" [0.2 0.2 0.2] {dir}"
+        )
+    };
+    let cases = [
+        ("", mix("\"vector3 dir\" [-3 0 0]"), 1.0),
+        ("", mix(""), 0.0),
+        ("", mix("\"vector3 dir\" [1 1 0]"), 0.5_f64.sqrt()),
+        // (1, 0, 0) turned by 60° about z: a = cos 60°.
+        ("Rotate 60 0 0 1", mix("\"vector3 dir\" [1 0 0]"), 0.5),
+        // (0, 1, 0) taken to (1, 3, 0) (pbrt lists the matrix by columns): a = 1/√10.
+        (
+            "Transform [1 0 0 0  1 3 0 0  0 0 1 0  0 0 0 1]",
+            mix(""),
+            0.1_f64.sqrt(),
+        ),
+    ];
+    let path = Path::new("directionmix.pbrt");
+    for (k, (transform, texture, amount)) in cases.iter().enumerate() {
+        let root = prism_mitsuba::pbrt::read_pbrt_str(&textured_square(transform, texture), path)
+            .unwrap_or_else(|e| panic!("{texture}: {e}"))
+            .root;
+        let scene = prism_mitsuba::factory::build_scene(&root).unwrap().scene;
+        let film = render_film(&scene, 64, 20 + k as u64, None);
+        let (mean, variance) = block_mean(&film, 0, 0, 8, 1);
+        let expected = amount * 0.8 + (1.0 - amount) * 0.2;
+        // 5 estimates: 4.5 standard errors fail a correct texture with probability 3·10⁻⁵;
+        // the standard error is below a tenth of the smallest step between the cases (0.05).
+        let z = (mean - expected) / variance.sqrt();
+        assert!(
+            z.abs() < 4.5 && variance.sqrt() < 0.005,
+            "{transform} {texture}: Y {mean} ± {} where {expected} is expected",
+            variance.sqrt()
+        );
+    }
+}
+
 /// A grey square (reflectance ½) in the plane x = 0, seen from +x, under pbrt's image infinite
 /// light `light` (an equal-area map, scale 2), in an orthographic view that it fills.
 fn square_under_sky(light: &str) -> String {

@@ -528,9 +528,40 @@ fn scale_and_mix_textures_nest_their_operands() {
         error("WorldBegin\nTexture \"c\" \"spectrum\" \"checkerboard\"\nTexture \"s\" \"float\" \"scale\" \"texture tex\" \"c\"")
             .contains("test.pbrt:3:29: Texture \"s\" \"float\" \"scale\": parameter \"texture tex\" names the unknown float texture \"c\"")
     );
+}
+
+#[test]
+fn a_direction_mix_takes_its_direction_to_the_world() {
+    let scene = root(
+        "WorldBegin\nRotate 90 0 0 1\nScale 1 3 1\nTexture \"d\" \"spectrum\" \"directionmix\" \"rgb tex1\" [0.8 0.8 0.8] \"vector dir\" [0 2 0]\nMaterial \"diffuse\" \"texture reflectance\" \"d\"\nShape \"sphere\"",
+    );
+    let shape = nodes(&scene, PluginClass::Shape)[0];
+    let mix = &shape.children[0].node.children[0].node.children[0].node;
+    assert_eq!(mix.plugin_type, "directionmix");
+    assert_eq!(property(mix, "tex1"), &PropertyValue::Rgb([0.8; 3]));
+    // pbrt's defaults: tex2 = 1, dir = (0, 1, 0).
+    assert_eq!(property(mix, "tex2"), &PropertyValue::Float(1.0));
+    // (0, 2, 0) scaled to (0, 6, 0), then turned by 90° about z to (−6, 0, 0).
+    let PropertyValue::Vector(dir) = property(mix, "dir") else {
+        panic!("dir is a vector");
+    };
     assert!(
-        error("WorldBegin\nTexture \"d\" \"float\" \"directionmix\" \"vector3 dir\" [0 1 0]")
-            .contains("test.pbrt:2:1: Texture \"d\" \"float\" \"directionmix\": blends by the surface normal's direction")
+        (*dir - DVec3::new(-6.0, 0.0, 0.0)).length() < 1e-12,
+        "{dir}"
+    );
+    let default = root(
+        "WorldBegin\nTexture \"d\" \"spectrum\" \"directionmix\"\nMaterial \"diffuse\" \"texture reflectance\" \"d\"\nShape \"sphere\"",
+    );
+    let shape = nodes(&default, PluginClass::Shape)[0];
+    let mix = &shape.children[0].node.children[0].node.children[0].node;
+    assert_eq!(property(mix, "dir"), &PropertyValue::Vector(DVec3::Y));
+    assert!(
+        error("WorldBegin\nTexture \"d\" \"float\" \"directionmix\" \"vector3 dir\" [0 0 0]")
+            .contains("test.pbrt:2:36: Texture \"d\" \"float\" \"directionmix\": parameter \"vector3 dir\" has no direction")
+    );
+    assert!(
+        error("WorldBegin\nScale 1 0 1\nTexture \"d\" \"float\" \"directionmix\"")
+            .contains("test.pbrt:3:1: Texture \"d\" \"float\" \"directionmix\": \"dir\" (0, 1, 0) has no direction")
     );
 }
 
