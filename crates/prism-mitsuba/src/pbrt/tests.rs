@@ -594,7 +594,7 @@ fn an_image_infinite_light_is_an_equal_area_map() {
 #[test]
 fn a_uniform_grid_is_a_heterogeneous_medium_with_an_empty_border() {
     let root = root(
-        "WorldBegin\nTranslate 1 0 0\nMakeNamedMedium \"smoke\" \"string type\" \"uniformgrid\" \"integer nx\" 2 \"float density\" [3 5] \"point3 p0\" [0 0 0] \"point3 p1\" [4 1 1] \"rgb sigma_a\" [1 1 1] \"rgb sigma_s\" [3 3 3] \"float scale\" 2 \"float g\" 0.5\nMediumInterface \"smoke\" \"\"\nMaterial \"interface\"\nShape \"sphere\"",
+        "WorldBegin\nTranslate 1 0 0\nMakeNamedMedium \"smoke\" \"string type\" \"uniformgrid\" \"integer nx\" 2 \"float density\" [3 5] \"point3 p0\" [0 0 0] \"point3 p1\" [4 1 1] \"rgb sigma_a\" [1 1 1] \"rgb sigma_s\" [0.5 3 4] \"float scale\" 2 \"float g\" 0.5\nMediumInterface \"smoke\" \"\"\nMaterial \"interface\"\nShape \"sphere\"",
     );
     let shape = nodes(&root, PluginClass::Shape)[0];
     let medium = &shape
@@ -604,11 +604,15 @@ fn a_uniform_grid_is_a_heterogeneous_medium_with_an_empty_border() {
         .expect("an interior")
         .node;
     assert_eq!(medium.plugin_type, "heterogeneous");
-    // σ_t = 2 · (1 + 3) · d, albedo 3 / 4.
-    assert_eq!(property(medium, "scale"), &PropertyValue::Float(8.0));
-    assert_eq!(property(medium, "albedo"), &PropertyValue::Float(0.75));
+    // σ_a = 2 · d · (1, 1, 1), σ_s = 2 · d · (0.5, 3, 4).
+    assert_eq!(property(medium, "scale"), &PropertyValue::Float(2.0));
+    assert_eq!(property(medium, "sigma_a"), &PropertyValue::Rgb([1.0; 3]));
+    assert_eq!(
+        property(medium, "sigma_s"),
+        &PropertyValue::Rgb([0.5, 3.0, 4.0])
+    );
     let grid = &medium.children[0];
-    assert_eq!(grid.name.as_deref(), Some("sigma_t"));
+    assert_eq!(grid.name.as_deref(), Some("density"));
     assert_eq!(grid.node.plugin_type, "inlinegrid");
     assert_eq!(medium.children[1].node.plugin_type, "hg");
     // 2 × 1 × 1 voxels in a 4 × 3 × 3 grid of zeros, over the box grown by a voxel (2 × 1 × 1).
@@ -641,9 +645,5 @@ fn a_uniform_grid_is_a_heterogeneous_medium_with_an_empty_border() {
     medium(
         "\"float density\" [1] \"float temperature\" [900]",
         "test.pbrt:2:69: MakeNamedMedium \"m\": parameter \"float temperature\" makes the medium glow",
-    );
-    medium(
-        "\"float density\" [1] \"rgb sigma_s\" [1 2 3]",
-        "test.pbrt:2:69: MakeNamedMedium \"m\": parameter \"rgb sigma_s\" must be grey",
     );
 }
