@@ -1,7 +1,8 @@
 //! Participating media against closed forms (docs/testing.md, closed-form scenes): transmittance
 //! through a homogeneous slab, single scattering in a slab lit by a directional light, a closed
 //! furnace filled with a non-absorbing medium (L = Lₑ), an emitter inside an absorbing medium; and
-//! ratio tracking's transmittance against the exact optical depth of generated grids.
+//! ratio tracking's transmittance against the exact optical depth of generated grids (also of
+//! a density grid times chromatic coefficients, pbrt-v4's grid media).
 
 use glam::{DMat4, DVec3, Mat3, UVec2, Vec3};
 use prism_core::bsdf::{Material, Null};
@@ -11,13 +12,16 @@ use prism_core::integrator::{Integrator, Tracking, VolPathIntegrator};
 use prism_core::light::{DirectionalLight, Light};
 use prism_core::math::{Ray, Transform};
 use prism_core::medium::{
-    GridFilter, GridVolume, HenyeyGreenstein, Heterogeneous, Homogeneous, Isotropic, Medium,
-    MediumInterface, MediumKind, PhaseFunction, PhaseModel, Rayleigh, Sggx, TabulatedPhase, Volume,
+    GridFilter, GridVolume, HenyeyGreenstein, Heterogeneous, HeterogeneousAbsorbingScattering,
+    Homogeneous, Isotropic, Medium, MediumInterface, MediumKind, PhaseFunction, PhaseModel,
+    Rayleigh, Sggx, TabulatedPhase, Volume,
 };
 use prism_core::sampling::rng::Pcg32;
 use prism_core::scene::Scene;
 use prism_core::spectrum::cie::cie_y;
-use prism_core::spectrum::{LAMBDA_MAX, LAMBDA_MIN, PiecewiseLinear, Spectrum, WavelengthSampling};
+use prism_core::spectrum::{
+    LAMBDA_MAX, LAMBDA_MIN, PiecewiseLinear, SampledWavelengths, Spectrum, WavelengthSampling,
+};
 use prism_mitsuba::factory::build_scene;
 use prism_mitsuba::factory::shapes::{cube, transform_mesh};
 use prism_mitsuba::reader::read_scene_str;
@@ -116,6 +120,12 @@ fn slab(
     spp: u32,
     seed: u64,
 ) -> Film {
+    let medium = homogeneous(sigma_t, albedo, PhaseFunction::Isotropic(Isotropic));
+    slab_of(medium, integrator, spp, seed)
+}
+
+/// The slab of [`slab`] filled with `medium` (the box |z| ≤ 0.625, |x|, |y| ≤ 50).
+fn slab_of(medium: Medium, integrator: VolPathIntegrator, spp: u32, seed: u64) -> Film {
     let size = UVec2::new(16, 16);
     let (le, d) = (2.0f32, 1.25f64);
     let mut scene = build(
@@ -136,11 +146,7 @@ fn slab(
         size,
         integrator,
     );
-    scene.world.media = vec![homogeneous(
-        sigma_t,
-        albedo,
-        PhaseFunction::Isotropic(Isotropic),
-    )];
+    scene.world.media = vec![medium];
     // The tests' sample counts and margins were sized with this density (under `visible`, which
     // leaves the ends of the spectrum, where this σ_t is large, to few samples, the hero-only
     // estimator's variance is heavy-tailed and its own standard error several times larger).
@@ -497,6 +503,190 @@ fn closed_furnace_with_a_heterogeneous_non_absorbing_medium() {
             2048,
             6 + 10 * k as u64,
         );
+    }
+}
+
+/// pbrt-v4's grid medium ([`HeterogeneousAbsorbingScattering`]): `density` times `sigma_a` and
+/// `sigma_s`, times `scale`, with an isotropic phase function.
+fn density_medium(density: Volume, sigma_a: Spectrum, sigma_s: Spectrum, scale: f32) -> Medium {
+    Medium {
+        kind: MediumKind::HeterogeneousAbsorbingScattering(HeterogeneousAbsorbingScattering {
+            density,
+            sigma_a,
+            sigma_s,
+            scale,
+        }),
+        phase: PhaseFunction::Isotropic(Isotropic),
+        sample_emitters: true,
+    }
+}
+
+/// A grid of one value, `density`, over the cube [−1, 1]³.
+fn uniform_density(density: f32) -> Volume {
+    let to_world = Transform::new(
+        DMat4::from_translation(DVec3::splat(-1.0)) * DMat4::from_scale(DVec3::splat(2.0)),
+    )
+    .unwrap();
+    Volume::Grid(Box::new(
+        GridVolume::new([2, 2, 2], vec![density; 8], to_world, GridFilter::Trilinear).unwrap(),
+    ))
+}
+
+/// A purely absorbing slab of a uniform density grid (0.5) times a chromatic σ_a (times 2): the
+/// homogeneous slab's L = Lₑ exp(−σ_t(λ) d) with σ_t = 0.5 · 2 · σ_a(λ), though the grid is ratio
+/// tracked, with one majorant for the four wavelengths.
+#[test]
+fn transmittance_through_a_chromatic_density_grid() {
+    let (le, d) = (2.0f64, 1.25f64);
+    let sigma_t = chromatic_sigma_t();
+    let expected = luminance(|lambda| le * (-f64::from(sigma_t.value(lambda as f32)) * d).exp());
+    for (k, (name, integrator)) in chromatic_unbiased().into_iter().enumerate() {
+        let medium = density_medium(
+            uniform_density(0.5),
+            Spectrum::PiecewiseLinear(sigma_t.clone()),
+            Spectrum::Constant(0.0),
+            2.0,
+        );
+        let film = slab_of(medium, integrator, 2048, 21 + k as u64);
+        assert_mean_luminance(&format!("{name}: chromatic density grid"), &film, expected);
+    }
+}
+
+/// A density grid times a chromatic σ_s, without absorption, fills the closed furnace of
+/// [`medium_furnace`]: L = 2, for `volpath` and `volpathmis` (see [`chromatic_unbiased`]).
+#[test]
+fn closed_furnace_with_a_chromatic_density_grid() {
+    let to_world = Transform::new(
+        DMat4::from_translation(DVec3::splat(-0.8)) * DMat4::from_scale(DVec3::splat(1.6)),
+    )
+    .unwrap();
+    let grid = GridVolume::new(
+        [5, 6, 4],
+        random_grid([5, 6, 4], 0.0, 2.0, 8),
+        to_world,
+        GridFilter::Trilinear,
+    )
+    .unwrap();
+    let sigma_s = PiecewiseLinear::new(&[(360.0, 3.0), (550.0, 0.4), (830.0, 2.0)]).unwrap();
+    for (k, integrator) in chromatic_unbiased().into_iter().enumerate() {
+        medium_furnace(
+            density_medium(
+                Volume::Grid(Box::new(grid.clone())),
+                Spectrum::Constant(0.0),
+                Spectrum::PiecewiseLinear(sigma_s.clone()),
+                1.2,
+            ),
+            integrator,
+            2048,
+            31 + 10 * k as u64,
+        );
+    }
+}
+
+/// The XML form of pbrt's grid media: `density` with `sigma_a` and `sigma_s`, not mixed with
+/// Mitsuba's `sigma_t` and `albedo`, and all three given.
+#[test]
+fn a_density_medium_needs_its_three_parameters_alone() {
+    let scene = |medium: &str| {
+        format!(
+            r#"<scene version="3.0.0">
+    <integrator type="volpath"/>
+    <sensor type="perspective"><film type="hdrfilm"><integer name="width" value="4"/><integer name="height" value="4"/></film></sensor>
+    <shape type="sphere">
+        <bsdf type="null"/>
+        <medium type="heterogeneous" name="interior">{medium}</medium>
+    </shape>
+</scene>"#
+        )
+    };
+    let error = |medium: &str| match scene_from_xml(&scene(medium), "density.xml") {
+        Ok(_) => panic!("{medium}: the scene was built"),
+        Err(e) => e.to_string(),
+    };
+    let density = r#"<float name="density" value="2"/>"#;
+    let sigma_a = r#"<rgb name="sigma_a" value="0.1, 0.2, 0.3"/>"#;
+    let sigma_s = r#"<spectrum name="sigma_s" value="400:1, 700:2"/>"#;
+    scene_from_xml(
+        &scene(&format!("{density}{sigma_a}{sigma_s}")),
+        "density.xml",
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    let message = error(&format!("{density}{sigma_s}"));
+    assert!(message.contains("without \"sigma_a\""), "{message}");
+    let message = error(&format!(
+        "{density}{sigma_a}{sigma_s}<float name=\"albedo\" value=\"0.5\"/>"
+    ));
+    assert!(
+        message.contains("both density/sigma_a/sigma_s and \"albedo\""),
+        "{message}"
+    );
+}
+
+/// Ratio tracking through a density grid times chromatic σ_a + σ_s: at each of the path's four
+/// wavelengths, the mean of 40 000 estimates equals exp(−scale (σ_a(λᵢ) + σ_s(λᵢ)) ∫ d) within
+/// four standard errors, though the four share one majorant (the largest of their bounds).
+#[test]
+fn ratio_tracking_is_unbiased_in_a_chromatic_density_grid() {
+    let resolution = [5, 4, 6];
+    let grid = GridVolume::new(
+        resolution,
+        random_grid(resolution, 0.0, 2.0, 12),
+        Transform::IDENTITY,
+        GridFilter::Trilinear,
+    )
+    .unwrap();
+    let sigma_a = PiecewiseLinear::new(&[(360.0, 2.0), (550.0, 0.2), (830.0, 1.0)]).unwrap();
+    let scale = 1.3f32;
+    let medium = density_medium(
+        Volume::Grid(Box::new(grid.clone())),
+        Spectrum::PiecewiseLinear(sigma_a.clone()),
+        Spectrum::Constant(0.3),
+        scale,
+    );
+    let lambda = SampledWavelengths::sample(0.37, WavelengthSampling::Uniform);
+    let rays = [
+        Ray::new(
+            Vec3::new(-0.5, 0.3, 0.4),
+            Vec3::new(1.0, 0.1, 0.05).normalize(),
+            10.0,
+            0.0,
+        ),
+        Ray::new(
+            Vec3::new(0.5, 0.5, 0.5),
+            Vec3::new(-0.4, 0.5, 0.9).normalize(),
+            0.6,
+            0.0,
+        ),
+    ];
+    let runs = 40_000;
+    for (r, ray) in rays.iter().enumerate() {
+        let mut rng = Pcg32::new(77, r as u64);
+        let (mut sum, mut sum_sq) = ([0.0f64; 4], [0.0f64; 4]);
+        for _ in 0..runs {
+            let t = medium.transmittance(ray, ray.t_max, &lambda, || rng.next_f32());
+            for i in 0..4 {
+                sum[i] += f64::from(t[i]);
+                sum_sq[i] += f64::from(t[i]) * f64::from(t[i]);
+            }
+        }
+        for i in 0..4 {
+            let sigma_t = f64::from(sigma_a.value(lambda.lambda(i))) + 0.3;
+            let exact =
+                (-optical_depth(&grid, ray, ray.t_max, f64::from(scale) * sigma_t, true)).exp();
+            let mean = sum[i] / runs as f64;
+            let se = ((sum_sq[i] / runs as f64 - mean * mean) / (runs as f64 - 1.0)).sqrt();
+            assert!(
+                exact < 0.99 && se > 0.0,
+                "ray {r}, λ {}: the ray must cross the grid (exact {exact})",
+                lambda.lambda(i)
+            );
+            assert!(
+                (mean - exact).abs() < 4.0 * se,
+                "ray {r}, λ {}: ratio tracking gives {mean}, exact {exact} ({:.2} standard errors)",
+                lambda.lambda(i),
+                (mean - exact).abs() / se
+            );
+        }
     }
 }
 

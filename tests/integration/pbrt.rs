@@ -6,7 +6,9 @@ use std::path::{Path, PathBuf};
 use prism_core::film::Film;
 use prism_mitsuba::load_scene;
 
-use crate::common::scenes::{pixel_mean_and_variance, render_film, scene_from_xml};
+use crate::common::scenes::{
+    image_mean_and_standard_error, pixel_mean_and_variance, render_film, scene_from_xml,
+};
 
 /// Mean and variance of the mean of channel `c` over the square block of `block` pixels whose
 /// top-left pixel is (x0, y0).
@@ -481,6 +483,72 @@ fn scale_and_mix_textures_render_pbrts_values() {
     }
 }
 
+/// A diffuse square in the plane x = 0 (normal ±x), seen from +x under a uniform sky of
+/// luminance 1, whose reflectance is the spectrum texture `texture` (named "r") defined after
+/// `transform`.
+fn textured_square(transform: &str, texture: &str) -> String {
+    format!(
+        r#"
+LookAt 5 0 0  0 0 0  0 1 0
+Camera "orthographic"
+Film "rgb" "integer xresolution" 8 "integer yresolution" 8
+PixelFilter "box"
+Sampler "independent" "integer pixelsamples" 64
+Integrator "path" "integer maxdepth" 1
+WorldBegin
+LightSource "infinite" "rgb L" [1 1 1]
+AttributeBegin
+{transform}
+{texture}
+AttributeEnd
+Material "diffuse" "texture reflectance" "r"
+Shape "trianglemesh" "point3 P" [0 -2 -2  0 2 -2  0 2 2  0 -2 2] "integer indices" [0 1 2  0 2 3]
+"#
+    )
+}
+
+#[test]
+fn a_direction_mix_renders_the_blend_of_the_normals_angle() {
+    // Under a uniform sky of luminance 1 a diffuse surface has the luminance of its
+    // reflectance, here a · 0.8 + (1 − a) · 0.2 with a = |n · dir| and n = ±x.
+    let mix = |dir: &str| {
+        format!(
+            "Texture \"r\" \"spectrum\" \"directionmix\" \"rgb tex1\" [0.8 0.8 0.8] \"rgb tex2\" [0.2 0.2 0.2] {dir}"
+        )
+    };
+    let cases = [
+        ("", mix("\"vector3 dir\" [-3 0 0]"), 1.0),
+        ("", mix(""), 0.0),
+        ("", mix("\"vector3 dir\" [1 1 0]"), 0.5_f64.sqrt()),
+        // (1, 0, 0) turned by 60° about z: a = cos 60°.
+        ("Rotate 60 0 0 1", mix("\"vector3 dir\" [1 0 0]"), 0.5),
+        // (0, 1, 0) taken to (1, 3, 0) (pbrt lists the matrix by columns): a = 1/√10.
+        (
+            "Transform [1 0 0 0  1 3 0 0  0 0 1 0  0 0 0 1]",
+            mix(""),
+            0.1_f64.sqrt(),
+        ),
+    ];
+    let path = Path::new("directionmix.pbrt");
+    for (k, (transform, texture, amount)) in cases.iter().enumerate() {
+        let root = prism_mitsuba::pbrt::read_pbrt_str(&textured_square(transform, texture), path)
+            .unwrap_or_else(|e| panic!("{texture}: {e}"))
+            .root;
+        let scene = prism_mitsuba::factory::build_scene(&root).unwrap().scene;
+        let film = render_film(&scene, 64, 20 + k as u64, None);
+        let (mean, variance) = block_mean(&film, 0, 0, 8, 1);
+        let expected = amount * 0.8 + (1.0 - amount) * 0.2;
+        // 5 estimates: 4.5 standard errors fail a correct texture with probability 3·10⁻⁵;
+        // the standard error is below a tenth of the smallest step between the cases (0.05).
+        let z = (mean - expected) / variance.sqrt();
+        assert!(
+            z.abs() < 4.5 && variance.sqrt() < 0.005,
+            "{transform} {texture}: Y {mean} ± {} where {expected} is expected",
+            variance.sqrt()
+        );
+    }
+}
+
 /// A grey square (reflectance ½) in the plane x = 0, seen from +x, under pbrt's image infinite
 /// light `light` (an equal-area map, scale 2), in an orthographic view that it fills.
 fn square_under_sky(light: &str) -> String {
@@ -611,6 +679,7 @@ AttributeEnd
     )
 }
 
+/// Coloured σ_a and σ_s, which pbrt's grid medium scales by the density.
 #[test]
 fn a_constant_uniform_grid_renders_as_a_homogeneous_medium() {
     // A grid of 8³ voxels over [−1.5, 1.5]³: the ball lies more than half a voxel inside its
@@ -618,10 +687,10 @@ fn a_constant_uniform_grid_renders_as_a_homogeneous_medium() {
     let grid = |density: f64| {
         let values = vec![density.to_string(); 512].join(" ");
         format!(
-            "MakeNamedMedium \"fog\" \"string type\" \"uniformgrid\" \"integer nx\" 8 \"integer ny\" 8 \"integer nz\" 8 \"float density\" [{values}] \"point3 p0\" [-1.5 -1.5 -1.5] \"point3 p1\" [1.5 1.5 1.5] \"rgb sigma_a\" [0.5 0.5 0.5] \"rgb sigma_s\" [1 1 1] \"float scale\" 2 \"float g\" 0.3"
+            "MakeNamedMedium \"fog\" \"string type\" \"uniformgrid\" \"integer nx\" 8 \"integer ny\" 8 \"integer nz\" 8 \"float density\" [{values}] \"point3 p0\" [-1.5 -1.5 -1.5] \"point3 p1\" [1.5 1.5 1.5] \"rgb sigma_a\" [0.6 0.3 0.1] \"rgb sigma_s\" [0.4 0.9 1.6] \"float scale\" 2 \"float g\" 0.3"
         )
     };
-    let homogeneous = "MakeNamedMedium \"fog\" \"string type\" \"homogeneous\" \"rgb sigma_a\" [0.5 0.5 0.5] \"rgb sigma_s\" [1 1 1] \"float scale\" 2 \"float g\" 0.3";
+    let homogeneous = "MakeNamedMedium \"fog\" \"string type\" \"homogeneous\" \"rgb sigma_a\" [0.6 0.3 0.1] \"rgb sigma_s\" [0.4 0.9 1.6] \"float scale\" 2 \"float g\" 0.3";
     let render = |medium: &str, seed: u64| {
         let root = prism_mitsuba::pbrt::read_pbrt_str(&fog_ball(medium), Path::new("fog.pbrt"))
             .unwrap()
@@ -643,4 +712,143 @@ fn a_constant_uniform_grid_renders_as_a_homogeneous_medium() {
         z > 8.0,
         "half the density differs by only {z:.1} standard errors"
     );
+}
+
+/// A ball of radius 1 filled with pbrt's grid medium of density `density` (8³ voxels over
+/// [−1.5, 1.5]³), σ_a = 0 and the colour `sigma_s`, lit from above by a distant light; in pbrt-v4's
+/// format, and in Mitsuba 3's with the colour grid `sigma_t` = d · `sigma_s` in a `.vol` file
+/// named `grid` and albedo 1.
+fn lit_fog(density: &[f32], sigma_s: [f32; 3], grid: &str) -> (String, String) {
+    let values: Vec<String> = density.iter().map(|d| d.to_string()).collect();
+    let [r, g, b] = sigma_s;
+    let pbrt = format!(
+        r#"
+LookAt 0 0 -4  0 0 0  0 1 0
+Camera "perspective" "float fov" 40
+Film "rgb" "integer xresolution" 16 "integer yresolution" 16
+PixelFilter "box"
+Sampler "independent" "integer pixelsamples" 64
+Integrator "volpath" "integer maxdepth" 8
+WorldBegin
+LightSource "distant" "point3 from" [0 4 0] "point3 to" [0 0 0] "rgb L" [3 3 3]
+MakeNamedMedium "fog" "string type" "uniformgrid" "integer nx" 8 "integer ny" 8 "integer nz" 8 "float density" [{}] "point3 p0" [-1.5 -1.5 -1.5] "point3 p1" [1.5 1.5 1.5] "rgb sigma_a" [0 0 0] "rgb sigma_s" [{r} {g} {b}]
+AttributeBegin
+    MediumInterface "fog" ""
+    Material "interface"
+    Shape "sphere" "float radius" 1
+AttributeEnd
+"#,
+        values.join(" ")
+    );
+    let xml = format!(
+        r#"<scene version="3.0.0">
+    <integrator type="volpath"><integer name="max_depth" value="9"/></integrator>
+    <sensor type="perspective">
+        <float name="fov" value="40"/>
+        <transform name="to_world"><lookat origin="0, 0, -4" target="0, 0, 0" up="0, 1, 0"/></transform>
+        <film type="hdrfilm"><integer name="width" value="16"/><integer name="height" value="16"/><rfilter type="box"/></film>
+    </sensor>
+    <emitter type="directional">
+        <vector name="direction" x="0" y="-1" z="0"/>
+        <rgb name="irradiance" value="3"/>
+    </emitter>
+    <shape type="sphere">
+        <bsdf type="null"/>
+        <medium type="heterogeneous" name="interior">
+            <volume type="gridvolume" name="sigma_t">
+                <string name="filename" value="{grid}"/>
+                <transform name="to_world"><scale value="3"/><translate x="-1.5" y="-1.5" z="-1.5"/></transform>
+            </volume>
+            <float name="albedo" value="1"/>
+        </medium>
+    </shape>
+</scene>"#
+    );
+    (pbrt, xml)
+}
+
+/// Mitsuba's `.vol` file of the colour grid d · `rgb` (8³ voxels, x fastest).
+fn colour_vol(density: &[f32], rgb: [f32; 3]) -> Vec<u8> {
+    let mut vol = b"VOL\x03".to_vec();
+    for v in [1i32, 8, 8, 8, 3] {
+        vol.extend(v.to_le_bytes());
+    }
+    for v in [-1.5f32, -1.5, -1.5, 1.5, 1.5, 1.5] {
+        vol.extend(v.to_le_bytes());
+    }
+    for d in density {
+        for c in rgb {
+            vol.extend((d * c).to_le_bytes());
+        }
+    }
+    vol
+}
+
+#[test]
+fn a_coloured_uniform_grid_renders_as_mitsubas_colour_grid() {
+    // A density between 0.3 and 1.5 everywhere: a colour grid of one chromaticity upsamples to
+    // that colour's spectrum times the density (Mitsuba 3 interpolates the voxels' spectra and
+    // scales separately, which agree where no voxel is black), pbrt's σ_s(λ) d(p).
+    let density: Vec<f32> = (0..512)
+        .map(|i| 0.3 + 1.2 * ((i * 37 % 17) as f32 / 16.0))
+        .collect();
+    let sigma_s = [0.4, 1.0, 2.2];
+    let folder = folder("colour-grid");
+    std::fs::write(folder.join("fog.vol"), colour_vol(&density, sigma_s)).unwrap();
+    let render = |text: &str, pbrt: bool, seed: u64| {
+        let scene = if pbrt {
+            let root = prism_mitsuba::pbrt::read_pbrt_str(text, &folder.join("fog.pbrt"))
+                .unwrap()
+                .root;
+            prism_mitsuba::factory::build_scene(&root).unwrap().scene
+        } else {
+            scene_from_xml(text, folder.join("fog.xml").to_str().unwrap()).unwrap()
+        };
+        render_film(&scene, 512, seed, None)
+    };
+    let (pbrt, xml) = lit_fog(&density, sigma_s, "fog.vol");
+    let reference = render(&xml, false, 1);
+    let pbrt_film = render(&pbrt, true, 2);
+    // The other colour order, which the comparison must tell apart.
+    let (swapped, _) = lit_fog(&density, [2.2, 1.0, 0.4], "fog.vol");
+    let swapped_film = render(&swapped, true, 3);
+    std::fs::remove_dir_all(&folder).unwrap();
+    // pbrt's camera sees the world mirrored left to right against Mitsuba's with the same
+    // `LookAt`, so the images' means are compared: X, Y and Z, 4.5 standard errors (a false
+    // alarm with probability 2·10⁻⁵).
+    let largest_z = |film: &Film| {
+        (0..3)
+            .map(|c| {
+                let (a, sa) = image_mean_and_standard_error(&reference, c);
+                let (b, sb) = image_mean_and_standard_error(film, c);
+                (a - b).abs() / (sa * sa + sb * sb).sqrt()
+            })
+            .fold(0.0, f64::max)
+    };
+    let z = largest_z(&pbrt_film);
+    assert!(
+        z < 4.5,
+        "pbrt's grid and Mitsuba's differ by {z:.1} standard errors"
+    );
+    let z = largest_z(&swapped_film);
+    assert!(
+        z > 8.0,
+        "the other colour order differs by only {z:.1} standard errors"
+    );
+    // Mitsuba 3.9.1's image means of the XML scene (`scalar_spectral`, 32 × 32 pixels, whose
+    // box-filtered mean is the 16 × 16 image's; two renders of 1024 spp, seeds 11 and 12, their
+    // RGB taken to XYZ by the sRGB matrix; the standard errors from the two renders' difference).
+    let mitsuba = [
+        (0.052237, 0.000075),
+        (0.058552, 0.000068),
+        (0.083536, 0.000274),
+    ];
+    for (c, (expected, se)) in mitsuba.into_iter().enumerate() {
+        let (mean, prism_se) = image_mean_and_standard_error(&reference, c);
+        let z = (mean - expected) / prism_se.hypot(se);
+        assert!(
+            z.abs() < 4.5,
+            "channel {c}: Prism {mean} ± {prism_se}, Mitsuba {expected} ± {se} ({z:.1} standard errors)"
+        );
+    }
 }

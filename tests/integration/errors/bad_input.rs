@@ -966,6 +966,22 @@ fn cases() -> Vec<Case> {
             "is read here as a raw RGB triple (a normal map)",
         ),
         render_scene(
+            "directionmix texture as an emitter's radiance",
+            scene!(
+                "    <shape type=\"sphere\"><emitter type=\"area\"><texture type=\"directionmix\" name=\"radiance\"/></emitter></shape>"
+            ),
+            "scene.xml:3:",
+            "blends by the surface's normal, but an emitter looks its textures up by (u, v) alone",
+        ),
+        render_scene(
+            "directionmix texture of a zero direction",
+            scene!(
+                "    <shape type=\"sphere\"><bsdf type=\"diffuse\"><texture type=\"directionmix\" name=\"reflectance\"><vector name=\"dir\" x=\"0\" y=\"0\" z=\"0\"/></texture></bsdf></shape>"
+            ),
+            "scene.xml:3:",
+            "which has no direction",
+        ),
+        render_scene(
             "mesh_attribute: no name",
             scene!(
                 "    <shape type=\"sphere\"><bsdf type=\"diffuse\"><texture type=\"mesh_attribute\" name=\"reflectance\"/></bsdf></shape>"

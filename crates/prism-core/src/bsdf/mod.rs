@@ -276,7 +276,7 @@ pub struct ShadingPoint {
     pub p: Vec3,
     /// The shading frame that the local directions refer to (world space).
     pub frame: Frame,
-    /// The geometric normal, on the side of `frame.n`.
+    /// The geometric normal, on the side of `frame.n` (also for `directionmix` textures).
     pub ng: Vec3,
     /// ∂p/∂u and ∂p/∂v (world space, not normalised).
     pub dp_du: Vec3,
@@ -291,6 +291,7 @@ impl ShadingPoint {
             uv: self.uv,
             attributes: self.attributes,
             p: self.p,
+            n: self.ng,
         }
     }
 

@@ -91,6 +91,7 @@ fn luminance_density(texture: &Texture) -> (PiecewiseConstant2D, f32) {
         | Texture::MeshAttribute(_)
         | Texture::Scale(_)
         | Texture::Mix(_)
+        | Texture::DirectionMix(_)
         | Texture::Volume(_) => (PATTERN_RESOLUTION, PATTERN_RESOLUTION),
     };
     let weights: Vec<f32> = (0..nx * ny)

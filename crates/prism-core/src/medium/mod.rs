@@ -1,4 +1,5 @@
-//! Participating media: Mitsuba 3's `homogeneous` and `heterogeneous` media with their phase
+//! Participating media: Mitsuba 3's `homogeneous` and `heterogeneous` media (and pbrt-v4's grid
+//! media, a density times absorption and scattering spectra) with their phase
 //! functions ([`phase`]) and the volumes that give a heterogeneous medium's coefficients
 //! ([`volume`], grids looked up as [`lattice`] describes), and the three operations a
 //! volumetric path tracer needs from them.
@@ -16,7 +17,8 @@
 //! A path carries four wavelengths, and σ_t may differ between them (a chromatic medium). The
 //! free-flight distances are drawn with a single majorant m ≥ σ_t(x, λᵢ) for all four (its
 //! largest value over them: for a homogeneous medium maxᵢ σ_t(λᵢ), for a heterogeneous one the
-//! grid's maximum), as tentative collisions with density m·exp(−m t) (delta tracking, Woodcock
+//! grid's maximum, for a density grid times a spectrum the density's maximum times maxᵢ σ_t(λᵢ)
+//! per unit density), as tentative collisions with density m·exp(−m t) (delta tracking, Woodcock
 //! et al. 1965). At a tentative collision, each wavelength i has a real part σ_t(λᵢ) and a null
 //! part σ_n(λᵢ) = m − σ_t(λᵢ); one event is chosen for all four (spectral tracking, Kutz et al.
 //! 2017, "Spectral and Decomposition Tracking for Rendering Heterogeneous Volumes", §4) with the
@@ -97,6 +99,7 @@ plugin_class! {
         HomogeneousAbsorbingScattering(HomogeneousAbsorbingScattering),
         HomogeneousExtinction(HomogeneousExtinction),
         Heterogeneous(Heterogeneous),
+        HeterogeneousAbsorbingScattering(HeterogeneousAbsorbingScattering),
     }
 }
 
@@ -232,6 +235,62 @@ impl MediumModel for Heterogeneous {
 
     fn ray_extent(&self, ray: &Ray, t_max: f32) -> Option<(f32, f32)> {
         self.sigma_t.ray_extent(ray, t_max)
+    }
+}
+
+/// A density d(x) from a volume times absorption and scattering spectra (pbrt-v4's grid media,
+/// `GridMedium` in `src/pbrt/media.h`): σ_a(x, λ) = scale·d(x)·sigma_a(λ) and
+/// σ_s(x, λ) = scale·d(x)·sigma_s(λ), so σ_t(x, λ) = scale·d(x)·(sigma_a(λ) + sigma_s(λ)) and
+/// the albedo sigma_s/(sigma_a + sigma_s) is the same everywhere. Outside the box of a grid
+/// `density` the medium is empty.
+///
+/// The extinction is the density times a spectrum, so the bound on it for the wavelengths λᵢ is
+/// scale·max d·(sigma_a(λᵢ) + sigma_s(λᵢ)), and the one majorant of the trackers is its
+/// largest value over the four, as for a chromatic homogeneous medium; the wavelengths whose
+/// extinction is smaller meet null collisions in proportion. `volpathmis` takes that majorant
+/// for all four too ([`Medium::majorants`]), as the ratio tracking of its shadow rays does.
+#[derive(Clone, Debug)]
+pub struct HeterogeneousAbsorbingScattering {
+    pub density: Volume,
+    pub sigma_a: Spectrum,
+    pub sigma_s: Spectrum,
+    pub scale: f32,
+}
+
+impl HeterogeneousAbsorbingScattering {
+    /// scale·sigma_s(λᵢ) and scale·(sigma_a(λᵢ) + sigma_s(λᵢ)): the coefficients at density 1.
+    #[inline]
+    fn per_unit_density(&self, lambda: &SampledWavelengths) -> MediumCoefficients {
+        let sigma_s = self.sigma_s.sample(lambda) * self.scale;
+        MediumCoefficients {
+            sigma_t: self.sigma_a.sample(lambda) * self.scale + sigma_s,
+            sigma_s,
+        }
+    }
+}
+
+impl MediumModel for HeterogeneousAbsorbingScattering {
+    #[inline]
+    fn coefficients(&self, p: Vec3, lambda: &SampledWavelengths) -> MediumCoefficients {
+        let unit = self.per_unit_density(lambda);
+        let density = self.density.eval(p, lambda);
+        MediumCoefficients {
+            sigma_t: unit.sigma_t * density,
+            sigma_s: unit.sigma_s * density,
+        }
+    }
+
+    fn is_homogeneous(&self) -> bool {
+        false
+    }
+
+    #[inline]
+    fn majorant(&self, lambda: &SampledWavelengths) -> f32 {
+        self.density.max_value() * self.per_unit_density(lambda).sigma_t.max_value()
+    }
+
+    fn ray_extent(&self, ray: &Ray, t_max: f32) -> Option<(f32, f32)> {
+        self.density.ray_extent(ray, t_max)
     }
 }
 

@@ -100,7 +100,7 @@ mod tests {
             let at = TexturePoint {
                 uv: glam::Vec2::ZERO,
                 attributes: values,
-                p: Vec3::ZERO,
+                ..TexturePoint::default()
             };
             let value = texture.eval(at, &lambda);
             for i in 0..4 {
@@ -121,7 +121,7 @@ mod tests {
         let at = TexturePoint {
             uv: glam::Vec2::ZERO,
             attributes: values,
-            p: Vec3::ZERO,
+            ..TexturePoint::default()
         };
         assert_eq!(texture.eval_1(at), 0.15);
         let lambda = SampledWavelengths::sample(0.7, WavelengthSampling::default());

@@ -9,12 +9,14 @@
 //! * as a raw RGB triple ([`Texture::eval_3`]): normal maps.
 //!
 //! A texture is looked up at a [`TexturePoint`]: the surface's (u, v), the mesh attributes
-//! interpolated there (for `mesh_attribute`) and its world position (for `volume`); a bare
-//! `Vec2` is a point without attributes or position, as emitters look their textures up.
+//! interpolated there (for `mesh_attribute`), its world position (for `volume`) and its
+//! geometric normal (for `directionmix`); a bare `Vec2` is a point without attributes, position
+//! or normal, as emitters look their textures up.
 
 pub mod bitmap;
 pub mod checkerboard;
 pub mod constant;
+pub mod direction_mix;
 pub mod mesh_attribute;
 pub mod mix;
 pub mod scale;
@@ -26,6 +28,7 @@ use glam::{DMat4, Vec2, Vec3};
 
 pub use bitmap::{BitmapTexture, FilterType, TextureUse, WrapMode};
 pub use checkerboard::Checkerboard;
+pub use direction_mix::DirectionMixTexture;
 pub use mesh_attribute::MeshAttributeTexture;
 pub use mix::MixTexture;
 pub use scale::ScaledTexture;
@@ -85,6 +88,8 @@ plugin_class! {
         Scale(Box<ScaledTexture>),
         /// Two textures blended by a number-valued texture (pbrt-v4's `mix`).
         Mix(Box<MixTexture>),
+        /// Two textures blended by the surface normal's direction (pbrt-v4's `directionmix`).
+        DirectionMix(Box<DirectionMixTexture>),
         /// A volume read at the surface point's world position (Mitsuba's `volume`).
         Volume(Arc<VolumeTexture>),
     }
@@ -99,15 +104,19 @@ pub struct TexturePoint {
     /// The point's world position (the origin for a lookup by (u, v) alone, which the scene
     /// reader never gives a `volume` texture).
     pub p: Vec3,
+    /// The surface's geometric normal (world space, unit; zero for a lookup by (u, v) alone,
+    /// which the scene reader never gives a `directionmix` texture).
+    pub n: Vec3,
 }
 
 impl From<Vec2> for TexturePoint {
-    /// A point of a surface without mesh attributes or position.
+    /// A point of a surface without mesh attributes, position or normal.
     fn from(uv: Vec2) -> TexturePoint {
         TexturePoint {
             uv,
             attributes: AttributeValues::default(),
             p: Vec3::ZERO,
+            n: Vec3::ZERO,
         }
     }
 }
@@ -123,6 +132,7 @@ impl Texture {
     pub fn reads_position(&self) -> bool {
         match self {
             Texture::Volume(_) => true,
+            Texture::DirectionMix(m) => m.tex1.reads_position() || m.tex2.reads_position(),
             Texture::Constant(_) | Texture::Bitmap(_) | Texture::MeshAttribute(_) => false,
             Texture::Checkerboard(c) => c.color0.reads_position() || c.color1.reads_position(),
             Texture::Scale(s) => s.texture.reads_position() || s.scale.reads_position(),

@@ -16,8 +16,9 @@ use prism_core::math::Transform;
 use prism_core::medium::volume::{VolFile, parse_vol};
 use prism_core::medium::{
     BlendPhase, ConstantInBox, GridFilter, GridVolume, GridWrap, HenyeyGreenstein, Heterogeneous,
-    Homogeneous, HomogeneousAbsorbingScattering, HomogeneousExtinction, Isotropic, Medium,
-    MediumKind, PhaseFunction, Rayleigh, Sggx, SpectralGridVolume, TabulatedPhase, Volume,
+    HeterogeneousAbsorbingScattering, Homogeneous, HomogeneousAbsorbingScattering,
+    HomogeneousExtinction, Isotropic, Medium, MediumKind, PhaseFunction, Rayleigh, Sggx,
+    SpectralGridVolume, TabulatedPhase, Volume,
 };
 use prism_core::spectrum::Spectrum;
 
@@ -51,9 +52,22 @@ pub static MEDIA: Registry<BuildMedium> = Registry {
             name: "heterogeneous",
             origin: Origin::Mitsuba3,
             summary: "σ_t(x) = scale · sigma_t(x) and albedo(x) from volumes (a `gridvolume` is \
-                      empty outside its box); free flights by spectral tracking with the \
-                      grid's maximum as majorant, shadow rays by ratio tracking.",
-            params: &[SIGMA_T_VOLUME, ALBEDO_VOLUME, SCALE, SAMPLE_EMITTERS, PHASE],
+                      empty outside its box); or, in Prism's form of pbrt-v4's grid media, \
+                      σ_a(x) = scale · density(x) · sigma_a and σ_s(x) = scale · density(x) · \
+                      sigma_s with `sigma_a` and `sigma_s` colours or spectra (which Mitsuba 3 \
+                      does not read). Free flights by spectral tracking with the grid's maximum \
+                      (times the largest σ_a + σ_s of the path's wavelengths) as majorant, \
+                      shadow rays by ratio tracking.",
+            params: &[
+                SIGMA_T_VOLUME,
+                ALBEDO_VOLUME,
+                DENSITY,
+                GRID_SIGMA_A,
+                GRID_SIGMA_S,
+                SCALE,
+                SAMPLE_EMITTERS,
+                PHASE,
+            ],
             build: build_heterogeneous,
         },
     ],
@@ -154,6 +168,9 @@ params! {
     SIGMA_A = ParamSpec::new("sigma_a", ParamKind::Spectrum { range: Range::Coefficient, textured: false, }, Default::None, "Mitsuba 0.6: absorption coefficient, with `sigma_s` in place of `sigma_t` and `albedo`");
     SIGMA_S = ParamSpec::new("sigma_s", ParamKind::Spectrum { range: Range::Coefficient, textured: false, }, Default::None, "Mitsuba 0.6: scattering coefficient, with `sigma_a`");
     SIGMA_T_VOLUME = ParamSpec::new("sigma_t", ParamKind::Volume(Range::Coefficient), Default::Float(1.0), "extinction coefficient per scene unit; the medium is empty outside its box (a plain value's is the unit cube, as in Mitsuba 3)");
+    DENSITY = ParamSpec::new("density", ParamKind::Volume(Range::Coefficient), Default::None, "Prism: the density d(x), with `sigma_a` and `sigma_s` in place of `sigma_t` and `albedo`; the medium is empty outside its box (a plain value's is the unit cube)");
+    GRID_SIGMA_A = ParamSpec::new("sigma_a", ParamKind::Spectrum { range: Range::Coefficient, textured: false, }, Default::None, "Prism, with `density`: the absorption coefficient per unit density");
+    GRID_SIGMA_S = ParamSpec::new("sigma_s", ParamKind::Spectrum { range: Range::Coefficient, textured: false, }, Default::None, "Prism, with `density`: the scattering coefficient per unit density");
     ALBEDO_VOLUME = ParamSpec::new("albedo", ParamKind::Volume(Range::Albedo), Default::Float(0.75), "single-scattering albedo σ_s/σ_t, in [0, 1]");
     SCALE = ParamSpec::new("scale", ParamKind::Float, Default::Float(1.0), "factor on the coefficients (a change of units)");
     SAMPLE_EMITTERS = ParamSpec::new("sample_emitters", ParamKind::Boolean, Default::Boolean(true), "sample lights at scattering points in the medium (next-event estimation)");
@@ -325,22 +342,62 @@ pub(super) fn volume_param(params: &Params, spec: &ParamSpec) -> Result<Volume> 
     Ok(Volume::Constant(spectrum))
 }
 
-fn build_heterogeneous(params: &Params) -> Result<Medium> {
-    // Mitsuba reads a plain value as a `constvolume` over the unit cube, outside which the
-    // medium is empty.
-    let sigma_t = match volume_param(params, &SIGMA_T_VOLUME)? {
+/// A volume that bounds a heterogeneous medium: Mitsuba reads a plain value as a `constvolume`
+/// over the unit cube, outside which the medium is empty.
+fn bounding_volume(params: &Params, spec: &ParamSpec) -> Result<Volume> {
+    Ok(match volume_param(params, spec)? {
         Volume::Constant(value) => {
             Volume::ConstantInBox(Box::new(ConstantInBox::new(value, &Transform::IDENTITY)))
         }
         volume => volume,
-    };
-    let albedo = volume_param(params, &ALBEDO_VOLUME)?;
-    Ok(Medium {
-        kind: MediumKind::Heterogeneous(Heterogeneous {
-            sigma_t,
-            albedo,
+    })
+}
+
+fn build_heterogeneous(params: &Params) -> Result<Medium> {
+    let node = params.node();
+    let pbrt_form = [&DENSITY, &GRID_SIGMA_A, &GRID_SIGMA_S];
+    let kind = if pbrt_form.iter().any(|spec| params.has(spec)) {
+        for spec in [&SIGMA_T_VOLUME, &ALBEDO_VOLUME] {
+            if params.has(spec) {
+                return Err(Error::input(
+                    params.location_of(spec),
+                    format!(
+                        "{} is given both density/sigma_a/sigma_s and \"{}\"",
+                        node.describe(),
+                        spec.name
+                    ),
+                )
+                .with_help(
+                    "give either sigma_t and albedo (Mitsuba 3) or density, sigma_a and sigma_s",
+                ));
+            }
+        }
+        if let Some(missing) = pbrt_form.iter().find(|spec| !params.has(spec)) {
+            return Err(Error::input(
+                params.location(),
+                format!(
+                    "{} gives density, sigma_a or sigma_s without \"{}\"",
+                    node.describe(),
+                    missing.name
+                ),
+            )
+            .with_help("give all three, or sigma_t and albedo"));
+        }
+        MediumKind::HeterogeneousAbsorbingScattering(HeterogeneousAbsorbingScattering {
+            density: bounding_volume(params, &DENSITY)?,
+            sigma_a: spectrum_param(params, &GRID_SIGMA_A)?,
+            sigma_s: spectrum_param(params, &GRID_SIGMA_S)?,
             scale: scale(params)?,
-        }),
+        })
+    } else {
+        MediumKind::Heterogeneous(Heterogeneous {
+            sigma_t: bounding_volume(params, &SIGMA_T_VOLUME)?,
+            albedo: volume_param(params, &ALBEDO_VOLUME)?,
+            scale: scale(params)?,
+        })
+    };
+    Ok(Medium {
+        kind,
         phase: phase(params)?,
         sample_emitters: params.boolean(&SAMPLE_EMITTERS)?,
     })

@@ -1,5 +1,5 @@
 //! Texture plugins (`bitmap`, `checkerboard`, `mesh_attribute`, `rawconstant`, `volume`, and
-//! pbrt-v4's `scale` and `mix`) and texture-valued parameters: any colour or
+//! pbrt-v4's `scale`, `mix` and `directionmix`) and texture-valued parameters: any colour or
 //! number a BSDF takes may be given as a value (`<rgb>`, `<spectrum>`, `<float>`) or as a nested
 //! `<texture>` (inline or a `<ref name="..." id="..."/>` to a texture declared at the top level).
 //!
@@ -29,7 +29,7 @@ use prism_core::texture::{
     BitmapTexture, Checkerboard, FilterType, TextureUse, UvTransform, WrapMode,
 };
 use prism_core::texture::{
-    MeshAttributeTexture, MixTexture, ScaledTexture, Texture, VolumeTexture,
+    DirectionMixTexture, MeshAttributeTexture, MixTexture, ScaledTexture, Texture, VolumeTexture,
 };
 
 type Build = fn(&Params, TextureUse, &mut TextureCache) -> Result<Texture>;
@@ -104,6 +104,16 @@ pub static TEXTURES: Registry<Build> = Registry {
             params: &[TEX1, TEX2, AMOUNT],
             build: build_mix,
         },
+        Plugin {
+            name: "directionmix",
+            origin: Origin::Prism,
+            summary: "pbrt-v4's `directionmix` texture: a · `tex1` + (1 − a) · `tex2` with a the \
+                      absolute value of n · `dir`, two textures blended by the direction of the \
+                      surface's geometric normal n. Emitters, which look textures up by (u, v) \
+                      alone, refuse it.",
+            params: &[DIRECTION_TEX1, DIRECTION_TEX2, DIRECTION],
+            build: build_direction_mix,
+        },
     ],
 };
 
@@ -125,6 +135,9 @@ params! {
     TEX1 = ParamSpec::new("tex1", ParamKind::Spectrum { range: Range::Coefficient, textured: true, }, Default::Float(0.0), "the texture where `amount` is 0 (a number when the texture is read as one)");
     TEX2 = ParamSpec::new("tex2", ParamKind::Spectrum { range: Range::Coefficient, textured: true, }, Default::Float(1.0), "the texture where `amount` is 1");
     VOLUME = ParamSpec::new("volume", ParamKind::Volume(Range::Coefficient), Default::Float(0.75), "the volume, placed in the world by its own `to_world`");
+    DIRECTION_TEX1 = ParamSpec::new("tex1", ParamKind::Spectrum { range: Range::Coefficient, textured: true, }, Default::Float(0.0), "the texture where the normal is parallel to `dir` (a number when the texture is read as one)");
+    DIRECTION_TEX2 = ParamSpec::new("tex2", ParamKind::Spectrum { range: Range::Coefficient, textured: true, }, Default::Float(1.0), "the texture where the normal is perpendicular to `dir`");
+    DIRECTION = ParamSpec::new("dir", ParamKind::Vector, Default::Text("(0, 1, 0)"), "the direction (world space, any non-zero length)");
     AMOUNT = ParamSpec::new("amount", ParamKind::FloatTexture(Bounds::UNIT), Default::Float(0.5), "the weight of `tex2`, a number or a texture read as numbers");
 }
 
@@ -496,6 +509,42 @@ fn build_mix(params: &Params, usage: TextureUse, cache: &mut TextureCache) -> Re
         tex2: operand(params, &TEX2, &SCALAR_TEX2, usage, cache)?,
         amount: float_texture(params, &AMOUNT, cache)?,
     })))
+}
+
+fn build_direction_mix(
+    params: &Params,
+    usage: TextureUse,
+    cache: &mut TextureCache,
+) -> Result<Texture> {
+    let node = params.node();
+    if usage == TextureUse::Emission {
+        return Err(Error::input(
+            &node.location,
+            format!(
+                "{} blends by the surface's normal, but an emitter looks its textures up by \
+                 (u, v) alone",
+                node.describe()
+            ),
+        )
+        .with_help("give the emitter a bitmap, a pattern or a value"));
+    }
+    let dir = params
+        .vector_opt(&DIRECTION)?
+        .unwrap_or(glam::DVec3::Y)
+        .as_vec3();
+    let tex1 = operand(params, &DIRECTION_TEX1, &SCALAR_TEX1, usage, cache)?;
+    let tex2 = operand(params, &DIRECTION_TEX2, &SCALAR_TEX2, usage, cache)?;
+    let texture = DirectionMixTexture::new(tex1, tex2, dir).ok_or_else(|| {
+        Error::input(
+            params.location_of(&DIRECTION),
+            format!(
+                "the direction \"dir\" of {} is {dir}, which has no direction",
+                node.describe()
+            ),
+        )
+        .with_help("give a non-zero, finite vector")
+    })?;
+    Ok(Texture::DirectionMix(Box::new(texture)))
 }
 
 /// Mitsuba's `volume` texture, refused where it would be read without a surface point

@@ -562,7 +562,7 @@ impl Builder {
                     ),
                     location,
                 )?;
-                self.add_texture(&name, &kind, &class.text, &list)
+                self.add_texture(&name, &kind, &class.text, &list, self.state.ctm)
             }
             "LightSource" => {
                 self.world_only(token)?;

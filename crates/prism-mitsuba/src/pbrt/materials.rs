@@ -440,13 +440,14 @@ impl Builder {
         Ok(node)
     }
 
-    /// `Texture "name" "spectrum"|"float" "class" ...`.
+    /// `Texture "name" "spectrum"|"float" "class" ...`, defined where `ctm` places it.
     pub(super) fn add_texture(
         &mut self,
         name: &Token,
         kind: &Token,
         class: &str,
         list: &ParameterList,
+        ctm: DMat4,
     ) -> Result<()> {
         let float = match kind.text.as_str() {
             "float" => true,
@@ -613,16 +614,31 @@ impl Builder {
                 node
             }
             "directionmix" => {
-                return Err(list
-                    .directive_error(
-                        "blends by the surface normal's direction, which Prism's textures do not see",
-                    )
-                    .with_help("use \"mix\" with an \"amount\""));
+                let mut node = plugin(
+                    PluginClass::Texture,
+                    "directionmix",
+                    &location,
+                    &self.search_paths,
+                );
+                self.texture_operand(&mut node, list, float, "tex1", 0.0)?;
+                self.texture_operand(&mut node, list, float, "tex2", 1.0)?;
+                // pbrt-v4 takes `dir` to render space by the transformation current here.
+                let dir = ctm.transform_vector3(list.vector3("dir", DVec3::Y)?);
+                if !(dir.length() > 0.0 && dir.is_finite()) {
+                    let problem =
+                        "has no direction (it is zero, or the transformation makes it zero)";
+                    return Err(match list.get("dir") {
+                        Some(parameter) => list.error(parameter, problem),
+                        None => list.directive_error(format!("\"dir\" (0, 1, 0) {problem}")),
+                    });
+                }
+                set(&mut node, "dir", PropertyValue::Vector(dir), &location);
+                node
             }
             _ => {
                 return Err(list
                     .directive_error("Prism has no texture with this pbrt-v4 model")
-                    .with_help("Prism reads imagemap, checkerboard, scale and mix"));
+                    .with_help("Prism reads imagemap, checkerboard, scale, mix and directionmix"));
             }
         };
         list.finish()?;
@@ -635,7 +651,7 @@ impl Builder {
         Ok(())
     }
 
-    /// The operand `name` of a `scale` or `mix` texture: a number or float texture in a float
+    /// The operand `name` of a `scale`, `mix` or `directionmix` texture: a number or float texture in a float
     /// texture, a spectrum or spectrum texture in a spectrum texture; `default` when absent.
     fn texture_operand(
         &self,

@@ -1,12 +1,14 @@
 //! `MakeNamedMedium`: pbrt-v4's `homogeneous` medium as Mitsuba's, σ_a and σ_s times `scale`,
-//! and its `uniformgrid` as a `heterogeneous` medium whose extinction is an `inlinegrid`
-//! volume; both with a Henyey-Greenstein phase function of parameter `g`. pbrt's emissive
-//! media (`Le`, `temperature`) and its measured presets are refused.
+//! and its `uniformgrid` as a `heterogeneous` medium in Prism's form of pbrt's grid media, an
+//! `inlinegrid` density times σ_a and σ_s; both with a Henyey-Greenstein phase function of
+//! parameter `g`. pbrt's emissive media (`Le`, `temperature`) and its measured presets are
+//! refused.
 //!
 //! pbrt's grid medium scales σ_a and σ_s by a density d(p) over the box `p0`–`p1`:
-//! σ_t(p) = scale (σ_a + σ_s) d(p) with a constant albedo σ_s / (σ_a + σ_s). d is interpolated
-//! trilinearly between voxel centres, and a lookup beyond the outermost centres reads 0
-//! (pbrt-v4's `SampledGrid::Lookup`), so the density fades to half its value at the box's faces.
+//! σ_t(p, λ) = scale (σ_a(λ) + σ_s(λ)) d(p) with a constant albedo σ_s / (σ_a + σ_s). d is
+//! interpolated trilinearly between voxel centres, and a lookup beyond the outermost centres
+//! reads 0 (pbrt-v4's `SampledGrid::Lookup`), so the density fades to half its value at the
+//! box's faces.
 //! The translation surrounds the grid with a layer of empty voxels, so that Prism's grid,
 //! clamped at its faces, has pbrt's density everywhere inside the box.
 
@@ -82,27 +84,33 @@ impl Builder {
             &location,
             &self.search_paths,
         );
+        self.coefficients(&mut node, list)?;
+        Ok(node)
+    }
+
+    /// `sigma_a` and `sigma_s` (1 by default) and `scale`, which a homogeneous and a grid
+    /// medium read alike.
+    fn coefficients(&self, node: &mut PluginNode, list: &ParameterList) -> Result<()> {
         for name in ["sigma_a", "sigma_s"] {
             match list.spectrum(name, false)? {
                 Some((value, parameter)) => {
                     let value = spectra::spectrum(list, parameter, &value, &self.search_paths)?;
-                    set(&mut node, name, value, &parameter.location);
+                    set(node, name, value, &parameter.location);
                 }
-                None => set(&mut node, name, PropertyValue::Float(1.0), &location),
+                None => set(node, name, PropertyValue::Float(1.0), &list.location),
             }
         }
         set(
-            &mut node,
+            node,
             "scale",
             PropertyValue::Float(list.float("scale", 1.0)?),
-            &location,
+            &list.location,
         );
-        Ok(node)
+        Ok(())
     }
 
     /// pbrt's `uniformgrid`: `density` (`nx` × `ny` × `nz` values, x fastest) over `p0`–`p1`
-    /// in the medium's space (the current transformation), `sigma_a`, `sigma_s` (grey: Prism's
-    /// grid media have one extinction at every wavelength) and `scale`.
+    /// in the medium's space (the current transformation), `sigma_a`, `sigma_s` and `scale`.
     fn uniform_grid(&mut self, list: &ParameterList, ctm: DMat4) -> Result<PluginNode> {
         let location = list.location.clone();
         Self::refuse_emission(list)?;
@@ -149,10 +157,6 @@ impl Builder {
         if !(p1.cmpgt(p0).all()) {
             return Err(list.directive_error("\"p1\" must exceed \"p0\" along every axis"));
         }
-        let sigma_a = self.grey(list, "sigma_a")?;
-        let sigma_s = self.grey(list, "sigma_s")?;
-        let sigma_t = sigma_a + sigma_s;
-        let scale = list.float("scale", 1.0)?;
 
         // The grid with a layer of empty voxels around it, over the box grown by one voxel.
         let padded = [nx + 2, ny + 2, nz + 2];
@@ -209,36 +213,8 @@ impl Builder {
             &location,
             &self.search_paths,
         );
-        nest(&mut node, Some("sigma_t"), Arc::new(grid), &location);
-        let albedo = if sigma_t > 0.0 {
-            sigma_s / sigma_t
-        } else {
-            0.0
-        };
-        set(&mut node, "albedo", PropertyValue::Float(albedo), &location);
-        set(
-            &mut node,
-            "scale",
-            PropertyValue::Float(scale * sigma_t),
-            &location,
-        );
+        nest(&mut node, Some("density"), Arc::new(grid), &location);
+        self.coefficients(&mut node, list)?;
         Ok(node)
-    }
-
-    /// The grey coefficient `name` (1 when absent): an `rgb` of three equal values.
-    fn grey(&self, list: &ParameterList, name: &str) -> Result<f64> {
-        let Some((value, parameter)) = list.spectrum(name, false)? else {
-            return Ok(1.0);
-        };
-        match value {
-            SpectrumParam::Rgb([r, g, b]) if r == g && g == b && r >= 0.0 => Ok(r),
-            _ => Err(list
-                .error(
-                    parameter,
-                    "must be grey (the same at every wavelength): Prism's grid media have one \
-                     extinction at every wavelength",
-                )
-                .with_help("give it as \"rgb\" with three equal values")),
-        }
     }
 }

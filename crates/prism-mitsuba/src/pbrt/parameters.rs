@@ -240,6 +240,13 @@ impl ParameterList {
             .map(|v| DVec3::new(v[0], v[1], v[2])))
     }
 
+    /// A `vector3`, or `default` when absent.
+    pub fn vector3(&self, name: &str, default: DVec3) -> Result<DVec3> {
+        Ok(self
+            .fixed(name, &["vector3"], 3)?
+            .map_or(default, |v| DVec3::new(v[0], v[1], v[2])))
+    }
+
     /// A `point3`, or `default` when absent.
     pub fn point3(&self, name: &str, default: DVec3) -> Result<DVec3> {
         Ok(self.point3_opt(name)?.unwrap_or(default))

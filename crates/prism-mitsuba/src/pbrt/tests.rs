@@ -528,9 +528,40 @@ fn scale_and_mix_textures_nest_their_operands() {
         error("WorldBegin\nTexture \"c\" \"spectrum\" \"checkerboard\"\nTexture \"s\" \"float\" \"scale\" \"texture tex\" \"c\"")
             .contains("test.pbrt:3:29: Texture \"s\" \"float\" \"scale\": parameter \"texture tex\" names the unknown float texture \"c\"")
     );
+}
+
+#[test]
+fn a_direction_mix_takes_its_direction_to_the_world() {
+    let scene = root(
+        "WorldBegin\nRotate 90 0 0 1\nScale 1 3 1\nTexture \"d\" \"spectrum\" \"directionmix\" \"rgb tex1\" [0.8 0.8 0.8] \"vector dir\" [0 2 0]\nMaterial \"diffuse\" \"texture reflectance\" \"d\"\nShape \"sphere\"",
+    );
+    let shape = nodes(&scene, PluginClass::Shape)[0];
+    let mix = &shape.children[0].node.children[0].node.children[0].node;
+    assert_eq!(mix.plugin_type, "directionmix");
+    assert_eq!(property(mix, "tex1"), &PropertyValue::Rgb([0.8; 3]));
+    // pbrt's defaults: tex2 = 1, dir = (0, 1, 0).
+    assert_eq!(property(mix, "tex2"), &PropertyValue::Float(1.0));
+    // (0, 2, 0) scaled to (0, 6, 0), then turned by 90° about z to (−6, 0, 0).
+    let PropertyValue::Vector(dir) = property(mix, "dir") else {
+        panic!("dir is a vector");
+    };
     assert!(
-        error("WorldBegin\nTexture \"d\" \"float\" \"directionmix\" \"vector3 dir\" [0 1 0]")
-            .contains("test.pbrt:2:1: Texture \"d\" \"float\" \"directionmix\": blends by the surface normal's direction")
+        (*dir - DVec3::new(-6.0, 0.0, 0.0)).length() < 1e-12,
+        "{dir}"
+    );
+    let default = root(
+        "WorldBegin\nTexture \"d\" \"spectrum\" \"directionmix\"\nMaterial \"diffuse\" \"texture reflectance\" \"d\"\nShape \"sphere\"",
+    );
+    let shape = nodes(&default, PluginClass::Shape)[0];
+    let mix = &shape.children[0].node.children[0].node.children[0].node;
+    assert_eq!(property(mix, "dir"), &PropertyValue::Vector(DVec3::Y));
+    assert!(
+        error("WorldBegin\nTexture \"d\" \"float\" \"directionmix\" \"vector3 dir\" [0 0 0]")
+            .contains("test.pbrt:2:36: Texture \"d\" \"float\" \"directionmix\": parameter \"vector3 dir\" has no direction")
+    );
+    assert!(
+        error("WorldBegin\nScale 1 0 1\nTexture \"d\" \"float\" \"directionmix\"")
+            .contains("test.pbrt:3:1: Texture \"d\" \"float\" \"directionmix\": \"dir\" (0, 1, 0) has no direction")
     );
 }
 
@@ -563,7 +594,7 @@ fn an_image_infinite_light_is_an_equal_area_map() {
 #[test]
 fn a_uniform_grid_is_a_heterogeneous_medium_with_an_empty_border() {
     let root = root(
-        "WorldBegin\nTranslate 1 0 0\nMakeNamedMedium \"smoke\" \"string type\" \"uniformgrid\" \"integer nx\" 2 \"float density\" [3 5] \"point3 p0\" [0 0 0] \"point3 p1\" [4 1 1] \"rgb sigma_a\" [1 1 1] \"rgb sigma_s\" [3 3 3] \"float scale\" 2 \"float g\" 0.5\nMediumInterface \"smoke\" \"\"\nMaterial \"interface\"\nShape \"sphere\"",
+        "WorldBegin\nTranslate 1 0 0\nMakeNamedMedium \"smoke\" \"string type\" \"uniformgrid\" \"integer nx\" 2 \"float density\" [3 5] \"point3 p0\" [0 0 0] \"point3 p1\" [4 1 1] \"rgb sigma_a\" [1 1 1] \"rgb sigma_s\" [0.5 3 4] \"float scale\" 2 \"float g\" 0.5\nMediumInterface \"smoke\" \"\"\nMaterial \"interface\"\nShape \"sphere\"",
     );
     let shape = nodes(&root, PluginClass::Shape)[0];
     let medium = &shape
@@ -573,11 +604,15 @@ fn a_uniform_grid_is_a_heterogeneous_medium_with_an_empty_border() {
         .expect("an interior")
         .node;
     assert_eq!(medium.plugin_type, "heterogeneous");
-    // σ_t = 2 · (1 + 3) · d, albedo 3 / 4.
-    assert_eq!(property(medium, "scale"), &PropertyValue::Float(8.0));
-    assert_eq!(property(medium, "albedo"), &PropertyValue::Float(0.75));
+    // σ_a = 2 · d · (1, 1, 1), σ_s = 2 · d · (0.5, 3, 4).
+    assert_eq!(property(medium, "scale"), &PropertyValue::Float(2.0));
+    assert_eq!(property(medium, "sigma_a"), &PropertyValue::Rgb([1.0; 3]));
+    assert_eq!(
+        property(medium, "sigma_s"),
+        &PropertyValue::Rgb([0.5, 3.0, 4.0])
+    );
     let grid = &medium.children[0];
-    assert_eq!(grid.name.as_deref(), Some("sigma_t"));
+    assert_eq!(grid.name.as_deref(), Some("density"));
     assert_eq!(grid.node.plugin_type, "inlinegrid");
     assert_eq!(medium.children[1].node.plugin_type, "hg");
     // 2 × 1 × 1 voxels in a 4 × 3 × 3 grid of zeros, over the box grown by a voxel (2 × 1 × 1).
@@ -610,9 +645,5 @@ fn a_uniform_grid_is_a_heterogeneous_medium_with_an_empty_border() {
     medium(
         "\"float density\" [1] \"float temperature\" [900]",
         "test.pbrt:2:69: MakeNamedMedium \"m\": parameter \"float temperature\" makes the medium glow",
-    );
-    medium(
-        "\"float density\" [1] \"rgb sigma_s\" [1 2 3]",
-        "test.pbrt:2:69: MakeNamedMedium \"m\": parameter \"rgb sigma_s\" must be grey",
     );
 }
