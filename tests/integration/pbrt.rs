@@ -852,3 +852,47 @@ fn a_coloured_uniform_grid_renders_as_mitsubas_colour_grid() {
         );
     }
 }
+
+/// pbrt-v4 reads a medium's RGB σ_a and σ_s as unbounded spectra (2·max(rgb) times the spectrum
+/// fitted to rgb / (2·max(rgb))), also where every component is at most 1, which Prism's XML
+/// reads as a reflectance: the reader gives the medium pbrt's spectrum.
+#[test]
+fn medium_coefficients_are_pbrts_unbounded_spectra() {
+    use glam::Vec3;
+    use prism_core::spectrum::{RgbIntent, SampledWavelengths, Spectrum, WavelengthSampling};
+    let (sigma_a, sigma_s) = ([0.05f32, 0.1, 0.3], [0.2f32, 0.5, 0.9]);
+    let medium = format!(
+        "MakeNamedMedium \"fog\" \"string type\" \"homogeneous\" \"rgb sigma_a\" [{} {} {}] \"rgb sigma_s\" [{} {} {}] \"float scale\" 2",
+        sigma_a[0], sigma_a[1], sigma_a[2], sigma_s[0], sigma_s[1], sigma_s[2]
+    );
+    let root = prism_mitsuba::pbrt::read_pbrt_str(&fog_ball(&medium), Path::new("fog.pbrt"))
+        .unwrap()
+        .root;
+    let scene = prism_mitsuba::factory::build_scene(&root).unwrap().scene;
+    let fog = &scene.world.media[0];
+    let unbounded = |rgb| Spectrum::from_rgb(rgb, RgbIntent::Unbounded);
+    let albedo = |rgb| Spectrum::from_rgb(rgb, RgbIntent::Albedo);
+    let mut largest_albedo_difference = 0.0f32;
+    for u in [0.05, 0.3, 0.55, 0.8] {
+        let lambda = SampledWavelengths::sample(u, WavelengthSampling::Uniform);
+        let c = fog.coefficients(Vec3::ZERO, Vec3::Z, &lambda);
+        for i in 0..4 {
+            let l = lambda.lambda(i);
+            let (a, s) = (unbounded(sigma_a).value(l), unbounded(sigma_s).value(l));
+            let expected = [2.0 * (a + s), 2.0 * s];
+            for (got, want) in [c.sigma_t[i], c.sigma_s[i]].into_iter().zip(expected) {
+                assert!(
+                    (got - want).abs() <= 2e-3 * want,
+                    "at {l} nm: {got} against pbrt's {want}"
+                );
+            }
+            let reflectance = albedo(sigma_s).value(l);
+            largest_albedo_difference = largest_albedo_difference.max((reflectance - s).abs() / s);
+        }
+    }
+    // The test can fail: read as reflectances, the coefficients would differ.
+    assert!(
+        largest_albedo_difference > 0.05,
+        "the two upsamplings differ by only {largest_albedo_difference}"
+    );
+}

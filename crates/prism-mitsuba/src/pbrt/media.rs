@@ -11,6 +11,12 @@
 //! box's faces.
 //! The translation surrounds the grid with a layer of empty voxels, so that Prism's grid,
 //! clamped at its faces, has pbrt's density everywhere inside the box.
+//!
+//! pbrt reads a medium's RGB coefficients as unbounded spectra (`SpectrumType::Unbounded`:
+//! 2·max(rgb) times the spectrum fitted to rgb / (2·max(rgb))), where Prism's factory upsamples
+//! an `<rgb>` whose components are at most 1 as a reflectance, a different spectrum of the same
+//! colour that light crossing the medium would tell apart; so the reader gives the factory
+//! pbrt's spectrum, sampled every 5 nm.
 
 use std::sync::Arc;
 
@@ -20,8 +26,9 @@ use super::builder::Builder;
 use super::parameters::{ParameterList, SpectrumParam};
 use super::spectra;
 use super::{nest, plugin, set};
-use crate::description::{PluginClass, PluginNode, PropertyValue};
+use crate::description::{PluginClass, PluginNode, PropertyValue, SpectrumValue};
 use prism_core::error::Result;
+use prism_core::spectrum::{RgbIntent, Spectrum};
 
 impl Builder {
     /// The medium of `MakeNamedMedium`'s parameters, in the space `ctm` places.
@@ -94,7 +101,12 @@ impl Builder {
         for name in ["sigma_a", "sigma_s"] {
             match list.spectrum(name, false)? {
                 Some((value, parameter)) => {
-                    let value = spectra::spectrum(list, parameter, &value, &self.search_paths)?;
+                    let value = match value {
+                        SpectrumParam::Rgb(rgb) if is_coloured_coefficient(rgb) => {
+                            unbounded_samples(rgb)
+                        }
+                        _ => spectra::spectrum(list, parameter, &value, &self.search_paths)?,
+                    };
                     set(node, name, value, &parameter.location);
                 }
                 None => set(node, name, PropertyValue::Float(1.0), &list.location),
@@ -217,4 +229,23 @@ impl Builder {
         self.coefficients(&mut node, list)?;
         Ok(node)
     }
+}
+
+/// Whether an RGB coefficient is one the factory would upsample otherwise than pbrt does: of
+/// several colours (a grey one is a constant either way), finite and not negative (the factory
+/// refuses the rest with its own message).
+fn is_coloured_coefficient(rgb: [f64; 3]) -> bool {
+    rgb.iter().all(|c| c.is_finite() && *c >= 0.0) && (rgb[0] != rgb[1] || rgb[1] != rgb[2])
+}
+
+/// pbrt-v4's unbounded spectrum of `rgb`, sampled every 5 nm over 360–830 nm.
+fn unbounded_samples(rgb: [f64; 3]) -> PropertyValue {
+    let spectrum = Spectrum::from_rgb(rgb.map(|c| c as f32), RgbIntent::Unbounded);
+    let samples = (0..=94)
+        .map(|i| {
+            let lambda = 360.0 + 5.0 * i as f32;
+            (f64::from(lambda), f64::from(spectrum.value(lambda)))
+        })
+        .collect();
+    PropertyValue::Spectrum(SpectrumValue::Samples(samples))
 }
