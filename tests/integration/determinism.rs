@@ -5,7 +5,8 @@ use prism_core::geometry::Shape;
 use prism_core::geometry::Sphere;
 use prism_core::integrator::distribution::DirectLights;
 use prism_core::integrator::{
-    DistributionIntegrator, Integrator, PathIntegrator, Tracking, VolPathIntegrator,
+    DirectIntegrator, DistributionIntegrator, Integrator, PathIntegrator, Tracking,
+    VolPathIntegrator,
 };
 use prism_core::math::Transform;
 use prism_mitsuba::factory::shapes::{cube, transform_mesh};
@@ -157,6 +158,30 @@ fn distribution_trees_in_lanes_give_the_film_of_trees_one_at_a_time() {
         assert!(
             one_at_a_time.iter().any(|p| p.sum(1) > 0.0),
             "{distrib:?}: the image is black"
+        );
+    }
+}
+
+/// The same for direct illumination, whose camera sample is one step (its BSDF samples' rays
+/// traced within it).
+#[test]
+fn direct_samples_in_lanes_give_the_film_of_samples_one_at_a_time() {
+    for direct in [
+        DirectIntegrator::default(),
+        DirectIntegrator {
+            emitter_samples: 3,
+            bsdf_samples: 2,
+            hide_emitters: true,
+        },
+    ] {
+        let scene = lit_room(UVec2::new(13, 11), direct.clone());
+        let (in_lanes, one_at_a_time, occupancy) = in_lanes_and_one_at_a_time(&scene, 3, 7);
+        let occupancy = occupancy.expect("direct runs in lanes");
+        assert!(occupancy > 0.0 && occupancy <= 1.0, "occupancy {occupancy}");
+        assert_eq!(in_lanes, one_at_a_time, "{direct:?}");
+        assert!(
+            one_at_a_time.iter().any(|p| p.sum(1) > 0.0),
+            "{direct:?}: the image is black"
         );
     }
 }

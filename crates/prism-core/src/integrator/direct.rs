@@ -20,12 +20,15 @@
 //!   sample refracted through a dispersive interface, keep only the hero wavelength.
 
 use crate::bsdf::BxdfTree;
+use crate::geometry::SurfaceInteraction;
 use crate::integrator::SampleContext;
 use crate::integrator::mis::{ScatterOrigin, Strategies, emission_found, sample_light_at_surface};
+use crate::integrator::stepped::SteppedPath;
 use crate::integrator::vertex::{path_estimate, surface_scattering, wavelengths_after};
 use crate::light::Receiver;
 use crate::math::Ray;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+use crate::world::World;
 
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct DirectIntegrator {
@@ -55,19 +58,20 @@ impl DirectIntegrator {
         }
     }
 
-    pub(super) fn radiance(
+    /// The estimate along the camera ray `ray`, whose nearest surface is `hit`.
+    fn estimate_at(
         &self,
         ctx: &mut SampleContext,
-        ray: Ray,
+        ray: &Ray,
+        hit: Option<SurfaceInteraction>,
         wavelengths: &SampledWavelengths,
     ) -> SampledSpectrum {
         let world = ctx.world();
         let strategies = self.strategies();
         let mut lambda = *wavelengths;
         let mut result = SampledSpectrum::ZERO;
-        let hit = ctx.intersect(&ray);
         if !self.hide_emitters {
-            result += emission_found(ctx, &ray, hit.as_ref(), None, &lambda, strategies);
+            result += emission_found(ctx, ray, hit.as_ref(), None, &lambda, strategies);
         }
         let Some(si) = hit else {
             return result;
@@ -120,5 +124,53 @@ impl DirectIntegrator {
             result += bsdf * (1.0 / self.bsdf_samples as f32);
         }
         path_estimate(result, wavelengths, &lambda)
+    }
+}
+
+/// The camera sample of the direct integrator before its one ray query: the camera ray and its
+/// wavelengths, and the estimate once the query is answered.
+#[derive(Clone, Debug)]
+pub struct DirectState {
+    ray: Ray,
+    wavelengths: SampledWavelengths,
+    result: SampledSpectrum,
+}
+
+impl SteppedPath for DirectIntegrator {
+    type State = DirectState;
+
+    fn start(
+        &self,
+        _world: &World,
+        ray: Ray,
+        wavelengths: &SampledWavelengths,
+    ) -> Option<DirectState> {
+        Some(DirectState {
+            ray,
+            wavelengths: *wavelengths,
+            result: SampledSpectrum::ZERO,
+        })
+    }
+
+    #[inline]
+    fn ray(state: &DirectState) -> &Ray {
+        &state.ray
+    }
+
+    /// The whole estimate at the camera ray's hit: the emission there, the light samples and
+    /// the BSDF samples (whose rays it traces itself). The sample ends with it.
+    fn step(
+        &self,
+        ctx: &mut SampleContext,
+        state: &mut DirectState,
+        hit: Option<SurfaceInteraction>,
+    ) -> bool {
+        state.result = self.estimate_at(ctx, &state.ray, hit, &state.wavelengths);
+        false
+    }
+
+    #[inline]
+    fn estimate(&self, state: &DirectState) -> SampledSpectrum {
+        state.result
     }
 }

@@ -312,6 +312,7 @@ impl PreparedIntegrator<'_> {
     pub(crate) fn stepped(&self) -> Option<SteppedIntegrator<'_>> {
         match self.integrator {
             Integrator::Path(path) => Some(SteppedIntegrator::Path(path)),
+            Integrator::Direct(direct) => Some(SteppedIntegrator::Direct(direct)),
             Integrator::Distribution(distrib) => Some(SteppedIntegrator::Distribution(distrib)),
             Integrator::VolPath(integrator) => Some(match integrator.tracking {
                 Tracking::Spectral => SteppedIntegrator::VolPath(VolPathWith {
@@ -350,13 +351,13 @@ impl PreparedIntegrator<'_> {
             count,
         };
         match self.integrator {
-            Integrator::Path(_) | Integrator::Distribution(_) | Integrator::VolPath(_) => {
-                match self.stepped() {
-                    Some(stepped) => stepped.radiance(ctx, ray, lambda),
-                    None => unreachable!("the path tracers and distrib are stepped"),
-                }
-            }
-            Integrator::Direct(integrator) => integrator.radiance(ctx, ray, lambda),
+            Integrator::Path(_)
+            | Integrator::Direct(_)
+            | Integrator::Distribution(_)
+            | Integrator::VolPath(_) => match self.stepped() {
+                Some(stepped) => stepped.radiance(ctx, ray, lambda),
+                None => unreachable!("these integrators are stepped"),
+            },
             Integrator::Moment(_) => MomentIntegrator::radiance(ctx, ray, lambda, aovs),
             Integrator::Aov(integrator) => integrator.radiance(ctx, ray, lambda, aovs),
             Integrator::Depth(_) => DepthIntegrator::radiance(ctx, &ray),

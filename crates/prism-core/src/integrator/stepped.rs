@@ -4,14 +4,15 @@
 //! lanes, docs/architecture.md, Paths in lanes); the estimate of one path at a time
 //! ([`SteppedPath::radiance`]) runs the same step, so the two give the same numbers bit for bit.
 //!
-//! The path tracer ([`super::path`]), the lecture's distribution ray tracer
+//! The path tracer ([`super::path`]), direct illumination ([`super::direct`], one step), the
+//! lecture's distribution ray tracer
 //! ([`super::distribution`], its tree of rays one ray per step) and the volumetric path tracers
 //! ([`super::volpath`], [`super::volpathmis`]) are written so.
 
 use crate::geometry::SurfaceInteraction;
 use crate::integrator::volpath::{SpectralTracking, VolPathWith};
 use crate::integrator::volpathmis::SpectralMis;
-use crate::integrator::{DistributionIntegrator, PathIntegrator, SampleContext};
+use crate::integrator::{DirectIntegrator, DistributionIntegrator, PathIntegrator, SampleContext};
 use crate::math::Ray;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use crate::world::World;
@@ -68,6 +69,7 @@ pub trait SteppedPath {
 /// The scene's integrator where it is a [`SteppedPath`], with the weights its paths start with.
 pub(crate) enum SteppedIntegrator<'a> {
     Path(&'a PathIntegrator),
+    Direct(&'a DirectIntegrator),
     Distribution(&'a DistributionIntegrator),
     VolPath(VolPathWith<'a, SpectralTracking>),
     VolPathMis(VolPathWith<'a, SpectralMis>),
@@ -83,6 +85,7 @@ impl SteppedIntegrator<'_> {
     ) -> SampledSpectrum {
         match self {
             SteppedIntegrator::Path(path) => path.radiance(ctx, ray, wavelengths),
+            SteppedIntegrator::Direct(direct) => direct.radiance(ctx, ray, wavelengths),
             SteppedIntegrator::Distribution(distrib) => distrib.radiance(ctx, ray, wavelengths),
             SteppedIntegrator::VolPath(volpath) => volpath.radiance(ctx, ray, wavelengths),
             SteppedIntegrator::VolPathMis(volpath) => volpath.radiance(ctx, ray, wavelengths),

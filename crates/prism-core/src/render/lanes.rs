@@ -203,6 +203,7 @@ pub(super) fn trace_in_lanes(
     let run = (pixels, range, samples_per_pixel, seed, cancel, sink);
     match paths {
         SteppedIntegrator::Path(path) => trace_stepped(estimator, *path, run),
+        SteppedIntegrator::Direct(direct) => trace_stepped(estimator, *direct, run),
         SteppedIntegrator::Distribution(distrib) => trace_stepped(estimator, *distrib, run),
         SteppedIntegrator::VolPath(volpath) => trace_stepped(estimator, volpath, run),
         SteppedIntegrator::VolPathMis(volpath) => trace_stepped(estimator, volpath, run),
