@@ -2,9 +2,9 @@
 //! illumination, the lecture's distribution ray tracer with splitting and the volumetric path
 //! tracers; `moment` runs nested integrators and writes their estimates and second moments as
 //! extra film channels, `aov` the albedo, normals, depth and other variables of the first hit
-//! beside nested integrators' images. `ptracer` and `sppm` start paths at the lights too; the
-//! render driver runs their passes, and the iterations of `guided_path`, the path tracer that
-//! learns where light comes from.
+//! beside nested integrators' images. `ptracer`, `bdpt`, `sppm` and `vcm` start paths at the
+//! lights too; the render driver runs their passes, and the iterations of `guided_path`, the
+//! path tracer that learns where light comes from.
 //!
 //! An [`Integrator`] is what a scene asks for: an estimator and its parameters. Before a render
 //! it is prepared for the world ([`Integrator::prepare`]), which builds the light sampler it
@@ -36,6 +36,7 @@ pub mod ptracer;
 pub mod sppm;
 pub mod stokes;
 pub mod transmittance;
+pub mod vcm;
 pub mod vertex;
 pub mod volpath;
 pub mod volpathmis;
@@ -53,6 +54,7 @@ pub use polarized_path::PolarizedPathIntegrator;
 pub use ptracer::{LightPathSample, ParticleTracer, Splat};
 pub use sppm::SppmIntegrator;
 pub use stokes::StokesIntegrator;
+pub use vcm::VcmIntegrator;
 pub use volpath::{Tracking, VolPathIntegrator};
 
 use volpath::SpectralTracking;
@@ -103,6 +105,7 @@ integrator_enum! {
         PolarizedPath(PolarizedPathIntegrator),
         Stokes(StokesIntegrator),
         Guided(GuidedPathIntegrator),
+        Vcm(VcmIntegrator),
     }
 }
 
@@ -133,7 +136,8 @@ impl Integrator {
             | Integrator::Depth(_)
             | Integrator::Particle(_)
             | Integrator::Bdpt(_)
-            | Integrator::Sppm(_) => LightSelection::Power,
+            | Integrator::Sppm(_)
+            | Integrator::Vcm(_) => LightSelection::Power,
             Integrator::Guided(_) => LightSelection::Exhaustive,
         }
     }
@@ -153,7 +157,8 @@ impl Integrator {
             | Integrator::Sppm(_)
             | Integrator::PolarizedPath(_)
             | Integrator::Stokes(_)
-            | Integrator::Guided(_) => &[],
+            | Integrator::Guided(_)
+            | Integrator::Vcm(_) => &[],
         };
         nested.iter().map(|(_, integrator)| integrator)
     }
@@ -169,6 +174,7 @@ impl Integrator {
             Integrator::Particle(ptracer) => ptracer.hide_emitters,
             Integrator::Bdpt(bdpt) => bdpt.hide_emitters,
             Integrator::Sppm(_) => false,
+            Integrator::Vcm(vcm) => vcm.hide_emitters,
             Integrator::PolarizedPath(polarized) => polarized.path.hide_emitters,
             Integrator::Stokes(stokes) => stokes.nested.path.hide_emitters,
             Integrator::Guided(guided) => guided.hide_emitters,
@@ -200,7 +206,8 @@ impl Integrator {
             | Integrator::Bdpt(_)
             | Integrator::Sppm(_)
             | Integrator::PolarizedPath(_)
-            | Integrator::Guided(_) => Vec::new(),
+            | Integrator::Guided(_)
+            | Integrator::Vcm(_) => Vec::new(),
             Integrator::Moment(moment) => moment.aov_names(),
             Integrator::Stokes(stokes) => stokes.aov_names(),
             Integrator::Aov(aov) => aov.aov_names(),
@@ -279,6 +286,15 @@ impl PreparedIntegrator<'_> {
         }
     }
 
+    /// Vertex connection and merging, where the integrator is it: the render driver runs its
+    /// iterations, whose camera subpaths read every light subpath's vertices.
+    pub fn vcm(&self) -> Option<&VcmIntegrator> {
+        match self.integrator {
+            Integrator::Vcm(vcm) => Some(vcm),
+            _ => None,
+        }
+    }
+
     /// Traces one sample of bidirectional path tracing `bdpt` (this integrator's) from the
     /// camera ray `ray`, drawing random numbers from `sampler`: returns the estimate for the
     /// camera sample's pixel and hands the light subpaths' splats to `out`.
@@ -345,13 +361,14 @@ impl PreparedIntegrator<'_> {
             Integrator::PolarizedPath(integrator) => integrator.radiance(ctx, ray, lambda),
             Integrator::Stokes(integrator) => integrator.radiance(ctx, ray, lambda, aovs),
             // Light subpaths reach the film by splats, not along camera rays: the render driver
-            // runs them ([`Self::trace_light_paths`], [`Self::trace_bidirectional`]), and
-            // photon mapping's passes and path guiding's iterations run apart ([`Self::sppm`],
-            // [`Self::guided`]).
+            // runs them ([`Self::trace_light_paths`], [`Self::trace_bidirectional`], the
+            // iterations of [`Self::vcm`]), and photon mapping's passes and path guiding's
+            // iterations run apart ([`Self::sppm`], [`Self::guided`]).
             Integrator::Particle(_)
             | Integrator::Bdpt(_)
             | Integrator::Sppm(_)
-            | Integrator::Guided(_) => SampledSpectrum::ZERO,
+            | Integrator::Guided(_)
+            | Integrator::Vcm(_) => SampledSpectrum::ZERO,
             Integrator::VolPath(integrator) => match integrator.tracking {
                 Tracking::Spectral => integrator.trace(SpectralTracking::new(), ctx, ray, lambda),
                 Tracking::HeroMis { spectral_mis } => {
