@@ -1,7 +1,8 @@
 //! Vertex connection and merging (`vcm`): against closed forms (furnaces in a sphere and in a
 //! box, the disk light over a plane), with merging off against `bdpt` and with it on against
-//! the path tracer, bit-identical for any thread count, its resumed and merged renders equal to
-//! one render, and its bad parameters and a target error refused.
+//! the path tracer (the Cornell box, glass, a point light, dispersive glass, each switch),
+//! bit-identical for any thread count, its resumed and merged renders equal to one render, and
+//! its bad parameters and a target error refused.
 
 use glam::UVec2;
 use prism_core::film::Film;
@@ -150,6 +151,9 @@ fn vcm_and_path_agree_on_the_cornell_box() {
     assert_agrees_with_path("Cornell box", cornell_box(16), integrator, 1024, 256);
 }
 
+const RECTANGLE_LIGHT: &str = r#"<shape type="rectangle"><transform name="to_world"><scale value="0.4"/><rotate x="1" angle="180"/><translate x="0.4" z="1.8"/></transform>
+                <emitter type="area"><rgb name="radiance" value="10"/></emitter></shape>"#;
+
 /// Through smooth and rough glass (caustics, which merging finds) and glossy surfaces under a
 /// point light, vcm (with merging) and the path tracer estimate the same image.
 #[test]
@@ -158,8 +162,6 @@ fn vcm_and_path_agree_through_glass_and_under_a_point_light() {
             <bsdf type="roughdielectric"><float name="alpha" value="0.2"/><float name="int_ior" value="1.5"/></bsdf></shape>
         <shape type="sphere"><point name="center" x="-0.6" y="-0.4" z="0.3"/><float name="radius" value="0.3"/>
             <bsdf type="dielectric"/></shape>"#;
-    let light = r#"<shape type="rectangle"><transform name="to_world"><scale value="0.4"/><rotate x="1" angle="180"/><translate x="0.4" z="1.8"/></transform>
-                <emitter type="area"><rgb name="radiance" value="10"/></emitter></shape>"#;
     let small = VcmIntegrator {
         max_depth: 8,
         radius_scale: 0.25,
@@ -167,7 +169,7 @@ fn vcm_and_path_agree_through_glass_and_under_a_point_light() {
     };
     assert_agrees_with_path(
         "glass",
-        lit_scene(PINHOLE, light, glass),
+        lit_scene(PINHOLE, RECTANGLE_LIGHT, glass),
         small.clone(),
         1024,
         256,
@@ -182,6 +184,62 @@ fn vcm_and_path_agree_through_glass_and_under_a_point_light() {
         512,
         256,
     );
+}
+
+/// Behind rough glass whose index varies with wavelength, where the subpaths that meet it keep
+/// only the hero wavelength, the estimate keeps its scale.
+#[test]
+fn vcm_and_path_agree_behind_dispersive_rough_glass() {
+    let glass = r#"<shape type="sphere"><point name="center" x="0.3" y="-0.7" z="0.5"/><float name="radius" value="0.45"/>
+            <bsdf type="roughdielectric"><float name="alpha" value="0.2"/>
+                <spectrum type="cauchy" name="int_ior"><float name="a" value="1.3"/><float name="b" value="0.03"/></spectrum></bsdf></shape>"#;
+    assert_agrees_with_path(
+        "dispersive glass",
+        lit_scene(PINHOLE, RECTANGLE_LIGHT, glass),
+        VcmIntegrator {
+            max_depth: 8,
+            radius_scale: 0.25,
+            ..VcmIntegrator::default()
+        },
+        1024,
+        512,
+    );
+}
+
+/// Without the light image (the strategies t = 1 then leave the weights too), with hidden
+/// emitters and with a depth limit, the estimate is the path tracer's.
+#[test]
+fn vcm_switches_keep_the_estimate() {
+    let sphere_light = r#"<shape type="sphere"><point name="center" x="0.6" y="0" z="1.3"/><float name="radius" value="0.2"/>
+                <emitter type="area"><rgb name="radiance" value="8, 6, 4"/></emitter></shape>"#;
+    let variants = [
+        (
+            "no light image",
+            VcmIntegrator {
+                light_image: false,
+                radius_scale: 0.25,
+                ..VcmIntegrator::default()
+            },
+        ),
+        (
+            "hidden emitters, depth 3",
+            VcmIntegrator {
+                hide_emitters: true,
+                max_depth: 3,
+                radius_scale: 0.25,
+                ..VcmIntegrator::default()
+            },
+        ),
+    ];
+    for (name, integrator) in variants {
+        assert_agrees_with_path(
+            name,
+            lit_scene(PINHOLE, sphere_light, ""),
+            integrator,
+            512,
+            256,
+        );
+    }
 }
 
 fn small_scene() -> Scene {

@@ -32,7 +32,8 @@
 //! and c + l + 1 for a connection, c + l for a merge (the two vertices made one).
 //!
 //! **Weights.** Each vertex carries SmallVCM's three running quantities d_VCM, d_VC, d_VM (the
-//! technical report's eqs. 31–38): sums over the strategies that would have made the subpath's
+//! recursive formulation of the paper's technical report, "Implementing Vertex Connection and
+//! Merging", Georgiev 2012): sums over the strategies that would have made the subpath's
 //! prefix with more vertices from the other side, as ratios of densities per unit area, each
 //! squared for the power heuristic. With η_VCM = π r² N, a subpath leaving vertex x_i by a
 //! non-delta sample with density p→ (and reverse density p←, per unit solid angle) and
@@ -45,24 +46,24 @@
 //! ```
 //!
 //! (a delta sample sets d_VCM to 0 and multiplies the others by cos_o²), and on arriving at
-//! the next vertex, d² away with cosine cos_i, d_VCM ← d_VCM d²/cos_i² and d_VC, d_VM ← …/cos_i².
-//! A light subpath starts with d_VCM = 1/p_ω², d_VC = cos_light²/p_e² (0 for a point light,
+//! the next vertex, d away with cosine cos_i, d_VCM ← d_VCM (d²/cos_i)² and d_VC, d_VM are
+//! divided by cos_i². A light subpath starts with d_VCM = 1/p_ω², d_VC = cos_light²/p_e² (0 for a point light,
 //! which nothing can hit), d_VM = d_VC/η_VCM², p_e the density of its point and direction; a
 //! camera subpath with d_VCM = 1/p_c(z₁)², p_c the camera's density of its first vertex per
 //! unit area (the importance normalised to the whole film, as `bdpt`'s, so that the t = 1
 //! strategies of N light subpaths compare per film; 0 without `lightImage`, which removes them)
 //! and d_VC = d_VM = 0. Each contribution's weight is then 1/(1 + w_light + w_camera) with the
-//! report's w for its kind (eqs. 39–47), in which η_VCM² weighs a connection against the merges
+//! report's w for its kind, in which η_VCM² weighs a connection against the merges
 //! of its vertices. The densities are the nominal ones (a light's point 1/A, chosen by power),
 //! as in `bdpt`; Russian roulette is left out of them. Without merging (`useVM` false) the
 //! η_VCM terms are left out and no vertices are gathered: the estimator is bidirectional path
 //! tracing with light sampling for s = 1.
 //!
-//! **Radius.** Iteration i (from 1) merges within r_i = r₁ · i^((α−1)/2) (the paper's eq. 14,
-//! Knaus & Zwicker's schedule): the merges' bias vanishes and their variance grows slowly
-//! enough for the average over iterations to converge. r₁ = `initialRadius` × `radiusScale`,
-//! with an automatic `initialRadius` of three times the scene's bounding radius over the
-//! film's larger side.
+//! **Radius.** Iteration i (from 1) merges within r_i = r₁ · i^((α−1)/2) (the paper's
+//! schedule, after Knaus & Zwicker 2011): the merges' bias vanishes and their variance grows
+//! slowly enough for the average over iterations to converge. r₁ = `initialRadius` ×
+//! `radiusScale`, with an automatic `initialRadius` of three times the scene's bounding radius
+//! over the film's larger side.
 //!
 //! **Spectral.** Merging needs one set of wavelengths for the vertices of all the light
 //! subpaths an iteration keeps, so every subpath of an iteration uses the iteration's
