@@ -94,6 +94,7 @@ fn integrator_named(name: &str, scene: &Scene) -> Result<Integrator> {
         Integrator::Particle(p) => p.max_depth,
         Integrator::Bdpt(b) => b.max_depth,
         Integrator::Sppm(s) => s.max_depth,
+        Integrator::Vcm(v) => v.max_depth,
         Integrator::Guided(g) => g.max_depth,
         Integrator::Moment(_) | Integrator::Aov(_) | Integrator::Depth(_) => -1,
     };
@@ -166,6 +167,7 @@ fn integrator_label(integrator: &Integrator) -> &'static str {
         Integrator::Bdpt(_) => "bdpt",
         Integrator::Sppm(_) => "sppm",
         Integrator::Guided(_) => "guided_path",
+        Integrator::Vcm(_) => "vcm",
     }
 }
 

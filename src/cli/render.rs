@@ -608,6 +608,10 @@ fn report(
             }
             // A biased estimate with one value per pixel: there is no error to report.
             Integrator::Sppm(_) => " (sppm: biased, no error estimate)",
+            Integrator::Vcm(ref vcm) if vcm.merging => {
+                " (vcm: biased; the spread over sample indices leaves out the merges' bias)"
+            }
+            Integrator::Vcm(_) => " (by batch means over sample indices)",
             _ => "",
         },
         exr.display(),
@@ -633,10 +637,10 @@ fn trace_pixel(
         )
         .with_help("render a --crop around the pixel instead"));
     }
-    if let Integrator::Bdpt(_) = scene.integrator {
+    if let Integrator::Bdpt(_) | Integrator::Vcm(_) = scene.integrator {
         return Err(Error::usage(
-            "--pixel prints a pixel's camera samples, and bdpt's are not the pixel's whole \
-             estimate: its light subpaths reach pixels anywhere on the film",
+            "--pixel prints a pixel's camera samples, and bdpt's and vcm's are not the pixel's \
+             whole estimate: their light subpaths reach pixels anywhere on the film",
         )
         .with_help("render a --crop around the pixel instead"));
     }

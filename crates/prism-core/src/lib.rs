@@ -31,7 +31,7 @@
 //! | [`world`] | geometry, materials, lights and media together |
 //! | [`film`] | reconstruction filters, pixel sums and their error, the images written |
 //! | [`camera`] | perspective, thin-lens and orthographic cameras, the radiance, irradiance and distant meters, the batch of sensors, and the shutter |
-//! | [`integrator`] | the estimators: path, direct, distrib, volpath, volpathmis, moment, aov, depth, ptracer, bdpt, sppm, guided_path, the polarized path tracer and stokes |
+//! | [`integrator`] | the estimators: path, direct, distrib, volpath, volpathmis, moment, aov, depth, ptracer, bdpt, sppm, vcm, guided_path, the polarized path tracer and stokes |
 //! | [`scene`] | the world with camera, film, sampler and integrator |
 //! | [`render`] | passes, tiles, threads, progress, render states |
 

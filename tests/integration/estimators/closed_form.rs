@@ -29,7 +29,7 @@ pub(super) fn inner_sphere() -> Shape {
 }
 
 /// The inside of a 2 × 3 × 4 box.
-fn inner_box() -> Shape {
+pub(super) fn inner_box() -> Shape {
     let to_world = Transform::new(DMat4::from_scale(DVec3::new(1.0, 1.5, 2.0))).unwrap();
     Shape::Mesh(transform_mesh(cube(), &to_world, true, true))
 }

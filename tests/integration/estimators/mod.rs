@@ -1,6 +1,6 @@
 //! The integrators' estimators against closed forms and against each other, their error, and
 //! the `aov` and `moment` integrators, the particle tracer, bidirectional path tracing, photon
-//! mapping and path guiding.
+//! mapping, vertex connection and merging, and path guiding.
 
 mod aov;
 mod bdpt;
@@ -13,3 +13,4 @@ mod moment;
 mod ptracer;
 mod sppm;
 mod strict_normals;
+mod vcm;

@@ -2,9 +2,9 @@
 //! illumination, the lecture's distribution ray tracer with splitting and the volumetric path
 //! tracers; `moment` runs nested integrators and writes their estimates and second moments as
 //! extra film channels, `aov` the albedo, normals, depth and other variables of the first hit
-//! beside nested integrators' images. `ptracer` and `sppm` start paths at the lights too; the
-//! render driver runs their passes, and the iterations of `guided_path`, the path tracer that
-//! learns where light comes from.
+//! beside nested integrators' images. `ptracer`, `bdpt`, `sppm` and `vcm` start paths at the
+//! lights too; the render driver runs their passes, and the iterations of `guided_path`, the
+//! path tracer that learns where light comes from.
 //!
 //! An [`Integrator`] is what a scene asks for: an estimator and its parameters. Before a render
 //! it is prepared for the world ([`Integrator::prepare`]), which builds the light sampler it
@@ -37,6 +37,7 @@ pub mod sppm;
 pub mod stepped;
 pub mod stokes;
 pub mod transmittance;
+pub mod vcm;
 pub mod vertex;
 pub mod volpath;
 pub mod volpathmis;
@@ -55,6 +56,7 @@ pub use ptracer::{LightPathSample, ParticleTracer, Splat};
 pub use sppm::SppmIntegrator;
 pub use stepped::SteppedPath;
 pub use stokes::StokesIntegrator;
+pub use vcm::VcmIntegrator;
 pub use volpath::{Tracking, VolPathIntegrator};
 
 use stepped::SteppedIntegrator;
@@ -106,6 +108,7 @@ integrator_enum! {
         PolarizedPath(PolarizedPathIntegrator),
         Stokes(StokesIntegrator),
         Guided(GuidedPathIntegrator),
+        Vcm(VcmIntegrator),
     }
 }
 
@@ -136,7 +139,8 @@ impl Integrator {
             | Integrator::Depth(_)
             | Integrator::Particle(_)
             | Integrator::Bdpt(_)
-            | Integrator::Sppm(_) => LightSelection::Power,
+            | Integrator::Sppm(_)
+            | Integrator::Vcm(_) => LightSelection::Power,
             Integrator::Guided(_) => LightSelection::Exhaustive,
         }
     }
@@ -156,7 +160,8 @@ impl Integrator {
             | Integrator::Sppm(_)
             | Integrator::PolarizedPath(_)
             | Integrator::Stokes(_)
-            | Integrator::Guided(_) => &[],
+            | Integrator::Guided(_)
+            | Integrator::Vcm(_) => &[],
         };
         nested.iter().map(|(_, integrator)| integrator)
     }
@@ -172,6 +177,7 @@ impl Integrator {
             Integrator::Particle(ptracer) => ptracer.hide_emitters,
             Integrator::Bdpt(bdpt) => bdpt.hide_emitters,
             Integrator::Sppm(_) => false,
+            Integrator::Vcm(vcm) => vcm.hide_emitters,
             Integrator::PolarizedPath(polarized) => polarized.path.hide_emitters,
             Integrator::Stokes(stokes) => stokes.nested.path.hide_emitters,
             Integrator::Guided(guided) => guided.hide_emitters,
@@ -203,7 +209,8 @@ impl Integrator {
             | Integrator::Bdpt(_)
             | Integrator::Sppm(_)
             | Integrator::PolarizedPath(_)
-            | Integrator::Guided(_) => Vec::new(),
+            | Integrator::Guided(_)
+            | Integrator::Vcm(_) => Vec::new(),
             Integrator::Moment(moment) => moment.aov_names(),
             Integrator::Stokes(stokes) => stokes.aov_names(),
             Integrator::Aov(aov) => aov.aov_names(),
@@ -278,6 +285,15 @@ impl PreparedIntegrator<'_> {
     pub fn bidirectional(&self) -> Option<&BdptIntegrator> {
         match self.integrator {
             Integrator::Bdpt(bdpt) => Some(bdpt),
+            _ => None,
+        }
+    }
+
+    /// Vertex connection and merging, where the integrator is it: the render driver runs its
+    /// iterations, whose camera subpaths read every light subpath's vertices.
+    pub fn vcm(&self) -> Option<&VcmIntegrator> {
+        match self.integrator {
+            Integrator::Vcm(vcm) => Some(vcm),
             _ => None,
         }
     }
@@ -364,13 +380,14 @@ impl PreparedIntegrator<'_> {
             Integrator::PolarizedPath(integrator) => integrator.radiance(ctx, ray, lambda),
             Integrator::Stokes(integrator) => integrator.radiance(ctx, ray, lambda, aovs),
             // Light subpaths reach the film by splats, not along camera rays: the render driver
-            // runs them ([`Self::trace_light_paths`], [`Self::trace_bidirectional`]), and
-            // photon mapping's passes and path guiding's iterations run apart ([`Self::sppm`],
-            // [`Self::guided`]).
+            // runs them ([`Self::trace_light_paths`], [`Self::trace_bidirectional`], the
+            // iterations of [`Self::vcm`]), and photon mapping's passes and path guiding's
+            // iterations run apart ([`Self::sppm`], [`Self::guided`]).
             Integrator::Particle(_)
             | Integrator::Bdpt(_)
             | Integrator::Sppm(_)
-            | Integrator::Guided(_) => SampledSpectrum::ZERO,
+            | Integrator::Guided(_)
+            | Integrator::Vcm(_) => SampledSpectrum::ZERO,
         }
     }
 }

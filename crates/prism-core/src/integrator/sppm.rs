@@ -110,26 +110,38 @@ pub struct Photon {
     pub hero_only: bool,
 }
 
+impl Located for Photon {
+    fn position(&self) -> Vec3 {
+        self.p
+    }
+}
+
+/// What a [`PhotonMap`] holds: anything with a position (photons, and the light vertices of
+/// vertex merging, [`super::vcm`]).
+pub trait Located {
+    fn position(&self) -> Vec3;
+}
+
 /// The photons of one pass in a hash grid (Teschner et al. 2003's spatial hash): cells of one
 /// size, hashed into as many buckets as there are photons, each bucket's photons stored
 /// together in the order they were traced, so lookups are deterministic.
-pub struct PhotonMap {
-    photons: Vec<Photon>,
+pub struct PhotonMap<P = Photon> {
+    photons: Vec<P>,
     /// Where each bucket's photons start in `photons` (one more entry than buckets).
     starts: Vec<u32>,
     cell_size: f32,
 }
 
-impl PhotonMap {
+impl<P: Located + Clone> PhotonMap<P> {
     /// The map of `photons` for searches within `largest_radius`: cells twice as wide, so that
     /// a search spans at most two cells per axis.
-    pub fn new(photons: Vec<Photon>, largest_radius: f32) -> PhotonMap {
+    pub fn new(photons: Vec<P>, largest_radius: f32) -> PhotonMap<P> {
         let cell_size = 2.0 * largest_radius.max(f32::MIN_POSITIVE);
         let buckets = photons.len().max(1);
         let mut starts = vec![0u32; buckets + 1];
         let bucket_of: Vec<usize> = photons
             .iter()
-            .map(|photon| bucket(cell_of(photon.p, cell_size), buckets))
+            .map(|photon| bucket(cell_of(photon.position(), cell_size), buckets))
             .collect();
         for &b in &bucket_of {
             starts[b + 1] += 1;
@@ -144,7 +156,7 @@ impl PhotonMap {
             next[b] += 1;
         }
         PhotonMap {
-            photons: order.iter().map(|&i| photons[i as usize]).collect(),
+            photons: order.iter().map(|&i| photons[i as usize].clone()).collect(),
             starts,
             cell_size,
         }
@@ -152,7 +164,7 @@ impl PhotonMap {
 
     /// Calls `f` for every photon within `radius` (at most the largest radius the map was
     /// made for) of `p`, in a fixed order.
-    pub fn for_each_near(&self, p: Vec3, radius: f32, mut f: impl FnMut(&Photon)) {
+    pub fn for_each_near(&self, p: Vec3, radius: f32, mut f: impl FnMut(&P)) {
         let buckets = self.starts.len() - 1;
         let low = cell_of(p - Vec3::splat(radius), self.cell_size);
         let high = cell_of(p + Vec3::splat(radius), self.cell_size);
@@ -174,7 +186,7 @@ impl PhotonMap {
         for &b in &visit[..count] {
             let range = self.starts[b] as usize..self.starts[b + 1] as usize;
             for photon in &self.photons[range] {
-                if (photon.p - p).length_squared() <= radius_squared {
+                if (photon.position() - p).length_squared() <= radius_squared {
                     f(photon);
                 }
             }

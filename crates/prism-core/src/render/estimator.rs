@@ -64,8 +64,11 @@ impl<'a> SampleEstimator<'a> {
     }
 
     /// The estimator whose samples are splatted, where the scene's integrator is one: the
-    /// particle tracer or bidirectional path tracing.
+    /// particle tracer, bidirectional path tracing or vertex connection and merging.
     pub(super) fn splatting(&self) -> Option<Splatting<'_>> {
+        if let Some(vcm) = self.integrator.vcm() {
+            return Some(Splatting::Vcm(vcm));
+        }
         match (self.particle_tracer(), self.integrator.bidirectional()) {
             (Some(ptracer), _) => Some(Splatting::Particle(ptracer)),
             (None, Some(bdpt)) => Some(Splatting::Bidirectional(bdpt)),

@@ -34,6 +34,7 @@ mod sppm;
 pub mod state;
 mod stop;
 mod tiles;
+mod vcm;
 
 use std::ops::Range;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
@@ -179,6 +180,12 @@ pub fn render_with_preview(
             checkpoints,
             preview,
         );
+    }
+    if estimator.integrator.vcm().is_some_and(|vcm| vcm.merging) && stop.target_error.is_some() {
+        return Err(Error::usage(
+            "the vcm integrator has no error estimate to stop at: its merges are biased at any \
+             finite sample count (set use_vm to false for an unbiased estimate)",
+        ));
     }
     // Sums of extra channels per pixel.
     let k = AOV_SUMS_PER_CHANNEL * estimator.aov_count();

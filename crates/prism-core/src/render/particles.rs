@@ -29,7 +29,9 @@ use super::tiles::TileSums;
 use crate::camera::{CameraModel, CameraRay};
 use crate::film::accumulation::{AOV_SUMS_PER_CHANNEL, acceptable_sample, add_aov_sample};
 use crate::film::{CropWindow, SplatSums, SplatValue, Splatter};
-use crate::integrator::{BdptIntegrator, LightPathSample, ParticleTracer, RayCount, Splat};
+use crate::integrator::{
+    BdptIntegrator, LightPathSample, ParticleTracer, RayCount, Splat, VcmIntegrator,
+};
 use crate::sampling::sampler::Sampler;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 
@@ -48,22 +50,27 @@ pub(super) enum Splatting<'a> {
     /// one-pixel reconstruction weighs it), and a light subpath whose connections to the
     /// camera are splatted.
     Bidirectional(&'a BdptIntegrator),
+    /// Vertex connection and merging: each sample index an iteration, all its light subpaths
+    /// traced (their connections to the camera splatted) before its camera subpaths, which
+    /// connect to their pixel's light subpath and merge with every light subpath's vertices
+    /// ([`super::vcm`]).
+    Vcm(&'a VcmIntegrator),
 }
 
 /// Gathers one task's contributions in CIE XYZ, spread over the pixels they reach.
-struct Collector<'a> {
-    splatter: &'a Splatter,
-    crop: CropWindow,
+pub(super) struct Collector<'a> {
+    pub(super) splatter: &'a Splatter,
+    pub(super) crop: CropWindow,
     /// The wavelengths of the sample at hand, and its shutter weight.
-    lambda: SampledWavelengths,
-    time_weight: f32,
-    values: Vec<SplatValue>,
+    pub(super) lambda: SampledWavelengths,
+    pub(super) time_weight: f32,
+    pub(super) values: Vec<SplatValue>,
 }
 
 impl Collector<'_> {
     /// Adds the CIE XYZ `xyz` to the full film's pixel `pixel` alone, if it is in the crop
     /// window.
-    fn add_to_pixel(&mut self, pixel: UVec2, xyz: [f32; 3]) {
+    pub(super) fn add_to_pixel(&mut self, pixel: UVec2, xyz: [f32; 3]) {
         let (offset, size) = (self.crop.offset, self.crop.size);
         if pixel.x < offset.x
             || pixel.y < offset.y
@@ -136,15 +143,19 @@ impl Pass<'_, '_> {
         let mut rays = 0;
         for index in range {
             image.clear(crop_pixels as usize);
-            for batch in tasks.chunks(TASKS_PER_BATCH) {
-                let traced: Vec<Option<(Vec<SplatValue>, u64)>> = batch
-                    .par_iter()
-                    .map(|pixels| self.trace_task(splatting, &splatter, pixels.clone(), index))
-                    .collect();
-                for task in traced {
-                    let (values, task_rays) = task?;
-                    image.add(&values);
-                    rays += task_rays;
+            if let Splatting::Vcm(vcm) = splatting {
+                rays += self.trace_vcm_iteration(vcm, &splatter, &tasks, index, &mut image)?;
+            } else {
+                for batch in tasks.chunks(TASKS_PER_BATCH) {
+                    let traced: Vec<Option<(Vec<SplatValue>, u64)>> = batch
+                        .par_iter()
+                        .map(|pixels| self.trace_task(splatting, &splatter, pixels.clone(), index))
+                        .collect();
+                    for task in traced {
+                        let (values, task_rays) = task?;
+                        image.add(&values);
+                        rays += task_rays;
+                    }
                 }
             }
             out.par_iter_mut()
@@ -196,6 +207,7 @@ impl Pass<'_, '_> {
             time_weight: 1.0,
             values: Vec::new(),
         };
+        let integrator = &self.estimator.integrator;
         for pixel in pixels {
             let pixel = UVec2::new(pixel % film.size.x, pixel / film.size.x);
             sampler.start_pixel_sample(pixel, index);
@@ -210,7 +222,6 @@ impl Pass<'_, '_> {
                 time,
                 u_lens: primary.lens,
             };
-            let integrator = &self.estimator.integrator;
             match splatting {
                 Splatting::Particle(ptracer) => integrator.trace_light_paths(
                     ptracer,
@@ -236,6 +247,7 @@ impl Pass<'_, '_> {
                     let xyz = lambda.to_xyz(&radiance).map(|v| v * scale);
                     collector.add_to_pixel(pixel, xyz);
                 }
+                Splatting::Vcm(_) => unreachable!("vcm's iterations are traced whole"),
             }
         }
         Some((collector.values, count.rays))

@@ -85,6 +85,15 @@ impl PixelState {
     }
 }
 
+/// The random number that draws the wavelengths of pass `pass` of a render with seed `seed`:
+/// the radical inverse of the pass in base 2, rotated by a number drawn from the seed
+/// (Cranley–Patterson), so that every run of 2ᵏ passes covers the wavelengths evenly.
+pub(super) fn pass_wavelength(seed: u64, pass: u32) -> f32 {
+    let rotation = Pcg32::new(hash_u64s(&[seed]), WAVELENGTH_STREAM).next_f64();
+    let u = f64::from(pass.reverse_bits()) / 2f64.powi(32) + rotation;
+    (u.fract() as f32).min(1.0f32.next_down())
+}
+
 /// Mitsuba 0.6's initial radius: five times the scene's bounding radius over the film's larger
 /// side.
 fn automatic_radius(scene: &Scene) -> f32 {
@@ -252,8 +261,10 @@ impl PassContext<'_> {
     /// returns the rays traced, or None when the pass was cancelled.
     fn run(&self, pass: u32, state: &mut [PixelState], width: usize) -> Option<u64> {
         let film = &self.scene.film;
-        let lambda =
-            SampledWavelengths::sample(self.pass_wavelength(pass), film.wavelength_sampling);
+        let lambda = SampledWavelengths::sample(
+            pass_wavelength(self.options.seed, pass),
+            film.wavelength_sampling,
+        );
         let (photons, mut rays) = self.trace_photons(pass, &lambda)?;
         let largest = state.iter().map(|s| s.radius).fold(0.0, f64::max) as f32;
         let map = PhotonMap::new(photons, largest);
@@ -267,15 +278,6 @@ impl PassContext<'_> {
             rays += row?;
         }
         Some(rays)
-    }
-
-    /// The random number that draws pass `pass`'s wavelengths: the radical inverse of the pass
-    /// in base 2, rotated by a number drawn from the seed (Cranley–Patterson), so that every
-    /// run of 2ᵏ passes covers the wavelengths evenly.
-    fn pass_wavelength(&self, pass: u32) -> f32 {
-        let rotation = Pcg32::new(hash_u64s(&[self.options.seed]), WAVELENGTH_STREAM).next_f64();
-        let u = f64::from(pass.reverse_bits()) / 2f64.powi(32) + rotation;
-        (u.fract() as f32).min(1.0f32.next_down())
     }
 
     /// The photons of pass `pass`, in the order of their indices, and the rays traced.

@@ -1,10 +1,10 @@
 //! Integrator plugins: `path` (with Prism's `emitter_sampling`, see
 //! [`prism_core::light::sampler`]), `direct`, `moment`, `aov`, the lecture's `distrib`, and
 //! `volpath` and `volpathmis` for media, `ptracer`, the particle tracer, Mitsuba 0.6's
-//! `bdpt`, bidirectional path tracing, `sppm`, stochastic progressive photon mapping,
-//! `guided_path`, Müller et al.'s practical path guiding (their Mitsuba 0.6 plugin), and
-//! `stokes`, the polarized path tracer's Stokes vectors (a scene with a polarizing BSDF gets
-//! the polarized path tracer in place of `path`: [`polarized_where_needed`]).
+//! `bdpt`, bidirectional path tracing, `sppm`, stochastic progressive photon mapping, `vcm`,
+//! vertex connection and merging, `guided_path`, Müller et al.'s practical path guiding (their
+//! Mitsuba 0.6 plugin), and `stokes`, the polarized path tracer's Stokes vectors (a scene with a
+//! polarizing BSDF gets the polarized path tracer in place of `path`: [`polarized_where_needed`]).
 
 use glam::Vec3;
 
@@ -22,7 +22,8 @@ use prism_core::integrator::guided::{Budget, NextEvent, SampleCombination, Spati
 use prism_core::integrator::{
     AovIntegrator, BdptIntegrator, DepthIntegrator, DirectIntegrator, DistributionIntegrator,
     GuidedPathIntegrator, Integrator, MomentIntegrator, ParticleTracer, PathIntegrator,
-    PolarizedPathIntegrator, SppmIntegrator, StokesIntegrator, Tracking, VolPathIntegrator,
+    PolarizedPathIntegrator, SppmIntegrator, StokesIntegrator, Tracking, VcmIntegrator,
+    VolPathIntegrator,
 };
 use prism_core::light::{Light, LightSelection};
 
@@ -194,6 +195,33 @@ pub static INTEGRATORS: Registry<Build> = Registry {
             build: build_sppm,
         },
         Plugin {
+            name: "vcm",
+            origin: Origin::Mitsuba06,
+            summary: "Vertex connection and merging (Georgiev et al. 2012, with SmallVCM's \
+                      recursive weights; the parameters of the one public Mitsuba `vcm` plugin \
+                      found, in the UPMM code (a Mitsuba 0.5 fork on GitHub, \
+                      xiaoyu-zhang-betsy/UPMM), with SmallVCM's `alpha`): per iteration (sample index) one light subpath per \
+                      pixel, connected to the camera and kept; then one camera subpath per \
+                      pixel with light sampling, connections to its pixel's light subpath and \
+                      merges with every kept light vertex within the radius r_i = r_1 \
+                      i^((alpha-1)/2), all weighted by the power heuristic; one set of \
+                      wavelengths per iteration. Biased at any finite sample count with merging \
+                      (consistent): the EXR's variance is the spread over iterations, which \
+                      leaves out the bias, and a target error is refused; `use_vm` false gives \
+                      unbiased bidirectional path tracing. Surfaces, area and point lights only.",
+            params: &[
+                MAX_DEPTH,
+                RR_DEPTH,
+                HIDE_EMITTERS,
+                LIGHT_IMAGE,
+                VCM_INITIAL_RADIUS,
+                RADIUS_SCALE,
+                VCM_ALPHA,
+                USE_VM,
+            ],
+            build: build_vcm,
+        },
+        Plugin {
             name: "guided_path",
             origin: Origin::Mitsuba06,
             summary: "Practical path guiding (Müller, Gross & Novák 2017; the authors' Mitsuba \
@@ -263,6 +291,10 @@ params! {
     GRANULARITY = ParamSpec::new("granularity", ParamKind::Integer, Default::Integer(0), "light subpaths per parallel task (0: 4096); the image does not depend on it");
     SPPM_MAX_DEPTH = ParamSpec::new("max_depth", ParamKind::Integer, Default::Integer(-1), "longest path: −1 unbounded, 2 direct light, at least 2");
     SPPM_RR_DEPTH = ParamSpec::new("rr_depth", ParamKind::Integer, Default::Integer(3), "bounces after which Russian roulette may end photons and camera paths (Mitsuba 0.6's code uses 3)");
+    VCM_INITIAL_RADIUS = ParamSpec::new("initial_radius", ParamKind::Float, Default::Float(0.0), "the merge radius of the first iteration before `radius_scale`, in world units (0: three times the scene's bounding radius over the film's larger side, as the UPMM plugin)");
+    RADIUS_SCALE = ParamSpec::new("radius_scale", ParamKind::Float, Default::Float(1.0), "a factor on the initial radius (positive)");
+    VCM_ALPHA = ParamSpec::new("alpha", ParamKind::Float, Default::Float(0.75), "the radius schedule r_i = r_1 i^((alpha-1)/2) of iteration i (0 < alpha < 1; SmallVCM's default)");
+    USE_VM = ParamSpec::new("use_vm", ParamKind::Boolean, Default::Boolean(true), "merge camera vertices with light vertices; false leaves connections only (unbiased bidirectional path tracing)");
     SPP_PER_PASS = ParamSpec::new("spp_per_pass", ParamKind::Integer, Default::Integer(4), "samples per pixel of a pass; iteration k renders 2^k passes");
     BUDGET_TYPE = ParamSpec::new("budget_type", ParamKind::Choice(&[Choice::new("spp", &BudgetType::Samples), Choice::new("seconds", &BudgetType::Seconds)]), Default::Str("spp"), "what `budget` counts: samples per pixel or seconds, over all iterations (the authors' default is seconds)");
     BUDGET = ParamSpec::new("budget", ParamKind::Float, Default::Float(-1.0), "samples per pixel or seconds over all iterations (−1: the render's sample count, or its time limit; the authors' default is 300 seconds)");
@@ -451,6 +483,44 @@ fn build_bdpt(params: &Params) -> Result<Integrator> {
         hide_emitters: params.boolean(&HIDE_EMITTERS)?,
         light_image: params.boolean(&LIGHT_IMAGE)?,
         sample_direct: params.boolean(&SAMPLE_DIRECT)?,
+    }))
+}
+
+fn build_vcm(params: &Params) -> Result<Integrator> {
+    let refuse =
+        |spec: &ParamSpec, message: String| Err(Error::input(params.location_of(spec), message));
+    let initial_radius = params.float(&VCM_INITIAL_RADIUS)?;
+    if !(initial_radius.is_finite() && initial_radius >= 0.0) {
+        return refuse(
+            &VCM_INITIAL_RADIUS,
+            format!(
+                "initial_radius must be 0 (automatic) or a positive length, not {initial_radius}"
+            ),
+        );
+    }
+    let radius_scale = params.float(&RADIUS_SCALE)?;
+    if !(radius_scale.is_finite() && radius_scale > 0.0) {
+        return refuse(
+            &RADIUS_SCALE,
+            format!("radius_scale must be positive, not {radius_scale}"),
+        );
+    }
+    let alpha = params.float(&VCM_ALPHA)?;
+    if !(alpha > 0.0 && alpha < 1.0) {
+        return refuse(
+            &VCM_ALPHA,
+            format!("alpha must lie strictly between 0 and 1, not {alpha}"),
+        );
+    }
+    Ok(Integrator::Vcm(VcmIntegrator {
+        max_depth: max_depth(params)?,
+        rr_depth: rr_depth(params)?,
+        hide_emitters: params.boolean(&HIDE_EMITTERS)?,
+        light_image: params.boolean(&LIGHT_IMAGE)?,
+        initial_radius: (initial_radius > 0.0).then_some(initial_radius as f32),
+        radius_scale: radius_scale as f32,
+        alpha: alpha as f32,
+        merging: params.boolean(&USE_VM)?,
     }))
 }
 

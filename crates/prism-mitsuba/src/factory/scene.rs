@@ -237,6 +237,7 @@ fn check_connectable(
     let name = match integrator {
         Integrator::Particle(_) => "ptracer",
         Integrator::Bdpt(_) => "bdpt",
+        Integrator::Vcm(_) => "vcm",
         _ => return Ok(()),
     };
     let kind = match &sensor.camera {
@@ -262,6 +263,7 @@ fn check_renders_media(integrator: &Integrator, media: &MediaCache) -> Result<()
         Integrator::Bdpt(_) => "bdpt",
         Integrator::Sppm(_) => "sppm",
         Integrator::Guided(_) => "guided_path",
+        Integrator::Vcm(_) => "vcm",
         _ => return Ok(()),
     };
     if let Some(location) = &media.first {
@@ -293,6 +295,7 @@ fn check_renders_polarization(
         Integrator::Bdpt(_) => "bdpt",
         Integrator::Sppm(_) => "sppm",
         Integrator::Guided(_) => "guided_path",
+        Integrator::Vcm(_) => "vcm",
         Integrator::Moment(_) => "moment",
         _ => return Ok(()),
     };
@@ -312,16 +315,18 @@ fn check_renders_polarization(
     ))
 }
 
-/// The bdpt integrator starts light subpaths on area and point lights only: any other light is
-/// an error where it was declared.
+/// The bdpt and vcm integrators start light subpaths on area and point lights only: any other
+/// light is an error where it was declared.
 fn check_bdpt_lights(
     integrator: &Integrator,
     lights: &[Light],
     locations: &[SourceLocation],
 ) -> Result<()> {
-    if !matches!(integrator, Integrator::Bdpt(_)) {
-        return Ok(());
-    }
+    let name = match integrator {
+        Integrator::Bdpt(_) => "bdpt",
+        Integrator::Vcm(_) => "vcm",
+        _ => return Ok(()),
+    };
     for (light, location) in lights.iter().zip(locations) {
         let kind = match light {
             Light::Area(_) | Light::Point(_) => continue,
@@ -336,11 +341,11 @@ fn check_bdpt_lights(
         };
         return Err(Error::input(
             location,
-            format!("the bdpt integrator does not start light paths on a {kind} emitter"),
+            format!("the {name} integrator does not start light paths on a {kind} emitter"),
         )
-        .with_help(
-            "bdpt takes area and point emitters; render this scene with <integrator type=\"path\">",
-        ));
+        .with_help(format!(
+            "{name} takes area and point emitters; render this scene with <integrator type=\"path\">"
+        )));
     }
     Ok(())
 }

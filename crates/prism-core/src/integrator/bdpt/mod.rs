@@ -411,7 +411,11 @@ impl Connections<'_> {
 /// (Veach's eq. 5.19, pbrt-v4's `CorrectShadingNormal`). Unlike the particle tracer, directions
 /// the geometric and shading normals put on different sides do not end the subpath: the camera
 /// subpath (the path tracer's) scatters there, and every strategy must see the same integrand.
-fn shading_correction(si: &SurfaceInteraction, w_light: Vec3, w_out: Vec3) -> Option<f32> {
+pub(crate) fn shading_correction(
+    si: &SurfaceInteraction,
+    w_light: Vec3,
+    w_out: Vec3,
+) -> Option<f32> {
     let (light_g, light_s) = (si.n.dot(w_light), si.shading.n.dot(w_light));
     let (out_g, out_s) = (si.n.dot(w_out), si.shading.n.dot(w_out));
     let correction = ((light_s * out_g) / (out_s * light_g)).abs();
