@@ -6,14 +6,15 @@
 //! `prism_core::integrator::bdpt::weights`.
 
 use glam::UVec2;
-use prism_core::film::Film;
 use prism_core::integrator::{BdptIntegrator, Integrator, PathIntegrator};
 use prism_core::math::special::regularized_gamma_q;
-use prism_core::render::{RenderOptions, StopRule, render};
 use prism_core::scene::Scene;
 
 use super::closed_form::{furnace_scene, inner_sphere};
 use super::convergence::assert_same_image;
+use super::guarantees::{
+    assert_bit_identical_for_any_thread_count, assert_resumed_and_merged_equal_one_render,
+};
 use super::ptracer::{PINHOLE, coarse_sphere_obj, cornell_box, lit_scene};
 use crate::common::scenes::{
     assert_mean_luminance, disk_light_over_plane, pixel_mean_and_variance, render_film,
@@ -225,41 +226,14 @@ fn small_scene() -> Scene {
 /// One and two threads give the same film to the last bit, and another seed another film.
 #[test]
 fn bdpt_is_bit_identical_for_any_thread_count() {
-    let scene = small_scene();
-    let one = render_film(&scene, 4, 42, Some(1));
-    let two = render_film(&scene, 4, 42, Some(2));
-    assert!(one.pixels.iter().any(|p| p.sum(1) > 0.0), "black");
-    assert_eq!(one.pixels, two.pixels);
-    assert_ne!(one.pixels, render_film(&scene, 4, 43, Some(2)).pixels);
+    assert_bit_identical_for_any_thread_count(&small_scene(), 4);
 }
 
 /// A render continued pass by pass from its state (as `--resume` does), and the renders of
 /// disjoint sample ranges merged (as `prism merge` does), equal one render of all the samples.
 #[test]
 fn bdpt_resumed_and_merged_renders_equal_one_render() {
-    let scene = small_scene();
-    let whole = render_film(&scene, 6, 7, Some(2));
-    let mut initial = None;
-    let mut merged: Option<Film> = None;
-    for range in [0..2, 2..5, 5..6] {
-        let mut options = RenderOptions::fixed(6, 7, Some(2));
-        options.first_sample = range.start;
-        options.stop = StopRule::samples(range.end);
-        let part = render(&scene, &options).unwrap().film;
-        options.initial = initial.take();
-        let resumed = render(&scene, &options).unwrap().film;
-        initial = Some((resumed.pixels, resumed.aovs));
-        match &mut merged {
-            None => merged = Some(part),
-            Some(m) => {
-                for (a, b) in m.pixels.iter_mut().zip(&part.pixels) {
-                    a.merge(b);
-                }
-            }
-        }
-    }
-    assert_eq!(merged.unwrap().pixels, whole.pixels, "merged");
-    assert_eq!(initial.unwrap().0, whole.pixels, "resumed");
+    assert_resumed_and_merged_equal_one_render(&small_scene(), &[2, 5, 6]);
 }
 
 /// The error of reading `xml` (a scene), as text.

@@ -8,6 +8,7 @@ mod closed_form;
 mod convergence;
 mod depth;
 mod direct;
+mod guarantees;
 mod guided;
 mod moment;
 mod ptracer;
