@@ -8,6 +8,7 @@ use prism_core::film::{BoxFilter, CropWindow, Film, Filter, Reconstruction};
 use prism_core::geometry::{Geometry, Primitive, Shape};
 use prism_core::integrator::{Integrator, PathIntegrator};
 use prism_core::light::{AreaLight, Light};
+use prism_core::math::special::regularized_gamma_q;
 use prism_core::math::transform::look_at;
 use prism_core::math::{AnimatedTransform, Transform};
 use prism_core::render::{RenderOptions, render};
@@ -151,6 +152,37 @@ pub fn assert_mean_luminance(name: &str, film: &Film, expected: f64) {
 pub struct DiskOverPlane {
     pub scene: Scene,
     pub exact: Vec<f64>,
+}
+
+impl DiskOverPlane {
+    /// Checks a render `film` of the scene against the exact values: each pixel, by the
+    /// variance the film reports for it, in a chi-square test at significance 10⁻³, and the
+    /// image's mean within 4 standard errors, which must be below 1 % of the exact mean (so
+    /// that the test can tell a wrong image).
+    pub fn assert_matches(&self, film: &Film) {
+        let (mut statistic, mut pixels) = (0.0, 0.0);
+        let (mut difference, mut variance_sum) = (0.0, 0.0);
+        for (i, exact) in self.exact.iter().enumerate() {
+            let (mean, variance) = pixel_mean_and_variance(film, i, 1);
+            assert!(variance > 0.0, "pixel {i} has no spread");
+            statistic += (mean - exact).powi(2) / variance;
+            difference += mean - exact;
+            variance_sum += variance;
+            pixels += 1.0;
+        }
+        let p_value = regularized_gamma_q(pixels / 2.0, statistic / 2.0);
+        assert!(
+            p_value > 1e-3,
+            "chi-square {statistic} over {pixels} pixels: p = {p_value}"
+        );
+        let (bias, se) = (difference / pixels, variance_sum.sqrt() / pixels);
+        let mean_exact = self.exact.iter().sum::<f64>() / pixels;
+        assert!(
+            se < 0.01 * mean_exact,
+            "the standard error {se} is too large"
+        );
+        assert!(bias.abs() < 4.0 * se, "mean differs by {bias} ± {se}");
+    }
 }
 
 pub fn disk_light_over_plane(size: UVec2) -> DiskOverPlane {

@@ -8,7 +8,6 @@ use std::path::Path;
 use glam::UVec2;
 use prism_core::film::Film;
 use prism_core::integrator::{Integrator, ParticleTracer};
-use prism_core::math::special::regularized_gamma_q;
 use prism_core::scene::Scene;
 
 use super::convergence::assert_same_image;
@@ -35,28 +34,7 @@ fn ptracer_matches_the_disk_light_closed_form() {
     let mut setup = disk_light_over_plane(UVec2::new(24, 24));
     setup.scene.integrator = ptracer(2);
     let film = render_film(&setup.scene, 512, 5, None);
-    let (mut statistic, mut pixels) = (0.0, 0.0);
-    let (mut difference, mut variance_sum) = (0.0, 0.0);
-    for (i, exact) in setup.exact.iter().enumerate() {
-        let (mean, variance) = pixel_mean_and_variance(&film, i, 1);
-        assert!(variance > 0.0, "pixel {i} has no spread");
-        statistic += (mean - exact).powi(2) / variance;
-        difference += mean - exact;
-        variance_sum += variance;
-        pixels += 1.0;
-    }
-    let p_value = regularized_gamma_q(pixels / 2.0, statistic / 2.0);
-    assert!(
-        p_value > 1e-3,
-        "chi-square {statistic} over {pixels} pixels: p = {p_value}"
-    );
-    let (bias, se) = (difference / pixels, variance_sum.sqrt() / pixels);
-    let mean_exact = setup.exact.iter().sum::<f64>() / pixels;
-    assert!(
-        se < 0.01 * mean_exact,
-        "the standard error {se} is too large"
-    );
-    assert!(bias.abs() < 4.0 * se, "mean differs by {bias} ± {se}");
+    setup.assert_matches(&film);
 }
 
 /// The variance the film reports, by batch means over sample indices, predicts the spread

@@ -7,7 +7,6 @@
 use glam::UVec2;
 use prism_core::film::Film;
 use prism_core::integrator::{BdptIntegrator, Integrator, PathIntegrator, VcmIntegrator};
-use prism_core::math::special::regularized_gamma_q;
 use prism_core::render::{RenderOptions, StopRule, render};
 use prism_core::scene::Scene;
 
@@ -18,8 +17,7 @@ use super::guarantees::{
 };
 use super::ptracer::{PINHOLE, cornell_box, lit_scene};
 use crate::common::scenes::{
-    assert_mean_luminance, disk_light_over_plane, pixel_mean_and_variance, render_film,
-    scene_from_xml,
+    assert_mean_luminance, disk_light_over_plane, render_film, scene_from_xml,
 };
 
 /// Connections only (`use_vm` false): bidirectional path tracing.
@@ -87,23 +85,7 @@ fn vcm_matches_the_disk_light_closed_form() {
         ..connections_only()
     });
     let film = render_film(&setup.scene, 256, 5, None);
-    let (mut statistic, mut pixels) = (0.0, 0.0);
-    let (mut difference, mut variance_sum) = (0.0, 0.0);
-    for (i, exact) in setup.exact.iter().enumerate() {
-        let (mean, variance) = pixel_mean_and_variance(&film, i, 1);
-        assert!(variance > 0.0, "pixel {i} has no spread");
-        statistic += (mean - exact).powi(2) / variance;
-        difference += mean - exact;
-        variance_sum += variance;
-        pixels += 1.0;
-    }
-    let p_value = regularized_gamma_q(pixels / 2.0, statistic / 2.0);
-    assert!(
-        p_value > 1e-3,
-        "chi-square {statistic} over {pixels} pixels: p = {p_value}"
-    );
-    let (bias, se) = (difference / pixels, variance_sum.sqrt() / pixels);
-    assert!(bias.abs() < 4.0 * se, "mean differs by {bias} ± {se}");
+    setup.assert_matches(&film);
 }
 
 /// With merging off, vcm and bdpt estimate the same image of the Cornell box, per channel.
