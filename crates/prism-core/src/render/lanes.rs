@@ -5,11 +5,11 @@
 //! A step traces the ray of every active lane to its closest hit (the trace stage, the lanes'
 //! BVH traversals interleaved so that one ray's cache misses overlap another's:
 //! [`crate::geometry::Aggregate::closest_hits`]), then turns each hit into its surface
-//! interaction and runs the path's step ([`SteppedPath::step`]: the path tracer's vertex, the
-//! volumetric path tracers' next event) on it (the vertex stage). A lane whose path ends writes its sample to the film and regenerates:
-//! it takes its pixel's next sample index, or, when its pixel has all the pass's samples, the
-//! next pixel of the tile that no lane has taken, so that a few long paths do not idle the
-//! others. A lane keeps its pixel's samples in order, which keeps its sampler's walk along the
+//! interaction and runs the estimator's step on it ([`SteppedPath::step`]: the path tracer's
+//! vertex, a volumetric path tracer's next event, a ray of `distrib`'s tree; the vertex
+//! stage). A lane whose path ends writes its sample to the film and regenerates: it takes its
+//! pixel's next sample index, or, when its pixel has all the pass's samples, the next pixel of
+//! the tile that no lane has taken, so that a few long paths do not idle the others. A lane keeps its pixel's samples in order, which keeps its sampler's walk along the
 //! pixel's random stream one step per sample.
 //!
 //! Where the samples come from and go is the caller's: the one-pixel reconstruction hands
@@ -200,29 +200,40 @@ pub(super) fn trace_in_lanes(
     cancel: &Cancel,
     sink: &mut impl SampleSink,
 ) -> Option<(u64, Occupancy)> {
-    let run = (pixels, range, samples_per_pixel, seed, cancel, sink);
+    macro_rules! trace {
+        ($stepped:expr) => {
+            trace_stepped(
+                estimator,
+                $stepped,
+                pixels,
+                range,
+                samples_per_pixel,
+                seed,
+                cancel,
+                sink,
+            )
+        };
+    }
     match paths {
-        SteppedIntegrator::Path(path) => trace_stepped(estimator, *path, run),
-        SteppedIntegrator::Direct(direct) => trace_stepped(estimator, *direct, run),
-        SteppedIntegrator::Distribution(distrib) => trace_stepped(estimator, *distrib, run),
-        SteppedIntegrator::VolPath(volpath) => trace_stepped(estimator, volpath, run),
-        SteppedIntegrator::VolPathMis(volpath) => trace_stepped(estimator, volpath, run),
+        SteppedIntegrator::Path(path) => trace!(*path),
+        SteppedIntegrator::Direct(direct) => trace!(*direct),
+        SteppedIntegrator::Distribution(distrib) => trace!(*distrib),
+        SteppedIntegrator::VolPath(volpath) => trace!(volpath),
+        SteppedIntegrator::VolPathMis(volpath) => trace!(volpath),
     }
 }
 
 /// [`trace_in_lanes`] for the stepped estimator `path`.
-#[allow(clippy::type_complexity)]
+#[allow(clippy::too_many_arguments)]
 fn trace_stepped<T: SteppedPath>(
     estimator: &SampleEstimator,
     path: &T,
-    (pixels, range, samples_per_pixel, seed, cancel, sink): (
-        impl Iterator<Item = (usize, UVec2)>,
-        Range<u32>,
-        u32,
-        u64,
-        &Cancel,
-        &mut impl SampleSink,
-    ),
+    pixels: impl Iterator<Item = (usize, UVec2)>,
+    range: Range<u32>,
+    samples_per_pixel: u32,
+    seed: u64,
+    cancel: &Cancel,
+    sink: &mut impl SampleSink,
 ) -> Option<(u64, Occupancy)> {
     let scene = estimator.scene;
     let mut run = LaneRun {
