@@ -63,6 +63,21 @@ pub struct LeafTrees {
     pub building: DirectionalTree,
     /// α where it is learned (`bsdfSamplingFractionLoss`).
     pub selection: LearnedSelection,
+    /// The mean indirect radiance the leaf's vertices sent back along their paths, learned in
+    /// the previous iteration (0 where none was recorded).
+    reflected: f32,
+    /// The statistical weight and the weighted sum of this iteration's records of it.
+    reflected_sums: (f64, f64),
+}
+
+impl LeafTrees {
+    /// The mean indirect radiance the leaf's vertices sent back along their paths, as learned
+    /// in the previous iteration (0 where none was recorded): the L_o of the weight window
+    /// ([`super::weight_window`]).
+    #[inline]
+    pub fn reflected(&self) -> f32 {
+        self.reflected
+    }
 }
 
 /// The trees found for a point and orientation: their index and the extent of their spatial
@@ -136,12 +151,19 @@ impl SdTree {
         &self.leaves[index as usize]
     }
 
-    /// Files `record` into its leaf: its flux into the building tree and, under `loss`, its
-    /// gradient into the leaf's learned α.
+    /// Files `record` into its leaf: its flux into the building tree, its reflected radiance
+    /// into the leaf's mean and, under `loss`, its gradient into the leaf's learned α.
     pub fn file(&mut self, record: &Record, loss: SelectionLoss) {
         let leaf = &mut self.leaves[record.leaf as usize];
         leaf.building
             .record(record.point, record.flux, record.weight);
+        if let Some(reflected) = record.reflected
+            && reflected.is_finite()
+        {
+            let weight = f64::from(record.weight);
+            leaf.reflected_sums.0 += weight;
+            leaf.reflected_sums.1 += weight * f64::from(reflected);
+        }
         if let Some(sample) = &record.selection {
             leaf.selection.train(sample, loss);
         }
@@ -223,11 +245,17 @@ impl SdTree {
     }
 
     /// Ends an iteration: every leaf's recorded tree, its sums built, becomes the tree paths
-    /// sample from.
+    /// sample from, and the mean of its recorded reflected radiance the one they read.
     pub fn build(&mut self) {
         for leaf in &mut self.leaves {
             leaf.building.build();
             leaf.sampling = leaf.building.clone();
+            let (weight, sum) = std::mem::take(&mut leaf.reflected_sums);
+            leaf.reflected = if weight > 0.0 {
+                (sum / weight) as f32
+            } else {
+                0.0
+            };
         }
     }
 }
@@ -247,6 +275,7 @@ mod tests {
             leaf: 0,
             point: Vec2::splat(0.5),
             flux: 1.0,
+            reflected: None,
             weight: 1.0,
             selection: None,
         };
@@ -288,6 +317,7 @@ mod tests {
                 leaf: leaf.index,
                 point,
                 flux: 1.0,
+                reflected: None,
                 weight: 1.0,
                 selection: None,
             };
