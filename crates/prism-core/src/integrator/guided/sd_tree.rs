@@ -296,6 +296,36 @@ mod tests {
         assert!(tree.leaf(a.index).sampling.pdf(Vec2::splat(0.5)) > 1.0);
     }
 
+    /// A leaf's reflected radiance is the weighted mean of its records' from the iteration
+    /// built last (records without one left out), and 0 where an iteration recorded none.
+    #[test]
+    fn reflected_radiance_is_the_mean_of_the_last_iterations_records() {
+        let mut tree = SdTree::new(Vec3::ZERO, Vec3::ONE);
+        tree.refine(1e9, 0.01, None);
+        let record = |reflected, weight| Record {
+            leaf: 0,
+            point: Vec2::splat(0.5),
+            flux: 1.0,
+            reflected,
+            weight,
+            selection: None,
+        };
+        for r in [
+            record(Some(1.0), 1.0),
+            record(Some(4.0), 0.5),
+            record(None, 1.0),
+            record(Some(f32::NAN), 1.0),
+        ] {
+            tree.file(&r, SelectionLoss::None);
+        }
+        assert_eq!(tree.leaf(0).reflected(), 0.0);
+        tree.build();
+        assert_eq!(tree.leaf(0).reflected(), 2.0);
+        tree.refine(1e9, 0.01, None);
+        tree.build();
+        assert_eq!(tree.leaf(0).reflected(), 0.0);
+    }
+
     /// Records of the two sides of a surface go to trees of their own in the same leaf, and
     /// the leaf splits by the weight of both; the classes are the normal's dominant axis and
     /// sign.
