@@ -10,7 +10,7 @@ use glam::{DVec3, Mat3, UVec2, Vec3};
 use prism_core::film::Film;
 use prism_core::geometry::{Shape, Sphere};
 use prism_core::integrator::guided::selection::SelectionLoss;
-use prism_core::integrator::guided::{NextEvent, SampleCombination, SpatialFilter};
+use prism_core::integrator::guided::{Adrrs, NextEvent, SampleCombination, SpatialFilter};
 use prism_core::integrator::{GuidedPathIntegrator, Integrator};
 use prism_core::render::{RenderOptions, StopRule, render};
 use prism_core::scene::Scene;
@@ -32,16 +32,23 @@ fn guided() -> GuidedPathIntegrator {
 
 /// Inside a sphere of reflectance rho that emits le everywhere, the radiance is
 /// le / (1 − rho) = 2 in every direction: the image's mean Y is 2 within 4 standard errors, with
-/// light samples (`always`) and without (`never`), with α fixed and learned (`kl`, `var`).
+/// light samples (`always`) and without (`never`), with α fixed and learned (`kl`, `var`), and
+/// with Russian roulette by the learned radiance, `path`'s, and with splitting.
 #[test]
 fn guided_sphere_furnace_gives_le_over_one_minus_rho() {
     let cases = [
-        (NextEvent::Always, SelectionLoss::None),
-        (NextEvent::Never, SelectionLoss::None),
-        (NextEvent::Always, SelectionLoss::KullbackLeibler),
-        (NextEvent::Never, SelectionLoss::Variance),
+        (NextEvent::Always, SelectionLoss::None, Adrrs::Roulette),
+        (NextEvent::Never, SelectionLoss::None, Adrrs::Roulette),
+        (
+            NextEvent::Always,
+            SelectionLoss::KullbackLeibler,
+            Adrrs::Roulette,
+        ),
+        (NextEvent::Never, SelectionLoss::Variance, Adrrs::Roulette),
+        (NextEvent::Always, SelectionLoss::None, Adrrs::Off),
+        (NextEvent::Never, SelectionLoss::None, Adrrs::Splitting),
     ];
-    for (nee, loss) in cases {
+    for (nee, loss, adrrs) in cases {
         let size = UVec2::new(16, 16);
         let camera = camera(
             DVec3::new(0.1, 0.2, -0.3),
@@ -64,11 +71,12 @@ fn guided_sphere_furnace_gives_le_over_one_minus_rho() {
         let integrator = GuidedPathIntegrator {
             nee,
             bsdf_sampling_fraction_loss: loss,
+            adrrs,
             ..guided()
         };
         let scene = build(vec![object], vec![], camera, size, integrator);
-        let film = render_film(&scene, 512, 1, None);
-        assert_mean_luminance(&format!("{nee:?}, {loss:?}"), &film, 2.0);
+        let film = render_film(&scene, 1024, 1, None);
+        assert_mean_luminance(&format!("{nee:?}, {loss:?}, {adrrs:?}"), &film, 2.0);
     }
 }
 
@@ -83,28 +91,34 @@ fn cornell_box(size: u32) -> Scene {
 
 /// On the Cornell box the image means of X, Y and Z agree with the path tracer's within 4
 /// combined standard errors (the guided image is the last iteration's, 516 of 1024 samples per
-/// pixel), and the combined standard error is small enough to see a 4 % difference.
+/// pixel), with Russian roulette by the learned radiance and with splitting too, and the
+/// combined standard error is small enough to see a 4 % difference.
 #[test]
 fn guided_and_path_agree_on_the_cornell_box() {
     let mut scene = cornell_box(32);
     let path = render_film(&scene, 1024, 3, None);
-    scene.integrator = Integrator::from(guided());
-    let guided = render_film(&scene, 1024, 4, None);
-    for c in 0..3 {
-        let (a, sa) = image_mean_and_standard_error(&guided, c);
-        let (b, sb) = image_mean_and_standard_error(&path, c);
-        let se = (sa * sa + sb * sb).sqrt();
-        assert!(se < 0.01 * b, "channel {c}: standard error {se} of {b}");
-        assert!(
-            (a - b).abs() < 4.0 * se,
-            "channel {c}: guided {a} ± {sa}, path {b} ± {sb}"
-        );
+    for adrrs in [Adrrs::Roulette, Adrrs::Splitting] {
+        scene.integrator = Integrator::from(GuidedPathIntegrator { adrrs, ..guided() });
+        let guided = render_film(&scene, 1024, 4, None);
+        for c in 0..3 {
+            let (a, sa) = image_mean_and_standard_error(&guided, c);
+            let (b, sb) = image_mean_and_standard_error(&path, c);
+            let se = (sa * sa + sb * sb).sqrt();
+            assert!(
+                se < 0.01 * b,
+                "{adrrs:?}, channel {c}: standard error {se} of {b}"
+            );
+            assert!(
+                (a - b).abs() < 4.0 * se,
+                "{adrrs:?}, channel {c}: guided {a} ± {sa}, path {b} ± {sb}"
+            );
+        }
     }
 }
 
 /// The same image, bit for bit, on one thread and on two: with the nearest and the stochastic
-/// spatial filter and with `kickstart` light samples, with the inverse-variance mix, and with α
-/// learned.
+/// spatial filter and with `kickstart` light samples, with the inverse-variance mix, with α
+/// learned, and with paths split by the learned radiance.
 #[test]
 fn guided_is_deterministic_for_any_thread_count() {
     let variants = [
@@ -120,6 +134,10 @@ fn guided_is_deterministic_for_any_thread_count() {
         },
         GuidedPathIntegrator {
             bsdf_sampling_fraction_loss: SelectionLoss::KullbackLeibler,
+            ..guided()
+        },
+        GuidedPathIntegrator {
+            adrrs: Adrrs::Splitting,
             ..guided()
         },
     ];
@@ -240,6 +258,7 @@ fn guided_refuses_bad_parameters() {
             "sd_tree_max_memory",
         ),
         (r#"<integer name="max_depth" value="-2"/>"#, "max_depth"),
+        (r#"<string name="adrrs" value="on"/>"#, "adrrs"),
     ];
     for (parameter, name) in cases {
         let xml = format!(

@@ -31,7 +31,7 @@ use crate::film::accumulation::{AOV_SUMS_PER_CHANNEL, add_aov_sample};
 use crate::film::{Film, PixelSums, ValueSum};
 use crate::integrator::guided::sd_tree::SdTree;
 use crate::integrator::guided::{
-    Budget, Guide, GuidedPathIntegrator, NextEvent, Record, SampleCombination,
+    Adrrs, Budget, Guide, GuidedPathIntegrator, NextEvent, Record, SampleCombination,
 };
 use crate::integrator::{RayCount, SampleContext};
 use crate::render::relative_error;
@@ -57,10 +57,12 @@ enum Plan {
     Seconds(f64),
 }
 
-/// An iteration's image: its tiles' sums, its passes, whether it has all it was planned to
-/// have, and its mean pixel variance.
+/// An iteration's image: its tiles' sums, its pixels' sums of their samples' radiance (the
+/// mean over the wavelengths, per tile), its passes, whether it has all it was planned to have,
+/// and its mean pixel variance.
 struct Image {
     sums: Vec<TileSums>,
+    radiance: Vec<Vec<f64>>,
     passes: u32,
     complete: bool,
     variance: f64,
@@ -171,6 +173,8 @@ pub(super) fn render(
     let mut images: Vec<Image> = Vec::new();
     let mut reason = StopReason::Completed;
     let mut extrapolated = f64::INFINITY;
+    // The pixels' estimates from the last finished iteration, per tile, for the weight window.
+    let mut estimates: Option<Vec<Vec<f32>>> = None;
     loop {
         let (passes, last) = match plan {
             Plan::Passes(total) => {
@@ -207,6 +211,7 @@ pub(super) fn render(
             passes,
             light_samples,
             !last,
+            estimates.as_deref(),
             &mut state,
         );
         if !finished {
@@ -226,6 +231,9 @@ pub(super) fn render(
         let stop_training = guided.sample_combination == SampleCombination::Automatic
             && left > 0.0
             && (left < this || (spp_before > TRUSTED_SPP && extrapolated > previous_extrapolated));
+        if guided.adrrs != Adrrs::Off {
+            estimates = Some(driver.estimates(&image));
+        }
         images.push(image);
         if last {
             break;
@@ -242,6 +250,7 @@ pub(super) fn render(
                 rest,
                 light_samples,
                 false,
+                estimates.as_deref(),
                 &mut state,
             );
             images.push(image);
@@ -310,8 +319,13 @@ struct Driver<'a> {
     k: usize,
 }
 
-/// What a pass returns: the tiles' sums, their records in tile order, the rays traced.
-type PassResult = (Vec<TileSums>, Vec<Vec<Record>>, u64);
+/// What a tile's pass returns: its sums, its pixels' radiance sums, its records, the rays
+/// traced.
+type TileResult = (TileSums, Vec<f64>, Vec<Record>, u64);
+
+/// What a pass returns: the tiles' sums and radiance sums, their records in tile order, the
+/// rays traced.
+type PassResult = (Vec<TileSums>, Vec<Vec<f64>>, Vec<Vec<Record>>, u64);
 
 impl Driver<'_> {
     /// An image without samples.
@@ -323,6 +337,11 @@ impl Driver<'_> {
                 self.k,
                 None,
             )?,
+            radiance: self
+                .tiles
+                .iter()
+                .map(|t| vec![0.0; (t.size.x * t.size.y) as usize])
+                .collect(),
             passes: 0,
             complete: false,
             variance: f64::INFINITY,
@@ -330,8 +349,10 @@ impl Driver<'_> {
     }
 
     /// Renders `passes` passes into `image`, with light samples or not, recording into the
-    /// tree's recording trees or not; returns whether all were rendered (false when one was
-    /// cancelled). Sets the image's variance.
+    /// tree's recording trees or not, with the pixels' `estimates` (per tile) where the weight
+    /// window uses them; returns whether all were rendered (false when one was cancelled).
+    /// Sets the image's variance.
+    #[allow(clippy::too_many_arguments)]
     fn run(
         &self,
         tree: &mut SdTree,
@@ -339,6 +360,7 @@ impl Driver<'_> {
         passes: u32,
         light_samples: bool,
         record: bool,
+        estimates: Option<&[Vec<f32>]>,
         state: &mut Iterations,
     ) -> bool {
         let spp = self.guided.spp_per_pass;
@@ -350,11 +372,13 @@ impl Driver<'_> {
                 record_weight: record.then_some(1.0),
             };
             let range = state.passes_done * spp..(state.passes_done + 1) * spp;
-            let Some((sums, records, rays)) = self.pass(&guide, &image.sums, range) else {
+            let Some((sums, radiance, records, rays)) = self.pass(&guide, image, estimates, range)
+            else {
                 image.variance = self.mean_variance(image);
                 return false;
             };
             image.sums = sums;
+            image.radiance = radiance;
             image.passes += 1;
             state.passes_done += 1;
             state.rays += rays;
@@ -369,44 +393,70 @@ impl Driver<'_> {
         true
     }
 
-    /// The sums `sums` with the samples `range` of every pixel added, guided by `guide`, with
-    /// the tiles' records; None when the pass was cancelled.
+    /// The sums of `image` with the samples `range` of every pixel added, guided by `guide`
+    /// (and the pixels' `estimates`, per tile), with the tiles' records; None when the pass
+    /// was cancelled.
     fn pass(
         &self,
         guide: &Guide,
-        sums: &[TileSums],
+        image: &Image,
+        estimates: Option<&[Vec<f32>]>,
         range: std::ops::Range<u32>,
     ) -> Option<PassResult> {
-        let results: Vec<Option<(TileSums, Vec<Record>, u64)>> = self.pool.install(|| {
+        let results: Vec<Option<TileResult>> = self.pool.install(|| {
             self.tiles
                 .par_iter()
-                .zip(sums)
-                .map(|(&tile, tile_sums)| self.tile(guide, tile, tile_sums, range.clone()))
+                .enumerate()
+                .map(|(t, &tile)| {
+                    self.tile(
+                        guide,
+                        tile,
+                        &image.sums[t],
+                        &image.radiance[t],
+                        estimates.map(|e| e[t].as_slice()),
+                        range.clone(),
+                    )
+                })
                 .collect()
         });
         let mut out = Vec::with_capacity(results.len());
+        let mut radiance = Vec::with_capacity(results.len());
         let mut records = Vec::with_capacity(results.len());
         let mut rays = 0;
         for result in results {
-            let (tile_sums, tile_records, tile_rays) = result?;
+            let (tile_sums, tile_radiance, tile_records, tile_rays) = result?;
             out.push(tile_sums);
+            radiance.push(tile_radiance);
             records.push(tile_records);
             rays += tile_rays;
         }
         if self.cancel.raised() {
             return None;
         }
-        Some((out, records, rays))
+        Some((out, radiance, records, rays))
     }
 
-    /// One tile's sums with the samples `range` of its pixels added, and its records.
+    /// The mean radiance (over the wavelengths) of each pixel's samples in `image`, per tile.
+    fn estimates(&self, image: &Image) -> Vec<Vec<f32>> {
+        let samples = f64::from(image.passes * self.guided.spp_per_pass).max(1.0);
+        image
+            .radiance
+            .iter()
+            .map(|tile| tile.iter().map(|&sum| (sum / samples) as f32).collect())
+            .collect()
+    }
+
+    /// One tile's sums and radiance sums with the samples `range` of its pixels added (guided
+    /// by `guide` and the pixels' `estimates`), and its records.
     fn tile(
         &self,
         guide: &Guide,
         tile: Tile,
         sums: &TileSums,
+        radiance_sums: &[f64],
+        estimates: Option<&[f32]>,
         range: std::ops::Range<u32>,
-    ) -> Option<(TileSums, Vec<Record>, u64)> {
+    ) -> Option<TileResult> {
         let estimator = self.estimator;
         let scene = estimator.scene;
         let mut sampler = Sampler::new(
@@ -416,6 +466,7 @@ impl Driver<'_> {
         );
         let mut count = RayCount::default();
         let mut out = sums.clone();
+        let mut radiance_out = radiance_sums.to_vec();
         let mut records = Vec::new();
         let aov_count = estimator.aov_count();
         let mut aovs = vec![0.0f32; aov_count];
@@ -437,9 +488,16 @@ impl Driver<'_> {
                             sampler: &mut sampler,
                             count: &mut count,
                         };
-                        self.guided
-                            .radiance(ctx, sample.ray, &sample.lambda, guide, &mut records)
+                        self.guided.radiance(
+                            ctx,
+                            sample.ray,
+                            &sample.lambda,
+                            guide,
+                            estimates.map(|e| e[i]),
+                            &mut records,
+                        )
                     };
+                    radiance_out[i] += f64::from(radiance.average());
                     let (_, weight, xyz) = estimator.film_sample(&sample, radiance, &mut aovs);
                     out.pixels[i].add(xyz.map(|v| v * weight));
                     for v in aovs.iter_mut() {
@@ -452,7 +510,7 @@ impl Driver<'_> {
         }
         self.progress
             .advance(u64::from(tile.size.x * tile.size.y) * u64::from(range.end - range.start));
-        Some((out, records, count.rays))
+        Some((out, radiance_out, records, count.rays))
     }
 
     /// The mean over the pixels of the variance of a sample's Y, each pixel's capped (the

@@ -18,7 +18,7 @@ use prism_core::film::output::IMAGE_CHANNELS;
 use prism_core::integrator::aov::{Aov, AovKind};
 use prism_core::integrator::distribution::DirectLights;
 use prism_core::integrator::guided::selection::SelectionLoss;
-use prism_core::integrator::guided::{Budget, NextEvent, SampleCombination, SpatialFilter};
+use prism_core::integrator::guided::{Adrrs, Budget, NextEvent, SampleCombination, SpatialFilter};
 use prism_core::integrator::{
     AovIntegrator, BdptIntegrator, DepthIntegrator, DirectIntegrator, DistributionIntegrator,
     GuidedPathIntegrator, Integrator, MomentIntegrator, ParticleTracer, PathIntegrator,
@@ -228,7 +228,8 @@ pub static INTEGRATORS: Registry<Build> = Registry {
                       0.6 plugin): path tracing whose directions are drawn by one-sample MIS \
                       from the BSDF and from an SD-tree of incident radiance (a spatial binary \
                       tree of directional quadtrees) learned in iterations of doubling sample \
-                      counts; next-event estimation and Russian roulette as `path`. The image \
+                      counts; next-event estimation as `path`, Russian roulette by the \
+                      learned radiance (`adrrs`). The image \
                       is the last iteration's (or an inverse-variance mix of the last four); \
                       bit-identical for any thread count; one-pixel reconstruction; no \
                       checkpoints, resume or merge; no media.",
@@ -250,6 +251,7 @@ pub static INTEGRATORS: Registry<Build> = Registry {
                 DIRECTIONAL_FILTER,
                 BSDF_SAMPLING_FRACTION_LOSS,
                 SD_TREE_MAX_MEMORY,
+                ADRRS,
                 DUMP_SD_TREE,
             ],
             build: build_guided,
@@ -308,6 +310,7 @@ params! {
     DIRECTIONAL_FILTER = ParamSpec::new("directional_filter", ParamKind::Choice(&[Choice::new("nearest", &())]), Default::Str("nearest"), "records go to the quadrant of their direction (`box` is not supported)");
     BSDF_SAMPLING_FRACTION_LOSS = ParamSpec::new("bsdf_sampling_fraction_loss", ParamKind::Choice(&[Choice::new("none", &SelectionLoss::None), Choice::new("kl", &SelectionLoss::KullbackLeibler), Choice::new("var", &SelectionLoss::Variance)]), Default::Str("none"), "α fixed at bsdf_sampling_fraction (`none`), or learned per spatial leaf by Adam on the KL divergence from the integrand to the mixture (`kl`) or on the estimate's variance (`var`)");
     SD_TREE_MAX_MEMORY = ParamSpec::new("sd_tree_max_memory", ParamKind::Integer, Default::Integer(-1), "megabytes of quadtrees beyond which spatial leaves stop splitting (−1: no limit)");
+    ADRRS = ParamSpec::new("adrrs", ParamKind::Choice(&[Choice::new("off", &Adrrs::Off), Choice::new("roulette", &Adrrs::Roulette), Choice::new("split", &Adrrs::Splitting)]), Default::Str("roulette"), "Russian roulette (and splitting) by the learned radiance (Vorba & Křivánek 2016): from the second iteration on, a path whose expected contribution (its throughput times the indirect radiance its vertex's spatial leaf sent back in the previous iteration) falls below ⅓ of its pixel's estimate survives with that ratio as probability (at least 0.05), and elsewhere goes on; with `split`, one above 5⁄3 of it splits into that many paths (at most 8 per camera sample); `off`, and where nothing is learned: Russian roulette as `path`");
     DUMP_SD_TREE = ParamSpec::new("dump_sd_tree", ParamKind::Boolean, Default::Boolean(false), "must be false: Prism writes no SD-tree files");
     RR_THRESHOLD = ParamSpec::new("rr_threshold", ParamKind::Float, Default::Float(0.1), "potential below which Russian roulette starts");
 }
@@ -707,6 +710,7 @@ fn build_guided(params: &Params) -> Result<Integrator> {
         nee: params.choice(&NEE)?,
         spatial_filter,
         sd_tree_max_memory,
+        adrrs: params.choice(&ADRRS)?,
     }))
 }
 

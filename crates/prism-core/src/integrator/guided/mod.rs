@@ -6,7 +6,8 @@
 //!
 //! Its parameters (`sppPerPass`, `budgetType`, `budget`, `sampleCombination`,
 //! `sTreeThreshold`, `dTreeThreshold`, `bsdfSamplingFraction`, `nee`, `spatialFilter`,
-//! `sdTreeMaxMemory`, `maxDepth`, `rrDepth`, `strictNormals`, `hideEmitters`) and their
+//! `sdTreeMaxMemory`, `maxDepth`, `rrDepth`, `strictNormals`, `hideEmitters`, and Prism's
+//! `adrrs`) and their
 //! defaults are listed in docs/plugins.md. The render driver (`render::guided`) runs the
 //! iterations.
 //!
@@ -29,8 +30,14 @@
 //! the BSDF keeps its own weight divided by α; BSDFs without smooth lobes are
 //! sampled as the path tracer samples them. Next-event estimation (`nee`, by default
 //! `always`) takes one light sample per vertex as `path` does, weighed against the mixture's
-//! density by the power heuristic, as is the emission a sampled direction finds; Russian
-//! roulette is `path`'s.
+//! density by the power heuristic, as is the emission a sampled direction finds.
+//!
+//! **Russian roulette** (`adrrs`, [`weight_window`]): once the tree has learned, a path at a
+//! vertex with a smooth lobe measures its throughput times the indirect radiance the vertex's
+//! leaf sent back in the previous iteration against its pixel's estimate from that iteration,
+//! and survives (or, with `split`, splits) by the weight window of Vorba & Křivánek 2016;
+//! elsewhere, and with `off`, Russian roulette is `path`'s. A path split at a vertex goes on as
+//! several, each drawing its own direction there and recording its own vertices.
 //!
 //! **Recording.** Where the path has gone on from a vertex with a smooth lobe, the radiance
 //! its later vertices bring back, divided by the throughput to the vertex, estimates the
@@ -54,12 +61,14 @@ pub mod quadtree;
 pub mod sd_tree;
 pub mod selection;
 pub mod vertex_guide;
+pub mod weight_window;
 
 use std::f32::consts::PI;
 
 use glam::{Vec2, Vec3};
 
-use crate::bsdf::{BsdfFlags, BxdfTree};
+use crate::bsdf::{BsdfFlags, BxdfTree, Scattering};
+use crate::geometry::SurfaceInteraction;
 use crate::integrator::SampleContext;
 use crate::integrator::mis::{
     ScatterOrigin, Strategies, emission_found, power_heuristic, sample_light, unoccluded,
@@ -75,6 +84,7 @@ use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use sd_tree::{SdTree, SpatialLeaf, orientation};
 use selection::{SelectionLoss, SelectionSample};
 use vertex_guide::VertexGuide;
+use weight_window::Window;
 
 /// How the iterations' images make the final one.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -86,6 +96,19 @@ pub enum SampleCombination {
     Automatic,
     /// The last four iterations' images weighted by their inverse mean pixel variance.
     InverseVariance,
+}
+
+/// How paths are ended or split by the learned radiance ([`weight_window`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Adrrs {
+    /// Russian roulette as `path`'s.
+    Off,
+    /// Russian roulette by the weight window where the learned radiance is known, as `path`'s
+    /// elsewhere.
+    Roulette,
+    /// Russian roulette and splitting by the weight window, into at most
+    /// [`weight_window::MAX_SPLIT`] paths per camera sample.
+    Splitting,
 }
 
 /// What the render may spend.
@@ -141,6 +164,8 @@ pub struct GuidedPathIntegrator {
     pub spatial_filter: SpatialFilter,
     /// Megabytes beyond which the spatial tree stops splitting (None: no limit).
     pub sd_tree_max_memory: Option<u32>,
+    /// Whether Russian roulette (and splitting) follow the learned radiance where it is known.
+    pub adrrs: Adrrs,
 }
 
 impl Default for GuidedPathIntegrator {
@@ -160,6 +185,7 @@ impl Default for GuidedPathIntegrator {
             nee: NextEvent::Always,
             spatial_filter: SpatialFilter::Nearest,
             sd_tree_max_memory: None,
+            adrrs: Adrrs::Roulette,
         }
     }
 }
@@ -183,6 +209,9 @@ pub struct Record {
     pub point: Vec2,
     /// L_i / p(ω).
     pub flux: f32,
+    /// The indirect radiance the vertex sends towards its path's previous vertex,
+    /// L_i f cos θ / p(ω), where the record is a vertex's.
+    pub reflected: Option<f32>,
     pub weight: f32,
     /// What the record brings to the leaf's learned α, where it is learned.
     pub selection: Option<SelectionSample>,
@@ -224,6 +253,8 @@ struct RecordingVertex {
     point: Vec2,
     /// The path's throughput once the vertex's sample is taken.
     throughput: SampledSpectrum,
+    /// The sample's weight f cos θ / p.
+    scatter: SampledSpectrum,
     /// The radiance the path has brought back through the vertex.
     radiance: SampledSpectrum,
     pdf: f32,
@@ -272,6 +303,12 @@ impl RecordingVertices {
             self.last_is_current = true;
         }
     }
+
+    /// Drops the vertices from `count` on.
+    fn truncate(&mut self, count: usize) {
+        self.count = count.min(self.count);
+        self.last_is_current = false;
+    }
 }
 
 /// `radiance` / `throughput` per wavelength, where the throughput is not negligible: the
@@ -290,8 +327,49 @@ fn incident_radiance(
     })
 }
 
+/// What every vertex of a path works with.
+struct PathSetup<'g> {
+    guide: &'g Guide<'g>,
+    strategies: Strategies,
+    /// Whether the emission a vertex's own sample finds is left out of its record.
+    own_emission_is_direct: bool,
+    learns_alpha: bool,
+    /// The pixel's estimate, where the weight window ([`weight_window`]) applies.
+    pixel_estimate: Option<f32>,
+}
+
+/// Where a path (or one of the paths it split into) stands on its way to its next vertex.
+#[derive(Clone, Copy, Debug)]
+struct Walk {
+    ray: Ray,
+    /// The wavelengths the walk began with: its estimate is for them.
+    started: SampledWavelengths,
+    lambda: SampledWavelengths,
+    throughput: SampledSpectrum,
+    eta_scale: f32,
+    previous: Option<ScatterOrigin>,
+    depth: i32,
+    /// The most paths the walk may still split into, over all its later vertices.
+    splits_left: u32,
+}
+
+/// A vertex with a smooth or delta lobe, its scattering and its guide.
+struct Vertex<'v, 't, 'w> {
+    si: SurfaceInteraction,
+    scattering: Scattering<'t, 'w>,
+    /// The spatial leaf the vertex samples from and records into, where its BSDF has a smooth
+    /// lobe.
+    leaf: Option<SpatialLeaf>,
+    /// The orientation class of the surface's front side.
+    class: u32,
+    trees: Option<VertexGuide<'v>>,
+    /// The probability of sampling the BSDF rather than the guide.
+    alpha: f32,
+}
+
 impl GuidedPathIntegrator {
-    /// The estimate along the camera ray `ray` at `wavelengths`, guided by `guide`; the path's
+    /// The estimate along the camera ray `ray` at `wavelengths`, guided by `guide`, in a pixel
+    /// whose estimate from the previous iteration is `pixel_estimate` (where known); the path's
     /// records go to `records`.
     pub fn radiance(
         &self,
@@ -299,55 +377,83 @@ impl GuidedPathIntegrator {
         ray: Ray,
         wavelengths: &SampledWavelengths,
         guide: &Guide,
+        pixel_estimate: Option<f32>,
         records: &mut Vec<Record>,
     ) -> SampledSpectrum {
         if self.max_depth == 0 {
             return SampledSpectrum::ZERO;
         }
-        let world = ctx.world();
-        let learns_alpha = self.bsdf_sampling_fraction_loss != SelectionLoss::None;
-        let strategies = Strategies {
-            light_samples: if guide.light_samples { 1.0 } else { 0.0 },
-            bsdf_samples: 1.0,
+        let setup = PathSetup {
+            guide,
+            strategies: Strategies {
+                light_samples: if guide.light_samples { 1.0 } else { 0.0 },
+                bsdf_samples: 1.0,
+            },
+            // With light samples always on, what a vertex's own sample finds is theirs to learn.
+            own_emission_is_direct: guide.light_samples && self.nee == NextEvent::Always,
+            learns_alpha: self.bsdf_sampling_fraction_loss != SelectionLoss::None,
+            pixel_estimate: pixel_estimate.filter(|_| self.adrrs != Adrrs::Off && guide.trained),
         };
-        // With light samples always on, what a vertex's own sample finds is theirs to learn.
-        let own_emission_is_direct = guide.light_samples && self.nee == NextEvent::Always;
-        let mut ray = ray;
-        let mut lambda = *wavelengths;
-        let mut result = SampledSpectrum::ZERO;
-        let mut throughput = SampledSpectrum::ONE;
-        let mut eta_scale = 1.0f32;
-        let mut previous: Option<ScatterOrigin> = None;
-        let mut depth = 0i32;
+        let walk = Walk {
+            ray,
+            started: *wavelengths,
+            lambda: *wavelengths,
+            throughput: SampledSpectrum::ONE,
+            eta_scale: 1.0,
+            previous: None,
+            depth: 0,
+            splits_left: match self.adrrs {
+                Adrrs::Splitting => weight_window::MAX_SPLIT,
+                Adrrs::Off | Adrrs::Roulette => 1,
+            },
+        };
         let mut recording = RecordingVertices::new();
+        self.walk(ctx, &setup, walk, 0, &mut recording, records)
+    }
+
+    /// The estimate of the path `w` from its ray on, for the wavelengths it began with; where
+    /// the weight window splits it, the sum of its branches'. Files the records of the
+    /// recording vertices from `first_record` on when the path ends, and drops them.
+    fn walk(
+        &self,
+        ctx: &mut SampleContext,
+        setup: &PathSetup,
+        mut w: Walk,
+        first_record: usize,
+        recording: &mut RecordingVertices,
+        records: &mut Vec<Record>,
+    ) -> SampledSpectrum {
+        let world = ctx.world();
+        let guide = setup.guide;
+        let mut result = SampledSpectrum::ZERO;
         let mut lobes = BxdfTree::empty();
         loop {
-            let hit = ctx.intersect(&ray);
-            if !(self.hide_emitters && depth == 0) {
-                let found = throughput
+            let hit = ctx.intersect(&w.ray);
+            if !(self.hide_emitters && w.depth == 0) {
+                let found = w.throughput
                     * emission_found(
                         ctx,
-                        &ray,
+                        &w.ray,
                         hit.as_ref(),
-                        previous.as_ref(),
-                        &lambda,
-                        strategies,
+                        w.previous.as_ref(),
+                        &w.lambda,
+                        setup.strategies,
                     );
                 if !found.is_black() {
                     result += found;
-                    recording.add(found, own_emission_is_direct);
+                    recording.add(found, setup.own_emission_is_direct);
                 }
             }
             let Some(si) = hit else {
                 break;
             };
-            let wo = -ray.d.normalize();
-            if !allows_next_vertex(self.max_depth, depth)
+            let wo = -w.ray.d.normalize();
+            if !allows_next_vertex(self.max_depth, w.depth)
                 || (self.strict_normals && !normals_agree(&si, wo))
             {
                 break;
             }
-            let scattering = surface_scattering(world, &si, wo, &mut lambda, &mut lobes);
+            let scattering = surface_scattering(world, &si, wo, &mut w.lambda, &mut lobes);
             let smooth = scattering.flags().has_smooth_lobe();
             let side = wo.dot(si.shading.n);
             let front = if side < 0.0 {
@@ -367,10 +473,18 @@ impl GuidedPathIntegrator {
                 }
             });
             let alpha = match leaf {
-                Some(l) if learns_alpha && guide.trained => {
+                Some(l) if setup.learns_alpha && guide.trained => {
                     guide.tree.leaf(l.index).selection.fraction()
                 }
                 _ => self.bsdf_sampling_fraction,
+            };
+            let vertex = Vertex {
+                si,
+                scattering,
+                leaf,
+                class,
+                trees,
+                alpha,
             };
             let mixture = |bsdf_pdf: f32, wi: Vec3| match trees {
                 Some(tree) => alpha * bsdf_pdf + (1.0 - alpha) * tree.pdf(wi),
@@ -378,30 +492,32 @@ impl GuidedPathIntegrator {
             };
 
             if guide.light_samples && smooth {
+                let si = &vertex.si;
                 let receiver = Receiver::surface(si.p, si.shading.n);
                 let mut light_direction = Vec3::ZERO;
-                let light = sample_light(ctx, &receiver, si.time, &lambda, |ctx, ls| {
-                    if self.strict_normals && !normals_agree(&si, ls.wi) {
+                let light = sample_light(ctx, &receiver, si.time, &w.lambda, |ctx, ls| {
+                    if self.strict_normals && !normals_agree(si, ls.wi) {
                         return None;
                     }
-                    let mut f = unoccluded(ctx, &si, &scattering, ls)?;
+                    let mut f = unoccluded(ctx, si, &vertex.scattering, ls)?;
                     f.pdf = mixture(f.pdf, ls.wi);
                     light_direction = ls.wi;
                     Some((f, ShadowTransmittance::ONE))
                 });
                 if let Some(light) = light {
-                    let contribution = throughput * light.weighted(strategies);
+                    let contribution = w.throughput * light.weighted(setup.strategies);
                     result += contribution;
                     recording.add(contribution, false);
                     if let (Some(weight), Some(leaf)) = (guide.record_weight, leaf)
                         && self.nee == NextEvent::Kickstart
                         && !light.is_delta
                     {
-                        let w = power_heuristic(light.light_pdf, light.direction_pdf);
+                        let mis = power_heuristic(light.light_pdf, light.direction_pdf);
                         records.push(Record {
                             leaf: leaf.index,
                             point: direction_to_square(light_direction),
-                            flux: (light.radiance * w).average() / light.light_pdf,
+                            flux: (light.radiance * mis).average() / light.light_pdf,
+                            reflected: None,
                             weight: weight * 0.5,
                             selection: None,
                         });
@@ -409,98 +525,166 @@ impl GuidedPathIntegrator {
                 }
             }
 
-            // The next direction, by one-sample MIS of the BSDF and the guide.
-            let u_choice = if trees.is_some() {
-                ctx.sampler.next_1d()
-            } else {
-                0.0
+            let verdict = match (setup.pixel_estimate, leaf) {
+                (Some(pixel), Some(l)) => weight_window::window(
+                    w.throughput.average(),
+                    guide.tree.leaf(l.index).reflected(),
+                    pixel,
+                ),
+                _ => None,
             };
-            let u_lobe = ctx.sampler.next_1d();
-            let u = ctx.sampler.next_2d();
-            let (wi, weight, pdf, delta, eta, next_lambda, selection) = match trees {
-                Some(tree) if u_choice >= alpha => {
-                    let wi = tree.sample(u);
-                    let f = scattering.eval(wi);
-                    let guide_pdf = tree.pdf(wi);
-                    let pdf = alpha * f.pdf + (1.0 - alpha) * guide_pdf;
-                    if !(pdf > 0.0) {
+            match verdict {
+                Some(Window::Roulette(survival)) => {
+                    if ctx.sampler.next_1d() >= survival {
                         break;
                     }
-                    let selection = learns_alpha.then_some((f.value, f.pdf, guide_pdf));
-                    (
-                        wi,
-                        f.value * (1.0 / pdf),
-                        pdf,
-                        false,
-                        1.0,
-                        lambda,
-                        selection,
-                    )
+                    w.throughput *= 1.0 / survival;
                 }
-                _ => {
-                    let Some(bs) = scattering.sample(u_lobe, u) else {
-                        break;
-                    };
-                    let next_lambda = wavelengths_after(&lambda, &bs);
-                    let delta = bs.flags.is_delta();
-                    let (weight, pdf, selection) = match trees {
-                        Some(_) if delta => (bs.weight * (1.0 / alpha), bs.pdf * alpha, None),
-                        Some(tree) => {
-                            let guide_pdf = tree.pdf(bs.wi);
-                            let pdf = alpha * bs.pdf + (1.0 - alpha) * guide_pdf;
-                            let selection =
-                                learns_alpha.then_some((bs.weight * bs.pdf, bs.pdf, guide_pdf));
-                            (bs.weight * (bs.pdf / pdf), pdf, selection)
+                Some(Window::Split(n)) if w.splits_left >= 2 => {
+                    let n = n.min(w.splits_left);
+                    let share = 1.0 / n as f32;
+                    for _ in 0..n {
+                        let first = recording.count;
+                        let mut branch = Walk {
+                            started: w.lambda,
+                            throughput: w.throughput * share,
+                            splits_left: w.splits_left / n,
+                            ..w
+                        };
+                        if self.scatter(ctx, setup, &vertex, &mut branch, recording) {
+                            result += self.walk(ctx, setup, branch, first, recording, records);
                         }
-                        None => (bs.weight, bs.pdf, None),
-                    };
-                    (bs.wi, weight, pdf, delta, bs.eta, next_lambda, selection)
+                    }
+                    break;
                 }
-            };
-            if self.strict_normals && !normals_agree(&si, wi) {
+                Some(Window::Keep | Window::Split(_)) | None => {}
+            }
+            if !self.scatter(ctx, setup, &vertex, &mut w, recording) {
                 break;
             }
-            lambda = next_lambda;
-            throughput *= weight;
-            eta_scale *= eta;
-            if throughput.is_black() || !throughput.is_finite() {
-                break;
-            }
-            recording.push(
-                leaf.filter(|_| guide.record_weight.is_some() && !delta)
-                    .map(|leaf| RecordingVertex {
-                        leaf,
-                        class,
-                        p: si.p,
-                        point: direction_to_square(wi),
-                        throughput,
-                        radiance: SampledSpectrum::ZERO,
-                        pdf,
-                        selection,
-                    }),
-            );
-            ray = si.spawn_ray(wi);
-            previous = Some(ScatterOrigin {
-                receiver: Receiver::surface(si.p, si.shading.n),
-                pdf,
-                specular: delta,
-            });
-            depth += 1;
-
-            if depth >= self.rr_depth {
-                let Some(factor) = russian_roulette(ctx, throughput, eta_scale) else {
+            if verdict.is_none() && w.depth >= self.rr_depth {
+                let Some(factor) = russian_roulette(ctx, w.throughput, w.eta_scale) else {
                     break;
                 };
-                throughput *= factor;
+                w.throughput *= factor;
             }
         }
+        self.file_records(ctx, guide, recording, first_record, records);
+        path_estimate(result, &w.started, &w.lambda)
+    }
+
+    /// Draws the next direction at `vertex`, by one-sample MIS of the BSDF and the guide, and
+    /// moves the path `w` onto it (its recording vertex pushed); false where the path ends
+    /// there.
+    fn scatter(
+        &self,
+        ctx: &mut SampleContext,
+        setup: &PathSetup,
+        vertex: &Vertex,
+        w: &mut Walk,
+        recording: &mut RecordingVertices,
+    ) -> bool {
+        let (si, scattering, alpha) = (&vertex.si, &vertex.scattering, vertex.alpha);
+        let u_choice = if vertex.trees.is_some() {
+            ctx.sampler.next_1d()
+        } else {
+            0.0
+        };
+        let u_lobe = ctx.sampler.next_1d();
+        let u = ctx.sampler.next_2d();
+        let (wi, weight, pdf, delta, eta, next_lambda, selection) = match vertex.trees {
+            Some(tree) if u_choice >= alpha => {
+                let wi = tree.sample(u);
+                let f = scattering.eval(wi);
+                let guide_pdf = tree.pdf(wi);
+                let pdf = alpha * f.pdf + (1.0 - alpha) * guide_pdf;
+                if !(pdf > 0.0) {
+                    return false;
+                }
+                let selection = setup.learns_alpha.then_some((f.value, f.pdf, guide_pdf));
+                (
+                    wi,
+                    f.value * (1.0 / pdf),
+                    pdf,
+                    false,
+                    1.0,
+                    w.lambda,
+                    selection,
+                )
+            }
+            _ => {
+                let Some(bs) = scattering.sample(u_lobe, u) else {
+                    return false;
+                };
+                let next_lambda = wavelengths_after(&w.lambda, &bs);
+                let delta = bs.flags.is_delta();
+                let (weight, pdf, selection) = match vertex.trees {
+                    Some(_) if delta => (bs.weight * (1.0 / alpha), bs.pdf * alpha, None),
+                    Some(tree) => {
+                        let guide_pdf = tree.pdf(bs.wi);
+                        let pdf = alpha * bs.pdf + (1.0 - alpha) * guide_pdf;
+                        let selection =
+                            setup
+                                .learns_alpha
+                                .then_some((bs.weight * bs.pdf, bs.pdf, guide_pdf));
+                        (bs.weight * (bs.pdf / pdf), pdf, selection)
+                    }
+                    None => (bs.weight, bs.pdf, None),
+                };
+                (bs.wi, weight, pdf, delta, bs.eta, next_lambda, selection)
+            }
+        };
+        if self.strict_normals && !normals_agree(si, wi) {
+            return false;
+        }
+        w.lambda = next_lambda;
+        w.throughput *= weight;
+        w.eta_scale *= eta;
+        if w.throughput.is_black() || !w.throughput.is_finite() {
+            return false;
+        }
+        recording.push(
+            vertex
+                .leaf
+                .filter(|_| setup.guide.record_weight.is_some() && !delta)
+                .map(|leaf| RecordingVertex {
+                    leaf,
+                    class: vertex.class,
+                    p: si.p,
+                    point: direction_to_square(wi),
+                    throughput: w.throughput,
+                    scatter: weight,
+                    radiance: SampledSpectrum::ZERO,
+                    pdf,
+                    selection,
+                }),
+        );
+        w.ray = si.spawn_ray(wi);
+        w.previous = Some(ScatterOrigin {
+            receiver: Receiver::surface(si.p, si.shading.n),
+            pdf,
+            specular: delta,
+        });
+        w.depth += 1;
+        true
+    }
+
+    /// Files the records of the recording vertices from `first` on and drops them.
+    fn file_records(
+        &self,
+        ctx: &mut SampleContext,
+        guide: &Guide,
+        recording: &mut RecordingVertices,
+        first: usize,
+        records: &mut Vec<Record>,
+    ) {
         if let Some(weight) = guide.record_weight {
             let weight = if self.nee == NextEvent::Kickstart && guide.light_samples {
                 weight * 0.5
             } else {
                 weight
             };
-            for v in recording.vertices[..recording.count].iter().flatten() {
+            for v in recording.vertices[first..recording.count].iter().flatten() {
                 let leaf = match self.spatial_filter {
                     SpatialFilter::Nearest => v.leaf.index,
                     SpatialFilter::StochasticBox => {
@@ -520,6 +704,7 @@ impl GuidedPathIntegrator {
                     leaf,
                     point: v.point,
                     flux: incident.average() / v.pdf,
+                    reflected: Some((incident * v.scatter).average()),
                     weight,
                     selection: v.selection.map(|(bsdf_value, bsdf_pdf, guide_pdf)| {
                         SelectionSample {
@@ -532,6 +717,6 @@ impl GuidedPathIntegrator {
                 });
             }
         }
-        path_estimate(result, wavelengths, &lambda)
+        recording.truncate(first);
     }
 }

@@ -63,6 +63,21 @@ pub struct LeafTrees {
     pub building: DirectionalTree,
     /// α where it is learned (`bsdfSamplingFractionLoss`).
     pub selection: LearnedSelection,
+    /// The mean indirect radiance the leaf's vertices sent back along their paths, learned in
+    /// the previous iteration (0 where none was recorded).
+    reflected: f32,
+    /// The statistical weight and the weighted sum of this iteration's records of it.
+    reflected_sums: (f64, f64),
+}
+
+impl LeafTrees {
+    /// The mean indirect radiance the leaf's vertices sent back along their paths, as learned
+    /// in the previous iteration (0 where none was recorded): the L_o of the weight window
+    /// ([`super::weight_window`]).
+    #[inline]
+    pub fn reflected(&self) -> f32 {
+        self.reflected
+    }
 }
 
 /// The trees found for a point and orientation: their index and the extent of their spatial
@@ -136,12 +151,19 @@ impl SdTree {
         &self.leaves[index as usize]
     }
 
-    /// Files `record` into its leaf: its flux into the building tree and, under `loss`, its
-    /// gradient into the leaf's learned α.
+    /// Files `record` into its leaf: its flux into the building tree, its reflected radiance
+    /// into the leaf's mean and, under `loss`, its gradient into the leaf's learned α.
     pub fn file(&mut self, record: &Record, loss: SelectionLoss) {
         let leaf = &mut self.leaves[record.leaf as usize];
         leaf.building
             .record(record.point, record.flux, record.weight);
+        if let Some(reflected) = record.reflected
+            && reflected.is_finite()
+        {
+            let weight = f64::from(record.weight);
+            leaf.reflected_sums.0 += weight;
+            leaf.reflected_sums.1 += weight * f64::from(reflected);
+        }
         if let Some(sample) = &record.selection {
             leaf.selection.train(sample, loss);
         }
@@ -223,11 +245,17 @@ impl SdTree {
     }
 
     /// Ends an iteration: every leaf's recorded tree, its sums built, becomes the tree paths
-    /// sample from.
+    /// sample from, and the mean of its recorded reflected radiance the one they read.
     pub fn build(&mut self) {
         for leaf in &mut self.leaves {
             leaf.building.build();
             leaf.sampling = leaf.building.clone();
+            let (weight, sum) = std::mem::take(&mut leaf.reflected_sums);
+            leaf.reflected = if weight > 0.0 {
+                (sum / weight) as f32
+            } else {
+                0.0
+            };
         }
     }
 }
@@ -247,6 +275,7 @@ mod tests {
             leaf: 0,
             point: Vec2::splat(0.5),
             flux: 1.0,
+            reflected: None,
             weight: 1.0,
             selection: None,
         };
@@ -265,6 +294,36 @@ mod tests {
         assert_eq!(a.size, Vec3::new(1.0, 1.0, 2.0));
         // The sampling trees are the parent's.
         assert!(tree.leaf(a.index).sampling.pdf(Vec2::splat(0.5)) > 1.0);
+    }
+
+    /// A leaf's reflected radiance is the weighted mean of its records' from the iteration
+    /// built last (records without one left out), and 0 where an iteration recorded none.
+    #[test]
+    fn reflected_radiance_is_the_mean_of_the_last_iterations_records() {
+        let mut tree = SdTree::new(Vec3::ZERO, Vec3::ONE);
+        tree.refine(1e9, 0.01, None);
+        let record = |reflected, weight| Record {
+            leaf: 0,
+            point: Vec2::splat(0.5),
+            flux: 1.0,
+            reflected,
+            weight,
+            selection: None,
+        };
+        for r in [
+            record(Some(1.0), 1.0),
+            record(Some(4.0), 0.5),
+            record(None, 1.0),
+            record(Some(f32::NAN), 1.0),
+        ] {
+            tree.file(&r, SelectionLoss::None);
+        }
+        assert_eq!(tree.leaf(0).reflected(), 0.0);
+        tree.build();
+        assert_eq!(tree.leaf(0).reflected(), 2.0);
+        tree.refine(1e9, 0.01, None);
+        tree.build();
+        assert_eq!(tree.leaf(0).reflected(), 0.0);
     }
 
     /// Records of the two sides of a surface go to trees of their own in the same leaf, and
@@ -288,6 +347,7 @@ mod tests {
                 leaf: leaf.index,
                 point,
                 flux: 1.0,
+                reflected: None,
                 weight: 1.0,
                 selection: None,
             };
