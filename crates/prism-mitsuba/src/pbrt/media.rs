@@ -16,7 +16,8 @@
 //! 2·max(rgb) times the spectrum fitted to rgb / (2·max(rgb))), where Prism's factory upsamples
 //! an `<rgb>` whose components are at most 1 as a reflectance, a different spectrum of the same
 //! colour that light crossing the medium would tell apart; so the reader gives the factory
-//! pbrt's spectrum, sampled every 5 nm.
+//! pbrt's spectrum for such a triple, sampled every 5 nm (above 1 the factory scales the triple
+//! as pbrt does, and it is passed as it is).
 
 use std::sync::Arc;
 
@@ -232,10 +233,11 @@ impl Builder {
 }
 
 /// Whether an RGB coefficient is one the factory would upsample otherwise than pbrt does: of
-/// several colours (a grey one is a constant either way), finite and not negative (the factory
-/// refuses the rest with its own message).
+/// several colours (a grey one is a constant either way), with every component in [0, 1] (above
+/// 1 the factory scales it as pbrt does; the factory refuses negative and non-finite ones with
+/// its own message).
 fn is_coloured_coefficient(rgb: [f64; 3]) -> bool {
-    rgb.iter().all(|c| c.is_finite() && *c >= 0.0) && (rgb[0] != rgb[1] || rgb[1] != rgb[2])
+    rgb.iter().all(|c| (0.0..=1.0).contains(c)) && (rgb[0] != rgb[1] || rgb[1] != rgb[2])
 }
 
 /// pbrt-v4's unbounded spectrum of `rgb`, sampled every 5 nm over 360–830 nm.
