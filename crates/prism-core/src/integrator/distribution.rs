@@ -34,8 +34,10 @@
 //!
 //! The recursion is traced as a tree of rays, depth first and one ray per step
 //! ([`SteppedPath`]), so that the estimator's camera samples run in the render driver's lanes:
-//! at a vertex, after its shadow rays, the N bounce directions are drawn, and each bounce's
-//! subtree is traced before the next, as the slides' recursion orders the rays. The factors
+//! at a vertex, after its shadow rays, all N bounce directions are drawn, then each bounce's
+//! subtree is traced before the next, as the slides' recursion orders the rays (the recursion
+//! draws each bounce's direction just before its subtree, so the random numbers fall in
+//! another order than a literal transcription's, for the same estimator). The factors
 //! along a branch (the weights, 1/s, 1/N and the hero-only factor of a dispersive vertex or
 //! bounce) are all per wavelength, so they multiply into the branch's weight instead of being
 //! applied on the way back up.
@@ -51,7 +53,9 @@ use crate::geometry::SurfaceInteraction;
 use crate::integrator::SampleContext;
 use crate::integrator::mis::{emission_along, sample_point_on, unoccluded};
 use crate::integrator::stepped::SteppedPath;
-use crate::integrator::vertex::{allows_next_vertex, hero_only, surface_scattering};
+use crate::integrator::vertex::{
+    CERTAIN_SURVIVAL_DEPTH, MAX_SURVIVAL, allows_next_vertex, hero_only, surface_scattering,
+};
 use crate::light::{Light, LightSelection, Receiver};
 use crate::math::Ray;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
@@ -90,9 +94,6 @@ impl Default for DistributionIntegrator {
     }
 }
 
-/// The depth below which the roulette may let a path survive with certainty.
-pub const CERTAIN_SURVIVAL_DEPTH: i32 = 128;
-
 /// A count from the potential: clamp(round(maximum · potential), 1, maximum).
 fn count_from_potential(maximum: u32, potential: f32) -> u32 {
     ((maximum as f32 * potential).round() as u32).clamp(1, maximum.max(1))
@@ -106,7 +107,7 @@ impl DistributionIntegrator {
     pub fn choose_s(&self, potential: f32, depth: i32) -> f32 {
         let survival = (potential / self.rr_threshold).min(1.0);
         if depth >= CERTAIN_SURVIVAL_DEPTH {
-            survival.min(0.95)
+            survival.min(MAX_SURVIVAL)
         } else {
             survival
         }

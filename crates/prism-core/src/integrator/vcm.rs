@@ -530,7 +530,9 @@ impl VcmIntegrator {
                     let emission = direct * cos_in / PI;
                     1.0 / (1.0 + mis(direct) * weights.d_vcm + mis(emission) * weights.d_vc)
                 };
-                result += estimate(beta * le * weight, started, &lambda, &lambda);
+                if weight.is_finite() {
+                    result += estimate(beta * le * weight, started, &lambda, &lambda);
+                }
             }
             if !self.allows(depth + 1) {
                 break;

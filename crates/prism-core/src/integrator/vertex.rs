@@ -54,8 +54,18 @@ pub fn allows_next_vertex(max_depth: i32, depth: i32) -> bool {
     max_depth < 0 || depth + 1 < max_depth
 }
 
+/// The largest survival probability of Russian roulette, so that every path ends: 0.95, as in
+/// Mitsuba 3.
+pub const MAX_SURVIVAL: f32 = 0.95;
+
+/// The depth below which an estimator whose roulette is not bounded by [`MAX_SURVIVAL`] (the
+/// lecture's potential rule, the guide's weight window) may let a path survive with certainty;
+/// from it on, survival is at most [`MAX_SURVIVAL`], so that a path caught between mirrors or
+/// in a white furnace ends too.
+pub const CERTAIN_SURVIVAL_DEPTH: i32 = 128;
+
 /// Russian roulette on the path's potential (the lecture's "Termination of Recursion"): the
-/// path survives with probability s = min(max_λ throughput · η², 0.95), η the product of the
+/// path survives with probability s = min(max_λ throughput · η², [`MAX_SURVIVAL`]), η the product of the
 /// relative indices of refraction crossed (which undoes the radiance scaling of refractions,
 /// so light inside glass is not killed for being compressed, as in Mitsuba 3). Returns the
 /// factor 1/s that keeps the estimator unbiased, or None when the path ends.
@@ -65,7 +75,7 @@ pub fn russian_roulette(
     throughput: SampledSpectrum,
     eta_scale: f32,
 ) -> Option<f32> {
-    let survival = (throughput.max_value() * eta_scale * eta_scale).min(0.95);
+    let survival = (throughput.max_value() * eta_scale * eta_scale).min(MAX_SURVIVAL);
     (ctx.sampler.next_1d() < survival).then(|| 1.0 / survival)
 }
 

@@ -50,13 +50,27 @@ impl TextureValues for DirectionMixTexture {
     fn eval(&self, at: impl Into<TexturePoint>, lambda: &SampledWavelengths) -> SampledSpectrum {
         let at = at.into();
         let amount = self.amount(&at);
-        self.tex1.eval(at, lambda) * amount + self.tex2.eval(at, lambda) * (1.0 - amount)
+        let mut value = SampledSpectrum::ZERO;
+        if amount > 0.0 {
+            value += self.tex1.eval(at, lambda) * amount;
+        }
+        if amount < 1.0 {
+            value += self.tex2.eval(at, lambda) * (1.0 - amount);
+        }
+        value
     }
 
     fn eval_1(&self, at: impl Into<TexturePoint>) -> f32 {
         let at = at.into();
         let amount = self.amount(&at);
-        amount * self.tex1.eval_1(at) + (1.0 - amount) * self.tex2.eval_1(at)
+        let mut value = 0.0;
+        if amount > 0.0 {
+            value += amount * self.tex1.eval_1(at);
+        }
+        if amount < 1.0 {
+            value += (1.0 - amount) * self.tex2.eval_1(at);
+        }
+        value
     }
 
     /// a ∇tex1 + (1 − a) ∇tex2: the normal held fixed, as pbrt-v4's bump mapping shifts only

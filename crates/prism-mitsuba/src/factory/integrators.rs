@@ -196,12 +196,11 @@ pub static INTEGRATORS: Registry<Build> = Registry {
         },
         Plugin {
             name: "vcm",
-            origin: Origin::Mitsuba06,
+            origin: Origin::Prism,
             summary: "Vertex connection and merging (Georgiev et al. 2012, with SmallVCM's \
-                      recursive weights; the parameters of the one public Mitsuba `vcm` plugin \
-                      found, in the UPMM code (a Mitsuba 0.5 fork on GitHub, \
-                      xiaoyu-zhang-betsy/UPMM), with SmallVCM's `alpha`): per iteration (sample index) one light subpath per \
-                      pixel, connected to the camera and kept; then one camera subpath per \
+                      recursive weights; the parameters of the `vcm` plugin of UPMM, a Mitsuba \
+                      0.5 fork (xiaoyu-zhang-betsy/UPMM on GitHub), with SmallVCM's `alpha`): \
+                      per iteration (sample index) one light subpath per pixel, connected to the camera and kept; then one camera subpath per \
                       pixel with light sampling, connections to its pixel's light subpath and \
                       merges with every kept light vertex within the radius r_i = r_1 \
                       i^((alpha-1)/2), all weighted by the power heuristic; one set of \

@@ -75,8 +75,8 @@ use crate::integrator::mis::{
 };
 use crate::integrator::transmittance::ShadowTransmittance;
 use crate::integrator::vertex::{
-    allows_next_vertex, normals_agree, path_estimate, russian_roulette, surface_scattering,
-    wavelengths_after,
+    CERTAIN_SURVIVAL_DEPTH, MAX_SURVIVAL, allows_next_vertex, normals_agree, path_estimate,
+    russian_roulette, surface_scattering, wavelengths_after,
 };
 use crate::light::Receiver;
 use crate::math::Ray;
@@ -562,11 +562,23 @@ impl GuidedPathIntegrator {
             if !self.scatter(ctx, setup, &vertex, &mut w, recording) {
                 break;
             }
-            if verdict.is_none() && w.depth >= self.rr_depth {
-                let Some(factor) = russian_roulette(ctx, w.throughput, w.eta_scale) else {
-                    break;
-                };
-                w.throughput *= factor;
+            match verdict {
+                None if w.depth >= self.rr_depth => {
+                    let Some(factor) = russian_roulette(ctx, w.throughput, w.eta_scale) else {
+                        break;
+                    };
+                    w.throughput *= factor;
+                }
+                // A path the window keeps survives with at most MAX_SURVIVAL from
+                // CERTAIN_SURVIVAL_DEPTH on: where the learned radiance stays in the window
+                // bounce after bounce (a white furnace), nothing else would end it.
+                Some(Window::Keep | Window::Split(_)) if w.depth >= CERTAIN_SURVIVAL_DEPTH => {
+                    if ctx.sampler.next_1d() >= MAX_SURVIVAL {
+                        break;
+                    }
+                    w.throughput *= 1.0 / MAX_SURVIVAL;
+                }
+                _ => {}
             }
         }
         self.file_records(ctx, guide, recording, first_record, records);
