@@ -20,7 +20,8 @@ use prism_core::error::{Result, SourceLocation};
 const FAR_CLIP: f64 = 1e9;
 
 impl Builder {
-    /// The `Integrator` (pbrt-v4's default: `volpath`, `maxdepth` 5).
+    /// The `Integrator` (pbrt-v4's default: `volpath`, `maxdepth` 5): `path`, `volpath` or
+    /// `bdpt`, whose `maxdepth` counts bounces (Prism's `max_depth` is one more).
     pub(super) fn integrator_node(&mut self, location: &SourceLocation) -> Result<PluginNode> {
         let empty = ParameterList::new("Integrator".into(), location.clone(), Vec::new());
         let given = self.integrator.take();
@@ -28,10 +29,10 @@ impl Builder {
             Some((ty, list)) => (ty.as_str(), list),
             None => ("volpath", &empty),
         };
-        if !matches!(ty, "path" | "volpath") {
+        if !matches!(ty, "path" | "volpath" | "bdpt") {
             return Err(list
                 .directive_error("Prism has no integrator with pbrt-v4's model")
-                .with_help("use \"path\" or \"volpath\""));
+                .with_help("use \"path\", \"volpath\" or \"bdpt\""));
         }
         let max_depth = list.integer("maxdepth", 5)?;
         if max_depth < -1 {
@@ -45,7 +46,21 @@ impl Builder {
                 "asks for pbrt's BSDF regularisation, which Prism does not have",
             ));
         }
-        let emitter_sampling = match list.string("lightsampler", "bvh")? {
+        let bidirectional = ty == "bdpt";
+        if bidirectional {
+            for flag in ["visualizestrategies", "visualizeweights"] {
+                if list.boolean(flag, false)? {
+                    let parameter = list.get(flag).expect("read above");
+                    return Err(list.error(
+                        parameter,
+                        "asks for pbrt's images of each strategy, which Prism does not write",
+                    ));
+                }
+            }
+        }
+        // pbrt-v4's bdpt chooses lights by power, its path tracers by its light BVH.
+        let default_sampler = if bidirectional { "power" } else { "bvh" };
+        let emitter_sampling = match list.string("lightsampler", default_sampler)? {
             "bvh" => "exhaustive",
             "power" => "power",
             "uniform" => "uniform",
@@ -57,6 +72,12 @@ impl Builder {
                 ));
             }
         };
+        if bidirectional && emitter_sampling != "power" {
+            let parameter = list
+                .get("lightsampler")
+                .expect("only a given sampler differs");
+            return Err(list.error(parameter, "Prism's bdpt chooses lights by power only"));
+        }
         list.finish()?;
         let location = &list.location;
         let mut node = plugin(PluginClass::Integrator, ty, location, &self.search_paths);
@@ -67,12 +88,14 @@ impl Builder {
             PropertyValue::Integer(max_depth),
             location,
         );
-        set(
-            &mut node,
-            "emitter_sampling",
-            PropertyValue::String(emitter_sampling.into()),
-            location,
-        );
+        if !bidirectional {
+            set(
+                &mut node,
+                "emitter_sampling",
+                PropertyValue::String(emitter_sampling.into()),
+                location,
+            );
+        }
         Ok(node)
     }
 

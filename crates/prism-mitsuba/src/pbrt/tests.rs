@@ -647,3 +647,22 @@ fn a_uniform_grid_is_a_heterogeneous_medium_with_an_empty_border() {
         "test.pbrt:2:69: MakeNamedMedium \"m\": parameter \"float temperature\" makes the medium glow",
     );
 }
+
+#[test]
+fn bdpt_is_prisms_bdpt_with_one_more_depth() {
+    let root = root("Integrator \"bdpt\" \"integer maxdepth\" 7\nWorldBegin\nShape \"sphere\"");
+    let integrator = nodes(&root, PluginClass::Integrator)[0];
+    assert_eq!(integrator.plugin_type, "bdpt");
+    assert_eq!(
+        property(integrator, "max_depth"),
+        &PropertyValue::Integer(8)
+    );
+    assert!(
+        error("Integrator \"bdpt\" \"string lightsampler\" \"uniform\"\nWorldBegin")
+            .contains("chooses lights by power only")
+    );
+    assert!(
+        error("Integrator \"bdpt\" \"bool visualizestrategies\" true\nWorldBegin")
+            .contains("images of each strategy")
+    );
+}
