@@ -493,6 +493,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             samples: output.samples.clone(),
             pixels: &output.film.pixels,
             aovs: &output.film.aovs,
+            integrator_state: output.integrator_state.as_ref(),
         };
         continuation.state(&snapshot).write(&state_path)?;
     }

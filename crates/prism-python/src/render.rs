@@ -293,6 +293,7 @@ fn render_loaded(
             samples: output.samples,
             pixels: &output.film.pixels,
             aovs: &output.film.aovs,
+            integrator_state: output.integrator_state.as_ref(),
         };
         let state = continuation.state(&snapshot);
         return Ok(Py::new(py, RenderState { state })?.into_any());

@@ -2,6 +2,7 @@
 //! any thread count, and a render resumed or merged from parts equal to one render.
 
 use prism_core::film::Film;
+use prism_core::render::resume::InitialState;
 use prism_core::render::{RenderOptions, StopRule, render};
 use prism_core::scene::Scene;
 
@@ -33,7 +34,7 @@ pub(super) fn assert_resumed_and_merged_equal_one_render(scene: &Scene, ends: &[
         let part = render(scene, &options).unwrap().film;
         options.initial = initial.take();
         let resumed = render(scene, &options).unwrap().film;
-        initial = Some((resumed.pixels, resumed.aovs));
+        initial = Some(InitialState::sums(resumed.pixels, resumed.aovs));
         match &mut merged {
             None => merged = Some(part),
             Some(m) => {
@@ -45,5 +46,5 @@ pub(super) fn assert_resumed_and_merged_equal_one_render(scene: &Scene, ends: &[
         start = end;
     }
     assert_eq!(merged.unwrap().pixels, whole.pixels, "merged");
-    assert_eq!(initial.unwrap().0, whole.pixels, "resumed");
+    assert_eq!(initial.unwrap().pixels, whole.pixels, "resumed");
 }

@@ -11,6 +11,7 @@ use prism_core::geometry::{Shape, Sphere};
 use prism_core::integrator::{DirectIntegrator, Integrator, MomentIntegrator, PathIntegrator};
 use prism_core::light::{ConstantLight, Light};
 use prism_core::math::Transform;
+use prism_core::render::resume::InitialState;
 use prism_core::render::{RenderOptions, StopRule, render};
 use prism_core::scene::Scene;
 use prism_core::spectrum::{SampledSpectrum, SampledWavelengths, Spectrum};
@@ -192,7 +193,7 @@ fn extra_channels_do_not_depend_on_threads_or_resuming() {
     let half = render(&scene, &first_half).unwrap().film;
     let mut second_half = RenderOptions::fixed(8, 42, Some(2));
     second_half.first_sample = 4;
-    second_half.initial = Some((half.pixels, half.aovs));
+    second_half.initial = Some(InitialState::sums(half.pixels, half.aovs));
     let resumed = render(&scene, &second_half).unwrap().film;
     assert_eq!(resumed.aovs, one.aovs);
     assert_eq!(resumed.pixels, one.pixels);

@@ -268,6 +268,7 @@ pub(super) fn render(
                 samples: 0..state.passes_done * guided.spp_per_pass,
                 pixels: &film.pixels,
                 aovs: &film.aovs,
+                integrator_state: None,
             })?;
         }
     }
@@ -290,6 +291,7 @@ pub(super) fn render(
         stop: reason,
         relative_error: error,
         lane_occupancy: None,
+        integrator_state: None,
     })
 }
 

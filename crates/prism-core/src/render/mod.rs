@@ -52,6 +52,7 @@ pub use options::RenderOptions;
 use pass::Pass;
 use progress::Silent;
 pub use progress::{ProgressCounter, ProgressReport};
+use state::IntegratorState;
 use stop::{Cancel, next_pass};
 pub use stop::{StopReason, StopRule, StopRuleNames};
 use tiles::{row_major, tile_major, tiles};
@@ -69,6 +70,8 @@ pub struct Snapshot<'a> {
     pub pixels: &'a [PixelSums],
     /// The extra channels' sums, 2K per pixel in the same order.
     pub aovs: &'a [ValueSum],
+    /// A progressive integrator's state after the same passes.
+    pub integrator_state: Option<&'a IntegratorState>,
 }
 
 impl Snapshot<'_> {
@@ -110,6 +113,8 @@ pub struct RenderOutput {
     /// The mean share of the lanes that held a path per step, where the integrator's paths
     /// ran in lanes.
     pub lane_occupancy: Option<f64>,
+    /// A progressive integrator's state at the end, for a state file.
+    pub integrator_state: Option<IntegratorState>,
 }
 
 /// Renders the scene.
@@ -186,6 +191,12 @@ pub fn render_with_preview(
             "the vcm integrator has no error estimate to stop at: its merges are biased at any \
              finite sample count (set use_vm to false for an unbiased estimate)",
         ));
+    }
+    if let Some(state) = options.initial.as_ref().and_then(|i| i.integrator.as_ref()) {
+        return Err(Error::usage(format!(
+            "cannot resume this render from the state of a {} render",
+            state.integrator
+        )));
     }
     // Sums of extra channels per pixel.
     let k = AOV_SUMS_PER_CHANNEL * estimator.aov_count();
@@ -272,6 +283,7 @@ pub fn render_with_preview(
                 samples: first..next,
                 pixels: &pixels,
                 aovs: &aovs,
+                integrator_state: None,
             };
             if let Some(preview) = &mut preview {
                 preview(&snapshot)?;
@@ -294,6 +306,7 @@ pub fn render_with_preview(
             samples: first..next,
             pixels: &film.pixels,
             aovs: &film.aovs,
+            integrator_state: None,
         })?;
     }
     Ok(RenderOutput {
@@ -305,5 +318,6 @@ pub fn render_with_preview(
         stop: reason,
         relative_error: error,
         lane_occupancy: occupancy.mean(),
+        integrator_state: None,
     })
 }

@@ -5,8 +5,8 @@ use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 
 use super::progress::ProgressReport;
+use super::resume::InitialState;
 use super::stop::StopRule;
-use crate::film::{PixelSums, ValueSum};
 
 /// How to render.
 #[derive(Clone, Debug)]
@@ -18,9 +18,8 @@ pub struct RenderOptions {
     /// Index of the first sample to take in every pixel (past a checkpoint, or the start of a
     /// range given to this render).
     pub first_sample: u32,
-    /// Sums the render starts from (a resumed render's), row-major over the crop window: the
-    /// image's, and the extra channels' (2K per pixel, as [`crate::film::Film::aovs`] holds them).
-    pub initial: Option<(Vec<PixelSums>, Vec<ValueSum>)>,
+    /// What the render starts from (a resumed render's sums and integrator state).
+    pub initial: Option<InitialState>,
     pub stop: StopRule,
     /// Raised from outside (by a signal handler) to stop the render after dropping its pass.
     pub interrupt: Option<Arc<AtomicBool>>,

@@ -7,14 +7,32 @@ use std::ops::Range;
 use std::path::Path;
 
 use super::Snapshot;
-use super::state::{RenderIdentity, RenderState};
+use super::state::{IntegratorState, RenderIdentity, RenderState};
 use crate::error::{Error, Result};
 use crate::film::{PixelSums, ValueSum};
 use crate::scene::Scene;
 
-/// The sums a resumed render starts from: the image's and the extra channels', as
-/// [`super::RenderOptions::initial`] takes them.
-pub type InitialSums = (Vec<PixelSums>, Vec<ValueSum>);
+/// What a resumed render starts from ([`super::RenderOptions::initial`]).
+#[derive(Clone, Debug)]
+pub struct InitialState {
+    /// The image's sums, row-major over the crop window.
+    pub pixels: Vec<PixelSums>,
+    /// The extra channels' sums, 2K per pixel, as [`crate::film::Film::aovs`] holds them.
+    pub aovs: Vec<ValueSum>,
+    /// A progressive integrator's state, where the render had one.
+    pub integrator: Option<IntegratorState>,
+}
+
+impl InitialState {
+    /// The sums of a render whose integrator keeps no state of its own.
+    pub fn sums(pixels: Vec<PixelSums>, aovs: Vec<ValueSum>) -> InitialState {
+        InitialState {
+            pixels,
+            aovs,
+            integrator: None,
+        }
+    }
+}
 
 /// A render's identity and the samples it continues.
 #[derive(Clone, Debug)]
@@ -46,7 +64,7 @@ impl Continuation {
     /// Continues the render saved at `path`, whose samples must start at `first_sample` (0,
     /// or the start of the sample range asked for): checks that the state is of this render,
     /// and gives the sample index its samples end at, where this render starts, with its sums.
-    pub fn resume(&mut self, path: &Path, first_sample: u32) -> Result<(u32, InitialSums)> {
+    pub fn resume(&mut self, path: &Path, first_sample: u32) -> Result<(u32, InitialState)> {
         let state = RenderState::read(path)?;
         let cannot = |reason: String| {
             Error::usage(format!(
@@ -78,7 +96,14 @@ impl Continuation {
             ));
         }
         self.previous = vec![range.clone()];
-        Ok((range.end, (state.pixels, state.aovs)))
+        Ok((
+            range.end,
+            InitialState {
+                pixels: state.pixels,
+                aovs: state.aovs,
+                integrator: state.integrator_state,
+            },
+        ))
     }
 
     /// Saves the state of `snapshot` ([`Continuation::state`]) to `path`, unless it holds no
@@ -107,6 +132,7 @@ impl Continuation {
             pixels: snapshot.pixels.to_vec(),
             aov_names: self.aov_names.clone(),
             aovs: snapshot.aovs.to_vec(),
+            integrator_state: snapshot.integrator_state.cloned(),
         }
     }
 }

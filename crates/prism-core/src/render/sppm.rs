@@ -205,6 +205,7 @@ pub(super) fn render(
                 samples: 0..passes,
                 pixels: &film.pixels,
                 aovs: &film.aovs,
+                integrator_state: None,
             })?;
         }
     };
@@ -221,6 +222,7 @@ pub(super) fn render(
         stop: reason,
         relative_error: error,
         lane_occupancy: None,
+        integrator_state: None,
     })
 }
 

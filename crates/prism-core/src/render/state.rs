@@ -6,8 +6,11 @@
 //! and crop window), the sample index ranges the pixels hold, the names of the integrator's extra
 //! channels (K), the pixel count and each pixel's exact sums (264 bytes: the image's, then those
 //! of filter MIS's control variate; then 32 for each extra channel, its sum over all samples and
-//! over half A), and a CRC-32 of all of it. Version 2 added the extra channels, version 3 the
-//! control variate's sums; a state of another version is refused with its version named. A state is written to a temporary file,
+//! over half A), and a CRC-32 of all of it. Between the channel names and the pixel count, the
+//! state of a progressive integrator (see [`IntegratorState`]): its name's length (0 when there is
+//! none), its name, its byte count and its bytes. Version 2 added the extra channels, version 3
+//! the control variate's sums, version 4 the integrator's state; a state of another version is
+//! refused with its version named. A state is written to a temporary file,
 //! flushed to disk and renamed over the old one, so a crash while writing leaves the previous
 //! state intact.
 
@@ -22,7 +25,7 @@ use crate::film::CropWindow;
 use crate::film::accumulation::{AOV_SUMS_PER_CHANNEL, ExactSum, PixelSums, ValueSum};
 
 const MAGIC: &[u8; 8] = b"PRISMRS\0";
-const VERSION: u32 = 3;
+const VERSION: u32 = 4;
 /// Bytes per pixel: fifteen 128-bit sums and three 64-bit counts.
 const PIXEL_BYTES: usize = 15 * 16 + 3 * 8;
 /// Bytes per pixel and extra channel: two 128-bit sums.
@@ -32,6 +35,8 @@ const MAX_RANGES: usize = 1 << 16;
 /// At most this many extra channels, each name at most this long.
 const MAX_AOVS: usize = 1 << 12;
 const MAX_AOV_NAME: usize = 256;
+/// At most this long, an integrator's name.
+const MAX_INTEGRATOR_NAME: usize = 64;
 
 /// What a render state belongs to: two states can be continued or merged only if they agree.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -85,6 +90,17 @@ impl RenderIdentity {
     }
 }
 
+/// What a progressive integrator (`sppm`, `guided_path`) carries from pass to pass besides pixel
+/// sums (per-pixel photon statistics, a learned guiding distribution): the integrator's name and
+/// its own encoding, which only that integrator reads. Pixel sums can be merged by adding them;
+/// such states are merged by their integrator ([`RenderState::merge`]).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct IntegratorState {
+    /// The integrator's type name, as the scene names it.
+    pub integrator: String,
+    pub bytes: Vec<u8>,
+}
+
 /// The accumulated sums of a render and what they belong to.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct RenderState {
@@ -97,6 +113,8 @@ pub struct RenderState {
     pub aov_names: Vec<String>,
     /// Their sums, 2K per pixel in the pixels' order, as [`crate::film::Film::aovs`] holds them.
     pub aovs: Vec<ValueSum>,
+    /// What a progressive integrator needs to continue besides the sums.
+    pub integrator_state: Option<IntegratorState>,
 }
 
 fn corrupt(path: &Path, what: impl std::fmt::Display) -> Error {
@@ -179,6 +197,15 @@ impl RenderState {
             out.extend_from_slice(&(name.len() as u32).to_le_bytes());
             out.extend_from_slice(name.as_bytes());
         }
+        match &self.integrator_state {
+            None => out.extend_from_slice(&0u32.to_le_bytes()),
+            Some(state) => {
+                out.extend_from_slice(&(state.integrator.len() as u32).to_le_bytes());
+                out.extend_from_slice(state.integrator.as_bytes());
+                out.extend_from_slice(&(state.bytes.len() as u64).to_le_bytes());
+                out.extend_from_slice(&state.bytes);
+            }
+        }
         let k = self.aov_names.len() * AOV_SUMS_PER_CHANNEL;
         out.extend_from_slice(&(self.pixels.len() as u64).to_le_bytes());
         for (i, p) in self.pixels.iter().enumerate() {
@@ -234,8 +261,8 @@ impl RenderState {
                 location: None,
                 message: format!(
                     "\"{}\" is a render state of format version {version}; this Prism reads \
-                     version {VERSION} only (version 3 holds the sums of filter MIS's control \
-                     variate)",
+                     version {VERSION} only (version 4 holds the state of progressive \
+                     integrators)",
                     path.display()
                 ),
                 help: Some(
@@ -312,6 +339,26 @@ impl RenderState {
                 .map_err(|_| corrupt(path, "an extra channel's name is not text"))?;
             aov_names.push(name.to_string());
         }
+        let name_length = r.u32().ok_or_else(truncated)? as usize;
+        let integrator_state = if name_length == 0 {
+            None
+        } else {
+            if name_length > MAX_INTEGRATOR_NAME {
+                return Err(corrupt(path, "its integrator's name is too long"));
+            }
+            let integrator = std::str::from_utf8(r.take(name_length).ok_or_else(truncated)?)
+                .map_err(|_| corrupt(path, "its integrator's name is not text"))?
+                .to_string();
+            let length = r.u64().ok_or_else(truncated)?;
+            if length > r.left() as u64 {
+                return Err(corrupt(
+                    path,
+                    format!("its integrator's state declares {length} bytes"),
+                ));
+            }
+            let bytes = r.take(length as usize).ok_or_else(truncated)?.to_vec();
+            Some(IntegratorState { integrator, bytes })
+        };
         let pixel_bytes = (PIXEL_BYTES + AOV_BYTES * aov_count) as u64;
         let pixel_count = r.u64().ok_or_else(truncated)?;
         let expected = u64::from(identity.crop.size.x) * u64::from(identity.crop.size.y);
@@ -369,6 +416,7 @@ impl RenderState {
             pixels,
             aov_names,
             aovs,
+            integrator_state,
         })
     }
 
@@ -407,11 +455,27 @@ impl RenderState {
     }
 
     /// The union of states of the same render over disjoint sample ranges: exactly the sums of
-    /// one render of all their samples.
+    /// one render of all their samples. States of a progressive integrator are merged by that
+    /// integrator, after the same checks.
     pub fn merge(states: &[RenderState], paths: &[&Path]) -> Result<RenderState> {
         let Some(first) = states.first() else {
             return Err(Error::usage("nothing to merge"));
         };
+        for (i, state) in states.iter().enumerate() {
+            let integrator = |s: &RenderState| {
+                s.integrator_state
+                    .as_ref()
+                    .map(|state| state.integrator.clone())
+            };
+            if integrator(state) != integrator(first) {
+                return Err(Error::usage(format!(
+                    "\"{}\" cannot be merged with \"{}\": they were rendered by different \
+                     integrators",
+                    paths[i].display(),
+                    paths[0].display()
+                )));
+            }
+        }
         let mut ranges: Vec<(Range<u32>, usize)> = Vec::new();
         for (i, state) in states.iter().enumerate() {
             if let Some(reason) = first.identity.mismatch(&state.identity) {
@@ -447,6 +511,12 @@ impl RenderState {
                 .with_help("merge renders of disjoint --sample-range values"));
             }
         }
+        if let Some(state) = &first.integrator_state {
+            return Err(Error::usage(format!(
+                "the {} integrator's render states cannot be merged",
+                state.integrator
+            )));
+        }
         let mut pixels = first.pixels.clone();
         let mut aovs = first.aovs.clone();
         for state in &states[1..] {
@@ -471,6 +541,7 @@ impl RenderState {
             pixels,
             aov_names: first.aov_names.clone(),
             aovs,
+            integrator_state: None,
         })
     }
 }
@@ -508,20 +579,32 @@ mod tests {
             pixels,
             aov_names: vec!["dd.T".into(), "m2_dd.T".into()],
             aovs,
+            integrator_state: None,
+        }
+    }
+
+    fn progressive(ranges: Vec<Range<u32>>) -> RenderState {
+        RenderState {
+            integrator_state: Some(IntegratorState {
+                integrator: "sppm".into(),
+                bytes: vec![1, 2, 3, 250],
+            }),
+            ..state(ranges)
         }
     }
 
     #[test]
     fn round_trip() {
-        let s = state(vec![0..4, 8..12]);
         let path = Path::new("x.state");
-        assert_eq!(RenderState::decode(&s.encode(), path).unwrap(), s);
+        for s in [state(vec![0..4, 8..12]), progressive(vec![0..4])] {
+            assert_eq!(RenderState::decode(&s.encode(), path).unwrap(), s);
+        }
     }
 
     /// Every truncation and every flipped byte is detected; nothing panics.
     #[test]
     fn damage_is_detected() {
-        let bytes = state(vec![0..4]).encode();
+        let bytes = progressive(vec![0..4]).encode();
         let path = Path::new("x.state");
         for n in 0..bytes.len() {
             assert!(
@@ -549,7 +632,7 @@ mod tests {
         bytes[body..].copy_from_slice(&checksum.to_le_bytes());
         let error = RenderState::decode(&bytes, Path::new("old.state")).unwrap_err();
         assert!(error.message.contains("format version 2"), "{error}");
-        assert!(error.message.contains("reads version 3 only"), "{error}");
+        assert!(error.message.contains("reads version 4 only"), "{error}");
         assert!(error.help.unwrap().contains("render the scene again"));
     }
 
@@ -569,7 +652,9 @@ mod tests {
         assert!(error.message.contains("seed"), "{error}");
         let mut other_channels = b;
         other_channels.aov_names[1] = "m2_other.T".into();
-        let error = RenderState::merge(&[a, other_channels], &paths).unwrap_err();
+        let error = RenderState::merge(&[a.clone(), other_channels], &paths).unwrap_err();
         assert!(error.message.contains("extra channels"), "{error}");
+        let error = RenderState::merge(&[a, progressive(vec![4..8])], &paths).unwrap_err();
+        assert!(error.message.contains("different integrators"), "{error}");
     }
 }

@@ -3,6 +3,7 @@
 
 use glam::UVec2;
 
+use super::resume::InitialState;
 use crate::error::{Error, Result};
 use crate::film::{PixelSums, ValueSum};
 
@@ -60,10 +61,10 @@ pub(super) fn tile_major(
     tiles: &[Tile],
     size: UVec2,
     k: usize,
-    initial: Option<&(Vec<PixelSums>, Vec<ValueSum>)>,
+    initial: Option<&InitialState>,
 ) -> Result<Vec<TileSums>> {
     let pixel_count = (size.x * size.y) as usize;
-    if let Some((pixels, aovs)) = initial
+    if let Some(InitialState { pixels, aovs, .. }) = initial
         && (pixels.len() != pixel_count || aovs.len() != pixel_count * k)
     {
         return Err(Error::usage(
@@ -82,7 +83,7 @@ pub(super) fn tile_major(
                 for x in 0..t.size.x {
                     let index = ((t.origin.y + y) * size.x + t.origin.x + x) as usize;
                     match initial {
-                        Some((pixels, aovs)) => {
+                        Some(InitialState { pixels, aovs, .. }) => {
                             sums.pixels.push(pixels[index]);
                             sums.aovs
                                 .extend_from_slice(&aovs[index * k..(index + 1) * k]);
