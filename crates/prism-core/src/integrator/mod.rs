@@ -21,6 +21,7 @@
 //! of `path`: the same estimator with a Mueller matrix per wavelength for a throughput, in its
 //! own file, so that unpolarized scenes run the path tracer's code unchanged.
 
+pub mod adjoint;
 pub mod aov;
 pub mod bdpt;
 pub mod context;
@@ -31,6 +32,7 @@ pub mod guided;
 pub mod mis;
 pub mod moment;
 pub mod path;
+pub mod photon_map;
 pub mod polarized_path;
 pub mod ptracer;
 pub mod sppm;

@@ -44,12 +44,12 @@
 
 use glam::{Vec2, Vec3};
 
-use crate::bsdf::{BsdfFlags, BsdfSample, BxdfTree, Scattering};
+use crate::bsdf::{BsdfFlags, BxdfTree};
 use crate::camera::{Camera, CameraModel};
-use crate::geometry::SurfaceInteraction;
 use crate::geometry::interaction::SHADOW_EPSILON;
 use crate::geometry::offset::offset_ray_origin;
 use crate::integrator::SampleContext;
+use crate::integrator::adjoint::{sample_adjoint, shading_correction_without_leaks};
 use crate::integrator::vertex::{
     path_estimate, russian_roulette, surface_scattering, wavelengths_after,
 };
@@ -111,41 +111,6 @@ fn shadow_ray(from: Vec3, n: Vec3, to: Vec3, time: f32) -> Ray {
         offset_ray_origin(from, if d.dot(n) >= 0.0 { n } else { -n })
     };
     Ray::new(origin, to - origin, 1.0 - SHADOW_EPSILON, time)
-}
-
-/// Veach's shading-normal factor for the adjoint BSDF at `si` (eq. 5.19), for light arriving
-/// from `w_light` and leaving along `w_out`: None where the geometric and shading normals put
-/// either direction on different sides.
-pub(super) fn shading_correction(
-    si: &SurfaceInteraction,
-    w_light: Vec3,
-    w_out: Vec3,
-) -> Option<f32> {
-    let (light_g, light_s) = (si.n.dot(w_light), si.shading.n.dot(w_light));
-    let (out_g, out_s) = (si.n.dot(w_out), si.shading.n.dot(w_out));
-    if !(light_g * light_s > 0.0 && out_g * out_s > 0.0) {
-        return None;
-    }
-    let correction = ((light_s * out_g) / (out_s * light_g)).abs();
-    correction.is_finite().then_some(correction)
-}
-
-/// The next direction of a light subpath at `si`, reached by light from `w_light`: a sample of
-/// the BSDF `scattering` read as the adjoint, with the factor its weight f·cos/p takes on a
-/// light subpath, Veach's shading-normal correction times η² (radiance is compressed by η²
-/// across a refraction, importance is not; Veach 1997, §5.2). None where the subpath ends.
-pub(super) fn sample_adjoint(
-    ctx: &mut SampleContext,
-    si: &SurfaceInteraction,
-    scattering: &Scattering,
-    w_light: Vec3,
-) -> Option<(BsdfSample, f32)> {
-    let u_lobe = ctx.sampler.next_1d();
-    let u = ctx.sampler.next_2d();
-    let bs = scattering.sample(u_lobe, u)?;
-    let correction = shading_correction(si, w_light, bs.wi)?;
-    let factor = correction * bs.eta * bs.eta;
-    Some((bs, factor))
 }
 
 impl ParticleTracer {
@@ -277,7 +242,7 @@ impl ParticleTracer {
             if flags.has_smooth_lobe()
                 && let Some(camera) = sample.camera.sample_importance(si.p, u_lens, si.time)
                 && out.reaches(camera.film)
-                && let Some(correction) = shading_correction(&si, w_light, camera.wi)
+                && let Some(correction) = shading_correction_without_leaks(&si, w_light, camera.wi)
             {
                 let value = if si.n.dot(w_light) * si.n.dot(camera.wi) < 0.0
                     && flags.contains(BsdfFlags::TRANSMISSION)

@@ -51,8 +51,10 @@
 use glam::Vec3;
 
 use crate::bsdf::{BsdfFlags, BxdfTree};
+use crate::integrator::adjoint::sample_adjoint;
 use crate::integrator::mis::{Strategies, emission_found, sample_light_at_surface};
-use crate::integrator::ptracer::{choose_light, emission_ray, sample_adjoint};
+use crate::integrator::photon_map::{Located, PhotonMap};
+use crate::integrator::ptracer::{choose_light, emission_ray};
 use crate::integrator::vertex::{
     allows_next_vertex, hero_only, path_estimate, russian_roulette, surface_scattering,
     wavelengths_after,
@@ -114,97 +116,6 @@ impl Located for Photon {
     fn position(&self) -> Vec3 {
         self.p
     }
-}
-
-/// What a [`PhotonMap`] holds: anything with a position (photons, and the light vertices of
-/// vertex merging, [`super::vcm`]).
-pub trait Located {
-    fn position(&self) -> Vec3;
-}
-
-/// The photons of one pass in a hash grid (Teschner et al. 2003's spatial hash): cells of one
-/// size, hashed into as many buckets as there are photons, each bucket's photons stored
-/// together in the order they were traced, so lookups are deterministic.
-pub struct PhotonMap<P = Photon> {
-    photons: Vec<P>,
-    /// Where each bucket's photons start in `photons` (one more entry than buckets).
-    starts: Vec<u32>,
-    cell_size: f32,
-}
-
-impl<P: Located + Clone> PhotonMap<P> {
-    /// The map of `photons` for searches within `largest_radius`: cells twice as wide, so that
-    /// a search spans at most two cells per axis.
-    pub fn new(photons: Vec<P>, largest_radius: f32) -> PhotonMap<P> {
-        let cell_size = 2.0 * largest_radius.max(f32::MIN_POSITIVE);
-        let buckets = photons.len().max(1);
-        let mut starts = vec![0u32; buckets + 1];
-        let bucket_of: Vec<usize> = photons
-            .iter()
-            .map(|photon| bucket(cell_of(photon.position(), cell_size), buckets))
-            .collect();
-        for &b in &bucket_of {
-            starts[b + 1] += 1;
-        }
-        for b in 0..buckets {
-            starts[b + 1] += starts[b];
-        }
-        let mut next = starts.clone();
-        let mut order = vec![0u32; photons.len()];
-        for (i, &b) in bucket_of.iter().enumerate() {
-            order[next[b] as usize] = i as u32;
-            next[b] += 1;
-        }
-        PhotonMap {
-            photons: order.iter().map(|&i| photons[i as usize].clone()).collect(),
-            starts,
-            cell_size,
-        }
-    }
-
-    /// Calls `f` for every photon within `radius` (at most the largest radius the map was
-    /// made for) of `p`, in a fixed order.
-    pub fn for_each_near(&self, p: Vec3, radius: f32, mut f: impl FnMut(&P)) {
-        let buckets = self.starts.len() - 1;
-        let low = cell_of(p - Vec3::splat(radius), self.cell_size);
-        let high = cell_of(p + Vec3::splat(radius), self.cell_size);
-        // Two cells of the search may share a bucket: each bucket is visited once.
-        let mut visit = [0usize; 8];
-        let mut count = 0;
-        for z in low[2]..=high[2] {
-            for y in low[1]..=high[1] {
-                for x in low[0]..=high[0] {
-                    let b = bucket([x, y, z], buckets);
-                    if count < visit.len() && !visit[..count].contains(&b) {
-                        visit[count] = b;
-                        count += 1;
-                    }
-                }
-            }
-        }
-        let radius_squared = radius * radius;
-        for &b in &visit[..count] {
-            let range = self.starts[b] as usize..self.starts[b + 1] as usize;
-            for photon in &self.photons[range] {
-                if (photon.position() - p).length_squared() <= radius_squared {
-                    f(photon);
-                }
-            }
-        }
-    }
-}
-
-/// The grid cell of `p`.
-fn cell_of(p: Vec3, cell_size: f32) -> [i32; 3] {
-    (p / cell_size).floor().as_ivec3().to_array()
-}
-
-/// The bucket of cell `cell` among `buckets`.
-fn bucket(cell: [i32; 3], buckets: usize) -> usize {
-    let [x, y, z] = cell.map(|c| c as u32 as u64);
-    let h =
-        (x.wrapping_mul(73_856_093)) ^ (y.wrapping_mul(19_349_663)) ^ (z.wrapping_mul(83_492_791));
-    (h % buckets as u64) as usize
 }
 
 /// What one pass's camera path brings its pixel: the direct estimate, the flux Φ of the
@@ -320,7 +231,7 @@ impl SppmIntegrator {
         mut ray: Ray,
         weight: f32,
         lambda: &SampledWavelengths,
-        photons: &PhotonMap,
+        photons: &PhotonMap<Photon>,
         radius: f32,
     ) -> PixelPass {
         let ctx = &mut SampleContext {
@@ -422,44 +333,3 @@ const LIGHT_SAMPLES_ONLY: Strategies = Strategies {
     light_samples: 1.0,
     bsdf_samples: 0.0,
 };
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::sampling::rng::Pcg32;
-
-    /// A search of the map finds exactly the photons a search of every photon finds, in
-    /// searches of radii up to the largest, over photons spread across many cells (including
-    /// negative coordinates).
-    #[test]
-    fn photon_map_finds_what_a_brute_force_search_finds() {
-        let mut rng = Pcg32::seeded(3);
-        let point = |rng: &mut Pcg32| {
-            Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 4.0 - Vec3::splat(2.0)
-        };
-        let photons: Vec<Photon> = (0..5000)
-            .map(|i| Photon {
-                p: point(&mut rng),
-                wi: Vec3::Z,
-                beta: SampledSpectrum::splat(1.0),
-                depth: i,
-                hero_only: false,
-            })
-            .collect();
-        let largest = 0.3;
-        let map = PhotonMap::new(photons.clone(), largest);
-        for _ in 0..500 {
-            let p = point(&mut rng);
-            let radius = largest * rng.next_f32();
-            let mut found = Vec::new();
-            map.for_each_near(p, radius, |photon| found.push(photon.depth));
-            found.sort_unstable();
-            let expected: Vec<i32> = photons
-                .iter()
-                .filter(|photon| (photon.p - p).length_squared() <= radius * radius)
-                .map(|photon| photon.depth)
-                .collect();
-            assert_eq!(found, expected, "search at {p} within {radius}");
-        }
-    }
-}

@@ -87,8 +87,8 @@ use crate::bsdf::{BxdfTree, Scattering};
 use crate::camera::CameraModel;
 use crate::geometry::SurfaceInteraction;
 use crate::geometry::offset::offset_ray_origin;
-use crate::integrator::bdpt::shading_correction;
-use crate::integrator::sppm::{Located, PhotonMap};
+use crate::integrator::adjoint::shading_correction;
+use crate::integrator::photon_map::{Located, PhotonMap};
 use crate::integrator::vertex::{
     hero_only, russian_roulette, surface_scattering, wavelengths_after,
 };
@@ -256,9 +256,10 @@ fn direction(from: Vec3, to: Vec3) -> Option<(Vec3, f32)> {
     (r2 > 0.0 && r2.is_finite()).then(|| (d / r2.sqrt(), r2))
 }
 
-/// The estimate for the iteration's wavelengths `started` of a contribution whose subpaths
-/// have the wavelengths `a` and `b`.
-fn estimate(
+/// A contribution whose subpaths have the wavelengths `a` and `b` as an estimate for the
+/// iteration's wavelengths `started`: its hero wavelength's alone where either subpath kept
+/// only its hero ([`hero_only`]).
+fn for_started_wavelengths(
     value: SampledSpectrum,
     started: &SampledWavelengths,
     a: &SampledWavelengths,
@@ -470,7 +471,7 @@ impl VcmIntegrator {
         let weight = 1.0 / (1.0 + w_light);
         out.splat(
             importance.film,
-            estimate(value * weight, sample.lambda, &y.lambda, &y.lambda),
+            for_started_wavelengths(value * weight, sample.lambda, &y.lambda, &y.lambda),
         );
     }
 
@@ -478,7 +479,7 @@ impl VcmIntegrator {
     /// estimate of every strategy with t ≥ 2, connecting to `light_path` (its pixel's light
     /// subpath's kept vertices) and merging with `vertices` (every light subpath's, where the
     /// iteration merges).
-    pub fn estimate(
+    pub fn trace_camera_path(
         &self,
         ctx: &mut SampleContext,
         sample: &LightPathSample,
@@ -531,7 +532,8 @@ impl VcmIntegrator {
                     1.0 / (1.0 + mis(direct) * weights.d_vcm + mis(emission) * weights.d_vc)
                 };
                 if weight.is_finite() {
-                    result += estimate(beta * le * weight, started, &lambda, &lambda);
+                    result +=
+                        for_started_wavelengths(beta * le * weight, started, &lambda, &lambda);
                 }
             }
             if !self.allows(depth + 1) {
@@ -645,7 +647,7 @@ impl VcmIntegrator {
         if !weight.is_finite() || ctx.occluded(&z.si.spawn_ray_to(ls.p, ls.n)) {
             return SampledSpectrum::ZERO;
         }
-        estimate(value * weight, sample.lambda, z.lambda, z.lambda)
+        for_started_wavelengths(value * weight, sample.lambda, z.lambda, z.lambda)
     }
 
     /// The camera vertex `z` connected to the light vertex `y` by a shadow ray.
@@ -682,7 +684,7 @@ impl VcmIntegrator {
         if !weight.is_finite() || ctx.occluded(&z.si.spawn_ray_to(y.si.p, y.si.n)) {
             return SampledSpectrum::ZERO;
         }
-        estimate(value * weight, started, z.lambda, &y.lambda)
+        for_started_wavelengths(value * weight, started, z.lambda, &y.lambda)
     }
 
     /// The light vertices of `vertices` within the iteration's radius of the camera vertex `z`,
@@ -714,7 +716,7 @@ impl VcmIntegrator {
             let weight = 1.0 / (w_light + 1.0 + w_camera);
             if weight.is_finite() {
                 let term = y.beta * e.value * (weight / cos);
-                sum += estimate(term, started, z.lambda, &y.lambda);
+                sum += for_started_wavelengths(term, started, z.lambda, &y.lambda);
             }
         });
         z.beta * sum * (1.0 / iteration.eta())

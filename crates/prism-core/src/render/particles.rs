@@ -32,7 +32,7 @@ use crate::film::{CropWindow, SplatSums, SplatValue, Splatter};
 use crate::integrator::{
     BdptIntegrator, LightPathSample, ParticleTracer, RayCount, Splat, VcmIntegrator,
 };
-use crate::sampling::sampler::Sampler;
+use crate::sampling::sampler::{CameraSample, Sampler};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 
 /// Light subpaths a worker traces at a time (pixels of the full film, row-major).
@@ -67,7 +67,22 @@ pub(super) struct Collector<'a> {
     pub(super) values: Vec<SplatValue>,
 }
 
-impl Collector<'_> {
+impl<'a> Collector<'a> {
+    /// A collector for the crop window `crop`, with no contribution yet.
+    pub(super) fn new(
+        splatter: &'a Splatter,
+        crop: CropWindow,
+        lambda: SampledWavelengths,
+    ) -> Collector<'a> {
+        Collector {
+            splatter,
+            crop,
+            lambda,
+            time_weight: 1.0,
+            values: Vec::new(),
+        }
+    }
+
     /// Adds the CIE XYZ `xyz` to the full film's pixel `pixel` alone, if it is in the crop
     /// window.
     pub(super) fn add_to_pixel(&mut self, pixel: UVec2, xyz: [f32; 3]) {
@@ -112,6 +127,21 @@ impl Splat for Collector<'_> {
 }
 
 impl Pass<'_, '_> {
+    /// The camera sample of `pixel` for sample index `index` drawn from `sampler` (which the
+    /// light and camera subpaths of that sample go on drawing from), with its time and shutter
+    /// weight.
+    pub(super) fn start_sample(
+        &self,
+        sampler: &mut Sampler,
+        pixel: UVec2,
+        index: u32,
+    ) -> (CameraSample, f32, f32) {
+        sampler.start_pixel_sample(pixel, index);
+        let primary = sampler.camera_sample();
+        let (time, time_weight) = self.estimator.scene.shutter.sample(primary.time);
+        (primary, time, time_weight)
+    }
+
     /// Writes into `out` the tiles' `sums` with the light subpaths of the sample indices
     /// `range` added (see the module's text); returns the rays traced, or None when the pass
     /// was cancelled.
@@ -200,20 +230,16 @@ impl Pass<'_, '_> {
             self.options.seed,
         );
         let mut count = RayCount::default();
-        let mut collector = Collector {
+        let mut collector = Collector::new(
             splatter,
-            crop: film.crop,
-            lambda: SampledWavelengths::sample(0.5, film.wavelength_sampling),
-            time_weight: 1.0,
-            values: Vec::new(),
-        };
+            film.crop,
+            SampledWavelengths::sample(0.5, film.wavelength_sampling),
+        );
         let integrator = &self.estimator.integrator;
         for pixel in pixels {
             let pixel = UVec2::new(pixel % film.size.x, pixel / film.size.x);
-            sampler.start_pixel_sample(pixel, index);
-            let primary = sampler.camera_sample();
+            let (primary, time, time_weight) = self.start_sample(&mut sampler, pixel, index);
             let lambda = SampledWavelengths::sample(primary.wavelength, film.wavelength_sampling);
-            let (time, time_weight) = scene.shutter.sample(primary.time);
             collector.lambda = lambda;
             collector.time_weight = time_weight;
             let sample = LightPathSample {

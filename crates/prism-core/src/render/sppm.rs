@@ -31,7 +31,8 @@ use crate::error::{Error, Result};
 use crate::film::accumulation::{AOV_SUMS_PER_CHANNEL, add_aov_sample};
 use crate::film::{Film, FilterSampler};
 use crate::integrator::RayCount;
-use crate::integrator::sppm::{Photon, PhotonMap, SppmIntegrator};
+use crate::integrator::photon_map::PhotonMap;
+use crate::integrator::sppm::{Photon, SppmIntegrator};
 use crate::light::BoundingSphere;
 use crate::render::relative_error;
 use crate::sampling::rng::{Pcg32, hash_u64s};
@@ -269,7 +270,7 @@ impl PassContext<'_> {
         );
         let (photons, mut rays) = self.trace_photons(pass, &lambda)?;
         let largest = state.iter().map(|s| s.radius).fold(0.0, f64::max) as f32;
-        let map = PhotonMap::new(photons, largest);
+        let map = PhotonMap::new(&photons, largest);
         let filter = FilterSampler::new(film.filter);
         let rows: Vec<Option<u64>> = state
             .par_chunks_mut(width)
@@ -336,7 +337,7 @@ impl PassContext<'_> {
         y: u32,
         row: &mut [PixelState],
         lambda: &SampledWavelengths,
-        map: &PhotonMap,
+        map: &PhotonMap<Photon>,
         filter: &FilterSampler,
     ) -> Option<u64> {
         if self.cancel.raised() {

@@ -16,7 +16,7 @@
 
 use std::ops::Range;
 
-use glam::{UVec2, Vec2};
+use glam::UVec2;
 use rayon::prelude::*;
 
 use super::particles::Collector;
@@ -24,7 +24,7 @@ use super::pass::Pass;
 use super::sppm::pass_wavelength;
 use crate::camera::{CameraModel, CameraRay};
 use crate::film::{SplatSums, SplatValue, Splatter};
-use crate::integrator::sppm::PhotonMap;
+use crate::integrator::photon_map::PhotonMap;
 use crate::integrator::vcm::{Iteration, LightVertex};
 use crate::integrator::{LightPathSample, RayCount, SampleContext, VcmIntegrator};
 use crate::light::BoundingSphere;
@@ -98,7 +98,7 @@ impl Pass<'_, '_> {
         }
         let map = vcm
             .merging
-            .then(|| PhotonMap::new(vertices.clone(), iteration.radius));
+            .then(|| PhotonMap::new(&vertices, iteration.radius));
         let camera = CameraTask {
             vcm,
             splatter,
@@ -119,20 +119,6 @@ impl Pass<'_, '_> {
             rays += task_rays;
         }
         Some(rays)
-    }
-
-    /// The camera sample of `pixel` for sample index `index`, drawn from `sampler`: its time,
-    /// shutter weight, film sample and lens sample.
-    fn vcm_camera_sample(
-        &self,
-        sampler: &mut Sampler,
-        pixel: UVec2,
-        index: u32,
-    ) -> (f32, f32, Vec2, Vec2) {
-        sampler.start_pixel_sample(pixel, index);
-        let primary = sampler.camera_sample();
-        let (time, time_weight) = self.estimator.scene.shutter.sample(primary.time);
-        (time, time_weight, primary.film, primary.lens)
     }
 
     /// The light subpaths of iteration `index` keyed by the pixels `pixels`.
@@ -161,26 +147,19 @@ impl Pass<'_, '_> {
             hash_u64s(&[self.options.seed, LIGHT_STREAM]),
         );
         let mut count = RayCount::default();
-        let mut collector = Collector {
-            splatter,
-            crop: film.crop,
-            lambda: *lambda,
-            time_weight: 1.0,
-            values: Vec::new(),
-        };
+        let mut collector = Collector::new(splatter, film.crop, *lambda);
         let mut vertices = Vec::new();
         let mut counts = Vec::with_capacity(pixels.len());
         for pixel in pixels.clone() {
             let pixel = UVec2::new(pixel % film.size.x, pixel / film.size.x);
-            let (time, time_weight, _, u_lens) =
-                self.vcm_camera_sample(&mut camera_sampler, pixel, index);
+            let (primary, time, time_weight) = self.start_sample(&mut camera_sampler, pixel, index);
             collector.time_weight = time_weight;
             sampler.start_pixel_sample(pixel, index);
             let sample = LightPathSample {
                 camera: &scene.camera,
                 lambda,
                 time,
-                u_lens,
+                u_lens: primary.lens,
             };
             let ctx = &mut SampleContext {
                 prepared: &self.estimator.integrator,
@@ -217,24 +196,18 @@ impl Pass<'_, '_> {
             self.options.seed,
         );
         let mut count = RayCount::default();
-        let mut collector = Collector {
-            splatter: camera.splatter,
-            crop: film.crop,
-            lambda: *camera.lambda,
-            time_weight: 1.0,
-            values: Vec::new(),
-        };
+        let mut collector = Collector::new(camera.splatter, film.crop, *camera.lambda);
         for key in pixels.clone() {
             let pixel = UVec2::new(key % film.size.x, key / film.size.x);
-            let (time, time_weight, u_film, u_lens) =
-                self.vcm_camera_sample(&mut sampler, pixel, camera.index);
-            let (film_position, filter_weight) = self.estimator.film_position(pixel, u_film);
-            let CameraRay { ray, weight } = scene.camera.generate_ray(film_position, u_lens, time);
+            let (primary, time, time_weight) = self.start_sample(&mut sampler, pixel, camera.index);
+            let (film_position, filter_weight) = self.estimator.film_position(pixel, primary.film);
+            let CameraRay { ray, weight } =
+                scene.camera.generate_ray(film_position, primary.lens, time);
             let sample = LightPathSample {
                 camera: &scene.camera,
                 lambda: camera.lambda,
                 time,
-                u_lens,
+                u_lens: primary.lens,
             };
             let ctx = &mut SampleContext {
                 prepared: &self.estimator.integrator,
@@ -243,10 +216,14 @@ impl Pass<'_, '_> {
             };
             let light_path = &camera.vertices
                 [camera.starts[key as usize] as usize..camera.starts[key as usize + 1] as usize];
-            let radiance =
-                camera
-                    .vcm
-                    .estimate(ctx, &sample, ray, camera.iteration, light_path, camera.map);
+            let radiance = camera.vcm.trace_camera_path(
+                ctx,
+                &sample,
+                ray,
+                camera.iteration,
+                light_path,
+                camera.map,
+            );
             let scale = weight * time_weight * filter_weight;
             let xyz = camera.lambda.to_xyz(&radiance).map(|v| v * scale);
             collector.add_to_pixel(pixel, xyz);
@@ -265,6 +242,6 @@ struct CameraTask<'a> {
     /// `starts[j + 1]`.
     vertices: &'a [LightVertex],
     starts: &'a [u32],
-    map: Option<&'a PhotonMap<LightVertex>>,
+    map: Option<&'a PhotonMap<'a, LightVertex>>,
     index: u32,
 }

@@ -66,6 +66,7 @@ use crate::bsdf::BxdfTree;
 use crate::camera::{Camera, CameraModel};
 use crate::geometry::SurfaceInteraction;
 use crate::geometry::offset::offset_ray_origin;
+use crate::integrator::adjoint::shading_correction;
 use crate::integrator::vertex::{
     hero_only, russian_roulette, surface_scattering, wavelengths_after,
 };
@@ -404,22 +405,6 @@ impl Connections<'_> {
             ..*v
         })
     }
-}
-
-/// The adjoint BSDF's shading-normal correction at `si` for light arriving from `w_light` and
-/// leaving along `w_out`, |cos_s θ_light| |cos_g θ_out| / (|cos_g θ_light| |cos_s θ_out|)
-/// (Veach's eq. 5.19, pbrt-v4's `CorrectShadingNormal`). Unlike the particle tracer, directions
-/// the geometric and shading normals put on different sides do not end the subpath: the camera
-/// subpath (the path tracer's) scatters there, and every strategy must see the same integrand.
-pub(crate) fn shading_correction(
-    si: &SurfaceInteraction,
-    w_light: Vec3,
-    w_out: Vec3,
-) -> Option<f32> {
-    let (light_g, light_s) = (si.n.dot(w_light), si.shading.n.dot(w_light));
-    let (out_g, out_s) = (si.n.dot(w_out), si.shading.n.dot(w_out));
-    let correction = ((light_s * out_g) / (out_s * light_g)).abs();
-    correction.is_finite().then_some(correction)
 }
 
 /// A subpath's way on: whether it carries importance (the light subpath, sampling the adjoint
