@@ -86,7 +86,8 @@ fn integrator_named(name: &str, scene: &Scene) -> Result<Integrator> {
     let max_depth = match image {
         Integrator::Path(p) => p.max_depth,
         Integrator::PolarizedPath(p) => p.path.max_depth,
-        Integrator::Stokes(s) => s.nested.path.max_depth,
+        Integrator::PolarizedVolPath(p) => p.volpath.max_depth,
+        Integrator::Stokes(s) => s.nested.max_depth(),
         // Direct illumination is the path tracer's estimate of paths of two vertices.
         Integrator::Direct(_) => 2,
         Integrator::Distribution(d) => d.max_depth,
@@ -159,7 +160,8 @@ fn integrator_label(integrator: &Integrator) -> &'static str {
         Integrator::Direct(_) => "direct",
         Integrator::Distribution(_) => "distrib",
         Integrator::VolPath(v) if v.tracking == Tracking::Spectral => "volpath",
-        Integrator::VolPath(_) => "volpathmis",
+        Integrator::PolarizedVolPath(p) if p.volpath.tracking == Tracking::Spectral => "volpath",
+        Integrator::VolPath(_) | Integrator::PolarizedVolPath(_) => "volpathmis",
         Integrator::Moment(_) => "moment",
         Integrator::Aov(_) => "aov",
         Integrator::Depth(_) => "depth",

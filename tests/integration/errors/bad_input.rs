@@ -277,12 +277,20 @@ fn cases() -> Vec<Case> {
             "not a finite number",
         ),
         render_scene(
-            "polarizer under volpath",
+            "polarizer under ptracer",
             scene!(
-                "    <integrator type=\"volpath\"/>\n    <shape type=\"sphere\"><bsdf type=\"polarizer\"/></shape>"
+                "    <integrator type=\"ptracer\"/>\n    <shape type=\"sphere\"><bsdf type=\"polarizer\"/></shape>"
             ),
             "scene.xml:3:",
             "does not render polarized light",
+        ),
+        render_scene(
+            "stokes around direct",
+            scene!(
+                "    <integrator type=\"stokes\"><integrator type=\"direct\"/></integrator>\n    <shape type=\"sphere\"/>"
+            ),
+            "scene.xml:3:",
+            "cannot be nested in \"stokes\"",
         ),
         render_scene(
             "degenerate lookat",

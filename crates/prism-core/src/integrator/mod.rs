@@ -19,7 +19,9 @@
 //!
 //! A scene with a polarizing element or the `stokes` integrator gets [`polarized_path`] in place
 //! of `path`: the same estimator with a Mueller matrix per wavelength for a throughput, in its
-//! own file, so that unpolarized scenes run the path tracer's code unchanged.
+//! own file, so that unpolarized scenes run the path tracer's code unchanged; and
+//! [`polarized_volpath`] in place of `volpath` and `volpathmis`: their one step, written over
+//! what a path carries ([`volpath::Throughput`]), run with Mueller matrices.
 
 pub mod adjoint;
 pub mod aov;
@@ -34,6 +36,7 @@ pub mod moment;
 pub mod path;
 pub mod photon_map;
 pub mod polarized_path;
+pub mod polarized_volpath;
 pub mod ptracer;
 pub mod sppm;
 pub mod stepped;
@@ -54,10 +57,11 @@ pub use guided::GuidedPathIntegrator;
 pub use moment::MomentIntegrator;
 pub use path::PathIntegrator;
 pub use polarized_path::PolarizedPathIntegrator;
+pub use polarized_volpath::PolarizedVolPathIntegrator;
 pub use ptracer::{LightPathSample, ParticleTracer, Splat};
 pub use sppm::SppmIntegrator;
 pub use stepped::SteppedPath;
-pub use stokes::StokesIntegrator;
+pub use stokes::{PolarizedIntegrator, StokesIntegrator};
 pub use vcm::VcmIntegrator;
 pub use volpath::{Tracking, VolPathIntegrator};
 
@@ -108,6 +112,7 @@ integrator_enum! {
         Bdpt(BdptIntegrator),
         Sppm(SppmIntegrator),
         PolarizedPath(PolarizedPathIntegrator),
+        PolarizedVolPath(PolarizedVolPathIntegrator),
         Stokes(StokesIntegrator),
         Guided(GuidedPathIntegrator),
         Vcm(VcmIntegrator),
@@ -135,6 +140,7 @@ impl Integrator {
             Integrator::Distribution(distrib) => distrib.light_selection(),
             Integrator::VolPath(volpath) => volpath.light_selection,
             Integrator::PolarizedPath(polarized) => polarized.light_selection(),
+            Integrator::PolarizedVolPath(polarized) => polarized.light_selection(),
             Integrator::Stokes(stokes) => stokes.nested.light_selection(),
             Integrator::Moment(_)
             | Integrator::Aov(_)
@@ -161,6 +167,7 @@ impl Integrator {
             | Integrator::Bdpt(_)
             | Integrator::Sppm(_)
             | Integrator::PolarizedPath(_)
+            | Integrator::PolarizedVolPath(_)
             | Integrator::Stokes(_)
             | Integrator::Guided(_)
             | Integrator::Vcm(_) => &[],
@@ -181,7 +188,8 @@ impl Integrator {
             Integrator::Sppm(_) => false,
             Integrator::Vcm(vcm) => vcm.hide_emitters,
             Integrator::PolarizedPath(polarized) => polarized.path.hide_emitters,
-            Integrator::Stokes(stokes) => stokes.nested.path.hide_emitters,
+            Integrator::PolarizedVolPath(polarized) => polarized.volpath.hide_emitters,
+            Integrator::Stokes(stokes) => stokes.nested.hides_emitters(),
             Integrator::Guided(guided) => guided.hide_emitters,
             Integrator::Moment(_) | Integrator::Aov(_) => match self.nested().next() {
                 Some(first) => first.hides_emitters(),
@@ -211,6 +219,7 @@ impl Integrator {
             | Integrator::Bdpt(_)
             | Integrator::Sppm(_)
             | Integrator::PolarizedPath(_)
+            | Integrator::PolarizedVolPath(_)
             | Integrator::Guided(_)
             | Integrator::Vcm(_) => Vec::new(),
             Integrator::Moment(moment) => moment.aov_names(),
@@ -380,6 +389,7 @@ impl PreparedIntegrator<'_> {
             Integrator::Aov(integrator) => integrator.radiance(ctx, ray, lambda, aovs),
             Integrator::Depth(_) => DepthIntegrator::radiance(ctx, &ray),
             Integrator::PolarizedPath(integrator) => integrator.radiance(ctx, ray, lambda),
+            Integrator::PolarizedVolPath(integrator) => integrator.radiance(ctx, ray, lambda),
             Integrator::Stokes(integrator) => integrator.radiance(ctx, ray, lambda, aovs),
             // Light subpaths reach the film by splats, not along camera rays: the render driver
             // runs them ([`Self::trace_light_paths`], [`Self::trace_bidirectional`], the

@@ -5,6 +5,7 @@
 
 use glam::Vec3;
 
+use crate::bsdf::Material;
 use crate::geometry::SurfaceInteraction;
 use crate::geometry::interaction::SHADOW_EPSILON;
 use crate::geometry::offset::offset_ray_origin;
@@ -73,13 +74,31 @@ impl ShadowTransmittance {
 /// product of the transmittances of the media crossed (closed form in homogeneous media, ratio
 /// tracking in heterogeneous ones) and of the null transmissions of the surfaces crossed; zero
 /// when a surface without a null lobe is in the way.
+#[inline]
 pub fn shadow_transmittance(
+    ctx: &mut SampleContext,
+    origin: Vec3,
+    end: Vec3,
+    time: f32,
+    medium: Option<u32>,
+    lambda: &SampledWavelengths,
+) -> ShadowTransmittance {
+    shadow_transmittance_crossing(ctx, origin, end, time, medium, lambda, |material, si, d| {
+        material.null_transmission(si, -d, lambda)
+    })
+}
+
+/// [`shadow_transmittance`] with `cross` giving the null transmission of each surface with a
+/// null lobe that the ray (unit direction d) crosses, at its hit: the hook by which a
+/// polarized path also follows what those surfaces do to the light's polarization.
+pub fn shadow_transmittance_crossing(
     ctx: &mut SampleContext,
     origin: Vec3,
     end: Vec3,
     time: f32,
     mut medium: Option<u32>,
     lambda: &SampledWavelengths,
+    mut cross: impl FnMut(&Material, &SurfaceInteraction, Vec3) -> SampledSpectrum,
 ) -> ShadowTransmittance {
     let world = ctx.world();
     let d = (end - origin).normalize();
@@ -109,7 +128,7 @@ pub fn shadow_transmittance(
             if !material.has_null_lobe() {
                 return ShadowTransmittance::ZERO;
             }
-            transmittance.surfaces *= material.null_transmission(&si, -d, lambda);
+            transmittance.surfaces *= cross(material, &si, d);
             if transmittance.surfaces.is_black() {
                 return transmittance;
             }

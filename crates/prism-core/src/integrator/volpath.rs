@@ -32,16 +32,20 @@
 //!
 //! The path's step below is shared with `volpathmis` ([`super::volpathmis`]): what differs is how
 //! free flights are drawn and how the path's weights and its estimate are kept, the
-//! [`PathWeights`] of each ([`SpectralTracking`] here).
+//! [`PathWeights`] of each ([`SpectralTracking`] here). Both are written over what the path
+//! carries ([`Throughput`]): a spectrum, or in scenes that polarize a Mueller matrix per
+//! wavelength ([`super::polarized_volpath`]).
 
 use glam::Vec3;
 
-use crate::bsdf::{BsdfEval, BxdfTree};
+use crate::bsdf::{BsdfEval, BsdfSample, BxdfTree, Scattering};
 use crate::geometry::SurfaceInteraction;
 use crate::integrator::SampleContext;
 use crate::integrator::mis::{LightSampleTerms, emission_along, power_heuristic, sample_light};
 use crate::integrator::stepped::SteppedPath;
-use crate::integrator::transmittance::{medium_after, shadow_end, shadow_transmittance};
+use crate::integrator::transmittance::{
+    ShadowTransmittance, medium_after, shadow_end, shadow_transmittance,
+};
 use crate::integrator::vertex::{
     allows_next_vertex, hero_only, russian_roulette, surface_scattering, wavelengths_after,
 };
@@ -90,11 +94,185 @@ pub enum Tracking {
     HeroMis { spectral_mis: bool },
 }
 
+/// What a volumetric path carries from one vertex to the next: a spectrum, or in polarized
+/// renders a Mueller matrix per wavelength ([`super::polarized_volpath`]). The path's step is
+/// written once over this trait; for a spectrum each method is the plain product it stands for.
+pub(crate) trait Throughput: Copy {
+    /// What the path sums: radiance, or a Stokes vector per wavelength.
+    type Estimate: Estimate;
+    /// What a light sample's vertex and the surfaces its shadow ray crosses do to the light
+    /// beyond the unpolarized values of [`LightSampleTerms`]: nothing for a spectrum.
+    type LightTransfer: Copy;
+    /// What the null surfaces a shadow ray crosses do to the light beyond their null
+    /// transmission ([`ShadowTransmittance::surfaces`]): nothing for a spectrum.
+    type SurfaceTransfer;
+
+    const ONE: Self;
+    const ZERO: Self;
+
+    /// What the throughput does to unpolarized light: Russian roulette, termination and the
+    /// tracking's collision probabilities look at it.
+    fn intensity(&self) -> SampledSpectrum;
+
+    /// Multiplies each wavelength's part by its factor.
+    fn scale(&mut self, factor: SampledSpectrum);
+
+    /// Multiplies every wavelength's part by `factor`.
+    fn scale_all(&mut self, factor: f32);
+
+    /// The throughput followed (towards the light) by the vertex weight `next`.
+    fn then(&mut self, next: Self);
+
+    /// The weight of the BSDF sample `bs` of `scattering`.
+    fn sampled(scattering: &Scattering, bs: &BsdfSample) -> Self;
+
+    /// What the path gathers of unpolarized radiance `radiance` arriving at its last vertex.
+    fn gathers(&self, radiance: SampledSpectrum) -> Self::Estimate;
+
+    /// What the path gathers of the light sample `s`, whose vertex and shadow ray also do
+    /// `transfer`: throughput · f · Tr · Lₑ, without MIS weight or density.
+    fn gathers_light(&self, s: &LightSampleTerms, transfer: &Self::LightTransfer)
+    -> Self::Estimate;
+
+    /// The transmittance from `origin` to `end` ([`shadow_transmittance`]) with what the null
+    /// surfaces on the way do to the light.
+    fn shadow(
+        ctx: &mut SampleContext,
+        origin: Vec3,
+        end: Vec3,
+        time: f32,
+        medium: Option<u32>,
+        lambda: &SampledWavelengths,
+    ) -> (ShadowTransmittance, Self::SurfaceTransfer);
+
+    /// A light sample's transfer at a surface vertex: `scattering`'s value `f` towards `wi`,
+    /// then the shadow ray's surfaces.
+    fn at_surface(
+        scattering: &Scattering,
+        wi: Vec3,
+        f: &BsdfEval,
+        surfaces: Self::SurfaceTransfer,
+    ) -> Self::LightTransfer;
+
+    /// A light sample's transfer at a scattering vertex in a medium whose phase function has
+    /// the value `phase_value` there, then the shadow ray's surfaces.
+    fn in_medium(phase_value: f32, surfaces: Self::SurfaceTransfer) -> Self::LightTransfer;
+}
+
+/// What a path sums: radiance, or a Stokes vector per wavelength.
+pub(crate) trait Estimate: Copy {
+    const ZERO: Self;
+
+    /// Adds `other`.
+    fn add(&mut self, other: Self);
+
+    /// Every wavelength's part times `factor`.
+    fn scaled(self, factor: f32) -> Self;
+
+    /// The estimate carried by the hero wavelength alone ([`hero_only`]).
+    fn hero_only(self) -> Self;
+
+    /// The intensity: the radiance, or S₀ of the Stokes vectors.
+    fn intensity(&self) -> SampledSpectrum;
+}
+
+impl Throughput for SampledSpectrum {
+    type Estimate = SampledSpectrum;
+    type LightTransfer = ();
+    type SurfaceTransfer = ();
+
+    const ONE: Self = SampledSpectrum::ONE;
+    const ZERO: Self = SampledSpectrum::ZERO;
+
+    #[inline]
+    fn intensity(&self) -> SampledSpectrum {
+        *self
+    }
+
+    #[inline]
+    fn scale(&mut self, factor: SampledSpectrum) {
+        *self *= factor;
+    }
+
+    #[inline]
+    fn scale_all(&mut self, factor: f32) {
+        *self *= factor;
+    }
+
+    #[inline]
+    fn then(&mut self, next: Self) {
+        *self *= next;
+    }
+
+    #[inline]
+    fn sampled(_scattering: &Scattering, bs: &BsdfSample) -> Self {
+        bs.weight
+    }
+
+    #[inline]
+    fn gathers(&self, radiance: SampledSpectrum) -> SampledSpectrum {
+        *self * radiance
+    }
+
+    #[inline]
+    fn gathers_light(&self, s: &LightSampleTerms, _transfer: &()) -> SampledSpectrum {
+        *self * s.value * s.transmittance.total() * s.radiance
+    }
+
+    #[inline]
+    fn shadow(
+        ctx: &mut SampleContext,
+        origin: Vec3,
+        end: Vec3,
+        time: f32,
+        medium: Option<u32>,
+        lambda: &SampledWavelengths,
+    ) -> (ShadowTransmittance, ()) {
+        (
+            shadow_transmittance(ctx, origin, end, time, medium, lambda),
+            (),
+        )
+    }
+
+    #[inline]
+    fn at_surface(_scattering: &Scattering, _wi: Vec3, _f: &BsdfEval, _surfaces: ()) {}
+
+    #[inline]
+    fn in_medium(_phase_value: f32, _surfaces: ()) {}
+}
+
+impl Estimate for SampledSpectrum {
+    const ZERO: Self = SampledSpectrum::ZERO;
+
+    #[inline]
+    fn add(&mut self, other: Self) {
+        *self += other;
+    }
+
+    #[inline]
+    fn scaled(self, factor: f32) -> Self {
+        self * factor
+    }
+
+    #[inline]
+    fn hero_only(self) -> Self {
+        hero_only(self)
+    }
+
+    #[inline]
+    fn intensity(&self) -> SampledSpectrum {
+        *self
+    }
+}
+
 /// What a volumetric path keeps besides its geometry: its weights, the state its MIS weights
 /// need, and the estimate it sums. The step of [`VolPathWith`] calls these at each event.
 pub(crate) trait PathWeights {
-    /// The factor by which the path's further contributions are weighted (before MIS against
-    /// light samples): Russian roulette and termination look at it.
+    /// What the path carries: a spectrum, or a Mueller matrix per wavelength.
+    type Throughput: Throughput;
+
+    /// The intensity of the factor by which the path's further contributions are weighted
+    /// (before MIS against light samples): Russian roulette and termination look at it.
     fn throughput(&self) -> SampledSpectrum;
 
     /// Multiplies the path's weight by `factor` (Russian roulette's 1/survival).
@@ -115,12 +293,12 @@ pub(crate) trait PathWeights {
     /// A directional sample at a scattering vertex: value over density `weight`, solid-angle
     /// density `pdf`; `unweighted` when no light sample could have found what it finds (a
     /// delta lobe, or a medium without `sample_emitters`), whose emission then counts in full.
-    fn scatter(&mut self, weight: SampledSpectrum, pdf: f32, unweighted: bool);
+    fn scatter(&mut self, weight: Self::Throughput, pdf: f32, unweighted: bool);
 
     /// A surface crossed by a null lobe with the sample's `weight`: not a scattering vertex, so
     /// the densities that MIS refers to stay those of the last one. The crossing is weighed
     /// outside MIS, as the light sample's factor of null transmission is.
-    fn pass_through(&mut self, weight: SampledSpectrum);
+    fn pass_through(&mut self, weight: Self::Throughput);
 
     /// Whether emission found next is weighted against light sampling (so its light density
     /// is needed).
@@ -130,45 +308,56 @@ pub(crate) trait PathWeights {
     /// vertex finds with solid-angle density `light_pdf` (ignored when unweighted).
     fn add_emission(&mut self, emitted: SampledSpectrum, light_pdf: f32);
 
-    /// Adds a light sample taken at the path's current vertex.
-    fn add_light_sample(&mut self, sample: &LightSampleTerms);
+    /// Adds a light sample taken at the path's current vertex, whose vertex and shadow ray also
+    /// do `transfer`.
+    fn add_light_sample(
+        &mut self,
+        sample: &LightSampleTerms,
+        transfer: &<Self::Throughput as Throughput>::LightTransfer,
+    );
 
     /// The path's estimate for the caller's wavelengths; `lambda_was_whole` when the path
     /// started with all four.
-    fn estimate(&self, lambda: &SampledWavelengths, lambda_was_whole: bool) -> SampledSpectrum;
+    fn estimate(
+        &self,
+        lambda: &SampledWavelengths,
+        lambda_was_whole: bool,
+    ) -> <Self::Throughput as Throughput>::Estimate;
 }
 
 /// `volpath`'s weights: the throughput of spectral tracking and the density of the last
 /// directional sample, for the power heuristic against light samples.
 #[derive(Clone)]
-pub(crate) struct SpectralTracking {
-    throughput: SampledSpectrum,
+pub(crate) struct SpectralTracking<T: Throughput = SampledSpectrum> {
+    throughput: T,
     /// Solid-angle density of the last directional sample.
     pdf: f32,
     unweighted: bool,
-    result: SampledSpectrum,
+    result: T::Estimate,
 }
 
-impl SpectralTracking {
+impl<T: Throughput> SpectralTracking<T> {
     pub(crate) fn new() -> Self {
         SpectralTracking {
-            throughput: SampledSpectrum::ONE,
+            throughput: T::ONE,
             pdf: 0.0,
             unweighted: true,
-            result: SampledSpectrum::ZERO,
+            result: T::Estimate::ZERO,
         }
     }
 }
 
-impl PathWeights for SpectralTracking {
+impl<T: Throughput> PathWeights for SpectralTracking<T> {
+    type Throughput = T;
+
     #[inline]
     fn throughput(&self) -> SampledSpectrum {
-        self.throughput
+        self.throughput.intensity()
     }
 
     #[inline]
     fn scale(&mut self, factor: f32) {
-        self.throughput *= factor;
+        self.throughput.scale_all(factor);
     }
 
     #[inline]
@@ -191,15 +380,15 @@ impl PathWeights for SpectralTracking {
     }
 
     #[inline]
-    fn scatter(&mut self, weight: SampledSpectrum, pdf: f32, unweighted: bool) {
-        self.throughput *= weight;
+    fn scatter(&mut self, weight: T, pdf: f32, unweighted: bool) {
+        self.throughput.then(weight);
         self.pdf = pdf;
         self.unweighted = unweighted;
     }
 
     #[inline]
-    fn pass_through(&mut self, weight: SampledSpectrum) {
-        self.throughput *= weight;
+    fn pass_through(&mut self, weight: T) {
+        self.throughput.then(weight);
     }
 
     #[inline]
@@ -214,28 +403,29 @@ impl PathWeights for SpectralTracking {
         } else {
             power_heuristic(self.pdf, light_pdf)
         };
-        self.result += self.throughput * emitted * weight;
+        self.result
+            .add(self.throughput.gathers(emitted).scaled(weight));
     }
 
     /// f·Tr·L·w / p_light, w the power heuristic against the directional density.
     #[inline]
-    fn add_light_sample(&mut self, s: &LightSampleTerms) {
+    fn add_light_sample(&mut self, s: &LightSampleTerms, transfer: &T::LightTransfer) {
         let weight = if s.is_delta {
             1.0
         } else {
             power_heuristic(s.light_pdf, s.direction_pdf)
         };
-        self.result += self.throughput
-            * s.value
-            * s.transmittance.total()
-            * s.radiance
-            * (weight / s.light_pdf);
+        self.result.add(
+            self.throughput
+                .gathers_light(s, transfer)
+                .scaled(weight / s.light_pdf),
+        );
     }
 
     #[inline]
-    fn estimate(&self, lambda: &SampledWavelengths, lambda_was_whole: bool) -> SampledSpectrum {
+    fn estimate(&self, lambda: &SampledWavelengths, lambda_was_whole: bool) -> T::Estimate {
         if lambda_was_whole && lambda.secondary_terminated() {
-            hero_only(self.result)
+            self.result.hero_only()
         } else {
             self.result
         }
@@ -259,12 +449,12 @@ fn counted(throughput: SampledSpectrum, lambda: &SampledWavelengths) -> SampledS
 /// the distance of a real collision, or `None` when the path reaches the surface (or leaves
 /// the medium's extent) first. The throughput is multiplied by each event's weight.
 #[inline]
-fn spectral_tracking(
+fn spectral_tracking<T: Throughput>(
     medium: &Medium,
     ray: &Ray,
     t_surface: f32,
     lambda: &SampledWavelengths,
-    throughput: &mut SampledSpectrum,
+    throughput: &mut T,
     sampler: &mut Sampler,
 ) -> Option<f32> {
     let (t0, t1) = medium.ray_extent(ray, t_surface)?;
@@ -274,18 +464,18 @@ fn spectral_tracking(
         t = sample_free_flight(t, t1, majorant, sampler.next_1d())?;
         let c = medium.coefficients(ray.at(t), ray.d, lambda);
         match choose_collision(
-            counted(*throughput, lambda),
+            counted(throughput.intensity(), lambda),
             &c,
             majorant,
             sampler.next_1d(),
         ) {
             Collision::Real(weight) => {
-                *throughput *= weight;
+                throughput.scale(weight);
                 return Some(t);
             }
             Collision::Null(weight) => {
-                *throughput *= weight;
-                if throughput.is_black() {
+                throughput.scale(weight);
+                if throughput.intensity().is_black() {
                     return None;
                 }
             }
@@ -385,18 +575,19 @@ impl<W: PathWeights + Clone> SteppedPath for VolPathWith<'_, W> {
                 let p = ray.at(t);
                 let wo = -ray.d;
                 if med.sample_emitters
-                    && let Some(terms) = VolPathIntegrator::light_sample_in_medium(
-                        ctx, p, wo, ray.time, med, *medium, lambda,
-                    )
+                    && let Some((terms, transfer)) =
+                        VolPathIntegrator::light_sample_in_medium::<W::Throughput>(
+                            ctx, p, wo, ray.time, med, *medium, lambda,
+                        )
                 {
-                    weights.add_light_sample(&terms);
+                    weights.add_light_sample(&terms, &transfer);
                 }
                 let ps = med.phase.sample(wo, ctx.sampler.next_2d());
                 if !(ps.pdf > 0.0) {
                     return false;
                 }
                 *ray = Ray::new(p, ps.wi, f32::INFINITY, ray.time);
-                weights.scatter(SampledSpectrum::ONE, ps.pdf, !med.sample_emitters);
+                weights.scatter(W::Throughput::ONE, ps.pdf, !med.sample_emitters);
                 *previous = Receiver::point(p);
                 *depth += 1;
                 return integrator.survives_roulette(ctx, *depth, weights, *eta_scale);
@@ -438,6 +629,7 @@ impl<W: PathWeights + Clone> SteppedPath for VolPathWith<'_, W> {
         if may_bounce && scattering.flags().has_smooth_lobe() {
             let receiver = Receiver::surface(si.p, si.shading.n);
             let current = *medium;
+            let mut transfer = None;
             let terms = sample_light(ctx, &receiver, si.time, lambda, |ctx, ls| {
                 let f = scattering.eval(ls.wi);
                 if f.value.is_black() {
@@ -446,11 +638,16 @@ impl<W: PathWeights + Clone> SteppedPath for VolPathWith<'_, W> {
                 let shadow = si.spawn_ray_to(ls.p, ls.n);
                 let end = shadow.o + shadow.d * shadow.t_max;
                 let shadow_medium = medium_after(world, &si, ls.wi, current);
-                let tr = shadow_transmittance(ctx, shadow.o, end, si.time, shadow_medium, lambda);
-                (!tr.is_black()).then_some((f, tr))
+                let (tr, surfaces) =
+                    W::Throughput::shadow(ctx, shadow.o, end, si.time, shadow_medium, lambda);
+                if tr.is_black() {
+                    return None;
+                }
+                transfer = Some(W::Throughput::at_surface(&scattering, ls.wi, &f, surfaces));
+                Some((f, tr))
             });
-            if let Some(terms) = terms {
-                weights.add_light_sample(&terms);
+            if let (Some(terms), Some(transfer)) = (terms, transfer) {
+                weights.add_light_sample(&terms, &transfer);
             }
         }
 
@@ -460,7 +657,7 @@ impl<W: PathWeights + Clone> SteppedPath for VolPathWith<'_, W> {
             return false;
         };
         if bs.flags.has_null_lobe() {
-            weights.pass_through(bs.weight);
+            weights.pass_through(W::Throughput::sampled(&scattering, &bs));
             if weights.throughput().is_black() {
                 return false;
             }
@@ -472,7 +669,11 @@ impl<W: PathWeights + Clone> SteppedPath for VolPathWith<'_, W> {
             return false;
         }
         *lambda = wavelengths_after(lambda, &bs);
-        weights.scatter(bs.weight, bs.pdf, bs.flags.is_delta());
+        weights.scatter(
+            W::Throughput::sampled(&scattering, &bs),
+            bs.pdf,
+            bs.flags.is_delta(),
+        );
         *eta_scale *= bs.eta;
         if weights.throughput().is_black() {
             return false;
@@ -487,6 +688,18 @@ impl<W: PathWeights + Clone> SteppedPath for VolPathWith<'_, W> {
 
     #[inline]
     fn estimate(&self, state: &VolPathState<W>) -> SampledSpectrum {
+        self.full_estimate(state).intensity()
+    }
+}
+
+impl<W: PathWeights + Clone> VolPathWith<'_, W> {
+    /// The estimate of a path that has ended, for the wavelengths it started with: radiance,
+    /// or a Stokes vector per wavelength.
+    #[inline]
+    pub(crate) fn full_estimate(
+        &self,
+        state: &VolPathState<W>,
+    ) -> <W::Throughput as Throughput>::Estimate {
         state
             .weights
             .estimate(&state.lambda, state.lambda_was_whole)
@@ -516,8 +729,9 @@ impl VolPathIntegrator {
 
     /// One light sample at the point `p` of `med` (index `medium`), scattered towards `wo` by
     /// its phase function (the path's weight already carries σ_s of the real collision), with
-    /// the transmittance of the media and null surfaces the shadow ray crosses.
-    fn light_sample_in_medium(
+    /// the transmittance of the media and null surfaces the shadow ray crosses, and what the
+    /// phase function and those surfaces do to the light beyond that.
+    fn light_sample_in_medium<T: Throughput>(
         ctx: &mut SampleContext,
         p: Vec3,
         wo: Vec3,
@@ -525,18 +739,24 @@ impl VolPathIntegrator {
         med: &Medium,
         medium: Option<u32>,
         lambda: &SampledWavelengths,
-    ) -> Option<LightSampleTerms> {
-        sample_light(ctx, &Receiver::point(p), time, lambda, |ctx, ls| {
+    ) -> Option<(LightSampleTerms, T::LightTransfer)> {
+        let mut transfer = None;
+        let terms = sample_light(ctx, &Receiver::point(p), time, lambda, |ctx, ls| {
             let phase_value = med.phase.eval(wo, ls.wi);
             if !(phase_value > 0.0) {
                 return None;
             }
-            let tr = shadow_transmittance(ctx, p, shadow_end(p, ls), time, medium, lambda);
+            let (tr, surfaces) = T::shadow(ctx, p, shadow_end(p, ls), time, medium, lambda);
+            if tr.is_black() {
+                return None;
+            }
+            transfer = Some(T::in_medium(phase_value, surfaces));
             let f = BsdfEval {
                 value: SampledSpectrum::splat(phase_value),
                 pdf: phase_value,
             };
-            (!tr.is_black()).then_some((f, tr))
-        })
+            Some((f, tr))
+        })?;
+        Some((terms, transfer?))
     }
 }

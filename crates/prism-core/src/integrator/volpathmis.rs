@@ -61,8 +61,7 @@
 //! share one path.
 
 use crate::integrator::mis::LightSampleTerms;
-use crate::integrator::vertex::hero_only;
-use crate::integrator::volpath::PathWeights;
+use crate::integrator::volpath::{Estimate, PathWeights, Throughput};
 use crate::math::Ray;
 use crate::medium::{Medium, sample_free_flight};
 use crate::sampling::sampler::Sampler;
@@ -70,10 +69,10 @@ use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 
 /// `volpathmis`'s weights (see the module's documentation for the symbols).
 #[derive(Clone)]
-pub(crate) struct SpectralMis {
+pub(crate) struct SpectralMis<T: Throughput = SampledSpectrum> {
     spectral_mis: bool,
     /// βᵢ = fᵢ / D.
-    beta: SampledSpectrum,
+    beta: T,
     /// Uⱼ = p_uni,ⱼ / D, with mean 1.
     uni: SampledSpectrum,
     /// Nⱼ = p_nee,ⱼ / (D p_light) since the last scattering vertex.
@@ -81,9 +80,9 @@ pub(crate) struct SpectralMis {
     /// Whether emission found next counts without MIS against light samples.
     unweighted: bool,
     /// The estimate with the four wavelengths' densities combined.
-    result: SampledSpectrum,
+    result: T::Estimate,
     /// The estimate with the hero's densities alone.
-    hero_result: SampledSpectrum,
+    hero_result: T::Estimate,
 }
 
 /// e^{−mΔ}, 1 where m = 0 (also for Δ = ∞).
@@ -100,24 +99,24 @@ fn attenuation(majorant: SampledSpectrum, delta: f32) -> SampledSpectrum {
 
 /// `value / denominator`, zero where the denominator is zero or not finite.
 #[inline]
-fn over(value: SampledSpectrum, denominator: f32) -> SampledSpectrum {
+fn over<E: Estimate>(value: E, denominator: f32) -> E {
     if denominator > 0.0 && denominator.is_finite() {
-        value * (1.0 / denominator)
+        value.scaled(1.0 / denominator)
     } else {
-        SampledSpectrum::ZERO
+        E::ZERO
     }
 }
 
-impl SpectralMis {
+impl<T: Throughput> SpectralMis<T> {
     pub(crate) fn new(spectral_mis: bool) -> Self {
         SpectralMis {
             spectral_mis,
-            beta: SampledSpectrum::ONE,
+            beta: T::ONE,
             uni: SampledSpectrum::ONE,
             nee: SampledSpectrum::ZERO,
             unweighted: true,
-            result: SampledSpectrum::ZERO,
-            hero_result: SampledSpectrum::ZERO,
+            result: T::Estimate::ZERO,
+            hero_result: T::Estimate::ZERO,
         }
     }
 
@@ -125,30 +124,32 @@ impl SpectralMis {
     /// densities `p_nee` (per wavelength), then the renormalisation to mean(U) = 1.
     #[inline]
     fn event(&mut self, f: SampledSpectrum, p_uni: SampledSpectrum, p_nee: SampledSpectrum) {
-        self.beta *= f;
+        self.beta.scale(f);
         self.uni *= p_uni;
         self.nee *= p_nee;
         let scale = self.uni.average();
         if scale > 0.0 && scale.is_finite() {
             let inverse = 1.0 / scale;
-            self.beta *= inverse;
+            self.beta.scale_all(inverse);
             self.uni *= inverse;
             self.nee *= inverse;
         } else {
-            self.beta = SampledSpectrum::ZERO;
+            self.beta = T::ZERO;
         }
     }
 }
 
-impl PathWeights for SpectralMis {
+impl<T: Throughput> PathWeights for SpectralMis<T> {
+    type Throughput = T;
+
     #[inline]
     fn throughput(&self) -> SampledSpectrum {
-        self.beta
+        self.beta.intensity()
     }
 
     #[inline]
     fn scale(&mut self, factor: f32) {
-        self.beta *= factor;
+        self.beta.scale_all(factor);
     }
 
     fn free_flight(
@@ -185,15 +186,15 @@ impl PathWeights for SpectralMis {
             let sigma_n =
                 SampledSpectrum::from_fn(|j| (majorant[j] - c.sigma_t[j]).max(0.0)) * reach;
             self.event(sigma_n, sigma_n, majorant * reach);
-            if self.beta.is_black() {
+            if self.beta.intensity().is_black() {
                 return None;
             }
         }
     }
 
     #[inline]
-    fn scatter(&mut self, weight: SampledSpectrum, pdf: f32, unweighted: bool) {
-        self.beta *= weight;
+    fn scatter(&mut self, weight: T, pdf: f32, unweighted: bool) {
+        self.beta.then(weight);
         self.unweighted = unweighted || !(pdf > 0.0);
         self.nee = if self.unweighted {
             SampledSpectrum::ZERO
@@ -204,8 +205,8 @@ impl PathWeights for SpectralMis {
 
     /// β times the weight; U and N as they were (the crossing is no technique of the MIS).
     #[inline]
-    fn pass_through(&mut self, weight: SampledSpectrum) {
-        self.beta *= weight;
+    fn pass_through(&mut self, weight: T) {
+        self.beta.then(weight);
     }
 
     #[inline]
@@ -216,32 +217,36 @@ impl PathWeights for SpectralMis {
     /// Lₑ βᵢ / (mean U + p_light mean N), or Lₑ βᵢ / mean U when unweighted.
     #[inline]
     fn add_emission(&mut self, emitted: SampledSpectrum, light_pdf: f32) {
-        let found = emitted * self.beta;
+        let found = self.beta.gathers(emitted);
         let light_pdf = if self.unweighted { 0.0 } else { light_pdf };
-        self.result += over(found, self.uni.average() + light_pdf * self.nee.average());
-        self.hero_result += over(found, self.uni[0] + light_pdf * self.nee[0]);
+        self.result.add(over(
+            found,
+            self.uni.average() + light_pdf * self.nee.average(),
+        ));
+        self.hero_result
+            .add(over(found, self.uni[0] + light_pdf * self.nee[0]));
     }
 
     /// f Tr Lₑ βᵢ / (p_light mean U + p_dir mean(U·Tr_media)), p_dir = 0 for a delta light.
     #[inline]
-    fn add_light_sample(&mut self, s: &LightSampleTerms) {
-        let found = self.beta * s.value * s.transmittance.total() * s.radiance;
+    fn add_light_sample(&mut self, s: &LightSampleTerms, transfer: &T::LightTransfer) {
+        let found = self.beta.gathers_light(s, transfer);
         let direction_pdf = if s.is_delta { 0.0 } else { s.direction_pdf };
         let passing = self.uni * s.transmittance.media;
-        self.result += over(
+        self.result.add(over(
             found,
             s.light_pdf * self.uni.average() + direction_pdf * passing.average(),
-        );
-        self.hero_result += over(
+        ));
+        self.hero_result.add(over(
             found,
             s.light_pdf * self.uni[0] + direction_pdf * passing[0],
-        );
+        ));
     }
 
     #[inline]
-    fn estimate(&self, lambda: &SampledWavelengths, lambda_was_whole: bool) -> SampledSpectrum {
+    fn estimate(&self, lambda: &SampledWavelengths, lambda_was_whole: bool) -> T::Estimate {
         if lambda_was_whole && lambda.secondary_terminated() {
-            hero_only(self.hero_result)
+            self.hero_result.hero_only()
         } else if self.spectral_mis {
             self.result
         } else {

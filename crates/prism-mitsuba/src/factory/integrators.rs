@@ -22,8 +22,8 @@ use prism_core::integrator::guided::{Adrrs, Budget, NextEvent, SampleCombination
 use prism_core::integrator::{
     AovIntegrator, BdptIntegrator, DepthIntegrator, DirectIntegrator, DistributionIntegrator,
     GuidedPathIntegrator, Integrator, MomentIntegrator, ParticleTracer, PathIntegrator,
-    PolarizedPathIntegrator, SppmIntegrator, StokesIntegrator, Tracking, VcmIntegrator,
-    VolPathIntegrator,
+    PolarizedIntegrator, PolarizedPathIntegrator, PolarizedVolPathIntegrator, SppmIntegrator,
+    StokesIntegrator, Tracking, VcmIntegrator, VolPathIntegrator,
 };
 use prism_core::light::{Light, LightSelection};
 
@@ -91,7 +91,8 @@ pub static INTEGRATORS: Registry<Build> = Registry {
         Plugin {
             name: "stokes",
             origin: Origin::Mitsuba3,
-            summary: "Renders its nested `path` integrator polarized and writes the Stokes \
+            summary: "Renders its nested `path`, `volpath` or `volpathmis` integrator polarized \
+                      and writes the Stokes \
                       vector at the sensor as the EXR channels S0.R, S0.G, S0.B, … S3.B (each \
                       component as linear sRGB, in the sensor's frame, as Mitsuba 3); the \
                       image is S0, the intensity.",
@@ -276,7 +277,7 @@ params! {
     EMITTER_SAMPLES = ParamSpec::new("emitter_samples", ParamKind::Integer, Default::Text("shading_samples"), "light samples per camera ray");
     BSDF_SAMPLES = ParamSpec::new("bsdf_samples", ParamKind::Integer, Default::Text("shading_samples"), "BSDF samples per camera ray");
     NESTED_INTEGRATORS = ParamSpec::nested(PluginClass::Integrator, Default::Required, "the integrators whose moments are recorded (at least one), in order");
-    NESTED_POLARIZED = ParamSpec::nested(PluginClass::Integrator, Default::Required, "the integrator rendered polarized: `path` (Prism's only polarized estimator)");
+    NESTED_POLARIZED = ParamSpec::nested(PluginClass::Integrator, Default::Required, "the integrator rendered polarized: `path`, `volpath` or `volpathmis` (Prism's polarized estimators)");
     NESTED_IMAGE_INTEGRATORS = ParamSpec::nested(PluginClass::Integrator, Default::Text("none (a black image)"), "the integrators whose images are written beside the variables, in order");
     AOVS = ParamSpec::new("aovs", ParamKind::String, Default::Required, "comma-separated name:type pairs, e.g. \"dd.y:depth,nn:sh_normal,alb:albedo\"");
     BOUNCE_SAMPLES = ParamSpec::new("bounce_samples", ParamKind::Integer, Default::Integer(4), "bounce samples at potential 1 (1 to 1024)");
@@ -342,7 +343,7 @@ pub fn check_channel_names(integrator: &Integrator, location: &SourceLocation) -
     }
 }
 
-/// `stokes`: its one nested integrator, which must be `path`, rendered polarized.
+/// `stokes`: its one nested integrator, `path`, `volpath` or `volpathmis`, rendered polarized.
 fn build_stokes(params: &Params) -> Result<Integrator> {
     let nested = params.children(&NESTED_POLARIZED);
     let [child] = nested.as_slice() else {
@@ -355,29 +356,39 @@ fn build_stokes(params: &Params) -> Result<Integrator> {
         )
         .with_help("nest the integrator to render polarized: <integrator type=\"path\"/>"));
     };
-    let Integrator::Path(path) = build_integrator(&child.node)? else {
-        return Err(Error::input(
-            &child.location,
-            format!(
-                "Prism renders only `path` polarized, so {} cannot be nested in \"stokes\"",
-                child.node.describe()
-            ),
-        )
-        .with_help("nest <integrator type=\"path\"/> (volpath without media renders the same)"));
+    let nested = match build_integrator(&child.node)? {
+        Integrator::Path(path) => PolarizedIntegrator::Path(PolarizedPathIntegrator { path }),
+        Integrator::VolPath(volpath) => {
+            PolarizedIntegrator::VolPath(PolarizedVolPathIntegrator { volpath })
+        }
+        _ => {
+            return Err(Error::input(
+                &child.location,
+                format!(
+                    "Prism renders only `path`, `volpath` and `volpathmis` polarized, so {} \
+                     cannot be nested in \"stokes\"",
+                    child.node.describe()
+                ),
+            )
+            .with_help("nest <integrator type=\"path\"/> or <integrator type=\"volpath\"/>"));
+        }
     };
     Ok(Integrator::Stokes(StokesIntegrator {
-        nested: PolarizedPathIntegrator { path },
+        nested,
         sensor_up: Vec3::Y,
     }))
 }
 
-/// The integrator a scene renders with: `path` becomes the polarized path tracer where the
-/// scene holds a polarizing BSDF (`polarizing`), as Mitsuba's polarized variants render it;
-/// any other integrator is kept.
+/// The integrator a scene renders with: `path`, `volpath` and `volpathmis` become their
+/// polarized estimators where the scene holds a polarizing BSDF (`polarizing`), as Mitsuba's
+/// polarized variants render them; any other integrator is kept.
 pub fn polarized_where_needed(integrator: Integrator, polarizing: bool) -> Integrator {
     match integrator {
         Integrator::Path(path) if polarizing => {
             Integrator::PolarizedPath(PolarizedPathIntegrator { path })
+        }
+        Integrator::VolPath(volpath) if polarizing => {
+            Integrator::PolarizedVolPath(PolarizedVolPathIntegrator { volpath })
         }
         other => other,
     }

@@ -278,18 +278,17 @@ fn check_renders_media(integrator: &Integrator, media: &MediaCache) -> Result<()
     Ok(())
 }
 
-/// A scene with a polarizing BSDF renders polarized with `path` (and `stokes`); `direct`, whose
-/// light from unpolarized emitters scatters once, gives the polarized intensity exactly
-/// (S₀ = M₀₀ L), and `depth` and `aov` trace no light. The integrators that follow light over
-/// several vertices carry no polarization, so that light through two polarizers would come out
-/// wrong: such a scene is an error at the integrator.
+/// A scene with a polarizing BSDF renders polarized with `path`, `volpath` and `volpathmis`
+/// (and `stokes`); `direct`, whose light from unpolarized emitters scatters once, gives the
+/// polarized intensity exactly (S₀ = M₀₀ L), and `depth` and `aov` trace no light. The other
+/// integrators that follow light over several vertices carry no polarization, so that light
+/// through two polarizers would come out wrong: such a scene is an error at the integrator.
 fn check_renders_polarization(
     integrator: &Integrator,
     materials: &[Material],
     location: &SourceLocation,
 ) -> Result<()> {
     let name = match integrator {
-        Integrator::VolPath(_) => "volpath (and volpathmis)",
         Integrator::Distribution(_) => "distrib",
         Integrator::Particle(_) => "ptracer",
         Integrator::Bdpt(_) => "bdpt",
@@ -310,8 +309,9 @@ fn check_renders_polarization(
         ),
     )
     .with_help(
-        "render it with <integrator type=\"path\"> (polarized, as Mitsuba's *_polarized \
-         variants render it; nested in <integrator type=\"stokes\"> for the Stokes vector)",
+        "render it with <integrator type=\"path\"> or \"volpath\" (polarized, as Mitsuba's \
+         *_polarized variants render them; nested in <integrator type=\"stokes\"> for the \
+         Stokes vector)",
     ))
 }
 
