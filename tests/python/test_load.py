@@ -181,3 +181,28 @@ def test_a_pbrt_v4_scene_loads_by_its_name(cornell_path):
     assert abs(difference) < 4 * np.sqrt(variance), (difference, np.sqrt(variance))
     with pytest.raises(pr.PrismError, match="no parameters to set"):
         pr.load_file(pbrt, spp=4)
+
+
+def test_tensor_parameters_come_from_numpy_arrays():
+    """Mitsuba's tensor parameters (`sdfgrid`'s `grid`, `ellipsoids`' `data`), which only a
+    dictionary can give, read from numpy arrays: hits against their closed forms."""
+    n = 5
+    heights = np.linspace(0.0, 1.0, n) - 0.37  # the plane z = 0.37, reproduced exactly
+    grid = np.broadcast_to(heights[:, None, None, None], (n, n, n, 1)).astype(np.float32)
+    data = np.array([[3.0, 0.0, 0.0, 0.2, 0.4, 0.6, 0.0, 0.0, 0.0, 1.0]], dtype=np.float32)
+    scene = pr.load_dict({
+        "type": "scene",
+        "sensor": {"type": "perspective"},
+        "plane": {"type": "sdfgrid", "grid": grid},
+        "cloud": {"type": "ellipsoids", "data": data, "extent": 1.0},
+    })
+    origins = np.array([[0.5, 0.5, 2.0], [3.0, 0.0, 2.0], [3.0, 2.0, 0.0], [5.0, 0.0, 0.0]])
+    directions = np.array([[0, 0, -1], [0, 0, -1], [0, -1, 0], [-1, 0, 0]], dtype=float)
+    si = scene.ray_intersect(origins, directions)
+    np.testing.assert_allclose(si.t, [2.0 - 0.37, 2.0 - 0.6, 2.0 - 0.4, 2.0 - 0.2], rtol=1e-5)
+    with pytest.raises(pr.PrismError, match="scene.plane.grid"):
+        pr.load_dict({
+            "type": "scene",
+            "sensor": {"type": "perspective"},
+            "plane": {"type": "sdfgrid", "grid": grid[..., 0]},
+        })

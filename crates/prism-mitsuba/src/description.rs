@@ -154,6 +154,13 @@ pub enum PropertyValue {
     /// A list of numbers, which XML cannot write: the arrays of a mesh given inline (the pbrt-v4
     /// reader's `trianglemesh`).
     Numbers(Vec<f64>),
+    /// An array of numbers of any number of dimensions, which XML cannot write either: a
+    /// scene dictionary's nested lists or numpy array (Mitsuba's tensor parameters). `values`
+    /// holds them with the last index fastest; `shape` has at least one dimension.
+    Tensor {
+        shape: Vec<usize>,
+        values: Vec<f64>,
+    },
 }
 
 impl PropertyValue {
@@ -171,6 +178,7 @@ impl PropertyValue {
             PropertyValue::Transform(_) => "transform",
             PropertyValue::Animation(_) => "animation",
             PropertyValue::Numbers(_) => "list of numbers",
+            PropertyValue::Tensor { .. } => "tensor",
         }
     }
 }

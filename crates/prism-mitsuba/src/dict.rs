@@ -8,6 +8,9 @@
 //!
 //! * a boolean, integer, float or string is a property of that type;
 //! * three numbers are a point (which every vector parameter accepts too, as in Mitsuba);
+//! * any other list of numbers, or nested lists of numbers of a rectangular shape (a numpy
+//!   array's `tolist()`), is a tensor (Mitsuba's `TensorXf` parameters, such as `sdfgrid`'s
+//!   `grid`);
 //! * a 4 × 4 matrix (row-major, acting on column vectors) is a transform;
 //! * `{"type": "rgb", "value": v}` is an RGB colour, with `v` one number or three;
 //! * `{"type": "spectrum", "value": v}` is a spectrum, with `v` one number or a list of
@@ -373,9 +376,19 @@ fn plain_value(value: &DictValue, location: &SourceLocation) -> Result<PropertyV
         }
         DictValue::List(items) => {
             let numbers: Option<Vec<f64>> = items.iter().map(DictValue::number).collect();
-            match numbers.as_deref() {
-                Some(&[x, y, z]) if x.is_finite() && y.is_finite() && z.is_finite() => {
+            match (numbers.as_deref(), tensor_of(value)) {
+                (Some(&[x, y, z]), _) if x.is_finite() && y.is_finite() && z.is_finite() => {
                     PropertyValue::Point(DVec3::new(x, y, z))
+                }
+                (_, Some((shape, values))) => {
+                    if let Some(v) = values.iter().find(|v| !v.is_finite()) {
+                        return Err(Error::input(
+                            location,
+                            format!("the tensor holds {v}, which is not a finite number"),
+                        )
+                        .with_help("give finite numbers"));
+                    }
+                    PropertyValue::Tensor { shape, values }
                 }
                 _ => {
                     return Err(Error::input(
@@ -394,6 +407,47 @@ fn plain_value(value: &DictValue, location: &SourceLocation) -> Result<PropertyV
         }
         DictValue::Dict(_) => unreachable!("nested dictionaries are read as plugins"),
     })
+}
+
+/// The shape and values (last index fastest) of `value`, (nested) lists of numbers whose
+/// lists at each depth all have the same length (a 4 × 4 block of them may have been read as a
+/// matrix); None for anything else, and for empty lists.
+fn tensor_of(value: &DictValue) -> Option<(Vec<usize>, Vec<f64>)> {
+    let mut shape = Vec::new();
+    let mut level = value;
+    loop {
+        match level {
+            DictValue::List(items) => {
+                shape.push(items.len());
+                level = items.first()?;
+            }
+            DictValue::Matrix(_) => {
+                shape.extend([4, 4]);
+                break;
+            }
+            _ => break,
+        }
+    }
+    if shape.is_empty() {
+        return None;
+    }
+    let mut values = Vec::new();
+    gather(value, &shape, &mut values).then_some((shape, values))
+}
+
+/// Appends the numbers of `value`, which must have the shape `shape`; false where it does not.
+fn gather(value: &DictValue, shape: &[usize], values: &mut Vec<f64>) -> bool {
+    match (value, shape.split_first()) {
+        (DictValue::List(items), Some((&length, inner))) => {
+            items.len() == length && items.iter().all(|item| gather(item, inner, values))
+        }
+        (DictValue::Matrix(rows), Some((4, [4]))) => {
+            values.extend(rows.iter().flatten());
+            true
+        }
+        (_, None) => value.number().map(|v| values.push(v)).is_some(),
+        _ => false,
+    }
 }
 
 /// A value of an `rgb` or `spectrum` dictionary written as the XML attribute it stands for:

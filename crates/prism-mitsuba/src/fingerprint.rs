@@ -94,6 +94,15 @@ fn add_node(hash: &mut Fnv64, node: &PluginNode) {
                     hash.write(&value.to_le_bytes());
                 }
             }
+            PropertyValue::Tensor { shape, values } => {
+                for &n in shape {
+                    hash.write(&(n as u64).to_le_bytes());
+                }
+                hash.write(&(values.len() as u64).to_le_bytes());
+                for value in values {
+                    hash.write(&value.to_le_bytes());
+                }
+            }
             value => hash.write_str(&format!("{value:?}")),
         }
         if property.name == "filename"

@@ -7,6 +7,7 @@
 //! [`Params::finish_with_warnings`] turns the parameters declared [`Default::Ignored`] (Mitsuba
 //! 0.6 forms Prism reads but does not implement) into one [`Warning`] each.
 
+use std::borrow::Cow;
 use std::cell::Cell;
 
 use glam::{DMat4, DVec3};
@@ -16,6 +17,14 @@ use crate::registry::{Choice, Default, ParamKind, ParamSpec};
 use crate::suggest::closest_match;
 use prism_core::error::{Error, Result, SourceLocation};
 use prism_core::math::{AnimatedTransform, Transform};
+
+/// An array of numbers of given dimensions: a tensor parameter's value.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Tensor<'a> {
+    pub shape: Vec<usize>,
+    /// The numbers, the last index fastest.
+    pub values: Cow<'a, [f64]>,
+}
 
 /// Reads the properties of one plugin node through its plugin's declared parameters, and
 /// remembers which were read.
@@ -85,13 +94,19 @@ impl<'a> Params<'a> {
     }
 
     fn wrong_type(&self, property: &Property, expected: &str) -> Error {
+        let given = match &property.value {
+            PropertyValue::Tensor { shape, .. } if shape.len() == 1 => {
+                format!("list of {} numbers", shape[0])
+            }
+            PropertyValue::Tensor { shape, .. } => format!("tensor of shape {shape:?}"),
+            value => value.type_name().to_string(),
+        };
         Error::input(
             &property.location,
             format!(
-                "parameter \"{}\" of {} must be {expected}, but a {} was given",
+                "parameter \"{}\" of {} must be {expected}, but a {given} was given",
                 property.name,
                 self.node.describe(),
-                property.value.type_name()
             ),
         )
         .with_help(format!(
@@ -248,10 +263,64 @@ impl<'a> Params<'a> {
         match self.property(spec) {
             None => Ok(None),
             Some(p) => match &p.value {
-                PropertyValue::Numbers(v) => Ok(Some(v.as_slice())),
+                PropertyValue::Numbers(v) | PropertyValue::Tensor { values: v, .. } => {
+                    Ok(Some(v.as_slice()))
+                }
                 _ => Err(self.wrong_type(p, "a list of numbers")),
             },
         }
+    }
+
+    /// A tensor, if present. A list of numbers is one of one dimension, a point or vector one
+    /// of three numbers, and a 4 × 4 matrix (read as a transform) one of 4 × 4, row by row.
+    pub fn tensor_opt(&self, spec: &ParamSpec) -> Result<Option<Tensor<'a>>> {
+        let Some(p) = self.property(spec) else {
+            return Ok(None);
+        };
+        let (shape, values) = match &p.value {
+            PropertyValue::Tensor { shape, values } => {
+                (shape.clone(), Cow::from(values.as_slice()))
+            }
+            PropertyValue::Numbers(values) => (vec![values.len()], Cow::from(values.as_slice())),
+            PropertyValue::Point(v) | PropertyValue::Vector(v) => {
+                (vec![3], Cow::from(v.to_array().to_vec()))
+            }
+            PropertyValue::Transform(m) => (
+                vec![4, 4],
+                Cow::from(m.transpose().to_cols_array().to_vec()),
+            ),
+            _ => {
+                return Err(Error::input(
+                    &p.location,
+                    format!(
+                        "parameter \"{}\" of {} must be a tensor, but a {} was given",
+                        p.name,
+                        self.node.describe(),
+                        p.value.type_name()
+                    ),
+                )
+                .with_help(
+                    "give it in a scene dictionary as a numpy array or nested lists of numbers \
+                     (XML has no form for tensors)",
+                ));
+            }
+        };
+        Ok(Some(Tensor { shape, values }))
+    }
+
+    /// The names of the tensor properties the plugin does not declare, marked as used (read
+    /// past, as Mitsuba keeps such tensors as per-primitive attributes), in document order.
+    pub fn undeclared_tensors(&self) -> Vec<&'a str> {
+        let mut found = Vec::new();
+        for (index, property) in self.node.properties.iter().enumerate() {
+            if matches!(property.value, PropertyValue::Tensor { .. })
+                && !self.declared.iter().any(|d| d.name == property.name)
+            {
+                self.used_properties[index].set(true);
+                found.push(property.name.as_str());
+            }
+        }
+        found
     }
 
     /// A point, if present.

@@ -85,6 +85,9 @@ pub enum ParamKind {
     Nested(PluginClass),
     /// A list of numbers (no XML form: the pbrt-v4 reader writes it).
     Numbers,
+    /// An array of numbers of given dimensions (no XML form: Mitsuba's tensors, from scene
+    /// dictionaries).
+    Tensor,
 }
 
 impl ParamKind {
@@ -122,6 +125,7 @@ impl ParamKind {
             ParamKind::Ior => "index of refraction".into(),
             ParamKind::Nested(class) => format!("nested {}", class.tag()),
             ParamKind::Numbers => "list of numbers".into(),
+            ParamKind::Tensor => "tensor (scene dictionaries only)".into(),
         }
     }
 }

@@ -216,7 +216,7 @@ pub(super) fn child_names(node: &PluginNode, parent: Option<&str>) -> Vec<String
 }
 
 /// The key suffix and kind of a property's value; None for a value that is not a parameter
-/// (a string, an animation, a pbrt-v4 scene's inline list of numbers).
+/// (a string, an animation, a pbrt-v4 scene's inline list of numbers, a tensor).
 fn property_kind(value: &PropertyValue) -> Option<(&'static str, Kind)> {
     Some(match value {
         PropertyValue::Float(_) => ("", Kind::Float),
@@ -231,7 +231,10 @@ fn property_kind(value: &PropertyValue) -> Option<(&'static str, Kind)> {
         PropertyValue::Point(_) => ("", Kind::Point),
         PropertyValue::Vector(_) => ("", Kind::Vector),
         PropertyValue::Transform(_) => ("", Kind::Transform),
-        PropertyValue::String(_) | PropertyValue::Animation(_) | PropertyValue::Numbers(_) => {
+        PropertyValue::String(_)
+        | PropertyValue::Animation(_)
+        | PropertyValue::Numbers(_)
+        | PropertyValue::Tensor { .. } => {
             return None;
         }
     })

@@ -99,8 +99,11 @@ pub(super) fn to_python<'py>(
         PropertyValue::Transform(matrix) => {
             Transform { matrix: *matrix }.into_pyobject(py)?.into_any()
         }
-        PropertyValue::String(_) | PropertyValue::Animation(_) | PropertyValue::Numbers(_) => {
-            unreachable!("strings, animations and lists of numbers are not parameters")
+        PropertyValue::String(_)
+        | PropertyValue::Animation(_)
+        | PropertyValue::Numbers(_)
+        | PropertyValue::Tensor { .. } => {
+            unreachable!("strings, animations, lists of numbers and tensors are not parameters")
         }
     })
 }
