@@ -21,7 +21,7 @@
 //! of `path`: the same estimator with a Mueller matrix per wavelength for a throughput, in its
 //! own file, so that unpolarized scenes run the path tracer's code unchanged; and
 //! [`polarized_volpath`] in place of `volpath` and `volpathmis`: their one step, written over
-//! what a path carries ([`volpath::Throughput`]), run with Mueller matrices.
+//! what a path carries ([`throughput::Throughput`]), run with Mueller matrices.
 
 pub mod adjoint;
 pub mod aov;
@@ -41,6 +41,7 @@ pub mod ptracer;
 pub mod sppm;
 pub mod stepped;
 pub mod stokes;
+pub mod throughput;
 pub mod transmittance;
 pub mod vcm;
 pub mod vertex;

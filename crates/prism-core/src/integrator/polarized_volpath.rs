@@ -36,9 +36,10 @@ use crate::integrator::SampleContext;
 use crate::integrator::mis::LightSampleTerms;
 use crate::integrator::polarized_path::SampledStokes;
 use crate::integrator::stepped::SteppedPath;
+use crate::integrator::throughput::{Estimate, Throughput};
 use crate::integrator::transmittance::{ShadowTransmittance, shadow_transmittance_crossing};
 use crate::integrator::volpath::{
-    Estimate, PathWeights, SpectralTracking, Throughput, Tracking, VolPathIntegrator, VolPathWith,
+    PathWeights, SpectralTracking, Tracking, VolPathIntegrator, VolPathWith,
 };
 use crate::integrator::volpathmis::SpectralMis;
 use crate::light::LightSelection;

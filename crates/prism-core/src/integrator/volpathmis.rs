@@ -61,7 +61,8 @@
 //! share one path.
 
 use crate::integrator::mis::LightSampleTerms;
-use crate::integrator::volpath::{Estimate, PathWeights, Throughput};
+use crate::integrator::throughput::{Estimate, Throughput};
+use crate::integrator::volpath::PathWeights;
 use crate::math::Ray;
 use crate::medium::{Medium, sample_free_flight};
 use crate::sampling::sampler::Sampler;
