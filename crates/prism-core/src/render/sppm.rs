@@ -435,11 +435,7 @@ pub(super) fn render(
     let width = crop.size.x as usize;
     let pixel_count = u64::from(crop.size.x) * u64::from(crop.size.y);
     let first = options.first_sample;
-    let Chain {
-        origin,
-        passes: _,
-        pixels: mut state,
-    } = match &options.initial {
+    let mut chain = match &options.initial {
         Some(initial) => resumed_chain(initial.integrator.as_ref(), pixel_count, first)?,
         None => {
             let radius = f64::from(
@@ -454,10 +450,10 @@ pub(super) fn render(
         }
     };
     let end = match sppm.max_passes {
-        Some(max_passes) => Some(origin.saturating_add(max_passes)),
+        Some(max_passes) => Some(chain.origin.saturating_add(max_passes)),
         None => options.stop.sample_end,
     };
-    let mut next_state = state.clone();
+    let mut next_state = chain.pixels.clone();
     let aov_count = estimator.aov_count();
     let progress: &dyn ProgressReport = options.progress.as_deref().unwrap_or(&Silent);
     progress.begin(end.map(|end| pixel_count * u64::from(end.saturating_sub(first))));
@@ -476,15 +472,6 @@ pub(super) fn render(
         options,
         cancel: &cancel,
         progress,
-    };
-    let snapshot_of = |state: &[PixelState], next: u32| {
-        let chain = Chain {
-            origin,
-            passes: next - origin,
-            pixels: state.to_vec(),
-        };
-        let film = film_of(scene, sppm, &chain, aov_count);
-        (film, chain.encode())
     };
     let mut last_checkpoint = start;
     let mut next = first;
@@ -508,7 +495,7 @@ pub(super) fn render(
         if interrupted() {
             break StopReason::Interrupted;
         }
-        next_state.copy_from_slice(&state);
+        next_state.copy_from_slice(&chain.pixels);
         let done = pool.install(|| pass.run(next, &mut next_state, width));
         let Some(pass_rays) = done.filter(|_| !abort.load(Ordering::Relaxed)) else {
             break if interrupted() {
@@ -517,14 +504,16 @@ pub(super) fn render(
                 StopReason::TimeLimit
             };
         };
-        std::mem::swap(&mut state, &mut next_state);
+        std::mem::swap(&mut chain.pixels, &mut next_state);
         rays.fetch_add(pass_rays, Ordering::Relaxed);
+        chain.passes += 1;
         next += 1;
         progress.pass_done(next - first, f64::INFINITY);
         let checkpoint_due = (checkpoints.as_ref())
             .is_some_and(|checkpoint| last_checkpoint.elapsed() >= checkpoint.every);
         if checkpoint_due || preview.is_some() {
-            let (film, integrator_state) = snapshot_of(&state, next);
+            let film = film_of(scene, sppm, &chain, aov_count);
+            let integrator_state = chain.encode();
             let snapshot = Snapshot {
                 samples: first..next,
                 pixels: &film.pixels,
@@ -544,7 +533,8 @@ pub(super) fn render(
     };
     let elapsed = start.elapsed();
     progress.end();
-    let (film, integrator_state) = snapshot_of(&state, next);
+    let film = film_of(scene, sppm, &chain, aov_count);
+    let integrator_state = chain.encode();
     if let Some(checkpoint) = &mut checkpoints {
         (checkpoint.write)(&Snapshot {
             samples: first..next,
