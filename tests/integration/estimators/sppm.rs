@@ -460,10 +460,14 @@ fn sppm_refuses_bad_and_foreign_states() {
     assert!(error.contains("sppm"), "{error}");
 }
 
-/// A scene file for the command line: an sppm render of a lit room whose pass count is the
-/// sample count (no `maxPasses`).
+/// A scene file for the command line: an sppm render of a lit room of 8 samples per pixel whose
+/// pass count is the sample count unless `-D max_passes=N` sets one.
 const ROOM_XML: &str = r#"<scene version="3.0.0">
-    <integrator type="sppm"><integer name="photon_count" value="2000"/></integrator>
+    <default name="max_passes" value="-1"/>
+    <integrator type="sppm">
+        <integer name="photon_count" value="2000"/>
+        <integer name="max_passes" value="$max_passes"/>
+    </integrator>
     <sensor type="perspective">
         <float name="fov" value="60"/>
         <transform name="to_world"><lookat origin="0, 0, 0.9" target="0, 0, 0" up="0, 1, 0"/></transform>
@@ -513,7 +517,9 @@ fn assert_identical_images(a: &Path, b: &Path) {
 
 /// Through the command line: a chain of 3 passes checkpointed, then resumed to 8 on two threads,
 /// gives the image of 8 passes in one go; `prism merge` of two chains says that its image has the
-/// bias of one chain and no error estimate, and its state is refused on resume.
+/// bias of one chain and no error estimate, and its state is refused on resume; where
+/// `maxPasses` exceeds the sample count, a chain resumed past the sample count still ends at
+/// `maxPasses`.
 #[test]
 fn sppm_checkpoints_resume_and_merge_through_the_command_line() {
     let dir = std::env::temp_dir().join(format!("prism-sppm-cli-{}", std::process::id()));
@@ -549,5 +555,38 @@ fn sppm_checkpoints_resume_and_merge_through_the_command_line() {
     let (status, text) = run("render room.xml --sample-range 0..20 --resume merged.state -o x.exr");
     assert_eq!(status, 2, "{text}");
     assert!(text.contains("merge of 2 sppm chains"), "{text}");
+
+    // With `maxPasses` 11 (more than the 8 samples), a chain stopped after 9 passes (by an
+    // interruption, here raised from the library's preview) resumes to 11.
+    render("-D max_passes=11 --threads 2 -o long.exr");
+    let defines = [("max_passes".to_string(), "11".to_string())];
+    let loaded = prism_mitsuba::load_scene(&dir.join("room.xml"), &defines).unwrap();
+    let scene = loaded.scene;
+    let interrupt = Arc::new(AtomicBool::new(false));
+    let mut raise = |snapshot: &Snapshot| -> prism_core::error::Result<()> {
+        if snapshot.samples.end == 9 {
+            interrupt.store(true, Ordering::Relaxed);
+        }
+        Ok(())
+    };
+    let options = RenderOptions {
+        interrupt: Some(interrupt.clone()),
+        ..RenderOptions::fixed(8, loaded.seed, Some(1))
+    };
+    let stopped = render_with_preview(&scene, &options, None, Some(&mut raise as Preview)).unwrap();
+    assert_eq!(stopped.samples, 0..9);
+    Continuation::new(&scene, loaded.seed, scene.strata(8))
+        .save(
+            &Snapshot {
+                samples: stopped.samples.clone(),
+                pixels: &stopped.film.pixels,
+                aovs: &stopped.film.aovs,
+                integrator_state: stopped.integrator_state.as_ref(),
+            },
+            &dir.join("long.state"),
+        )
+        .unwrap();
+    render("-D max_passes=11 --threads 1 --resume long.state -o long-resumed.exr");
+    assert_identical_images(&dir.join("long-resumed.exr"), &dir.join("long.exr"));
     let _ = std::fs::remove_dir_all(&dir);
 }

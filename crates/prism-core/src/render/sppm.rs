@@ -53,8 +53,8 @@ use crate::camera::{CameraModel, CameraRay};
 use crate::error::{Error, Result};
 use crate::film::accumulation::{AOV_SUMS_PER_CHANNEL, PixelSums, ValueSum, add_aov_sample};
 use crate::film::{Film, FilterSampler};
-use crate::integrator::RayCount;
 use crate::integrator::sppm::{Photon, PhotonMap, SppmIntegrator};
+use crate::integrator::{Integrator, RayCount};
 use crate::light::BoundingSphere;
 use crate::render::relative_error;
 use crate::sampling::rng::{Pcg32, hash_u64s};
@@ -411,6 +411,17 @@ fn automatic_radius(scene: &Scene) -> f32 {
     5.0 * sphere.radius / size.x.max(size.y) as f32
 }
 
+/// Where a chain of `scene` whose first pass is sample index `origin` ends when the scene's sppm
+/// sets `maxPasses`, which replaces the sample count: `origin + maxPasses`. None for any other
+/// scene, whose sample count or range decides. A caller that checks whether anything is left to
+/// render (a resumed render) asks this first.
+pub fn chain_end(scene: &Scene, origin: u32) -> Option<u32> {
+    match &scene.integrator {
+        Integrator::Sppm(sppm) => sppm.max_passes.map(|passes| origin.saturating_add(passes)),
+        _ => None,
+    }
+}
+
 /// Renders the scene with `sppm` (see the module's text).
 pub(super) fn render(
     scene: &Scene,
@@ -449,10 +460,7 @@ pub(super) fn render(
             }
         }
     };
-    let end = match sppm.max_passes {
-        Some(max_passes) => Some(chain.origin.saturating_add(max_passes)),
-        None => options.stop.sample_end,
-    };
+    let end = chain_end(scene, chain.origin).or(options.stop.sample_end);
     let mut next_state = chain.pixels.clone();
     let aov_count = estimator.aov_count();
     let progress: &dyn ProgressReport = options.progress.as_deref().unwrap_or(&Silent);
