@@ -1,7 +1,9 @@
 //! Any bytes given as a render state (`--resume`, `prism merge`) decode or are refused; never a
 //! panic, and never an allocation sized by a count the file cannot back. The CRC makes random
 //! bytes fail early, so the target also tries the bytes with a correct CRC appended, which lets
-//! the fuzzer reach the decoder proper.
+//! the fuzzer reach the decoder proper. A progressive integrator's state is opaque bytes at this
+//! level; its integrator reads them with size checks of its own when a render resumes or a merge
+//! combines them (`render::sppm`'s tests try every truncation and a flipped bit in every byte).
 #![no_main]
 
 use std::path::Path;

@@ -3,7 +3,9 @@
 //! since pixel sums are exact. It reads the states, not the renders' EXR files, so how those
 //! were stored (half floats, luminance only) does not matter; the merged EXR holds R, G, B,
 //! X, Y, Z, their statistics and the extra channels the states carry (the coverage alpha
-//! among them), as 32-bit floats or, with `--half`, half floats.
+//! among them), as 32-bit floats or, with `--half`, half floats. States of `sppm` chains are
+//! averaged instead (their statistics are no sums); the summary then says how biased the image
+//! is.
 
 use std::path::PathBuf;
 
@@ -14,6 +16,7 @@ use prism_core::film::stats::rejected_report;
 use prism_core::film::{
     ComponentFormat, ExrOutput, Film, ImageOutput, LdrOutput, RenderMetadata, write_images_with,
 };
+use prism_core::render::sppm;
 use prism_core::render::state::RenderState;
 
 #[derive(Args, Debug)]
@@ -92,6 +95,9 @@ pub fn run(args: &MergeArgs) -> Result<()> {
         exr.display(),
         png.display()
     );
+    if let Some(note) = (merged.integrator_state.as_ref()).and_then(sppm::merge_summary) {
+        eprintln!("prism: {note}");
+    }
     if let Some(line) = rejected_report(&film) {
         eprintln!("{line}");
     }

@@ -29,6 +29,7 @@ use prism_core::film::{
 };
 use prism_core::integrator::{Integrator, RayCount};
 use prism_core::render::resume::Continuation;
+use prism_core::render::sppm;
 use prism_core::render::{
     Checkpoints, Preview, ProgressReport, RenderOptions, SampleEstimator, Snapshot, StopReason,
     StopRule, StopRuleNames, render_with_preview,
@@ -367,14 +368,18 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     }
     // Where the samples start: the range asked for, or past a resumed state's samples.
     let mut continuation = Continuation::new(&scene, seed, strata);
-    let mut first_sample = args.sample_range.as_ref().map_or(0, |r| r.start);
+    let range_start = args.sample_range.as_ref().map_or(0, |r| r.start);
+    let mut first_sample = range_start;
     let mut initial = None;
     if let Some(path) = &args.resume {
         let (end, sums) = continuation.resume(path, first_sample)?;
         first_sample = end;
         initial = Some(sums);
     }
-    let stop = stop_rule(args, spp)?;
+    let mut stop = stop_rule(args, spp)?;
+    if let Some(end) = sppm::chain_end(&scene, range_start) {
+        stop.sample_end = Some(end);
+    }
     if let Some(end) = stop.sample_end
         && first_sample >= end
     {

@@ -24,6 +24,7 @@ use glam::UVec2;
 use prism_core::error::Error;
 use prism_core::film::{CropWindow, Film, FilmImages, RenderMetadata};
 use prism_core::render::resume::Continuation;
+use prism_core::render::sppm;
 use prism_core::render::{
     Checkpoints, Preview, ProgressCounter, RenderOptions, Snapshot, StopRule, StopRuleNames,
     render_with_preview,
@@ -184,6 +185,9 @@ fn render_loaded(
         }
         None => (range_start, None),
     };
+    if let Some(end) = sppm::chain_end(&loaded.scene, range_start) {
+        stop.sample_end = Some(end);
+    }
     if let Some(end) = stop.sample_end
         && first_sample >= end
     {

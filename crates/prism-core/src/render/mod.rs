@@ -30,7 +30,7 @@ mod particles;
 mod pass;
 mod progress;
 pub mod resume;
-mod sppm;
+pub mod sppm;
 pub mod state;
 mod stop;
 mod tiles;

@@ -183,7 +183,9 @@ pub static INTEGRATORS: Registry<Build> = Registry {
                       within the pixel's radius, and the radius and flux updated by the \
                       progressive rule; one set of wavelengths per pass. Biased at any finite \
                       pass count (consistent): the EXR's variance channels are infinite, not \
-                      an error bar; no checkpoints, resume or merge; no media.",
+                      an error bar. Checkpoints and resume continue a chain of passes bit for \
+                      bit; a sample range is a chain of its own, and `prism merge` averages \
+                      chains weighted by their passes (the bias stays one chain's); no media.",
             params: &[
                 INITIAL_RADIUS,
                 ALPHA,
