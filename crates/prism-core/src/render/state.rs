@@ -512,10 +512,13 @@ impl RenderState {
             }
         }
         if let Some(state) = &first.integrator_state {
-            return Err(Error::usage(format!(
-                "the {} integrator's render states cannot be merged",
-                state.integrator
-            )));
+            return match state.integrator.as_str() {
+                "guided_path" => super::guided::merge_states(states, paths),
+                _ => Err(Error::usage(format!(
+                    "the {} integrator's render states cannot be merged",
+                    state.integrator
+                ))),
+            };
         }
         let mut pixels = first.pixels.clone();
         let mut aovs = first.aovs.clone();

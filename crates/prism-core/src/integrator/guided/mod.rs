@@ -57,6 +57,7 @@
 //!
 //! No participating media: scenes with media are refused when read.
 
+pub mod encoding;
 pub mod quadtree;
 pub mod sd_tree;
 pub mod selection;
