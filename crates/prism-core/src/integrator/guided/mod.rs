@@ -9,7 +9,8 @@
 //! `sdTreeMaxMemory`, `maxDepth`, `rrDepth`, `strictNormals`, `hideEmitters`, and Prism's
 //! `adrrs`) and their
 //! defaults are listed in docs/plugins.md. The render driver (`render::guided`) runs the
-//! iterations.
+//! iterations, and saves a run in checkpoints and continues it on resume (the tree's bytes:
+//! [`encoding`]).
 //!
 //! **Iterations.** Iteration k renders 2ᵏ passes of `sppPerPass` samples per pixel (the last
 //! one takes what is left of the budget, at least half of it). Each iteration's paths sample
