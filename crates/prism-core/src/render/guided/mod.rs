@@ -32,6 +32,8 @@
 //! sample counts for its own pixel (the one-pixel reconstruction, the filter
 //! importance-sampled), whatever the film's `reconstruction`.
 
+mod run_state;
+
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
@@ -54,6 +56,7 @@ use crate::integrator::{RayCount, SampleContext};
 use crate::render::relative_error;
 use crate::sampling::sampler::Sampler;
 use crate::scene::Scene;
+pub(crate) use run_state::merge_states;
 
 /// Samples per pixel below which `nee` = `kickstart` takes light samples (the authors').
 const KICKSTART_SPP: u64 = 128;
@@ -64,10 +67,6 @@ const VARIANCE_CAP: f64 = 10_000.0;
 const COMBINED_IMAGES: usize = 4;
 /// `automatic` trusts an iteration's variance from this many samples per pixel on.
 const TRUSTED_SPP: u64 = 256;
-
-mod run_state;
-
-pub(crate) use run_state::merge_states;
 
 /// What the run may spend.
 #[derive(Clone, Copy, Debug, PartialEq)]
