@@ -375,6 +375,55 @@ fn initial_of(output: &RenderOutput) -> InitialState {
     }
 }
 
+/// Interrupts the run of `scene` (`spp` samples per pixel in passes of `spp_per_pass`) after
+/// each of the passes `points`, on one thread and on two, resumes it, and checks that it ends
+/// with the film and the state of one uninterrupted run, which it returns.
+fn assert_resumed_equals_one_render(
+    scene: &Scene,
+    spp: u32,
+    spp_per_pass: u32,
+    points: &[u32],
+) -> RenderOutput {
+    let whole = render_part(scene, spp, 2, 0, None, None).unwrap();
+    assert_eq!(whole.samples, 0..spp);
+    assert!(whole.integrator_state.is_some());
+    for threads in [1, 2] {
+        for &after in points {
+            let part = render_part(scene, spp, threads, 0, None, Some(after)).unwrap();
+            assert_eq!(part.stop, StopReason::Interrupted);
+            assert_eq!(part.samples, 0..after * spp_per_pass);
+            let rest = render_part(
+                scene,
+                spp,
+                threads,
+                part.samples.end,
+                Some(initial_of(&part)),
+                None,
+            )
+            .unwrap();
+            assert_eq!(rest.stop, StopReason::Completed);
+            assert_eq!(rest.samples, part.samples.end..spp);
+            let what = format!(
+                "{:?}, {threads} threads, after pass {after}",
+                scene.integrator
+            );
+            assert!(
+                rest.film.pixels == whole.film.pixels,
+                "{what}: the films differ"
+            );
+            assert!(
+                rest.film.aovs == whole.film.aovs,
+                "{what}: the channels differ"
+            );
+            assert!(
+                rest.integrator_state == whole.integrator_state,
+                "{what}: the states differ"
+            );
+        }
+    }
+    whole
+}
+
 /// Interrupted after any pass (within an iteration and at its end), on one thread and on
 /// two, then resumed, a run ends with the film and the state of one uninterrupted run: with
 /// `discard`; with the inverse-variance mix, `kickstart` light samples, the stochastic filter
@@ -403,40 +452,12 @@ fn guided_resumed_after_any_pass_equals_one_render() {
         scene.integrator = Integrator::from(integrator.clone());
         // 7 passes: iterations of 1, 2 and 4.
         let spp = 7 * integrator.spp_per_pass;
-        let whole = render_part(&scene, spp, 2, 0, None, None).unwrap();
-        assert_eq!(whole.samples, 0..spp);
-        assert!(whole.integrator_state.is_some());
-        for threads in [1, 2] {
-            for after in 1..7 {
-                let part = render_part(&scene, spp, threads, 0, None, Some(after)).unwrap();
-                assert_eq!(part.stop, StopReason::Interrupted);
-                assert_eq!(part.samples, 0..after * integrator.spp_per_pass);
-                let rest = render_part(
-                    &scene,
-                    spp,
-                    threads,
-                    part.samples.end,
-                    Some(initial_of(&part)),
-                    None,
-                )
-                .unwrap();
-                assert_eq!(rest.stop, StopReason::Completed);
-                assert_eq!(rest.samples, part.samples.end..spp);
-                let what = format!("{integrator:?}, {threads} threads, after pass {after}");
-                assert!(
-                    rest.film.pixels == whole.film.pixels,
-                    "{what}: the films differ"
-                );
-                assert!(
-                    rest.film.aovs == whole.film.aovs,
-                    "{what}: the channels differ"
-                );
-                assert!(
-                    rest.integrator_state == whole.integrator_state,
-                    "{what}: the states differ"
-                );
-            }
-        }
+        let whole = assert_resumed_equals_one_render(
+            &scene,
+            spp,
+            integrator.spp_per_pass,
+            &[1, 2, 3, 4, 5, 6],
+        );
         let first = render_part(&scene, spp, 2, 0, None, Some(2)).unwrap();
         let second = render_part(
             &scene,
@@ -465,6 +486,27 @@ fn guided_resumed_after_any_pass_equals_one_render() {
             "{integrator:?}: twice interrupted"
         );
     }
+}
+
+/// `automatic` stops training where the extrapolated variance grows, from 256 samples per
+/// pixel on: on a 4 × 4 image in passes of 64 samples, a run of 100 passes stops after
+/// iterations of 1, 2, 4 and 8 passes and renders the other 85 from the tree it has (the
+/// image holds 85 · 64 samples per pixel, where the iterations would end with one of 69
+/// passes). Interrupted in any iteration and resumed, that run too equals one render.
+#[test]
+fn guided_resumed_after_training_stopped_equals_one_render() {
+    let mut scene = cornell_box(4);
+    let integrator = GuidedPathIntegrator {
+        sample_combination: SampleCombination::Automatic,
+        spp_per_pass: 64,
+        ..guided()
+    };
+    scene.integrator = Integrator::from(integrator);
+    let whole = assert_resumed_equals_one_render(&scene, 6400, 64, &[1, 3, 7, 15, 16, 60, 99]);
+    assert!(
+        whole.film.pixels.iter().all(|p| p.samples == 85 * 64),
+        "training did not stop after the fourth iteration"
+    );
 }
 
 /// A render state of `output` (a run of `scene`'s samples `range`), as the command line
@@ -561,8 +603,8 @@ fn guided_runs_of_sample_ranges_merge_as_documented() {
 }
 
 /// A guided run's state that is cut short or damaged is refused with a message naming it, never
-/// a panic; a state of another sample count, of a `path` render, and a guided state given to
-/// `path` are refused too.
+/// a panic; a state of another crop or sample count, of a `path` render, and a guided state
+/// given to `path` are refused too.
 #[test]
 fn guided_refuses_states_that_do_not_fit() {
     let mut scene = cornell_box(6);
@@ -603,6 +645,13 @@ fn guided_refuses_states_that_do_not_fit() {
         let error = resume(damaged).expect("a damaged state was accepted");
         assert!(error.contains(says), "{error}");
     }
+    let mut larger = cornell_box(7);
+    larger.integrator = Integrator::from(guided());
+    let error = render_part(&larger, 16, 1, 8, Some(initial.clone()), None)
+        .err()
+        .expect("resumed with another crop")
+        .to_string();
+    assert!(error.contains("6×6 crop"), "{error}");
     let error = render_part(&scene, 32, 1, 8, Some(initial.clone()), None)
         .err()
         .expect("resumed with another sample count")
