@@ -22,7 +22,8 @@ use prism_core::integrator::{GuidedPathIntegrator, Integrator, PathIntegrator};
 use prism_core::render::resume::InitialState;
 use prism_core::render::state::{IntegratorState, RenderIdentity, RenderState};
 use prism_core::render::{
-    ProgressReport, RenderOptions, RenderOutput, StopReason, StopRule, render,
+    Checkpoints, ProgressReport, RenderOptions, RenderOutput, Snapshot, StopReason, StopRule,
+    render, render_with_checkpoints,
 };
 use prism_core::scene::Scene;
 
@@ -484,6 +485,53 @@ fn guided_resumed_after_any_pass_equals_one_render() {
         assert!(
             rest.film.pixels == whole.film.pixels,
             "{integrator:?}: twice interrupted"
+        );
+    }
+}
+
+/// A checkpoint is written after every pass when due (here always) and at the end: each holds
+/// the samples so far, the image the render would give if it stopped there, and a state from
+/// which the run, resumed, ends as one uninterrupted render.
+#[test]
+fn guided_checkpoints_resume_to_one_render() {
+    let mut scene = cornell_box(8);
+    scene.integrator = Integrator::from(GuidedPathIntegrator {
+        sample_combination: SampleCombination::InverseVariance,
+        ..guided()
+    });
+    let whole = render_part(&scene, 28, 2, 0, None, None).unwrap();
+    let mut saved: Vec<(std::ops::Range<u32>, InitialState)> = Vec::new();
+    let mut write = |snapshot: &Snapshot| {
+        saved.push((
+            snapshot.samples.clone(),
+            InitialState {
+                pixels: snapshot.pixels.to_vec(),
+                aovs: snapshot.aovs.to_vec(),
+                integrator: snapshot.integrator_state.cloned(),
+            },
+        ));
+        Ok(())
+    };
+    let checkpoints = Checkpoints {
+        every: Duration::ZERO,
+        write: &mut write,
+    };
+    let options = RenderOptions::fixed(28, 5, Some(2));
+    let output = render_with_checkpoints(&scene, &options, Some(checkpoints)).unwrap();
+    assert!(output.film.pixels == whole.film.pixels);
+    // One after each of the 7 passes, and the last again at the end.
+    let ends: Vec<u32> = saved.iter().map(|(samples, _)| samples.end).collect();
+    assert_eq!(ends, [4, 8, 12, 16, 20, 24, 28, 28]);
+    for (samples, initial) in saved.into_iter().take(6) {
+        let part = render_part(&scene, 28, 2, 0, None, Some(samples.end / 4)).unwrap();
+        assert!(
+            part.film.pixels == initial.pixels,
+            "the image after {samples:?}"
+        );
+        let rest = render_part(&scene, 28, 1, samples.end, Some(initial), None).unwrap();
+        assert!(
+            rest.film.pixels == whole.film.pixels,
+            "resumed after {samples:?}"
         );
     }
 }
