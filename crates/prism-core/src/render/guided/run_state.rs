@@ -302,9 +302,9 @@ fn decode_run(
         if asked != plan_in_state {
             return Err(cannot(format!(
                 "its run was planned for {} samples per pixel, this render for {}",
-                passes * spp_per_pass,
+                u64::from(passes) * u64::from(spp_per_pass),
                 match asked {
-                    Plan::Passes(p) => format!("{}", p * spp_per_pass),
+                    Plan::Passes(p) => format!("{}", u64::from(p) * u64::from(spp_per_pass)),
                     Plan::Seconds(s) => format!("{s} seconds"),
                 }
             ))
@@ -363,6 +363,7 @@ fn decode_run(
     };
     let consistent = done_in_iteration <= planned
         && done_in_iteration <= passes_done
+        && images.iter().all(|image| image.passes <= passes_done)
         && end_of_iteration <= last_pass
         && u64::from(first_sample) + last_pass * u64::from(spp_per_pass) <= u64::from(u32::MAX);
     if !consistent {
