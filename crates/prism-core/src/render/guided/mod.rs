@@ -304,10 +304,13 @@ pub(super) fn render(
         Plan::Seconds(_) => None,
     });
     let start = run.started;
+    // A budget too large for a clock sets no deadline.
     let deadline = match run.plan {
-        Plan::Seconds(seconds) => Some(
-            start + std::time::Duration::from_secs_f64((seconds - run.seconds_before).max(0.0)),
-        ),
+        Plan::Seconds(seconds) => {
+            std::time::Duration::try_from_secs_f64((seconds - run.seconds_before).max(0.0))
+                .ok()
+                .and_then(|left| start.checked_add(left))
+        }
         Plan::Passes(_) => None,
     };
     let deadline = match (deadline, options.stop.time_limit.map(|limit| start + limit)) {
