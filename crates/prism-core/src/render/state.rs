@@ -514,6 +514,7 @@ impl RenderState {
         if let Some(state) = &first.integrator_state {
             return match state.integrator.as_str() {
                 "sppm" => super::sppm::merge_states(states, paths),
+                "guided_path" => super::guided::merge_states(states, paths),
                 _ => Err(Error::usage(format!(
                     "the {} integrator's render states cannot be merged",
                     state.integrator

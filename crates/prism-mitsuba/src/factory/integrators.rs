@@ -233,8 +233,10 @@ pub static INTEGRATORS: Registry<Build> = Registry {
                       counts; next-event estimation as `path`, Russian roulette by the \
                       learned radiance (`adrrs`). The image \
                       is the last iteration's (or an inverse-variance mix of the last four); \
-                      bit-identical for any thread count; one-pixel reconstruction; no \
-                      checkpoints, resume or merge; no media.",
+                      bit-identical for any thread count; one-pixel reconstruction; \
+                      checkpoints and resume (bit-identical with a budget in samples); a \
+                      sample range is a run of its own, and `prism merge` combines the runs' \
+                      final images; no media.",
             params: &[
                 MAX_DEPTH,
                 RR_DEPTH,
@@ -301,7 +303,7 @@ params! {
     USE_VM = ParamSpec::new("use_vm", ParamKind::Boolean, Default::Boolean(true), "merge camera vertices with light vertices; false leaves connections only (unbiased bidirectional path tracing)");
     SPP_PER_PASS = ParamSpec::new("spp_per_pass", ParamKind::Integer, Default::Integer(4), "samples per pixel of a pass; iteration k renders 2^k passes");
     BUDGET_TYPE = ParamSpec::new("budget_type", ParamKind::Choice(&[Choice::new("spp", &BudgetType::Samples), Choice::new("seconds", &BudgetType::Seconds)]), Default::Str("spp"), "what `budget` counts: samples per pixel or seconds, over all iterations (the authors' default is seconds)");
-    BUDGET = ParamSpec::new("budget", ParamKind::Float, Default::Float(-1.0), "samples per pixel or seconds over all iterations (−1: the render's sample count, or its time limit; the authors' default is 300 seconds)");
+    BUDGET = ParamSpec::new("budget", ParamKind::Float, Default::Float(-1.0), "samples per pixel or seconds over all iterations (−1: the render's sample count, or its time limit; −1 for a sample range a..b with a > 0, whose run spends b − a; the authors' default is 300 seconds)");
     SAMPLE_COMBINATION = ParamSpec::new("sample_combination", ParamKind::Choice(&[Choice::new("discard", &SampleCombination::Discard), Choice::new("automatic", &SampleCombination::Automatic), Choice::new("inversevar", &SampleCombination::InverseVariance)]), Default::Str("automatic"), "the image: the last iteration's (`discard`), the same with training stopped where the extrapolated variance grows (`automatic`), or the last four iterations' weighted by their inverse variance (`inversevar`, one estimate per pixel: no error bar)");
     S_TREE_THRESHOLD = ParamSpec::new("s_tree_threshold", ParamKind::Float, Default::Float(12_000.0), "c: a spatial leaf splits where its recorded samples exceed c·√(2^k · spp_per_pass / 4) at iteration k");
     D_TREE_THRESHOLD = ParamSpec::new("d_tree_threshold", ParamKind::Float, Default::Float(0.01), "ρ: a quadrant splits where it holds more than this share of its quadtree's flux (0 < ρ < 1)");

@@ -9,7 +9,8 @@
 //! `sdTreeMaxMemory`, `maxDepth`, `rrDepth`, `strictNormals`, `hideEmitters`, and Prism's
 //! `adrrs`) and their
 //! defaults are listed in docs/plugins.md. The render driver (`render::guided`) runs the
-//! iterations.
+//! iterations, and saves a run in checkpoints and continues it on resume (the tree's bytes:
+//! [`encoding`]).
 //!
 //! **Iterations.** Iteration k renders 2ᵏ passes of `sppPerPass` samples per pixel (the last
 //! one takes what is left of the budget, at least half of it). Each iteration's paths sample
@@ -57,6 +58,7 @@
 //!
 //! No participating media: scenes with media are refused when read.
 
+pub mod encoding;
 pub mod quadtree;
 pub mod sd_tree;
 pub mod selection;

@@ -15,8 +15,13 @@
 
 use glam::Vec2;
 
+use super::encoding::{Decoder, Encoder, Malformed};
+
 /// The deepest level of a quadtree (the authors' limit).
 pub const MAX_DEPTH: u32 = 20;
+
+/// Bytes of a node in [`DirectionalTree::encode`]: four fluxes and four children.
+const NODE_BYTES: usize = 4 * 8 + 4 * 4;
 
 /// A node: the flux of each quadrant and the node that refines it (0 for a leaf quadrant: the
 /// root is never a child). Quadrant i covers x ≥ ½ where bit 0 of i is set, y ≥ ½ where bit 1
@@ -207,6 +212,54 @@ impl DirectionalTree {
             (origin[1] + size * uy) as f32,
         )
         .clamp(Vec2::ZERO, Vec2::ONE)
+    }
+
+    /// Appends the tree's bytes: its node count, each node's four fluxes and four children,
+    /// its total flux and its weight.
+    pub fn encode(&self, out: &mut Encoder) {
+        out.length(self.nodes.len());
+        for node in &self.nodes {
+            for flux in node.flux {
+                out.f64(flux);
+            }
+            for child in node.children {
+                out.u32(child);
+            }
+        }
+        out.f64(self.total);
+        out.f64(self.weight);
+    }
+
+    /// Reads a tree [`Self::encode`] wrote: at least the root, every flux and weight finite and
+    /// not negative, every child after its parent (so descents end) and within the tree.
+    pub fn decode(input: &mut Decoder) -> Result<DirectionalTree, Malformed> {
+        let count = input.length(NODE_BYTES, "quadtree nodes")?;
+        if count == 0 {
+            return Err("a quadtree has no root".into());
+        }
+        let mut nodes = Vec::with_capacity(count);
+        for index in 0..count {
+            let mut node = QuadNode::default();
+            for flux in &mut node.flux {
+                *flux = input.f64_at_least(0.0, "a quadrant's flux")?;
+            }
+            for child in &mut node.children {
+                *child = input.u32()?;
+                if *child != 0 && !(*child as usize > index && (*child as usize) < count) {
+                    return Err(format!(
+                        "quadtree node {index} of {count} names child {child}"
+                    ));
+                }
+            }
+            nodes.push(node);
+        }
+        let total = input.f64_at_least(0.0, "a quadtree's total flux")?;
+        let weight = input.f64_at_least(0.0, "a quadtree's weight")?;
+        Ok(DirectionalTree {
+            nodes,
+            total,
+            weight,
+        })
     }
 
     /// An empty tree (no flux, no weight) whose quadrants are those of `previous` refined by

@@ -22,6 +22,7 @@
 use glam::Vec3;
 
 use super::Record;
+use super::encoding::{Decoder, Encoder, Malformed};
 use super::quadtree::{self, DirectionalTree};
 use super::selection::{LearnedSelection, SelectionLoss};
 
@@ -260,10 +261,181 @@ impl SdTree {
     }
 }
 
+/// The fewest bytes a leaf's trees take in [`SdTree::encode`]: two quadtrees of one node, the
+/// learned α, the reflected radiance and its sums.
+const LEAF_TREES_BYTES: usize = 2 * (8 + 48 + 16) + 28 + 4 + 16;
+/// The fewest bytes a spatial node takes (a leaf).
+const NODE_BYTES: usize = 6;
+
+impl LeafTrees {
+    fn encode(&self, out: &mut Encoder) {
+        self.sampling.encode(out);
+        self.building.encode(out);
+        self.selection.encode(out);
+        out.f32(self.reflected);
+        out.f64(self.reflected_sums.0);
+        out.f64(self.reflected_sums.1);
+    }
+
+    fn decode(input: &mut Decoder) -> Result<LeafTrees, Malformed> {
+        Ok(LeafTrees {
+            sampling: DirectionalTree::decode(input)?,
+            building: DirectionalTree::decode(input)?,
+            selection: LearnedSelection::decode(input)?,
+            reflected: input.f32_at_least(f32::MIN, "a leaf's reflected radiance")?,
+            reflected_sums: (
+                input.f64_at_least(0.0, "a leaf's recorded weight")?,
+                input.f64_at_least(f64::MIN, "a leaf's sum of reflected radiance")?,
+            ),
+        })
+    }
+}
+
+impl SdTree {
+    /// Appends the tree's bytes: its cube, every leaf's trees (sampling and recording
+    /// quadtrees, learned α, reflected radiance and its sums), then the spatial nodes.
+    pub fn encode(&self, out: &mut Encoder) {
+        for v in self.origin.to_array() {
+            out.f32(v);
+        }
+        out.f32(self.extent);
+        out.length(self.leaves.len());
+        for leaf in &self.leaves {
+            leaf.encode(out);
+        }
+        out.length(self.nodes.len());
+        for node in &self.nodes {
+            match *node {
+                SpatialNode::Leaf { trees, axis } => {
+                    out.u8(0);
+                    out.u32(trees);
+                    out.u8(axis);
+                }
+                SpatialNode::Split { axis, children } => {
+                    out.u8(1);
+                    out.u8(axis);
+                    out.u32(children[0]);
+                    out.u32(children[1]);
+                }
+            }
+        }
+    }
+
+    /// Reads a tree [`Self::encode`] wrote, checking that its cube is finite, that its leaves
+    /// come in whole orientation classes, that every node's children come after it and within
+    /// the tree, and that every leaf node's trees exist.
+    pub fn decode(input: &mut Decoder) -> Result<SdTree, Malformed> {
+        let mut origin = [0.0; 3];
+        for v in &mut origin {
+            *v = input.f32_at_least(f32::MIN, "the SD-tree's corner")?;
+        }
+        let extent = input.f32_at_least(f32::MIN_POSITIVE, "the SD-tree's extent")?;
+        let leaf_count = input.length(LEAF_TREES_BYTES, "leaf trees")?;
+        if leaf_count == 0 || !leaf_count.is_multiple_of(ORIENTATIONS as usize) {
+            return Err(format!(
+                "it holds {leaf_count} leaf trees, not a positive multiple of {ORIENTATIONS}"
+            ));
+        }
+        let mut leaves = Vec::with_capacity(leaf_count);
+        for _ in 0..leaf_count {
+            leaves.push(LeafTrees::decode(input)?);
+        }
+        let node_count = input.length(NODE_BYTES, "spatial nodes")?;
+        if node_count == 0 {
+            return Err("the spatial tree has no root".into());
+        }
+        let mut nodes = Vec::with_capacity(node_count);
+        for index in 0..node_count {
+            let node = match input.u8()? {
+                0 => {
+                    let trees = input.u32()?;
+                    let axis = input.u8()?;
+                    let fits = (trees as usize)
+                        .checked_add(ORIENTATIONS as usize)
+                        .is_some_and(|end| end <= leaf_count);
+                    if !fits || !trees.is_multiple_of(ORIENTATIONS) || axis > 2 {
+                        return Err(format!(
+                            "spatial leaf {index} names trees {trees} of {leaf_count} and axis {axis}"
+                        ));
+                    }
+                    SpatialNode::Leaf { trees, axis }
+                }
+                1 => {
+                    let axis = input.u8()?;
+                    let children = [input.u32()?, input.u32()?];
+                    let within = |c: u32| c as usize > index && (c as usize) < node_count;
+                    if axis > 2 || !children.iter().all(|&c| within(c)) {
+                        return Err(format!(
+                            "spatial node {index} of {node_count} splits axis {axis} into nodes {} and {}",
+                            children[0], children[1]
+                        ));
+                    }
+                    SpatialNode::Split { axis, children }
+                }
+                tag => return Err(format!("spatial node {index} is of kind {tag}")),
+            };
+            nodes.push(node);
+        }
+        Ok(SdTree {
+            origin: Vec3::from_array(origin),
+            extent,
+            nodes,
+            leaves,
+        })
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use glam::Vec2;
+
+    /// A trained tree (small quadtrees: ρ = 0.3) comes back from its bytes the same (it
+    /// encodes the same and samples the same); every truncation, and indices out of range, are
+    /// refused without a panic.
+    #[test]
+    fn a_tree_round_trips_through_its_bytes() {
+        let mut tree = SdTree::new(Vec3::ZERO, Vec3::ONE);
+        tree.refine(0.0, 0.3, None);
+        for i in 0..200 {
+            let record = Record {
+                leaf: (i % 12) as u32 % ORIENTATIONS,
+                point: Vec2::new((i as f32 * 0.37).fract(), (i as f32 * 0.61).fract()),
+                flux: 1.0 + (i % 7) as f32,
+                reflected: Some(0.5),
+                weight: 1.0,
+                selection: None,
+            };
+            tree.file(&record, SelectionLoss::None);
+        }
+        tree.build();
+        tree.refine(30.0, 0.3, None);
+        let mut out = Encoder::default();
+        tree.encode(&mut out);
+        assert!(tree.leaf_count() > 1 && out.bytes.len() < 20_000);
+        let mut input = Decoder::new(&out.bytes);
+        let decoded = SdTree::decode(&mut input).unwrap();
+        input.finish().unwrap();
+        let mut again = Encoder::default();
+        decoded.encode(&mut again);
+        assert_eq!(again.bytes, out.bytes);
+        assert_eq!(decoded.leaf_count(), tree.leaf_count());
+        let p = Vec2::new(0.3, 0.8);
+        let a = tree.leaf_at(Vec3::splat(0.2), 1).index;
+        assert_eq!(
+            decoded.leaf(a).sampling.pdf(p),
+            tree.leaf(a).sampling.pdf(p)
+        );
+        for n in 0..out.bytes.len() {
+            assert!(SdTree::decode(&mut Decoder::new(&out.bytes[..n])).is_err());
+        }
+        // The last node's tree index, beyond the leaves.
+        let mut damaged = out.bytes.clone();
+        let at = damaged.len() - 5;
+        damaged[at..at + 4].copy_from_slice(&u32::MAX.to_le_bytes());
+        let error = SdTree::decode(&mut Decoder::new(&damaged)).unwrap_err();
+        assert!(error.contains("names trees"), "{error}");
+    }
 
     /// A leaf with more recorded weight than the threshold splits, and its halves split again
     /// while half the weight still exceeds it; points find the leaf of their octant.

@@ -17,6 +17,8 @@
 //! choices), clamped to [−20, 20]. θ starts at 0 (α = ½), is copied to both halves where a leaf
 //! splits, and is kept from one iteration to the next.
 
+use super::encoding::{Decoder, Encoder, Malformed};
+
 /// Which loss trains α.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum SelectionLoss {
@@ -102,6 +104,35 @@ impl LearnedSelection {
         if gradient.is_finite() {
             self.step(gradient);
         }
+    }
+
+    /// Appends θ, Adam's two moments and its step count.
+    pub fn encode(&self, out: &mut Encoder) {
+        out.f64(self.theta);
+        out.f64(self.first_moment);
+        out.f64(self.second_moment);
+        out.i32(self.steps);
+    }
+
+    /// Reads what [`Self::encode`] wrote: θ within its bound, the moments finite, the second
+    /// and the step count not negative.
+    pub fn decode(input: &mut Decoder) -> Result<LearnedSelection, Malformed> {
+        let theta = input.f64_at_least(-THETA_BOUND, "a learned θ")?;
+        if theta > THETA_BOUND {
+            return Err(format!("a learned θ is {theta}"));
+        }
+        let first_moment = input.f64_at_least(f64::MIN, "a learned θ's first moment")?;
+        let second_moment = input.f64_at_least(0.0, "a learned θ's second moment")?;
+        let steps = input.i32()?;
+        if steps < 0 {
+            return Err(format!("a learned θ has taken {steps} steps"));
+        }
+        Ok(LearnedSelection {
+            theta,
+            first_moment,
+            second_moment,
+            steps,
+        })
     }
 
     /// One step of Adam with `gradient`.
