@@ -142,8 +142,8 @@ fn a_filtered_edge_is_unbiased_with_honest_errors() {
 
 /// Filter MIS is much less noisy than the one-pixel estimator across the edge, and no noisier
 /// on its flat sides: the mean variance of the pixels' luminance, at equal samples. (Measured:
-/// across the edge 0.49×, 0.15× and 0.07× for the tent, the Gaussian and Mitchell's cubic; on
-/// the flat sides 0.66×, 0.47× and 0.002×: the one-pixel estimator's negative weights are noise
+/// across the edge 0.51×, 0.15× and 0.07× for the tent, the Gaussian and Mitchell's cubic; on
+/// the flat sides, the film's border columns, 0.75×, 0.55× and 0.003×: the one-pixel estimator's negative weights are noise
 /// even where the image is constant.)
 #[test]
 fn filter_mis_is_quieter_than_one_pixel_estimates() {

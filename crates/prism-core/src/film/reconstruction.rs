@@ -5,23 +5,34 @@
 //!
 //! Pixel i (centre cᵢ) estimates Iᵢ = ∫ k(x − cᵢ) f(x) dx, with k the separable filter
 //! k(x)k(y) / (∫k)² normalised to unit integral. Every film pixel l draws N samples from its own
-//! density pₗ(x) = p(x − cₗ), the filter sampler's density (∝ |k|). Seen from pixel i these are
-//! W·H sampling strategies of the image plane, and the balance heuristic combines them (Veach
-//! 1997, §9.2): a sample x of any pixel adds
+//! density pₗ(x), on each axis uniform over its own square, except on the film's first and last
+//! columns and rows, which draw from the filter sampler's density (∝ |k|) around their centre so
+//! that every point some pixel's filter covers, beyond the film's edge too, is drawn
+//! ([`FilterMis::sample_offset`]). Seen from pixel i these are W·H
+//! sampling strategies of the image plane, and the balance heuristic combines them (Veach 1997,
+//! §9.2): a sample x of any pixel adds
 //!
 //! ```text
 //!     k(x − cᵢ) f(x) / (N · D(x)),   D(x) = Σₗ pₗ(x)   (over the film's pixels),
 //! ```
 //!
-//! to every pixel i whose support contains x. Every point where k(x − cᵢ) ≠ 0 has D(x) ≥ pᵢ(x) > 0,
-//! so the estimate is unbiased for any filter, negative lobes included. D is a product of two
-//! sums because the pixel grid is: D(x, y) = Dₓ(x) D_y(y) with Dₓ(x) = Σ_{columns l} p(x − cₗ),
-//! which near the film's border has fewer terms (there, fewer pixels draw samples and each
-//! counts for more). D is taken over the whole film, not the crop window, so a crop renders its
-//! pixels exactly as the full film does; the samples of pixels up to [`FilterMis::reach`] outside
-//! the crop are drawn for it. For a tent, whose translates sum to one, D = 1 inside the film and
-//! this is splatting k(x − cᵢ) f(x) / N, without the normalisation by Σk that makes Mitsuba's
-//! and pbrt's splatting biased.
+//! to every pixel i whose support contains x. Every point where k(x − cᵢ) ≠ 0 has D(x) > 0, so
+//! the estimate is unbiased for any filter, negative lobes included. D is a product of two sums
+//! because the pixel grid is: D(x, y) = Dₓ(x) D_y(y) with Dₓ(x) = Σ_{columns l} pₗ(x). Inside the
+//! film D = 1 away from the border pixels, and this is splatting k(x − cᵢ) f(x) / N, without
+//! the normalisation by Σk that makes Mitsuba's and pbrt's splatting biased; a border pixel's
+//! own samples are importance-sampled from its filter. D is taken over the
+//! whole film, not the crop window, so a crop renders its pixels exactly as the full film does;
+//! the samples of pixels up to [`FilterMis::reach`] outside the crop are drawn for it.
+//!
+//! Drawing each pixel's samples within its own square, rather than from the filter around its
+//! centre, stratifies the samples by pixel as Mitsuba's splatting does: every square holds
+//! exactly N samples, so a smooth gradient across a filter's support adds no variance of its
+//! own (on a spot-lit floor under the Gaussian filter, 0.89 times the per-pixel variance of
+//! filter-shaped draws; docs/performance.md). The sampler's stratification of the film
+//! dimensions then stratifies within each square as well. The border rows and columns keep
+//! filter-shaped draws, whose tails cover the points beyond the film's edge that the filters
+//! of the pixels near it reach.
 //!
 //! ## The control variate
 //!
@@ -125,20 +136,47 @@ impl FilterMis {
         self.reach
     }
 
-    /// The filter sampler that draws each pixel's samples.
-    pub fn sampler(&self) -> &FilterSampler {
-        &self.sampler
+    /// Whether column (or row) `pixel` of a film `extent` pixels across is on the film's border,
+    /// where samples are drawn from the filter rather than from the pixel's square.
+    fn on_border(pixel: u32, extent: u32) -> bool {
+        pixel == 0 || pixel + 1 >= extent
+    }
+
+    /// The offset from the centre of `pixel` (full-film coordinates) of the sample drawn with
+    /// the uniform numbers `u`, on each axis uniform over the pixel's square, or from the filter
+    /// in a border column or row; and the weight the one-pixel estimator would give it, k / p.
+    pub fn sample_offset(&self, pixel: glam::UVec2, u: Vec2) -> (Vec2, f32) {
+        let axis = |u: f32, pixel: u32, extent: u32| {
+            if Self::on_border(pixel, extent) {
+                self.sampler.sample_1d(u)
+            } else {
+                let offset = (u - 0.5).min(0.5f32.next_down());
+                (offset, self.kernel(offset) / self.sampler.integral_1d())
+            }
+        };
+        let (x, wx) = axis(u.x, pixel.x, self.width);
+        let (y, wy) = axis(u.y, pixel.y, self.height);
+        (Vec2::new(x, y), wx * wy)
     }
 
     /// Dₓ at offset `offset` from the centre of column (or row) `pixel` of a film `extent` pixels
-    /// across: Σ p(offset + pixel − l) over the film's columns l within reach.
+    /// across: Σ pₗ over the film's columns l within reach, pₗ the filter sampler's density on the
+    /// border and 1 on the column's own square [−½, ½) elsewhere.
     fn density_1d(&self, offset: f32, pixel: u32, extent: u32) -> f32 {
         let reach = self.reach as i64 + 1;
-        let pixel = i64::from(pixel);
-        let first = (pixel - reach).max(0);
-        let last = (pixel + reach).min(i64::from(extent) - 1);
+        let first = (i64::from(pixel) - reach).max(0);
+        let last = (i64::from(pixel) + reach).min(i64::from(extent) - 1);
         (first..=last)
-            .map(|l| self.sampler.pdf_1d(offset + (pixel - l) as f32))
+            .map(|l| {
+                let d = offset + (i64::from(pixel) - l) as f32;
+                if Self::on_border(l as u32, extent) {
+                    self.sampler.pdf_1d(d)
+                } else if (-0.5..0.5).contains(&d) {
+                    1.0
+                } else {
+                    0.0
+                }
+            })
             .sum()
     }
 
@@ -194,7 +232,7 @@ mod tests {
             let scale = mis.sample_scale(UVec2::new(7, 9), offset);
             assert!((scale - 1.0).abs() < 1e-5, "{offset}: {scale}");
         }
-        // At the border only half the density is there.
+        // Beyond the film's edge only the border column's tent reaches: D = ½ there.
         let scale = mis.sample_scale(UVec2::new(0, 8), Vec2::new(-0.5, 0.0));
         assert!((scale - 2.0).abs() < 1e-4, "{scale}");
     }
@@ -215,7 +253,8 @@ mod tests {
             let mut rng = Pcg32::seeded(11);
             for _ in 0..n {
                 let column = ((rng.next_f32() * width as f32) as u32).min(width - 1);
-                let (offset, _) = mis.sampler().sample_1d(rng.next_f32());
+                let u = Vec2::new(rng.next_f32(), 0.5);
+                let offset = mis.sample_offset(UVec2::new(column, 0), u).0.x;
                 let x = column as f32 + 0.5 + offset;
                 let bin = (((x - lo) / bin_width) as usize).min(bins - 1);
                 counts[bin] += 1;

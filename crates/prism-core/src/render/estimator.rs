@@ -118,7 +118,10 @@ impl<'a> SampleEstimator<'a> {
         sampler.start_pixel_sample(pixel, index);
         let primary = sampler.camera_sample();
         let lambda = SampledWavelengths::sample(primary.wavelength, scene.film.wavelength_sampling);
-        let (offset, filter_weight) = self.filter.sample(primary.film);
+        let (offset, filter_weight) = match &self.shared {
+            Some(mis) => mis.sample_offset(pixel, primary.film),
+            None => self.filter.sample(primary.film),
+        };
         let (time, time_weight) = scene.shutter.sample(primary.time);
         let film_position = pixel.as_vec2() + Vec2::splat(0.5) + offset;
         let CameraRay {
