@@ -109,14 +109,12 @@ pub fn render_film(scene: &Scene, spp: u32, seed: u64, threads: Option<usize>) -
         .film
 }
 
-/// Mean of a pixel's estimate of channel `c` (0 = X, 1 = Y, 2 = Z) and the variance of that
-/// mean, estimated from the samples: (Σv²/N − m²)/(N − 1).
+/// A pixel's estimate of channel `c` (0 = X, 1 = Y, 2 = Z), as the image holds it (with filter
+/// MIS's control variate where samples are shared), and the variance of that estimate, as the
+/// image's variance channels hold it ([`prism_core::film::PixelSums::variance_of_mean`]).
 pub fn pixel_mean_and_variance(film: &Film, index: usize, c: usize) -> (f64, f64) {
     let p = &film.pixels[index];
-    let n = p.samples as f64;
-    let mean = p.sum(c) / n;
-    let variance = ((p.sum_of_squares(c) / n - mean * mean) / (n - 1.0)).max(0.0);
-    (mean, variance)
+    (p.mean()[c], p.variance_of_mean(c))
 }
 
 /// The image's mean of channel `c` and its standard error (pixels are independent).
