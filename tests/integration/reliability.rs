@@ -6,8 +6,9 @@ use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
-use prism_core::image::read_exr;
 use prism_core::sampling::rng::Pcg32;
+
+use crate::common::scenes::assert_identical_images;
 
 fn folder(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("prism-reliability-{}-{name}", std::process::id()));
@@ -64,22 +65,6 @@ fn signal(child: &Child, name: &str) {
         .status()
         .unwrap();
     assert!(status.success());
-}
-
-/// Every channel of two EXR files, compared bit for bit.
-fn assert_identical_images(a: &Path, b: &Path) {
-    let (a, b) = (read_exr(a).unwrap(), read_exr(b).unwrap());
-    assert_eq!((a.width, a.height), (b.width, b.height));
-    for (name, values) in &a.channels {
-        let other = b
-            .channel(name)
-            .unwrap_or_else(|| panic!("channel {name} missing"));
-        let same = values
-            .iter()
-            .zip(other)
-            .all(|(x, y)| x.to_bits() == y.to_bits());
-        assert!(same, "channel {name} differs");
-    }
 }
 
 /// The reference: the same render, uninterrupted.

@@ -253,3 +253,22 @@ pub fn disk_light_over_plane(size: UVec2) -> DiskOverPlane {
     }
     DiskOverPlane { scene, exact }
 }
+
+/// Every channel of two EXR files, compared bit for bit.
+pub fn assert_identical_images(a: &std::path::Path, b: &std::path::Path) {
+    let (a, b) = (
+        prism_core::image::read_exr(a).unwrap(),
+        prism_core::image::read_exr(b).unwrap(),
+    );
+    assert_eq!((a.width, a.height), (b.width, b.height));
+    for (name, values) in &a.channels {
+        let other = b
+            .channel(name)
+            .unwrap_or_else(|| panic!("channel {name} missing"));
+        let same = values
+            .iter()
+            .zip(other)
+            .all(|(x, y)| x.to_bits() == y.to_bits());
+        assert!(same, "channel {name} differs");
+    }
+}

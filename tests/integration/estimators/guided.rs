@@ -15,7 +15,6 @@ use glam::{DVec3, Mat3, UVec2, Vec3};
 use prism_core::film::Film;
 use prism_core::film::{CropWindow, PixelSums};
 use prism_core::geometry::{Shape, Sphere};
-use prism_core::image::read_exr;
 use prism_core::integrator::guided::selection::SelectionLoss;
 use prism_core::integrator::guided::{Adrrs, Budget, NextEvent, SampleCombination, SpatialFilter};
 use prism_core::integrator::{GuidedPathIntegrator, Integrator, PathIntegrator};
@@ -28,8 +27,8 @@ use prism_core::render::{
 use prism_core::scene::Scene;
 
 use crate::common::scenes::{
-    Object, assert_mean_luminance, build, camera, image_mean_and_standard_error, render_film,
-    scene_from_xml,
+    Object, assert_identical_images, assert_mean_luminance, build, camera,
+    image_mean_and_standard_error, render_film, scene_from_xml,
 };
 
 /// The guided path tracer with small spatial leaves, so that a small image trains a tree of
@@ -367,15 +366,6 @@ fn render_part(
     render(scene, &options)
 }
 
-/// What a render leaves to resume from (as the command line saves it).
-fn initial_of(output: &RenderOutput) -> InitialState {
-    InitialState {
-        pixels: output.film.pixels.clone(),
-        aovs: output.film.aovs.clone(),
-        integrator: output.integrator_state.clone(),
-    }
-}
-
 /// Interrupts the run of `scene` (`spp` samples per pixel in passes of `spp_per_pass`) after
 /// each of the passes `points`, on one thread and on two, resumes it, and checks that it ends
 /// with the film and the state of one uninterrupted run, which it returns.
@@ -398,7 +388,7 @@ fn assert_resumed_equals_one_render(
                 spp,
                 threads,
                 part.samples.end,
-                Some(initial_of(&part)),
+                Some(part.initial_state()),
                 None,
             )
             .unwrap();
@@ -465,7 +455,7 @@ fn guided_resumed_after_any_pass_equals_one_render() {
             spp,
             1,
             first.samples.end,
-            Some(initial_of(&first)),
+            Some(first.initial_state()),
             Some(3),
         )
         .unwrap();
@@ -478,7 +468,7 @@ fn guided_resumed_after_any_pass_equals_one_render() {
             spp,
             2,
             second.samples.end,
-            Some(initial_of(&second)),
+            Some(second.initial_state()),
             None,
         )
         .unwrap();
@@ -502,14 +492,7 @@ fn guided_checkpoints_resume_to_one_render() {
     let whole = render_part(&scene, 28, 2, 0, None, None).unwrap();
     let mut saved: Vec<(std::ops::Range<u32>, InitialState)> = Vec::new();
     let mut write = |snapshot: &Snapshot| {
-        saved.push((
-            snapshot.samples.clone(),
-            InitialState {
-                pixels: snapshot.pixels.to_vec(),
-                aovs: snapshot.aovs.to_vec(),
-                integrator: snapshot.integrator_state.cloned(),
-            },
-        ));
+        saved.push((snapshot.samples.clone(), snapshot.initial_state()));
         Ok(())
     };
     let checkpoints = Checkpoints {
@@ -658,7 +641,7 @@ fn guided_refuses_states_that_do_not_fit() {
     let mut scene = cornell_box(6);
     scene.integrator = Integrator::from(guided());
     let part = render_part(&scene, 16, 1, 0, None, Some(2)).unwrap();
-    let initial = initial_of(&part);
+    let initial = part.initial_state();
     let bytes = initial.integrator.clone().unwrap().bytes;
     let resume = |bytes: Vec<u8>| {
         let mut damaged = initial.clone();
@@ -837,20 +820,4 @@ fn guided_checkpoint_and_resume_through_the_command_line() {
     ));
     assert_eq!(status, 2, "{text}");
     assert!(text.contains("merge of runs"), "{text}");
-}
-
-/// Every channel of two EXR files, compared bit for bit.
-fn assert_identical_images(a: &Path, b: &Path) {
-    let (a, b) = (read_exr(a).unwrap(), read_exr(b).unwrap());
-    assert_eq!((a.width, a.height), (b.width, b.height));
-    for (name, values) in &a.channels {
-        let other = b
-            .channel(name)
-            .unwrap_or_else(|| panic!("channel {name} missing"));
-        let same = values
-            .iter()
-            .zip(other)
-            .all(|(x, y)| x.to_bits() == y.to_bits());
-        assert!(same, "channel {name} differs");
-    }
 }

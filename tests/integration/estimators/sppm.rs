@@ -255,15 +255,6 @@ fn render_range(
     render(scene, &options)
 }
 
-/// What a resumed render starts from: the film and integrator state of `output`.
-fn resume_from(output: &RenderOutput) -> InitialState {
-    InitialState {
-        pixels: output.film.pixels.clone(),
-        aovs: output.film.aovs.clone(),
-        integrator: output.integrator_state.clone(),
-    }
-}
-
 /// P₁ passes, then resumed to P, equal P passes in one go, bit for bit: the film and the
 /// integrator state, at several split points, on one thread and on two; and so does a render
 /// resumed from each checkpoint written between its passes.
@@ -275,7 +266,7 @@ fn sppm_resumed_renders_equal_one_render() {
     for threads in [1, 2] {
         for split in [1, 3, 5] {
             let part = render_range(&scene, 0, split, None, threads).unwrap();
-            let resumed = render_range(&scene, split, 6, Some(resume_from(&part)), threads);
+            let resumed = render_range(&scene, split, 6, Some(part.initial_state()), threads);
             let resumed = resumed.unwrap();
             assert_eq!(resumed.samples, split..6);
             assert_eq!(resumed.film.pixels, whole.film.pixels, "split at {split}");
@@ -286,14 +277,7 @@ fn sppm_resumed_renders_equal_one_render() {
     // A checkpoint after every pass and one at the end.
     let mut snapshots = Vec::new();
     let mut write = |snapshot: &Snapshot| {
-        snapshots.push((
-            snapshot.samples.clone(),
-            InitialState {
-                pixels: snapshot.pixels.to_vec(),
-                aovs: snapshot.aovs.to_vec(),
-                integrator: snapshot.integrator_state.cloned(),
-            },
-        ));
+        snapshots.push((snapshot.samples.clone(), snapshot.initial_state()));
         Ok(())
     };
     let checkpoints = Checkpoints {
@@ -337,7 +321,7 @@ fn sppm_interrupted_render_leaves_a_state_to_resume_from() {
     let stopped = render_with_preview(&scene, &options, None, Some(&mut raise as Preview)).unwrap();
     assert_eq!(stopped.stop, StopReason::Interrupted);
     assert_eq!(stopped.samples, 0..2);
-    let resumed = render_range(&scene, 2, 6, Some(resume_from(&stopped)), 1).unwrap();
+    let resumed = render_range(&scene, 2, 6, Some(stopped.initial_state()), 1).unwrap();
     assert_eq!(resumed.film.pixels, whole.film.pixels);
     assert_eq!(resumed.integrator_state, whole.integrator_state);
 }
@@ -413,7 +397,7 @@ fn sppm_refuses_bad_and_foreign_states() {
             bytes,
             ..good.clone()
         }),
-        ..resume_from(&part)
+        ..part.initial_state()
     };
     let mut unknown_kind = good.bytes.clone();
     unknown_kind[0] = 9;
@@ -439,7 +423,7 @@ fn sppm_refuses_bad_and_foreign_states() {
             .to_string();
         assert!(error.contains(says), "{error}");
     }
-    let error = render_range(&scene, 3, 4, Some(resume_from(&part)), 1)
+    let error = render_range(&scene, 3, 4, Some(part.initial_state()), 1)
         .err()
         .expect("resumed at the wrong sample")
         .to_string();
@@ -448,12 +432,12 @@ fn sppm_refuses_bad_and_foreign_states() {
     let mut path_scene = small_scene();
     path_scene.integrator = Integrator::from(PathIntegrator::default());
     let path = render_range(&path_scene, 0, 2, None, 1).unwrap();
-    let error = render_range(&scene, 2, 4, Some(resume_from(&path)), 1)
+    let error = render_range(&scene, 2, 4, Some(path.initial_state()), 1)
         .err()
         .expect("sppm resumed a path state")
         .to_string();
     assert!(error.contains("no sppm statistics"), "{error}");
-    let error = render_range(&path_scene, 2, 4, Some(resume_from(&part)), 1)
+    let error = render_range(&path_scene, 2, 4, Some(part.initial_state()), 1)
         .err()
         .expect("path resumed an sppm state")
         .to_string();

@@ -75,6 +75,15 @@ pub struct Snapshot<'a> {
 }
 
 impl Snapshot<'_> {
+    /// What a render resumed from this snapshot starts from.
+    pub fn initial_state(&self) -> resume::InitialState {
+        resume::InitialState {
+            pixels: self.pixels.to_vec(),
+            aovs: self.aovs.to_vec(),
+            integrator: self.integrator_state.cloned(),
+        }
+    }
+
     /// The developing image: the film of `scene` holding the snapshot's sums.
     pub fn film(&self, scene: &Scene) -> Film {
         Film {
@@ -115,6 +124,18 @@ pub struct RenderOutput {
     pub lane_occupancy: Option<f64>,
     /// A progressive integrator's state at the end, for a state file.
     pub integrator_state: Option<IntegratorState>,
+}
+
+impl RenderOutput {
+    /// What a render resumed from this one's end starts from (what an interrupted render's
+    /// state file holds).
+    pub fn initial_state(&self) -> resume::InitialState {
+        resume::InitialState {
+            pixels: self.film.pixels.clone(),
+            aovs: self.film.aovs.clone(),
+            integrator: self.integrator_state.clone(),
+        }
+    }
 }
 
 /// Renders the scene.
