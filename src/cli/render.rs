@@ -625,9 +625,10 @@ fn report(
     );
 }
 
-/// `--pixel x,y`: renders the samples `range` drawn for one pixel and prints each with its
-/// one-pixel weight, marking the non-finite ones (under filter MIS the same samples also feed
-/// the pixels around).
+/// `--pixel x,y`: renders the samples `range` drawn for one pixel, as the render draws them,
+/// and prints each, marking the non-finite ones: weighted by its one-pixel weight, or under
+/// filter MIS, where each sample feeds the pixels around by the balance heuristic, unweighted
+/// (their mean is then not the pixel's value).
 fn trace_pixel(
     scene: &Scene,
     pixel: UVec2,
@@ -674,7 +675,8 @@ fn trace_pixel(
     );
     println!("{:>8} {:>14} {:>14} {:>14}", "sample", "X", "Y", "Z");
     for index in range {
-        let xyz = estimator.estimate(&mut sampler, pixel, index, &mut count, &mut aovs);
+        let draw = estimator.offset_draw();
+        let xyz = estimator.estimate(&mut sampler, pixel, index, draw, &mut count, &mut aovs);
         let bad = !xyz.iter().all(|v| v.is_finite());
         println!(
             "{index:>8} {:>14.6e} {:>14.6e} {:>14.6e}{}",

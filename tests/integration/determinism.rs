@@ -89,8 +89,9 @@ fn in_lanes_and_one_at_a_time(
         for x in 0..size.x {
             let mut sums = PixelSums::default();
             for index in 0..spp {
-                let xyz =
-                    estimator.estimate(&mut sampler, UVec2::new(x, y), index, &mut count, &mut []);
+                let pixel = UVec2::new(x, y);
+                let draw = estimator.offset_draw();
+                let xyz = estimator.estimate(&mut sampler, pixel, index, draw, &mut count, &mut []);
                 sums.add(xyz);
             }
             one_at_a_time.push(sums);

@@ -310,12 +310,19 @@ impl<'a> Params<'a> {
 
     /// The names of the tensor properties the plugin does not declare, marked as used (read
     /// past, as Mitsuba keeps such tensors as per-primitive attributes), in document order.
+    /// A dictionary reads some tensors as other values: three numbers as a point, a 4 × 4 array
+    /// as a transform, and those count as tensors here too.
     pub fn undeclared_tensors(&self) -> Vec<&'a str> {
         let mut found = Vec::new();
         for (index, property) in self.node.properties.iter().enumerate() {
-            if matches!(property.value, PropertyValue::Tensor { .. })
-                && !self.declared.iter().any(|d| d.name == property.name)
-            {
+            let tensor = matches!(
+                property.value,
+                PropertyValue::Tensor { .. }
+                    | PropertyValue::Numbers(_)
+                    | PropertyValue::Point(_)
+                    | PropertyValue::Transform(_)
+            );
+            if tensor && !self.declared.iter().any(|d| d.name == property.name) {
                 self.used_properties[index].set(true);
                 found.push(property.name.as_str());
             }

@@ -143,20 +143,21 @@ impl FilterMis {
     }
 
     /// The offset from the centre of `pixel` (full-film coordinates) of the sample drawn with
-    /// the uniform numbers `u`, on each axis uniform over the pixel's square, or from the filter
-    /// in a border column or row; and the weight the one-pixel estimator would give it, k / p.
-    pub fn sample_offset(&self, pixel: glam::UVec2, u: Vec2) -> (Vec2, f32) {
+    /// the uniform numbers `u`: on each axis from pₗ, the indicator of the pixel's square,
+    /// 𝟙[−½, ½)(x − cₗ), or in a border column or row the filter sampler's density
+    /// |k(x − cₗ)| / ∫|k|.
+    pub fn draw_offset(&self, pixel: glam::UVec2, u: Vec2) -> Vec2 {
         let axis = |u: f32, pixel: u32, extent: u32| {
             if Self::on_border(pixel, extent) {
-                self.sampler.sample_1d(u)
+                self.sampler.sample_1d(u).0
             } else {
-                let offset = (u - 0.5).min(0.5f32.next_down());
-                (offset, self.kernel(offset) / self.sampler.integral_1d())
+                u.min(1.0f32.next_down()) - 0.5
             }
         };
-        let (x, wx) = axis(u.x, pixel.x, self.width);
-        let (y, wy) = axis(u.y, pixel.y, self.height);
-        (Vec2::new(x, y), wx * wy)
+        Vec2::new(
+            axis(u.x, pixel.x, self.width),
+            axis(u.y, pixel.y, self.height),
+        )
     }
 
     /// Dₓ at offset `offset` from the centre of column (or row) `pixel` of a film `extent` pixels
@@ -232,7 +233,7 @@ mod tests {
             let scale = mis.sample_scale(UVec2::new(7, 9), offset);
             assert!((scale - 1.0).abs() < 1e-5, "{offset}: {scale}");
         }
-        // Beyond the film's edge only the border column's tent reaches: D = ½ there.
+        // At the film's edge (x = 0) only column 0's tent reaches: D = p(−½) = ½.
         let scale = mis.sample_scale(UVec2::new(0, 8), Vec2::new(-0.5, 0.0));
         assert!((scale - 2.0).abs() < 1e-4, "{scale}");
     }
@@ -254,7 +255,7 @@ mod tests {
             for _ in 0..n {
                 let column = ((rng.next_f32() * width as f32) as u32).min(width - 1);
                 let u = Vec2::new(rng.next_f32(), 0.5);
-                let offset = mis.sample_offset(UVec2::new(column, 0), u).0.x;
+                let offset = mis.draw_offset(UVec2::new(column, 0), u).x;
                 let x = column as f32 + 0.5 + offset;
                 let bin = (((x - lo) / bin_width) as usize).min(bins - 1);
                 counts[bin] += 1;

@@ -15,6 +15,17 @@ use crate::sampling::sampler::Sampler;
 use crate::scene::Scene;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 
+/// How a camera sample's film position is drawn.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum OffsetDraw {
+    /// From the reconstruction filter around the pixel's centre, with the weight k / (p ∫k) of
+    /// the one-pixel estimator.
+    Filter,
+    /// As filter MIS draws its shared samples ([`FilterMis::draw_offset`]), with no one-pixel
+    /// weight (1): each sample feeds the pixels around by the balance heuristic instead.
+    Shared,
+}
+
 /// A camera sample drawn, with its ray: what the film needs of it once the integrator has
 /// estimated the radiance along the ray.
 pub(super) struct CameraSampleRay {
@@ -22,7 +33,7 @@ pub(super) struct CameraSampleRay {
     pub(super) lambda: SampledWavelengths,
     /// Film offset from the pixel's centre.
     offset: Vec2,
-    /// The weight the one-pixel estimator gives the sample.
+    /// The weight the one-pixel estimator gives the sample (1 for a shared sample).
     filter_weight: f32,
     /// The shutter's filter weight.
     time_weight: f32,
@@ -76,6 +87,16 @@ impl<'a> SampleEstimator<'a> {
         }
     }
 
+    /// How the render draws its camera samples' film positions: as filter MIS shares them, or
+    /// from the filter for the one-pixel estimator.
+    pub fn offset_draw(&self) -> OffsetDraw {
+        if self.shared.is_some() {
+            OffsetDraw::Shared
+        } else {
+            OffsetDraw::Filter
+        }
+    }
+
     /// The film position (full film, pixels) of a camera sample of `pixel` drawn with `u`
     /// through the reconstruction filter, and the filter weight the one-pixel estimator gives
     /// it.
@@ -103,14 +124,15 @@ impl<'a> SampleEstimator<'a> {
     }
 
     /// Draws sample `index` of `pixel` (full-film coordinates): its wavelengths, film
-    /// position, time and lens position, and its camera ray; writes the coverage alpha, where
-    /// the film records it, to its place in `aovs`.
+    /// position (drawn as `draw` says), time and lens position, and its camera ray; writes the
+    /// coverage alpha, where the film records it, to its place in `aovs`.
     #[inline]
     pub(super) fn camera_sample(
         &self,
         sampler: &mut Sampler,
         pixel: UVec2,
         index: u32,
+        draw: OffsetDraw,
         count: &mut RayCount,
         aovs: &mut [f32],
     ) -> CameraSampleRay {
@@ -118,9 +140,9 @@ impl<'a> SampleEstimator<'a> {
         sampler.start_pixel_sample(pixel, index);
         let primary = sampler.camera_sample();
         let lambda = SampledWavelengths::sample(primary.wavelength, scene.film.wavelength_sampling);
-        let (offset, filter_weight) = match &self.shared {
-            Some(mis) => mis.sample_offset(pixel, primary.film),
-            None => self.filter.sample(primary.film),
+        let (offset, filter_weight) = match (draw, &self.shared) {
+            (OffsetDraw::Shared, Some(mis)) => (mis.draw_offset(pixel, primary.film), 1.0),
+            _ => self.filter.sample(primary.film),
         };
         let (time, time_weight) = scene.shutter.sample(primary.time);
         let film_position = pixel.as_vec2() + Vec2::splat(0.5) + offset;
@@ -173,19 +195,21 @@ impl<'a> SampleEstimator<'a> {
         (sample.offset, sample.filter_weight, xyz)
     }
 
-    /// Traces sample `index` of `pixel` (full-film coordinates): its film offset from the
-    /// pixel's centre, the filter weight the one-pixel estimator gives it, and its CIE XYZ
-    /// weighted by the shutter's filter; its extra channels, weighted alike, go to `aovs`.
+    /// Traces sample `index` of `pixel` (full-film coordinates), its film position drawn as
+    /// `draw` says: its film offset from the pixel's centre, the filter weight the one-pixel
+    /// estimator gives it, and its CIE XYZ weighted by the shutter's filter; its extra
+    /// channels, weighted alike, go to `aovs`.
     #[inline]
     pub(super) fn trace(
         &self,
         sampler: &mut Sampler,
         pixel: UVec2,
         index: u32,
+        draw: OffsetDraw,
         count: &mut RayCount,
         aovs: &mut [f32],
     ) -> (Vec2, f32, [f32; 3]) {
-        let sample = self.camera_sample(sampler, pixel, index, count, aovs);
+        let sample = self.camera_sample(sampler, pixel, index, draw, count, aovs);
         let radiance = self.integrator.radiance(
             sample.ray,
             &sample.lambda,
@@ -196,19 +220,21 @@ impl<'a> SampleEstimator<'a> {
         self.film_sample(&sample, radiance, aovs)
     }
 
-    /// The one-pixel estimate of sample `index` of `pixel` (full-film coordinates): its
-    /// filter-weighted CIE XYZ; the sample's extra channels, weighted by the same filter weight,
-    /// go to `aovs`. Under filter MIS the same sample also feeds the pixels around.
+    /// Sample `index` of `pixel` (full-film coordinates), its film position drawn as `draw`
+    /// says: its CIE XYZ times its one-pixel weight (its one-pixel estimate; 1 for a shared
+    /// sample, which feeds the pixels around instead); the sample's extra channels, weighted
+    /// alike, go to `aovs`.
     #[inline]
     pub fn estimate(
         &self,
         sampler: &mut Sampler,
         pixel: UVec2,
         index: u32,
+        draw: OffsetDraw,
         count: &mut RayCount,
         aovs: &mut [f32],
     ) -> [f32; 3] {
-        let (_, weight, xyz) = self.trace(sampler, pixel, index, count, aovs);
+        let (_, weight, xyz) = self.trace(sampler, pixel, index, draw, count, aovs);
         for v in aovs.iter_mut() {
             *v *= weight;
         }

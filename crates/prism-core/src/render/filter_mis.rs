@@ -8,7 +8,7 @@ use glam::{UVec2, Vec2, Vec4};
 use rayon::prelude::*;
 
 use super::RenderOptions;
-use super::estimator::SampleEstimator;
+use super::estimator::{OffsetDraw, SampleEstimator};
 use super::lanes::{LaneCounter, SampleSink, trace_in_lanes};
 use super::stop::Cancel;
 use super::tiles::{Tile, TileSums};
@@ -153,8 +153,14 @@ impl SharedSamples {
                 for (pixel, s, record) in records {
                     let index = range.start + s as u32;
                     aovs.fill(0.0);
-                    let (offset, _, xyz) =
-                        estimator.trace(&mut sampler, pixel, index, &mut count, &mut aovs);
+                    let (offset, _, xyz) = estimator.trace(
+                        &mut sampler,
+                        pixel,
+                        index,
+                        OffsetDraw::Shared,
+                        &mut count,
+                        &mut aovs,
+                    );
                     write_record(record, mis, pixel, offset, xyz, &aovs, reach);
                 }
                 Some(count.rays)

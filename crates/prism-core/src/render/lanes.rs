@@ -137,6 +137,7 @@ impl<T: SteppedPath, P: Iterator<Item = (usize, UVec2)>, S: SampleSink> LaneRun<
                 &mut lane.sampler,
                 lane.pixel,
                 lane.index,
+                self.estimator.offset_draw(),
                 &mut self.count,
                 &mut lane.aovs,
             );

@@ -45,7 +45,7 @@ use crate::film::accumulation::AOV_SUMS_PER_CHANNEL;
 pub use crate::film::stats::relative_error;
 use crate::film::{Film, PixelSums, ValueSum};
 use crate::scene::Scene;
-pub use estimator::SampleEstimator;
+pub use estimator::{OffsetDraw, SampleEstimator};
 pub use lanes::LANES;
 use lanes::LaneCounter;
 pub use options::RenderOptions;

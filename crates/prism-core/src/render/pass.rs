@@ -8,7 +8,7 @@ use glam::{UVec2, Vec2};
 use rayon::prelude::*;
 
 use super::RenderOptions;
-use super::estimator::SampleEstimator;
+use super::estimator::{OffsetDraw, SampleEstimator};
 use super::filter_mis::{SharedSamples, gather_tile};
 use super::lanes::{LaneCounter, SampleSink, trace_in_lanes};
 use super::progress::ProgressReport;
@@ -53,7 +53,14 @@ fn render_tile(
             let i = (y * tile.size.x + x) as usize;
             for index in range.clone() {
                 aovs.fill(0.0);
-                let xyz = estimator.estimate(&mut sampler, pixel, index, &mut count, &mut aovs);
+                let xyz = estimator.estimate(
+                    &mut sampler,
+                    pixel,
+                    index,
+                    OffsetDraw::Filter,
+                    &mut count,
+                    &mut aovs,
+                );
                 sums.pixels[i].add(xyz);
                 add_aov_sample(&mut sums.aovs[i * stride..i * stride + k], &aovs);
             }

@@ -40,7 +40,7 @@ use std::time::Instant;
 use glam::UVec2;
 use rayon::prelude::*;
 
-use super::estimator::SampleEstimator;
+use super::estimator::{OffsetDraw, SampleEstimator};
 use super::progress::{ProgressReport, Silent};
 use super::stop::Cancel;
 use super::tiles::{Tile, TileSums, row_major, tile_major, tiles};
@@ -712,8 +712,14 @@ impl Driver<'_> {
                 let i = (y * tile.size.x + x) as usize;
                 for index in range.clone() {
                     aovs.fill(0.0);
-                    let sample =
-                        estimator.camera_sample(&mut sampler, pixel, index, &mut count, &mut aovs);
+                    let sample = estimator.camera_sample(
+                        &mut sampler,
+                        pixel,
+                        index,
+                        OffsetDraw::Filter,
+                        &mut count,
+                        &mut aovs,
+                    );
                     let radiance = {
                         let ctx = &mut SampleContext {
                             prepared: &estimator.integrator,

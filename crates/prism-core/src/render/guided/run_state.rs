@@ -315,6 +315,9 @@ fn decode_run(
     let iteration = input.u32().map_err(bad)?;
     let passes_done = input.u32().map_err(bad)?;
     let extrapolated = input.f64().map_err(bad)?;
+    if extrapolated.is_nan() || extrapolated < 0.0 {
+        return Err(bad(format!("its extrapolated variance is {extrapolated}")));
+    }
     let image_count = input.length(PIXEL_BYTES, "finished images").map_err(bad)?;
     if image_count > kept_images(combination) {
         return Err(bad(format!("it keeps {image_count} finished images")));
@@ -361,7 +364,9 @@ fn decode_run(
         Plan::Passes(total) => u64::from(total),
         Plan::Seconds(_) => end_of_iteration,
     };
+    // Every finished iteration has at least one pass.
     let consistent = done_in_iteration <= planned
+        && iteration <= passes_done
         && done_in_iteration <= passes_done
         && images.iter().all(|image| image.passes <= passes_done)
         && end_of_iteration <= last_pass

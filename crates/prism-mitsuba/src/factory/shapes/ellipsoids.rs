@@ -61,7 +61,7 @@ fn build_ellipsoids(params: &Params, to_world: &Transform) -> Result<Shape> {
     let node = params.node();
     let (data, filename) = match params.string_opt(&ELLIPSOIDS_FILENAME)? {
         Some(filename) => {
-            for spec in [&DATA, &CENTERS] {
+            for spec in [&DATA, &CENTERS, &SCALES, &QUATERNIONS, &OPACITIES] {
                 if params.has(spec) {
                     return Err(Error::input(
                         params.location_of(spec),
@@ -192,6 +192,15 @@ fn tensor_data(params: &Params) -> Result<EllipsoidsData> {
             .with_help("add <string name=\"filename\" value=\"ellipsoids.ply\"/>"));
         }
         (Some(tensor), None) => {
+            for spec in [&SCALES, &QUATERNIONS] {
+                if params.has(spec) {
+                    return Err(Error::input(
+                        params.location_of(spec),
+                        format!("\"{}\" cannot be given with \"data\"", spec.name),
+                    )
+                    .with_help("give the ellipsoids one way (as Mitsuba requires)"));
+                }
+            }
             let location = params.location_of(&DATA);
             let rows = rows_of(&tensor, 10).ok_or_else(|| {
                 Error::input(
