@@ -8,7 +8,7 @@
 //! density pₗ(x), on each axis uniform over its own square, except on the film's first and last
 //! columns and rows, which draw from the filter sampler's density (∝ |k|) around their centre so
 //! that every point some pixel's filter covers, beyond the film's edge too, is drawn
-//! ([`FilterMis::sample_offset`]). Seen from pixel i these are W·H
+//! ([`FilterMis::draw_offset`]). Seen from pixel i these are W·H
 //! sampling strategies of the image plane, and the balance heuristic combines them (Veach 1997,
 //! §9.2): a sample x of any pixel adds
 //!
@@ -239,11 +239,15 @@ mod tests {
     }
 
     /// Chi-square test of D: positions drawn by picking a film column uniformly and a sample from
-    /// its density are distributed as Dₓ / W (the mixture of the columns' densities).
+    /// its density are distributed as Dₓ / W (the mixture of the columns' densities), on films
+    /// of 1, 2, 3 and 6 columns.
     #[test]
     fn the_mixture_density_matches_the_samples_of_all_pixels() {
-        for filter in filters_under_test() {
-            let width = 6u32;
+        // Widths 1 and 2 are all border; 3 has one square between two borders.
+        for (filter, width) in filters_under_test()
+            .into_iter()
+            .flat_map(|filter| [1u32, 2, 3, 6].map(|width| (filter, width)))
+        {
             let mis = FilterMis::new(filter, width, 1);
             let r = filter.radius();
             let (lo, hi) = (-r, width as f32 + r);
@@ -280,7 +284,7 @@ mod tests {
                 if expected < 5.0 {
                     assert!(
                         count < 20,
-                        "{filter:?}: bin {b} expected {expected} got {count}"
+                        "{filter:?} width {width}: bin {b} expected {expected} got {count}"
                     );
                     continue;
                 }
@@ -289,7 +293,10 @@ mod tests {
             }
             // The 99.9th percentile of chi-square is below dof + 4.5 √(2 dof) for these dof.
             let limit = dof as f64 + 4.5 * (2.0 * dof as f64).sqrt();
-            assert!(chi2 < limit, "{filter:?}: chi2 {chi2} over {dof} bins");
+            assert!(
+                chi2 < limit,
+                "{filter:?} width {width}: chi2 {chi2} over {dof} bins"
+            );
         }
     }
 }
